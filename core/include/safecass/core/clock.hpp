@@ -1,0 +1,51 @@
+#pragma once
+/// @file clock.hpp
+/// Injectable time source: every timestamp in SAFECASS comes from a Clock, so tests, scenarios
+/// and replay run deterministically in simulated time.
+
+#include <atomic>
+#include <chrono>
+
+namespace safecass {
+
+/// A point in time, as the duration since the clock's epoch.
+using Time = std::chrono::nanoseconds;
+
+/// Converts seconds (as in specs and scenarios) to Time, rounding to the nearest nanosecond.
+constexpr Time seconds_to_time(double seconds) noexcept {
+  return Time{static_cast<Time::rep>(seconds * 1e9 + (seconds < 0 ? -0.5 : 0.5))};
+}
+constexpr double to_seconds(Time t) noexcept { return static_cast<double>(t.count()) * 1e-9; }
+
+/// Source of time. now() is thread-safe, lock-free and never allocates.
+class Clock {
+public:
+  virtual ~Clock() = default;
+  virtual Time now() const noexcept = 0;
+};
+
+/// Monotonic wall time (std::chrono::steady_clock), epoch = construction.
+class SteadyClock final : public Clock {
+public:
+  SteadyClock() noexcept : start_(std::chrono::steady_clock::now()) {}
+  Time now() const noexcept override {
+    return std::chrono::duration_cast<Time>(std::chrono::steady_clock::now() - start_);
+  }
+
+private:
+  std::chrono::steady_clock::time_point start_;
+};
+
+/// Simulated time: only set() and advance() move it. Thread-safe.
+class SimulatedClock final : public Clock {
+public:
+  explicit SimulatedClock(Time start = Time{0}) noexcept : now_(start.count()) {}
+  Time now() const noexcept override { return Time{now_.load(std::memory_order_acquire)}; }
+  void set(Time t) noexcept { now_.store(t.count(), std::memory_order_release); }
+  void advance(Time dt) noexcept { now_.fetch_add(dt.count(), std::memory_order_acq_rel); }
+
+private:
+  std::atomic<Time::rep> now_;
+};
+
+}  // namespace safecass

@@ -1,0 +1,46 @@
+#pragma once
+/// @file condition.hpp
+/// Active conditions and their root causes (DESIGN §2.4, §2.6).
+
+#include <cstdint>
+
+#include "safecass/core/clock.hpp"
+#include "safecass/core/ids.hpp"
+#include "safecass/core/state.hpp"
+
+namespace safecass {
+
+/// What a filter saw when it fired; all fields are optional (kNoName when absent).
+struct SampleCause {
+  NameId filter = kNoName;  ///< interned filter name
+  NameId signal = kNoName;  ///< interned signal name ("Component.signal")
+  double value = 0.0;       ///< the sample value the filter judged
+  Time sample_time{};       ///< when the sample was taken
+  bool injected = false;    ///< the sample came from fault injection
+
+  bool present() const noexcept { return filter != kNoName || signal != kNoName; }
+};
+
+/// The original onset a condition traces back to.
+struct RootCause {
+  EventId event = kNoEvent;       ///< the onset that started it all
+  MachineId origin = kNoMachine;  ///< the machine it was generated on
+  Time time{};                    ///< when it was processed at the origin
+  SampleCause sample;             ///< filter data, for filter events
+};
+
+/// An active condition of a state machine.
+struct Condition {
+  EventId event = kNoEvent;  ///< the event; for mirrors EVT_SERVICE_FAILURE/DEGRADED
+  State level = State::Normal;
+  std::uint8_t severity = 0;
+  bool mirror = false;                 ///< propagated from a provider (DESIGN §2.6)
+  ConnectionId via = kNoConnection;    ///< mirrors: the connection it arrived through
+  Time first{};                        ///< activation time
+  Time last{};                         ///< last onset (refresh) time
+  std::uint32_t count = 1;             ///< onsets seen while active (1 + refreshes)
+  std::uint64_t seq = 0;               ///< activation order, for "most recent" ties
+  RootCause root;                      ///< for a root condition, root.event == event
+};
+
+}  // namespace safecass

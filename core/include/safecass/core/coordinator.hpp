@@ -1,0 +1,387 @@
+#pragma once
+/// @file coordinator.hpp
+/// The coordinator: one per process. It owns the Generic Component Model of that process's
+/// components (their state machines, the event definitions, the connections), applies events with
+/// the severity policy of DESIGN §2.4, propagates errors along connections (§2.6), fires callbacks
+/// (§2.5) and publishes everything that happens on one observer stream.
+///
+/// Lifecycle: configure (add components, interfaces, events, services, connections), then run
+/// (generate, reset, read). Configuration calls are not safe against concurrent readers: finish
+/// the configuration before other threads start reading or generating. After that:
+/// - state reads (`state()`, `extended()`, `service_state()`, `dispatch()`) are lock-free, wait-free
+///   and never allocate;
+/// - `generate()`/`reset()` take the coordinator's lock; once the condition vectors have grown to
+///   their working size they do not allocate. All local consequences (propagation, callbacks,
+///   observers) have happened when they return;
+/// - callbacks and observers run on the thread that caused the change, under the lock. They must
+///   not block. An event they generate (or a reset they ask for) is queued and processed before the
+///   outer call returns. An exception thrown by a callback becomes EVT_CALLBACK_EXCEPTION on the
+///   component's s_F.
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "safecass/core/clock.hpp"
+#include "safecass/core/condition.hpp"
+#include "safecass/core/event.hpp"
+#include "safecass/core/expected.hpp"
+#include "safecass/core/ids.hpp"
+#include "safecass/core/observer.hpp"
+#include "safecass/core/state.hpp"
+
+namespace safecass {
+
+/// The four kinds of state machine a component owns (DESIGN §2.2).
+enum class MachineKind : std::uint8_t { Framework, Application, Provided, Required };
+
+/// What the service state of a provided interface depends on (DESIGN §2.2):
+/// s_S.p = s_P.p ⊗ [s_F] ⊗ [s_A] ⊗ (⊗ over the listed required interfaces).
+/// The default-constructed value is the conservative default used when a provided interface has
+/// no `service` entry: s_F, s_A and every required interface.
+struct ServiceDependency {
+  bool framework = true;      ///< include s_F
+  bool application = true;    ///< include s_A
+  bool all_required = true;   ///< include every required interface (ignores `required`)
+  std::vector<std::string> required;  ///< used when all_required is false
+  State propagate = State::Error;     ///< lowest level that crosses connections (Error or Warning)
+
+  /// `"dependency": {}`: the service state is s_P alone.
+  static ServiceDependency provided_only() {
+    ServiceDependency d;
+    d.framework = d.application = d.all_required = false;
+    return d;
+  }
+};
+
+/// A connection from a client's required interface to a provider's provided interface.
+struct Connection {
+  ComponentId client = kNoComponent;
+  std::uint32_t required = kNone;  ///< index into the client's required interfaces
+  ComponentId provider = kNoComponent;
+  std::uint32_t provided = kNone;  ///< index into the provider's provided interfaces
+};
+
+/// A parsed address: `SYSTEM`, `C`, `C.s_F`, `C.s_A`, `C.s_P.p`, `C.s_R.r`, `C.s_S.p`.
+struct Address {
+  enum class Kind : std::uint8_t { System, Component, Machine, Service };
+  Kind kind = Kind::System;
+  ComponentId component = kNoComponent;
+  MachineId machine = kNoMachine;
+  std::uint32_t service = kNone;  ///< Service: index of the provided interface
+};
+
+/// A state and the event that explains it, read atomically together.
+struct StateSnapshot {
+  State state = State::Normal;
+  EventId outstanding = kNoEvent;
+};
+
+/// Passed to on_transition callbacks.
+struct TransitionInfo {
+  ComponentId component = kNoComponent;
+  MachineId machine = kNoMachine;  ///< kNoMachine for the extended component state
+  Transition transition = Transition::N2W;
+  EventId event = kNoEvent;        ///< the event processed (kNoEvent for a reset)
+  const RootCause* root = nullptr; ///< the root cause of the condition added/removed, if any
+  Time time{};
+};
+
+/// Callbacks on a machine or on a component's extended state, fired in the order
+/// on_exit(old), on_transition(info), on_entry(new). Any of them may be empty.
+struct StateCallbacks {
+  std::function<void(State)> on_exit;
+  std::function<void(const TransitionInfo&)> on_transition;
+  std::function<void(State)> on_entry;
+};
+
+/// One active condition, with its root cause and the path it took (DESIGN §2.6 `explain`).
+struct Explanation {
+  std::string machine;   ///< address of the machine holding the condition
+  std::string event;
+  State level = State::Normal;
+  int severity = 0;
+  bool mirror = false;
+  bool outstanding = false;  ///< the machine's outstanding condition
+  std::uint32_t count = 0;
+  Time first{};
+  Time last{};
+  std::string root_event;
+  std::string root_origin;   ///< address of the origin machine
+  Time root_time{};
+  std::string hazard;        ///< of the root event
+  std::string filter;        ///< empty unless a filter fired the root
+  std::string signal;
+  double value = 0.0;
+  Time sample_time{};
+  bool injected = false;
+  std::vector<std::string> path;  ///< origin machine → services/interfaces … → this machine
+};
+
+/// One line: "CONTROL.s_R.ForceData Error EVT_SERVICE_FAILURE ← JR3.s_A:EVT_FORCE_ERROR (...) via ...".
+std::string to_string(const Explanation& e);
+
+struct CoordinatorOptions {
+  std::size_t history_capacity = 256;  ///< records kept per machine and per component
+  std::size_t pending_capacity = 256;  ///< events generated from callbacks, reserved up front
+};
+
+class Coordinator {
+public:
+  /// `clock` must outlive the coordinator; null means an owned SteadyClock.
+  explicit Coordinator(std::string name = "local", const Clock* clock = nullptr,
+                       CoordinatorOptions options = {});
+  ~Coordinator();
+  Coordinator(const Coordinator&) = delete;
+  Coordinator& operator=(const Coordinator&) = delete;
+
+  std::string_view name() const noexcept { return name_; }
+  const Clock& clock() const noexcept { return *clock_; }
+
+  // ---- configuration -------------------------------------------------------------------------
+  /// Errors: Duplicate, InvalidArgument (empty or dotted name).
+  Expected<ComponentId> add_component(std::string_view name);
+  /// Adds provided interface `name` (machine C.s_P.name). Errors: NotFound, Duplicate, InvalidArgument.
+  Expected<MachineId> add_provided(ComponentId component, std::string_view name);
+  /// Adds required interface `name` (machine C.s_R.name). Errors: NotFound, Duplicate, InvalidArgument.
+  Expected<MachineId> add_required(ComponentId component, std::string_view name);
+  /// Errors: Duplicate name, InvalidArgument (severity outside 1–255, empty or mixed transitions,
+  /// `completes`/`latched` on the wrong kind of event, completion with no onset name).
+  Expected<EventId> add_event(const EventDef& def);
+  /// Sets the service dependency entry of a provided interface.
+  /// Errors: NotFound (component, provided or required interface), InvalidArgument (propagate Normal).
+  Expected<void> set_service(ComponentId component, std::string_view provided,
+                             const ServiceDependency& dependency);
+  /// Connects `client_required` ("C.r") to `provider_provided` ("P.p").
+  /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected).
+  Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
+
+  // ---- lookup --------------------------------------------------------------------------------
+  Expected<ComponentId> find_component(std::string_view name) const;
+  Expected<EventId> find_event(std::string_view name) const;
+  /// Parses an address (see Address). Errors: Parse, NotFound.
+  Expected<Address> resolve(std::string_view address) const;
+  /// Resolves an address that must name one state machine.
+  Expected<MachineId> find_machine(std::string_view address) const;
+
+  std::size_t component_count() const noexcept { return components_.size(); }
+  std::size_t machine_count() const noexcept { return machines_.size(); }
+  std::size_t event_count() const noexcept { return events_.size(); }
+  const Event& event(EventId id) const noexcept { return events_[id]; }
+  const std::vector<Connection>& connections() const noexcept { return connections_; }
+  std::string_view component_name(ComponentId id) const noexcept;
+  MachineId framework_machine(ComponentId id) const noexcept;
+  MachineId application_machine(ComponentId id) const noexcept;
+  const std::vector<MachineId>& provided_machines(ComponentId id) const noexcept;
+  const std::vector<MachineId>& required_machines(ComponentId id) const noexcept;
+  /// Interface name of a provided/required machine; "s_F"/"s_A" otherwise.
+  std::string_view interface_name(MachineId id) const noexcept;
+  MachineKind machine_kind(MachineId id) const noexcept;
+  ComponentId machine_component(MachineId id) const noexcept;
+  /// "C.s_F", "C.s_A", "C.s_P.p", "C.s_R.r".
+  const std::string& address_of(MachineId id) const noexcept;
+  /// The dependency entry of provided interface `provided` (index) of `component`.
+  const ServiceDependency& service(ComponentId component, std::uint32_t provided) const noexcept;
+
+  /// Interns a string (filter, signal or reason name) for use in SampleCause. Thread-safe.
+  NameId intern(std::string_view text);
+  std::string_view name_of(NameId id) const;
+
+  // ---- events --------------------------------------------------------------------------------
+  /// Processes `event` on machine `target` (broadcast events: on s_A of every component) with the
+  /// rules of DESIGN §2.4 and propagates the consequences (§2.6). `target` and `event` must be
+  /// valid ids. Allocation-free once condition vectors have reached their working size.
+  void generate(EventId event, MachineId target, const SampleCause& cause = {}) noexcept;
+  /// Name-based form for tools. Errors: NotFound (event or address), InvalidArgument (address is
+  /// not a machine), InvalidState (completion of an onset that was never defined).
+  Expected<void> generate(std::string_view event, std::string_view target);
+  /// Processes a broadcast event (severity 251–255) on s_A of every component.
+  Expected<void> broadcast(std::string_view event);
+  /// Clears every condition originating in `target` (machine, component, SYSTEM or the
+  /// coordinator's name), latched ones too, and records who and why. Mirrored conditions whose
+  /// root is outside the target and still active stay: the fault they report is still present.
+  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why);
+  void reset(const Address& target, std::string_view who, std::string_view why);
+
+  // ---- lock-free reads -----------------------------------------------------------------------
+  State state(MachineId id) const noexcept { return unpack(machines_[id]->snapshot.load(std::memory_order_acquire)).state; }
+  StateSnapshot snapshot(MachineId id) const noexcept { return unpack(machines_[id]->snapshot.load(std::memory_order_acquire)); }
+  /// The extended component state ŝ_ext(C) and its outstanding event.
+  StateSnapshot extended(ComponentId id) const noexcept { return unpack(components_[id]->snapshot.load(std::memory_order_acquire)); }
+  State extended_state(ComponentId id) const noexcept { return extended(id).state; }
+  /// Service state s_S.p of provided interface `provided` (index) of `component`.
+  State service_state(ComponentId component, std::uint32_t provided) const noexcept;
+  /// Product over every component of this coordinator.
+  State coordinator_state() const noexcept;
+  /// State of any address (SYSTEM, component, machine or service).
+  State state_of(const Address& address) const noexcept;
+
+  /// Calls exactly one of normal(), warning(const Event&), error(const Event&) according to the
+  /// extended state of `component`, passing its outstanding event. Lock-free (paper §V-B).
+  template <class Normal, class Warning, class Error>
+  void dispatch(ComponentId component, Normal&& normal, Warning&& warning, Error&& error) const {
+    const StateSnapshot s = extended(component);
+    switch (s.state) {
+      case State::Normal: normal(); return;
+      case State::Warning: warning(events_[s.outstanding]); return;
+      case State::Error: error(events_[s.outstanding]); return;
+    }
+  }
+
+  // ---- introspection (takes the lock; allocates) ---------------------------------------------
+  std::vector<Condition> conditions(MachineId id) const;
+  /// The machine's outstanding condition, if any.
+  std::optional<Condition> outstanding(MachineId id) const;
+  /// The last records of a machine, oldest first.
+  std::vector<Record> history(MachineId id) const;
+  /// The last extended-state transitions of a component, oldest first.
+  std::vector<Record> component_history(ComponentId id) const;
+  /// Every active condition at `address` (machine, service, component, SYSTEM) with its root
+  /// cause and hop path. Errors: as resolve().
+  Expected<std::vector<Explanation>> explain(std::string_view address) const;
+  std::vector<Explanation> explain(const Address& address) const;
+
+  // ---- callbacks and observers ---------------------------------------------------------------
+  using SubscriptionId = std::uint32_t;
+  /// Registers callbacks on one machine.
+  void on_machine(MachineId id, StateCallbacks callbacks);
+  /// Registers callbacks on a component's extended state.
+  void on_component(ComponentId id, StateCallbacks callbacks);
+  /// Subscribes to the observer stream. The function must not block or throw.
+  SubscriptionId subscribe(std::function<void(const Record&)> observer);
+  void unsubscribe(SubscriptionId id);
+  /// Publishes a record that originates outside the core (e.g. an injection) on the stream and,
+  /// when it names a machine, in that machine's history.
+  void publish(Record record);
+
+private:
+  struct Edge {
+    MachineId to;
+    State min_level;
+    ConnectionId via;
+  };
+  struct Ring {
+    std::vector<Record> items;
+    std::size_t next = 0;
+    std::size_t size = 0;
+    void push(const Record& r) noexcept;
+    std::vector<Record> ordered() const;
+  };
+  struct MachineData {
+    MachineKind kind;
+    ComponentId component;
+    std::uint32_t iface;  ///< index of the interface for Provided/Required
+    std::string address;
+    std::vector<Condition> conditions;
+    std::array<std::uint32_t, 3> level_count{};
+    State state = State::Normal;
+    std::int32_t outstanding = -1;  ///< index into conditions
+    std::atomic<std::uint64_t> snapshot{0};
+    Ring history;
+    std::vector<StateCallbacks> callbacks;
+    std::vector<Edge> fanout;
+  };
+  struct ServiceData {
+    ServiceDependency dependency;
+    std::vector<std::uint32_t> required;  ///< resolved indices of the required interfaces
+  };
+  struct ComponentData {
+    std::string name;
+    MachineId framework;
+    MachineId application;
+    std::vector<MachineId> provided;
+    std::vector<MachineId> required;
+    std::vector<ServiceData> services;            ///< one per provided interface
+    std::vector<ConnectionId> required_connection;///< one per required interface
+    std::array<std::uint32_t, 3> machine_state_count{};
+    State state = State::Normal;
+    EventId outstanding = kNoEvent;
+    std::atomic<std::uint64_t> snapshot{0};
+    Ring history;
+    std::vector<StateCallbacks> callbacks;
+  };
+  enum class PendingKind : std::uint8_t { Generate, Reset };
+  struct Pending {
+    PendingKind kind;
+    EventId event;
+    MachineId machine;
+    SampleCause cause;
+    Address address;
+    NameId who;
+    NameId why;
+  };
+
+  static constexpr std::uint64_t pack(StateSnapshot s) noexcept {
+    return static_cast<std::uint64_t>(s.state) | (static_cast<std::uint64_t>(s.outstanding) << 8);
+  }
+  static constexpr StateSnapshot unpack(std::uint64_t v) noexcept {
+    return StateSnapshot{static_cast<State>(v & 0xffu), static_cast<EventId>(v >> 8)};
+  }
+
+  EventId add_event_unchecked(Event event);
+  MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
+  void rebuild_fanout();
+  bool depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept;
+
+  // Processing (lock held).
+  void run(const Pending& op) noexcept;
+  void drain_pending() noexcept;
+  void process(EventId event, MachineId target, const SampleCause& cause) noexcept;
+  void process_onset(const Event& event, MachineId target, const SampleCause& cause, Time now) noexcept;
+  void process_completion(const Event& event, MachineId target, Time now) noexcept;
+  void reset_locked(const Address& target, NameId who_why, Time now) noexcept;
+  /// Adds a condition (root or mirror) to a machine and applies §2.4 step 2.
+  void add_condition(MachineId id, Condition c, Time now) noexcept;
+  /// Removes condition `index` of a machine; `completion` is the event recorded.
+  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now,
+                        std::string_view text) noexcept;
+  void propagate_onset(const Condition& root) noexcept;
+  void propagate_clear(const RootCause& root, State level, Time now) noexcept;
+  std::int32_t find_mirror(const MachineData& m, const RootCause& root) const noexcept;
+  std::int32_t find_root(const MachineData& m, EventId event) const noexcept;
+  std::int32_t find_any_root(const MachineData& m) const noexcept;
+  void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
+  void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
+  void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
+            State from, State to) noexcept;
+  void emit(const Record& r) noexcept;
+  void record_machine(MachineId id, Record r) noexcept;
+  std::vector<Explanation> explain_machine(MachineId id) const;
+  std::vector<std::string> hop_path(MachineId holder, const Condition& c) const;
+
+  std::string name_;
+  std::unique_ptr<Clock> owned_clock_;
+  const Clock* clock_;
+  CoordinatorOptions options_;
+
+  std::vector<std::unique_ptr<MachineData>> machines_;
+  std::vector<std::unique_ptr<ComponentData>> components_;
+  std::deque<Event> events_;
+  std::vector<Connection> connections_;
+
+  mutable std::recursive_mutex mutex_;
+  bool processing_ = false;
+  std::uint64_t condition_seq_ = 0;
+  std::uint64_t record_seq_ = 0;
+  std::vector<Pending> pending_;
+  std::vector<MachineId> work_;              ///< BFS queue for propagation, reserved up front
+  std::vector<std::uint64_t> visit_marks_;   ///< per machine: last BFS that visited it
+  std::uint64_t visit_epoch_ = 0;
+  std::vector<std::pair<SubscriptionId, std::function<void(const Record&)>>> observers_;
+  SubscriptionId next_subscription_ = 1;
+
+  mutable std::mutex names_mutex_;
+  std::deque<std::string> names_;
+};
+
+}  // namespace safecass

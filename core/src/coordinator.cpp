@@ -1,0 +1,1033 @@
+#include "safecass/core/coordinator.hpp"
+
+#include <algorithm>
+#include <string>
+#include <utility>
+
+#include "safecass/core/assert.hpp"
+
+namespace safecass {
+
+namespace {
+
+constexpr std::string_view kIgnoredNotActive = "not active";
+constexpr std::string_view kIgnoredLatched = "latched: needs reset";
+constexpr std::string_view kIgnoredNoOnset = "completes an onset that is not defined";
+constexpr std::string_view kCallbackThrew = "callback threw";
+
+constexpr std::size_t index(State s) noexcept { return static_cast<std::size_t>(s); }
+
+State state_from_counts(const std::array<std::uint32_t, 3>& counts) noexcept {
+  if (counts[index(State::Error)] > 0) return State::Error;
+  if (counts[index(State::Warning)] > 0) return State::Warning;
+  return State::Normal;
+}
+
+bool valid_name(std::string_view name) noexcept {
+  return !name.empty() && name.find('.') == std::string_view::npos &&
+         name.find_first_of(" \t\r\n") == std::string_view::npos;
+}
+
+struct FrameworkEventSpec {
+  const char* name;
+  int severity;
+  TransitionSet onset;
+  TransitionSet completion;
+  const char* description;
+};
+
+constexpr TransitionSet kToError{Transition::N2E, Transition::W2E};
+constexpr TransitionSet kFromError{Transition::E2N, Transition::E2W};
+constexpr TransitionSet kToWarning{Transition::N2W};
+constexpr TransitionSet kFromWarning{Transition::W2N};
+
+// Order fixes the ids in framework_event (onset at 2k, completion at 2k+1).
+constexpr FrameworkEventSpec kFrameworkEvents[] = {
+    {"EVT_SERVICE_FAILURE", 220, kToError, kFromError, "a service this component requires has failed"},
+    {"EVT_SERVICE_DEGRADED", 215, kToWarning, kFromWarning, "a service this component requires is degraded"},
+    {"EVT_THREAD_EXCEPTION", 210, kToError, kFromError, "the component's thread threw an exception"},
+    {"EVT_PERIOD_OVERRUN", 205, kToWarning, kFromWarning, "the component's cycle overran its period"},
+    {"EVT_STALE", 230, kToError, kFromError, "no new sample or heartbeat within the timeout"},
+    {"EVT_CALLBACK_EXCEPTION", 210, kToError, kFromError, "a SAFECASS callback threw an exception"},
+    {"EVT_COORDINATOR_LOST", 240, kToError, kFromError, "a connected coordinator stopped sending heartbeats"},
+};
+
+}  // namespace
+
+// ---- Ring ------------------------------------------------------------------------------------
+
+void Coordinator::Ring::push(const Record& r) noexcept {
+  if (items.empty()) return;
+  items[next] = r;
+  next = (next + 1) % items.size();
+  if (size < items.size()) ++size;
+}
+
+std::vector<Record> Coordinator::Ring::ordered() const {
+  std::vector<Record> out;
+  out.reserve(size);
+  const std::size_t start = (next + items.size() - size) % std::max<std::size_t>(items.size(), 1);
+  for (std::size_t i = 0; i < size; ++i) out.push_back(items[(start + i) % items.size()]);
+  return out;
+}
+
+// ---- construction and configuration ----------------------------------------------------------
+
+Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOptions options)
+    : name_(std::move(name)), clock_(clock), options_(options) {
+  if (clock_ == nullptr) {
+    owned_clock_ = std::make_unique<SteadyClock>();
+    clock_ = owned_clock_.get();
+  }
+  pending_.reserve(options_.pending_capacity);
+  for (const FrameworkEventSpec& spec : kFrameworkEvents) {
+    Event onset;
+    onset.name = spec.name;
+    onset.severity = static_cast<std::uint8_t>(spec.severity);
+    onset.transitions = spec.onset;
+    onset.description = spec.description;
+    const EventId onset_id = add_event_unchecked(std::move(onset));
+    Event completion;
+    completion.name = std::string("/") + spec.name;
+    completion.severity = static_cast<std::uint8_t>(spec.severity);
+    completion.transitions = spec.completion;
+    completion.is_onset = false;
+    completion.completes = spec.name;
+    completion.counterpart = onset_id;
+    const EventId completion_id = add_event_unchecked(std::move(completion));
+    events_[onset_id].counterpart = completion_id;
+  }
+  SAFECASS_ASSERT(events_.size() == framework_event::kCount);
+}
+
+Coordinator::~Coordinator() = default;
+
+EventId Coordinator::add_event_unchecked(Event event) {
+  event.id = static_cast<EventId>(events_.size());
+  events_.push_back(std::move(event));
+  return events_.back().id;
+}
+
+Expected<ComponentId> Coordinator::add_component(std::string_view name) {
+  if (!valid_name(name)) {
+    return fail(ErrorCode::InvalidArgument,
+                "component name '" + std::string(name) + "' must be non-empty, without dots or spaces");
+  }
+  if (find_component(name)) {
+    return fail(ErrorCode::Duplicate, "duplicate component '" + std::string(name) + "'");
+  }
+  const auto id = static_cast<ComponentId>(components_.size());
+  auto c = std::make_unique<ComponentData>();
+  c->name = std::string(name);
+  c->history.items.resize(options_.history_capacity);
+  components_.push_back(std::move(c));
+  ComponentData& cd = *components_.back();
+  cd.framework = add_machine(id, MachineKind::Framework, kNone, cd.name + ".s_F");
+  cd.application = add_machine(id, MachineKind::Application, kNone, cd.name + ".s_A");
+  cd.machine_state_count[index(State::Normal)] = 2;
+  return id;
+}
+
+MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std::uint32_t iface,
+                                   std::string address) {
+  auto m = std::make_unique<MachineData>();
+  m->kind = kind;
+  m->component = component;
+  m->iface = iface;
+  m->address = std::move(address);
+  m->history.items.resize(options_.history_capacity);
+  m->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
+  machines_.push_back(std::move(m));
+  return static_cast<MachineId>(machines_.size() - 1);
+}
+
+Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
+  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  ComponentData& c = *components_[component];
+  if (!valid_name(name)) {
+    return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
+                                                "' must be non-empty, without dots or spaces");
+  }
+  for (MachineId m : c.provided) {
+    if (machines_[m]->address == c.name + ".s_P." + std::string(name)) {
+      return fail(ErrorCode::Duplicate, "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
+    }
+  }
+  const auto iface = static_cast<std::uint32_t>(c.provided.size());
+  const MachineId id = add_machine(component, MachineKind::Provided, iface, c.name + ".s_P." + std::string(name));
+  c.provided.push_back(id);
+  c.services.push_back(ServiceData{});
+  ++c.machine_state_count[index(State::Normal)];
+  rebuild_fanout();
+  return id;
+}
+
+Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
+  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  ComponentData& c = *components_[component];
+  if (!valid_name(name)) {
+    return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
+                                                "' must be non-empty, without dots or spaces");
+  }
+  for (MachineId m : c.required) {
+    if (machines_[m]->address == c.name + ".s_R." + std::string(name)) {
+      return fail(ErrorCode::Duplicate, "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
+    }
+  }
+  const auto iface = static_cast<std::uint32_t>(c.required.size());
+  const MachineId id = add_machine(component, MachineKind::Required, iface, c.name + ".s_R." + std::string(name));
+  c.required.push_back(id);
+  c.required_connection.push_back(kNoConnection);
+  ++c.machine_state_count[index(State::Normal)];
+  rebuild_fanout();
+  return id;
+}
+
+Expected<EventId> Coordinator::add_event(const EventDef& def) {
+  const std::string where = "event '" + def.name + "'";
+  if (def.name.empty()) return fail(ErrorCode::InvalidArgument, "an event needs a name");
+  if (find_event(def.name)) return fail(ErrorCode::Duplicate, "duplicate " + where);
+  if (def.severity < kMinSeverity || def.severity > kMaxSeverity) {
+    return fail(ErrorCode::InvalidArgument,
+                where + ": severity " + std::to_string(def.severity) + " is outside 1-255");
+  }
+  if (def.transitions.empty()) return fail(ErrorCode::InvalidArgument, where + ": state_transition is empty");
+  const bool onset = def.transitions.worsening_only();
+  if (!onset && !def.transitions.improving_only()) {
+    return fail(ErrorCode::InvalidArgument,
+                where + ": state_transition mixes worsening (N2W, N2E, W2E) and improving (W2N, E2N, E2W) transitions");
+  }
+  Event e;
+  e.name = def.name;
+  e.severity = static_cast<std::uint8_t>(def.severity);
+  e.transitions = def.transitions;
+  e.is_onset = onset;
+  e.latched = def.latched;
+  e.hazard = def.hazard;
+  e.description = def.description;
+  if (onset) {
+    if (!def.completes.empty()) {
+      return fail(ErrorCode::InvalidArgument, where + ": only a completion may say which onset it 'completes'");
+    }
+    // A completion defined earlier may be waiting for this onset.
+    for (Event& other : events_) {
+      if (!other.is_onset && other.counterpart == kNoEvent && other.completes == def.name) {
+        other.counterpart = static_cast<EventId>(events_.size());
+        e.counterpart = other.id;
+      }
+    }
+  } else {
+    if (def.latched) return fail(ErrorCode::InvalidArgument, where + ": only an onset can be latched");
+    e.completes = def.completes;
+    if (e.completes.empty()) {
+      if (def.name.size() < 2 || def.name[0] != '/') {
+        return fail(ErrorCode::InvalidArgument,
+                    where + ": a completion must be named '/ONSET' or say which onset it 'completes'");
+      }
+      e.completes = def.name.substr(1);
+    }
+    if (auto o = find_event(e.completes)) {
+      Event& target = events_[*o];
+      if (!target.is_onset) {
+        return fail(ErrorCode::InvalidArgument, where + ": completes '" + e.completes + "', which is not an onset");
+      }
+      e.counterpart = *o;
+      if (target.counterpart == kNoEvent) target.counterpart = static_cast<EventId>(events_.size());
+    }
+  }
+  return add_event_unchecked(std::move(e));
+}
+
+Expected<void> Coordinator::set_service(ComponentId component, std::string_view provided,
+                                        const ServiceDependency& dependency) {
+  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  ComponentData& c = *components_[component];
+  std::uint32_t p = kNone;
+  for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
+    if (interface_name(c.provided[i]) == provided) p = i;
+  }
+  if (p == kNone) {
+    return fail(ErrorCode::NotFound, "service '" + std::string(provided) + "' of component '" + c.name +
+                                         "': no provided interface of that name");
+  }
+  if (dependency.propagate == State::Normal) {
+    return fail(ErrorCode::InvalidArgument, "service '" + c.name + "." + std::string(provided) +
+                                                "': propagate must be Warning or Error");
+  }
+  ServiceData data;
+  data.dependency = dependency;
+  if (!dependency.all_required) {
+    for (const std::string& r : dependency.required) {
+      std::uint32_t found = kNone;
+      for (std::uint32_t i = 0; i < c.required.size(); ++i) {
+        if (interface_name(c.required[i]) == r) found = i;
+      }
+      if (found == kNone) {
+        return fail(ErrorCode::NotFound, "service '" + c.name + "." + std::string(provided) +
+                                             "' depends on unknown required interface '" + r + "'");
+      }
+      data.required.push_back(found);
+    }
+  }
+  std::lock_guard lock(mutex_);
+  for (const auto& m : machines_) {
+    if (!m->conditions.empty()) {
+      return fail(ErrorCode::InvalidState, "service '" + c.name + "." + std::string(provided) +
+                                               "': dependencies cannot change while conditions are active");
+    }
+  }
+  c.services[p] = std::move(data);
+  rebuild_fanout();
+  return {};
+}
+
+Expected<ConnectionId> Coordinator::connect(std::string_view client_required, std::string_view provider_provided) {
+  auto split = [this](std::string_view text, const char* role) -> Expected<std::pair<ComponentId, std::string_view>> {
+    const auto dot = text.find('.');
+    if (dot == std::string_view::npos || dot == 0 || dot + 1 == text.size() ||
+        text.find('.', dot + 1) != std::string_view::npos) {
+      return fail(ErrorCode::InvalidArgument, std::string(role) + " '" + std::string(text) +
+                                                  "' must be written Component.Interface");
+    }
+    auto comp = find_component(text.substr(0, dot));
+    if (!comp) {
+      return fail(ErrorCode::NotFound, std::string(role) + " '" + std::string(text) + "': no component '" +
+                                           std::string(text.substr(0, dot)) + "'");
+    }
+    return std::make_pair(*comp, text.substr(dot + 1));
+  };
+  auto client = split(client_required, "required interface");
+  if (!client) return tl::unexpected(client.error());
+  auto provider = split(provider_provided, "provided interface");
+  if (!provider) return tl::unexpected(provider.error());
+  ComponentData& cc = *components_[client->first];
+  ComponentData& pc = *components_[provider->first];
+  std::uint32_t r = kNone;
+  for (std::uint32_t i = 0; i < cc.required.size(); ++i) {
+    if (interface_name(cc.required[i]) == client->second) r = i;
+  }
+  if (r == kNone) {
+    return fail(ErrorCode::NotFound, "connection " + std::string(client_required) + " -> " +
+                                         std::string(provider_provided) + ": '" + cc.name +
+                                         "' has no required interface '" + std::string(client->second) + "'");
+  }
+  std::uint32_t p = kNone;
+  for (std::uint32_t i = 0; i < pc.provided.size(); ++i) {
+    if (interface_name(pc.provided[i]) == provider->second) p = i;
+  }
+  if (p == kNone) {
+    return fail(ErrorCode::NotFound, "connection " + std::string(client_required) + " -> " +
+                                         std::string(provider_provided) + ": '" + pc.name +
+                                         "' has no provided interface '" + std::string(provider->second) + "'");
+  }
+  if (cc.required_connection[r] != kNoConnection) {
+    const Connection& old = connections_[cc.required_connection[r]];
+    return fail(ErrorCode::Duplicate, "required interface " + std::string(client_required) +
+                                          " is already connected to " + components_[old.provider]->name + "." +
+                                          std::string(interface_name(components_[old.provider]->provided[old.provided])));
+  }
+  std::lock_guard lock(mutex_);
+  const auto id = static_cast<ConnectionId>(connections_.size());
+  connections_.push_back(Connection{client->first, r, provider->first, p});
+  cc.required_connection[r] = id;
+  rebuild_fanout();
+  // A connection made while faults are active carries them at once (mirrors are defined by reachability).
+  processing_ = true;
+  for (MachineId m = 0; m < machines_.size(); ++m) {
+    const std::vector<Condition> snapshot = machines_[m]->conditions;
+    for (const Condition& c : snapshot) {
+      if (!c.mirror) propagate_onset(c);
+    }
+  }
+  drain_pending();
+  processing_ = false;
+  return id;
+}
+
+bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept {
+  if (m.component != component) return false;
+  const ServiceDependency& d = components_[component]->services[provided].dependency;
+  switch (m.kind) {
+    case MachineKind::Framework: return d.framework;
+    case MachineKind::Application: return d.application;
+    case MachineKind::Provided: return m.iface == provided;
+    case MachineKind::Required: {
+      if (d.all_required) return true;
+      const auto& req = components_[component]->services[provided].required;
+      return std::find(req.begin(), req.end(), m.iface) != req.end();
+    }
+  }
+  return false;
+}
+
+void Coordinator::rebuild_fanout() {
+  for (auto& m : machines_) m->fanout.clear();
+  for (ConnectionId k = 0; k < connections_.size(); ++k) {
+    const Connection& conn = connections_[k];
+    const ComponentData& provider = *components_[conn.provider];
+    const MachineId client_machine = components_[conn.client]->required[conn.required];
+    const State min_level = provider.services[conn.provided].dependency.propagate;
+    for (MachineId m = 0; m < machines_.size(); ++m) {
+      if (depends_on(conn.provider, conn.provided, *machines_[m])) {
+        machines_[m]->fanout.push_back(Edge{client_machine, min_level, k});
+      }
+    }
+  }
+  const std::size_t limit = machines_.size();
+  if (work_.capacity() < limit) work_.reserve(limit);
+  visit_marks_.resize(machines_.size(), 0);
+}
+
+// ---- lookup ----------------------------------------------------------------------------------
+
+Expected<ComponentId> Coordinator::find_component(std::string_view name) const {
+  for (ComponentId i = 0; i < components_.size(); ++i) {
+    if (components_[i]->name == name) return i;
+  }
+  return fail(ErrorCode::NotFound, "no component '" + std::string(name) + "'");
+}
+
+Expected<EventId> Coordinator::find_event(std::string_view name) const {
+  for (const Event& e : events_) {
+    if (e.name == name) return e.id;
+  }
+  return fail(ErrorCode::NotFound, "no event '" + std::string(name) + "'");
+}
+
+Expected<Address> Coordinator::resolve(std::string_view text) const {
+  Address a;
+  if (text == "SYSTEM" || text == name_) return a;
+  const auto dot = text.find('.');
+  auto comp = find_component(text.substr(0, dot));
+  if (!comp) return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': no component '" +
+                                                  std::string(text.substr(0, dot)) + "'");
+  a.component = *comp;
+  const ComponentData& c = *components_[*comp];
+  if (dot == std::string_view::npos) {
+    a.kind = Address::Kind::Component;
+    return a;
+  }
+  const std::string_view rest = text.substr(dot + 1);
+  a.kind = Address::Kind::Machine;
+  if (rest == "s_F") {
+    a.machine = c.framework;
+    return a;
+  }
+  if (rest == "s_A") {
+    a.machine = c.application;
+    return a;
+  }
+  const auto dot2 = rest.find('.');
+  const std::string_view kind = rest.substr(0, dot2);
+  if (dot2 == std::string_view::npos || (kind != "s_P" && kind != "s_R" && kind != "s_S")) {
+    return fail(ErrorCode::Parse, "address '" + std::string(text) +
+                                      "': expected C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p or SYSTEM");
+  }
+  const std::string_view iface = rest.substr(dot2 + 1);
+  const auto& list = kind == "s_R" ? c.required : c.provided;
+  for (std::uint32_t i = 0; i < list.size(); ++i) {
+    if (interface_name(list[i]) == iface) {
+      if (kind == "s_S") {
+        a.kind = Address::Kind::Service;
+        a.service = i;
+      } else {
+        a.machine = list[i];
+      }
+      return a;
+    }
+  }
+  return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': component '" + c.name + "' has no " +
+                                       (kind == "s_R" ? "required" : "provided") + " interface '" +
+                                       std::string(iface) + "'");
+}
+
+Expected<MachineId> Coordinator::find_machine(std::string_view address) const {
+  auto a = resolve(address);
+  if (!a) return tl::unexpected(a.error());
+  if (a->kind != Address::Kind::Machine) {
+    return fail(ErrorCode::InvalidArgument, "address '" + std::string(address) +
+                                                "' is not a state machine (use C.s_F, C.s_A, C.s_P.p or C.s_R.r)");
+  }
+  return a->machine;
+}
+
+std::string_view Coordinator::component_name(ComponentId id) const noexcept { return components_[id]->name; }
+MachineId Coordinator::framework_machine(ComponentId id) const noexcept { return components_[id]->framework; }
+MachineId Coordinator::application_machine(ComponentId id) const noexcept { return components_[id]->application; }
+const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept { return components_[id]->provided; }
+const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept { return components_[id]->required; }
+MachineKind Coordinator::machine_kind(MachineId id) const noexcept { return machines_[id]->kind; }
+ComponentId Coordinator::machine_component(MachineId id) const noexcept { return machines_[id]->component; }
+const std::string& Coordinator::address_of(MachineId id) const noexcept { return machines_[id]->address; }
+
+std::string_view Coordinator::interface_name(MachineId id) const noexcept {
+  const MachineData& m = *machines_[id];
+  switch (m.kind) {
+    case MachineKind::Framework: return "s_F";
+    case MachineKind::Application: return "s_A";
+    case MachineKind::Provided:
+    case MachineKind::Required: break;
+  }
+  const std::string_view a = m.address;
+  return a.substr(a.rfind('.') + 1);
+}
+
+const ServiceDependency& Coordinator::service(ComponentId component, std::uint32_t provided) const noexcept {
+  return components_[component]->services[provided].dependency;
+}
+
+NameId Coordinator::intern(std::string_view text) {
+  std::lock_guard lock(names_mutex_);
+  for (std::size_t i = 0; i < names_.size(); ++i) {
+    if (names_[i] == text) return static_cast<NameId>(i);
+  }
+  names_.emplace_back(text);
+  return static_cast<NameId>(names_.size() - 1);
+}
+
+std::string_view Coordinator::name_of(NameId id) const {
+  std::lock_guard lock(names_mutex_);
+  if (id >= names_.size()) return {};
+  return names_[id];
+}
+
+// ---- reads -----------------------------------------------------------------------------------
+
+State Coordinator::service_state(ComponentId component, std::uint32_t provided) const noexcept {
+  const ComponentData& c = *components_[component];
+  const ServiceData& s = c.services[provided];
+  State st = state(c.provided[provided]);
+  if (s.dependency.framework) st = st * state(c.framework);
+  if (s.dependency.application) st = st * state(c.application);
+  if (s.dependency.all_required) {
+    for (MachineId r : c.required) st = st * state(r);
+  } else {
+    for (std::uint32_t r : s.required) st = st * state(c.required[r]);
+  }
+  return st;
+}
+
+State Coordinator::coordinator_state() const noexcept {
+  State s = State::Normal;
+  for (ComponentId c = 0; c < components_.size(); ++c) s = s * extended_state(c);
+  return s;
+}
+
+State Coordinator::state_of(const Address& a) const noexcept {
+  switch (a.kind) {
+    case Address::Kind::System: return coordinator_state();
+    case Address::Kind::Component: return extended_state(a.component);
+    case Address::Kind::Machine: return state(a.machine);
+    case Address::Kind::Service: return service_state(a.component, a.service);
+  }
+  return State::Normal;
+}
+
+std::vector<Condition> Coordinator::conditions(MachineId id) const {
+  std::lock_guard lock(mutex_);
+  return machines_[id]->conditions;
+}
+
+std::optional<Condition> Coordinator::outstanding(MachineId id) const {
+  std::lock_guard lock(mutex_);
+  const MachineData& m = *machines_[id];
+  if (m.outstanding < 0) return std::nullopt;
+  return m.conditions[static_cast<std::size_t>(m.outstanding)];
+}
+
+std::vector<Record> Coordinator::history(MachineId id) const {
+  std::lock_guard lock(mutex_);
+  return machines_[id]->history.ordered();
+}
+
+std::vector<Record> Coordinator::component_history(ComponentId id) const {
+  std::lock_guard lock(mutex_);
+  return components_[id]->history.ordered();
+}
+
+// ---- callbacks and observers -----------------------------------------------------------------
+
+void Coordinator::on_machine(MachineId id, StateCallbacks callbacks) {
+  std::lock_guard lock(mutex_);
+  machines_[id]->callbacks.push_back(std::move(callbacks));
+}
+
+void Coordinator::on_component(ComponentId id, StateCallbacks callbacks) {
+  std::lock_guard lock(mutex_);
+  components_[id]->callbacks.push_back(std::move(callbacks));
+}
+
+Coordinator::SubscriptionId Coordinator::subscribe(std::function<void(const Record&)> observer) {
+  std::lock_guard lock(mutex_);
+  const SubscriptionId id = next_subscription_++;
+  observers_.emplace_back(id, std::move(observer));
+  return id;
+}
+
+void Coordinator::unsubscribe(SubscriptionId id) {
+  std::lock_guard lock(mutex_);
+  std::erase_if(observers_, [id](const auto& o) { return o.first == id; });
+}
+
+void Coordinator::publish(Record record) {
+  std::lock_guard lock(mutex_);
+  if (record.machine != kNoMachine && record.machine < machines_.size()) {
+    record.component = machines_[record.machine]->component;
+    record_machine(record.machine, record);
+  } else {
+    record.seq = ++record_seq_;
+    emit(record);
+  }
+}
+
+void Coordinator::emit(const Record& r) noexcept {
+  for (auto& [id, fn] : observers_) {
+    try {
+      fn(r);
+    } catch (...) {
+      // Observers must not throw; a throwing observer must still not break monitoring.
+    }
+  }
+}
+
+void Coordinator::record_machine(MachineId id, Record r) noexcept {
+  r.seq = ++record_seq_;
+  machines_[id]->history.push(r);
+  emit(r);
+}
+
+// ---- event processing ------------------------------------------------------------------------
+
+void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
+  SAFECASS_ASSERT(event < events_.size());
+  SAFECASS_ASSERT(target < machines_.size() || events_[event].is_broadcast());
+  std::lock_guard lock(mutex_);
+  Pending op{PendingKind::Generate, event, target, cause, Address{}, kNoName, kNoName};
+  if (processing_) {
+    pending_.push_back(op);
+    return;
+  }
+  processing_ = true;
+  run(op);
+  drain_pending();
+  processing_ = false;
+}
+
+Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
+  auto e = find_event(event);
+  if (!e) return tl::unexpected(e.error());
+  const Event& ev = events_[*e];
+  if (!ev.is_onset && ev.counterpart == kNoEvent) {
+    return fail(ErrorCode::InvalidState, "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
+  }
+  if (ev.is_broadcast()) {
+    generate(*e, kNoMachine);
+    return {};
+  }
+  auto m = find_machine(target);
+  if (!m) return tl::unexpected(m.error());
+  generate(*e, *m);
+  return {};
+}
+
+Expected<void> Coordinator::broadcast(std::string_view event) {
+  auto e = find_event(event);
+  if (!e) return tl::unexpected(e.error());
+  if (!events_[*e].is_broadcast()) {
+    return fail(ErrorCode::InvalidArgument, "event '" + std::string(event) + "' has severity " +
+                                                std::to_string(events_[*e].severity) +
+                                                "; broadcasts need severity 251-255");
+  }
+  generate(*e, kNoMachine);
+  return {};
+}
+
+Expected<void> Coordinator::reset(std::string_view target, std::string_view who, std::string_view why) {
+  auto a = resolve(target);
+  if (!a) return tl::unexpected(a.error());
+  if (a->kind == Address::Kind::Service) {
+    return fail(ErrorCode::InvalidArgument, "cannot reset service state '" + std::string(target) +
+                                                "': it is derived; reset its component or a machine");
+  }
+  reset(*a, who, why);
+  return {};
+}
+
+void Coordinator::reset(const Address& target, std::string_view who, std::string_view why) {
+  std::string text(who);
+  text += ": ";
+  text += why;
+  const NameId reason = intern(text);
+  std::lock_guard lock(mutex_);
+  Pending op{PendingKind::Reset, kNoEvent, kNoMachine, SampleCause{}, target, reason, reason};
+  if (processing_) {
+    pending_.push_back(op);
+    return;
+  }
+  processing_ = true;
+  run(op);
+  drain_pending();
+  processing_ = false;
+}
+
+void Coordinator::run(const Pending& op) noexcept {
+  switch (op.kind) {
+    case PendingKind::Generate: process(op.event, op.machine, op.cause); return;
+    case PendingKind::Reset: reset_locked(op.address, op.why, clock_->now()); return;
+  }
+}
+
+void Coordinator::drain_pending() noexcept {
+  // Events generated by callbacks while processing. A callback that keeps generating events on
+  // every transition could loop forever; the bound keeps the monitored system alive.
+  constexpr std::size_t kMaxChained = 1u << 16;
+  for (std::size_t i = 0; i < pending_.size() && i < kMaxChained; ++i) {
+    const Pending op = pending_[i];
+    run(op);
+  }
+  pending_.clear();
+}
+
+void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
+  const Event& event = events_[event_id];
+  const Time now = clock_->now();
+  if (event.is_broadcast()) {
+    for (const auto& c : components_) {
+      if (event.is_onset) {
+        process_onset(event, c->application, cause, now);
+      } else {
+        process_completion(event, c->application, now);
+      }
+    }
+    return;
+  }
+  if (event.is_onset) {
+    process_onset(event, target, cause, now);
+  } else {
+    process_completion(event, target, now);
+  }
+}
+
+std::int32_t Coordinator::find_root(const MachineData& m, EventId event) const noexcept {
+  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
+    if (!m.conditions[i].mirror && m.conditions[i].event == event) return static_cast<std::int32_t>(i);
+  }
+  return -1;
+}
+
+std::int32_t Coordinator::find_any_root(const MachineData& m) const noexcept {
+  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
+    if (!m.conditions[i].mirror) return static_cast<std::int32_t>(i);
+  }
+  return -1;
+}
+
+std::int32_t Coordinator::find_mirror(const MachineData& m, const RootCause& root) const noexcept {
+  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
+    const Condition& c = m.conditions[i];
+    if (c.mirror && c.root.event == root.event && c.root.origin == root.origin) return static_cast<std::int32_t>(i);
+  }
+  return -1;
+}
+
+void Coordinator::process_onset(const Event& event, MachineId target, const SampleCause& cause, Time now) noexcept {
+  MachineData& m = *machines_[target];
+  if (const std::int32_t i = find_root(m, event.id); i >= 0) {
+    // §2.4 onset rule 1: already active → refresh only.
+    Condition& c = m.conditions[static_cast<std::size_t>(i)];
+    c.last = now;
+    ++c.count;
+    return;
+  }
+  Condition c;
+  c.event = event.id;
+  c.level = onset_level(event.transitions, m.state);
+  c.severity = event.severity;
+  c.first = c.last = now;
+  c.seq = ++condition_seq_;
+  c.root = RootCause{event.id, target, now, cause};
+  add_condition(target, c, now);
+  propagate_onset(c);
+}
+
+void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
+  MachineData& m = *machines_[target];
+  Record r;
+  r.kind = RecordKind::Event;
+  r.time = now;
+  r.component = m.component;
+  r.machine = target;
+  r.event = event.id;
+  r.from = r.to = m.state;
+  r.severity = event.severity;
+  if (event.counterpart == kNoEvent) {
+    r.outcome = Outcome::Ignored;
+    r.text = kIgnoredNoOnset;
+    record_machine(target, r);
+    return;
+  }
+  const std::int32_t i = find_root(m, event.counterpart);
+  if (i < 0) {
+    r.outcome = Outcome::Ignored;
+    r.text = kIgnoredNotActive;
+    record_machine(target, r);
+    return;
+  }
+  if (events_[event.counterpart].latched) {
+    r.outcome = Outcome::Ignored;
+    r.text = kIgnoredLatched;
+    r.root = m.conditions[static_cast<std::size_t>(i)].root;
+    record_machine(target, r);
+    return;
+  }
+  const Condition removed = m.conditions[static_cast<std::size_t>(i)];
+  remove_condition(target, static_cast<std::size_t>(i), event.id, now, {});
+  propagate_clear(removed.root, removed.level, now);
+}
+
+void Coordinator::add_condition(MachineId id, Condition c, Time now) noexcept {
+  MachineData& m = *machines_[id];
+  const State old = m.state;
+  Outcome outcome = Outcome::Masked;
+  if (c.level > old) {
+    outcome = Outcome::Raised;
+  } else if (c.level == old) {
+    const bool overrides = m.outstanding < 0 ||
+                           c.severity >= m.conditions[static_cast<std::size_t>(m.outstanding)].severity;
+    outcome = overrides ? Outcome::Override : Outcome::Joined;
+  }
+  m.conditions.push_back(c);
+  ++m.level_count[index(c.level)];
+  Record r;
+  r.kind = RecordKind::Event;
+  r.outcome = outcome;
+  r.time = now;
+  r.component = m.component;
+  r.machine = id;
+  r.event = c.event;
+  r.from = old;
+  r.level = c.level;
+  r.severity = c.severity;
+  r.mirror = c.mirror;
+  r.via = c.via;
+  r.root = c.root;
+  m.state = state_from_counts(m.level_count);
+  r.to = m.state;
+  record_machine(id, r);
+  update_machine(id, old, c.event, &m.conditions.back().root, now);
+}
+
+void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now,
+                                   std::string_view text) noexcept {
+  MachineData& m = *machines_[id];
+  const State old = m.state;
+  const Condition removed = m.conditions[i];
+  --m.level_count[index(removed.level)];
+  m.conditions[i] = m.conditions.back();
+  m.conditions.pop_back();
+  m.state = state_from_counts(m.level_count);
+  Record r;
+  r.kind = RecordKind::Event;
+  r.outcome = Outcome::Cleared;
+  r.time = now;
+  r.component = m.component;
+  r.machine = id;
+  r.event = event;
+  r.from = old;
+  r.to = m.state;
+  r.level = removed.level;
+  r.severity = removed.severity;
+  r.mirror = removed.mirror;
+  r.via = removed.via;
+  r.root = removed.root;
+  r.text = text;
+  record_machine(id, r);
+  update_machine(id, old, event, &removed.root, now);
+}
+
+void Coordinator::update_machine(MachineId id, State old_state, EventId event, const RootCause* root,
+                                 Time now) noexcept {
+  MachineData& m = *machines_[id];
+  // Outstanding: highest severity at the current level; ties go to the most recent activation.
+  m.outstanding = -1;
+  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
+    const Condition& c = m.conditions[i];
+    if (c.level != m.state) continue;
+    if (m.outstanding < 0) {
+      m.outstanding = static_cast<std::int32_t>(i);
+      continue;
+    }
+    const Condition& best = m.conditions[static_cast<std::size_t>(m.outstanding)];
+    if (c.severity > best.severity || (c.severity == best.severity && c.seq > best.seq)) {
+      m.outstanding = static_cast<std::int32_t>(i);
+    }
+  }
+  const EventId outstanding =
+      m.outstanding < 0 ? kNoEvent : m.conditions[static_cast<std::size_t>(m.outstanding)].event;
+  m.snapshot.store(pack(StateSnapshot{m.state, outstanding}), std::memory_order_release);
+
+  ComponentData& comp = *components_[m.component];
+  if (old_state != m.state) {
+    --comp.machine_state_count[index(old_state)];
+    ++comp.machine_state_count[index(m.state)];
+    Record r;
+    r.kind = RecordKind::Transition;
+    r.time = now;
+    r.component = m.component;
+    r.machine = id;
+    r.event = event;
+    r.from = old_state;
+    r.to = m.state;
+    if (root != nullptr) r.root = *root;
+    record_machine(id, r);
+    TransitionInfo info{m.component, id, transition_between(old_state, m.state), event, root, now};
+    fire(m.callbacks, m.component, info, old_state, m.state);
+  }
+  update_component(m.component, event, root, now);
+}
+
+void Coordinator::update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept {
+  ComponentData& c = *components_[id];
+  const State old = c.state;
+  c.state = state_from_counts(c.machine_state_count);
+  // The component's outstanding event: over its machines at the extended level, the outstanding
+  // condition of highest severity, most recent on ties.
+  const Condition* best = nullptr;
+  auto consider = [&](MachineId mid) {
+    const MachineData& m = *machines_[mid];
+    if (m.state != c.state || m.outstanding < 0) return;
+    const Condition& cand = m.conditions[static_cast<std::size_t>(m.outstanding)];
+    if (best == nullptr || cand.severity > best->severity ||
+        (cand.severity == best->severity && cand.seq > best->seq)) {
+      best = &cand;
+    }
+  };
+  consider(c.framework);
+  consider(c.application);
+  for (MachineId p : c.provided) consider(p);
+  for (MachineId r : c.required) consider(r);
+  c.outstanding = best == nullptr ? kNoEvent : best->event;
+  c.snapshot.store(pack(StateSnapshot{c.state, c.outstanding}), std::memory_order_release);
+  if (old == c.state) return;
+  Record r;
+  r.kind = RecordKind::ComponentTransition;
+  r.time = now;
+  r.seq = ++record_seq_;
+  r.component = id;
+  r.event = event;
+  r.from = old;
+  r.to = c.state;
+  if (root != nullptr) r.root = *root;
+  c.history.push(r);
+  emit(r);
+  TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
+  fire(c.callbacks, id, info, old, c.state);
+}
+
+void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
+                       State from, State to) noexcept {
+  for (StateCallbacks& cb : callbacks) {
+    try {
+      if (cb.on_exit) cb.on_exit(from);
+      if (cb.on_transition) cb.on_transition(info);
+      if (cb.on_entry) cb.on_entry(to);
+    } catch (...) {
+      // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
+      SampleCause cause;
+      pending_.push_back(Pending{PendingKind::Generate, framework_event::kCallbackException,
+                                 components_[component]->framework, cause, Address{}, kNoName, kNoName});
+    }
+  }
+}
+
+// ---- propagation (DESIGN §2.6) ---------------------------------------------------------------
+
+void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
+  const RootCause root = root_condition.root;
+  const State level = root_condition.level;
+  const Time now = root_condition.first;
+  const EventId mirror_event =
+      level == State::Error ? framework_event::kServiceFailure : framework_event::kServiceDegraded;
+  const std::uint64_t mark = ++visit_epoch_;
+  work_.clear();
+  work_.push_back(root.origin);
+  visit_marks_[root.origin] = mark;
+  for (std::size_t head = 0; head < work_.size(); ++head) {
+    const MachineId from = work_[head];
+    for (const Edge& e : machines_[from]->fanout) {
+      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
+      visit_marks_[e.to] = mark;
+      work_.push_back(e.to);
+      if (find_mirror(*machines_[e.to], root) >= 0) continue;
+      Condition c;
+      c.event = mirror_event;
+      c.level = level;
+      c.severity = events_[mirror_event].severity;
+      c.mirror = true;
+      c.via = e.via;
+      c.first = c.last = now;
+      c.seq = ++condition_seq_;
+      c.root = root;
+      add_condition(e.to, c, now);
+    }
+  }
+}
+
+void Coordinator::propagate_clear(const RootCause& root, State level, Time now) noexcept {
+  const std::uint64_t mark = ++visit_epoch_;
+  work_.clear();
+  work_.push_back(root.origin);
+  visit_marks_[root.origin] = mark;
+  for (std::size_t head = 0; head < work_.size(); ++head) {
+    const MachineId from = work_[head];
+    for (const Edge& e : machines_[from]->fanout) {
+      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
+      visit_marks_[e.to] = mark;
+      work_.push_back(e.to);
+      const std::int32_t i = find_mirror(*machines_[e.to], root);
+      if (i < 0) continue;
+      const EventId completion = framework_event::completion_of(
+          machines_[e.to]->conditions[static_cast<std::size_t>(i)].event);
+      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, {});
+    }
+  }
+}
+
+void Coordinator::reset_locked(const Address& target, NameId reason, Time now) noexcept {
+  const std::string_view text = name_of(reason);
+  std::vector<MachineId> targets;
+  switch (target.kind) {
+    case Address::Kind::System:
+      for (MachineId m = 0; m < machines_.size(); ++m) targets.push_back(m);
+      break;
+    case Address::Kind::Component:
+    case Address::Kind::Service: {
+      const ComponentData& c = *components_[target.component];
+      targets.push_back(c.framework);
+      targets.push_back(c.application);
+      targets.insert(targets.end(), c.provided.begin(), c.provided.end());
+      targets.insert(targets.end(), c.required.begin(), c.required.end());
+      break;
+    }
+    case Address::Kind::Machine: targets.push_back(target.machine); break;
+  }
+  for (MachineId id : targets) {
+    MachineData& m = *machines_[id];
+    Record r;
+    r.kind = RecordKind::Reset;
+    r.time = now;
+    r.component = m.component;
+    r.machine = id;
+    r.from = r.to = m.state;
+    r.text = text;
+    record_machine(id, r);
+    // Propagating a clear may shrink this machine's conditions (a cycle), so search afresh each time.
+    for (std::int32_t i = find_any_root(m); i >= 0; i = find_any_root(m)) {
+      const Condition c = m.conditions[static_cast<std::size_t>(i)];
+      remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
+      propagate_clear(c.root, c.level, now);
+    }
+  }
+}
+
+}  // namespace safecass

@@ -1,0 +1,168 @@
+// explain(): each active condition with its root cause and the path of hops it took (DESIGN §2.6).
+
+#include <algorithm>
+#include <cstdio>
+
+#include "safecass/core/coordinator.hpp"
+
+namespace safecass {
+
+namespace {
+std::string seconds_text(Time t) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
+  return buf;
+}
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+}  // namespace
+
+std::string to_string(const Explanation& e) {
+  std::string out = e.machine;
+  out += ": ";
+  out += to_string(e.level);
+  out += ' ';
+  out += e.event;
+  out += " (severity " + std::to_string(e.severity) + ")";
+  if (e.mirror) {
+    out += " <- ";
+    out += e.root_origin + ":" + e.root_event;
+  }
+  out += " since " + seconds_text(e.root_time) + " s";
+  if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
+  if (!e.filter.empty() || !e.signal.empty()) {
+    out += " [";
+    if (!e.filter.empty()) out += "filter " + e.filter;
+    if (!e.signal.empty()) {
+      if (!e.filter.empty()) out += ", ";
+      out += e.signal + " = " + number_text(e.value) + " at " + seconds_text(e.sample_time) + " s";
+    }
+    if (e.injected) out += ", injected";
+    out += "]";
+  }
+  if (e.path.size() > 1) {
+    out += " path ";
+    for (std::size_t i = 0; i < e.path.size(); ++i) {
+      if (i > 0) out += " -> ";
+      out += e.path[i];
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition& condition) const {
+  std::vector<std::string> reversed{machines_[holder]->address};
+  if (!condition.mirror) return reversed;
+  const RootCause& root = condition.root;
+  const Condition* current = &condition;
+  // Walk back along the connections the mirrors arrived through. Each step moves one component
+  // upstream; the bound protects against a corrupted model.
+  for (std::size_t step = 0; step <= machines_.size(); ++step) {
+    const Connection& conn = connections_[current->via];
+    const ComponentData& provider = *components_[conn.provider];
+    reversed.push_back(provider.name + ".s_S." + std::string(interface_name(provider.provided[conn.provided])));
+    const MachineData& origin = *machines_[root.origin];
+    if (depends_on(conn.provider, conn.provided, origin)) {
+      reversed.push_back(origin.address);
+      break;
+    }
+    const Condition* next = nullptr;
+    for (MachineId r : provider.required) {
+      const MachineData& m = *machines_[r];
+      if (!depends_on(conn.provider, conn.provided, m)) continue;
+      const std::int32_t i = find_mirror(m, root);
+      if (i >= 0) {
+        reversed.push_back(m.address);
+        next = &m.conditions[static_cast<std::size_t>(i)];
+        break;
+      }
+    }
+    if (next == nullptr) break;
+    current = next;
+  }
+  std::reverse(reversed.begin(), reversed.end());
+  return reversed;
+}
+
+std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
+  const MachineData& m = *machines_[id];
+  std::vector<const Condition*> sorted;
+  for (const Condition& c : m.conditions) sorted.push_back(&c);
+  std::sort(sorted.begin(), sorted.end(), [](const Condition* a, const Condition* b) {
+    if (a->level != b->level) return a->level > b->level;
+    if (a->severity != b->severity) return a->severity > b->severity;
+    return a->seq > b->seq;
+  });
+  std::vector<Explanation> out;
+  for (const Condition* c : sorted) {
+    Explanation e;
+    e.machine = m.address;
+    e.event = events_[c->event].name;
+    e.level = c->level;
+    e.severity = c->severity;
+    e.mirror = c->mirror;
+    e.outstanding = m.outstanding >= 0 && &m.conditions[static_cast<std::size_t>(m.outstanding)] == c;
+    e.count = c->count;
+    e.first = c->first;
+    e.last = c->last;
+    e.root_event = events_[c->root.event].name;
+    e.root_origin = machines_[c->root.origin]->address;
+    e.root_time = c->root.time;
+    e.hazard = events_[c->root.event].hazard;
+    if (c->root.sample.filter != kNoName) e.filter = std::string(name_of(c->root.sample.filter));
+    if (c->root.sample.signal != kNoName) e.signal = std::string(name_of(c->root.sample.signal));
+    e.value = c->root.sample.value;
+    e.sample_time = c->root.sample.sample_time;
+    e.injected = c->root.sample.injected;
+    e.path = hop_path(id, *c);
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+std::vector<Explanation> Coordinator::explain(const Address& address) const {
+  std::lock_guard lock(mutex_);
+  std::vector<MachineId> machines;
+  switch (address.kind) {
+    case Address::Kind::System:
+      for (MachineId m = 0; m < machines_.size(); ++m) machines.push_back(m);
+      break;
+    case Address::Kind::Component: {
+      const ComponentData& c = *components_[address.component];
+      machines.push_back(c.framework);
+      machines.push_back(c.application);
+      machines.insert(machines.end(), c.provided.begin(), c.provided.end());
+      machines.insert(machines.end(), c.required.begin(), c.required.end());
+      break;
+    }
+    case Address::Kind::Service: {
+      const ComponentData& c = *components_[address.component];
+      for (MachineId m : {c.framework, c.application}) {
+        if (depends_on(address.component, address.service, *machines_[m])) machines.push_back(m);
+      }
+      machines.push_back(c.provided[address.service]);
+      for (MachineId m : c.required) {
+        if (depends_on(address.component, address.service, *machines_[m])) machines.push_back(m);
+      }
+      break;
+    }
+    case Address::Kind::Machine: machines.push_back(address.machine); break;
+  }
+  std::vector<Explanation> out;
+  for (MachineId m : machines) {
+    auto part = explain_machine(m);
+    out.insert(out.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
+  }
+  return out;
+}
+
+Expected<std::vector<Explanation>> Coordinator::explain(std::string_view address) const {
+  auto a = resolve(address);
+  if (!a) return tl::unexpected(a.error());
+  return explain(*a);
+}
+
+}  // namespace safecass
