@@ -54,34 +54,35 @@ std::string to_string(const Explanation& e) {
 }
 
 std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition& condition) const {
+  if (!condition.mirror) return {machines_[holder]->address};
+  // The shortest path of hops the condition's level passes, found by a breadth-first search from
+  // the origin along the same edges propagation uses. Walking back from the holder instead can
+  // circle a cycle of connections forever (every machine on the cycle holds a mirror).
+  const MachineId origin = condition.root.origin;
+  constexpr std::size_t kUnseen = static_cast<std::size_t>(-1);
+  std::vector<std::size_t> parent_edge(machines_.size(), kUnseen);  // index into `edges`
+  std::vector<std::pair<MachineId, const Edge*>> edges;              // (from, edge)
+  std::vector<MachineId> queue{origin};
+  std::vector<bool> seen(machines_.size(), false);
+  seen[origin] = true;
+  for (std::size_t head = 0; head < queue.size() && !seen[holder]; ++head) {
+    const MachineId from = queue[head];
+    for (const Edge& e : machines_[from]->fanout) {
+      if (condition.level < e.min_level || seen[e.to]) continue;
+      seen[e.to] = true;
+      parent_edge[e.to] = edges.size();
+      edges.emplace_back(from, &e);
+      queue.push_back(e.to);
+    }
+  }
   std::vector<std::string> reversed{machines_[holder]->address};
-  if (!condition.mirror) return reversed;
-  const RootCause& root = condition.root;
-  const Condition* current = &condition;
-  // Walk back along the connections the mirrors arrived through. Each step moves one component
-  // upstream; the bound protects against a corrupted model.
-  for (std::size_t step = 0; step <= machines_.size(); ++step) {
-    const Connection& conn = connections_[current->via];
+  for (MachineId at = holder; at != origin && parent_edge[at] != kUnseen;) {
+    const auto [from, edge] = edges[parent_edge[at]];
+    const Connection& conn = connections_[edge->via];
     const ComponentData& provider = *components_[conn.provider];
     reversed.push_back(provider.name + ".s_S." + std::string(interface_name(provider.provided[conn.provided])));
-    const MachineData& origin = *machines_[root.origin];
-    if (depends_on(conn.provider, conn.provided, origin)) {
-      reversed.push_back(origin.address);
-      break;
-    }
-    const Condition* next = nullptr;
-    for (MachineId r : provider.required) {
-      const MachineData& m = *machines_[r];
-      if (!depends_on(conn.provider, conn.provided, m)) continue;
-      const std::int32_t i = find_mirror(m, root);
-      if (i >= 0) {
-        reversed.push_back(m.address);
-        next = &m.conditions[static_cast<std::size_t>(i)];
-        break;
-      }
-    }
-    if (next == nullptr) break;
-    current = next;
+    reversed.push_back(machines_[from]->address);
+    at = from;
   }
   std::reverse(reversed.begin(), reversed.end());
   return reversed;

@@ -10,9 +10,11 @@
 /// the configuration before other threads start reading or generating. After that:
 /// - state reads (`state()`, `extended()`, `service_state()`, `dispatch()`) are lock-free, wait-free
 ///   and never allocate;
-/// - `generate()`/`reset()` take the coordinator's lock; once the condition vectors have grown to
-///   their working size they do not allocate. All local consequences (propagation, callbacks,
-///   observers) have happened when they return;
+/// - `generate()` takes the coordinator's lock; once the condition vectors have grown to their
+///   working size it does not allocate. `reset()` takes the lock and may allocate (it records who
+///   and why). All local consequences (propagation, callbacks, observers) have happened when they
+///   return;
+/// - callbacks and observers must not change the configuration or register callbacks/observers;
 /// - callbacks and observers run on the thread that caused the change, under the lock. They must
 ///   not block. An event they generate (or a reset they ask for) is queued and processed before the
 ///   outer call returns. An exception thrown by a callback becomes EVT_CALLBACK_EXCEPTION on the
@@ -238,6 +240,13 @@ public:
     }
   }
 
+  /// Events and resets requested from callbacks beyond the chain bound (65536 per outer call) and
+  /// therefore not processed. Non-zero means a callback loop: a bug in the application.
+  std::uint64_t dropped_requests() const {
+    std::lock_guard lock(mutex_);
+    return dropped_requests_;
+  }
+
   // ---- introspection (takes the lock; allocates) ---------------------------------------------
   std::vector<Condition> conditions(MachineId id) const;
   /// The machine's outstanding condition, if any.
@@ -350,6 +359,7 @@ private:
   std::int32_t find_mirror(const MachineData& m, const RootCause& root) const noexcept;
   std::int32_t find_root(const MachineData& m, EventId event) const noexcept;
   std::int32_t find_any_root(const MachineData& m) const noexcept;
+  void refresh_outstanding(MachineData& m) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
   void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
@@ -373,6 +383,7 @@ private:
   bool processing_ = false;
   std::uint64_t condition_seq_ = 0;
   std::uint64_t record_seq_ = 0;
+  std::uint64_t dropped_requests_ = 0;
   std::vector<Pending> pending_;
   std::vector<MachineId> work_;              ///< BFS queue for propagation, reserved up front
   std::vector<std::uint64_t> visit_marks_;   ///< per machine: last BFS that visited it

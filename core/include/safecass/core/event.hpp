@@ -70,7 +70,8 @@ inline constexpr EventId kPeriodOverrun = 6;       ///< EVT_PERIOD_OVERRUN (205)
 inline constexpr EventId kStale = 8;               ///< EVT_STALE (230)
 inline constexpr EventId kCallbackException = 10;  ///< EVT_CALLBACK_EXCEPTION (210)
 inline constexpr EventId kCoordinatorLost = 12;    ///< EVT_COORDINATOR_LOST (240)
-inline constexpr EventId kCount = 14;
+inline constexpr EventId kInvalidSample = 14;      ///< EVT_INVALID_SAMPLE (225): NaN or infinite input
+inline constexpr EventId kCount = 16;
 constexpr EventId completion_of(EventId onset) noexcept { return onset + 1; }
 }  // namespace framework_event
 

@@ -1,0 +1,158 @@
+#pragma once
+/// @file filter.hpp
+/// The filter base (DESIGN §3). A filter reads input signals, may write output signals, and
+/// generates onset/completion events to a target state machine.
+///
+/// Filter authors derive from Filter, publish a static `manifest()` and implement the protected
+/// hooks:
+/// - `on_sample(input, sample)`: one new sample of input `input` (in order, none skipped unless
+///   the history buffer overflowed);
+/// - `on_tick(now)`: once per run, after the new samples (timing filters: Watchdog, Deadline);
+/// - `on_reset()`: forget internal state.
+/// They call `report(detected, value, sample_time)` to turn a detection into events according to
+/// the detection mode, and `write(output, time, values)` to feed output signals.
+///
+/// Lifecycle: created by Monitor::add_filter (parameters checked, inputs resolved, nothing half
+/// built on error) → run() repeatedly from one thread (the component's loop for ACTIVE, the
+/// monitor thread for PASSIVE) → destroyed with the monitor. run() without a detection takes no
+/// lock and allocates nothing. A non-finite input sample is never passed to on_sample: it raises
+/// EVT_INVALID_SAMPLE on the target component's s_F until a finite sample arrives.
+
+#include <atomic>
+#include <cstddef>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/filters/params.hpp"
+#include "safecass/filters/signal.hpp"
+
+namespace safecass {
+
+/// EDGE: one onset per crossing, one completion on return. LEVEL: an onset every sample while
+/// detected (the state machine refreshes), one completion on return.
+enum class DetectionMode : std::uint8_t { Edge, Level };
+/// ACTIVE: run in the owning component's loop. PASSIVE: run by the monitor thread.
+enum class ExecutionMode : std::uint8_t { Active, Passive };
+
+/// Where a filter's events go: `{"type": "s_A", "component": "JR3"}`.
+struct FilterTarget {
+  MachineKind kind = MachineKind::Application;
+  std::string component;
+  std::string interface;  ///< for s_P / s_R
+};
+
+/// A filter instance as written in a specification.
+struct FilterConfig {
+  std::string name;   ///< unique within the monitor (default: the type and an index)
+  std::string type;   ///< registry name
+  FilterTarget target;
+  ExecutionMode execution = ExecutionMode::Active;
+  DetectionMode detection = DetectionMode::Edge;
+  bool enabled = true;
+  Params params;
+};
+
+/// Everything a filter needs at construction, prepared by the monitor.
+struct FilterInit {
+  FilterConfig config;              ///< params checked and completed with defaults
+  Coordinator* coordinator = nullptr;
+  MachineId target = kNoMachine;
+  ComponentId component = kNoComponent;
+  std::vector<Signal*> inputs;      ///< resolved, in manifest order (lists expanded)
+  std::vector<Signal*> outputs;     ///< resolved or created, in manifest order
+  EventId onset = kNoEvent;
+  EventId completion = kNoEvent;
+  NameId name_id = kNoName;
+};
+
+class Filter {
+public:
+  virtual ~Filter() = default;
+  Filter(const Filter&) = delete;
+  Filter& operator=(const Filter&) = delete;
+
+  const std::string& name() const noexcept { return config_.name; }
+  const std::string& type() const noexcept { return config_.type; }
+  const FilterConfig& config() const noexcept { return config_; }
+  ExecutionMode execution() const noexcept { return config_.execution; }
+  DetectionMode detection() const noexcept { return config_.detection; }
+  ComponentId component() const noexcept { return component_; }
+  MachineId target() const noexcept { return target_; }
+  const std::vector<Signal*>& inputs() const noexcept { return inputs_; }
+  const std::vector<Signal*>& outputs() const noexcept { return outputs_; }
+
+  bool enabled() const noexcept { return enabled_.load(std::memory_order_acquire); }
+  /// A disabled filter skips its runs; its unread samples are dropped when it is enabled again.
+  void set_enabled(bool enabled) noexcept { enabled_.store(enabled, std::memory_order_release); }
+  /// True while the filter's detection is active (an onset sent, its completion not yet).
+  bool detected() const noexcept { return detected_.load(std::memory_order_acquire); }
+  /// Samples lost to history-buffer overflow since creation.
+  std::uint64_t missed_samples() const noexcept;
+
+  /// Processes the new samples of every input, then on_tick(now). Call from one thread only.
+  void run(Time now) noexcept;
+  /// Shallow fault injection: each queued sample replaces the first input's samples for one run,
+  /// seen by this filter alone. Errors: InvalidArgument when a sample's size is not the input's.
+  Expected<void> inject(const std::vector<std::vector<double>>& samples);
+  /// Forgets internal state and the detection (no completion is sent: the machine is reset
+  /// separately). Call from the thread that runs the filter.
+  void reset() noexcept;
+
+protected:
+  explicit Filter(FilterInit init);
+
+  virtual void on_sample(std::size_t input, const SampleView& sample) noexcept = 0;
+  virtual void on_tick(Time /*now*/) noexcept {}
+  virtual void on_reset() noexcept {}
+
+  /// Turns a detection into events (EDGE/LEVEL), carrying the filter, signal and value as the
+  /// root cause. Takes the coordinator's lock only when an event is generated.
+  void report(bool detected, double value, Time sample_time, std::size_t input = 0) noexcept;
+  /// Writes a sample of output `output` (size doubles must match the output signal).
+  void write(std::size_t output, Time time, const double* values) noexcept;
+  void write(std::size_t output, Time time, double value) noexcept { write(output, time, &value); }
+  bool has_output(std::size_t output) const noexcept { return output < outputs_.size() && outputs_[output] != nullptr; }
+  /// The newest value of input `input` seen by this filter (zero-order hold), or nullptr.
+  const double* held(std::size_t input) const noexcept;
+  /// Whether the sample being processed was injected.
+  bool current_injected() const noexcept { return current_injected_; }
+
+  const Params& params() const noexcept { return config_.params; }
+  double number(std::string_view param) const;
+  const std::string& text(std::string_view param) const;
+  bool flag(std::string_view param) const;
+
+private:
+  void invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept;
+  void deliver(std::size_t input, const SampleView& sample) noexcept;
+
+  FilterConfig config_;
+  Coordinator* coordinator_;
+  MachineId target_;
+  ComponentId component_;
+  std::vector<Signal*> inputs_;
+  std::vector<Signal*> outputs_;
+  std::vector<SignalCursor> cursors_;
+  std::vector<std::vector<double>> held_;
+  std::vector<char> has_held_;
+  std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
+  std::vector<char> has_pending_;
+  EventId onset_;
+  EventId completion_;
+  NameId name_id_;
+  std::atomic<bool> enabled_;
+  std::atomic<bool> detected_{false};
+  bool invalid_ = false;
+  bool current_injected_ = false;
+  bool was_enabled_ = true;
+
+  std::atomic<bool> injection_pending_{false};
+  std::mutex injection_mutex_;
+  std::deque<std::vector<double>> injections_;
+  std::vector<double> injected_scratch_;
+};
+
+}  // namespace safecass

@@ -1,0 +1,261 @@
+// Timing supervision: Occurrence, Watchdog, Frequency, DutyCycle, Deadline.
+
+#include <cmath>
+
+#include "common.hpp"
+
+namespace safecass::builtin {
+
+namespace {
+
+Expected<std::vector<std::size_t>> any_input_no_output(const FilterShape&) { return std::vector<std::size_t>(1, 1); }
+
+/// At least `count` occurrences (rising edges of a non-zero input) within the last `window`
+/// seconds → onset; fewer → completion.
+class Occurrence final : public Filter {
+public:
+  explicit Occurrence(FilterInit init)
+      : Filter(std::move(init)),
+        count_(static_cast<std::size_t>(number("count"))),
+        window_(seconds_to_time(number("window"))),
+        times_(count_) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "event when the input turns on at least count times within window seconds";
+    m.params = {ParamSpec::signal("input_signal", "scalar signal; each change from 0 to non-zero is an occurrence"),
+                ParamSpec::integer("count", "occurrences that make a fault", 3.0, 1, 1e6),
+                ParamSpec::number("window", "sliding window in seconds", std::nullopt, 1e-9, 1e9),
+                ParamSpec::signal("output_signal", "occurrences within the window", true)};
+    add_event_params(m, true);
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    return m;
+  }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const bool on = s.scalar() != 0.0;
+    if (on && !was_on_) {
+      times_[next_] = s.time;
+      next_ = (next_ + 1) % count_;
+      if (seen_ < count_) ++seen_;
+    }
+    was_on_ = on;
+    judge(s.time, s.scalar());
+  }
+  void on_tick(Time now) noexcept override { judge(now, 0.0); }
+  void on_reset() noexcept override {
+    seen_ = next_ = 0;
+    was_on_ = false;
+  }
+
+private:
+  void judge(Time now, double value) noexcept {
+    std::size_t within = 0;
+    for (std::size_t i = 0; i < seen_; ++i) within += (now - times_[i] <= window_) ? 1 : 0;
+    report(within >= count_, value, now);
+    write(0, now, static_cast<double>(within));
+  }
+  std::size_t count_;
+  Time window_;
+  std::vector<Time> times_;  ///< the last `count_` occurrence times (ring)
+  std::size_t next_ = 0;
+  std::size_t seen_ = 0;
+  bool was_on_ = false;
+};
+
+/// No new sample for `timeout` seconds (counted from start-up, i.e. the first run) → onset; a new
+/// sample → completion. Defaults to EVT_STALE / /EVT_STALE.
+class Watchdog final : public Filter {
+public:
+  explicit Watchdog(FilterInit init) : Filter(std::move(init)), timeout_(seconds_to_time(number("timeout"))) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "event when the input has no new sample for timeout seconds (heartbeat, staleness)";
+    m.params = {ParamSpec::signal("input_signal", "any signal (a heartbeat)"),
+                ParamSpec::number("timeout", "seconds without a new sample that make it stale", std::nullopt, 1e-9, 1e9),
+                ParamSpec::signal("output_signal", "age of the newest sample in seconds, every run", true),
+                ParamSpec::event("event_onset", "event when stale", std::string("EVT_STALE")),
+                ParamSpec::event("event_completion", "event when fresh again", std::string("/EVT_STALE"))};
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return any_input_no_output(s); }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    if (!started_ || s.time > last_) last_ = s.time;
+    started_ = true;
+  }
+  void on_tick(Time now) noexcept override {
+    if (!started_) {
+      last_ = now;  // start-up counts as the last sign of life
+      started_ = true;
+    }
+    const Time age = now - last_;
+    report(age > timeout_, to_seconds(age), last_);
+    write(0, now, to_seconds(age));
+  }
+  void on_reset() noexcept override { started_ = false; }
+
+private:
+  Time timeout_;
+  Time last_{};
+  bool started_ = false;
+};
+
+/// Rate and jitter of a signal's samples over the last `window` intervals.
+class Frequency final : public Filter {
+public:
+  explicit Frequency(FilterInit init)
+      : Filter(std::move(init)),
+        min_rate_(number("min_rate")),
+        max_rate_(number("max_rate")),
+        max_jitter_(number("max_jitter")),
+        window_(static_cast<std::size_t>(number("window"))),
+        intervals_(window_, 0.0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "event when the sample rate leaves [min_rate, max_rate] or an interval deviates from the mean by more than max_jitter";
+    m.params = {ParamSpec::signal("input_signal", "any signal whose sample times are judged"),
+                ParamSpec::number("min_rate", "lowest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
+                ParamSpec::number("max_rate", "highest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
+                ParamSpec::number("max_jitter", "largest allowed |interval - mean interval| in seconds (0: no bound)", 0.0, 0, 1e9),
+                ParamSpec::integer("window", "intervals averaged; judged once the window is full", 10.0, 1, 1e6),
+                ParamSpec::signal("output_signal", "the mean rate in Hz", true)};
+    add_event_params(m, true);
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return any_input_no_output(s); }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    if (has_previous_) {
+      const double dt = to_seconds(s.time - previous_);
+      if (filled_ == window_) sum_ -= intervals_[next_];
+      intervals_[next_] = dt;
+      sum_ += dt;
+      next_ = (next_ + 1) % window_;
+      if (filled_ < window_) ++filled_;
+      if (filled_ == window_ && sum_ > 0) {
+        const double mean = sum_ / static_cast<double>(window_);
+        const double rate = 1.0 / mean;
+        const bool slow = min_rate_ > 0 && rate < min_rate_;
+        const bool fast = max_rate_ > 0 && rate > max_rate_;
+        const bool jitter = max_jitter_ > 0 && std::fabs(dt - mean) > max_jitter_;
+        report(slow || fast || jitter, rate, s.time);
+        write(0, s.time, rate);
+      }
+    }
+    previous_ = s.time;
+    has_previous_ = true;
+  }
+  void on_reset() noexcept override {
+    has_previous_ = false;
+    filled_ = next_ = 0;
+    sum_ = 0;
+  }
+
+private:
+  double min_rate_, max_rate_, max_jitter_;
+  std::size_t window_;
+  std::vector<double> intervals_;
+  std::size_t next_ = 0;
+  std::size_t filled_ = 0;
+  double sum_ = 0;
+  Time previous_{};
+  bool has_previous_ = false;
+};
+
+/// Execution time / period above `max_duty` → onset.
+class DutyCycle final : public Filter {
+public:
+  explicit DutyCycle(FilterInit init) : Filter(std::move(init)), period_(number("period")), max_duty_(number("max_duty")) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "event when a task's execution time exceeds max_duty of its period";
+    m.params = {ParamSpec::signal("input_signal", "execution time of each cycle, in seconds"),
+                ParamSpec::number("period", "the task's period in seconds", std::nullopt, 1e-9, 1e9),
+                ParamSpec::number("max_duty", "largest allowed execution time / period", 0.8, 0, 1e6),
+                ParamSpec::signal("output_signal", "the duty cycle", true)};
+    add_event_params(m, true);
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    return m;
+  }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const double duty = s.scalar() / period_;
+    report(duty > max_duty_, duty, s.time);
+    write(0, s.time, duty);
+  }
+
+private:
+  double period_;
+  double max_duty_;
+};
+
+/// A sample of the first input opens a checkpoint, one of the second closes it; more than
+/// `deadline` seconds between them (or still open after `deadline`) → onset; a pair within the
+/// deadline → completion.
+class Deadline final : public Filter {
+public:
+  explicit Deadline(FilterInit init) : Filter(std::move(init)), deadline_(seconds_to_time(number("deadline"))) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "event when the time from a start checkpoint to an end checkpoint exceeds deadline seconds";
+    m.params = {ParamSpec::signals("input_signals", "two signals: [start checkpoint, end checkpoint]"),
+                ParamSpec::number("deadline", "longest allowed time from start to end, in seconds", std::nullopt, 1e-9, 1e9),
+                ParamSpec::signal("output_signal", "elapsed time of each completed pair", true)};
+    add_event_params(m, true);
+    m.inputs = {"input_signals"};
+    m.outputs = {"output_signal"};
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    if (s.inputs.size() != 2) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Deadline): 'input_signals' must list exactly two signals (start, end), not " +
+                                                  std::to_string(s.inputs.size()));
+    }
+    return std::vector<std::size_t>{1};
+  }
+
+protected:
+  void on_sample(std::size_t input, const SampleView& s) noexcept override {
+    if (input == 0) {
+      open_ = true;
+      start_ = s.time;
+      return;
+    }
+    if (!open_) return;
+    open_ = false;
+    const Time elapsed = s.time - start_;
+    report(elapsed > deadline_, to_seconds(elapsed), s.time, 1);
+    write(0, s.time, to_seconds(elapsed));
+  }
+  void on_tick(Time now) noexcept override {
+    if (open_ && now - start_ > deadline_) report(true, to_seconds(now - start_), now);
+  }
+  void on_reset() noexcept override { open_ = false; }
+
+private:
+  Time deadline_;
+  Time start_{};
+  bool open_ = false;
+};
+
+}  // namespace
+
+void register_timing(FilterRegistry& r) {
+  (void)r.add<Occurrence>("Occurrence");
+  (void)r.add<Watchdog>("Watchdog");
+  (void)r.add<Frequency>("Frequency");
+  (void)r.add<DutyCycle>("DutyCycle");
+  (void)r.add<Deadline>("Deadline");
+}
+
+}  // namespace safecass::builtin

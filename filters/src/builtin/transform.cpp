@@ -1,0 +1,319 @@
+// Signal transforms: Derivative, MovingAverage, Norm, Arithmetic, Vectorize, Bypass, NOP.
+
+#include <algorithm>
+#include <cmath>
+
+#include "common.hpp"
+
+namespace safecass::builtin {
+
+Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, const FilterShape& s) {
+  const std::size_t size = s.inputs.empty() ? 1 : s.inputs[0]->size();
+  for (const Signal* in : s.inputs) {
+    if (in->size() != size) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (" + m.type + "): input '" + in->name() +
+                                                  "' has size " + std::to_string(in->size()) + " but '" +
+                                                  s.inputs[0]->name() + "' has size " + std::to_string(size));
+    }
+  }
+  return std::vector<std::size_t>(m.outputs.size(), size);
+}
+
+namespace {
+
+template <class T>
+Expected<std::vector<std::size_t>> same_size(const FilterShape& s) {
+  static const FilterManifest m = [] {
+    FilterManifest x = T::manifest();
+    x.type = T::kType;
+    return x;
+  }();
+  return same_size_shape(m, s);
+}
+
+/// (x_k − x_{k−1}) / (t_k − t_{k−1}), element-wise; cascade two for acceleration.
+class Derivative final : public Filter {
+public:
+  static constexpr const char* kType = "Derivative";
+  explicit Derivative(FilterInit init)
+      : Filter(std::move(init)), previous_(inputs()[0]->size(), 0.0), out_(inputs()[0]->size(), 0.0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "rate of change of the input per second (element-wise)";
+    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
+                ParamSpec::signal("output_signal", "the derivative, same size as the input")};
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Derivative>(s); }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const double dt = to_seconds(s.time - previous_time_);
+    if (has_previous_ && dt > 0) {
+      for (std::size_t i = 0; i < s.size; ++i) out_[i] = (s[i] - previous_[i]) / dt;
+      write(0, s.time, out_.data());
+    }
+    std::copy(s.data, s.data + s.size, previous_.begin());
+    previous_time_ = s.time;
+    has_previous_ = true;
+  }
+  void on_reset() noexcept override { has_previous_ = false; }
+
+private:
+  std::vector<double> previous_;
+  std::vector<double> out_;
+  Time previous_time_{};
+  bool has_previous_ = false;
+};
+
+/// Mean of the last `window` samples (fewer at start-up), element-wise.
+class MovingAverage final : public Filter {
+public:
+  static constexpr const char* kType = "MovingAverage";
+  explicit MovingAverage(FilterInit init)
+      : Filter(std::move(init)),
+        size_(inputs()[0]->size()),
+        window_(static_cast<std::size_t>(number("window"))),
+        ring_(window_ * size_, 0.0),
+        sum_(size_, 0.0),
+        out_(size_, 0.0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "moving average over the last window samples (element-wise)";
+    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
+                ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
+                ParamSpec::signal("output_signal", "the average, same size as the input")};
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<MovingAverage>(s); }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    double* slot = &ring_[next_ * size_];
+    for (std::size_t i = 0; i < size_; ++i) {
+      if (count_ == window_) sum_[i] -= slot[i];
+      slot[i] = s[i];
+      sum_[i] += s[i];
+    }
+    next_ = (next_ + 1) % window_;
+    if (count_ < window_) ++count_;
+    // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
+    if (next_ == 0) {
+      std::fill(sum_.begin(), sum_.end(), 0.0);
+      for (std::size_t k = 0; k < count_; ++k)
+        for (std::size_t i = 0; i < size_; ++i) sum_[i] += ring_[k * size_ + i];
+    }
+    for (std::size_t i = 0; i < size_; ++i) out_[i] = sum_[i] / static_cast<double>(count_);
+    write(0, s.time, out_.data());
+  }
+  void on_reset() noexcept override {
+    count_ = next_ = 0;
+    std::fill(sum_.begin(), sum_.end(), 0.0);
+  }
+
+private:
+  std::size_t size_;
+  std::size_t window_;
+  std::vector<double> ring_;
+  std::vector<double> sum_;
+  std::vector<double> out_;
+  std::size_t next_ = 0;
+  std::size_t count_ = 0;
+};
+
+/// L2 (default), L1 or L∞ norm of a vector.
+class Norm final : public Filter {
+public:
+  explicit Norm(FilterInit init) : Filter(std::move(init)), kind_(text("norm") == "L1" ? 1 : text("norm") == "Linf" ? 2 : 0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "norm of a vector signal";
+    m.params = {ParamSpec::signal("input_signal", "vector (or scalar) signal"),
+                ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
+                ParamSpec::signal("output_signal", "the norm (scalar)")};
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{1}; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    double n = 0.0;
+    for (std::size_t i = 0; i < s.size; ++i) {
+      const double a = std::fabs(s[i]);
+      if (kind_ == 0) n += a * a;
+      else if (kind_ == 1) n += a;
+      else n = std::max(n, a);
+    }
+    write(0, s.time, kind_ == 0 ? std::sqrt(n) : n);
+  }
+
+private:
+  int kind_;
+};
+
+/// Element-wise a (op) b, where b is a second signal or the constant `operand`.
+class Arithmetic final : public Filter {
+public:
+  static constexpr const char* kType = "Arithmetic";
+  explicit Arithmetic(FilterInit init)
+      : Filter(std::move(init)), op_(op_of(text("operation"))), operand_(number("operand")), out_(inputs()[0]->size(), 0.0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "element-wise add, subtract, multiply, divide, min or max of two signals, or of a signal and a constant";
+    m.params = {ParamSpec::signal("input_signal", "first operand (with 'operand' as the second)", true),
+                ParamSpec::signals("input_signals", "two signals of the same size", true),
+                ParamSpec::choice("operation", "the operation", {"add", "subtract", "multiply", "divide", "min", "max"}, "add"),
+                ParamSpec::number("operand", "constant second operand when there is one input", 0.0),
+                ParamSpec::signal("output_signal", "the result, same size as the inputs")};
+    m.inputs = {"input_signal", "input_signals"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    const bool one = s.params.count("input_signal") > 0;
+    const bool two = s.params.count("input_signals") > 0;
+    if (one == two) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Arithmetic): give either 'input_signal' (with 'operand') or 'input_signals' (two signals)");
+    }
+    if (two && s.inputs.size() != 2) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Arithmetic): 'input_signals' must list exactly two signals, not " + std::to_string(s.inputs.size()));
+    }
+    return same_size<Arithmetic>(s);
+  }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const double* a = held(0);
+    const double* b = inputs().size() > 1 ? held(1) : nullptr;
+    if (a == nullptr || (inputs().size() > 1 && b == nullptr)) return;
+    for (std::size_t i = 0; i < out_.size(); ++i) out_[i] = apply(a[i], b != nullptr ? b[i] : operand_);
+    write(0, s.time, out_.data());
+  }
+
+private:
+  enum class Op { Add, Subtract, Multiply, Divide, Min, Max };
+  static Op op_of(const std::string& s) {
+    if (s == "subtract") return Op::Subtract;
+    if (s == "multiply") return Op::Multiply;
+    if (s == "divide") return Op::Divide;
+    if (s == "min") return Op::Min;
+    if (s == "max") return Op::Max;
+    return Op::Add;
+  }
+  double apply(double a, double b) const noexcept {
+    switch (op_) {
+      case Op::Add: return a + b;
+      case Op::Subtract: return a - b;
+      case Op::Multiply: return a * b;
+      case Op::Divide: return a / b;  // a zero divisor gives ±inf/NaN: consumers raise EVT_INVALID_SAMPLE
+      case Op::Min: return std::min(a, b);
+      case Op::Max: return std::max(a, b);
+    }
+    return a;
+  }
+  Op op_;
+  double operand_;
+  std::vector<double> out_;
+};
+
+/// Scalars → one vector, in the order listed; written when any input has a new sample and all
+/// have at least one.
+class Vectorize final : public Filter {
+public:
+  explicit Vectorize(FilterInit init) : Filter(std::move(init)), out_(inputs().size(), 0.0) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "combines scalar signals into one vector signal";
+    m.params = {ParamSpec::signals("input_signals", "scalar signals, in vector order"),
+                ParamSpec::signal("output_signal", "vector of the inputs' latest values")};
+    m.inputs = {"input_signals"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    for (const Signal* in : s.inputs) {
+      if (in->size() != 1) {
+        return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Vectorize): input '" + in->name() +
+                                                    "' has size " + std::to_string(in->size()) + "; Vectorize takes scalars");
+      }
+    }
+    return std::vector<std::size_t>{s.inputs.size()};
+  }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    for (std::size_t i = 0; i < inputs().size(); ++i) {
+      const double* v = held(i);
+      if (v == nullptr) return;
+      out_[i] = v[0];
+    }
+    write(0, s.time, out_.data());
+  }
+
+private:
+  std::vector<double> out_;
+};
+
+/// Copies its input to its output unchanged.
+class Bypass final : public Filter {
+public:
+  static constexpr const char* kType = "Bypass";
+  explicit Bypass(FilterInit init) : Filter(std::move(init)) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "copies the input to the output (a tap for injection and observation)";
+    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
+                ParamSpec::signal("output_signal", "the same samples")};
+    m.inputs = {"input_signal"};
+    m.outputs = {"output_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Bypass>(s); }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override { write(0, s.time, s.data); }
+};
+
+/// Reads its input and does nothing: a placeholder and a carrier for fault-injection tests.
+class Nop final : public Filter {
+public:
+  explicit Nop(FilterInit init) : Filter(std::move(init)) {}
+  static FilterManifest manifest() {
+    FilterManifest m;
+    m.doc = "reads its input and does nothing (placeholder, injection carrier)";
+    m.params = {ParamSpec::signal("input_signal", "any signal")};
+    m.inputs = {"input_signal"};
+    m.generates_events = false;
+    return m;
+  }
+  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{}; }
+
+protected:
+  void on_sample(std::size_t, const SampleView&) noexcept override {}
+};
+
+}  // namespace
+
+void register_transforms(FilterRegistry& r) {
+  (void)r.add<Derivative>("Derivative");
+  (void)r.add<MovingAverage>("MovingAverage");
+  (void)r.add<Norm>("Norm");
+  (void)r.add<Arithmetic>("Arithmetic");
+  (void)r.add<Vectorize>("Vectorize");
+  (void)r.add<Bypass>("Bypass");
+  (void)r.add<Nop>("NOP");
+}
+
+}  // namespace safecass::builtin

@@ -1,0 +1,169 @@
+#include "safecass/filters/filter.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace safecass {
+
+Filter::Filter(FilterInit init)
+    : config_(std::move(init.config)),
+      coordinator_(init.coordinator),
+      target_(init.target),
+      component_(init.component),
+      inputs_(std::move(init.inputs)),
+      outputs_(std::move(init.outputs)),
+      onset_(init.onset),
+      completion_(init.completion),
+      name_id_(init.name_id),
+      enabled_(config_.enabled) {
+  cursors_.reserve(inputs_.size());
+  for (Signal* s : inputs_) {
+    cursors_.emplace_back(s);
+    cursors_.back().skip_to_end();
+    held_.emplace_back(s->size(), 0.0);
+  }
+  has_held_.assign(inputs_.size(), 0);
+  pending_.resize(inputs_.size());
+  has_pending_.assign(inputs_.size(), 0);
+  if (!inputs_.empty()) injected_scratch_.assign(inputs_[0]->size(), 0.0);
+}
+
+std::uint64_t Filter::missed_samples() const noexcept {
+  std::uint64_t n = 0;
+  for (const SignalCursor& c : cursors_) n += c.missed();
+  return n;
+}
+
+void Filter::run(Time now) noexcept {
+  if (!enabled()) {
+    was_enabled_ = false;
+    return;
+  }
+  if (!was_enabled_) {
+    for (SignalCursor& c : cursors_) c.skip_to_end();
+    was_enabled_ = true;
+  }
+  bool injected_run = false;
+  if (injection_pending_.load(std::memory_order_acquire)) {
+    std::lock_guard lock(injection_mutex_);
+    if (!injections_.empty()) {
+      std::copy(injections_.front().begin(), injections_.front().end(), injected_scratch_.begin());
+      injections_.pop_front();
+      injected_run = true;
+    }
+    injection_pending_.store(!injections_.empty(), std::memory_order_release);
+  }
+  if (injected_run) {
+    // A shallow injection replaces the first input's samples for this run.
+    cursors_[0].skip_to_end();
+    deliver(0, SampleView{now, injected_scratch_.data(), injected_scratch_.size(), true});
+  }
+  if (inputs_.size() == 1) {
+    SampleView sample;
+    while (!injected_run && cursors_[0].next(sample)) deliver(0, sample);
+  } else {
+    // Several inputs: deliver their new samples merged in time order (ties: input order).
+    for (std::size_t i = 0; i < inputs_.size(); ++i) {
+      has_pending_[i] = !(i == 0 && injected_run) && cursors_[i].next(pending_[i]);
+    }
+    for (;;) {
+      std::size_t best = inputs_.size();
+      for (std::size_t i = 0; i < inputs_.size(); ++i) {
+        if (has_pending_[i] && (best == inputs_.size() || pending_[i].time < pending_[best].time)) best = i;
+      }
+      if (best == inputs_.size()) break;
+      deliver(best, pending_[best]);
+      has_pending_[best] = cursors_[best].next(pending_[best]);
+    }
+  }
+  current_injected_ = false;
+  on_tick(now);
+}
+
+void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
+  for (std::size_t k = 0; k < sample.size; ++k) {
+    if (!std::isfinite(sample.data[k])) {
+      invalid_sample(input, sample.time, true);
+      return;
+    }
+  }
+  if (invalid_) invalid_sample(input, sample.time, false);
+  std::copy(sample.data, sample.data + sample.size, held_[input].begin());
+  has_held_[input] = 1;
+  current_injected_ = sample.injected;
+  on_sample(input, sample);
+}
+
+Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
+  if (inputs_.empty()) return fail(ErrorCode::InvalidArgument, "filter '" + name() + "' has no input to inject into");
+  const std::size_t size = inputs_[0]->size();
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (samples[i].size() != size) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + name() + "': injected sample " + std::to_string(i + 1) +
+                                                  " has " + std::to_string(samples[i].size()) + " values; input '" +
+                                                  inputs_[0]->name() + "' has size " + std::to_string(size));
+    }
+  }
+  std::lock_guard lock(injection_mutex_);
+  injections_.insert(injections_.end(), samples.begin(), samples.end());
+  injection_pending_.store(!injections_.empty(), std::memory_order_release);
+  return {};
+}
+
+void Filter::reset() noexcept {
+  detected_.store(false, std::memory_order_release);
+  invalid_ = false;
+  std::fill(has_held_.begin(), has_held_.end(), 0);
+  on_reset();
+}
+
+const double* Filter::held(std::size_t input) const noexcept {
+  return input < held_.size() && has_held_[input] ? held_[input].data() : nullptr;
+}
+
+void Filter::report(bool detected, double value, Time sample_time, std::size_t input) noexcept {
+  const bool was = detected_.load(std::memory_order_relaxed);
+  if (!detected && !was) return;  // the common case: nothing to say
+  const SampleCause cause{name_id_, input < inputs_.size() ? inputs_[input]->name_id() : kNoName, value,
+                          sample_time, current_injected_};
+  if (detected) {
+    if (was && config_.detection == DetectionMode::Edge) return;
+    detected_.store(true, std::memory_order_release);
+    if (onset_ != kNoEvent) coordinator_->generate(onset_, target_, cause);
+    return;
+  }
+  detected_.store(false, std::memory_order_release);
+  if (completion_ != kNoEvent) coordinator_->generate(completion_, target_, cause);
+}
+
+void Filter::invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept {
+  if (invalid == invalid_) return;
+  invalid_ = invalid;
+  const SampleCause cause{name_id_, inputs_[input]->name_id(), invalid ? std::numeric_limits<double>::quiet_NaN() : 0.0,
+                          sample_time, current_injected_};
+  const EventId event = invalid ? framework_event::kInvalidSample
+                                : framework_event::completion_of(framework_event::kInvalidSample);
+  coordinator_->generate(event, coordinator_->framework_machine(component_), cause);
+}
+
+void Filter::write(std::size_t output, Time time, const double* values) noexcept {
+  if (output < outputs_.size() && outputs_[output] != nullptr) outputs_[output]->push(time, values);
+}
+
+double Filter::number(std::string_view param) const {
+  const auto it = config_.params.find(param);
+  return it == config_.params.end() ? 0.0 : std::get<double>(it->second);
+}
+
+const std::string& Filter::text(std::string_view param) const {
+  static const std::string kEmpty;
+  const auto it = config_.params.find(param);
+  return it == config_.params.end() ? kEmpty : std::get<std::string>(it->second);
+}
+
+bool Filter::flag(std::string_view param) const {
+  const auto it = config_.params.find(param);
+  return it != config_.params.end() && std::get<bool>(it->second);
+}
+
+}  // namespace safecass
