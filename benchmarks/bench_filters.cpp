@@ -1,0 +1,90 @@
+// Filter hot paths (DESIGN §7): a sample that causes no event takes no lock and allocates nothing.
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "safecass/filters/monitor.hpp"
+
+namespace safecass {
+namespace {
+
+struct FilterBench {
+  SimulatedClock clock;
+  Coordinator co{"bench", &clock};
+  FilterRegistry registry;
+  Monitor monitor{co, registry};
+  ComponentId component = 0;
+
+  FilterBench() {
+    register_builtin_filters(registry);
+    component = *co.add_component("C");
+    (void)co.add_event(EventDef{"EVT_X", 50, {Transition::N2E}, "", false, "", ""});
+    (void)co.add_event(EventDef{"/EVT_X", 50, {Transition::E2N}, "", false, "", ""});
+  }
+  Filter* add(std::string type, Params p, ExecutionMode mode = ExecutionMode::Active) {
+    FilterConfig c;
+    c.type = std::move(type);
+    c.target.component = "C";
+    c.execution = mode;
+    c.params = std::move(p);
+    return *monitor.add_filter(std::move(c));
+  }
+};
+
+// One new scalar sample below the threshold: written, read, judged; no event.
+void BM_ThresholdNoEvent(benchmark::State& state) {
+  FilterBench b;
+  Signal* x = *b.monitor.add_signal("C.x");
+  Filter* f = b.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
+                                  {"event_onset", std::string("EVT_X")}});
+  std::int64_t t = 0;
+  for (auto _ : state) {
+    x->push(Time{++t}, 1.0);
+    f->run(Time{t});
+  }
+  if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
+}
+BENCHMARK(BM_ThresholdNoEvent);
+
+// Norm of a 3-vector → moving average (window 10) → threshold, one new sample, no event.
+void BM_Pipeline3(benchmark::State& state) {
+  FilterBench b;
+  Signal* force = *b.monitor.add_signal("C.force", 3);
+  b.add("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}});
+  b.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
+  b.add("Threshold", {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  const double sample[] = {1.0, 2.0, 3.0};
+  std::int64_t t = 0;
+  for (auto _ : state) {
+    force->push(Time{++t}, sample);
+    b.monitor.run_active(b.component, Time{t});
+  }
+  if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
+}
+BENCHMARK(BM_Pipeline3);
+
+// One monitor tick over N passive thresholds (10 signals, each read by N/10 filters, each with a
+// new sample per tick); no event.
+void BM_MonitorTick(benchmark::State& state) {
+  FilterBench b;
+  const auto n = static_cast<int>(state.range(0));
+  std::vector<Signal*> signals;
+  for (int s = 0; s < 10; ++s) signals.push_back(*b.monitor.add_signal("C.s" + std::to_string(s)));
+  for (int i = 0; i < n; ++i) {
+    b.add("Threshold", {{"input_signal", "s" + std::to_string(i % 10)}, {"threshold", 10.0},
+                        {"event_onset", std::string("EVT_X")}}, ExecutionMode::Passive);
+  }
+  std::int64_t t = 0;
+  for (auto _ : state) {
+    ++t;
+    for (Signal* s : signals) s->push(Time{t}, 1.0);
+    b.monitor.tick(Time{t});
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+  if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
+}
+BENCHMARK(BM_MonitorTick)->Arg(1000);
+
+}  // namespace
+}  // namespace safecass

@@ -1,0 +1,71 @@
+#pragma once
+/// @file json.hpp
+/// A JSON reader that keeps the line and column of every value and key, accepts `//` and `/* */`
+/// comments (as the 2016 specifications do), and never crashes on any input: malformed text,
+/// deep nesting, huge numbers and invalid UTF-8 escapes all give an error with a position.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace safecass::spec {
+
+/// 1-based line and column (columns count bytes).
+struct TextPosition {
+  int line = 0;
+  int column = 0;
+};
+
+struct JsonMember;
+
+struct JsonValue {
+  enum class Type : std::uint8_t { Null, Bool, Number, String, Array, Object };
+  Type type = Type::Null;
+  bool boolean = false;
+  double number = 0.0;
+  bool integral = false;        ///< written without fraction or exponent
+  std::string string;
+  std::vector<JsonValue> array;
+  std::vector<JsonMember> object;  ///< in file order; duplicates kept (validation reports them)
+  TextPosition position;
+
+  bool is_null() const noexcept { return type == Type::Null; }
+  bool is_bool() const noexcept { return type == Type::Bool; }
+  bool is_number() const noexcept { return type == Type::Number; }
+  bool is_string() const noexcept { return type == Type::String; }
+  bool is_array() const noexcept { return type == Type::Array; }
+  bool is_object() const noexcept { return type == Type::Object; }
+  /// The first member called `key`, or nullptr (also when this is not an object).
+  const JsonValue* find(std::string_view key) const noexcept;
+  const JsonMember* find_member(std::string_view key) const noexcept;
+};
+
+struct JsonMember {
+  std::string key;
+  TextPosition key_position;
+  JsonValue value;
+};
+
+/// "object", "array", "string", "number", "boolean", "null".
+std::string_view type_name(JsonValue::Type t) noexcept;
+
+struct JsonError {
+  TextPosition position;
+  std::string message;
+};
+
+struct JsonParse {
+  std::optional<JsonValue> value;
+  std::optional<JsonError> error;
+};
+
+/// Parses one JSON document (comments allowed). Nesting deeper than `max_depth` is an error.
+JsonParse parse_json(std::string_view text, int max_depth = 64);
+
+/// Escapes a string for a JSON document (quotes included).
+std::string json_quote(std::string_view text);
+
+}  // namespace safecass::spec

@@ -1,0 +1,158 @@
+// Proves that the filter hot paths allocate nothing in steady state: a Threshold sample without
+// an event, the three-stage pipeline, and a monitor tick over passive filters.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <string>
+
+#include "safecass/filters/monitor.hpp"
+
+namespace {
+std::atomic<long> g_allocations{0};
+std::atomic<bool> g_counting{false};
+
+void* counted(std::size_t n) {
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(n == 0 ? 1 : n)) return p;
+  throw std::bad_alloc();
+}
+}  // namespace
+
+void* operator new(std::size_t n) { return counted(n); }
+void* operator new[](std::size_t n) { return counted(n); }
+void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
+  try { return counted(n); } catch (...) { return nullptr; }
+}
+void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
+  try { return counted(n); } catch (...) { return nullptr; }
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
+
+namespace safecass {
+namespace {
+
+/// Counts the allocations made by `body`.
+template <class F>
+long allocations_in(F&& body) {
+  g_allocations = 0;
+  g_counting = true;
+  body();
+  g_counting = false;
+  return g_allocations.load();
+}
+
+struct Rig {
+  SimulatedClock clock;
+  Coordinator co{"alloc", &clock};
+  FilterRegistry registry;
+  Monitor monitor{co, registry};
+  ComponentId component = 0;
+  Rig() {
+    register_builtin_filters(registry);
+    component = *co.add_component("C");
+    (void)co.add_event(EventDef{"EVT_X", 50, {Transition::N2E}, "", false, "", ""});
+    (void)co.add_event(EventDef{"/EVT_X", 50, {Transition::E2N}, "", false, "", ""});
+  }
+  Filter* add(std::string type, Params p, ExecutionMode mode = ExecutionMode::Active) {
+    FilterConfig c;
+    c.type = std::move(type);
+    c.target.component = "C";
+    c.execution = mode;
+    c.params = std::move(p);
+    auto f = monitor.add_filter(std::move(c));
+    EXPECT_TRUE(f);
+    return f ? *f : nullptr;
+  }
+};
+
+TEST(FilterAllocation, CounterDetectsAnAllocationSoTheseTestsCannotPassVacuously) {
+  std::string* s = nullptr;
+  const long n = allocations_in([&] { s = new std::string(100, 'x'); });
+  delete s;
+  EXPECT_GE(n, 1);
+}
+
+TEST(FilterAllocation, ThresholdSampleWithoutEventAllocatesNothing) {
+  Rig s;
+  Signal* x = *s.monitor.add_signal("C.x");
+  Filter* f = s.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  for (int i = 0; i < 10; ++i) {
+    x->push(Time{i}, 1.0);
+    f->run(Time{i});
+  }
+  EXPECT_EQ(allocations_in([&] {
+              for (int i = 10; i < 1000; ++i) {
+                x->push(Time{i}, 1.0);
+                f->run(Time{i});
+              }
+            }),
+            0);
+}
+
+TEST(FilterAllocation, ThreeStagePipelineAllocatesNothingInSteadyState) {
+  Rig s;
+  Signal* force = *s.monitor.add_signal("C.force", 3);
+  s.add("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}});
+  s.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
+  s.add("Threshold", {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  const double sample[] = {1, 2, 3};
+  for (int i = 0; i < 20; ++i) {
+    force->push(Time{i}, sample);
+    s.monitor.run_active(s.component, Time{i});
+  }
+  EXPECT_EQ(allocations_in([&] {
+              for (int i = 20; i < 1000; ++i) {
+                force->push(Time{i}, sample);
+                s.monitor.run_active(s.component, Time{i});
+              }
+            }),
+            0);
+}
+
+TEST(FilterAllocation, MonitorTickOverPassiveFiltersAllocatesNothing) {
+  Rig s;
+  Signal* x = *s.monitor.add_signal("C.x");
+  for (int i = 0; i < 100; ++i) {
+    s.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}},
+          ExecutionMode::Passive);
+  }
+  s.add("Watchdog", {{"input_signal", std::string("x")}, {"timeout", 1.0}}, ExecutionMode::Passive);
+  for (int i = 0; i < 10; ++i) {
+    x->push(Time{i}, 1.0);
+    s.monitor.tick(Time{i});
+  }
+  EXPECT_EQ(allocations_in([&] {
+              for (int i = 10; i < 500; ++i) {
+                x->push(Time{i}, 1.0);
+                s.monitor.tick(Time{i});
+              }
+            }),
+            0);
+}
+
+TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
+  Rig s;
+  Signal* x = *s.monitor.add_signal("C.x");
+  Filter* f = s.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  for (int i = 0; i < 10; ++i) {
+    x->push(Time{i}, i % 2 ? 20.0 : 1.0);
+    f->run(Time{i});
+  }
+  EXPECT_EQ(allocations_in([&] {
+              for (int i = 10; i < 1000; ++i) {
+                x->push(Time{i}, i % 2 ? 20.0 : 1.0);
+                f->run(Time{i});
+              }
+            }),
+            0);
+  EXPECT_EQ(s.co.coordinator_state(), State::Error);
+}
+
+}  // namespace
+}  // namespace safecass
