@@ -18,8 +18,10 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
+# The case study of the paper (examples/robodoc) in simulated time; the history lands in build/demo/.
 demo: build
-	@./$(BUILD)/bin/safecass demo
+	@mkdir -p $(BUILD)/demo
+	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
 
 test: build
 	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)

@@ -57,10 +57,12 @@ constexpr FrameworkEventSpec kFrameworkEvents[] = {
 // ---- Ring ------------------------------------------------------------------------------------
 
 void Coordinator::Ring::push(const Record& r) noexcept {
-  if (items.empty()) return;
+  // Runs for every record: no division, and the capacity read once (the copy may alias it).
+  const std::size_t capacity = items.size();
+  if (capacity == 0) return;
   items[next] = r;
-  next = (next + 1) % items.size();
-  if (size < items.size()) ++size;
+  if (++next == capacity) next = 0;
+  if (size < capacity) ++size;
 }
 
 std::vector<Record> Coordinator::Ring::ordered() const {
@@ -105,6 +107,7 @@ Coordinator::~Coordinator() = default;
 EventId Coordinator::add_event_unchecked(Event event) {
   event.id = static_cast<EventId>(events_.size());
   events_.push_back(std::move(event));
+  event_table_.push_back(&events_.back());  // deque elements never move
   return events_.back().id;
 }
 
@@ -116,9 +119,8 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
   if (find_component(name)) {
     return fail(ErrorCode::Duplicate, "duplicate component '" + std::string(name) + "'");
   }
-  if (name == "SYSTEM" || name == name_) {
-    return fail(ErrorCode::InvalidArgument, "component name '" + std::string(name) +
-                                                "' is reserved: it is the address of the whole coordinator");
+  if (name == "SYSTEM") {
+    return fail(ErrorCode::InvalidArgument, "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
   const auto id = static_cast<ComponentId>(components_.size());
   auto c = std::make_unique<ComponentData>();
@@ -405,7 +407,8 @@ Expected<EventId> Coordinator::find_event(std::string_view name) const {
 
 Expected<Address> Coordinator::resolve(std::string_view text) const {
   Address a;
-  if (text == "SYSTEM" || text == name_) return a;
+  // SYSTEM, or the coordinator's own name when no component has that name.
+  if (text == "SYSTEM" || (text == name_ && !find_component(text))) return a;
   const auto dot = text.find('.');
   auto comp = find_component(text.substr(0, dot));
   if (!comp) return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': no component '" +
@@ -599,26 +602,25 @@ void Coordinator::emit(const Record& r) noexcept {
   }
 }
 
-void Coordinator::record_machine(MachineId id, Record r) noexcept {
+void Coordinator::record_machine(MachineId id, Record& r) noexcept {
   r.seq = ++record_seq_;
   machines_[id]->history.push(r);
-  emit(r);
+  if (!observers_.empty()) emit(r);
 }
 
 // ---- event processing ------------------------------------------------------------------------
 
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
-  SAFECASS_ASSERT(event < events_.size());
-  SAFECASS_ASSERT(target < machines_.size() || events_[event].is_broadcast());
+  SAFECASS_ASSERT(event < event_table_.size());
+  SAFECASS_ASSERT(target < machines_.size() || event_table_[event]->is_broadcast());
   std::lock_guard lock(mutex_);
-  Pending op{PendingKind::Generate, event, target, cause, Address{}, kNoName, kNoName};
   if (processing_) {
-    pending_.push_back(op);
+    pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName, kNoName});
     return;
   }
   processing_ = true;
-  run(op);
-  drain_pending();
+  process(event, target, cause);
+  if (!pending_.empty()) drain_pending();
   processing_ = false;
 }
 
@@ -700,7 +702,7 @@ void Coordinator::drain_pending() noexcept {
 }
 
 void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
-  const Event& event = events_[event_id];
+  const Event& event = *event_table_[event_id];
   const Time now = clock_->now();
   if (event.is_broadcast()) {
     for (const auto& c : components_) {
@@ -727,10 +729,17 @@ std::int32_t Coordinator::find_root(const MachineData& m, EventId event) const n
 }
 
 std::int32_t Coordinator::find_any_root(const MachineData& m) const noexcept {
+  // Lowest level first: a reset that removes roots one by one then drops the state once
+  // (E2N), instead of passing through a Warning that callbacks would react to.
+  std::int32_t found = -1;
   for (std::size_t i = 0; i < m.conditions.size(); ++i) {
-    if (!m.conditions[i].mirror) return static_cast<std::int32_t>(i);
+    const Condition& c = m.conditions[i];
+    if (c.mirror) continue;
+    if (found < 0 || c.level < m.conditions[static_cast<std::size_t>(found)].level) {
+      found = static_cast<std::int32_t>(i);
+    }
   }
-  return -1;
+  return found;
 }
 
 std::int32_t Coordinator::find_mirror(const MachineData& m, const RootCause& root) const noexcept {
@@ -763,40 +772,32 @@ void Coordinator::process_onset(const Event& event, MachineId target, const Samp
 
 void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
   MachineData& m = *machines_[target];
-  Record r;
-  r.kind = RecordKind::Event;
-  r.time = now;
-  r.component = m.component;
-  r.machine = target;
-  r.event = event.id;
-  r.from = r.to = m.state;
-  r.severity = event.severity;
-  if (event.counterpart == kNoEvent) {
+  auto ignore = [&](std::string_view why, const RootCause* root) {
+    Record r;
+    r.kind = RecordKind::Event;
     r.outcome = Outcome::Ignored;
-    r.text = kIgnoredNoOnset;
+    r.time = now;
+    r.component = m.component;
+    r.machine = target;
+    r.event = event.id;
+    r.from = r.to = m.state;
+    r.severity = event.severity;
+    if (root != nullptr) r.root = *root;
+    r.text = why;
     record_machine(target, r);
-    return;
-  }
+  };
+  if (event.counterpart == kNoEvent) return ignore(kIgnoredNoOnset, nullptr);
   const std::int32_t i = find_root(m, event.counterpart);
-  if (i < 0) {
-    r.outcome = Outcome::Ignored;
-    r.text = kIgnoredNotActive;
-    record_machine(target, r);
-    return;
-  }
-  if (events_[event.counterpart].latched) {
-    r.outcome = Outcome::Ignored;
-    r.text = kIgnoredLatched;
-    r.root = m.conditions[static_cast<std::size_t>(i)].root;
-    record_machine(target, r);
-    return;
-  }
-  const Condition removed = m.conditions[static_cast<std::size_t>(i)];
+  if (i < 0) return ignore(kIgnoredNotActive, nullptr);
+  const Condition& found = m.conditions[static_cast<std::size_t>(i)];
+  if (event_table_[event.counterpart]->latched) return ignore(kIgnoredLatched, &found.root);
+  const RootCause root = found.root;
+  const State level = found.level;
   remove_condition(target, static_cast<std::size_t>(i), event.id, now, {});
-  propagate_clear(removed.root, removed.level, now);
+  propagate_clear(root, level, now);
 }
 
-void Coordinator::add_condition(MachineId id, Condition c, Time now) noexcept {
+void Coordinator::add_condition(MachineId id, const Condition& c, Time now) noexcept {
   MachineData& m = *machines_[id];
   const State old = m.state;
   Outcome outcome = Outcome::Masked;
@@ -896,8 +897,10 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
     r.to = m.state;
     if (root != nullptr) r.root = *root;
     record_machine(id, r);
-    TransitionInfo info{m.component, id, transition_between(old_state, m.state), event, root, now};
-    fire(m.callbacks, m.component, info, old_state, m.state);
+    if (!m.callbacks.empty()) {
+      const TransitionInfo info{m.component, id, transition_between(old_state, m.state), event, root, now};
+      fire(m.callbacks, m.component, info, old_state, m.state);
+    }
   }
   update_component(m.component, event, root, now);
 }
@@ -935,8 +938,9 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   r.to = c.state;
   if (root != nullptr) r.root = *root;
   c.history.push(r);
-  emit(r);
-  TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
+  if (!observers_.empty()) emit(r);
+  if (c.callbacks.empty()) return;
+  const TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
   fire(c.callbacks, id, info, old, c.state);
 }
 
@@ -978,7 +982,7 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
       Condition c;
       c.event = mirror_event;
       c.level = level;
-      c.severity = events_[mirror_event].severity;
+      c.severity = event_table_[mirror_event]->severity;
       c.mirror = true;
       c.via = e.via;
       c.first = c.last = now;
@@ -1037,11 +1041,19 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
     r.from = r.to = m.state;
     r.text = text;
     record_machine(id, r);
-    // Propagating a clear may shrink this machine's conditions (a cycle), so search afresh each time.
-    for (std::int32_t i = find_any_root(m); i >= 0; i = find_any_root(m)) {
-      const Condition c = m.conditions[static_cast<std::size_t>(i)];
-      remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
-      propagate_clear(c.root, c.level, now);
+  }
+  // Warnings first, in every target machine, then errors: the component and the system then drop
+  // once (E2N) instead of passing through a Warning that callbacks would react to.
+  for (const State pass : {State::Warning, State::Error}) {
+    for (MachineId id : targets) {
+      MachineData& m = *machines_[id];
+      // Propagating a clear may shrink this machine's conditions (a cycle): search afresh each time.
+      for (std::int32_t i = find_any_root(m); i >= 0 && m.conditions[static_cast<std::size_t>(i)].level <= pass;
+           i = find_any_root(m)) {
+        const Condition c = m.conditions[static_cast<std::size_t>(i)];
+        remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
+        propagate_clear(c.root, c.level, now);
+      }
     }
   }
 }

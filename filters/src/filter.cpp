@@ -23,6 +23,7 @@ Filter::Filter(FilterInit init)
     held_.emplace_back(s->size(), 0.0);
   }
   has_held_.assign(inputs_.size(), 0);
+  invalid_.assign(inputs_.size(), 0);
   pending_.resize(inputs_.size());
   has_pending_.assign(inputs_.size(), 0);
   if (!inputs_.empty()) injected_scratch_.assign(inputs_[0]->size(), 0.0);
@@ -81,16 +82,16 @@ void Filter::run(Time now) noexcept {
 }
 
 void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
+  current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
   for (std::size_t k = 0; k < sample.size; ++k) {
     if (!std::isfinite(sample.data[k])) {
       invalid_sample(input, sample.time, true);
       return;
     }
   }
-  if (invalid_) invalid_sample(input, sample.time, false);
+  if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
   std::copy(sample.data, sample.data + sample.size, held_[input].begin());
   has_held_[input] = 1;
-  current_injected_ = sample.injected;
   on_sample(input, sample);
 }
 
@@ -112,7 +113,8 @@ Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
 
 void Filter::reset() noexcept {
   detected_.store(false, std::memory_order_release);
-  invalid_ = false;
+  std::fill(invalid_.begin(), invalid_.end(), 0);
+  invalid_count_ = 0;
   std::fill(has_held_.begin(), has_held_.end(), 0);
   on_reset();
 }
@@ -137,8 +139,12 @@ void Filter::report(bool detected, double value, Time sample_time, std::size_t i
 }
 
 void Filter::invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept {
-  if (invalid == invalid_) return;
-  invalid_ = invalid;
+  if ((invalid_[input] != 0) == invalid) return;
+  invalid_[input] = invalid ? 1 : 0;
+  const bool was_raised = invalid_count_ > 0;
+  invalid_count_ = invalid ? invalid_count_ + 1 : invalid_count_ - 1;
+  // One condition for the filter: raised by the first bad input, cleared when none is left.
+  if (was_raised == (invalid_count_ > 0)) return;
   const SampleCause cause{name_id_, inputs_[input]->name_id(), invalid ? std::numeric_limits<double>::quiet_NaN() : 0.0,
                           sample_time, current_injected_};
   const EventId event = invalid ? framework_event::kInvalidSample

@@ -107,6 +107,11 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
     const std::string full = qualify(std::get<std::string>(it->second), config.target.component);
     const std::size_t size = k < sizes->size() ? (*sizes)[k] : 1;
     if (Signal* s = signals_.find(full)) {
+      if (std::find(init.inputs.begin(), init.inputs.end(), s) != init.inputs.end()) {
+        // Each write would be a new sample to read in the same run: the run would never end.
+        return fail(ErrorCode::InvalidArgument, where + ": parameter '" + manifest.outputs[k] + "': signal '" + full +
+                                                    "' is also an input of this filter");
+      }
       if (s->size() != size) {
         return fail(ErrorCode::InvalidArgument, where + ": parameter '" + manifest.outputs[k] + "': signal '" + full +
                                                     "' has size " + std::to_string(s->size()) + " but this filter writes " +

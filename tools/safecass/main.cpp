@@ -1,23 +1,49 @@
 // The `safecass` command: one entry point, one subcommand per tool.
-// Exit codes: 0 ok, 1 a check failed, 2 usage or I/O error.
+// Exit codes: 0 ok, 1 a check failed, 2 usage, input or I/O error.
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "spec_commands.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"SAFECASS: safety architecture for component-based robot systems"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "safecass 0.1.0");
+  int code = 0;
 
-  auto* demo = app.add_subcommand("demo", "Run the built-in demonstration of the core model");
-  demo->callback([] { std::exit(safecass::tools::run_demo()); });
+  auto* demo = app.add_subcommand("demo", "Run the demonstration of the core model");
+  demo->callback([&] { code = safecass::tools::run_demo(); });
+
+  std::vector<std::string> validate_files;
+  bool validate_json = false;
+  auto* validate = app.add_subcommand("validate", "Check system/component specifications; report every problem as file:line:col");
+  validate->add_option("SYSTEM", validate_files, "system or component files")->required();
+  validate->add_flag("--json", validate_json, "one JSON object per diagnostic");
+  validate->callback([&] { code = run_validate(validate_files, validate_json); });
+
+  auto* schema = app.add_subcommand("schema", "Print the JSON Schema of specification files");
+  schema->callback([&] { code = run_schema(); });
+
+  safecass::tools::RunArgs run_args;
+  auto* run = app.add_subcommand("run", "Run a system in-process in simulated time, driven by a scenario");
+  run->add_option("SYSTEM", run_args.system, "system file (default: the scenario's \"system\")");
+  run->add_option("--scenario,-s", run_args.scenario, "scenario file")->required();
+  run->add_flag("--json", run_args.json, "one JSON object per line (byte-identical across runs)");
+  run->add_option("--record", run_args.record, "write the whole history (JSON lines) to this file");
+  run->callback([&] { code = safecass::tools::run_run(run_args); });
+
+  safecass::tools::TestArgs test_args;
+  auto* test = app.add_subcommand("test", "Run scenarios and report pass/fail with event and transition coverage");
+  test->add_option("SCENARIO", test_args.scenarios, "scenario files")->required();
+  test->add_option("--junit", test_args.junit, "write JUnit XML to this file");
+  test->callback([&] { code = safecass::tools::run_test(test_args); });
 
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    const int exit = app.exit(e);
+    return exit == 0 ? 0 : 2;
   }
-  return 0;
+  return code;
 }

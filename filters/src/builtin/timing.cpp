@@ -41,20 +41,24 @@ protected:
       if (seen_ < count_) ++seen_;
     }
     was_on_ = on;
-    judge(s.time, s.scalar());
+    // Judged at the sample's time (occurrences processed late still count), written once per run.
+    report(within(s.time) >= count_, s.scalar(), s.time);
   }
-  void on_tick(Time now) noexcept override { judge(now, 0.0); }
+  void on_tick(Time now) noexcept override {
+    const std::size_t n = within(now);
+    report(n >= count_, 0.0, now);
+    write(0, now, static_cast<double>(n));
+  }
   void on_reset() noexcept override {
     seen_ = next_ = 0;
     was_on_ = false;
   }
 
 private:
-  void judge(Time now, double value) noexcept {
-    std::size_t within = 0;
-    for (std::size_t i = 0; i < seen_; ++i) within += (now - times_[i] <= window_) ? 1 : 0;
-    report(within >= count_, value, now);
-    write(0, now, static_cast<double>(within));
+  std::size_t within(Time now) const noexcept {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < seen_; ++i) n += (now - times_[i] <= window_) ? 1 : 0;
+    return n;
   }
   std::size_t count_;
   Time window_;

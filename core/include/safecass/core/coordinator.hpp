@@ -350,7 +350,7 @@ private:
   void process_completion(const Event& event, MachineId target, Time now) noexcept;
   void reset_locked(const Address& target, NameId who_why, Time now) noexcept;
   /// Adds a condition (root or mirror) to a machine and applies §2.4 step 2.
-  void add_condition(MachineId id, Condition c, Time now) noexcept;
+  void add_condition(MachineId id, const Condition& c, Time now) noexcept;
   /// Removes condition `index` of a machine; `completion` is the event recorded.
   void remove_condition(MachineId id, std::size_t index, EventId completion, Time now,
                         std::string_view text) noexcept;
@@ -358,6 +358,7 @@ private:
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
   std::int32_t find_mirror(const MachineData& m, const RootCause& root) const noexcept;
   std::int32_t find_root(const MachineData& m, EventId event) const noexcept;
+  /// A root condition of the lowest level, or -1.
   std::int32_t find_any_root(const MachineData& m) const noexcept;
   void refresh_outstanding(MachineData& m) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
@@ -365,7 +366,7 @@ private:
   void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
             State from, State to) noexcept;
   void emit(const Record& r) noexcept;
-  void record_machine(MachineId id, Record r) noexcept;
+  void record_machine(MachineId id, Record& r) noexcept;
   std::vector<Explanation> explain_machine(MachineId id) const;
   std::vector<std::string> hop_path(MachineId holder, const Condition& c) const;
 
@@ -377,6 +378,7 @@ private:
   std::vector<std::unique_ptr<MachineData>> machines_;
   std::vector<std::unique_ptr<ComponentData>> components_;
   std::deque<Event> events_;
+  std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
 
   mutable std::recursive_mutex mutex_;

@@ -45,19 +45,13 @@ struct Event {
 };
 
 /// The level an onset with `transitions` takes when processed in state `current` (DESIGN §2.3):
-/// from Normal, Error if N2E is listed else Warning (when N2W is listed); from Warning, Error if
-/// W2E is listed; otherwise the highest level its transitions reach.
+/// from Normal, Error if N2E is listed else Warning; from Warning, Error if W2E is listed;
+/// otherwise the highest level its transitions reach.
 constexpr State onset_level(TransitionSet transitions, State current) noexcept {
-  const State highest = (transitions.contains(Transition::N2E) || transitions.contains(Transition::W2E))
-                            ? State::Error
-                            : State::Warning;
-  if (current == State::Normal) {
-    if (transitions.contains(Transition::N2E)) return State::Error;
-    if (transitions.contains(Transition::N2W)) return State::Warning;
-    return highest;
-  }
+  if (current == State::Normal) return transitions.contains(Transition::N2E) ? State::Error : State::Warning;
   if (current == State::Warning && transitions.contains(Transition::W2E)) return State::Error;
-  return highest;
+  return (transitions.contains(Transition::N2E) || transitions.contains(Transition::W2E)) ? State::Error
+                                                                                           : State::Warning;
 }
 
 /// The framework events every coordinator defines (DESIGN §2.7), with fixed ids.

@@ -16,7 +16,8 @@
 /// built on error) → run() repeatedly from one thread (the component's loop for ACTIVE, the
 /// monitor thread for PASSIVE) → destroyed with the monitor. run() without a detection takes no
 /// lock and allocates nothing. A non-finite input sample is never passed to on_sample: it raises
-/// EVT_INVALID_SAMPLE on the target component's s_F until a finite sample arrives.
+/// EVT_INVALID_SAMPLE on the target component's s_F until a finite sample arrives on that input
+/// (with several inputs: on every input whose last sample was not finite).
 
 #include <atomic>
 #include <cstddef>
@@ -145,7 +146,8 @@ private:
   NameId name_id_;
   std::atomic<bool> enabled_;
   std::atomic<bool> detected_{false};
-  bool invalid_ = false;
+  std::vector<char> invalid_;       ///< per input: its last sample was not finite
+  std::size_t invalid_count_ = 0;   ///< inputs marked in invalid_
   bool current_injected_ = false;
   bool was_enabled_ = true;
 

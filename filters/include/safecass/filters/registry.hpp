@@ -77,6 +77,8 @@ public:
   const Entry* find(std::string_view type) const noexcept;
   /// Every registered type (not aliases), in registration order.
   std::vector<const FilterManifest*> manifests() const;
+  /// Every alias and the type it names, in registration order.
+  const std::vector<std::pair<std::string, std::string>>& aliases() const noexcept { return aliases_; }
 
 private:
   std::vector<std::pair<std::string, std::unique_ptr<Entry>>> entries_;

@@ -1,0 +1,111 @@
+#include "safecass/native/runtime.hpp"
+
+#include <chrono>
+
+namespace safecass::native {
+
+Runtime::Runtime(Monitor& monitor, Time monitor_period)
+    : monitor_(monitor), coordinator_(monitor.coordinator()), monitor_period_(monitor_period) {}
+
+Runtime::~Runtime() { stop(); }
+
+Expected<void> Runtime::add_task(ComponentId component, Time period, Body body) {
+  if (component >= coordinator_.component_count()) {
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  }
+  const std::string name(coordinator_.component_name(component));
+  if (period <= Time{0}) return fail(ErrorCode::InvalidArgument, "task of '" + name + "': period must be positive");
+  for (const Task& t : tasks_) {
+    if (t.component == component) return fail(ErrorCode::InvalidArgument, "component '" + name + "' already has a task");
+  }
+  tasks_.push_back(Task{component, period, std::move(body)});
+  return {};
+}
+
+Expected<void> Runtime::set_body(ComponentId component, Body body) {
+  for (Task& t : tasks_) {
+    if (t.component == component) {
+      t.body = std::move(body);
+      return {};
+    }
+  }
+  return fail(ErrorCode::NotFound, "component id " + std::to_string(component) + " has no task");
+}
+
+void Runtime::cycle(Task& task, Time now) noexcept {
+  monitor_.run_active(task.component, now);
+  if (!task.body) return;
+  const MachineId framework = coordinator_.framework_machine(task.component);
+  try {
+    task.body(now);
+    if (task.threw) {
+      task.threw = false;
+      coordinator_.generate(framework_event::completion_of(framework_event::kThreadException), framework);
+    }
+  } catch (...) {
+    // The application's loop failed: that is a framework fault of the component, not a crash.
+    if (!task.threw) {
+      task.threw = true;
+      coordinator_.generate(framework_event::kThreadException, framework);
+    }
+  }
+}
+
+void Runtime::step(Time now) noexcept {
+  for (Task& t : tasks_) {
+    if (!t.started) {
+      t.started = true;
+      t.next_due = now;
+    }
+    if (now < t.next_due) continue;
+    cycle(t, now);
+    while (t.next_due <= now) t.next_due += t.period;
+  }
+  if (!monitor_started_) {
+    monitor_started_ = true;
+    next_monitor_ = now;
+  }
+  if (now >= next_monitor_) {
+    monitor_.tick(now);
+    while (next_monitor_ <= now) next_monitor_ += monitor_period_;
+  }
+}
+
+void Runtime::start() {
+  if (!threads_.empty()) return;
+  stop_.store(false);
+  for (Task& task : tasks_) {
+    threads_.emplace_back([this, &task] {
+      const MachineId framework = coordinator_.framework_machine(task.component);
+      auto next = std::chrono::steady_clock::now();
+      while (!stop_.load(std::memory_order_acquire)) {
+        const auto begin = std::chrono::steady_clock::now();
+        cycle(task, coordinator_.clock().now());
+        const auto spent = std::chrono::steady_clock::now() - begin;
+        const bool overran = spent > task.period;
+        if (overran != task.overran) {
+          task.overran = overran;
+          coordinator_.generate(overran ? framework_event::kPeriodOverrun
+                                        : framework_event::completion_of(framework_event::kPeriodOverrun),
+                                framework);
+        }
+        next += task.period;
+        const auto now = std::chrono::steady_clock::now();
+        if (next < now) next = now;  // do not try to catch up missed cycles in a burst
+        std::this_thread::sleep_until(next);
+      }
+    });
+  }
+  monitor_.start(monitor_period_);
+}
+
+void Runtime::stop() noexcept {
+  stop_.store(true, std::memory_order_release);
+  for (std::thread& t : threads_) {
+    if (t.joinable()) t.join();
+  }
+  threads_.clear();
+  monitor_.stop();
+}
+
+}  // namespace safecass::native

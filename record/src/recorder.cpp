@@ -1,0 +1,217 @@
+#include "safecass/record/recorder.hpp"
+
+#include <cstdio>
+
+namespace safecass {
+
+namespace {
+
+void append_quoted(std::string& out, std::string_view s) {
+  out += '"';
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  out += '"';
+}
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string secs(Time t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
+  return buf;
+}
+
+std::string event_name(const Coordinator& co, EventId e) {
+  return e == kNoEvent || e >= co.event_count() ? std::string() : co.event(e).name;
+}
+
+}  // namespace
+
+std::string record_to_json(const Record& r, const Coordinator& co) {
+  std::string out = "{\"seq\":" + std::to_string(r.seq) + ",\"t\":" + secs(r.time) + ",\"kind\":";
+  append_quoted(out, to_string(r.kind));
+  if (r.outcome != Outcome::None) {
+    out += ",\"outcome\":";
+    append_quoted(out, to_string(r.outcome));
+  }
+  if (r.component != kNoComponent && r.component < co.component_count()) {
+    out += ",\"component\":";
+    append_quoted(out, co.component_name(r.component));
+  }
+  if (r.machine != kNoMachine && r.machine < co.machine_count()) {
+    out += ",\"machine\":";
+    append_quoted(out, co.address_of(r.machine));
+  }
+  if (r.event != kNoEvent) {
+    out += ",\"event\":";
+    append_quoted(out, event_name(co, r.event));
+  }
+  if (r.kind != RecordKind::Injection) {
+    out += ",\"from\":";
+    append_quoted(out, to_string(r.from));
+    out += ",\"to\":";
+    append_quoted(out, to_string(r.to));
+  }
+  if (r.kind == RecordKind::Event) {
+    out += ",\"level\":";
+    append_quoted(out, to_string(r.level));
+    out += ",\"severity\":" + std::to_string(r.severity);
+  }
+  if (r.mirror) out += ",\"mirror\":true";
+  if (r.root.event != kNoEvent && r.root.origin != kNoMachine && r.root.origin < co.machine_count()) {
+    out += ",\"root\":{\"event\":";
+    append_quoted(out, event_name(co, r.root.event));
+    out += ",\"origin\":";
+    append_quoted(out, co.address_of(r.root.origin));
+    out += ",\"t\":" + secs(r.root.time);
+    if (r.root.sample.filter != kNoName) {
+      out += ",\"filter\":";
+      append_quoted(out, co.name_of(r.root.sample.filter));
+    }
+    if (r.root.sample.signal != kNoName) {
+      out += ",\"signal\":";
+      append_quoted(out, co.name_of(r.root.sample.signal));
+      out += ",\"value\":" + num(r.root.sample.value) + ",\"sample_t\":" + secs(r.root.sample.sample_time);
+    }
+    if (r.root.sample.injected) out += ",\"injected\":true";
+    out += "}";
+  }
+  if (!r.text.empty()) {
+    out += ",\"text\":";
+    append_quoted(out, r.text);
+  }
+  out += "}";
+  return out;
+}
+
+std::string record_to_text(const Record& r, const Coordinator& co) {
+  std::string out = "t=" + secs(r.time) + "  ";
+  const std::string where = r.machine != kNoMachine && r.machine < co.machine_count()
+                                ? co.address_of(r.machine)
+                                : (r.component != kNoComponent ? std::string(co.component_name(r.component)) : std::string("-"));
+  out += where;
+  switch (r.kind) {
+    case RecordKind::Transition:
+    case RecordKind::ComponentTransition:
+      out += "  " + std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
+      if (r.event != kNoEvent) out += "  " + event_name(co, r.event);
+      break;
+    case RecordKind::Event:
+      out += "  " + std::string(to_string(r.outcome)) + " " + event_name(co, r.event);
+      break;
+    case RecordKind::Reset: out += "  reset"; break;
+    case RecordKind::Injection: out += "  injection"; break;
+  }
+  if (r.root.event != kNoEvent && r.root.origin != kNoMachine && r.root.origin < co.machine_count() &&
+      !(r.root.origin == r.machine && r.root.event == r.event)) {
+    out += "  <- " + co.address_of(r.root.origin) + ":" + event_name(co, r.root.event);
+  }
+  if (r.root.sample.filter != kNoName || r.root.sample.signal != kNoName) {
+    out += "  [";
+    if (r.root.sample.filter != kNoName) out += "filter " + std::string(co.name_of(r.root.sample.filter));
+    if (r.root.sample.signal != kNoName) {
+      out += ", " + std::string(co.name_of(r.root.sample.signal)) + " = " + num(r.root.sample.value);
+    }
+    if (r.root.sample.injected) out += ", injected";
+    out += "]";
+  }
+  if (!r.text.empty()) out += "  (" + std::string(r.text) + ")";
+  return out;
+}
+
+Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (f == nullptr) return fail(ErrorCode::Io, "cannot write history file '" + path + "'");
+  return std::unique_ptr<Recorder>(new Recorder(coordinator, f, capacity));
+}
+
+Recorder::Recorder(Coordinator& coordinator, std::FILE* file, std::size_t capacity)
+    : coordinator_(coordinator), file_(file), capacity_(capacity == 0 ? 1 : capacity) {
+  thread_ = std::thread([this] { writer(); });
+  subscription_ = coordinator_.subscribe([this](const Record& r) {
+    std::lock_guard lock(mutex_);
+    if (closing_) return;
+    if (queue_.size() >= capacity_) {
+      ++dropped_;
+      return;
+    }
+    queue_.push_back(r);
+    ready_.notify_one();
+  });
+}
+
+Recorder::~Recorder() { close(); }
+
+void Recorder::close() {
+  if (subscription_ != 0) {
+    coordinator_.unsubscribe(subscription_);
+    subscription_ = 0;
+  }
+  {
+    std::lock_guard lock(mutex_);
+    closing_ = true;
+    ready_.notify_one();
+  }
+  if (thread_.joinable()) thread_.join();
+  if (file_ != nullptr) {
+    std::fclose(file_);
+    file_ = nullptr;
+  }
+}
+
+void Recorder::writer() {
+  std::unique_lock lock(mutex_);
+  for (;;) {
+    ready_.wait(lock, [this] { return closing_ || !queue_.empty() || dropped_ != dropped_reported_; });
+    while (!queue_.empty() || dropped_ != dropped_reported_) {
+      std::string line;
+      if (dropped_ != dropped_reported_) {
+        line = "{\"kind\":\"overflow\",\"dropped\":" + std::to_string(dropped_ - dropped_reported_) + "}";
+        dropped_reported_ = dropped_;
+      } else {
+        const Record r = queue_.front();
+        queue_.pop_front();
+        lock.unlock();
+        line = record_to_json(r, coordinator_);
+        lock.lock();
+        ++written_;
+      }
+      lock.unlock();
+      std::fputs(line.c_str(), file_);
+      std::fputc('\n', file_);
+      std::fflush(file_);
+      lock.lock();
+    }
+    if (closing_) return;
+  }
+}
+
+std::uint64_t Recorder::dropped() const {
+  std::lock_guard lock(mutex_);
+  return dropped_;
+}
+
+std::uint64_t Recorder::written() const {
+  std::lock_guard lock(mutex_);
+  return written_;
+}
+
+}  // namespace safecass

@@ -1,0 +1,35 @@
+#pragma once
+/// @file diagnostics.hpp
+/// Problems found in a specification, each with the file, line and column of the offending value
+/// and its JSON pointer, formatted the way compilers do so that editors can jump to them.
+
+#include <string>
+
+namespace safecass::spec {
+
+/// Where a value is: the file as it was opened (relative paths stay relative), 1-based line and
+/// column (columns count bytes). Line 0 means "the file as a whole" (e.g. it cannot be read).
+struct Position {
+  std::string file;
+  int line = 0;
+  int column = 0;
+};
+
+/// One problem. Errors make a specification unusable; warnings point at something that is
+/// probably not what the author meant but can still be loaded.
+struct Diagnostic {
+  enum class Severity { Error, Warning } severity = Severity::Error;
+  Position where;
+  std::string message;
+  std::string pointer;  ///< JSON pointer of the value in its file, e.g. /filter/1/argument/threshold
+};
+
+/// "file:line:col: error: message [pointer]" ("warning:" likewise). The " [pointer]" part is left
+/// out when the pointer is empty (the whole document), the ":line:col" part when line is 0.
+std::string format(const Diagnostic& diagnostic);
+
+/// One diagnostic as a one-line JSON object:
+/// {"file": ..., "line": L, "column": C, "severity": "error"|"warning", "message": ..., "pointer": ...}.
+std::string to_json(const Diagnostic& diagnostic);
+
+}  // namespace safecass::spec

@@ -1,0 +1,68 @@
+#pragma once
+/// @file system.hpp
+/// A loaded and validated specification (DESIGN §5): the system, its components with their
+/// interfaces, signals, events, filters and services, the connections, and which coordinator
+/// (process) runs which components. Produced by load_system(); consumed by instantiate().
+
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/core/event.hpp"
+#include "safecass/filters/filter.hpp"
+#include "safecass/spec/diagnostics.hpp"
+
+namespace safecass::spec {
+
+/// One `filter` entry: a single filter (`pipeline` empty, one stage) or a pipeline (sugar for a
+/// chain: a stage without an input reads the previous stage's output).
+struct FilterSpec {
+  std::string pipeline;             ///< empty for a single filter
+  std::vector<FilterConfig> stages; ///< type is the registry's canonical name; unnamed filters get a name
+  Position where;
+};
+
+struct SignalSpec {
+  std::string name;      ///< "Component.signal"
+  std::size_t size = 1;  ///< doubles per sample
+};
+
+/// A `service` entry: what the service state of a provided interface depends on.
+struct ServiceSpec {
+  std::string provided;
+  ServiceDependency dependency;
+};
+
+struct ComponentSpec {
+  std::string name;
+  std::vector<std::string> provided, required;
+  std::vector<SignalSpec> signals;  ///< declared signals (and, for 2016 files, the implied ones)
+  std::vector<EventDef> events;
+  std::vector<FilterSpec> filters;
+  /// One entry per provided interface: the written ones in file order, then the conservative
+  /// default (ServiceDependency{}) for every provided interface without an entry.
+  std::vector<ServiceSpec> services;
+  std::optional<double> period;  ///< seconds
+  std::string file;              ///< the file that defines the component
+  Position where;                ///< its name
+};
+
+struct ConnectionSpec {
+  std::string required;  ///< "C.r"
+  std::string provided;  ///< "P.p"
+  Position where;
+};
+
+struct SystemSpec {
+  std::string name;
+  std::string path;  ///< the file it was loaded from
+  std::vector<ComponentSpec> components;
+  std::vector<ConnectionSpec> connections;
+  /// Coordinator name -> its components, in file order. Empty: one coordinator runs everything.
+  std::vector<std::pair<std::string, std::vector<std::string>>> coordinators;
+};
+
+}  // namespace safecass::spec

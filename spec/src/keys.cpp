@@ -1,0 +1,234 @@
+#include "keys.hpp"
+
+namespace safecass::spec::detail {
+
+namespace {
+
+const std::vector<std::string_view> kTransitions = {"N2W", "N2E", "W2E", "W2N", "E2N", "E2W"};
+
+Key text(std::string_view name, std::string_view doc, bool required = false) {
+  Key k;
+  k.name = name;
+  k.shape = Shape::String;
+  k.required = required;
+  k.doc = doc;
+  return k;
+}
+
+Key boolean(std::string_view name, std::string_view doc, std::string_view def = {}) {
+  Key k = text(name, doc);
+  k.shape = Shape::Bool;
+  k.default_json = def;
+  return k;
+}
+
+Key choice(std::string_view name, std::string_view doc, std::vector<std::string_view> choices,
+           std::string_view def = {}, bool required = false) {
+  Key k = text(name, doc, required);
+  k.shape = Shape::Choice;
+  k.choices = std::move(choices);
+  k.default_json = def;
+  return k;
+}
+
+Key object(std::string_view name, std::string_view doc, std::string_view ref, bool required = false) {
+  Key k = text(name, doc, required);
+  k.shape = Shape::Object;
+  k.ref = ref;
+  return k;
+}
+
+Key objects(std::string_view name, std::string_view doc, std::string_view ref, bool required = false) {
+  Key k = object(name, doc, ref, required);
+  k.shape = Shape::ObjectList;
+  return k;
+}
+
+Key strings(std::string_view name, std::string_view doc) {
+  Key k = text(name, doc);
+  k.shape = Shape::StringList;
+  return k;
+}
+
+const Key kSchemaKey = text("$schema", "URI of this schema, for editors (ignored by SAFECASS)");
+const Key kVersionKey = [] {
+  Key k = text("safecass", "format version (1)");
+  k.shape = Shape::Integer;
+  k.min = 1;
+  k.max = 1;
+  return k;
+}();
+const Key kDescriptionKey = text("description", "free text for people");
+
+}  // namespace
+
+const Key* ObjectKind::find(std::string_view key) const noexcept {
+  for (const Key& k : keys) {
+    if (k.name == key) return &k;
+  }
+  return nullptr;
+}
+
+const ObjectKind& system_kind() {
+  static const ObjectKind kind{
+      "system",
+      "a system file: components (inline or included), connections and coordinators",
+      {kSchemaKey, kVersionKey, text("system", "name of the system", true), kDescriptionKey,
+       objects("components", "the components: {\"include\": \"file.json\"} (a component or system file, "
+                             "relative to this file) or a component object",
+               "component_entry", true),
+       objects("connections", "connections from a required interface to a provided interface", "connection"),
+       object("coordinators", "coordinator (process) name -> the components it runs", "coordinators")}};
+  return kind;
+}
+
+const ObjectKind& include_kind() {
+  static const ObjectKind kind{
+      "include",
+      "a component or system file to include",
+      {text("include", "path of the file, relative to the including file", true)}};
+  return kind;
+}
+
+const ObjectKind& component_kind() {
+  static const ObjectKind kind{
+      "component",
+      "a component: its interfaces, signals, events, filters and services",
+      {kSchemaKey, kVersionKey, text("component", "name of the component (no dots or spaces)", true), kDescriptionKey,
+       object("interfaces", "provided and required interfaces", "interfaces"),
+       objects("signals", "signals of the component (Component.signal), scalar or vector", "signal"),
+       objects("event", "event definitions (names are unique in the system)", "event"),
+       objects("filter", "filters and pipelines", "filter_entry"),
+       objects("service", "what the service state of each provided interface depends on", "service"),
+       [] {
+         Key k = text("period", "period of the component's loop in seconds (runs its ACTIVE filters)");
+         k.shape = Shape::Number;
+         k.min = 0;
+         k.exclusive_min = true;
+         return k;
+       }()}};
+  return kind;
+}
+
+const ObjectKind& interfaces_kind() {
+  static const ObjectKind kind{
+      "interfaces",
+      "the interfaces of a component",
+      {strings("provided", "names of the provided interfaces (machines C.s_P.name)"),
+       strings("required", "names of the required interfaces (machines C.s_R.name)")}};
+  return kind;
+}
+
+const ObjectKind& signal_kind() {
+  static const ObjectKind kind{
+      "signal",
+      "a signal: a scalar or a fixed-size vector of doubles",
+      {text("name", "name of the signal within its component", true),
+       [] {
+         Key k = text("size", "number of doubles per sample (1: a scalar)");
+         k.shape = Shape::Integer;
+         k.min = 1;
+         k.max = kMaxSignalSize;
+         k.default_json = "1";
+         return k;
+       }(),
+       kDescriptionKey}};
+  return kind;
+}
+
+const ObjectKind& event_kind() {
+  static const ObjectKind kind{
+      "event",
+      "an event: an onset (worsening transitions) or a completion (improving transitions)",
+      {text("name", "unique name; a completion is usually named /ONSET", true),
+       [] {
+         Key k = text("severity", "1-200 application, 201-250 framework, 251-255 broadcast", true);
+         k.shape = Shape::Integer;
+         k.min = 1;
+         k.max = 255;
+         return k;
+       }(),
+       [] {
+         Key k = text("state_transition", "onset: N2W, N2E, W2E; completion: W2N, E2N, E2W", true);
+         k.shape = Shape::ChoiceList;
+         k.choices = kTransitions;
+         return k;
+       }(),
+       text("completes", "completion only: the onset it clears (default: the name without its leading '/')"),
+       boolean("latched", "onset only: a completion does not clear it, only a reset", "false"),
+       text("hazard", "an id from the hazard analysis"), kDescriptionKey}};
+  return kind;
+}
+
+const ObjectKind& filter_kind() {
+  static const ObjectKind kind{
+      "filter",
+      "a filter: reads signals, may write signals, generates events to a target state machine",
+      {text("name", "unique name in the system (default: Component.Type_index)"),
+       text("class_name", "filter type, e.g. Threshold (2016 names such as FilterThreshold are accepted)", true),
+       choice("type", "ACTIVE: runs in the component's loop; PASSIVE: runs in the monitor thread",
+              {"ACTIVE", "PASSIVE"}, "\"ACTIVE\""),
+       choice("event_type", "EDGE: one onset per crossing; LEVEL: an onset every sample while detected",
+              {"EDGE", "LEVEL"}, "\"EDGE\""),
+       boolean("enabled", "a disabled filter skips its runs", "true"),
+       object("target", "the state machine that receives the events (default: s_A of this component)", "target"),
+       object("argument", "the parameters of the filter type", ""), kDescriptionKey}};
+  return kind;
+}
+
+const ObjectKind& pipeline_kind() {
+  static const ObjectKind kind{
+      "pipeline",
+      "a chain of filters: a stage without an input reads the previous stage's output",
+      {text("name", "name of the pipeline (no dots or spaces); unnamed stages are called name.1, name.2...", true),
+       objects("pipeline", "the stages, in order", "filter", true),
+       object("target", "default target of the stages", "target"), kDescriptionKey}};
+  return kind;
+}
+
+const ObjectKind& target_kind() {
+  static const ObjectKind kind{
+      "target",
+      "a state machine: C.s_F, C.s_A, C.s_P.interface or C.s_R.interface",
+      {choice("type", "which machine", {"s_F", "s_A", "s_P", "s_R"}, "\"s_A\""),
+       text("component", "the component (default: the component that declares the filter)"),
+       text("interface", "the interface, for s_P and s_R")}};
+  return kind;
+}
+
+const ObjectKind& service_kind() {
+  static const ObjectKind kind{
+      "service",
+      "what the service state of a provided interface depends on (no entry: s_F, s_A and every required interface)",
+      {text("name", "the provided interface", true),
+       object("dependency", "the terms of the service state; {} means s_P alone", "dependency"),
+       choice("propagate", "lowest level that crosses connections to clients", {"error", "warning"}, "\"error\"")}};
+  return kind;
+}
+
+const ObjectKind& dependency_kind() {
+  static const ObjectKind kind{
+      "dependency",
+      "s_S.p = s_P.p x [s_F] x [s_A] x the listed required interfaces",
+      {boolean("s_F", "include the framework state", "false"),
+       boolean("s_A", "include the application state", "false"),
+       strings("s_R", "required interfaces included")}};
+  return kind;
+}
+
+const ObjectKind& connection_kind() {
+  static const ObjectKind kind{
+      "connection",
+      "a required interface connected to a provided interface; errors flow from provider to client",
+      {text("required", "the client's required interface, Component.interface", true),
+       text("provided", "the provider's provided interface, Component.interface", true), kDescriptionKey}};
+  return kind;
+}
+
+std::vector<const ObjectKind*> all_kinds() {
+  return {&system_kind(), &include_kind(), &component_kind(), &interfaces_kind(), &signal_kind(),
+          &event_kind(), &filter_kind(), &pipeline_kind(), &target_kind(), &service_kind(),
+          &dependency_kind(), &connection_kind()};
+}
+
+}  // namespace safecass::spec::detail

@@ -1,0 +1,62 @@
+#pragma once
+// The keys of every object of the specification format: one table, read by the loader (unknown,
+// missing and mistyped keys) and by the schema generator, so that the two cannot disagree.
+
+#include <limits>
+#include <string_view>
+#include <vector>
+
+namespace safecass::spec::detail {
+
+enum class Shape : unsigned char {
+  String,      ///< a string
+  Bool,
+  Integer,     ///< a whole number within [min, max]
+  Number,      ///< a number within [min, max] (above min when exclusive_min)
+  Choice,      ///< one of `choices`
+  StringList,  ///< an array of strings
+  ChoiceList,  ///< an array of `choices`
+  Object,      ///< an object described by `ref` (or free-form when ref is empty)
+  ObjectList,  ///< an array of objects described by `ref`
+};
+
+struct Key {
+  std::string_view name;
+  Shape shape = Shape::String;
+  bool required = false;
+  std::string_view doc;
+  std::string_view ref;                    ///< $defs name (Object/ObjectList)
+  std::vector<std::string_view> choices;   ///< Choice/ChoiceList
+  double min = -std::numeric_limits<double>::infinity();
+  double max = std::numeric_limits<double>::infinity();
+  bool exclusive_min = false;
+  std::string_view default_json;           ///< the default as JSON text, for the schema
+};
+
+struct ObjectKind {
+  std::string_view name;  ///< used in messages ("event") and as the schema's $defs name
+  std::string_view doc;
+  std::vector<Key> keys;
+  const Key* find(std::string_view key) const noexcept;
+};
+
+const ObjectKind& system_kind();
+const ObjectKind& include_kind();
+const ObjectKind& component_kind();
+const ObjectKind& interfaces_kind();
+const ObjectKind& signal_kind();
+const ObjectKind& event_kind();
+const ObjectKind& filter_kind();
+const ObjectKind& pipeline_kind();
+const ObjectKind& target_kind();
+const ObjectKind& service_kind();
+const ObjectKind& dependency_kind();
+const ObjectKind& connection_kind();
+
+/// Every kind, in schema order.
+std::vector<const ObjectKind*> all_kinds();
+
+inline constexpr int kFormatVersion = 1;
+inline constexpr double kMaxSignalSize = 4096;
+
+}  // namespace safecass::spec::detail

@@ -1,0 +1,189 @@
+#pragma once
+// The loader's internal model: what the files say, with the position of every value that a
+// check may need to point at. Built by the reader (reader.cpp), checked by the validator
+// (validate.cpp), then turned into the public SystemSpec.
+
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/core/event.hpp"
+#include "safecass/filters/filter.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/spec/diagnostics.hpp"
+#include "safecass/spec/json.hpp"
+#include "safecass/spec/system.hpp"
+
+namespace safecass::spec::detail {
+
+/// Where a value is: index of its file, position, JSON pointer in that file.
+struct Site {
+  int file = -1;
+  TextPosition position;
+  std::string pointer;
+};
+
+/// A loaded file: its path as opened, its bytes and its parsed document (kept alive while
+/// loading: the model points into it).
+struct Document {
+  std::string path;
+  std::string canonical;
+  std::string text;
+  std::optional<JsonValue> root;
+};
+
+/// Collects diagnostics and turns sites into positions.
+class Sink {
+public:
+  std::deque<Document> documents;
+  std::vector<Diagnostic> diagnostics;
+  std::vector<int> files;  ///< file index of each diagnostic, for sorting
+
+  void error(const Site& site, std::string message) { add(Diagnostic::Severity::Error, site, std::move(message)); }
+  void warning(const Site& site, std::string message) { add(Diagnostic::Severity::Warning, site, std::move(message)); }
+  /// "file:line:col", for "first defined at ...".
+  std::string at(const Site& site) const;
+  Position position(const Site& site) const;
+  std::size_t error_count() const;
+
+private:
+  void add(Diagnostic::Severity severity, const Site& site, std::string message);
+};
+
+struct Name {
+  std::string text;
+  Site site;
+};
+
+struct SignalItem {
+  std::string name;  ///< full: Component.signal
+  std::size_t size = 1;
+  Site site;
+  bool implicit = false;  ///< implied by a 2016 file that declares no signals
+};
+
+struct EventItem {
+  EventDef def;
+  std::string component;
+  Site site;  ///< the object
+  Site name_site;
+  Site severity_site;
+  Site transitions_site;
+  Site completes_site;
+  Site latched_site;
+  bool has_name = false;
+  bool has_severity = false;
+  bool has_transitions = false;
+  bool transitions_valid = true;  ///< every listed transition was understood
+};
+
+struct ParamItem {
+  std::string name;
+  Site key_site;
+  Site value_site;
+  const JsonValue* value = nullptr;  ///< null: synthesized by a pipeline (see `synthetic`)
+  std::string synthetic;             ///< a signal name filled in by a pipeline
+};
+
+struct FilterItem {
+  FilterConfig config;
+  std::string owner;  ///< the component whose file declares the filter
+  bool named = false;
+  std::string pipeline;  ///< the pipeline it is a stage of, if any
+  std::size_t stage = 0;
+  Site site;
+  Site name_site;
+  Site class_site;
+  Site target_site;  ///< the target object, or the filter when there is none
+  Site target_type_site;
+  Site target_component_site;
+  Site target_interface_site;
+  Site argument_site;  ///< the argument object, or the filter when there is none
+  bool has_class = false;
+  bool has_target_interface = false;
+  bool target_component_given = false;
+  std::vector<ParamItem> params;
+};
+
+struct FilterEntryItem {
+  std::string pipeline;  ///< empty for a single filter
+  Site site;
+  Site name_site;
+  std::vector<FilterItem> stages;
+};
+
+struct ServiceItem {
+  std::string provided;
+  ServiceDependency dependency;
+  Site site;
+  Site name_site;
+  std::vector<Name> required;  ///< the s_R list
+  bool has_name = false;
+};
+
+struct ComponentItem {
+  std::string name;
+  Site site;
+  Site name_site;
+  bool has_name = false;
+  bool has_interfaces = false;
+  bool has_signals = false;
+  std::vector<Name> provided;
+  std::vector<Name> required;
+  std::vector<SignalItem> signals;
+  std::vector<EventItem> events;
+  std::vector<FilterEntryItem> filters;
+  std::vector<ServiceItem> services;
+  std::optional<double> period;
+};
+
+struct ConnectionItem {
+  std::string required;
+  std::string provided;
+  Site site;
+  Site required_site;
+  Site provided_site;
+  bool complete = false;  ///< both ends given as strings
+};
+
+struct CoordinatorItem {
+  Name name;
+  std::vector<Name> components;
+};
+
+struct Model {
+  std::string name;
+  std::string path;
+  bool system_file = false;  ///< the loaded file is a system file (not a single component)
+  std::size_t component_entries = 0;  ///< entries of the top-level "components" list
+  std::vector<ComponentItem> components;
+  std::vector<ConnectionItem> connections;
+  std::vector<CoordinatorItem> coordinators;
+  Site coordinators_site;
+  bool has_coordinators = false;
+};
+
+/// Reads the top-level file (from disk when `text` is null) and everything it includes into
+/// `model`, reporting file, syntax and schema problems to `sink`.
+void read_files(const std::string& path, const std::string* text, Sink& sink, Model& model);
+
+/// Cross-reference checks of DESIGN §5. Fills the names of unnamed filters, implied interfaces
+/// and signals of 2016 files, and pipeline wiring into `model`.
+void validate(Model& model, const FilterRegistry& registry, Sink& sink);
+
+/// The public form of a model that passed validation.
+SystemSpec to_system(const Model& model, const Sink& sink);
+
+/// Names and kinds of the framework events every coordinator defines.
+struct FrameworkEvent {
+  std::string name;
+  bool onset = true;
+  std::string counterpart;
+  int severity = 0;
+};
+const std::vector<FrameworkEvent>& framework_events();
+
+}  // namespace safecass::spec::detail

@@ -1,0 +1,724 @@
+// Reading specification files: bytes -> JSON -> the loader's model, with the file, syntax and
+// schema checks (unknown, duplicate, missing and mistyped keys). Cross-references are checked
+// afterwards by validate.cpp.
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "keys.hpp"
+#include "model.hpp"
+#include "text.hpp"
+
+namespace safecass::spec::detail {
+
+namespace {
+
+constexpr std::size_t kMaxFileBytes = std::size_t{16} << 20;
+constexpr std::size_t kMaxIncludeDepth = 16;
+constexpr std::size_t kMaxFiles = 100000;
+constexpr int kMaxJsonDepth = 64;
+
+std::string a_type(JsonValue::Type t) {
+  switch (t) {
+    case JsonValue::Type::Null: return "null";
+    case JsonValue::Type::Bool: return "a boolean";
+    case JsonValue::Type::Number: return "a number";
+    case JsonValue::Type::String: return "a string";
+    case JsonValue::Type::Array: return "an array";
+    case JsonValue::Type::Object: return "an object";
+  }
+  return "a value";
+}
+
+std::vector<std::string> to_strings(const std::vector<std::string_view>& views) {
+  return {views.begin(), views.end()};
+}
+
+bool whole(double d) noexcept { return std::isfinite(d) && std::floor(d) == d; }
+
+/// The members of one object, checked against the table of its kind: duplicate keys, unknown
+/// keys (with the nearest known one), mistyped values and missing required keys are reported;
+/// get() then returns only members that are present and of the right shape.
+class Fields {
+public:
+  Fields(Sink& sink, int file, const JsonValue& object, std::string pointer, const ObjectKind& kind,
+         std::string context)
+      : sink_(sink), file_(file), object_(object), pointer_(std::move(pointer)), kind_(kind),
+        context_(std::move(context)) {
+    std::set<std::string_view> seen;
+    for (const JsonMember& m : object.object) {
+      const Site key_site{file_, m.key_position, pointer_join(pointer_, m.key)};
+      if (!seen.insert(m.key).second) {
+        const JsonMember* first = object.find_member(m.key);
+        sink_.error(key_site, context_ + ": duplicate key " + quote_name(m.key) + " (first at line " +
+                                  std::to_string(first->key_position.line) + ", column " +
+                                  std::to_string(first->key_position.column) + ")");
+        continue;
+      }
+      const Key* key = kind_.find(m.key);
+      if (key == nullptr) {
+        std::vector<std::string> known;
+        for (const Key& k : kind_.keys) known.emplace_back(k.name);
+        const auto near = nearest(m.key, known);
+        std::string message = context_ + ": unknown key " + quote_name(m.key);
+        if (near) {
+          message += "; did you mean " + quote_name(*near) + "?";
+        } else {
+          std::string list;
+          for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+          message += " (known keys: " + list + ")";
+        }
+        sink_.error(key_site, std::move(message));
+        continue;
+      }
+      if (check(*key, m)) good_.push_back(&m);
+    }
+    for (const Key& k : kind_.keys) {
+      if (k.required && object.find_member(k.name) == nullptr) {
+        sink_.error(object_site(), context_ + ": missing required key " + quote_name(k.name) + " (" +
+                                       std::string(k.doc) + ")");
+      }
+    }
+  }
+
+  const JsonValue* get(std::string_view key) const noexcept {
+    for (const JsonMember* m : good_) {
+      if (m->key == key) return &m->value;
+    }
+    return nullptr;
+  }
+  const JsonMember* member(std::string_view key) const noexcept { return object_.find_member(key); }
+  bool has(std::string_view key) const noexcept { return member(key) != nullptr; }
+  Site site(std::string_view key) const {
+    const JsonMember* m = member(key);
+    if (m == nullptr) return object_site();
+    return Site{file_, m->value.position, pointer(key)};
+  }
+  Site object_site() const { return Site{file_, object_.position, pointer_}; }
+  std::string pointer(std::string_view key) const { return pointer_join(pointer_, key); }
+  const std::string& context() const noexcept { return context_; }
+
+  /// The string items of a StringList member, with their sites.
+  std::vector<Name> names(std::string_view key) const {
+    std::vector<Name> out;
+    const JsonValue* v = get(key);
+    if (v == nullptr) return out;
+    for (std::size_t i = 0; i < v->array.size(); ++i) {
+      const JsonValue& item = v->array[i];
+      if (item.is_string()) out.push_back(Name{item.string, Site{file_, item.position, pointer_join(pointer(key), i)}});
+    }
+    return out;
+  }
+
+private:
+  bool check(const Key& key, const JsonMember& m) {
+    const JsonValue& v = m.value;
+    const Site site{file_, v.position, pointer(m.key)};
+    const std::string what = context_ + ": " + quote_name(m.key);
+    const auto wrong = [&](const std::string& expected) {
+      sink_.error(site, what + " must be " + expected + ", not " + a_type(v.type));
+      return false;
+    };
+    switch (key.shape) {
+      case Shape::String:
+        return v.is_string() || wrong("a string");
+      case Shape::Bool:
+        return v.is_bool() || wrong("true or false");
+      case Shape::Integer:
+      case Shape::Number: {
+        const bool integer = key.shape == Shape::Integer;
+        if (!v.is_number() || (integer && !whole(v.number))) {
+          if (v.is_number()) {
+            sink_.error(site, what + " must be a whole number, not " + number_text(v.number));
+            return false;
+          }
+          return wrong(integer ? "an integer" : "a number");
+        }
+        const double d = v.number;
+        const bool low = key.exclusive_min ? !(d > key.min) : d < key.min;
+        if (low || d > key.max) {
+          std::string range;
+          if (key.min == key.max) {
+            range = "must be " + number_text(key.min);
+          } else if (std::isinf(key.max)) {
+            range = std::string("must be ") + (key.exclusive_min ? "greater than " : "at least ") + number_text(key.min);
+          } else {
+            range = "must be within " + number_text(key.min) + "-" + number_text(key.max);
+          }
+          sink_.error(site, what + " " + range + ", not " + number_text(d));
+          return false;
+        }
+        return true;
+      }
+      case Shape::Choice: {
+        if (!v.is_string()) return wrong("a string (" + join_or(to_strings(key.choices)) + ")");
+        return check_choice(key, v, site, what);
+      }
+      case Shape::StringList:
+      case Shape::ChoiceList: {
+        if (!v.is_array()) return wrong(key.shape == Shape::StringList ? "an array of strings" : "an array of " + join_or(to_strings(key.choices)));
+        for (std::size_t i = 0; i < v.array.size(); ++i) {
+          const JsonValue& item = v.array[i];
+          const Site item_site{file_, item.position, pointer_join(site.pointer, i)};
+          if (!item.is_string()) {
+            sink_.error(item_site, what + " items must be strings, not " + a_type(item.type));
+          } else if (key.shape == Shape::ChoiceList) {
+            check_choice(key, item, item_site, what + " item");
+          }
+        }
+        return true;
+      }
+      case Shape::Object:
+        return v.is_object() || wrong("an object");
+      case Shape::ObjectList:
+        return v.is_array() || wrong("an array");
+    }
+    return false;
+  }
+
+  bool check_choice(const Key& key, const JsonValue& v, const Site& site, const std::string& what) {
+    for (const std::string_view c : key.choices) {
+      if (v.string == c) return true;
+    }
+    sink_.error(site, what + " must be " + join_or(to_strings(key.choices)) + ", not " + quote_name(v.string) +
+                          did_you_mean(v.string, to_strings(key.choices)));
+    return false;
+  }
+
+  Sink& sink_;
+  int file_;
+  const JsonValue& object_;
+  std::string pointer_;
+  const ObjectKind& kind_;
+  std::string context_;
+  std::vector<const JsonMember*> good_;
+};
+
+std::string named(std::string_view kind, const JsonValue& object, std::string_view name_key) {
+  const JsonValue* n = object.find(name_key);
+  if (n != nullptr && n->is_string()) return std::string(kind) + " " + quote_name(n->string);
+  return std::string(kind);
+}
+
+/// A target given on a pipeline, inherited by its stages.
+struct TargetDefault {
+  bool given = false;
+  FilterTarget target;
+  Site site, type_site, component_site, interface_site;
+  bool component_given = false;
+  bool has_interface = false;
+};
+
+class Reader {
+public:
+  Reader(Sink& sink, Model& model) : sink_(sink), model_(model) {}
+
+  void run(const std::string& path, const std::string* text) {
+    model_.path = path;
+    const int doc = open(path, text, nullptr);
+    if (doc < 0) return;
+    const JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
+    switch (kind_of(doc, root)) {
+      case FileKind::Component: {
+        ComponentItem c;
+        read_component(doc, root, "", c);
+        model_.name = c.name;
+        model_.components.push_back(std::move(c));
+        break;
+      }
+      case FileKind::System:
+        model_.system_file = true;
+        read_system(doc, root, "", true);
+        break;
+      case FileKind::Invalid: break;
+    }
+    stack_.pop_back();
+  }
+
+private:
+  enum class FileKind { System, Component, Invalid };
+
+  /// What a file holds; reports files that are neither or both.
+  FileKind kind_of(int doc, const JsonValue& root) {
+    const bool system = root.find_member("system") != nullptr || root.find_member("components") != nullptr;
+    const bool component = root.find_member("component") != nullptr;
+    const Site site{doc, root.position, ""};
+    if (system && component) {
+      sink_.error(site, "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both");
+      return FileKind::Invalid;
+    }
+    if (!system && !component) {
+      sink_.error(site, "not a specification: a system file has \"system\" and \"components\", a component file has \"component\"");
+      return FileKind::Invalid;
+    }
+    return system ? FileKind::System : FileKind::Component;
+  }
+
+  /// Opens and parses a file. Returns its document index (pushed on the include stack), or -1.
+  int open(const std::string& path, const std::string* given_text, const Site* include_site) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path p(path);
+    std::string canonical = fs::weakly_canonical(p, ec).string();
+    if (ec || canonical.empty()) canonical = fs::absolute(p, ec).lexically_normal().string();
+    if (include_site != nullptr) {
+      for (std::size_t i = 0; i < stack_.size(); ++i) {
+        if (stack_[i].first == canonical) {
+          std::string chain;
+          for (std::size_t k = i; k < stack_.size(); ++k) chain += stack_[k].second + " -> ";
+          sink_.error(*include_site, "include cycle: " + chain + path);
+          return -1;
+        }
+      }
+      if (const auto loaded = loaded_.find(canonical); loaded != loaded_.end()) {
+        const auto it = included_at_.find(loaded->second);
+        sink_.error(*include_site, "file " + quote_name(path) + " is already included" +
+                                       (it != included_at_.end() ? " (at " + sink_.at(it->second) + ")" : std::string()));
+        return -1;
+      }
+      if (stack_.size() >= kMaxIncludeDepth) {
+        sink_.error(*include_site, "includes nested deeper than " + std::to_string(kMaxIncludeDepth) + " files");
+        return -1;
+      }
+      if (sink_.documents.size() >= kMaxFiles) {
+        sink_.error(*include_site, "more than " + std::to_string(kMaxFiles) + " files included");
+        return -1;
+      }
+    }
+
+    std::string text;
+    std::string problem;
+    if (given_text != nullptr) {
+      text = *given_text;
+    } else {
+      const fs::file_status status = fs::status(p, ec);
+      if (ec || !fs::exists(status)) {
+        problem = "cannot read file " + quote_name(path) + ": no such file";
+      } else if (!fs::is_regular_file(status)) {
+        problem = "cannot read file " + quote_name(path) + ": not a regular file";
+      } else {
+        std::ifstream in(p, std::ios::binary);
+        if (!in) {
+          problem = "cannot read file " + quote_name(path) + ": permission denied or I/O error";
+        } else {
+          std::string buffer(64 * 1024, '\0');
+          while (in && text.size() <= kMaxFileBytes) {
+            in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+            text.append(buffer.data(), static_cast<std::size_t>(in.gcount()));
+          }
+          if (in.bad()) problem = "cannot read file " + quote_name(path) + ": I/O error";
+        }
+      }
+    }
+    if (problem.empty() && text.size() > kMaxFileBytes) {
+      problem = "file " + quote_name(path) + " is larger than " + std::to_string(kMaxFileBytes >> 20) + " MiB";
+    }
+    if (!problem.empty()) {
+      if (include_site != nullptr) {
+        sink_.error(*include_site, problem);
+      } else {
+        sink_.documents.push_back(Document{path, canonical, {}, std::nullopt});
+        sink_.error(Site{0, {}, ""}, problem);
+      }
+      return -1;
+    }
+
+    const int doc = static_cast<int>(sink_.documents.size());
+    sink_.documents.push_back(Document{path, canonical, std::move(text), std::nullopt});
+    loaded_.emplace(canonical, doc);
+    if (include_site != nullptr) included_at_.emplace(doc, *include_site);
+    Document& d = sink_.documents.back();
+    std::string_view body = d.text;
+    if (body.empty()) {
+      sink_.error(Site{doc, TextPosition{1, 1}, ""}, "empty file: expected a JSON object");
+      return -1;
+    }
+    if (body.substr(0, 3) == "\xEF\xBB\xBF") body.remove_prefix(3);  // a byte-order mark
+    if (const auto bad = check_utf8(body)) {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "0x%02x", bad->byte);
+      sink_.error(Site{doc, bad->position, ""},
+                  std::string("invalid UTF-8 (byte ") + hex + "): a specification is UTF-8 text");
+      return -1;
+    }
+    JsonParse parsed = parse_json(body, kMaxJsonDepth);
+    if (parsed.error) {
+      sink_.error(Site{doc, parsed.error->position, ""}, parsed.error->message);
+      return -1;
+    }
+    if (!parsed.value->is_object()) {
+      sink_.error(Site{doc, parsed.value->position, ""},
+                  "a specification file holds a JSON object, not " + a_type(parsed.value->type));
+      return -1;
+    }
+    d.root = std::move(parsed.value);
+    stack_.emplace_back(canonical, path);
+    return doc;
+  }
+
+  void include(int from, const JsonValue& entry, const std::string& pointer) {
+    Fields f(sink_, from, entry, pointer, include_kind(), "include");
+    const JsonValue* path = f.get("include");
+    if (path == nullptr) return;
+    const Site site = f.site("include");
+    if (path->string.empty()) {
+      sink_.error(site, "include: the path is empty");
+      return;
+    }
+    if (path->string.find('\0') != std::string::npos) {
+      sink_.error(site, "include: the path contains a NUL character");
+      return;
+    }
+    namespace fs = std::filesystem;
+    const fs::path including(sink_.documents[static_cast<std::size_t>(from)].path);
+    fs::path target(path->string);
+    if (target.is_relative()) target = including.parent_path() / target;
+    std::string resolved = target.lexically_normal().string();
+    if (resolved.empty()) resolved = ".";
+    const int doc = open(resolved, nullptr, &site);
+    if (doc < 0) return;
+    const JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
+    switch (kind_of(doc, root)) {
+      case FileKind::Component: {
+        ComponentItem c;
+        read_component(doc, root, "", c);
+        model_.components.push_back(std::move(c));
+        break;
+      }
+      case FileKind::System: read_system(doc, root, "", false); break;
+      case FileKind::Invalid: break;
+    }
+    stack_.pop_back();
+  }
+
+  void read_system(int doc, const JsonValue& root, const std::string& pointer, bool top) {
+    Fields f(sink_, doc, root, pointer, system_kind(), named("system", root, "system"));
+    if (top) {
+      if (const JsonValue* n = f.get("system")) model_.name = n->string;
+    }
+    if (const JsonValue* list = f.get("components")) {
+      if (top) model_.component_entries = list->array.size();
+      for (std::size_t i = 0; i < list->array.size(); ++i) {
+        const JsonValue& entry = list->array[i];
+        const std::string p = pointer_join(f.pointer("components"), i);
+        const Site site{doc, entry.position, p};
+        if (!entry.is_object()) {
+          sink_.error(site, "a 'components' entry must be an object ({\"include\": \"file.json\"} or a component), not " +
+                                a_type(entry.type));
+        } else if (entry.find_member("include") != nullptr) {
+          include(doc, entry, p);
+        } else if (entry.find_member("component") != nullptr) {
+          ComponentItem c;
+          read_component(doc, entry, p, c);
+          model_.components.push_back(std::move(c));
+        } else {
+          sink_.error(site, "a 'components' entry must be {\"include\": \"file.json\"} or a component object with \"component\"");
+        }
+      }
+    }
+    if (const JsonValue* list = f.get("connections")) {
+      for (std::size_t i = 0; i < list->array.size(); ++i) {
+        const JsonValue& entry = list->array[i];
+        const std::string p = pointer_join(f.pointer("connections"), i);
+        if (!entry.is_object()) {
+          sink_.error(Site{doc, entry.position, p}, "a connection must be an object {\"required\": \"C.r\", \"provided\": \"P.p\"}, not " +
+                                                        a_type(entry.type));
+          continue;
+        }
+        Fields c(sink_, doc, entry, p, connection_kind(), "connection");
+        ConnectionItem item;
+        item.site = c.object_site();
+        item.required_site = c.site("required");
+        item.provided_site = c.site("provided");
+        const JsonValue* r = c.get("required");
+        const JsonValue* pr = c.get("provided");
+        if (r != nullptr) item.required = r->string;
+        if (pr != nullptr) item.provided = pr->string;
+        item.complete = r != nullptr && pr != nullptr;
+        model_.connections.push_back(std::move(item));
+      }
+    }
+    if (const JsonValue* coordinators = f.get("coordinators")) {
+      const std::string base = f.pointer("coordinators");
+      if (top || !model_.has_coordinators) model_.coordinators_site = f.site("coordinators");
+      std::set<std::string_view> seen;
+      for (const JsonMember& m : coordinators->object) {
+        const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
+        if (!seen.insert(m.key).second) {
+          sink_.error(key_site, "coordinators: duplicate key " + quote_name(m.key));
+          continue;
+        }
+        CoordinatorItem item;
+        item.name = Name{m.key, key_site};
+        const Site value_site{doc, m.value.position, key_site.pointer};
+        if (!m.value.is_array()) {
+          sink_.error(value_site, "coordinator " + quote_name(m.key) + " must list its components in an array, not " +
+                                      a_type(m.value.type));
+          continue;
+        }
+        for (std::size_t i = 0; i < m.value.array.size(); ++i) {
+          const JsonValue& c = m.value.array[i];
+          const Site item_site{doc, c.position, pointer_join(key_site.pointer, i)};
+          if (!c.is_string()) {
+            sink_.error(item_site, "coordinator " + quote_name(m.key) + ": components are named by strings, not " + a_type(c.type));
+            continue;
+          }
+          item.components.push_back(Name{c.string, item_site});
+        }
+        model_.coordinators.push_back(std::move(item));
+        model_.has_coordinators = true;
+      }
+    }
+  }
+
+  void read_component(int doc, const JsonValue& value, const std::string& pointer, ComponentItem& c) {
+    Fields f(sink_, doc, value, pointer, component_kind(), named("component", value, "component"));
+    c.site = f.object_site();
+    c.name_site = f.site("component");
+    if (const JsonValue* n = f.get("component")) {
+      c.name = n->string;
+      c.has_name = true;
+    }
+    const std::string& ctx = f.context();
+    if (const JsonValue* interfaces = f.get("interfaces")) {
+      c.has_interfaces = true;
+      Fields fi(sink_, doc, *interfaces, f.pointer("interfaces"), interfaces_kind(), ctx);
+      c.provided = fi.names("provided");
+      c.required = fi.names("required");
+    }
+    if (const JsonValue* signals = f.get("signals")) {
+      c.has_signals = true;
+      for (std::size_t i = 0; i < signals->array.size(); ++i) {
+        const JsonValue& s = signals->array[i];
+        const std::string p = pointer_join(f.pointer("signals"), i);
+        if (!s.is_object()) {
+          sink_.error(Site{doc, s.position, p}, ctx + ": a signal must be an object {\"name\": ..., \"size\": ...}, not " + a_type(s.type));
+          continue;
+        }
+        Fields fs(sink_, doc, s, p, signal_kind(), named("signal", s, "name"));
+        const JsonValue* name = fs.get("name");
+        if (name == nullptr) continue;
+        SignalItem item;
+        item.name = name->string.find('.') == std::string::npos ? c.name + "." + name->string : name->string;
+        item.site = fs.site("name");
+        if (const JsonValue* size = fs.get("size")) item.size = static_cast<std::size_t>(size->number);
+        c.signals.push_back(std::move(item));
+      }
+    }
+    if (const JsonValue* events = f.get("event")) {
+      for (std::size_t i = 0; i < events->array.size(); ++i) {
+        const JsonValue& e = events->array[i];
+        const std::string p = pointer_join(f.pointer("event"), i);
+        if (!e.is_object()) {
+          sink_.error(Site{doc, e.position, p}, ctx + ": an event must be an object, not " + a_type(e.type));
+          continue;
+        }
+        c.events.push_back(read_event(doc, e, p, c.name));
+      }
+    }
+    if (const JsonValue* filters = f.get("filter")) {
+      for (std::size_t i = 0; i < filters->array.size(); ++i) {
+        const JsonValue& e = filters->array[i];
+        const std::string p = pointer_join(f.pointer("filter"), i);
+        if (!e.is_object()) {
+          sink_.error(Site{doc, e.position, p}, ctx + ": a filter must be an object, not " + a_type(e.type));
+          continue;
+        }
+        FilterEntryItem entry;
+        entry.site = Site{doc, e.position, p};
+        if (e.find_member("pipeline") != nullptr) {
+          Fields fp(sink_, doc, e, p, pipeline_kind(), named("pipeline", e, "name"));
+          entry.name_site = fp.site("name");
+          if (const JsonValue* n = fp.get("name")) entry.pipeline = n->string;
+          else entry.pipeline = "?";
+          TargetDefault target;
+          if (const JsonValue* t = fp.get("target")) target = read_target(doc, *t, fp.pointer("target"), fp.context(), c.name);
+          if (const JsonValue* stages = fp.get("pipeline")) {
+            for (std::size_t k = 0; k < stages->array.size(); ++k) {
+              const JsonValue& s = stages->array[k];
+              const std::string sp = pointer_join(fp.pointer("pipeline"), k);
+              if (!s.is_object()) {
+                sink_.error(Site{doc, s.position, sp}, fp.context() + ": a stage must be a filter object, not " + a_type(s.type));
+                continue;
+              }
+              FilterItem stage = read_filter(doc, s, sp, c.name, target);
+              stage.pipeline = entry.pipeline;
+              stage.stage = k;
+              entry.stages.push_back(std::move(stage));
+            }
+          }
+        } else {
+          entry.stages.push_back(read_filter(doc, e, p, c.name, TargetDefault{}));
+        }
+        c.filters.push_back(std::move(entry));
+      }
+    }
+    if (const JsonValue* services = f.get("service")) {
+      for (std::size_t i = 0; i < services->array.size(); ++i) {
+        const JsonValue& s = services->array[i];
+        const std::string p = pointer_join(f.pointer("service"), i);
+        if (!s.is_object()) {
+          sink_.error(Site{doc, s.position, p}, ctx + ": a service must be an object, not " + a_type(s.type));
+          continue;
+        }
+        Fields fs(sink_, doc, s, p, service_kind(), named("service", s, "name"));
+        ServiceItem item;
+        item.site = fs.object_site();
+        item.name_site = fs.site("name");
+        if (const JsonValue* n = fs.get("name")) {
+          item.provided = n->string;
+          item.has_name = true;
+        }
+        if (const JsonValue* d = fs.get("dependency")) {
+          Fields fd(sink_, doc, *d, fs.pointer("dependency"), dependency_kind(), fs.context() + " dependency");
+          ServiceDependency dep = ServiceDependency::provided_only();
+          if (const JsonValue* b = fd.get("s_F")) dep.framework = b->boolean;
+          if (const JsonValue* b = fd.get("s_A")) dep.application = b->boolean;
+          item.required = fd.names("s_R");
+          for (const Name& r : item.required) dep.required.push_back(r.text);
+          item.dependency = std::move(dep);
+        }
+        if (const JsonValue* pr = fs.get("propagate")) {
+          item.dependency.propagate = pr->string == "warning" ? State::Warning : State::Error;
+        }
+        c.services.push_back(std::move(item));
+      }
+    }
+    if (const JsonValue* period = f.get("period")) c.period = period->number;
+  }
+
+  EventItem read_event(int doc, const JsonValue& e, const std::string& pointer, const std::string& component) {
+    Fields f(sink_, doc, e, pointer, event_kind(), named("event", e, "name"));
+    EventItem item;
+    item.component = component;
+    item.site = f.object_site();
+    item.name_site = f.site("name");
+    item.severity_site = f.site("severity");
+    item.transitions_site = f.site("state_transition");
+    item.completes_site = f.site("completes");
+    item.latched_site = f.site("latched");
+    if (const JsonValue* n = f.get("name")) {
+      item.def.name = n->string;
+      item.has_name = true;
+    }
+    if (const JsonValue* s = f.get("severity")) {
+      item.def.severity = static_cast<int>(s->number);  // range checked: 1-255
+      item.has_severity = true;
+    }
+    if (const JsonValue* t = f.get("state_transition")) {
+      item.has_transitions = true;
+      for (const JsonValue& x : t->array) {
+        const auto tr = x.is_string() ? parse_transition(x.string) : std::nullopt;
+        if (tr) item.def.transitions.insert(*tr);
+        else item.transitions_valid = false;
+      }
+    } else if (f.has("state_transition")) {
+      item.transitions_valid = false;
+    }
+    if (const JsonValue* c = f.get("completes")) item.def.completes = c->string;
+    if (const JsonValue* l = f.get("latched")) item.def.latched = l->boolean;
+    if (const JsonValue* h = f.get("hazard")) item.def.hazard = h->string;
+    if (const JsonValue* d = f.get("description")) item.def.description = d->string;
+    return item;
+  }
+
+  TargetDefault read_target(int doc, const JsonValue& t, const std::string& pointer, const std::string& context,
+                            const std::string& owner) {
+    Fields f(sink_, doc, t, pointer, target_kind(), context + " target");
+    TargetDefault out;
+    out.given = true;
+    out.site = f.object_site();
+    out.type_site = f.site("type");
+    out.component_site = f.site("component");
+    out.interface_site = f.site("interface");
+    out.target.component = owner;
+    if (const JsonValue* type = f.get("type")) {
+      const std::string& s = type->string;
+      out.target.kind = s == "s_F" ? MachineKind::Framework
+                        : s == "s_P" ? MachineKind::Provided
+                        : s == "s_R" ? MachineKind::Required
+                                     : MachineKind::Application;
+    }
+    if (const JsonValue* c = f.get("component")) {
+      out.target.component = c->string;
+      out.component_given = true;
+    }
+    if (const JsonValue* i = f.get("interface")) {
+      out.target.interface = i->string;
+      out.has_interface = true;
+    }
+    return out;
+  }
+
+  FilterItem read_filter(int doc, const JsonValue& e, const std::string& pointer, const std::string& owner,
+                         const TargetDefault& inherited) {
+    Fields f(sink_, doc, e, pointer, filter_kind(), named("filter", e, "name"));
+    FilterItem item;
+    item.owner = owner;
+    item.site = f.object_site();
+    item.name_site = f.site("name");
+    item.class_site = f.site("class_name");
+    if (const JsonValue* n = f.get("name")) {
+      item.config.name = n->string;
+      item.named = true;
+    }
+    if (const JsonValue* c = f.get("class_name")) {
+      item.config.type = c->string;
+      item.has_class = true;
+    }
+    if (const JsonValue* t = f.get("type")) {
+      item.config.execution = t->string == "PASSIVE" ? ExecutionMode::Passive : ExecutionMode::Active;
+    }
+    if (const JsonValue* t = f.get("event_type")) {
+      item.config.detection = t->string == "LEVEL" ? DetectionMode::Level : DetectionMode::Edge;
+    }
+    if (const JsonValue* b = f.get("enabled")) item.config.enabled = b->boolean;
+    TargetDefault target = inherited;
+    if (const JsonValue* t = f.get("target")) target = read_target(doc, *t, f.pointer("target"), f.context(), owner);
+    if (target.given) {
+      item.config.target = target.target;
+      item.target_site = target.site;
+      item.target_type_site = target.type_site;
+      item.target_component_site = target.component_site;
+      item.target_interface_site = target.interface_site;
+      item.target_component_given = target.component_given;
+      item.has_target_interface = target.has_interface;
+    } else {
+      item.config.target.kind = MachineKind::Application;
+      item.config.target.component = owner;
+      item.target_site = item.target_type_site = item.target_component_site = item.target_interface_site = item.site;
+    }
+    item.argument_site = f.site("argument");
+    if (const JsonValue* a = f.get("argument")) {
+      std::set<std::string_view> seen;
+      const std::string base = f.pointer("argument");
+      for (const JsonMember& m : a->object) {
+        const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
+        if (!seen.insert(m.key).second) {
+          sink_.error(key_site, f.context() + ": duplicate parameter " + quote_name(m.key));
+          continue;
+        }
+        item.params.push_back(ParamItem{m.key, key_site, Site{doc, m.value.position, key_site.pointer}, &m.value, {}});
+      }
+    }
+    return item;
+  }
+
+  Sink& sink_;
+  Model& model_;
+  std::vector<std::pair<std::string, std::string>> stack_;  ///< canonical path, path as opened
+  std::map<int, Site> included_at_;
+  std::map<std::string, int, std::less<>> loaded_;  ///< canonical path -> document
+};
+
+}  // namespace
+
+void read_files(const std::string& path, const std::string* text, Sink& sink, Model& model) {
+  Reader(sink, model).run(path, text);
+}
+
+}  // namespace safecass::spec::detail

@@ -1,0 +1,353 @@
+#include "safecass/spec/scenario.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "safecass/core/state.hpp"
+#include "safecass/spec/json.hpp"
+
+namespace safecass::spec {
+
+bool read_file(const std::string& path, std::string& out, std::string& error) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    error = "is a directory";
+    return false;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = "cannot open file";
+    return false;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  if (in.bad()) {
+    error = "cannot read file";
+    return false;
+  }
+  out = ss.str();
+  return true;
+}
+
+namespace {
+
+class Reader {
+public:
+  Reader(std::string file, std::vector<Diagnostic>& out) : file_(std::move(file)), out_(out) {}
+
+  void error(const TextPosition& p, const std::string& pointer, std::string message) {
+    out_.push_back(Diagnostic{Diagnostic::Severity::Error, Position{file_, p.line, p.column}, std::move(message), pointer});
+  }
+  Position at(const TextPosition& p) const { return Position{file_, p.line, p.column}; }
+
+  bool number(const JsonValue& v, const std::string& pointer, const char* what, double& out) {
+    if (!v.is_number()) {
+      error(v.position, pointer, std::string(what) + " must be a number, not " + std::string(type_name(v.type)));
+      return false;
+    }
+    out = v.number;
+    return true;
+  }
+  bool text(const JsonValue& v, const std::string& pointer, const char* what, std::string& out) {
+    if (!v.is_string() || v.string.empty()) {
+      error(v.position, pointer, std::string(what) + " must be a non-empty string");
+      return false;
+    }
+    out = v.string;
+    return true;
+  }
+  /// A number or a list of numbers.
+  bool values(const JsonValue& v, const std::string& pointer, std::vector<double>& out) {
+    if (v.is_number()) {
+      out = {v.number};
+      return true;
+    }
+    if (v.is_array() && !v.array.empty()) {
+      for (std::size_t i = 0; i < v.array.size(); ++i) {
+        if (!v.array[i].is_number()) {
+          error(v.array[i].position, pointer + "/" + std::to_string(i), "sample values must be numbers");
+          return false;
+        }
+        out.push_back(v.array[i].number);
+      }
+      return true;
+    }
+    error(v.position, pointer, "a sample must be a number or a non-empty list of numbers");
+    return false;
+  }
+  void unknown_keys(const JsonValue& obj, const std::string& pointer, std::initializer_list<std::string_view> known) {
+    for (const JsonMember& m : obj.object) {
+      if (std::find(known.begin(), known.end(), m.key) == known.end()) {
+        std::string list;
+        for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
+        error(m.key_position, pointer + "/" + m.key, "unknown key \"" + m.key + "\" (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  std::string file_;
+  std::vector<Diagnostic>& out_;
+};
+
+std::string escape_pointer(const std::string& key) {
+  std::string out;
+  for (char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
+
+void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<ScenarioStep>& steps) {
+  const std::string base = "/steps/" + std::to_string(index);
+  if (!step.is_object()) {
+    r.error(step.position, base, "a step must be an object with \"at\" and one action");
+    return;
+  }
+  const JsonValue* at = step.find("at");
+  double when = 0.0;
+  if (at == nullptr) {
+    r.error(step.position, base, "step needs \"at\" (seconds)");
+    return;
+  }
+  if (!r.number(*at, base + "/at", "\"at\"", when)) return;
+  if (when < 0) {
+    r.error(at->position, base + "/at", "\"at\" must not be negative");
+    return;
+  }
+  static constexpr std::string_view kActions[] = {"sample", "ramp", "generate", "inject", "reset",
+                                                  "expect", "expect_outstanding", "expect_cause"};
+  int actions = 0;
+  for (const JsonMember& m : step.object) {
+    if (m.key == "at") continue;
+    const auto it = std::find(std::begin(kActions), std::end(kActions), m.key);
+    if (it == std::end(kActions)) {
+      r.error(m.key_position, base + "/" + escape_pointer(m.key),
+              "unknown step action \"" + m.key + "\" (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)");
+      continue;
+    }
+    ++actions;
+    const std::string p = base + "/" + m.key;
+    const JsonValue& v = m.value;
+    ScenarioStep s;
+    s.at = when;
+    s.index = index;
+    s.where = r.at(v.position);
+    s.pointer = p;
+    s.kind = static_cast<ScenarioStep::Kind>(it - std::begin(kActions));
+    bool ok = true;
+    switch (s.kind) {
+      case ScenarioStep::Kind::Sample:
+        if (!v.is_object() || v.object.empty()) {
+          r.error(v.position, p, "\"sample\" must be an object of signal: value");
+          ok = false;
+          break;
+        }
+        for (const JsonMember& sm : v.object) {
+          std::vector<double> vals;
+          ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
+          s.samples.emplace_back(sm.key, std::move(vals));
+        }
+        break;
+      case ScenarioStep::Kind::Ramp: {
+        if (!v.is_object()) {
+          r.error(v.position, p, "\"ramp\" must be an object {signal, from, to, until}");
+          ok = false;
+          break;
+        }
+        r.unknown_keys(v, p, {"signal", "from", "to", "until"});
+        const JsonValue* sig = v.find("signal");
+        const JsonValue* from = v.find("from");
+        const JsonValue* to = v.find("to");
+        const JsonValue* until = v.find("until");
+        if (sig == nullptr || from == nullptr || to == nullptr || until == nullptr) {
+          r.error(v.position, p, "\"ramp\" needs signal, from, to and until");
+          ok = false;
+          break;
+        }
+        ok = r.text(*sig, p + "/signal", "\"signal\"", s.signal) && ok;
+        ok = r.number(*from, p + "/from", "\"from\"", s.from) && ok;
+        ok = r.number(*to, p + "/to", "\"to\"", s.to) && ok;
+        ok = r.number(*until, p + "/until", "\"until\"", s.until) && ok;
+        if (ok && s.until < when) {
+          r.error(until->position, p + "/until", "\"until\" must not be before \"at\"");
+          ok = false;
+        }
+        break;
+      }
+      case ScenarioStep::Kind::Generate: {
+        if (!v.is_object()) {
+          r.error(v.position, p, "\"generate\" must be an object {event, target}");
+          ok = false;
+          break;
+        }
+        r.unknown_keys(v, p, {"event", "target"});
+        const JsonValue* e = v.find("event");
+        const JsonValue* t = v.find("target");
+        if (e == nullptr) {
+          r.error(v.position, p, "\"generate\" needs \"event\"");
+          ok = false;
+          break;
+        }
+        ok = r.text(*e, p + "/event", "\"event\"", s.event) && ok;
+        if (t != nullptr) ok = r.text(*t, p + "/target", "\"target\"", s.target) && ok;
+        break;
+      }
+      case ScenarioStep::Kind::Inject: {
+        if (!v.is_object()) {
+          r.error(v.position, p, "\"inject\" must be an object {filter|signal, deep, values}");
+          ok = false;
+          break;
+        }
+        r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
+        const JsonValue* f = v.find("filter");
+        const JsonValue* sig = v.find("signal");
+        const JsonValue* deep = v.find("deep");
+        const JsonValue* vals = v.find("values");
+        if ((f == nullptr) == (sig == nullptr)) {
+          r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
+          ok = false;
+          break;
+        }
+        if (f != nullptr) ok = r.text(*f, p + "/filter", "\"filter\"", s.filter) && ok;
+        if (sig != nullptr) ok = r.text(*sig, p + "/signal", "\"signal\"", s.signal) && ok;
+        if (deep != nullptr) {
+          if (!deep->is_bool()) {
+            r.error(deep->position, p + "/deep", "\"deep\" must be true or false");
+            ok = false;
+          } else {
+            s.deep = deep->boolean;
+          }
+        }
+        if (sig != nullptr && !s.deep) {
+          r.error(sig->position, p + "/signal", "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
+          ok = false;
+        }
+        if (vals == nullptr || !vals->is_array() || vals->array.empty()) {
+          r.error(vals == nullptr ? v.position : vals->position, p + "/values", "\"values\" must be a non-empty list of samples");
+          ok = false;
+          break;
+        }
+        for (std::size_t i = 0; i < vals->array.size(); ++i) {
+          std::vector<double> sample;
+          ok = r.values(vals->array[i], p + "/values/" + std::to_string(i), sample) && ok;
+          s.values.push_back(std::move(sample));
+        }
+        break;
+      }
+      case ScenarioStep::Kind::Reset: {
+        if (!v.is_object()) {
+          r.error(v.position, p, "\"reset\" must be an object {target, reason}");
+          ok = false;
+          break;
+        }
+        r.unknown_keys(v, p, {"target", "reason"});
+        const JsonValue* t = v.find("target");
+        const JsonValue* why = v.find("reason");
+        if (t == nullptr) {
+          r.error(v.position, p, "\"reset\" needs \"target\"");
+          ok = false;
+          break;
+        }
+        ok = r.text(*t, p + "/target", "\"target\"", s.target) && ok;
+        s.reason = "scenario";
+        if (why != nullptr) ok = r.text(*why, p + "/reason", "\"reason\"", s.reason) && ok;
+        break;
+      }
+      case ScenarioStep::Kind::Expect:
+      case ScenarioStep::Kind::ExpectOutstanding:
+      case ScenarioStep::Kind::ExpectCause:
+        if (!v.is_object() || v.object.empty()) {
+          r.error(v.position, p, "\"" + m.key + "\" must be an object of address: expected value");
+          ok = false;
+          break;
+        }
+        for (const JsonMember& em : v.object) {
+          std::string expected;
+          if (!r.text(em.value, p + "/" + escape_pointer(em.key), "an expectation", expected)) {
+            ok = false;
+            continue;
+          }
+          if (s.kind == ScenarioStep::Kind::Expect && !parse_state(expected)) {
+            r.error(em.value.position, p + "/" + escape_pointer(em.key),
+                    "expected state must be Normal, Warning or Error, not \"" + expected + "\"");
+            ok = false;
+            continue;
+          }
+          if (s.kind == ScenarioStep::Kind::ExpectCause && expected.find(':') == std::string::npos) {
+            r.error(em.value.position, p + "/" + escape_pointer(em.key),
+                    "a cause is written \"Component.s_X:EVENT\", not \"" + expected + "\"");
+            ok = false;
+            continue;
+          }
+          s.expectations.emplace_back(em.key, expected);
+        }
+        break;
+    }
+    if (ok) steps.push_back(std::move(s));
+  }
+  if (actions == 0) r.error(step.position, base, "step has no action (sample, ramp, generate, inject, reset or expect...)");
+}
+
+}  // namespace
+
+ScenarioLoad load_scenario(const std::string& path) {
+  ScenarioLoad out;
+  Reader r(path, out.diagnostics);
+  std::string text;
+  std::string why;
+  if (!read_file(path, text, why)) {
+    out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, Position{path, 1, 1}, why, ""});
+    return out;
+  }
+  const JsonParse parsed = parse_json(text);
+  if (parsed.error) {
+    r.error(parsed.error->position, "", parsed.error->message);
+    return out;
+  }
+  const JsonValue& root = *parsed.value;
+  if (!root.is_object()) {
+    r.error(root.position, "", "a scenario must be a JSON object");
+    return out;
+  }
+  r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
+  Scenario sc;
+  sc.path = path;
+  const JsonValue* system = root.find("system");
+  if (system == nullptr) {
+    r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
+  } else if (std::string s; r.text(*system, "/system", "\"system\"", s)) {
+    const std::filesystem::path base = std::filesystem::path(path).parent_path();
+    sc.system = (base / s).lexically_normal().string();
+  }
+  if (const JsonValue* period = root.find("period")) {
+    if (r.number(*period, "/period", "\"period\"", sc.period) && !(sc.period > 0 && sc.period <= 10)) {
+      r.error(period->position, "/period", "\"period\" must be in (0, 10] seconds");
+    }
+  }
+  const JsonValue* duration = root.find("duration");
+  if (duration == nullptr) {
+    r.error(root.position, "", "scenario needs \"duration\" (seconds)");
+  } else if (r.number(*duration, "/duration", "\"duration\"", sc.duration) && !(sc.duration >= 0 && sc.duration <= 1e6)) {
+    r.error(duration->position, "/duration", "\"duration\" must be in [0, 1e6] seconds");
+  }
+  if (sc.period > 0 && sc.duration / sc.period > 1e8) {
+    r.error(root.position, "", "duration / period is more than 1e8 ticks");
+  }
+  const JsonValue* steps = root.find("steps");
+  if (steps != nullptr && !steps->is_array()) {
+    r.error(steps->position, "/steps", "\"steps\" must be a list");
+  } else if (steps != nullptr) {
+    for (std::size_t i = 0; i < steps->array.size(); ++i) read_step(r, steps->array[i], i, sc.steps);
+  }
+  std::stable_sort(sc.steps.begin(), sc.steps.end(),
+                   [](const ScenarioStep& a, const ScenarioStep& b) { return a.at < b.at; });
+  if (out.diagnostics.empty()) out.scenario = std::move(sc);
+  return out;
+}
+
+}  // namespace safecass::spec

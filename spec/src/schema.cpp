@@ -1,0 +1,351 @@
+#include "safecass/spec/schema.hpp"
+
+#include <cmath>
+#include <map>
+
+#include "keys.hpp"
+#include "safecass/spec/json.hpp"
+#include "text.hpp"
+
+namespace safecass::spec {
+
+namespace {
+
+using detail::Key;
+using detail::ObjectKind;
+using detail::Shape;
+
+/// A JSON value under construction: members keep their insertion order, so the text is stable.
+struct Node {
+  enum class Kind { Scalar, Object, Array } kind = Kind::Object;
+  std::string scalar;  ///< JSON text
+  std::vector<std::string> keys;  ///< object: member names, in order
+  std::vector<Node> values;       ///< object: member values
+  std::vector<Node> items;        ///< array
+
+  static Node text(std::string_view s) {
+    Node n;
+    n.kind = Kind::Scalar;
+    n.scalar = json_quote(s);
+    return n;
+  }
+  static Node raw(std::string s) {
+    Node n;
+    n.kind = Kind::Scalar;
+    n.scalar = std::move(s);
+    return n;
+  }
+  static Node number(double d) { return raw(detail::number_text(d)); }
+  static Node array() {
+    Node n;
+    n.kind = Kind::Array;
+    return n;
+  }
+  static Node ref(std::string_view def) {
+    Node n;
+    n.set("$ref", text("#/$defs/" + std::string(def)));
+    return n;
+  }
+  /// Adds a member. The reference is valid until the next member is added.
+  Node& set(std::string key, Node value) {
+    keys.push_back(std::move(key));
+    values.push_back(std::move(value));
+    return values.back();
+  }
+  Node* member(std::string_view key) {
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      if (keys[i] == key) return &values[i];
+    }
+    return nullptr;
+  }
+  Node& push(Node value) {
+    items.push_back(std::move(value));
+    return items.back();
+  }
+
+  bool flat() const {
+    if (kind != Kind::Array) return kind == Kind::Scalar;
+    for (const Node& i : items) {
+      if (i.kind != Kind::Scalar) return false;
+    }
+    return true;
+  }
+
+  void write(std::string& out, int indent) const {
+    const std::string pad(static_cast<std::size_t>(indent + 2), ' ');
+    switch (kind) {
+      case Kind::Scalar: out += scalar; return;
+      case Kind::Array:
+        if (items.empty()) {
+          out += "[]";
+          return;
+        }
+        if (flat()) {
+          out += "[";
+          for (std::size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i].scalar;
+          out += "]";
+          return;
+        }
+        out += "[\n";
+        for (std::size_t i = 0; i < items.size(); ++i) {
+          out += pad;
+          items[i].write(out, indent + 2);
+          out += i + 1 < items.size() ? ",\n" : "\n";
+        }
+        out += std::string(static_cast<std::size_t>(indent), ' ') + "]";
+        return;
+      case Kind::Object:
+        if (keys.empty()) {
+          out += "{}";
+          return;
+        }
+        out += "{\n";
+        for (std::size_t i = 0; i < keys.size(); ++i) {
+          out += pad + json_quote(keys[i]) + ": ";
+          values[i].write(out, indent + 2);
+          out += i + 1 < keys.size() ? ",\n" : "\n";
+        }
+        out += std::string(static_cast<std::size_t>(indent), ' ') + "}";
+        return;
+    }
+  }
+};
+
+Node strings_of(const std::vector<std::string_view>& words) {
+  Node a = Node::array();
+  for (const std::string_view w : words) a.push(Node::text(w));
+  return a;
+}
+
+Node key_schema(const Key& k) {
+  Node n;
+  switch (k.shape) {
+    case Shape::String: n.set("type", Node::text("string")); break;
+    case Shape::Bool: n.set("type", Node::text("boolean")); break;
+    case Shape::Integer:
+    case Shape::Number:
+      n.set("type", Node::text(k.shape == Shape::Integer ? "integer" : "number"));
+      if (std::isfinite(k.min)) n.set(k.exclusive_min ? "exclusiveMinimum" : "minimum", Node::number(k.min));
+      if (std::isfinite(k.max)) n.set("maximum", Node::number(k.max));
+      break;
+    case Shape::Choice: n.set("enum", strings_of(k.choices)); break;
+    case Shape::StringList: {
+      n.set("type", Node::text("array"));
+      Node items;
+      items.set("type", Node::text("string"));
+      n.set("items", std::move(items));
+      break;
+    }
+    case Shape::ChoiceList: {
+      n.set("type", Node::text("array"));
+      Node items;
+      items.set("enum", strings_of(k.choices));
+      n.set("items", std::move(items));
+      break;
+    }
+    case Shape::Object:
+      if (k.ref.empty()) n.set("type", Node::text("object"));
+      else n.set("$ref", Node::text("#/$defs/" + std::string(k.ref)));
+      break;
+    case Shape::ObjectList:
+      n.set("type", Node::text("array"));
+      n.set("items", Node::ref(k.ref));
+      break;
+  }
+  if (!k.default_json.empty()) n.set("default", Node::raw(std::string(k.default_json)));
+  n.set("description", Node::text(k.doc));
+  return n;
+}
+
+Node object_schema(const ObjectKind& kind) {
+  Node n;
+  n.set("type", Node::text("object"));
+  n.set("description", Node::text(kind.doc));
+  Node& properties = n.set("properties", Node{});
+  Node required = Node::array();
+  for (const Key& k : kind.keys) {
+    properties.set(std::string(k.name), key_schema(k));
+    if (k.required) required.push(Node::text(k.name));
+  }
+  if (!required.items.empty()) n.set("required", std::move(required));
+  n.set("additionalProperties", Node::raw("false"));
+  return n;
+}
+
+Node param_value(const ParamValue& v) {
+  switch (v.index()) {
+    case 0: return Node::number(std::get<double>(v));
+    case 1: return Node::raw(std::get<bool>(v) ? "true" : "false");
+    case 2: return Node::text(std::get<std::string>(v));
+    case 3: {
+      Node a = Node::array();
+      for (const std::string& s : std::get<std::vector<std::string>>(v)) a.push(Node::text(s));
+      return a;
+    }
+    case 4: {
+      Node a = Node::array();
+      for (const double d : std::get<std::vector<double>>(v)) a.push(Node::number(d));
+      return a;
+    }
+  }
+  return Node::raw("null");
+}
+
+Node param_schema(const ParamSpec& p) {
+  Node n;
+  switch (p.type) {
+    case ParamType::Number:
+    case ParamType::Integer:
+      n.set("type", Node::text(p.type == ParamType::Integer ? "integer" : "number"));
+      if (p.min > -1e300) n.set("minimum", Node::number(p.min));
+      if (p.max < 1e300) n.set("maximum", Node::number(p.max));
+      break;
+    case ParamType::Bool: n.set("type", Node::text("boolean")); break;
+    case ParamType::String:
+    case ParamType::Signal:
+    case ParamType::Event:
+      n.set("type", Node::text("string"));
+      n.set("minLength", Node::raw("1"));
+      break;
+    case ParamType::Choice: {
+      Node e = Node::array();
+      for (const std::string& c : p.choices) e.push(Node::text(c));
+      n.set("enum", std::move(e));
+      break;
+    }
+    case ParamType::SignalList: {
+      n.set("type", Node::text("array"));
+      Node items;
+      items.set("type", Node::text("string"));
+      items.set("minLength", Node::raw("1"));
+      n.set("items", std::move(items));
+      n.set("minItems", Node::raw("1"));
+      break;
+    }
+    case ParamType::NumberList: {
+      n.set("type", Node::text("array"));
+      Node items;
+      items.set("type", Node::text("number"));
+      n.set("items", std::move(items));
+      break;
+    }
+  }
+  if (p.default_value) n.set("default", param_value(*p.default_value));
+  std::string doc = p.doc;
+  if (p.type == ParamType::Signal || p.type == ParamType::SignalList) doc += " (Component.signal, or a bare name for the target component)";
+  if (p.type == ParamType::Event) doc += " (an event of the system)";
+  n.set("description", Node::text(doc));
+  return n;
+}
+
+Node argument_schema(const FilterManifest& m) {
+  Node n;
+  n.set("type", Node::text("object"));
+  n.set("description", Node::text(m.type + ": " + m.doc));
+  Node& properties = n.set("properties", Node{});
+  Node required = Node::array();
+  for (const ParamSpec& p : m.params) {
+    properties.set(p.name, param_schema(p));
+    if (!p.default_value && !p.optional) required.push(Node::text(p.name));
+  }
+  if (!required.items.empty()) n.set("required", std::move(required));
+  n.set("additionalProperties", Node::raw("false"));
+  return n;
+}
+
+}  // namespace
+
+std::string json_schema(const FilterRegistry& registry) {
+  Node root;
+  root.set("$schema", Node::text("https://json-schema.org/draft/2020-12/schema"));
+  root.set("$id", Node::text("urn:safecass:spec:1"));
+  root.set("title", Node::text("SAFECASS specification"));
+  root.set("description", Node::text("A system file (\"system\") or a component file (\"component\"); comments (// and /* */) "
+                                     "are allowed by SAFECASS but not by JSON Schema tools. Generated from the format's key "
+                                     "tables and the filter manifests: see docs/spec-format.md."));
+  Node& one_of = root.set("oneOf", Node::array());
+  one_of.push(Node::ref("system"));
+  one_of.push(Node::ref("component"));
+  Node& defs = root.set("$defs", Node{});
+
+  const std::vector<const FilterManifest*> manifests = registry.manifests();
+  for (const ObjectKind* kind : detail::all_kinds()) {
+    Node schema = object_schema(*kind);
+    if (kind == &detail::filter_kind()) {
+      // class_name: every type and alias; argument: the schema of the named type.
+      Node names = Node::array();
+      Node all_of = Node::array();
+      for (const FilterManifest* m : manifests) {
+        Node these = Node::array();
+        these.push(Node::text(m->type));
+        for (const auto& [alias, type] : registry.aliases()) {
+          const FilterRegistry::Entry* e = registry.find(alias);
+          if (e != nullptr && &e->manifest == m) these.push(Node::text(alias));
+        }
+        for (const Node& n : these.items) names.push(n);
+        Node rule;
+        Node& condition = rule.set("if", Node{});
+        condition.set("properties", Node{}).set("class_name", Node{}).set("enum", these);
+        Node required = Node::array();
+        required.push(Node::text("class_name"));
+        condition.set("required", std::move(required));
+        Node& then = rule.set("then", Node{});
+        then.set("properties", Node{}).set("argument", Node::ref("argument_" + m->type));
+        const bool needs_argument = std::any_of(m->params.begin(), m->params.end(), [](const ParamSpec& p) {
+          return !p.default_value && !p.optional;
+        });
+        if (needs_argument) {
+          Node req = Node::array();
+          req.push(Node::text("argument"));
+          then.set("required", std::move(req));
+        }
+        all_of.push(std::move(rule));
+      }
+      if (Node* properties = schema.member("properties")) {
+        if (Node* class_name = properties->member("class_name")) {
+          // After "type", before "description".
+          class_name->keys.insert(class_name->keys.begin() + 1, "enum");
+          class_name->values.insert(class_name->values.begin() + 1, names);
+        }
+      }
+      schema.set("allOf", std::move(all_of));
+    }
+    defs.set(std::string(kind->name), std::move(schema));
+  }
+  {
+    Node entry;
+    entry.set("description", Node::text("an included file or an inline component"));
+    Node& alternatives = entry.set("oneOf", Node::array());
+    alternatives.push(Node::ref("include"));
+    alternatives.push(Node::ref("component"));
+    defs.set("component_entry", std::move(entry));
+  }
+  {
+    Node entry;
+    entry.set("description", Node::text("a filter, or a pipeline of filters"));
+    Node& alternatives = entry.set("oneOf", Node::array());
+    alternatives.push(Node::ref("filter"));
+    alternatives.push(Node::ref("pipeline"));
+    defs.set("filter_entry", std::move(entry));
+  }
+  {
+    Node c;
+    c.set("type", Node::text("object"));
+    c.set("description", Node::text("coordinator (process) name -> the components it runs; each component in one coordinator"));
+    Node& list = c.set("additionalProperties", Node{});
+    list.set("type", Node::text("array"));
+    Node items;
+    items.set("type", Node::text("string"));
+    list.set("items", std::move(items));
+    list.set("uniqueItems", Node::raw("true"));
+    defs.set("coordinators", std::move(c));
+  }
+  for (const FilterManifest* m : manifests) defs.set("argument_" + m->type, argument_schema(*m));
+
+  std::string out;
+  root.write(out, 0);
+  out += '\n';
+  return out;
+}
+
+}  // namespace safecass::spec

@@ -1,0 +1,51 @@
+#pragma once
+// Small text helpers of the spec module: suggestions, JSON pointers, UTF-8, number formatting.
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "safecass/spec/json.hpp"
+
+namespace safecass::spec::detail {
+
+/// Levenshtein distance, case-insensitive (ASCII).
+std::size_t edit_distance(std::string_view a, std::string_view b);
+
+/// The candidate nearest to `word`, if it is near enough to be a likely typo.
+std::optional<std::string> nearest(std::string_view word, const std::vector<std::string>& candidates);
+
+/// "; did you mean 'x'?" or "".
+std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates);
+
+/// `pointer` + "/" + the escaped token (RFC 6901: ~ -> ~0, / -> ~1).
+std::string pointer_join(const std::string& pointer, std::string_view token);
+std::string pointer_join(const std::string& pointer, std::size_t index);
+
+/// Position of the first byte that is not valid UTF-8 (overlong forms, surrogates and code
+/// points above U+10FFFF are invalid), and that byte.
+struct Utf8Error {
+  TextPosition position;
+  unsigned char byte = 0;
+};
+std::optional<Utf8Error> check_utf8(std::string_view text);
+
+/// %g-like, shortest form that reads back the same ("30", "0.001", "1e+300").
+std::string number_text(double value);
+
+/// "a", "b" and "c" -> "a, b or c".
+std::string join_or(const std::vector<std::string>& words);
+/// "a", "b" and "c" -> "a, b, c".
+std::string join_list(const std::vector<std::string>& words);
+
+/// Quotes a name for a message: 'name'. Control characters and long names are shortened.
+std::string quote_name(std::string_view name);
+
+/// A name that can be a component, interface, signal or coordinator name: non-empty, no dots,
+/// no white space or control characters.
+bool simple_name(std::string_view name) noexcept;
+/// Non-empty, no white space or control characters (events, filters).
+bool token_name(std::string_view name) noexcept;
+
+}  // namespace safecass::spec::detail

@@ -1,0 +1,94 @@
+#pragma once
+/// @file scenario_runner.hpp
+/// Runs a system in-process in simulated time, driven by a scenario (DESIGN §6): at each tick t,
+/// in order, (1) apply the steps due at t in file order (samples, ramps, generate, inject, reset),
+/// (2) run the filters due at t (each component's ACTIVE filters at its own period, PASSIVE
+/// filters at the monitor period) and the components' bodies, (3) check the expectations due at t.
+/// Same inputs → same output, byte for byte.
+///
+/// Example programs use it with their application code: prepare(), then set task bodies on
+/// runtime(), then run().
+
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/native/runtime.hpp"
+#include "safecass/spec/diagnostics.hpp"
+#include "safecass/spec/scenario.hpp"
+#include "safecass/spec/system.hpp"
+
+namespace safecass::runner {
+
+struct RunOptions {
+  bool json = false;            ///< one JSON object per line instead of text
+  bool quiet = false;           ///< print nothing but failures
+  std::string record_path;      ///< write the whole history as JSON lines
+  std::string system_override;  ///< run this system file instead of the scenario's "system"
+  std::FILE* out = stdout;
+};
+
+/// What a run did, for `safecass test`'s coverage summary.
+struct Coverage {
+  std::set<std::string> events_fired;                       ///< events processed (not ignored)
+  std::set<std::pair<std::string, std::string>> taken;      ///< (event, transition) that caused a transition
+  std::set<std::pair<std::string, std::string>> defined;    ///< (event, transition) listed by the system's events
+};
+
+struct RunResult {
+  int checks = 0;                       ///< expectations checked
+  std::vector<std::string> failures;    ///< "file:line:col: expectation failed at t=...: ..."
+  Coverage coverage;
+  bool passed() const noexcept { return failures.empty(); }
+};
+
+class ScenarioRunner {
+public:
+  ScenarioRunner(spec::Scenario scenario, spec::SystemSpec system, const FilterRegistry& registry);
+  ~ScenarioRunner();
+
+  /// Builds the system and checks every name the scenario uses (signals, sizes, events, filters,
+  /// addresses); every problem is returned with the step's position. Empty = ready.
+  std::vector<spec::Diagnostic> prepare();
+
+  Coordinator& coordinator() noexcept { return coordinator_; }
+  Monitor& monitor() noexcept { return *monitor_; }
+  native::Runtime& runtime() noexcept { return *runtime_; }
+  SimulatedClock& clock() noexcept { return clock_; }
+  const spec::Scenario& scenario() const noexcept { return scenario_; }
+
+  /// Runs the whole scenario. Precondition: prepare() returned no diagnostics.
+  RunResult run(const RunOptions& options);
+
+private:
+  struct Ramp {
+    Signal* signal;
+    Time from_time;
+    Time until;
+    double from;
+    double to;
+  };
+  void apply(const spec::ScenarioStep& step, Time now);
+  void check(const spec::ScenarioStep& step, Time now, RunResult& result);
+  std::string check_one(const spec::ScenarioStep& step, const std::string& address, const std::string& expected);
+
+  spec::Scenario scenario_;
+  spec::SystemSpec system_;
+  SimulatedClock clock_;
+  Coordinator coordinator_;
+  std::unique_ptr<Monitor> monitor_;
+  std::unique_ptr<native::Runtime> runtime_;
+  std::vector<Ramp> ramps_;
+};
+
+/// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,
+/// 1 an expectation failed, 2 invalid input. `result` (optional) receives the run's details.
+int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,
+                      RunResult* result = nullptr, std::FILE* err = stderr);
+
+}  // namespace safecass::runner

@@ -1,0 +1,82 @@
+// `safecass validate` and `safecass schema`.
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "safecass/filters/registry.hpp"
+#include "safecass/spec/spec.hpp"
+#include "spec_commands.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+      out += buf;
+      continue;
+    }
+    out += c;
+  }
+  return out + "\"";
+}
+
+bool readable(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  return static_cast<bool>(in);
+}
+
+}  // namespace
+
+int run_validate(const std::vector<std::string>& files, bool json_output) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  std::size_t errors = 0;
+  std::size_t warnings = 0;
+  bool unreadable = false;
+  for (const std::string& file : files) {
+    std::vector<spec::Diagnostic> diagnostics;
+    if (!readable(file)) {
+      unreadable = true;
+      spec::Diagnostic d;
+      d.where.file = file;
+      d.message = "cannot read file '" + file + "'";
+      diagnostics.push_back(std::move(d));
+    } else {
+      diagnostics = spec::load_system(file, registry).diagnostics;
+    }
+    for (const spec::Diagnostic& d : diagnostics) {
+      (d.severity == spec::Diagnostic::Severity::Error ? errors : warnings) += 1;
+      std::printf("%s\n", (json_output ? spec::to_json(d) : spec::format(d)).c_str());
+    }
+  }
+  if (json_output) {
+    std::string list;
+    for (const std::string& f : files) list += (list.empty() ? "" : ", ") + quote(f);
+    std::printf("{\"files\": [%s], \"errors\": %zu, \"warnings\": %zu}\n", list.c_str(), errors, warnings);
+  } else {
+    std::printf("%zu error%s, %zu warning%s\n", errors, errors == 1 ? "" : "s", warnings, warnings == 1 ? "" : "s");
+  }
+  std::fflush(stdout);
+  if (unreadable) return 2;
+  return errors > 0 ? 1 : 0;
+}
+
+int run_schema() {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  const std::string schema = spec::json_schema(registry);
+  std::fwrite(schema.data(), 1, schema.size(), stdout);
+  std::fflush(stdout);
+  return 0;
+}
+
+}  // namespace safecass::tools
