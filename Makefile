@@ -22,6 +22,8 @@ build: configure
 demo: build
 	@mkdir -p $(BUILD)/demo
 	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
+	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
+	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
 
 test: build
 	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)

@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
-  libexpected-dev libcli11-dev nlohmann-json3-dev
+  libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev
   clang libclang-rt-14-dev
 )
 

@@ -381,11 +381,16 @@ void Coordinator::rebuild_fanout() {
     const ComponentData& provider = *components_[conn.provider];
     const MachineId client_machine = components_[conn.client]->required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
-    for (MachineId m = 0; m < machines_.size(); ++m) {
+    // Only the provider's own machines can feed its service.
+    auto add_if_feeding = [&](MachineId m) {
       if (depends_on(conn.provider, conn.provided, *machines_[m])) {
         machines_[m]->fanout.push_back(Edge{client_machine, min_level, k});
       }
-    }
+    };
+    add_if_feeding(provider.framework);
+    add_if_feeding(provider.application);
+    for (MachineId m : provider.provided) add_if_feeding(m);
+    for (MachineId m : provider.required) add_if_feeding(m);
   }
 }
 

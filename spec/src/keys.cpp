@@ -181,7 +181,7 @@ const ObjectKind& pipeline_kind() {
       "pipeline",
       "a chain of filters: a stage without an input reads the previous stage's output",
       {text("name", "name of the pipeline (no dots or spaces); unnamed stages are called name.1, name.2...", true),
-       objects("pipeline", "the stages, in order", "filter", true),
+       objects("pipeline", "the stages, in order", "stage", true),
        object("target", "default target of the stages", "target"), kDescriptionKey}};
   return kind;
 }

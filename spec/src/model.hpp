@@ -159,10 +159,10 @@ struct Model {
   std::string path;
   bool system_file = false;  ///< the loaded file is a system file (not a single component)
   std::size_t component_entries = 0;  ///< entries of the top-level "components" list
+  bool has_components_key = false;    ///< the top-level file has a (well-typed) "components" list
   std::vector<ComponentItem> components;
   std::vector<ConnectionItem> connections;
   std::vector<CoordinatorItem> coordinators;
-  Site coordinators_site;
   bool has_coordinators = false;
 };
 

@@ -247,6 +247,11 @@ private:
     const bool system = root.find_member("system") != nullptr || root.find_member("components") != nullptr;
     const bool component = root.find_member("component") != nullptr;
     const Site site{doc, root.position, ""};
+    if (root.find_member("steps") != nullptr && !component) {
+      sink_.error(site, "this is a scenario (it has \"steps\"), not a system or component file: run it with "
+                        "`safecass run` or `safecass test`");
+      return FileKind::Invalid;
+    }
     if (system && component) {
       sink_.error(site, "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both");
       return FileKind::Invalid;
@@ -296,8 +301,10 @@ private:
       text = *given_text;
     } else {
       const fs::file_status status = fs::status(p, ec);
-      if (ec || !fs::exists(status)) {
+      if (status.type() == fs::file_type::not_found) {
         problem = "cannot read file " + quote_name(path) + ": no such file";
+      } else if (ec || !fs::exists(status)) {
+        problem = "cannot read file " + quote_name(path) + ": " + ec.message();
       } else if (!fs::is_regular_file(status)) {
         problem = "cannot read file " + quote_name(path) + ": not a regular file";
       } else {
@@ -401,7 +408,10 @@ private:
       if (const JsonValue* n = f.get("system")) model_.name = n->string;
     }
     if (const JsonValue* list = f.get("components")) {
-      if (top) model_.component_entries = list->array.size();
+      if (top) {
+        model_.component_entries = list->array.size();
+        model_.has_components_key = true;
+      }
       for (std::size_t i = 0; i < list->array.size(); ++i) {
         const JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("components"), i);
@@ -444,7 +454,6 @@ private:
     }
     if (const JsonValue* coordinators = f.get("coordinators")) {
       const std::string base = f.pointer("coordinators");
-      if (top || !model_.has_coordinators) model_.coordinators_site = f.site("coordinators");
       std::set<std::string_view> seen;
       for (const JsonMember& m : coordinators->object) {
         const Site key_site{doc, m.key_position, pointer_join(base, m.key)};

@@ -1,5 +1,6 @@
 #include "safecass/spec/schema.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -238,19 +239,80 @@ Node param_schema(const ParamSpec& p) {
   return n;
 }
 
+bool is_signal_param(const FilterManifest& m, const std::string& name) {
+  return std::find(m.inputs.begin(), m.inputs.end(), name) != m.inputs.end() ||
+         std::find(m.outputs.begin(), m.outputs.end(), name) != m.outputs.end();
+}
+
+/// Required parameters, either those a pipeline can fill in (inputs, outputs) or the others.
+Node required_params(const FilterManifest& m, bool signals) {
+  Node required = Node::array();
+  for (const ParamSpec& p : m.params) {
+    if (!p.default_value && !p.optional && is_signal_param(m, p.name) == signals) required.push(Node::text(p.name));
+  }
+  return required;
+}
+
+/// The parameters of a filter type. Inputs and outputs are not required here: a pipeline
+/// wires them; a standalone filter requires them (see filter_rules).
 Node argument_schema(const FilterManifest& m) {
   Node n;
   n.set("type", Node::text("object"));
   n.set("description", Node::text(m.type + ": " + m.doc));
   Node& properties = n.set("properties", Node{});
-  Node required = Node::array();
-  for (const ParamSpec& p : m.params) {
-    properties.set(p.name, param_schema(p));
-    if (!p.default_value && !p.optional) required.push(Node::text(p.name));
-  }
+  Node required = required_params(m, false);
+  for (const ParamSpec& p : m.params) properties.set(p.name, param_schema(p));
   if (!required.items.empty()) n.set("required", std::move(required));
   n.set("additionalProperties", Node::raw("false"));
   return n;
+}
+
+/// A filter (or, with `stage`, a pipeline stage, whose input and output the pipeline may fill
+/// in): class_name names every type and alias; argument follows the named type.
+Node filter_schema(const FilterRegistry& registry, const std::vector<const FilterManifest*>& manifests, bool stage) {
+  Node schema = object_schema(detail::filter_kind());
+  if (stage) {
+    *schema.member("description") = Node::text("a pipeline stage: a filter whose input may come from the previous stage and whose "
+                                  "output may be named by the pipeline");
+  }
+  Node names = Node::array();
+  Node all_of = Node::array();
+  for (const FilterManifest* m : manifests) {
+    Node these = Node::array();
+    these.push(Node::text(m->type));
+    for (const auto& [alias, type] : registry.aliases()) {
+      const FilterRegistry::Entry* e = registry.find(alias);
+      if (e != nullptr && &e->manifest == m) these.push(Node::text(alias));
+    }
+    for (const Node& n : these.items) names.push(n);
+    Node rule;
+    Node& condition = rule.set("if", Node{});
+    condition.set("properties", Node{}).set("class_name", Node{}).set("enum", these);
+    Node required = Node::array();
+    required.push(Node::text("class_name"));
+    condition.set("required", std::move(required));
+    Node& then = rule.set("then", Node{});
+    Node argument = Node::ref("argument_" + m->type);
+    Node signal_params = required_params(*m, true);
+    const bool needs_argument = !required_params(*m, false).items.empty() || (!stage && !signal_params.items.empty());
+    if (!stage && !signal_params.items.empty()) argument.set("required", std::move(signal_params));
+    then.set("properties", Node{}).set("argument", std::move(argument));
+    if (needs_argument) {
+      Node req = Node::array();
+      req.push(Node::text("argument"));
+      then.set("required", std::move(req));
+    }
+    all_of.push(std::move(rule));
+  }
+  if (Node* properties = schema.member("properties")) {
+    if (Node* class_name = properties->member("class_name")) {
+      // After "type", before "description".
+      class_name->keys.insert(class_name->keys.begin() + 1, "enum");
+      class_name->values.insert(class_name->values.begin() + 1, names);
+    }
+  }
+  schema.set("allOf", std::move(all_of));
+  return schema;
 }
 
 }  // namespace
@@ -270,47 +332,12 @@ std::string json_schema(const FilterRegistry& registry) {
 
   const std::vector<const FilterManifest*> manifests = registry.manifests();
   for (const ObjectKind* kind : detail::all_kinds()) {
-    Node schema = object_schema(*kind);
     if (kind == &detail::filter_kind()) {
-      // class_name: every type and alias; argument: the schema of the named type.
-      Node names = Node::array();
-      Node all_of = Node::array();
-      for (const FilterManifest* m : manifests) {
-        Node these = Node::array();
-        these.push(Node::text(m->type));
-        for (const auto& [alias, type] : registry.aliases()) {
-          const FilterRegistry::Entry* e = registry.find(alias);
-          if (e != nullptr && &e->manifest == m) these.push(Node::text(alias));
-        }
-        for (const Node& n : these.items) names.push(n);
-        Node rule;
-        Node& condition = rule.set("if", Node{});
-        condition.set("properties", Node{}).set("class_name", Node{}).set("enum", these);
-        Node required = Node::array();
-        required.push(Node::text("class_name"));
-        condition.set("required", std::move(required));
-        Node& then = rule.set("then", Node{});
-        then.set("properties", Node{}).set("argument", Node::ref("argument_" + m->type));
-        const bool needs_argument = std::any_of(m->params.begin(), m->params.end(), [](const ParamSpec& p) {
-          return !p.default_value && !p.optional;
-        });
-        if (needs_argument) {
-          Node req = Node::array();
-          req.push(Node::text("argument"));
-          then.set("required", std::move(req));
-        }
-        all_of.push(std::move(rule));
-      }
-      if (Node* properties = schema.member("properties")) {
-        if (Node* class_name = properties->member("class_name")) {
-          // After "type", before "description".
-          class_name->keys.insert(class_name->keys.begin() + 1, "enum");
-          class_name->values.insert(class_name->values.begin() + 1, names);
-        }
-      }
-      schema.set("allOf", std::move(all_of));
+      defs.set("filter", filter_schema(registry, manifests, false));
+      defs.set("stage", filter_schema(registry, manifests, true));
+    } else {
+      defs.set(std::string(kind->name), object_schema(*kind));
     }
-    defs.set(std::string(kind->name), std::move(schema));
   }
   {
     Node entry;

@@ -125,7 +125,10 @@ private:
   void check_components() {
     for (std::size_t i = 0; i < m_.components.size(); ++i) {
       ComponentItem& c = m_.components[i];
-      if (!c.has_name) continue;
+      if (!c.has_name) {
+        invalid_components_.insert(c.name);  // reported as a missing key
+        continue;
+      }
       if (!simple_name(c.name)) {
         sink_.error(c.name_site, "component name " + quote_name(c.name) + " must be non-empty, without dots or spaces");
         invalid_components_.insert(c.name);
@@ -142,7 +145,7 @@ private:
                                      sink_.at(m_.components[it->second].name_site) + ")");
       }
     }
-    if (m_.system_file && m_.component_entries == 0 && m_.components.empty()) {
+    if (m_.system_file && m_.has_components_key && m_.component_entries == 0) {
       sink_.warning(Site{0, sink_.documents.empty() || !sink_.documents[0].root ? TextPosition{} : sink_.documents[0].root->position, ""},
                     "system " + quote_name(m_.name) + " has no components");
     }
@@ -417,7 +420,12 @@ private:
   void check_coordinators() {
     if (!m_.has_coordinators) return;
     std::map<std::string, Site, std::less<>> assigned;
+    std::map<std::string, Site, std::less<>> names;
     for (const CoordinatorItem& co : m_.coordinators) {
+      if (const auto [it, fresh] = names.emplace(co.name.text, co.name.site); !fresh) {
+        sink_.error(co.name.site, "duplicate coordinator " + quote_name(co.name.text) + " (first at " +
+                                      sink_.at(it->second) + ")");
+      }
       if (!simple_name(co.name.text)) {
         sink_.error(co.name.site, "coordinator name " + quote_name(co.name.text) + " must be non-empty, without dots or spaces");
       } else if (co.name.text == "SYSTEM") {
@@ -634,7 +642,7 @@ private:
         f.stage > 0 ? "; the previous stage of pipeline " + quote_name(f.pipeline) + " writes no output it could read" : "";
     bool missing_input = false;
     for (const ParamSpec& spec : manifest.params) {
-      if (spec.default_value || spec.optional || given.count(spec.name) > 0 || items.count(spec.name) > 0) continue;
+      if (spec.default_value || spec.optional || given.count(spec.name) > 0) continue;
       if (std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == spec.name; })) continue;
       const bool input = std::find(manifest.inputs.begin(), manifest.inputs.end(), spec.name) != manifest.inputs.end();
       missing_input = missing_input || input;
@@ -642,7 +650,6 @@ private:
       if (misspelled.count(spec.name) > 0) continue;  // reported as the unknown parameter
       sink_.error(f.argument_site, ctx + ": missing parameter " + quote_name(spec.name) + " (" + spec.doc + ")" +
                                        (input ? pipeline_note : ""));
-      params_ok = false;
     }
     const bool has_input = std::any_of(manifest.inputs.begin(), manifest.inputs.end(), [&](const std::string& n) {
       return std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == n; });

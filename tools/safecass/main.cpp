@@ -5,6 +5,8 @@
 
 #include "commands.hpp"
 #include "spec_commands.hpp"
+#include "timeline.hpp"
+#include "console.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"SAFECASS: safety architecture for component-based robot systems"};
@@ -38,6 +40,15 @@ int main(int argc, char** argv) {
   test->add_option("SCENARIO", test_args.scenarios, "scenario files")->required();
   test->add_option("--junit", test_args.junit, "write JUnit XML to this file");
   test->callback([&] { code = safecass::tools::run_test(test_args); });
+
+  safecass::tools::add_console_command(app, code);
+
+  std::string timeline_history;
+  std::string timeline_html;
+  auto* timeline = app.add_subcommand("timeline", "Draw a recorded history as Normal/Warning/Error swimlanes in one static HTML page");
+  timeline->add_option("HISTORY", timeline_history, "history file (JSON lines, from `safecass run --record`)")->required();
+  timeline->add_option("--html", timeline_html, "write the page to this file")->required();
+  timeline->callback([&] { code = safecass::tools::run_timeline(timeline_history, timeline_html); });
 
   try {
     app.parse(argc, argv);

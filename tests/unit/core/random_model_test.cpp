@@ -632,7 +632,7 @@ public:
     } else if (roll < 500) {
       // Repeat an active onset at its origin: a refresh (level-triggered filters do this).
       const auto active = oracle_->active_roots();
-      if (active.empty()) return finish("nothing active", now);
+      if (active.empty()) return finish("nothing active");
       const auto [m, e] = rng_.pick(active);
       op << "refresh " << co_.event(e).name << " on " << co_.address_of(m);
       co_.generate(e, m);
@@ -706,7 +706,7 @@ public:
       for (const ComponentSpec& c : spec_.components) {
         for (const std::string& p : c.provided) services.push_back(c.name + ".s_S." + p);
       }
-      if (services.empty()) return finish("no services", now);
+      if (services.empty()) return finish("no services");
       const std::string target = rng_.pick(services);
       op << "reset " << target << " (refused)";
       const auto result = co_.reset(target, "random", "service");
@@ -722,11 +722,11 @@ public:
     } else {
       op << "idle";
     }
-    return finish(op.str(), now);
+    return finish(op.str());
   }
 
 private:
-  std::string finish(const std::string& op, Time /*now*/) {
+  std::string finish(const std::string& op) {
     last_ops_.push_back(op);
     if (last_ops_.size() > 8) last_ops_.erase(last_ops_.begin());
     std::string err = check();
@@ -773,7 +773,6 @@ private:
   }
 
   std::string check() {
-    std::ostringstream err;
     const Oracle& o = *oracle_;
     std::set<std::uint64_t> seqs;
     std::size_t total_conditions = 0;
@@ -934,7 +933,7 @@ private:
     if (step_ % 16 == 0) {
       if (std::string e = check_explain(); !e.empty()) return e;
     }
-    return err.str();
+    return {};
   }
 
   /// Every transition fired on_exit(old) → on_transition → on_entry(new), with consistent states.

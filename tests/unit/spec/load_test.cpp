@@ -31,7 +31,7 @@ std::vector<std::string> messages(const LoadResult& r) {
   return out;
 }
 
-TEST(Diagnostics, FormatLikeACompiler) {
+TEST(SpecDiagnostics, FormatLikeACompiler) {
   Diagnostic d{Diagnostic::Severity::Error, {"a.json", 3, 7}, "bad thing", "/filter/1/argument/threshold"};
   EXPECT_EQ(format(d), "a.json:3:7: error: bad thing [/filter/1/argument/threshold]");
   d.severity = Diagnostic::Severity::Warning;
@@ -41,12 +41,12 @@ TEST(Diagnostics, FormatLikeACompiler) {
   EXPECT_EQ(format(d), "a.json: warning: bad thing");
 }
 
-TEST(Diagnostics, ConvertToOneLineJson) {
+TEST(SpecDiagnostics, ConvertToOneLineJson) {
   const Diagnostic d{Diagnostic::Severity::Error, {"a.json", 3, 7}, "say \"x\"", "/a~1b"};
   EXPECT_EQ(to_json(d), R"({"file": "a.json", "line": 3, "column": 7, "severity": "error", "message": "say \"x\"", "pointer": "/a~1b"})");
 }
 
-TEST(Load, TheBaseComponentHasNoDiagnostic) {
+TEST(SpecLoad, TheBaseComponentHasNoDiagnostic) {
   const LoadResult r = load_text(component());
   EXPECT_EQ(formatted(r), "");
   EXPECT_TRUE(r.ok());
@@ -54,7 +54,7 @@ TEST(Load, TheBaseComponentHasNoDiagnostic) {
   EXPECT_EQ(r.warnings(), 0u);
 }
 
-TEST(Load, ReportsEveryProblemAtOnceSortedByPosition) {
+TEST(SpecLoad, ReportsEveryProblemAtOnceSortedByPosition) {
   const LoadResult r = load_text(R"({
   "component": "ARM",
   "evnt": [],
@@ -75,7 +75,7 @@ TEST(Load, ReportsEveryProblemAtOnceSortedByPosition) {
   EXPECT_FALSE(r.system);
 }
 
-TEST(Load, UnknownFilterClassFarFromAnyKnownOneListsThem) {
+TEST(SpecLoad, UnknownFilterClassFarFromAnyKnownOneListsThem) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "Kalman"})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre(
                                "filter 'ARM.Kalman_2': unknown filter class 'Kalman' (known: Threshold, Range, OnOff, "
@@ -83,38 +83,44 @@ TEST(Load, UnknownFilterClassFarFromAnyKnownOneListsThem) {
                                "NOP, Occurrence, Watchdog, Frequency, DutyCycle, Deadline)"));
 }
 
-TEST(Load, UnknownKeyFarFromAnyKnownKeyListsTheKnownKeys) {
+TEST(SpecLoad, UnknownKeyFarFromAnyKnownKeyListsTheKnownKeys) {
   const LoadResult r = load_text(R"({"component": "ARM", "colour": "red"})");
   EXPECT_THAT(messages(r), ::testing::ElementsAre(
                                "component 'ARM': unknown key 'colour' (known keys: $schema, safecass, component, "
                                "description, interfaces, signals, event, filter, service, period)"));
 }
 
-TEST(Load, JsonPointersEscapeSlashAndTilde) {
+TEST(SpecLoad, JsonPointersEscapeSlashAndTilde) {
   const LoadResult r = load_text(R"({"component": "ARM", "a/b~c": 1})");
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_EQ(r.diagnostics[0].pointer, "/a~1b~0c");
 }
 
-TEST(Load, AMissingFileIsAnErrorOnTheFileAsAWhole) {
+TEST(SpecLoad, AMissingFileIsAnErrorOnTheFileAsAWhole) {
   const LoadResult r = load_system("tests/data/no_such_file.json", builtin_registry());
   EXPECT_EQ(formatted(r), "tests/data/no_such_file.json: error: cannot read file 'tests/data/no_such_file.json': no such file\n");
   EXPECT_FALSE(r.ok());
 }
 
-TEST(Load, AcceptsAByteOrderMark) {
+TEST(SpecLoad, AnIncludeThatCannotBeExaminedGivesTheSystemsReason) {
+  const LoadResult r = load_text(R"({"system": "s", "components": [{"include": ")" + std::string(5000, 'a') + R"("}]})");
+  ASSERT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_THAT(r.diagnostics[0].message, HasSubstr("File name too long"));
+}
+
+TEST(SpecLoad, AcceptsAByteOrderMark) {
   const LoadResult r = load_text("\xEF\xBB\xBF" + component());
   EXPECT_EQ(formatted(r), "");
 }
 
-TEST(Load, RejectsFilesLargerThan16MiB) {
+TEST(SpecLoad, RejectsFilesLargerThan16MiB) {
   const std::string big = "{\"component\": \"ARM\", \"description\": \"" + std::string(17u << 20, 'x') + "\"}";
   const LoadResult r = load_text(big);
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_THAT(r.diagnostics[0].message, HasSubstr("is larger than 16 MiB"));
 }
 
-TEST(Load, IncludesAreRelativeToTheIncludingFile) {
+TEST(SpecLoad, IncludesAreRelativeToTheIncludingFile) {
   const LoadResult r = load_text(R"({"system": "s", "components": [{"include": "good_specs/jr3.json"}]})",
                                  "tests/data/inline_system.json");
   EXPECT_EQ(formatted(r), "");
@@ -122,29 +128,29 @@ TEST(Load, IncludesAreRelativeToTheIncludingFile) {
   EXPECT_EQ(r.system->components[0].file, "tests/data/good_specs/jr3.json");
 }
 
-TEST(Load, AnEmptyIncludePathIsAnError) {
+TEST(SpecLoad, AnEmptyIncludePathIsAnError) {
   const LoadResult r = load_text(R"({"system": "s", "components": [{"include": ""}]})");
   EXPECT_THAT(messages(r), ::testing::ElementsAre("include: the path is empty"));
 }
 
-TEST(Load, UnnamedFiltersAreNamedAfterComponentTypeAndPosition) {
+TEST(SpecLoad, UnnamedFiltersAreNamedAfterComponentTypeAndPosition) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "FilterNorm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
   ASSERT_TRUE(r.system) << formatted(r);
   EXPECT_EQ(r.system->components[0].filters[1].stages[0].name, "ARM.Norm_2");
   EXPECT_EQ(r.system->components[0].filters[1].stages[0].type, "Norm");
 }
 
-TEST(Load, OnsetMustNotSayWhatItCompletes) {
+TEST(SpecLoad, OnsetMustNotSayWhatItCompletes) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"], "completes": "EVT_F"})"));
   EXPECT_THAT(messages(r), ::testing::Contains("event 'EVT_G' is an onset: only a completion may say which onset it 'completes'"));
 }
 
-TEST(Load, CompletionMustBeNamedSlashOnsetOrSayWhatItCompletes) {
+TEST(SpecLoad, CompletionMustBeNamedSlashOnsetOrSayWhatItCompletes) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"]})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("completion 'F_CLEARED' must be named '/ONSET' or say which onset it 'completes'"));
 }
 
-TEST(Load, CompletionMayNameItsOnsetExplicitly) {
+TEST(SpecLoad, CompletionMayNameItsOnsetExplicitly) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"], "completes": "EVT_F"})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre(
                                "onset 'EVT_F' has 2 completions ('/EVT_F' and 'F_CLEARED'): name the one each filter sends "
@@ -152,76 +158,76 @@ TEST(Load, CompletionMayNameItsOnsetExplicitly) {
   EXPECT_TRUE(r.ok());
 }
 
-TEST(Load, CompletionOfACompletionIsAnError) {
+TEST(SpecLoad, CompletionOfACompletionIsAnError) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "X", "severity": 5, "state_transition": ["E2N"], "completes": "/EVT_F"})"));
   EXPECT_THAT(messages(r), ::testing::Contains("completion 'X' completes '/EVT_F', which is not an onset"));
 }
 
-TEST(Load, LatchedOnsetsAreExpectedToNeedAReset) {
+TEST(SpecLoad, LatchedOnsetsAreExpectedToNeedAReset) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 9, "event_onset": "EVT_L"}})",
                                            R"(, {"name": "EVT_L", "severity": 70, "state_transition": ["N2E"], "latched": true})"));
   EXPECT_EQ(formatted(r), "");
 }
 
-TEST(Load, BroadcastEventsNeedNoFilter) {
+TEST(SpecLoad, BroadcastEventsNeedNoFilter) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_ESTOP", "severity": 255, "state_transition": ["N2E"], "latched": true})"));
   EXPECT_EQ(formatted(r), "");
 }
 
-TEST(Load, AnEmptyTransitionListIsAnError) {
+TEST(SpecLoad, AnEmptyTransitionListIsAnError) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_G", "severity": 5, "state_transition": []})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("event 'EVT_G': 'state_transition' is empty: list worsening transitions "
                                                   "(an onset) or improving ones (a completion)"));
 }
 
-TEST(Load, FilterCompletionMustCompleteItsOnset) {
+TEST(SpecLoad, FilterCompletionMustCompleteItsOnset) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_onset": "EVT_G", "event_completion": "/EVT_F"}})",
                                            R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"]}, {"name": "/EVT_G", "severity": 5, "state_transition": ["W2N"]})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): completion '/EVT_F' does not complete "
                                                   "onset 'EVT_G' (it completes 'EVT_F')"));
 }
 
-TEST(Load, FilterCompletionWithoutOnsetIsAnError) {
+TEST(SpecLoad, FilterCompletionWithoutOnsetIsAnError) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_completion": "/EVT_F"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): parameter 'event_completion' gives a "
                                                   "completion but no onset ('event_onset')"));
 }
 
-TEST(Load, ProvidedOrRequiredTargetNeedsAnInterface) {
+TEST(SpecLoad, ProvidedOrRequiredTargetNeedsAnInterface) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_R"}, "argument": {"input_signal": "Force"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.NOP_2' (NOP): target type s_R needs an 'interface'"));
   const LoadResult ok = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_R", "interface": "Command"}, "argument": {"input_signal": "Force"}})"));
   EXPECT_EQ(formatted(ok), "");
 }
 
-TEST(Load, AnInterfaceOnAnApplicationTargetIsIgnoredWithAWarning) {
+TEST(SpecLoad, AnInterfaceOnAnApplicationTargetIsIgnoredWithAWarning) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_A", "interface": "Motion"}, "argument": {"input_signal": "Force"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.NOP_2' (NOP): 'interface' is ignored for target type s_A"));
   EXPECT_TRUE(r.ok());
 }
 
-TEST(Load, TwoFiltersWritingOneSignalGetAWarning) {
+TEST(SpecLoad, TwoFiltersWritingOneSignalGetAWarning) {
   const LoadResult r = load_text(component("", R"(, {"name": "a", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}},
                                                    {"name": "b", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_THAT(r.diagnostics[0].message, HasSubstr("filter 'b' (Norm) writes signal 'ARM.N', which filter 'a' also writes"));
 }
 
-TEST(Load, AFilterCanReadOnlyWhatAnEarlierFilterWrites) {
+TEST(SpecLoad, AFilterCanReadOnlyWhatAnEarlierFilterWrites) {
   const LoadResult r = load_text(component("", R"(, {"name": "late", "class_name": "Threshold", "argument": {"input_signal": "N", "threshold": 1}},
                                                    {"name": "norm", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'late' (Threshold): parameter 'input_signal': signal 'ARM.N' is not "
                                                   "declared and no earlier filter writes it"));
 }
 
-TEST(Load, VectorSizesFlowThroughOutputs) {
+TEST(SpecLoad, VectorSizesFlowThroughOutputs) {
   // MovingAverage of a 6-vector writes a 6-vector; Threshold needs a scalar.
   const LoadResult r = load_text(component("", R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Wrench", "output_signal": "W"}},
                                                    {"name": "lim", "class_name": "Threshold", "argument": {"input_signal": "W", "threshold": 1}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'lim' (Threshold): input 'ARM.W' has size 6; Threshold needs a scalar (use Norm for vectors)"));
 }
 
-TEST(Load, ParameterListsAreCheckedItemByItem) {
+TEST(SpecLoad, ParameterListsAreCheckedItemByItem) {
   const LoadResult r = load_text(component("", R"(, {"name": "v", "class_name": "Vectorize", "argument": {"input_signals": ["Force", "Forse"], "output_signal": "V"}},
                                                    {"name": "w", "class_name": "Vectorize", "argument": {"input_signals": ["Force", 3], "output_signal": "V2"}})"));
   ASSERT_EQ(r.diagnostics.size(), 2u) << formatted(r);
@@ -230,24 +236,24 @@ TEST(Load, ParameterListsAreCheckedItemByItem) {
   EXPECT_EQ(r.diagnostics[1].message, "filter 'w' (Vectorize): parameter 'input_signals' must be a list of signal names, not an array");
 }
 
-TEST(Load, IntegerParametersMustBeWhole) {
+TEST(SpecLoad, IntegerParametersMustBeWhole) {
   const LoadResult r = load_text(component("", R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Force", "output_signal": "A", "window": 2.5}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'avg' (MovingAverage): parameter 'window' must be a whole number, not 2.5"));
 }
 
-TEST(Load, ChoiceParametersUseTheFiltersModuleCheck) {
+TEST(SpecLoad, ChoiceParametersUseTheFiltersModuleCheck) {
   const LoadResult r = load_text(component("", R"(, {"name": "n", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N", "norm": "L3"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'n' (Norm): parameter 'norm' must be one of L2, L1, Linf"));
 }
 
-TEST(Load, EmptyPipelineAndDuplicatePipelineAreErrors) {
+TEST(SpecLoad, EmptyPipelineAndDuplicatePipelineAreErrors) {
   const LoadResult r = load_text(component("", R"(, {"name": "p", "pipeline": []},
       {"name": "q", "pipeline": [{"class_name": "NOP", "argument": {"input_signal": "Force"}}]},
       {"name": "q", "pipeline": [{"class_name": "NOP", "argument": {"input_signal": "Force"}}]})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("pipeline 'p' has no stages", ::testing::StartsWith("duplicate pipeline 'q'")));
 }
 
-TEST(Load, PipelineTargetIsTheDefaultOfItsStages) {
+TEST(SpecLoad, PipelineTargetIsTheDefaultOfItsStages) {
   const LoadResult r = load_text(R"({"component": "A", "interfaces": {"provided": ["P"]}, "signals": [{"name": "x"}],
     "event": [{"name": "E", "severity": 9, "state_transition": ["N2W"]}, {"name": "/E", "severity": 9, "state_transition": ["W2N"]}],
     "filter": [{"name": "p", "target": {"type": "s_P", "interface": "P"}, "pipeline": [
@@ -263,13 +269,13 @@ TEST(Load, PipelineTargetIsTheDefaultOfItsStages) {
   EXPECT_EQ(monitor.filters().size(), 2u);
 }
 
-TEST(Load, CoordinatorNamesMustNotBeComponentNames) {
+TEST(SpecLoad, CoordinatorNamesMustNotBeComponentNames) {
   const LoadResult r = load_text(R"({"system": "s", "components": [{"component": "A"}], "coordinators": {"A": ["A"]}})");
   EXPECT_THAT(messages(r), ::testing::ElementsAre(
                                "coordinator 'A' has the name of a component: a coordinator's name addresses all its components"));
 }
 
-TEST(Load, PipelineStagesRunInOneCoordinator) {
+TEST(SpecLoad, PipelineStagesRunInOneCoordinator) {
   const LoadResult r = load_text(R"({"system": "s", "components": [
     {"component": "A", "signals": [{"name": "x"}]}, {"component": "B"},
     {"component": "C", "filter": [{"name": "p", "pipeline": [
@@ -280,7 +286,7 @@ TEST(Load, PipelineStagesRunInOneCoordinator) {
                                "pipeline 'p': stage 2 targets a component of coordinator 'two' but the pipeline runs in 'one'"));
 }
 
-TEST(Load, SeverityBoundsAreInclusive) {
+TEST(SpecLoad, SeverityBoundsAreInclusive) {
   for (const char* ok : {"1", "255"}) {
     const LoadResult r = load_text(component("", "", std::string(R"(, {"name": "EVT_B", "severity": )") + ok + R"(, "state_transition": ["N2W"], "latched": true})"));
     EXPECT_TRUE(r.ok()) << formatted(r);
@@ -291,7 +297,7 @@ TEST(Load, SeverityBoundsAreInclusive) {
   }
 }
 
-TEST(Load, IncompatibleConnectionOnTheProvidedSide) {
+TEST(SpecLoad, IncompatibleConnectionOnTheProvidedSide) {
   const LoadResult r = load_text(R"({"system": "s", "components": [
     {"component": "A", "interfaces": {"provided": ["P"], "required": ["R"]}},
     {"component": "B", "interfaces": {"provided": ["Q"], "required": ["S"]}}],
@@ -300,7 +306,7 @@ TEST(Load, IncompatibleConnectionOnTheProvidedSide) {
                                "connection: 'B.S' is a required interface; 'provided' must name a provided interface of 'B' (Q)"));
 }
 
-TEST(Load, A2016ComponentImpliesItsInterfacesFromItsServices) {
+TEST(SpecLoad, A2016ComponentImpliesItsInterfacesFromItsServices) {
   const LoadResult r = load_text(R"({"component": "C", "service": [
     {"name": "Out", "dependency": {"s_R": ["In1", "In2"], "s_A": true}}]})");
   ASSERT_TRUE(r.system) << formatted(r);
@@ -308,35 +314,41 @@ TEST(Load, A2016ComponentImpliesItsInterfacesFromItsServices) {
   EXPECT_THAT(r.system->components[0].required, ::testing::ElementsAre("In1", "In2"));
 }
 
-TEST(Load, ComponentFileCanDeclareItsSchemaAndVersion) {
+TEST(SpecLoad, ComponentFileCanDeclareItsSchemaAndVersion) {
   const LoadResult r = load_text(R"({"$schema": "../../docs/schema.json", "safecass": 1, "component": "A"})");
   EXPECT_EQ(formatted(r), "");
 }
 
-TEST(Load, NeitherFileKindNorBothAreAccepted) {
+TEST(SpecLoad, NeitherFileKindNorBothAreAccepted) {
   const LoadResult r = load_text(R"({"system": "s", "component": "A", "components": []})");
   EXPECT_THAT(messages(r), ::testing::ElementsAre(
                                "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both"));
 }
 
-TEST(Load, NoComponentsIsAWarning) {
+TEST(SpecLoad, AComponentWithoutAValidNameReportsOnlyThat) {
+  const LoadResult r = load_text(R"({"system": "s", "components": [{"component": 3,
+    "filter": [{"class_name": "NOP", "argument": {"input_signal": "x"}}]}]})");
+  EXPECT_THAT(messages(r), ::testing::ElementsAre("component: 'component' must be a string, not a number"));
+}
+
+TEST(SpecLoad, NoComponentsIsAWarning) {
   const LoadResult r = load_text(R"({"system": "empty", "components": []})");
   EXPECT_THAT(messages(r), ::testing::ElementsAre("system 'empty' has no components"));
   EXPECT_TRUE(r.ok());
 }
 
-TEST(Load, NullAndObjectParametersAreRejected) {
+TEST(SpecLoad, NullAndObjectParametersAreRejected) {
   const LoadResult r = load_text(component("", R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": null, "tolerance": {}}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 't' (Threshold): parameter 'threshold' must be a number, not null",
                                                   "filter 't' (Threshold): parameter 'tolerance' must be a number, not an object"));
 }
 
-TEST(Load, DuplicateParametersAreErrors) {
+TEST(SpecLoad, DuplicateParametersAreErrors) {
   const LoadResult r = load_text(component("", R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 1, "threshold": 2}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 't': duplicate parameter 'threshold'"));
 }
 
-TEST(Load, WatchdogDefaultsToTheFrameworkStaleEvents) {
+TEST(SpecLoad, WatchdogDefaultsToTheFrameworkStaleEvents) {
   const LoadResult r = load_text(component("", R"(, {"name": "w", "class_name": "Heartbeat", "target": {"type": "s_F"}, "argument": {"input_signal": "Force", "timeout": 0.1}})"));
   EXPECT_EQ(formatted(r), "");
   ASSERT_TRUE(r.system);

@@ -14,7 +14,7 @@ namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 
-TEST(Schema, CheckedInFileEqualsTheGeneratedSchema) {
+TEST(SpecSchema, CheckedInFileEqualsTheGeneratedSchema) {
   const std::string schema = json_schema(builtin_registry());
   const char* update = std::getenv("SAFECASS_UPDATE_GOLDEN");
   if (update != nullptr && std::string(update) == "1") {
@@ -25,7 +25,7 @@ TEST(Schema, CheckedInFileEqualsTheGeneratedSchema) {
       << "docs/schema.json is stale: run `safecass schema > docs/schema.json` (or this test with SAFECASS_UPDATE_GOLDEN=1)";
 }
 
-TEST(Schema, IsDeterministicJsonOfDraft2020_12) {
+TEST(SpecSchema, IsDeterministicJsonOfDraft2020_12) {
   const std::string schema = json_schema(builtin_registry());
   EXPECT_EQ(schema, json_schema(builtin_registry()));
   const JsonParse p = parse_json(schema);
@@ -39,7 +39,7 @@ TEST(Schema, IsDeterministicJsonOfDraft2020_12) {
   }
 }
 
-TEST(Schema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
+TEST(SpecSchema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
   const JsonParse p = parse_json(json_schema(builtin_registry()));
   ASSERT_TRUE(p.value);
   const JsonValue* defs = p.value->find("$defs");
@@ -61,7 +61,7 @@ TEST(Schema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
   EXPECT_EQ(severity->find("maximum")->number, 255);
 }
 
-TEST(Schema, IncludesUserFilterTypes) {
+TEST(SpecSchema, IncludesUserFilterTypes) {
   FilterRegistry registry;
   register_builtin_filters(registry);
   FilterManifest m;

@@ -108,7 +108,7 @@ private:
   int loaded_ = 0;
 };
 
-TEST(SmokeFuzz, MutatedGoodSpecsNeverCrashAndAlwaysPointInsideTheText) {
+TEST(SpecSmokeFuzz, MutatedGoodSpecsNeverCrashAndAlwaysPointInsideTheText) {
   std::mt19937 rng(20160516);  // fixed: the run is the same every time
   Checker checker;
   constexpr int kRuns = 10000;
@@ -155,7 +155,7 @@ void collect(JsonValue& v, std::vector<JsonValue*>& out) {
   for (JsonMember& m : v.object) collect(m.value, out);
 }
 
-TEST(SmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
+TEST(SpecSmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
   const std::vector<std::string> replacements = {"null", "0", "-1", "1e300", "2.5", "\"\"", "\"x.y\"", "[]", "[1]", "{}",
                                                  "true"};
   Checker checker;

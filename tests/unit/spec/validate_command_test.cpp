@@ -14,7 +14,7 @@ using ::testing::HasSubstr;
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 
-TEST(ValidateCommand, GoodSystemExitsZero) {
+TEST(SpecValidateCommand, GoodSystemExitsZero) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/good_specs/robodoc.json"}, false);
   const std::string out = ::testing::internal::GetCapturedStdout();
@@ -22,7 +22,7 @@ TEST(ValidateCommand, GoodSystemExitsZero) {
   EXPECT_EQ(out, "0 errors, 0 warnings\n");
 }
 
-TEST(ValidateCommand, ErrorsExitOneAndPrintEveryDiagnostic) {
+TEST(SpecValidateCommand, ErrorsExitOneAndPrintEveryDiagnostic) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/bad_specs/unknown_key.json", "tests/data/bad_specs/needs_reset.json"}, false);
   const std::string out = ::testing::internal::GetCapturedStdout();
@@ -31,14 +31,14 @@ TEST(ValidateCommand, ErrorsExitOneAndPrintEveryDiagnostic) {
                      read_text("tests/data/bad_specs/needs_reset.json.expected") + "1 error, 1 warning\n");
 }
 
-TEST(ValidateCommand, WarningsAloneExitZero) {
+TEST(SpecValidateCommand, WarningsAloneExitZero) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/bad_specs/needs_reset.json"}, false);
   ::testing::internal::GetCapturedStdout();
   EXPECT_EQ(code, 0);
 }
 
-TEST(ValidateCommand, UnreadableFileExitsTwo) {
+TEST(SpecValidateCommand, UnreadableFileExitsTwo) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/no_such.json", "tests/data/good_specs/robodoc.json"}, false);
   const std::string out = ::testing::internal::GetCapturedStdout();
@@ -46,7 +46,7 @@ TEST(ValidateCommand, UnreadableFileExitsTwo) {
   EXPECT_THAT(out, HasSubstr("tests/data/no_such.json: error: cannot read file 'tests/data/no_such.json'"));
 }
 
-TEST(ValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
+TEST(SpecValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/bad_specs/unknown_key.json"}, true);
   const std::string out = ::testing::internal::GetCapturedStdout();
@@ -62,7 +62,7 @@ TEST(ValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
   EXPECT_EQ(lines[1], R"({"files": ["tests/data/bad_specs/unknown_key.json"], "errors": 1, "warnings": 0})");
 }
 
-TEST(SchemaCommand, PrintsTheSchema) {
+TEST(SpecSchemaCommand, PrintsTheSchema) {
   ::testing::internal::CaptureStdout();
   EXPECT_EQ(run_schema(), 0);
   EXPECT_EQ(::testing::internal::GetCapturedStdout(), json_schema(builtin_registry()));

@@ -221,35 +221,10 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
     std::fprintf(options.out, "%s\n", line.c_str());
   });
 
-  const Time::rep tick_ns = seconds_to_time(scenario_.period).count();
   const auto ticks = static_cast<std::int64_t>(std::llround(scenario_.duration / scenario_.period));
-  std::size_t next_step = 0;
-  std::size_t next_check = 0;
-  std::vector<const spec::ScenarioStep*> actions;
-  std::vector<const spec::ScenarioStep*> checks;
-  for (const spec::ScenarioStep& s : scenario_.steps) {
-    const bool is_check = s.kind == spec::ScenarioStep::Kind::Expect || s.kind == spec::ScenarioStep::Kind::ExpectOutstanding ||
-                          s.kind == spec::ScenarioStep::Kind::ExpectCause;
-    (is_check ? checks : actions).push_back(&s);
-  }
-  for (std::int64_t k = 0; k <= ticks; ++k) {
-    const Time now{k * tick_ns};
-    clock_.set(now);
-    // (1) steps due at this tick, in file order (first tick at or after their time).
-    while (next_step < actions.size() && seconds_to_time(actions[next_step]->at) <= now) apply(*actions[next_step++], now);
-    for (auto it = ramps_.begin(); it != ramps_.end();) {
-      const double span = to_seconds(it->until - it->from_time);
-      const double f = span <= 0 ? 1.0 : std::min(1.0, to_seconds(now - it->from_time) / span);
-      it->signal->push(now, it->from + (it->to - it->from) * f);
-      it = now >= it->until ? ramps_.erase(it) : it + 1;
-    }
-    // (2) filters and component loops due at this tick.
-    runtime_->step(now);
-    // (3) expectations due at this tick.
-    while (next_check < checks.size() && seconds_to_time(checks[next_check]->at) <= now) check(*checks[next_check++], now, result);
-  }
-  for (; next_check < checks.size(); ++next_check) {
-    const spec::ScenarioStep& s = *checks[next_check];
+  advance_to(Time{ticks * seconds_to_time(scenario_.period).count()}, result);
+  for (; next_check_ < checks_.size(); ++next_check_) {
+    const spec::ScenarioStep& s = *checks_[next_check_];
     result.failures.push_back(s.where.file + ":" + std::to_string(s.where.line) + ":" + std::to_string(s.where.column) +
                               ": expectation at t=" + secs(seconds_to_time(s.at)) + " is after the scenario's duration");
   }
@@ -262,6 +237,41 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
     }
   }
   return result;
+}
+
+void ScenarioRunner::split_steps() {
+  if (split_) return;
+  split_ = true;
+  for (const spec::ScenarioStep& s : scenario_.steps) {
+    const bool is_check = s.kind == spec::ScenarioStep::Kind::Expect || s.kind == spec::ScenarioStep::Kind::ExpectOutstanding ||
+                          s.kind == spec::ScenarioStep::Kind::ExpectCause;
+    (is_check ? checks_ : actions_).push_back(&s);
+  }
+}
+
+Time ScenarioRunner::now() const noexcept {
+  return Time{(next_tick_ - 1) * seconds_to_time(scenario_.period).count()};
+}
+
+void ScenarioRunner::advance_to(Time until, RunResult& result) {
+  split_steps();
+  const Time::rep tick_ns = seconds_to_time(scenario_.period).count();
+  for (; next_tick_ * tick_ns <= until.count(); ++next_tick_) {
+    const Time now{next_tick_ * tick_ns};
+    clock_.set(now);
+    // (1) steps due at this tick, in file order (first tick at or after their time).
+    while (next_step_ < actions_.size() && seconds_to_time(actions_[next_step_]->at) <= now) apply(*actions_[next_step_++], now);
+    for (auto it = ramps_.begin(); it != ramps_.end();) {
+      const double span = to_seconds(it->until - it->from_time);
+      const double f = span <= 0 ? 1.0 : std::min(1.0, to_seconds(now - it->from_time) / span);
+      it->signal->push(now, it->from + (it->to - it->from) * f);
+      it = now >= it->until ? ramps_.erase(it) : it + 1;
+    }
+    // (2) filters and component loops due at this tick.
+    runtime_->step(now);
+    // (3) expectations due at this tick.
+    while (next_check_ < checks_.size() && seconds_to_time(checks_[next_check_]->at) <= now) check(*checks_[next_check_++], now, result);
+  }
 }
 
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,

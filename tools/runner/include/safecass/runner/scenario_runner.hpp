@@ -9,6 +9,7 @@
 /// Example programs use it with their application code: prepare(), then set task bodies on
 /// runtime(), then run().
 
+#include <cstdint>
 #include <cstdio>
 #include <map>
 #include <memory>
@@ -65,6 +66,15 @@ public:
   /// Runs the whole scenario. Precondition: prepare() returned no diagnostics.
   RunResult run(const RunOptions& options);
 
+  /// Incremental driving, for interactive tools (the console's `watch`): processes every tick up
+  /// to and including `until` not processed yet, exactly as run() does (steps, ramps, filters,
+  /// expectations; failed expectations are appended to `result`). Ticks past the scenario's
+  /// duration keep running the system with no more steps. Precondition: prepare() returned no
+  /// diagnostics; do not combine with run().
+  void advance_to(Time until, RunResult& result);
+  /// The time of the last tick processed; negative before the first.
+  Time now() const noexcept;
+
 private:
   struct Ramp {
     Signal* signal;
@@ -74,6 +84,7 @@ private:
     double to;
   };
   void apply(const spec::ScenarioStep& step, Time now);
+  void split_steps();
   void check(const spec::ScenarioStep& step, Time now, RunResult& result);
   std::string check_one(const spec::ScenarioStep& step, const std::string& address, const std::string& expected);
 
@@ -84,6 +95,13 @@ private:
   std::unique_ptr<Monitor> monitor_;
   std::unique_ptr<native::Runtime> runtime_;
   std::vector<Ramp> ramps_;
+  // Progress of the tick loop (run() and advance_to()).
+  bool split_ = false;
+  std::vector<const spec::ScenarioStep*> actions_;
+  std::vector<const spec::ScenarioStep*> checks_;
+  std::size_t next_step_ = 0;
+  std::size_t next_check_ = 0;
+  std::int64_t next_tick_ = 0;
 };
 
 /// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,

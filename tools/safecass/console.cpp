@@ -1,0 +1,1342 @@
+// `safecass console`: the command executor (Console) and its terminal front end (run_console).
+
+#include "console.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <variant>
+
+#include <CLI/CLI.hpp>
+#include <editline/readline.h>
+
+#include "safecass/filters/registry.hpp"
+#include "safecass/record/recorder.hpp"
+#include "safecass/runner/scenario_runner.hpp"
+#include "safecass/spec/load.hpp"
+#include "safecass/spec/scenario.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+// ---- small text helpers --------------------------------------------------------------------------
+
+std::string_view trim(std::string_view s) {
+  const auto first = s.find_first_not_of(" \t\r\n");
+  if (first == std::string_view::npos) return {};
+  const auto last = s.find_last_not_of(" \t\r\n");
+  return s.substr(first, last - first + 1);
+}
+
+std::string seconds_text(Time t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
+  return buf;
+}
+
+std::string number_text(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
+  return number_text(v);
+}
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string json_list(const std::vector<std::string>& items) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + json_string(items[i]);
+  return out + "]";
+}
+
+/// One JSON object, built field by field: Json().str("a", "x").num("b", 1).text() == {"a":"x","b":1}.
+class Json {
+public:
+  Json& raw(std::string_view key, std::string_view value) {
+    text_ += first_ ? "" : ",";
+    first_ = false;
+    text_ += json_string(key);
+    text_ += ':';
+    text_ += value;
+    return *this;
+  }
+  Json& str(std::string_view key, std::string_view value) { return raw(key, json_string(value)); }
+  Json& num(std::string_view key, double value) { return raw(key, json_number(value)); }
+  Json& integer(std::string_view key, long long value) { return raw(key, std::to_string(value)); }
+  Json& boolean(std::string_view key, bool value) { return raw(key, value ? "true" : "false"); }
+  /// A string, or null when empty.
+  Json& opt(std::string_view key, std::string_view value) { return value.empty() ? raw(key, "null") : str(key, value); }
+  std::string text() const { return text_ + "}"; }
+
+private:
+  std::string text_ = "{";
+  bool first_ = true;
+};
+
+/// Left-aligned columns, two spaces apart; the last column is not padded.
+std::string columns(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& row : rows) {
+    if (width.size() < row.size()) width.resize(row.size(), 0);
+    for (std::size_t i = 0; i + 1 < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
+  }
+  std::string out;
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      line += row[i];
+      if (i + 1 < row.size()) line += std::string(width[i] - row[i].size() + 2, ' ');
+    }
+    line.erase(line.find_last_not_of(' ') + 1);  // an empty last column leaves padding behind
+    out += line + "\n";
+  }
+  return out;
+}
+
+// ---- tokens, numbers and samples -----------------------------------------------------------------
+
+/// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
+/// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
+Expected<std::vector<std::string>> tokenize(std::string_view line) {
+  std::vector<std::string> words;
+  std::size_t i = 0;
+  while (i < line.size()) {
+    const char c = line[i];
+    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
+      ++i;
+      continue;
+    }
+    std::string word;
+    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' && line[i] != '\n') {
+      const char d = line[i];
+      if (d == '[') {
+        const auto close = line.find(']', i);
+        if (close == std::string_view::npos) return fail(ErrorCode::Parse, "'[' without ']'");
+        word.append(line.substr(i, close - i + 1));
+        i = close + 1;
+      } else if (d == '"' || d == '\'') {
+        const auto close = line.find(d, i + 1);
+        if (close == std::string_view::npos) return fail(ErrorCode::Parse, std::string("unterminated ") + d);
+        word.append(line.substr(i + 1, close - i - 1));
+        i = close + 1;
+      } else {
+        word += d;
+        ++i;
+      }
+    }
+    words.push_back(std::move(word));
+  }
+  return words;
+}
+
+std::optional<double> parse_number(std::string_view s) {
+  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
+  if (s.empty()) return std::nullopt;
+  double v = 0.0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || end != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+/// Numbers separated by commas and/or blanks. Errors name the offending text.
+Expected<std::vector<double>> parse_numbers(std::string_view text) {
+  std::vector<double> values;
+  std::size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == ',' || text[i] == ' ' || text[i] == '\t' || text[i] == '\r') {
+      ++i;
+      continue;
+    }
+    std::size_t j = i;
+    while (j < text.size() && text[j] != ',' && text[j] != ' ' && text[j] != '\t' && text[j] != '\r') ++j;
+    const auto v = parse_number(text.substr(i, j - i));
+    if (!v) return fail(ErrorCode::Parse, "'" + std::string(text.substr(i, j - i)) + "' is not a number");
+    values.push_back(*v);
+    i = j;
+  }
+  return values;
+}
+
+/// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector).
+Expected<std::vector<double>> parse_sample(std::string_view word) {
+  if (!word.empty() && word.front() == '[') {
+    if (word.back() != ']') return fail(ErrorCode::Parse, "'" + std::string(word) + "': a vector sample ends with ']'");
+    auto values = parse_numbers(word.substr(1, word.size() - 2));
+    if (!values) return values;
+    if (values->empty()) return fail(ErrorCode::Parse, "'[]': a vector sample needs at least one value");
+    return values;
+  }
+  const auto v = parse_number(word);
+  if (!v) return fail(ErrorCode::Parse, "'" + std::string(word) + "' is not a number or a vector sample [a,b,...]");
+  return std::vector<double>{*v};
+}
+
+std::optional<long> parse_count(std::string_view s) {
+  long v = 0;
+  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (ec != std::errc{} || end != s.data() + s.size() || v <= 0) return std::nullopt;
+  return v;
+}
+
+// ---- the command table ---------------------------------------------------------------------------
+
+/// What a command's argument names, for completion.
+enum class Arg { None, Component, Address, Machine, Event, Filter, FilterOrType, Signal, File, Command };
+
+enum class Id {
+  StateList, StateHistory, FilterList, FilterInfo, FilterInject, FilterDinject, FilterDinload, EventList,
+  EventHistory, EventGenerate, EventBroadcast, ConnectionList, ServiceList, Explain, Watch, Reset, Time,
+  Help, Quit,
+};
+
+struct CommandSpec {
+  Id id;
+  std::string_view name;   ///< one or two words
+  std::string_view usage;
+  std::string_view doc;
+  bool writes;
+  std::size_t min_args;
+  std::size_t max_args;    ///< kMany: no limit
+  std::vector<Arg> args;   ///< completion kind of each argument; the last one repeats
+};
+
+constexpr std::size_t kMany = static_cast<std::size_t>(-1);
+constexpr long kDefaultHistory = 20;
+constexpr double kMaxWatchSeconds = 3600.0;
+
+const std::vector<CommandSpec>& commands() {
+  static const std::vector<CommandSpec> table = {
+      {Id::StateList, "state list", "state list [COMPONENT]",
+       "every component and state machine with its state and outstanding event", false, 0, 1, {Arg::Component}},
+      {Id::StateHistory, "state history", "state history [ADDRESS] [N]",
+       "the last N records (default 20) of a machine, a component or the whole system", false, 0, 2,
+       {Arg::Address, Arg::None}},
+      {Id::FilterList, "filter list", "filter list",
+       "every filter: type, target, execution, detection, enabled, detected, signals", false, 0, 0, {}},
+      {Id::FilterInfo, "filter info", "filter info NAME",
+       "a filter's manifest (parameters with type, value, default, range and doc; inputs; outputs) and its "
+       "current enabled/detected state; NAME may also be a filter type",
+       false, 1, 1, {Arg::FilterOrType}},
+      {Id::FilterInject, "filter inject", "filter inject NAME SAMPLE...",
+       "shallow fault injection: queue samples into one filter's private input, seen by that filter alone on "
+       "its next runs (SAMPLE: 1.5, or [1,2,3] for a vector)",
+       true, 2, kMany, {Arg::Filter, Arg::None}},
+      {Id::FilterDinject, "filter dinject", "filter dinject SIGNAL SAMPLE...",
+       "deep fault injection: write samples into a signal's history buffer at the current time; every "
+       "consumer sees them",
+       true, 2, kMany, {Arg::Signal, Arg::None}},
+      {Id::FilterDinload, "filter dinload", "filter dinload SIGNAL FILE",
+       "deep-inject every sample of a text file: one sample per line, numbers separated by spaces or commas "
+       "('#' starts a comment)",
+       true, 2, 2, {Arg::Signal, Arg::File}},
+      {Id::EventList, "event list", "event list",
+       "every event with its severity, transitions, counterpart, hazard and description", false, 0, 0, {}},
+      {Id::EventHistory, "event history", "event history [N]",
+       "the last N events processed, ignored or masked by any machine (default 20)", false, 0, 1, {Arg::None}},
+      {Id::EventGenerate, "event generate", "event generate EVENT TARGET",
+       "process EVENT on machine TARGET (C.s_F, C.s_A, C.s_P.p or C.s_R.r) and propagate it", true, 2, 2,
+       {Arg::Event, Arg::Machine}},
+      {Id::EventBroadcast, "event broadcast", "event broadcast EVENT",
+       "process a broadcast event (severity 251-255) on s_A of every component", true, 1, 1, {Arg::Event}},
+      {Id::ConnectionList, "connection list", "connection list",
+       "every connection: the client's required interface and state, the provider's service and state", false,
+       0, 0, {}},
+      {Id::ServiceList, "service list", "service list",
+       "every provided interface with its service state and dependency formula", false, 0, 0, {}},
+      {Id::Explain, "explain", "explain ADDRESS",
+       "every active condition at ADDRESS with its root cause and the path it took", false, 1, 1, {Arg::Address}},
+      {Id::Watch, "watch", "watch [SECONDS]",
+       "advance simulated time by SECONDS (default 1), running the scenario and the system and printing each "
+       "transition as it happens",
+       false, 0, 1, {Arg::None}},
+      {Id::Reset, "reset", "reset TARGET [REASON]",
+       "clear every condition (latched ones too) of a machine, a component or SYSTEM, recording the reason", true,
+       1, kMany, {Arg::Address, Arg::None}},
+      {Id::Time, "time", "time", "the current simulated time", false, 0, 0, {}},
+      {Id::Help, "help", "help [COMMAND]", "list the commands, or show one command's usage", false, 0, 2,
+       {Arg::Command, Arg::Command}},
+      {Id::Quit, "quit", "quit", "leave the console (also: exit, or end of input)", false, 0, 0, {}},
+  };
+  return table;
+}
+
+constexpr std::string_view kGroups[] = {"state", "filter", "event", "connection", "service"};
+
+bool is_group(std::string_view word) {
+  return std::find(std::begin(kGroups), std::end(kGroups), word) != std::end(kGroups);
+}
+
+const CommandSpec* find_command(std::string_view name) {
+  if (name == "exit") name = "quit";
+  for (const CommandSpec& c : commands()) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+/// "state list [COMPONENT] | state history [ADDRESS] [N]".
+std::string group_usage(std::string_view group) {
+  std::string out;
+  for (const CommandSpec& c : commands()) {
+    if (c.name.substr(0, c.name.find(' ')) == group && c.name.find(' ') != std::string_view::npos) {
+      out += (out.empty() ? "" : " | ") + std::string(c.usage);
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> top_words() {
+  std::set<std::string> words{"exit"};
+  for (const CommandSpec& c : commands()) words.emplace(c.name.substr(0, c.name.find(' ')));
+  return {words.begin(), words.end()};
+}
+
+std::vector<std::string> sub_words(std::string_view group) {
+  std::vector<std::string> words;
+  for (const CommandSpec& c : commands()) {
+    const auto space = c.name.find(' ');
+    if (space != std::string_view::npos && c.name.substr(0, space) == group) words.emplace_back(c.name.substr(space + 1));
+  }
+  return words;
+}
+
+std::string_view machine_kind_text(MachineKind k) {
+  switch (k) {
+    case MachineKind::Framework: return "framework";
+    case MachineKind::Application: return "application";
+    case MachineKind::Provided: return "provided";
+    case MachineKind::Required: return "required";
+  }
+  return "?";
+}
+
+std::string transitions_text(TransitionSet set) {
+  std::string out;
+  for (Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
+    if (set.contains(t)) out += (out.empty() ? "" : ",") + std::string(to_string(t));
+  }
+  return out;
+}
+
+std::string param_text(const ParamValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return number_text(x);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return x;
+        } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+          std::string out = "[";
+          for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + x[i];
+          return out + "]";
+        } else {
+          std::string out = "[";
+          for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + number_text(x[i]);
+          return out + "]";
+        }
+      },
+      v);
+}
+
+std::string param_json(const ParamValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return json_number(x);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return json_string(x);
+        } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+          return json_list(x);
+        } else {
+          std::string out = "[";
+          for (std::size_t i = 0; i < x.size(); ++i) out += (i ? "," : "") + json_number(x[i]);
+          return out + "]";
+        }
+      },
+      v);
+}
+
+std::string range_text(const ParamSpec& p) {
+  if (p.type == ParamType::Choice) {
+    std::string out;
+    for (const std::string& c : p.choices) out += (out.empty() ? "" : "|") + c;
+    return out;
+  }
+  if (p.type != ParamType::Number && p.type != ParamType::Integer) return {};
+  const bool low = p.min > -1e299;
+  const bool high = p.max < 1e299;
+  if (!low && !high) return {};
+  return "[" + (low ? number_text(p.min) : std::string("-inf")) + ", " + (high ? number_text(p.max) : std::string("+inf")) + "]";
+}
+
+std::string default_text(const ParamSpec& p) {
+  if (p.default_value) return param_text(*p.default_value);
+  return p.optional ? "(optional)" : "(required)";
+}
+
+bool shown_record(const Record& r) {
+  return r.kind == RecordKind::Transition || r.kind == RecordKind::Reset || r.kind == RecordKind::Injection ||
+         (r.kind == RecordKind::Event && (r.outcome == Outcome::Masked || r.outcome == Outcome::Ignored));
+}
+
+}  // namespace
+
+// ---- the executor --------------------------------------------------------------------------------
+
+struct Console::Impl {
+  ConsoleOptions options;
+  FilterRegistry registry;  // outlives the runner's monitor
+  std::unique_ptr<runner::ScenarioRunner> runner;
+  runner::RunResult run_result;       // expectation failures of the scenario so far
+  std::size_t failures_reported = 0;
+  std::vector<std::string> captured;  // records shown since the last flush, formatted
+  std::size_t transitions = 0;        // machine transitions seen, for the summary of watch
+  Coordinator::SubscriptionId subscription = 0;
+  std::string system_path;
+  std::string scenario_path;
+
+  ~Impl() {
+    if (runner && subscription != 0) runner->coordinator().unsubscribe(subscription);
+  }
+
+  Coordinator& co() { return runner->coordinator(); }
+  const Coordinator& co() const { return runner->coordinator(); }
+  Monitor& monitor() { return runner->monitor(); }
+  const Monitor& monitor() const { return runner->monitor(); }
+  Time now() const { return std::max(runner->now(), Time{0}); }
+
+  // ---- output ----
+  struct Out {
+    ConsoleReply reply;
+    void line(std::string text) { reply.out += std::move(text) + "\n"; }
+  };
+
+  /// A failed command: one line on stderr saying what went wrong and how the command is used.
+  ConsoleReply failure(std::string_view command, const std::string& message, std::string_view usage) const {
+    ConsoleReply r;
+    r.ok = false;
+    if (options.json) {
+      r.err = Json().boolean("ok", false).opt("command", command).str("error", message).str("usage", usage).text() + "\n";
+    } else {
+      r.err = (command.empty() ? std::string() : std::string(command) + ": ") + message + " (usage: " + std::string(usage) + ")\n";
+    }
+    return r;
+  }
+  ConsoleReply failure(const CommandSpec& c, const std::string& message) const { return failure(c.name, message, c.usage); }
+
+  void flush_captured(Out& out) {
+    for (std::string& line : captured) out.line(std::move(line));
+    captured.clear();
+  }
+
+  /// The confirmation line of a write command.
+  void write_done(Out& out, const CommandSpec& c, Json json, const std::string& text) const {
+    out.line(options.json ? json.boolean("ok", true).str("command", c.name).num("t", to_seconds(now())).text() : text);
+  }
+
+  // ---- names for completion ----
+  std::vector<std::string> names(Arg kind) const {
+    std::vector<std::string> out;
+    const Coordinator& c = co();
+    switch (kind) {
+      case Arg::Component:
+        for (ComponentId i = 0; i < c.component_count(); ++i) out.emplace_back(c.component_name(i));
+        break;
+      case Arg::Machine:
+        for (MachineId m = 0; m < c.machine_count(); ++m) out.push_back(c.address_of(m));
+        break;
+      case Arg::Address:
+        out.emplace_back("SYSTEM");
+        for (ComponentId i = 0; i < c.component_count(); ++i) {
+          out.emplace_back(c.component_name(i));
+          for (MachineId p : c.provided_machines(i)) {
+            out.push_back(std::string(c.component_name(i)) + ".s_S." + std::string(c.interface_name(p)));
+          }
+        }
+        for (MachineId m = 0; m < c.machine_count(); ++m) out.push_back(c.address_of(m));
+        break;
+      case Arg::Event:
+        for (EventId e = 0; e < c.event_count(); ++e) out.push_back(c.event(e).name);
+        break;
+      case Arg::Filter:
+      case Arg::FilterOrType:
+        for (const auto& f : monitor().filters()) out.push_back(f->name());
+        if (kind == Arg::FilterOrType) {
+          for (const FilterManifest* m : registry.manifests()) out.push_back(m->type);
+        }
+        break;
+      case Arg::Signal:
+        for (const auto& s : monitor().signals().all()) out.push_back(s->name());
+        break;
+      case Arg::Command: out = top_words(); break;
+      case Arg::None:
+      case Arg::File: break;
+    }
+    return out;
+  }
+
+  /// The command and argument position the word after `before` belongs to.
+  struct Context {
+    const CommandSpec* command = nullptr;
+    std::vector<std::string> words;
+    std::size_t arg = 0;  ///< index of the argument being typed
+    bool ok = false;
+  };
+  static Context context(std::string_view before) {
+    Context ctx;
+    auto words = tokenize(before);
+    if (!words) return ctx;
+    ctx.words = std::move(*words);
+    ctx.ok = true;
+    if (ctx.words.empty()) return ctx;
+    if (is_group(ctx.words[0])) {
+      if (ctx.words.size() < 2) return ctx;
+      ctx.command = find_command(ctx.words[0] + " " + ctx.words[1]);
+      ctx.arg = ctx.words.size() - 2;
+    } else {
+      ctx.command = find_command(ctx.words[0]);
+      ctx.arg = ctx.words.size() - 1;
+    }
+    return ctx;
+  }
+  static Arg arg_kind(const CommandSpec& c, std::size_t arg) {
+    if (c.args.empty() || arg >= c.max_args) return Arg::None;
+    return arg < c.args.size() ? c.args[arg] : c.args.back();
+  }
+
+  std::vector<std::string> complete(std::string_view before, std::string_view word) const {
+    const Context ctx = context(before);
+    if (!ctx.ok) return {};
+    std::vector<std::string> candidates;
+    if (ctx.words.empty()) {
+      candidates = top_words();
+    } else if (ctx.words.size() == 1 && is_group(ctx.words[0])) {
+      candidates = sub_words(ctx.words[0]);
+    } else if (ctx.command != nullptr && ctx.command->id == Id::Help) {
+      if (ctx.arg == 0) candidates = top_words();
+      else if (ctx.arg == 1 && is_group(ctx.words[1])) candidates = sub_words(ctx.words[1]);
+    } else if (ctx.command != nullptr) {
+      candidates = names(arg_kind(*ctx.command, ctx.arg));
+    }
+    std::vector<std::string> out;
+    for (std::string& c : candidates) {
+      if (c.compare(0, word.size(), word) == 0) out.push_back(std::move(c));
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  // ---- commands ----
+  ConsoleReply execute(std::string_view line) {
+    line = trim(line);
+    if (line.empty() || line.front() == '#') return {};
+    captured.clear();
+    auto words = tokenize(line);
+    if (!words) return failure("", words.error().message, "help [COMMAND]");
+    std::vector<std::string>& w = *words;
+    const CommandSpec* command = nullptr;
+    std::size_t first_arg = 1;
+    if (is_group(w[0])) {
+      if (w.size() < 2) return failure(w[0], "needs a subcommand", group_usage(w[0]));
+      command = find_command(w[0] + " " + w[1]);
+      if (command == nullptr) return failure(w[0], "unknown subcommand '" + w[1] + "'", group_usage(w[0]));
+      first_arg = 2;
+    } else {
+      command = find_command(w[0]);
+      if (command == nullptr) return failure("", "unknown command '" + w[0] + "'", "help [COMMAND]");
+    }
+    const std::vector<std::string> args(w.begin() + static_cast<std::ptrdiff_t>(first_arg), w.end());
+    if (args.size() < command->min_args || (command->max_args != kMany && args.size() > command->max_args)) {
+      return failure(*command, args.size() < command->min_args ? "missing arguments" : "too many arguments");
+    }
+    if (command->writes && !options.allow_write) {
+      return failure(*command, "refused: this console is read-only; start it with --allow-write to inject, "
+                              "generate, broadcast or reset");
+    }
+    Out out;
+    std::string error = run(*command, args, out);
+    if (!error.empty()) {
+      captured.clear();
+      return failure(*command, error);
+    }
+    flush_captured(out);
+    return std::move(out.reply);
+  }
+
+  /// Runs one command; returns an error message, or empty on success.
+  std::string run(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    switch (c.id) {
+      case Id::StateList: return state_list(args, out);
+      case Id::StateHistory: return state_history(args, out);
+      case Id::FilterList: return filter_list(out);
+      case Id::FilterInfo: return filter_info(args[0], out);
+      case Id::FilterInject: return filter_inject(c, args, out);
+      case Id::FilterDinject: return filter_dinject(c, args, out);
+      case Id::FilterDinload: return filter_dinload(c, args, out);
+      case Id::EventList: return event_list(out);
+      case Id::EventHistory: return event_history(args, out);
+      case Id::EventGenerate: return event_generate(c, args, out);
+      case Id::EventBroadcast: return event_broadcast(c, args, out);
+      case Id::ConnectionList: return connection_list(out);
+      case Id::ServiceList: return service_list(out);
+      case Id::Explain: return explain(args[0], out);
+      case Id::Watch: return watch(args, out);
+      case Id::Reset: return reset(c, args, out);
+      case Id::Time: return time(out);
+      case Id::Help: return help(args, out);
+      case Id::Quit: out.reply.quit = true; return {};
+    }
+    return "not implemented";
+  }
+
+  std::string outstanding_name(EventId e) const { return e == kNoEvent ? std::string() : co().event(e).name; }
+
+  std::string state_list(const std::vector<std::string>& args, Out& out) {
+    const Coordinator& c = co();
+    ComponentId only = kNoComponent;
+    if (!args.empty()) {
+      auto id = c.find_component(args[0]);
+      if (!id) return id.error().message;
+      only = *id;
+    }
+    std::vector<std::vector<std::string>> rows;
+    auto row = [&](const std::string& indent, const std::string& address, std::string_view kind, StateSnapshot s) {
+      if (options.json) {
+        out.line(Json().str("address", address).str("kind", kind).str("state", to_string(s.state))
+                     .opt("outstanding", outstanding_name(s.outstanding)).text());
+      } else {
+        const std::string event = outstanding_name(s.outstanding);
+        rows.push_back({indent + address, std::string(to_string(s.state)), event.empty() ? "-" : event});
+      }
+    };
+    if (only == kNoComponent) row("", "SYSTEM", "system", StateSnapshot{c.state_of(Address{}), kNoEvent});
+    for (ComponentId id = 0; id < c.component_count(); ++id) {
+      if (only != kNoComponent && id != only) continue;
+      row("", std::string(c.component_name(id)), "component", c.extended(id));
+      std::vector<MachineId> machines{c.framework_machine(id), c.application_machine(id)};
+      machines.insert(machines.end(), c.provided_machines(id).begin(), c.provided_machines(id).end());
+      machines.insert(machines.end(), c.required_machines(id).begin(), c.required_machines(id).end());
+      for (MachineId m : machines) row("  ", c.address_of(m), machine_kind_text(c.machine_kind(m)), c.snapshot(m));
+    }
+    if (!options.json) out.reply.out += columns(rows);
+    return {};
+  }
+
+  /// Records of every machine and component history in `scope`, merged in stream order.
+  std::vector<Record> merged_history(const Address& scope, bool events_only) const {
+    const Coordinator& c = co();
+    std::vector<Record> all;
+    auto add = [&](const std::vector<Record>& records) {
+      for (const Record& r : records) {
+        if (!events_only || r.kind == RecordKind::Event) all.push_back(r);
+      }
+    };
+    if (scope.kind == Address::Kind::Machine) {
+      add(c.history(scope.machine));
+    } else {
+      for (ComponentId id = 0; id < c.component_count(); ++id) {
+        if (scope.kind != Address::Kind::System && id != scope.component) continue;
+        if (!events_only) add(c.component_history(id));
+      }
+      for (MachineId m = 0; m < c.machine_count(); ++m) {
+        if (scope.kind != Address::Kind::System && c.machine_component(m) != scope.component) continue;
+        add(c.history(m));
+      }
+    }
+    std::sort(all.begin(), all.end(), [](const Record& a, const Record& b) { return a.seq < b.seq; });
+    all.erase(std::unique(all.begin(), all.end(), [](const Record& a, const Record& b) { return a.seq == b.seq; }), all.end());
+    return all;
+  }
+
+  void print_records(const std::vector<Record>& records, long last, Out& out, std::string_view empty) const {
+    const std::size_t n = std::min(records.size(), static_cast<std::size_t>(last));
+    for (std::size_t i = records.size() - n; i < records.size(); ++i) {
+      out.line(options.json ? record_to_json(records[i], co()) : record_to_text(records[i], co()));
+    }
+    if (n == 0 && !options.json) out.line(std::string(empty));
+  }
+
+  std::string state_history(const std::vector<std::string>& args, Out& out) {
+    Address scope;  // SYSTEM
+    long last = kDefaultHistory;
+    std::size_t next = 0;
+    if (!args.empty() && !parse_count(args[0])) {
+      auto a = co().resolve(args[0]);
+      if (!a) return a.error().message;
+      scope = *a;
+      if (scope.kind == Address::Kind::Service) scope.kind = Address::Kind::Component;
+      next = 1;
+    }
+    if (next < args.size()) {
+      const auto n = parse_count(args[next]);
+      if (!n) return "N must be a positive whole number, not '" + args[next] + "'";
+      last = *n;
+      ++next;
+    }
+    if (next < args.size()) return "too many arguments";
+    print_records(merged_history(scope, false), last, out, "no records");
+    return {};
+  }
+
+  std::string filter_list(Out& out) {
+    std::vector<std::vector<std::string>> rows;
+    for (const auto& f : monitor().filters()) {
+      std::vector<std::string> inputs;
+      std::vector<std::string> outputs;
+      for (const Signal* s : f->inputs()) if (s != nullptr) inputs.push_back(s->name());
+      for (const Signal* s : f->outputs()) if (s != nullptr) outputs.push_back(s->name());
+      const std::string target = f->target() == kNoMachine ? "-" : co().address_of(f->target());
+      const char* execution = f->execution() == ExecutionMode::Active ? "ACTIVE" : "PASSIVE";
+      const char* detection = f->detection() == DetectionMode::Edge ? "EDGE" : "LEVEL";
+      if (options.json) {
+        out.line(Json().str("filter", f->name()).str("type", f->type()).str("target", target).str("execution", execution)
+                     .str("detection", detection).boolean("enabled", f->enabled()).boolean("detected", f->detected())
+                     .raw("inputs", json_list(inputs)).raw("outputs", json_list(outputs)).text());
+        continue;
+      }
+      std::string signals;
+      for (const std::string& s : inputs) signals += (signals.empty() ? "" : ",") + s;
+      if (!outputs.empty()) {
+        signals += " ->";
+        for (std::size_t i = 0; i < outputs.size(); ++i) signals += (i ? "," : " ") + outputs[i];
+      }
+      rows.push_back({f->name(), f->type(), target, execution, detection, f->enabled() ? "enabled" : "disabled",
+                      f->detected() ? "DETECTED" : "-", signals});
+    }
+    if (!options.json) {
+      if (rows.empty()) out.line("no filters");
+      out.reply.out += columns(rows);
+    }
+    return {};
+  }
+
+  std::string filter_info(const std::string& name, Out& out) {
+    const Filter* f = monitor().find_filter(name);
+    const FilterRegistry::Entry* entry = registry.find(f != nullptr ? std::string_view(f->type()) : std::string_view(name));
+    if (entry == nullptr) return "no filter or filter type '" + name + "' (see filter list)";
+    const FilterManifest& m = entry->manifest;
+    if (options.json) {
+      Json head;
+      head.opt("filter", f != nullptr ? f->name() : std::string()).str("type", m.type).str("doc", m.doc)
+          .raw("inputs", json_list(m.inputs)).raw("outputs", json_list(m.outputs))
+          .boolean("generates_events", m.generates_events);
+      if (f != nullptr) {
+        std::vector<std::string> in, outs;
+        for (const Signal* s : f->inputs()) if (s != nullptr) in.push_back(s->name());
+        for (const Signal* s : f->outputs()) if (s != nullptr) outs.push_back(s->name());
+        head.str("target", f->target() == kNoMachine ? "" : co().address_of(f->target()))
+            .str("execution", f->execution() == ExecutionMode::Active ? "ACTIVE" : "PASSIVE")
+            .str("detection", f->detection() == DetectionMode::Edge ? "EDGE" : "LEVEL")
+            .boolean("enabled", f->enabled()).boolean("detected", f->detected())
+            .integer("missed_samples", static_cast<long long>(f->missed_samples()))
+            .raw("input_signals", json_list(in)).raw("output_signals", json_list(outs));
+      }
+      out.line(head.text());
+      for (const ParamSpec& p : m.params) {
+        Json j;
+        j.str("param", p.name).str("type", to_string(p.type))
+            .raw("default", p.default_value ? param_json(*p.default_value) : "null")
+            .boolean("required", !p.default_value && !p.optional);
+        if (p.type == ParamType::Number || p.type == ParamType::Integer) {
+          j.raw("min", p.min > -1e299 ? json_number(p.min) : "null").raw("max", p.max < 1e299 ? json_number(p.max) : "null");
+        }
+        if (p.type == ParamType::Choice) j.raw("choices", json_list(p.choices));
+        if (f != nullptr) {
+          const auto it = f->config().params.find(p.name);
+          j.raw("value", it == f->config().params.end() ? "null" : param_json(it->second));
+        }
+        out.line(j.str("doc", p.doc).text());
+      }
+      return {};
+    }
+    if (f != nullptr) {
+      out.line("filter " + f->name() + ": " + m.type + " - " + m.doc);
+      std::string in, outs;
+      for (const Signal* s : f->inputs()) if (s != nullptr) in += (in.empty() ? "" : ", ") + s->name() + " (size " + std::to_string(s->size()) + ")";
+      for (const Signal* s : f->outputs()) if (s != nullptr) outs += (outs.empty() ? "" : ", ") + s->name() + " (size " + std::to_string(s->size()) + ")";
+      out.line("  target " + (f->target() == kNoMachine ? std::string("-") : co().address_of(f->target())) + ", " +
+               (f->execution() == ExecutionMode::Active ? "ACTIVE" : "PASSIVE") + ", " +
+               (f->detection() == DetectionMode::Edge ? "EDGE" : "LEVEL"));
+      out.line(std::string("  ") + (f->enabled() ? "enabled" : "disabled") + ", " +
+               (f->detected() ? "detected (onset sent, no completion yet)" : "not detected") + ", " +
+               std::to_string(f->missed_samples()) + " missed samples");
+      out.line("  inputs:  " + (in.empty() ? std::string("-") : in));
+      out.line("  outputs: " + (outs.empty() ? std::string("-") : outs));
+    } else {
+      out.line("filter type " + m.type + ": " + m.doc);
+      std::string in, outs;
+      for (const std::string& s : m.inputs) in += (in.empty() ? "" : ", ") + s;
+      for (const std::string& s : m.outputs) outs += (outs.empty() ? "" : ", ") + s;
+      out.line("  inputs:  " + (in.empty() ? std::string("-") : in));
+      out.line("  outputs: " + (outs.empty() ? std::string("-") : outs));
+    }
+    out.line("  parameters:");
+    std::vector<std::vector<std::string>> rows;
+    rows.push_back({"    name", "type", f != nullptr ? "value" : "", "default", "range", "doc"});
+    for (const ParamSpec& p : m.params) {
+      std::string value;
+      if (f != nullptr) {
+        const auto it = f->config().params.find(p.name);
+        value = it == f->config().params.end() ? "-" : param_text(it->second);
+      }
+      const std::string range = range_text(p);
+      rows.push_back({"    " + p.name, std::string(to_string(p.type)), value, default_text(p), range.empty() ? "-" : range, p.doc});
+    }
+    if (f == nullptr) {
+      for (auto& r : rows) r.erase(r.begin() + 2);
+    }
+    out.reply.out += columns(rows);
+    return {};
+  }
+
+  Expected<std::vector<std::vector<double>>> samples_of(const std::vector<std::string>& words) const {
+    std::vector<std::vector<double>> samples;
+    for (const std::string& w : words) {
+      auto s = parse_sample(w);
+      if (!s) return tl::unexpected(s.error());
+      samples.push_back(std::move(*s));
+    }
+    return samples;
+  }
+
+  static std::string count_text(std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); }
+
+  std::string filter_inject(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    auto samples = samples_of({args.begin() + 1, args.end()});
+    if (!samples) return samples.error().message;
+    if (monitor().find_filter(args[0]) == nullptr) return "no filter '" + args[0] + "' (see filter list)";
+    if (auto r = monitor().inject_shallow(args[0], *samples); !r) return r.error().message;
+    write_done(out, c, Json().str("filter", args[0]).integer("samples", static_cast<long long>(samples->size())),
+               "queued " + count_text(samples->size()) + " into filter " + args[0] +
+                   " (seen by that filter alone on its next runs: use watch)");
+    return {};
+  }
+
+  std::string deep_inject(const CommandSpec& c, const std::string& signal, const std::vector<std::vector<double>>& samples,
+                          Out& out) {
+    Signal* s = monitor().signals().find(signal);
+    if (s == nullptr) return "no signal '" + signal + "' (signals are written Component.signal)";
+    if (samples.size() > s->buffer().capacity()) {
+      return count_text(samples.size()) + " would overflow the history of '" + signal + "' (" +
+             std::to_string(s->buffer().capacity()) + " samples): inject fewer at once";
+    }
+    if (auto r = monitor().inject_deep(signal, samples, now()); !r) return r.error().message;
+    write_done(out, c, Json().str("signal", signal).integer("samples", static_cast<long long>(samples.size())),
+               "wrote " + count_text(samples.size()) + " into signal " + signal + " at t=" + seconds_text(now()) +
+                   " (seen by every consumer on its next run: use watch)");
+    return {};
+  }
+
+  std::string filter_dinject(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    auto samples = samples_of({args.begin() + 1, args.end()});
+    if (!samples) return samples.error().message;
+    return deep_inject(c, args[0], *samples, out);
+  }
+
+  std::string filter_dinload(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    std::string text;
+    std::string error;
+    if (!spec::read_file(args[1], text, error)) return error;
+    std::vector<std::vector<double>> samples;
+    std::istringstream lines(text);
+    std::string line;
+    for (int number = 1; std::getline(lines, line); ++number) {
+      std::string_view body = line;
+      body = trim(body.substr(0, body.find('#')));
+      if (body.empty()) continue;
+      auto values = parse_numbers(body);
+      if (!values) return args[1] + ":" + std::to_string(number) + ": " + values.error().message;
+      samples.push_back(std::move(*values));
+    }
+    if (samples.empty()) return args[1] + ": no samples";
+    return deep_inject(c, args[0], samples, out);
+  }
+
+  std::string event_list(Out& out) {
+    const Coordinator& c = co();
+    std::vector<std::vector<std::string>> rows;
+    for (EventId id = 0; id < c.event_count(); ++id) {
+      const Event& e = c.event(id);
+      const std::string kind = e.is_broadcast() ? "broadcast" : e.is_onset ? "onset" : "completion";
+      const std::string counterpart = e.counterpart == kNoEvent ? std::string() : c.event(e.counterpart).name;
+      const bool framework = id < framework_event::kCount;
+      if (options.json) {
+        out.line(Json().str("event", e.name).integer("severity", e.severity).str("kind", kind)
+                     .str("transitions", transitions_text(e.transitions)).opt(e.is_onset ? "completion" : "completes", counterpart)
+                     .boolean("latched", e.latched).boolean("framework", framework).opt("hazard", e.hazard)
+                     .opt("description", e.description).text());
+        continue;
+      }
+      std::string extra;
+      if (!counterpart.empty()) extra += (e.is_onset ? "cleared by " : "clears ") + counterpart;
+      if (e.latched) extra += (extra.empty() ? "" : ", ") + std::string("latched");
+      if (framework) extra += (extra.empty() ? "" : ", ") + std::string("framework");
+      if (!e.hazard.empty()) extra += (extra.empty() ? "" : ", ") + std::string("hazard ") + e.hazard;
+      if (!e.description.empty()) extra += (extra.empty() ? "" : " - ") + e.description;
+      rows.push_back({e.name, std::to_string(e.severity), kind, transitions_text(e.transitions), extra});
+    }
+    if (!options.json) out.reply.out += columns(rows);
+    return {};
+  }
+
+  std::string event_history(const std::vector<std::string>& args, Out& out) {
+    long last = kDefaultHistory;
+    if (!args.empty()) {
+      const auto n = parse_count(args[0]);
+      if (!n) return "N must be a positive whole number, not '" + args[0] + "'";
+      last = *n;
+    }
+    print_records(merged_history(Address{}, true), last, out, "no events yet");
+    return {};
+  }
+
+  std::string event_generate(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    if (auto r = co().generate(args[0], args[1]); !r) return r.error().message;
+    write_done(out, c, Json().str("event", args[0]).str("target", args[1]),
+               "generated " + args[0] + " on " + args[1] + " at t=" + seconds_text(now()));
+    return {};
+  }
+
+  std::string event_broadcast(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    if (auto r = co().broadcast(args[0]); !r) return r.error().message;
+    write_done(out, c, Json().str("event", args[0]), "broadcast " + args[0] + " at t=" + seconds_text(now()));
+    return {};
+  }
+
+  std::string connection_list(Out& out) {
+    const Coordinator& c = co();
+    std::vector<std::vector<std::string>> rows;
+    for (const Connection& k : c.connections()) {
+      const MachineId required = c.required_machines(k.client)[k.required];
+      const MachineId provided = c.provided_machines(k.provider)[k.provided];
+      const std::string client = std::string(c.component_name(k.client)) + "." + std::string(c.interface_name(required));
+      const std::string provider = std::string(c.component_name(k.provider)) + "." + std::string(c.interface_name(provided));
+      const State required_state = c.state(required);
+      const State service_state = c.service_state(k.provider, k.provided);
+      const State propagate = c.service(k.provider, k.provided).propagate;
+      if (options.json) {
+        out.line(Json().str("required", client).str("provided", provider).str("required_state", to_string(required_state))
+                     .str("service_state", to_string(service_state)).str("propagates", to_string(propagate)).text());
+      } else {
+        rows.push_back({client, "->", provider, "s_R " + std::string(to_string(required_state)),
+                        "s_S " + std::string(to_string(service_state)),
+                        "propagates " + std::string(propagate == State::Warning ? "Warning and Error" : "Error")});
+      }
+    }
+    if (!options.json) {
+      if (rows.empty()) out.line("no connections");
+      out.reply.out += columns(rows);
+    }
+    return {};
+  }
+
+  std::string service_list(Out& out) {
+    const Coordinator& c = co();
+    std::vector<std::vector<std::string>> rows;
+    for (ComponentId id = 0; id < c.component_count(); ++id) {
+      const auto& provided = c.provided_machines(id);
+      for (std::uint32_t i = 0; i < provided.size(); ++i) {
+        const std::string p(c.interface_name(provided[i]));
+        const ServiceDependency& d = c.service(id, i);
+        std::vector<std::string> terms{"s_P." + p};
+        if (d.framework) terms.emplace_back("s_F");
+        if (d.application) terms.emplace_back("s_A");
+        if (d.all_required) {
+          for (MachineId r : c.required_machines(id)) terms.push_back("s_R." + std::string(c.interface_name(r)));
+        } else {
+          for (const std::string& r : d.required) terms.push_back("s_R." + r);
+        }
+        std::string formula;
+        for (const std::string& t : terms) formula += (formula.empty() ? "" : " * ") + t;
+        const std::string address = std::string(c.component_name(id)) + ".s_S." + p;
+        const State s = c.service_state(id, i);
+        if (options.json) {
+          out.line(Json().str("service", address).str("state", to_string(s)).raw("depends_on", json_list(terms))
+                       .str("propagates", to_string(d.propagate)).text());
+        } else {
+          rows.push_back({address, std::string(to_string(s)), "= " + formula,
+                          "(propagates " + std::string(d.propagate == State::Warning ? "Warning and Error" : "Error") + ")"});
+        }
+      }
+    }
+    if (!options.json) {
+      if (rows.empty()) out.line("no provided interfaces");
+      out.reply.out += columns(rows);
+    }
+    return {};
+  }
+
+  std::string explain(const std::string& address, Out& out) {
+    auto a = co().resolve(address);
+    if (!a) return a.error().message;
+    const std::vector<Explanation> all = co().explain(*a);
+    const State state = co().state_of(*a);
+    for (const Explanation& e : all) {
+      if (!options.json) {
+        out.line(to_string(e));
+        continue;
+      }
+      Json j;
+      j.str("address", address).str("machine", e.machine).str("event", e.event).str("level", to_string(e.level))
+          .integer("severity", e.severity).boolean("mirror", e.mirror).boolean("outstanding", e.outstanding)
+          .integer("count", e.count).num("first", to_seconds(e.first)).num("last", to_seconds(e.last))
+          .str("root_event", e.root_event).str("root_origin", e.root_origin).num("root_t", to_seconds(e.root_time))
+          .opt("hazard", e.hazard);
+      if (!e.filter.empty()) j.str("filter", e.filter);
+      if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
+      if (e.injected) j.boolean("injected", true);
+      out.line(j.raw("path", json_list(e.path)).text());
+    }
+    if (all.empty() && !options.json) out.line(address + " is " + std::string(to_string(state)) + ": no active condition");
+    return {};
+  }
+
+  std::string watch(const std::vector<std::string>& args, Out& out) {
+    double seconds = 1.0;
+    if (!args.empty()) {
+      const auto v = parse_number(args[0]);
+      if (!v || !std::isfinite(*v) || *v <= 0 || *v > kMaxWatchSeconds) {
+        return "SECONDS must be a number of seconds above 0 and at most " + number_text(kMaxWatchSeconds) + ", not '" + args[0] + "'";
+      }
+      seconds = *v;
+    }
+    const Time start = now();
+    const Time target = start + seconds_to_time(seconds);
+    const Time tick = seconds_to_time(runner->scenario().period);
+    const std::size_t transitions_before = transitions;
+    for (Time t = runner->now() + tick; t <= target; t += tick) {
+      runner->advance_to(t, run_result);
+      flush_captured(out);
+      for (; failures_reported < run_result.failures.size(); ++failures_reported) {
+        const std::string& f = run_result.failures[failures_reported];
+        out.line(options.json ? Json().str("kind", "expectation").str("failure", f).text() : f);
+      }
+    }
+    const std::size_t seen = transitions - transitions_before;
+    if (options.json) {
+      out.line(Json().str("command", "watch").num("from", to_seconds(start)).num("t", to_seconds(now()))
+                   .integer("transitions", static_cast<long long>(seen)).text());
+    } else {
+      out.line("t=" + seconds_text(now()) + "  watched " + number_text(seconds) + " s: " + std::to_string(seen) +
+               (seen == 1 ? " transition" : " transitions"));
+    }
+    return {};
+  }
+
+  std::string reset(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+    std::string reason;
+    for (std::size_t i = 1; i < args.size(); ++i) reason += (reason.empty() ? "" : " ") + args[i];
+    if (reason.empty()) reason = "reset from the console";
+    if (auto r = co().reset(args[0], "console", reason); !r) return r.error().message;
+    write_done(out, c, Json().str("target", args[0]).str("reason", reason),
+               "reset " + args[0] + " at t=" + seconds_text(now()) + " (" + reason + ")");
+    return {};
+  }
+
+  std::string time(Out& out) {
+    const spec::Scenario& s = runner->scenario();
+    if (options.json) {
+      Json j;
+      j.num("t", to_seconds(now())).num("period", s.period);
+      if (!scenario_path.empty()) j.str("scenario", scenario_path).num("duration", s.duration);
+      out.line(j.text());
+      return {};
+    }
+    std::string line = "t=" + seconds_text(now()) + " s (simulated; tick " + number_text(s.period) + " s";
+    if (!scenario_path.empty()) {
+      line += "; scenario " + scenario_path + " lasts " + number_text(s.duration) + " s" +
+              (now() > seconds_to_time(s.duration) ? ", ended" : "");
+    }
+    out.line(line + ")");
+    return {};
+  }
+
+  std::string help(const std::vector<std::string>& args, Out& out) {
+    std::vector<const CommandSpec*> selected;
+    std::string asked;
+    for (const std::string& a : args) asked += (asked.empty() ? "" : " ") + a;
+    for (const CommandSpec& c : commands()) {
+      const bool in_group = args.size() == 1 && is_group(args[0]) && c.name.substr(0, c.name.find(' ')) == args[0];
+      if (args.empty() || in_group || c.name == asked || (asked == "exit" && c.id == Id::Quit)) selected.push_back(&c);
+    }
+    if (selected.empty()) return "no command '" + asked + "'";
+    std::vector<std::vector<std::string>> rows;
+    for (const CommandSpec* c : selected) {
+      const std::string doc = std::string(c->doc) + (c->writes ? " [write: needs --allow-write]" : "");
+      if (options.json) {
+        out.line(Json().str("command", c->name).str("usage", c->usage).str("doc", c->doc).boolean("writes", c->writes).text());
+      } else if (selected.size() == 1) {
+        out.line("usage: " + std::string(c->usage));
+        out.line("  " + doc);
+      } else {
+        rows.push_back({std::string(c->usage), doc});
+      }
+    }
+    if (!rows.empty()) {
+      out.reply.out += columns(rows);
+      if (args.empty()) {
+        out.line("ADDRESS: SYSTEM, C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p. TAB completes commands and names.");
+        out.line(options.allow_write ? "Write commands are allowed (--allow-write)."
+                                     : "Read-only: write commands need --allow-write.");
+      }
+    }
+    return {};
+  }
+};
+
+// ---- Console -------------------------------------------------------------------------------------
+
+Console::Console(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Console::~Console() = default;
+
+Expected<std::unique_ptr<Console>> Console::open(const std::string& system, const std::string& scenario,
+                                                 ConsoleOptions options) {
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  register_builtin_filters(impl->registry);
+  auto errors = [](const std::vector<spec::Diagnostic>& diagnostics) {
+    std::string text;
+    for (const spec::Diagnostic& d : diagnostics) {
+      if (d.severity == spec::Diagnostic::Severity::Error) text += (text.empty() ? "" : "\n") + spec::format(d);
+    }
+    return text;
+  };
+  spec::Scenario sc;
+  if (!scenario.empty()) {
+    spec::ScenarioLoad load = spec::load_scenario(scenario);
+    if (!load.scenario) return fail(ErrorCode::Parse, errors(load.diagnostics));
+    sc = std::move(*load.scenario);
+    if (!system.empty()) sc.system = system;
+    impl->scenario_path = scenario;
+  } else {
+    if (system.empty()) return fail(ErrorCode::InvalidArgument, "a system file is needed (--system, or a --scenario that names one)");
+    sc.system = system;
+    sc.period = 0.001;
+    sc.duration = 0.0;
+  }
+  impl->system_path = sc.system;
+  spec::LoadResult loaded = spec::load_system(sc.system, impl->registry);
+  if (!loaded.ok() || !loaded.system) {
+    const std::string text = errors(loaded.diagnostics);
+    return fail(ErrorCode::Parse, text.empty() ? "cannot load system '" + sc.system + "'" : text);
+  }
+  impl->runner = std::make_unique<runner::ScenarioRunner>(std::move(sc), std::move(*loaded.system), impl->registry);
+  if (auto problems = impl->runner->prepare(); !problems.empty()) {
+    std::string text;
+    for (const spec::Diagnostic& d : problems) text += (text.empty() ? "" : "\n") + spec::format(d);
+    return fail(ErrorCode::InvalidArgument, text);
+  }
+  Impl* self = impl.get();
+  impl->subscription = impl->runner->coordinator().subscribe([self](const Record& r) {
+    if (!shown_record(r)) return;
+    if (r.kind == RecordKind::Transition) ++self->transitions;
+    self->captured.push_back(self->options.json ? record_to_json(r, self->co()) : record_to_text(r, self->co()));
+  });
+  impl->runner->advance_to(Time{0}, impl->run_result);
+  impl->captured.clear();  // what happened at t = 0 is in the histories
+  return std::unique_ptr<Console>(new Console(std::move(impl)));
+}
+
+ConsoleReply Console::execute(std::string_view line) { return impl_->execute(line); }
+
+std::vector<std::string> Console::complete(std::string_view before, std::string_view word) const {
+  return impl_->complete(before, word);
+}
+
+bool Console::completes_file(std::string_view before) const {
+  const Impl::Context ctx = Impl::context(before);
+  return ctx.command != nullptr && Impl::arg_kind(*ctx.command, ctx.arg) == Arg::File;
+}
+
+std::string Console::banner() const {
+  const Coordinator& c = impl_->co();
+  return "safecass console: system " + impl_->system_path + " (" + std::to_string(c.component_count()) +
+         " components" + (impl_->scenario_path.empty() ? "" : ", scenario " + impl_->scenario_path) +
+         "), simulated time t=" + seconds_text(impl_->now()) + ", " +
+         (impl_->options.allow_write ? "writes allowed" : "read-only") + ". Type help, or TAB to complete.";
+}
+
+// ---- terminal front end --------------------------------------------------------------------------
+
+namespace {
+
+void print(const ConsoleReply& reply) {
+  std::fputs(reply.out.c_str(), stdout);
+  std::fflush(stdout);
+  std::fputs(reply.err.c_str(), stderr);
+  std::fflush(stderr);
+}
+
+/// Runs commands one after the other; 2 when any failed, 0 otherwise.
+int run_batch(Console& console, const std::vector<std::string>& lines) {
+  bool failed = false;
+  for (const std::string& line : lines) {
+    const ConsoleReply reply = console.execute(line);
+    print(reply);
+    failed = failed || !reply.ok;
+    if (reply.quit) break;
+  }
+  return failed ? 2 : 0;
+}
+
+// libedit calls plain C functions: these statics connect them to the one interactive console.
+Console* g_console = nullptr;
+std::vector<std::string> g_matches;
+std::size_t g_next_match = 0;
+
+char* next_match(const char* /*text*/, int state) {
+  if (state == 0) g_next_match = 0;
+  if (g_next_match >= g_matches.size()) return nullptr;
+  return strdup(g_matches[g_next_match++].c_str());
+}
+
+char** attempt_completion(const char* text, int start, int /*end*/) {
+  const std::string line = rl_line_buffer != nullptr ? std::string(rl_line_buffer) : std::string();
+  const std::string before = line.substr(0, std::min(line.size(), static_cast<std::size_t>(std::max(start, 0))));
+  if (g_console->completes_file(before)) return nullptr;  // libedit completes the file name
+  rl_attempted_completion_over = 1;
+  g_matches = g_console->complete(before, text);
+  if (g_matches.empty()) return nullptr;
+  return rl_completion_matches(text, next_match);
+}
+
+int run_interactive(Console& console) {
+  g_console = &console;
+  rl_readline_name = "safecass";
+  rl_attempted_completion_function = attempt_completion;
+  using_history();
+  stifle_history(1000);
+  std::printf("%s\n", console.banner().c_str());
+  std::fflush(stdout);
+  std::string previous;
+  for (;;) {
+    char* raw = readline("safecass> ");
+    if (raw == nullptr) {  // end of input (Ctrl-D)
+      std::printf("\n");
+      break;
+    }
+    const std::string line(raw);
+    std::free(raw);
+    const std::string entry(trim(line));
+    if (!entry.empty() && entry != previous) {
+      add_history(entry.c_str());
+      previous = entry;
+    }
+    const ConsoleReply reply = console.execute(line);
+    print(reply);
+    if (reply.quit) break;
+  }
+  g_console = nullptr;
+  return 0;
+}
+
+/// "a; b\nc" -> {"a", "b", "c"}.
+std::vector<std::string> split_commands(const std::string& text) {
+  std::vector<std::string> out;
+  std::string current;
+  for (const char c : text) {
+    if (c == ';' || c == '\n') {
+      out.push_back(current);
+      current.clear();
+    } else {
+      current += c;
+    }
+  }
+  out.push_back(current);
+  return out;
+}
+
+}  // namespace
+
+int run_console(const ConsoleArgs& args) {
+  std::vector<std::string> script;
+  if (!args.script.empty()) {
+    std::string text;
+    std::string error;
+    if (!spec::read_file(args.script, text, error)) {
+      std::fprintf(stderr, "%s\n", error.c_str());
+      return 2;
+    }
+    std::istringstream lines(text);
+    for (std::string line; std::getline(lines, line);) script.push_back(line);
+  }
+  auto console = Console::open(args.system, args.scenario, ConsoleOptions{args.json, args.allow_write});
+  if (!console) {
+    std::fprintf(stderr, "%s\n", console.error().message.c_str());
+    return 2;
+  }
+  if (!args.commands.empty()) return run_batch(**console, split_commands(args.commands));
+  if (!args.script.empty()) return run_batch(**console, script);
+  if (isatty(STDIN_FILENO) != 0) return run_interactive(**console);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(std::cin, line);) lines.push_back(line);
+  return run_batch(**console, lines);
+}
+
+void add_console_command(CLI::App& app, int& code) {
+  auto args = std::make_shared<ConsoleArgs>();
+  auto* cmd = app.add_subcommand("console", "Read and write the component model of a system, interactively or from commands");
+  cmd->footer(
+      "Runs the system in-process in simulated time (as `safecass run` does); with --scenario its steps are "
+      "applied as `watch` advances time. Write commands (filter inject/dinject/dinload, event generate/broadcast, "
+      "reset) are refused unless --allow-write is given; in-process there is no token (tokens apply to remote "
+      "coordinators reached through the middleware). Without -c or --script, commands are read from the terminal "
+      "(line editing, history, TAB completion) or from stdin. Exit code 2 when the system cannot be loaded or, "
+      "with -c/--script/stdin, when any command failed; 0 otherwise. Type `help` inside the console for the commands.");
+  cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
+  cmd->add_option("--scenario,-s", args->scenario, "scenario file whose steps are applied as simulated time advances");
+  auto* commands = cmd->add_option("-c,--command", args->commands, "commands to run, separated by ';'");
+  cmd->add_option("--script", args->script, "file of commands, one per line ('#' starts a comment)")->excludes(commands);
+  cmd->add_flag("--json", args->json, "print one JSON object per result line");
+  cmd->add_flag("--allow-write", args->allow_write, "accept write commands (inject, generate, broadcast, reset)");
+  cmd->callback([args, &code] {
+    if (args->system.empty() && args->scenario.empty()) {
+      std::fprintf(stderr, "console: --system (or --scenario) is required\n");
+      code = 2;
+      return;
+    }
+    code = run_console(*args);
+  });
+}
+
+}  // namespace safecass::tools

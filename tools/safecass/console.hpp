@@ -1,0 +1,90 @@
+#pragma once
+// `safecass console`: read and write the Generic Component Model of a system (DESIGN §6).
+//
+// The console is split in two so that its commands can be tested without a terminal:
+// - Console parses and executes one command line against an in-process system running in
+//   simulated time, and returns the output text and whether the command succeeded. It never
+//   prints and never throws for a bad command: a wrong command is a usage line and changes nothing.
+// - run_console() does the I/O: -c commands, a script, stdin, or an interactive terminal with line
+//   editing, history and TAB completion (libedit).
+//
+// Write operations (filter inject/dinject/dinload, event generate/broadcast, reset) are refused
+// unless the console was opened with write access. In-process there is no token: the token only
+// applies to requests sent to remote coordinators through the middleware.
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "safecass/core/expected.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace safecass::tools {
+
+struct ConsoleArgs {
+  std::string system;         ///< system file (default: the scenario's "system")
+  std::string scenario;       ///< optional: its steps are applied as simulated time advances
+  std::string commands;       ///< -c: commands separated by ';'
+  std::string script;         ///< --script: one command per line ('#' starts a comment)
+  bool json = false;          ///< one JSON object per output line
+  bool allow_write = false;   ///< accept write operations
+};
+
+/// What one command line produced.
+struct ConsoleReply {
+  std::string out;    ///< result lines, each ending in '\n' (JSON objects with --json)
+  std::string err;    ///< one line when the command failed: what went wrong and the usage
+  bool ok = true;     ///< false: unknown command, wrong arguments, refused or failed write
+  bool quit = false;  ///< `quit` was entered
+};
+
+struct ConsoleOptions {
+  bool json = false;
+  bool allow_write = false;
+};
+
+/// An in-process system in simulated time and the commands that read and write it.
+///
+/// Lifecycle: open() loads the system (and scenario), builds it and processes the tick at t = 0;
+/// then execute() any number of times from one thread. Simulated time only moves with `watch`.
+class Console {
+public:
+  /// Loads and builds the system. `system` may be empty when `scenario` names its system.
+  /// Errors: Io/Parse/InvalidArgument with every diagnostic of the system or scenario, one per line.
+  static Expected<std::unique_ptr<Console>> open(const std::string& system, const std::string& scenario,
+                                                 ConsoleOptions options);
+  ~Console();
+  Console(const Console&) = delete;
+  Console& operator=(const Console&) = delete;
+
+  /// Parses and runs one command. Empty and comment ('#') lines do nothing and succeed.
+  ConsoleReply execute(std::string_view line);
+
+  /// Completion candidates for the word `word` being typed after `before` (the line up to the
+  /// start of that word): command words, then the names the command takes (components, machine
+  /// addresses, events, filters, signals). Sorted, each starting with `word`.
+  std::vector<std::string> complete(std::string_view before, std::string_view word) const;
+  /// Whether the word after `before` is a file name (so a terminal may complete file names).
+  bool completes_file(std::string_view before) const;
+
+  /// One line describing the system, the simulated time and the write access.
+  std::string banner() const;
+
+private:
+  struct Impl;
+  explicit Console(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Runs the console; returns the exit code: 0, or 2 when the system cannot be loaded or (with
+/// -c, --script or a non-terminal stdin) when any command failed.
+int run_console(const ConsoleArgs& args);
+
+/// Adds the `console` subcommand to the `safecass` command; its callback stores the exit code.
+void add_console_command(CLI::App& app, int& code);
+
+}  // namespace safecass::tools

@@ -1,0 +1,712 @@
+// `safecass timeline`: history (JSON lines) → model (lanes, bars, markers) → static HTML page.
+
+#include "timeline.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <optional>
+
+#include "timeline_assets.hpp"  // generated from web/timeline/ at build time
+
+namespace safecass::tools {
+
+namespace {
+
+using Kind = HistoryRecord::Kind;
+using spec::JsonValue;
+
+// ---------------------------------------------------------------------------------------------
+// Text helpers (all deterministic: no locale, no pointers, no clocks).
+
+/// Shortest decimal text that reads back as the same double ("0.486", "30.025", "2").
+std::string num(double v) {
+  char buf[40];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc() ? std::string(buf, end) : std::string("0");
+}
+
+/// Seconds for people: at most nine decimals, trailing zeros dropped ("0.252", "1.4", "0").
+std::string secs(double v) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.9f", v);
+  std::string s = buf;
+  if (s.find('.') != std::string::npos) {
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+  }
+  return s == "-0" ? "0" : s;
+}
+
+/// A JSON string that is also safe inside an HTML <script> element: <, > and & are escaped.
+std::string quote(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      case '\r': out += "\\r"; break;
+      case '<': out += "\\u003c"; break;
+      case '>': out += "\\u003e"; break;
+      case '&': out += "\\u0026"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string html_escape(std::string_view s) {
+  std::string out;
+  for (const char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// A parsed line written back as compact JSON, members in file order (comments dropped).
+void canonical(const JsonValue& v, std::string& out) {
+  switch (v.type) {
+    case JsonValue::Type::Null: out += "null"; return;
+    case JsonValue::Type::Bool: out += v.boolean ? "true" : "false"; return;
+    case JsonValue::Type::Number: out += num(v.number); return;
+    case JsonValue::Type::String: out += quote(v.string); return;
+    case JsonValue::Type::Array:
+      out += '[';
+      for (std::size_t i = 0; i < v.array.size(); ++i) {
+        if (i != 0) out += ',';
+        canonical(v.array[i], out);
+      }
+      out += ']';
+      return;
+    case JsonValue::Type::Object:
+      out += '{';
+      for (std::size_t i = 0; i < v.object.size(); ++i) {
+        if (i != 0) out += ',';
+        out += quote(v.object[i].key);
+        out += ':';
+        canonical(v.object[i].value, out);
+      }
+      out += '}';
+      return;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading one line.
+
+std::optional<Kind> parse_kind(std::string_view s) {
+  if (s == "event") return Kind::Event;
+  if (s == "transition") return Kind::Transition;
+  if (s == "component-transition") return Kind::ComponentTransition;
+  if (s == "reset") return Kind::Reset;
+  if (s == "injection") return Kind::Injection;
+  if (s == "overflow") return Kind::Overflow;
+  return std::nullopt;
+}
+
+bool is_state(std::string_view s) { return s == "Normal" || s == "Warning" || s == "Error"; }
+
+bool is_outcome(std::string_view s) {
+  return s == "raised" || s == "override" || s == "joined" || s == "masked" || s == "cleared" ||
+         s == "ignored";
+}
+
+/// Reads the fields of one record object; the first problem is returned as a message.
+class FieldReader {
+public:
+  explicit FieldReader(const JsonValue& object) : object_(object) {}
+
+  const std::optional<std::string>& error() const { return error_; }
+
+  std::string string(std::string_view key, bool required) {
+    const JsonValue* v = object_.find(key);
+    if (v == nullptr) {
+      if (required) fail("missing \"" + std::string(key) + "\"");
+      return {};
+    }
+    if (!v->is_string()) {
+      fail("\"" + std::string(key) + "\" must be a string, not " + std::string(spec::type_name(v->type)));
+      return {};
+    }
+    return v->string;
+  }
+
+  std::optional<double> number(std::string_view key, bool required) {
+    const JsonValue* v = object_.find(key);
+    if (v == nullptr) {
+      if (required) fail("missing \"" + std::string(key) + "\"");
+      return std::nullopt;
+    }
+    if (!v->is_number()) {
+      fail("\"" + std::string(key) + "\" must be a number, not " + std::string(spec::type_name(v->type)));
+      return std::nullopt;
+    }
+    return v->number;
+  }
+
+  bool boolean(std::string_view key) {
+    const JsonValue* v = object_.find(key);
+    if (v == nullptr) return false;
+    if (!v->is_bool()) {
+      fail("\"" + std::string(key) + "\" must be true or false, not " + std::string(spec::type_name(v->type)));
+      return false;
+    }
+    return v->boolean;
+  }
+
+  std::string state(std::string_view key, bool required) {
+    std::string s = string(key, required);
+    if (!s.empty() && !is_state(s)) fail("\"" + std::string(key) + "\" must be Normal, Warning or Error, not \"" + s + "\"");
+    return s;
+  }
+
+  void fail(std::string message) {
+    if (!error_) error_ = std::move(message);
+  }
+
+private:
+  const JsonValue& object_;
+  std::optional<std::string> error_;
+};
+
+/// Checks and types one parsed line. Returns an error message, or nothing when the record is good.
+std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
+  if (!v.is_object()) return "expected a JSON object (one record per line), not " + std::string(spec::type_name(v.type));
+  FieldReader f(v);
+  const std::string kind_text = f.string("kind", true);
+  if (f.error()) return f.error();
+  const auto kind = parse_kind(kind_text);
+  if (!kind) {
+    return "unknown record kind \"" + kind_text +
+           "\" (expected event, transition, component-transition, reset, injection or overflow)";
+  }
+  r.kind = *kind;
+  if (r.kind == Kind::Overflow) {
+    const auto dropped = f.number("dropped", true);
+    if (f.error()) return f.error();
+    if (*dropped < 0 || *dropped != std::floor(*dropped) || *dropped > 9.0e15) {
+      return "\"dropped\" must be a whole number of records, not " + num(*dropped);
+    }
+    r.dropped = static_cast<std::uint64_t>(*dropped);
+    return std::nullopt;
+  }
+
+  r.t = f.number("t", true).value_or(0.0);
+  r.component = f.string("component", false);
+  r.machine = f.string("machine", false);
+  r.event = f.string("event", false);
+  r.text = f.string("text", false);
+  r.mirror = f.boolean("mirror");
+  const bool has_states = r.kind != Kind::Injection;
+  r.from = f.state("from", has_states);
+  r.to = f.state("to", has_states);
+  if (r.kind == Kind::Event) {
+    r.outcome = f.string("outcome", true);
+    if (!f.error() && !is_outcome(r.outcome)) {
+      f.fail("unknown outcome \"" + r.outcome + "\" (expected raised, override, joined, masked, cleared or ignored)");
+    }
+    r.level = f.state("level", false);
+    if (const auto sev = f.number("severity", false)) r.severity = static_cast<int>(std::clamp(*sev, 0.0, 255.0));
+  }
+  if (const JsonValue* root = v.find("root")) {
+    if (!root->is_object()) {
+      f.fail("\"root\" must be an object, not " + std::string(spec::type_name(root->type)));
+    } else {
+      FieldReader rf(*root);
+      r.has_root = true;
+      r.root.event = rf.string("event", true);
+      r.root.origin = rf.string("origin", true);
+      r.root.t = rf.number("t", false).value_or(0.0);
+      r.root.filter = rf.string("filter", false);
+      r.root.signal = rf.string("signal", false);
+      r.root.has_signal = root->find("signal") != nullptr;
+      r.root.value = rf.number("value", false).value_or(0.0);
+      r.root.sample_t = rf.number("sample_t", false).value_or(0.0);
+      r.root.injected = rf.boolean("injected");
+      if (rf.error()) f.fail("in \"root\": " + *rf.error());
+    }
+  }
+  if (f.error()) return f.error();
+
+  switch (r.kind) {
+    case Kind::Event:
+    case Kind::Transition:
+      if (r.machine.empty()) return std::string("missing \"machine\" (a ") + (r.kind == Kind::Event ? "event" : "transition") + " record names its state machine)";
+      break;
+    case Kind::ComponentTransition:
+      if (r.component.empty()) return std::string("missing \"component\" (a component-transition names its component)");
+      break;
+    case Kind::Reset:
+    case Kind::Injection:
+      if (r.machine.empty() && r.component.empty()) return std::string("missing \"machine\" or \"component\"");
+      break;
+    case Kind::Overflow: break;
+  }
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+// The model.
+
+std::string component_of(const HistoryRecord& r) {
+  if (!r.component.empty()) return r.component;
+  return r.machine.substr(0, r.machine.find('.'));
+}
+
+/// Where a machine's lane goes inside its component: framework, application, provided,
+/// required, service, anything else (DESIGN §2.2 order).
+int machine_rank(std::string_view address) {
+  const auto dot = address.find('.');
+  const std::string_view rest = dot == std::string_view::npos ? std::string_view() : address.substr(dot + 1);
+  if (rest == "s_F") return 0;
+  if (rest == "s_A") return 1;
+  if (rest.starts_with("s_P")) return 2;
+  if (rest.starts_with("s_R")) return 3;
+  if (rest.starts_with("s_S")) return 4;
+  return 5;
+}
+
+struct Bar {
+  std::string state;
+  double from = 0.0;
+  std::optional<double> to;  ///< nothing: still in this state at the end of the history
+  const HistoryRecord* entered = nullptr;  ///< the transition that began it; null for the initial state
+  std::string reset_text;                  ///< a reset at the same time, when no event caused it
+};
+
+struct Marker {
+  std::string kind;
+  const HistoryRecord* record = nullptr;
+};
+
+struct Lane {
+  std::string address;
+  bool component = false;
+  std::optional<std::string> initial;  ///< state before the first record that tells it
+  std::vector<Bar> bars;
+  std::vector<Marker> markers;
+};
+
+struct Group {
+  std::string component;
+  std::map<std::string, Lane> machines;  // by address
+  Lane extended;
+};
+
+struct LastReset {
+  double t = 0.0;
+  std::string text;
+};
+
+int severity_rank(std::string_view state) { return state == "Error" ? 2 : state == "Warning" ? 1 : 0; }
+
+/// The root cause of a record; `clears` when the record ends that condition (an improving transition).
+std::string root_lines(const HistoryRecord& r, bool clears = false) {
+  if (!r.has_root) return {};
+  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" + r.root.event + " at " + secs(r.root.t) + " s";
+  if (!r.root.filter.empty() || r.root.has_signal || r.root.injected) {
+    out += "\n";
+    std::string detail;
+    if (!r.root.filter.empty()) detail += "filter " + r.root.filter;
+    if (r.root.has_signal) {
+      detail += (detail.empty() ? "" : ", ") + r.root.signal + " = " + num(r.root.value) + " (sample at " +
+                secs(r.root.sample_t) + " s)";
+    }
+    if (r.root.injected) detail += (detail.empty() ? "" : ", ") + std::string("injected sample");
+    out += detail;
+  }
+  return out;
+}
+
+std::string bar_tip(const Lane& lane, const Bar& b) {
+  std::string tip = lane.address + (lane.component ? " (extended state): " : ": ") + b.state + "\n";
+  tip += secs(b.from) + " s to " + (b.to ? secs(*b.to) + " s (" + secs(*b.to - b.from) + " s)" : std::string("the end of the history"));
+  if (b.entered == nullptr) return tip + "\nstate at the start of the history";
+  const HistoryRecord& r = *b.entered;
+  if (!r.event.empty()) {
+    tip += "\nentered by " + r.event + " (history line " + std::to_string(r.line) + ")";
+  } else if (!b.reset_text.empty()) {
+    tip += "\nentered by a reset (history line " + std::to_string(r.line) + ")\nreason: " + b.reset_text;
+  } else {
+    tip += "\nentered at history line " + std::to_string(r.line);
+  }
+  return tip + root_lines(r, severity_rank(r.to) < severity_rank(r.from));
+}
+
+std::string marker_tip(const Lane& lane, const Marker& m) {
+  const HistoryRecord& r = *m.record;
+  std::string head;
+  if (m.kind == "ignored") head = "Ignored completion " + r.event;
+  else if (m.kind == "masked") head = "Masked onset " + r.event + " (below the current state)";
+  else if (m.kind == "override") head = "Override: onset " + r.event + " at the current level, now outstanding";
+  else if (m.kind == "joined") head = "Joined: onset " + r.event + " at the current level";
+  else if (m.kind == "cleared") head = "Cleared " + (r.event.empty() ? "condition " + r.root.event : r.event) + " (no state change)";
+  else if (m.kind == "reset") head = "Reset (state before: " + r.from + ")";
+  else head = "Fault injection";
+  std::string tip = head + "\n" + lane.address + ", t = " + secs(r.t) + " s (history line " + std::to_string(r.line) + ")";
+  if (r.kind == Kind::Event) {
+    tip += "\n";
+    if (!r.level.empty()) tip += "level " + r.level + ", ";
+    tip += "severity " + std::to_string(r.severity);
+    if (r.mirror) tip += ", mirrored from a provider";
+  }
+  tip += root_lines(r);
+  if (!r.text.empty()) tip += (r.kind == Kind::Injection ? "\n" : "\nreason: ") + r.text;
+  return tip;
+}
+
+/// Writes JSON for the model, one bar, marker or band a line, so that golden diffs read well.
+class ModelWriter {
+public:
+  std::string out;
+
+  void lane(const Lane& l) {
+    out += "{\"address\":" + quote(l.address) + ",\"kind\":" + (l.component ? "\"component\"" : "\"machine\"") + ",\"bars\":[";
+    for (std::size_t i = 0; i < l.bars.size(); ++i) {
+      const Bar& b = l.bars[i];
+      out += i == 0 ? "\n" : ",\n";
+      out += "{\"state\":" + quote(b.state) + ",\"from\":" + num(b.from) + ",\"to\":" + (b.to ? num(*b.to) : "null");
+      if (b.entered != nullptr) {
+        out += ",\"line\":" + std::to_string(b.entered->line);
+        if (!b.entered->event.empty()) out += ",\"event\":" + quote(b.entered->event);
+      }
+      out += ",\"tip\":" + quote(bar_tip(l, b)) + "}";
+    }
+    out += "],\"markers\":[";
+    for (std::size_t i = 0; i < l.markers.size(); ++i) {
+      const Marker& m = l.markers[i];
+      out += i == 0 ? "\n" : ",\n";
+      out += "{\"kind\":" + quote(m.kind) + ",\"t\":" + num(m.record->t) + ",\"line\":" + std::to_string(m.record->line);
+      if (!m.record->event.empty()) out += ",\"event\":" + quote(m.record->event);
+      out += ",\"tip\":" + quote(marker_tip(l, m)) + "}";
+    }
+    out += "]}";
+  }
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+
+HistoryParse parse_history(std::string_view text) {
+  HistoryParse out;
+  std::optional<double> last_t;
+  int line_no = 0;
+  std::size_t pos = 0;
+  while (pos < text.size()) {
+    std::size_t eol = text.find('\n', pos);
+    if (eol == std::string_view::npos) eol = text.size();
+    std::string_view line = text.substr(pos, eol - pos);
+    pos = eol + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (line.find_first_not_of(" \t") == std::string_view::npos) {
+      out.errors.push_back({line_no, "empty line: expected a JSON object (one record per line)"});
+      continue;
+    }
+    spec::JsonParse parsed = spec::parse_json(line, 16);
+    if (parsed.error) {
+      out.errors.push_back({line_no, "invalid JSON at column " + std::to_string(parsed.error->position.column) + ": " +
+                                         parsed.error->message});
+      continue;
+    }
+    HistoryRecord r;
+    r.line = line_no;
+    if (auto problem = read_record(*parsed.value, r)) {
+      out.errors.push_back({line_no, std::move(*problem)});
+      continue;
+    }
+    if (r.kind != Kind::Overflow) {
+      if (last_t && r.t < *last_t) {
+        out.errors.push_back({line_no, "time " + secs(r.t) + " s is earlier than the previous record's (" + secs(*last_t) +
+                                           " s): records must be in time order"});
+        continue;
+      }
+      last_t = r.t;
+    }
+    r.json = std::move(*parsed.value);
+    out.records.push_back(std::move(r));
+  }
+  return out;
+}
+
+namespace {
+
+struct Model {
+  double start = 0.0;
+  double end = 0.0;
+  std::size_t transitions = 0;
+  std::size_t lanes = 0;
+  std::vector<Group> groups;  // in order of first appearance
+  struct Band {
+    const HistoryRecord* record;
+    double from;
+    std::optional<double> to;
+  };
+  std::vector<Band> overflows;
+};
+
+Model build_model(const std::vector<HistoryRecord>& records) {
+  Model m;
+  bool any_time = false;
+  for (const HistoryRecord& r : records) {
+    if (r.kind == Kind::Overflow) continue;
+    if (!any_time || r.t < m.start) m.start = r.t;
+    m.end = any_time ? std::max(m.end, r.t) : r.t;
+    any_time = true;
+  }
+  // Time 0 is the coordinator's start (clock epoch): show it unless a record comes before it.
+  m.start = std::min(m.start, 0.0);
+  m.end = std::max(m.end, m.start);
+
+  std::map<std::string, std::size_t> group_index;
+  auto group = [&](const std::string& component) -> Group& {
+    auto [it, added] = group_index.emplace(component, m.groups.size());
+    if (added) {
+      m.groups.emplace_back();
+      m.groups.back().component = component;
+      m.groups.back().extended.address = component;
+      m.groups.back().extended.component = true;
+    }
+    return m.groups[it->second];
+  };
+  auto lane_of = [&](const HistoryRecord& r) -> Lane& {
+    Group& g = group(component_of(r));
+    if (r.kind == Kind::ComponentTransition || r.machine.empty()) return g.extended;
+    Lane& l = g.machines[r.machine];
+    l.address = r.machine;
+    return l;
+  };
+
+  // Pass 1: the lanes and the state each starts in (the "from" of its first record that has one).
+  for (const HistoryRecord& r : records) {
+    if (r.kind == Kind::Overflow) continue;
+    Lane& l = lane_of(r);
+    const bool tells_state = r.kind == Kind::ComponentTransition || (!l.component && r.kind != Kind::Injection);
+    if (!l.initial && tells_state) l.initial = r.from;
+  }
+  auto open = [&](Lane& l) {
+    if (l.bars.empty()) l.bars.push_back(Bar{l.initial.value_or("Normal"), m.start, std::nullopt, nullptr, {}});
+  };
+  for (Group& g : m.groups) {
+    open(g.extended);
+    for (auto& [address, l] : g.machines) open(l);
+  }
+
+  // Pass 2: bars, markers, overflow bands.
+  std::map<std::string, LastReset> machine_reset;
+  std::map<std::string, LastReset> component_reset;
+  std::optional<double> previous_t;
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const HistoryRecord& r = records[i];
+    if (r.kind == Kind::Overflow) {
+      std::optional<double> next_t;
+      for (std::size_t j = i + 1; j < records.size(); ++j) {
+        if (records[j].kind != Kind::Overflow) {
+          next_t = records[j].t;
+          break;
+        }
+      }
+      m.overflows.push_back({&r, previous_t.value_or(m.start), next_t});
+      continue;
+    }
+    previous_t = r.t;
+    Lane& l = lane_of(r);
+    switch (r.kind) {
+      case Kind::Transition:
+      case Kind::ComponentTransition: {
+        ++m.transitions;
+        l.bars.back().to = r.t;
+        Bar b{r.to, r.t, std::nullopt, &r, {}};
+        const auto& resets = l.component ? component_reset : machine_reset;
+        const auto it = resets.find(l.address);
+        if (r.event.empty() && it != resets.end() && it->second.t == r.t) b.reset_text = it->second.text;
+        l.bars.push_back(std::move(b));
+        break;
+      }
+      case Kind::Event:
+        if (r.outcome == "ignored" || r.outcome == "masked" || r.outcome == "override" || r.outcome == "joined" ||
+            (r.outcome == "cleared" && r.from == r.to)) {
+          l.markers.push_back({r.outcome, &r});
+        }
+        break;
+      case Kind::Reset:
+        l.markers.push_back({"reset", &r});
+        machine_reset[l.address] = {r.t, r.text};
+        component_reset[component_of(r)] = {r.t, r.text};
+        break;
+      case Kind::Injection: l.markers.push_back({"injection", &r}); break;
+      case Kind::Overflow: break;
+    }
+  }
+  for (const Group& g : m.groups) m.lanes += 1 + g.machines.size();
+  return m;
+}
+
+std::vector<const Lane*> ordered_machines(const Group& g) {
+  std::vector<const Lane*> lanes;
+  for (const auto& [address, l] : g.machines) lanes.push_back(&l);
+  std::stable_sort(lanes.begin(), lanes.end(), [](const Lane* a, const Lane* b) {
+    return machine_rank(a->address) < machine_rank(b->address);
+  });
+  return lanes;
+}
+
+std::string model_json(const Model& m, std::size_t record_count) {
+  ModelWriter w;
+  w.out = "{\"start\":" + num(m.start) + ",\"end\":" + num(m.end) + ",\"records\":" + std::to_string(record_count) +
+          ",\"transitions\":" + std::to_string(m.transitions) + ",\"lanes\":" + std::to_string(m.lanes) + ",\n\"overflows\":[";
+  for (std::size_t i = 0; i < m.overflows.size(); ++i) {
+    const auto& band = m.overflows[i];
+    w.out += i == 0 ? "\n" : ",\n";
+    const std::string tip = "The recorder dropped " + std::to_string(band.record->dropped) +
+                            " records here (history line " + std::to_string(band.record->line) +
+                            "): states in this interval may be incomplete.";
+    w.out += "{\"line\":" + std::to_string(band.record->line) + ",\"dropped\":" + std::to_string(band.record->dropped) +
+             ",\"from\":" + num(band.from) + ",\"to\":" + (band.to ? num(*band.to) : "null") + ",\"tip\":" + quote(tip) + "}";
+  }
+  w.out += "],\n\"groups\":[";
+  for (std::size_t gi = 0; gi < m.groups.size(); ++gi) {
+    const Group& g = m.groups[gi];
+    w.out += gi == 0 ? "\n" : ",\n";
+    w.out += "{\"component\":" + quote(g.component) + ",\"lanes\":[\n";
+    w.lane(g.extended);
+    for (const Lane* l : ordered_machines(g)) {
+      w.out += ",\n";
+      w.lane(*l);
+    }
+    w.out += "]}";
+  }
+  w.out += "]}";
+  return w.out;
+}
+
+std::string history_json(const std::vector<HistoryRecord>& records) {
+  if (records.empty()) return "[]";
+  std::string out = "[\n";
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    if (i != 0) out += ",\n";
+    canonical(records[i].json, out);
+  }
+  return out + "\n]";
+}
+
+std::string summary_text(const Model& m, std::size_t record_count) {
+  if (record_count == 0) return "The history is empty: no transitions.";
+  std::string s = std::to_string(record_count) + (record_count == 1 ? " record, " : " records, ");
+  s += m.transitions == 0 ? std::string("no transitions")
+                          : std::to_string(m.transitions) + (m.transitions == 1 ? " transition" : " transitions");
+  s += ", " + std::to_string(m.lanes) + (m.lanes == 1 ? " lane" : " lanes") + " in " + std::to_string(m.groups.size()) +
+       (m.groups.size() == 1 ? " component" : " components");
+  s += ", from " + secs(m.start) + " s to " + secs(m.end) + " s.";
+  return s;
+}
+
+std::string warnings_html(const Model& m) {
+  std::string out;
+  for (const auto& band : m.overflows) {
+    out += "<p class=\"warning\">&#9888; History line " + std::to_string(band.record->line) + ": the recorder dropped " +
+           std::to_string(band.record->dropped) + " records between " + secs(band.from) + " s and " +
+           (band.to ? secs(*band.to) + " s" : std::string("the end")) +
+           "; states in that interval may be incomplete (hatched band).</p>\n";
+  }
+  return out;
+}
+
+/// Replaces each {{NAME}} of the template once, in one pass (inserted text is not scanned again).
+std::string fill(std::string_view tmpl, const std::map<std::string, std::string, std::less<>>& values) {
+  std::string out;
+  out.reserve(tmpl.size());
+  std::size_t pos = 0;
+  while (pos < tmpl.size()) {
+    const std::size_t open = tmpl.find("{{", pos);
+    if (open == std::string_view::npos) break;
+    const std::size_t close = tmpl.find("}}", open + 2);
+    if (close == std::string_view::npos) break;
+    const auto it = values.find(tmpl.substr(open + 2, close - open - 2));
+    out.append(tmpl.substr(pos, open - pos));
+    if (it != values.end()) {
+      out += it->second;
+    } else {
+      out.append(tmpl.substr(open, close + 2 - open));
+    }
+    pos = close + 2;
+  }
+  out.append(tmpl.substr(std::min(pos, tmpl.size())));
+  return out;
+}
+
+}  // namespace
+
+std::string timeline_model_json(const std::vector<HistoryRecord>& records) {
+  return model_json(build_model(records), records.size());
+}
+
+std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title) {
+  const Model m = build_model(records);
+  const std::map<std::string, std::string, std::less<>> values{
+      {"TITLE", html_escape(title)},
+      {"SUMMARY", html_escape(summary_text(m, records.size()))},
+      {"WARNINGS", warnings_html(m)},
+      {"CSS", std::string(web::kTimelineCss)},
+      {"JS", std::string(web::kTimelineJs)},
+      {"MODEL", model_json(m, records.size())},
+      {"HISTORY", history_json(records)},
+  };
+  return fill(web::kTimelineHtml, values);
+}
+
+int run_timeline(const std::string& history, const std::string& html_out) {
+  std::ifstream in(history, std::ios::binary);
+  if (!in) {
+    std::fprintf(stderr, "safecass timeline: cannot read history file '%s'\n", history.c_str());
+    return 2;
+  }
+  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  if (in.bad()) {
+    std::fprintf(stderr, "safecass timeline: cannot read history file '%s'\n", history.c_str());
+    return 2;
+  }
+  const HistoryParse parsed = parse_history(text);
+  if (!parsed.errors.empty()) {
+    for (const HistoryError& e : parsed.errors) {
+      std::fprintf(stderr, "%s:%d: error: %s\n", history.c_str(), e.line, e.message.c_str());
+    }
+    std::fprintf(stderr, "safecass timeline: %zu malformed %s in '%s'; no page written\n", parsed.errors.size(),
+                 parsed.errors.size() == 1 ? "line" : "lines", history.c_str());
+    return 2;
+  }
+  std::string title = history;
+  if (const auto slash = title.find_last_of('/'); slash != std::string::npos) title.erase(0, slash + 1);
+  const std::string page = render_timeline_page(parsed.records, title);
+  std::ofstream out(html_out, std::ios::binary | std::ios::trunc);
+  if (out) out.write(page.data(), static_cast<std::streamsize>(page.size()));
+  if (out) out.close();
+  if (!out) {
+    std::fprintf(stderr, "safecass timeline: cannot write '%s'\n", html_out.c_str());
+    return 2;
+  }
+  return 0;
+}
+
+}  // namespace safecass::tools

@@ -1,0 +1,79 @@
+#pragma once
+// `safecass timeline`: a recorded history (the JSON lines of `safecass run --record`) as one
+// self-contained static HTML page of Normal/Warning/Error swimlanes.
+//
+// The work is split in three pure steps, so that each can be tested on its own:
+//   parse_history()        text → typed records, every malformed line reported with its number;
+//   timeline_model_json()  records → the page's data model (lanes, bars, markers, overflow bands);
+//   render_timeline_page() records → the whole page (template, CSS and JS embedded at build time).
+// run_timeline() reads a file, runs the three and writes the page.
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "safecass/spec/json.hpp"
+
+namespace safecass::tools {
+
+/// One line of a history file, checked and typed. Field names follow record_to_json()
+/// (record/src/recorder.cpp); a field absent from the line is empty (strings) or false/0.
+struct HistoryRecord {
+  enum class Kind : std::uint8_t { Event, Transition, ComponentTransition, Reset, Injection, Overflow };
+
+  int line = 0;  ///< 1-based line number in the history file
+  Kind kind = Kind::Event;
+  double t = 0.0;         ///< seconds since the coordinator's clock started (not for Overflow)
+  std::string outcome;    ///< Event: raised, override, joined, masked, cleared, ignored
+  std::string component;  ///< component name
+  std::string machine;    ///< machine address (JR3.s_A, CONTROL.s_R.ForceData)
+  std::string event;
+  std::string from, to;   ///< Normal, Warning, Error
+  std::string level;      ///< Event: level of the condition added or removed
+  int severity = 0;
+  bool mirror = false;    ///< a condition mirrored along a connection
+  bool has_root = false;  ///< root cause present
+  struct {
+    std::string event, origin, filter, signal;
+    double t = 0.0, value = 0.0, sample_t = 0.0;
+    bool has_signal = false;
+    bool injected = false;
+  } root;
+  std::string text;           ///< reason (ignored, reset "who: why") or injection description
+  std::uint64_t dropped = 0;  ///< Overflow: how many records the recorder dropped
+  spec::JsonValue json;       ///< the line as read, re-emitted into the page
+};
+
+struct HistoryError {
+  int line = 0;
+  std::string message;
+};
+
+struct HistoryParse {
+  std::vector<HistoryRecord> records;
+  std::vector<HistoryError> errors;  ///< empty when every line is a valid record
+};
+
+/// Reads history text, one JSON object per line. Every line must be a record: an empty line,
+/// invalid JSON, an unknown kind, a missing or mistyped field, or a time earlier than the
+/// previous record's is an error naming its line. Nothing is skipped. Overflow lines
+/// (`{"kind":"overflow","dropped":N}`) are records too.
+HistoryParse parse_history(std::string_view text);
+
+/// The data model the page draws, as JSON (deterministic; safe to embed in a <script> element):
+/// {"start","end","records","transitions","overflows":[...],"groups":[{"component","lanes":[
+///   {"address","kind":"component"|"machine","bars":[...],"markers":[...]}]}]}.
+/// Documented in docs/tools.md, section "Timeline". Expects records as parse_history() returns them.
+std::string timeline_model_json(const std::vector<HistoryRecord>& records);
+
+/// The whole page: the embedded template with the model, the history (as a JSON array, one
+/// element per line), a static summary and the overflow warnings. `title` names the history
+/// (usually its file name). Same records and title → same bytes.
+std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title);
+
+/// `safecass timeline HISTORY --html OUT`: 0 the page was written; 2 the history cannot be read,
+/// has a malformed line (each printed as "HISTORY:LINE: error: message"), or OUT cannot be written.
+int run_timeline(const std::string& history, const std::string& html_out);
+
+}  // namespace safecass::tools
