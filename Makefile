@@ -5,7 +5,7 @@ JOBS ?= $(shell nproc)
 BUILD := build
 CTEST_ARGS ?=
 
-.PHONY: all deps configure build demo test bench asan tsan clean
+.PHONY: all deps configure build demo test fuzz-smoke bench asan tsan clean
 
 all: build
 
@@ -25,8 +25,23 @@ demo: build
 	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
 	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
 
-test: build
+test: build fuzz-smoke
 	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+
+# A short libFuzzer run of the spec loader (clang, ASan + UBSan); the long run is in docs/spec-format.md.
+FUZZ := $(BUILD)/fuzz
+fuzz-smoke: deps
+	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
+	  -DSAFECASS_BUILD_TOOLS=OFF -DSAFECASS_BUILD_EXAMPLES=OFF -DSAFECASS_BUILD_BENCHMARKS=OFF >/dev/null
+	@cmake --build $(FUZZ) -j $(JOBS) --target spec_loader_fuzz >/dev/null
+	@mkdir -p $(FUZZ)/corpus
+	@for f in tests/data/good_specs/*.json tests/data/good_specs/*/*.json tests/data/bad_specs/*.json; do \
+	  cp "$$f" "$(FUZZ)/corpus/$$(echo "$$f" | tr / _)"; done
+	@$(FUZZ)/bin/spec_loader_fuzz -dict=tests/fuzz/spec.dict -max_len=8192 -max_total_time=20 -print_final_stats=1 \
+	  -artifact_prefix=$(FUZZ)/ $(FUZZ)/corpus >$(FUZZ)/smoke.log 2>&1 \
+	  || { tail -40 $(FUZZ)/smoke.log; echo "fuzz-smoke: the spec loader fuzzer found a failure"; exit 1; }
+	@echo "fuzz-smoke: no failure in 20 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/smoke.log | tail -1))"
 
 # Benchmarks are built in Release in their own tree; results land in build/bench.json.
 bench: deps
