@@ -2,6 +2,8 @@
 
 #include "console.hpp"
 
+#include "safecass/spec/json.hpp"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -55,26 +57,7 @@ std::string json_number(double v) {
   return number_text(v);
 }
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
+std::string json_string(std::string_view s) { return spec::json_quote(s); }
 
 std::string json_list(const std::vector<std::string>& items) {
   std::string out = "[";

@@ -2,6 +2,8 @@
 
 #include "timeline.hpp"
 
+#include "safecass/spec/json.hpp"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -44,28 +46,16 @@ std::string secs(double v) {
 
 /// A JSON string that is also safe inside an HTML <script> element: <, > and & are escaped.
 std::string quote(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
+  std::string out;
+  for (const char c : spec::json_quote(s)) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      case '\r': out += "\\r"; break;
       case '<': out += "\\u003c"; break;
       case '>': out += "\\u003e"; break;
       case '&': out += "\\u0026"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
+      default: out += c;
     }
   }
-  return out + "\"";
+  return out;
 }
 
 std::string html_escape(std::string_view s) {
