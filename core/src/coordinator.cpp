@@ -620,7 +620,7 @@ void Coordinator::generate(EventId event, MachineId target, const SampleCause& c
   SAFECASS_ASSERT(target < machines_.size() || event_table_[event]->is_broadcast());
   std::lock_guard lock(mutex_);
   if (processing_) {
-    pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName, kNoName});
+    pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName});
     return;
   }
   processing_ = true;
@@ -675,7 +675,7 @@ void Coordinator::reset(const Address& target, std::string_view who, std::string
   text += why;
   const NameId reason = intern(text);
   std::lock_guard lock(mutex_);
-  Pending op{PendingKind::Reset, kNoEvent, kNoMachine, SampleCause{}, target, reason, reason};
+  Pending op{PendingKind::Reset, kNoEvent, kNoMachine, SampleCause{}, target, reason};
   if (processing_) {
     pending_.push_back(op);
     return;
@@ -960,7 +960,7 @@ void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId compo
       // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
       SampleCause cause;
       pending_.push_back(Pending{PendingKind::Generate, framework_event::kCallbackException,
-                                 components_[component]->framework, cause, Address{}, kNoName, kNoName});
+                                 components_[component]->framework, cause, Address{}, kNoName});
     }
   }
 }

@@ -99,8 +99,6 @@ TEST_F(InjectionTest, DeepInjectionWritesTheSignalSoEveryConsumerSeesIt) {
   monitor_.run_active(component_, Time{1});
   EXPECT_EQ(app_state(), State::Error);
   EXPECT_DOUBLE_EQ(latest("C.copy"), 42);
-  SignalCursor cursor(x);
-  (void)cursor;
   Time t{};
   bool injected = false;
   double v = 0;

@@ -326,8 +326,7 @@ private:
     MachineId machine;
     SampleCause cause;
     Address address;
-    NameId who;
-    NameId why;
+    NameId why;  ///< Reset: the interned "who: why" text
   };
 
   static constexpr std::uint64_t pack(StateSnapshot s) noexcept {
