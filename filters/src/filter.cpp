@@ -20,7 +20,8 @@ Filter::Filter(FilterInit init)
   for (Signal* s : inputs_) {
     cursors_.emplace_back(s);
     cursors_.back().skip_to_end();
-    held_.emplace_back(s->size(), 0.0);
+    held_offset_.push_back(held_.size());
+    held_.resize(held_.size() + s->size(), 0.0);
   }
   has_held_.assign(inputs_.size(), 0);
   invalid_.assign(inputs_.size(), 0);
@@ -35,6 +36,21 @@ std::uint64_t Filter::missed_samples() const noexcept {
   return n;
 }
 
+[[gnu::always_inline]] inline void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
+  current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
+  bool finite = true;
+  for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
+  if (!finite) {
+    invalid_sample(input, sample.time, true);
+    return;
+  }
+  if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+  double* held = &held_[held_offset_[input]];
+  for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
+  has_held_[input] = 1;
+  on_sample(input, sample);
+}
+
 void Filter::run(Time now) noexcept {
   if (!enabled()) {
     was_enabled_ = false;
@@ -44,55 +60,50 @@ void Filter::run(Time now) noexcept {
     for (SignalCursor& c : cursors_) c.skip_to_end();
     was_enabled_ = true;
   }
-  bool injected_run = false;
-  if (injection_pending_.load(std::memory_order_acquire)) {
-    std::lock_guard lock(injection_mutex_);
-    if (!injections_.empty()) {
-      std::copy(injections_.front().begin(), injections_.front().end(), injected_scratch_.begin());
-      injections_.pop_front();
-      injected_run = true;
-    }
-    injection_pending_.store(!injections_.empty(), std::memory_order_release);
-  }
-  if (injected_run) {
-    // A shallow injection replaces the first input's samples for this run.
-    cursors_[0].skip_to_end();
-    deliver(0, SampleView{now, injected_scratch_.data(), injected_scratch_.size(), true});
-  }
+  const bool injected_run = injection_pending_.load(std::memory_order_acquire) && run_injection(now);
   if (inputs_.size() == 1) {
+    // The hot path: one input, its new samples in order.
+    SignalCursor& cursor = cursors_[0];
     SampleView sample;
-    while (!injected_run && cursors_[0].next(sample)) deliver(0, sample);
-  } else {
-    // Several inputs: deliver their new samples merged in time order (ties: input order).
-    for (std::size_t i = 0; i < inputs_.size(); ++i) {
-      has_pending_[i] = !(i == 0 && injected_run) && cursors_[i].next(pending_[i]);
-    }
-    for (;;) {
-      std::size_t best = inputs_.size();
-      for (std::size_t i = 0; i < inputs_.size(); ++i) {
-        if (has_pending_[i] && (best == inputs_.size() || pending_[i].time < pending_[best].time)) best = i;
-      }
-      if (best == inputs_.size()) break;
-      deliver(best, pending_[best]);
-      has_pending_[best] = cursors_[best].next(pending_[best]);
-    }
+    while (!injected_run && cursor.next(sample)) deliver(0, sample);
+  } else if (!inputs_.empty()) {
+    run_merged(injected_run);
   }
   current_injected_ = false;
   on_tick(now);
 }
 
-void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
-  current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
-  for (std::size_t k = 0; k < sample.size; ++k) {
-    if (!std::isfinite(sample.data[k])) {
-      invalid_sample(input, sample.time, true);
-      return;
+bool Filter::run_injection(Time now) noexcept {
+  {
+    std::lock_guard lock(injection_mutex_);
+    if (injections_.empty()) {
+      injection_pending_.store(false, std::memory_order_release);
+      return false;
     }
+    std::copy(injections_.front().begin(), injections_.front().end(), injected_scratch_.begin());
+    injections_.pop_front();
+    injection_pending_.store(!injections_.empty(), std::memory_order_release);
   }
-  if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
-  std::copy(sample.data, sample.data + sample.size, held_[input].begin());
-  has_held_[input] = 1;
-  on_sample(input, sample);
+  // A shallow injection replaces the first input's samples for this run.
+  cursors_[0].skip_to_end();
+  deliver(0, SampleView{now, injected_scratch_.data(), injected_scratch_.size(), true});
+  return true;
+}
+
+void Filter::run_merged(bool injected_run) noexcept {
+  // Several inputs: deliver their new samples merged in time order (ties: input order).
+  for (std::size_t i = 0; i < inputs_.size(); ++i) {
+    has_pending_[i] = !(i == 0 && injected_run) && cursors_[i].next(pending_[i]);
+  }
+  for (;;) {
+    std::size_t best = inputs_.size();
+    for (std::size_t i = 0; i < inputs_.size(); ++i) {
+      if (has_pending_[i] && (best == inputs_.size() || pending_[i].time < pending_[best].time)) best = i;
+    }
+    if (best == inputs_.size()) break;
+    deliver(best, pending_[best]);
+    has_pending_[best] = cursors_[best].next(pending_[best]);
+  }
 }
 
 Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
@@ -119,13 +130,8 @@ void Filter::reset() noexcept {
   on_reset();
 }
 
-const double* Filter::held(std::size_t input) const noexcept {
-  return input < held_.size() && has_held_[input] ? held_[input].data() : nullptr;
-}
-
-void Filter::report(bool detected, double value, Time sample_time, std::size_t input) noexcept {
+void Filter::report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept {
   const bool was = detected_.load(std::memory_order_relaxed);
-  if (!detected && !was) return;  // the common case: nothing to say
   const SampleCause cause{name_id_, input < inputs_.size() ? inputs_[input]->name_id() : kNoName, value,
                           sample_time, current_injected_};
   if (detected) {
@@ -150,10 +156,6 @@ void Filter::invalid_sample(std::size_t input, Time sample_time, bool invalid) n
   const EventId event = invalid ? framework_event::kInvalidSample
                                 : framework_event::completion_of(framework_event::kInvalidSample);
   coordinator_->generate(event, coordinator_->framework_machine(component_), cause);
-}
-
-void Filter::write(std::size_t output, Time time, const double* values) noexcept {
-  if (output < outputs_.size() && outputs_[output] != nullptr) outputs_[output]->push(time, values);
 }
 
 double Filter::number(std::string_view param) const {

@@ -1,14 +1,8 @@
 #include "safecass/filters/signal.hpp"
 
-#include <bit>
-#include <cstring>
-
 namespace safecass {
 
 namespace {
-constexpr std::size_t kHeaderWords = 2;  // time, flags
-constexpr std::uint64_t kInjectedFlag = 1;
-
 std::size_t round_up_pow2(std::size_t n) {
   std::size_t p = 1;
   while (p < n) p <<= 1;
@@ -19,48 +13,44 @@ std::size_t round_up_pow2(std::size_t n) {
 HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity)
     : width_(width),
       mask_(round_up_pow2(capacity < 2 ? 2 : capacity) - 1),
-      slots_(std::make_unique<Slot[]>(mask_ + 1)),
-      words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * (width + kHeaderWords))) {}
-
-void HistoryBuffer::push(Time time, const double* values, bool injected) noexcept {
-  const std::uint64_t index = head_.fetch_add(1, std::memory_order_acq_rel);
-  Slot& slot = slots_[index & mask_];
-  std::atomic<std::uint64_t>* w = &words_[(index & mask_) * (width_ + kHeaderWords)];
-  slot.seq.store(2 * index + 1, std::memory_order_relaxed);
-  std::atomic_thread_fence(std::memory_order_release);
-  w[0].store(static_cast<std::uint64_t>(time.count()), std::memory_order_relaxed);
-  w[1].store(injected ? kInjectedFlag : 0, std::memory_order_relaxed);
-  for (std::size_t i = 0; i < width_; ++i) {
-    w[kHeaderWords + i].store(std::bit_cast<std::uint64_t>(values[i]), std::memory_order_relaxed);
-  }
-  slot.seq.store(2 * index + 2, std::memory_order_release);
-}
-
-bool HistoryBuffer::read(std::uint64_t index, Time& time, double* out, bool& injected) const noexcept {
-  const Slot& slot = slots_[index & mask_];
-  const std::atomic<std::uint64_t>* w = &words_[(index & mask_) * (width_ + kHeaderWords)];
-  const std::uint64_t before = slot.seq.load(std::memory_order_acquire);
-  if (before != 2 * index + 2) return false;
-  time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
-  injected = (w[1].load(std::memory_order_relaxed) & kInjectedFlag) != 0;
-  for (std::size_t i = 0; i < width_; ++i) {
-    out[i] = std::bit_cast<double>(w[kHeaderWords + i].load(std::memory_order_relaxed));
-  }
-  std::atomic_thread_fence(std::memory_order_acquire);
-  return slot.seq.load(std::memory_order_relaxed) == before;
-}
+      words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * (width + kHeader))) {}
 
 Signal::Signal(std::string name, ComponentId component, std::size_t size, std::size_t history)
     : name_(std::move(name)), component_(component), buffer_(size, history) {}
 
-bool Signal::latest(Time& time, double* out) const noexcept {
-  bool injected = false;
+void Signal::inject(Time time, const double* values) {
+  std::lock_guard lock(inject_mutex_);
+  if (!injection_ring_) {
+    injection_ring_ = std::make_unique<HistoryBuffer>(size(), buffer_.capacity() + 1);
+    injections_.store(injection_ring_.get(), std::memory_order_release);
+  }
+  // The key places the sample after every sample written so far (see SignalCursor).
+  injection_ring_->push(time, values, buffer_.end());
+}
+
+std::uint64_t Signal::count() const noexcept {
+  const HistoryBuffer* inj = injections();
+  return buffer_.end() + (inj != nullptr ? inj->end() : 0);
+}
+
+bool Signal::latest(Time& time, double* out, bool* injected) const noexcept {
   for (int attempt = 0; attempt < 8; ++attempt) {
-    const std::uint64_t end = buffer_.end();
-    if (end == 0) return false;
-    if (buffer_.read(end - 1, time, out, injected)) return true;
-    // The newest slot is still being written: the one before it is the newest published sample.
-    if (end >= 2 && buffer_.read(end - 2, time, out, injected)) return true;
+    const std::uint64_t written = buffer_.end();
+    const HistoryBuffer* inj = injections();
+    const std::uint64_t n = inj != nullptr ? inj->end() : 0;
+    if (n > 0) {
+      std::uint64_t key = 0;
+      if (!inj->read(n - 1, time, out, &key)) continue;  // overwritten by a concurrent injection
+      if (key >= written) {
+        if (injected != nullptr) *injected = true;
+        return true;
+      }
+    }
+    if (written == 0) return false;
+    if (buffer_.read(written - 1, time, out)) {
+      if (injected != nullptr) *injected = false;
+      return true;
+    }
   }
   return false;
 }
@@ -68,36 +58,41 @@ bool Signal::latest(Time& time, double* out) const noexcept {
 SignalCursor::SignalCursor(const Signal* signal)
     : signal_(signal), scratch_(signal != nullptr ? signal->size() : 0) {}
 
-bool SignalCursor::next(SampleView& out) noexcept {
-  if (signal_ == nullptr) return false;
-  const HistoryBuffer& b = signal_->buffer();
-  const std::uint64_t end = b.end();
-  if (next_ >= end) return false;
-  if (end - next_ > b.capacity()) {
-    missed_ += end - next_ - b.capacity();
-    next_ = end - b.capacity();
-  }
-  Time t{};
-  bool injected = false;
-  while (next_ < end) {
-    if (b.read(next_, t, scratch_.data(), injected)) {
-      ++next_;
-      out = SampleView{t, scratch_.data(), scratch_.size(), injected};
-      return true;
+bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexcept {
+  for (;;) {
+    const std::uint64_t end = inj.end();
+    if (injected_next_ >= end) return next_written(out);
+    if (end - injected_next_ > inj.capacity()) {
+      missed_ += end - injected_next_ - inj.capacity();
+      injected_next_ = end - inj.capacity();
     }
-    // Either not yet published (stop: read it next time) or overwritten (skip it).
-    if (b.end() - next_ > b.capacity()) {
-      ++missed_;
-      ++next_;
+    std::uint64_t key = 0;
+    Time t{};
+    if (!inj.read(injected_next_, t, scratch_.data(), &key)) {
+      ++missed_;  // overwritten while we copied it
+      ++injected_next_;
       continue;
     }
-    return false;
+    // Samples written before the injection come first. If they are gone, next_written() returns
+    // false with next_ past them, and the injected sample is read again on the next pass.
+    if (next_ < key) {
+      if (next_written(out)) return true;
+      continue;
+    }
+    ++injected_next_;
+    out.time = t;
+    out.data = scratch_.data();
+    out.size = scratch_.size();
+    out.injected = true;
+    return true;
   }
-  return false;
 }
 
 void SignalCursor::skip_to_end() noexcept {
-  if (signal_ != nullptr) next_ = signal_->buffer().end();
+  if (signal_ == nullptr) return;
+  next_ = signal_->buffer().end();
+  const HistoryBuffer* inj = signal_->injections();
+  injected_next_ = inj != nullptr ? inj->end() : 0;
 }
 
 Expected<Signal*> SignalRegistry::add(std::string_view name, ComponentId component, std::size_t size) {

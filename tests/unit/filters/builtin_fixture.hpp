@@ -44,16 +44,12 @@ protected:
     const Signal* s = monitor_.signals().find("C." + name);
     EXPECT_NE(s, nullptr) << name;
     if (s == nullptr) return out;
-    const HistoryBuffer& b = s->buffer();
-    const std::uint64_t end = b.end();
-    const std::uint64_t begin = end > b.capacity() ? end - b.capacity() : 0;
-    for (std::uint64_t i = begin; i < end; ++i) {
+    SignalCursor cursor(s);  // from the oldest sample still held
+    SampleView sample;
+    while (cursor.next(sample)) {
       Written w;
-      w.value.resize(s->size());
-      Time t{};
-      bool injected = false;
-      EXPECT_TRUE(b.read(i, t, w.value.data(), injected));
-      w.t = t;
+      w.value.assign(sample.data, sample.data + sample.size);
+      w.t = sample.time;
       out.push_back(std::move(w));
     }
     return out;
@@ -68,7 +64,7 @@ protected:
   std::uint64_t count_of(const std::string& name) {
     const Signal* s = monitor_.signals().find("C." + name);
     EXPECT_NE(s, nullptr) << name;
-    return s == nullptr ? 0 : s->buffer().end();
+    return s == nullptr ? 0 : s->count();
   }
   /// The newest sample of C.<name> as a vector.
   std::vector<double> latest_vector(const std::string& name) {

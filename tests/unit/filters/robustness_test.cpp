@@ -97,14 +97,14 @@ struct Rig {
     std::vector<std::vector<double>> out;
     const Signal* s = monitor.signals().find("C." + name);
     if (s == nullptr) return out;
-    for (std::uint64_t i = 0; i < s->buffer().end(); ++i) {
-      std::vector<double> v(s->size() + 1);
-      Time t{};
-      bool injected = false;
-      EXPECT_TRUE(s->buffer().read(i, t, v.data() + 1, injected));
-      v[0] = to_seconds(t);
+    SignalCursor cursor(s);
+    SampleView sample;
+    while (cursor.next(sample)) {
+      std::vector<double> v{to_seconds(sample.time)};
+      v.insert(v.end(), sample.data, sample.data + sample.size);
       out.push_back(std::move(v));
     }
+    EXPECT_EQ(cursor.missed(), 0u) << name << ": the history buffer overflowed";
     return out;
   }
 };

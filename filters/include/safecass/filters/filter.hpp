@@ -111,13 +111,20 @@ protected:
 
   /// Turns a detection into events (EDGE/LEVEL), carrying the filter, signal and value as the
   /// root cause. Takes the coordinator's lock only when an event is generated.
-  void report(bool detected, double value, Time sample_time, std::size_t input = 0) noexcept;
+  void report(bool detected, double value, Time sample_time, std::size_t input = 0) noexcept {
+    if (!detected && !detected_.load(std::memory_order_relaxed)) return;  // the common case: nothing to say
+    report_change(detected, value, sample_time, input);
+  }
   /// Writes a sample of output `output` (size doubles must match the output signal).
-  void write(std::size_t output, Time time, const double* values) noexcept;
+  void write(std::size_t output, Time time, const double* values) noexcept {
+    if (output < outputs_.size() && outputs_[output] != nullptr) outputs_[output]->push(time, values);
+  }
   void write(std::size_t output, Time time, double value) noexcept { write(output, time, &value); }
   bool has_output(std::size_t output) const noexcept { return output < outputs_.size() && outputs_[output] != nullptr; }
   /// The newest value of input `input` seen by this filter (zero-order hold), or nullptr.
-  const double* held(std::size_t input) const noexcept;
+  const double* held(std::size_t input) const noexcept {
+    return input < has_held_.size() && has_held_[input] != 0 ? &held_[held_offset_[input]] : nullptr;
+  }
   /// Whether the sample being processed was injected.
   bool current_injected() const noexcept { return current_injected_; }
 
@@ -127,8 +134,11 @@ protected:
   bool flag(std::string_view param) const;
 
 private:
+  void report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept;
   void invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept;
   void deliver(std::size_t input, const SampleView& sample) noexcept;
+  void run_merged(bool injected_run) noexcept;
+  bool run_injection(Time now) noexcept;
 
   FilterConfig config_;
   Coordinator* coordinator_;
@@ -137,7 +147,8 @@ private:
   std::vector<Signal*> inputs_;
   std::vector<Signal*> outputs_;
   std::vector<SignalCursor> cursors_;
-  std::vector<std::vector<double>> held_;
+  std::vector<double> held_;               ///< newest finite sample of each input, side by side
+  std::vector<std::size_t> held_offset_;   ///< where each input's sample starts in held_
   std::vector<char> has_held_;
   std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
   std::vector<char> has_pending_;

@@ -3,17 +3,27 @@
 /// Signals (DESIGN §3): named `Component.signal`, scalar or fixed-size vector of doubles, each
 /// sample timestamped, with a history buffer that keeps the recent samples.
 ///
-/// The history buffer is a ring that writers fill and any number of readers follow, without
-/// locks: a writer reserves a slot with one atomic increment and publishes it with a per-slot
-/// sequence number (so a deep fault injection from a tool thread may write beside the signal's
-/// own writer); a reader copies a slot and checks the sequence number again (seqlock). Nothing
-/// allocates after construction.
+/// Each signal has two lock-free rings that any number of readers follow:
+/// - the **history buffer**, written by the signal's one writer (the component, or the filter whose
+///   output it is) with plain stores and no read-modify-write: a push is a handful of stores;
+/// - the **injection ring**, created on the first deep fault injection, written under a mutex by
+///   any thread (tools), so an injection never races the writer.
+/// Each injected sample remembers how many samples the history buffer held when it was injected;
+/// a cursor merges the two rings in that order, so every consumer sees the samples in the order
+/// they were written. A reader copies a slot and then checks, with the ring's head, that the
+/// writer had not started to overwrite it (an overwriting ring: the newest capacity() samples are
+/// always readable). Nothing allocates after construction, except the injection ring, once.
+///
+/// The hot paths (push, read, SignalCursor::next) are defined here so they inline into filters.
 
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "safecass/core/clock.hpp"
@@ -32,40 +42,73 @@ struct SampleView {
   double scalar() const noexcept { return data[0]; }
 };
 
+/// A ring of timestamped samples with one writer at a time and any number of lock-free readers.
+/// Each slot holds the time, an order key (see Signal) and width() doubles, stored as bit
+/// patterns in relaxed atomics so that a reader racing the writer is well defined (the head check
+/// discards such a copy).
 class HistoryBuffer {
 public:
-  /// `width` doubles per sample; `capacity` is rounded up to a power of two.
+  /// `width` doubles per sample; the ring has `capacity` rounded up to a power of two slots.
   HistoryBuffer(std::size_t width, std::size_t capacity);
   HistoryBuffer(const HistoryBuffer&) = delete;
   HistoryBuffer& operator=(const HistoryBuffer&) = delete;
 
   std::size_t width() const noexcept { return width_; }
-  std::size_t capacity() const noexcept { return mask_ + 1; }
+  /// How many of the newest samples are always readable: the ring's size minus one (the slot the
+  /// writer fills next may be half-written).
+  std::size_t capacity() const noexcept { return mask_; }
 
-  /// Appends a sample (`values` holds width() doubles). Lock-free, allocation-free.
-  void push(Time time, const double* values, bool injected = false) noexcept;
+  /// Appends a sample (`values` holds width() doubles). One writer at a time; lock-free,
+  /// allocation-free, no read-modify-write.
+  void push(Time time, const double* values, std::uint64_t key = 0) noexcept {
+    const std::uint64_t index = head_.load(std::memory_order_relaxed);
+    // Orders the previous head store before this slot's stores (pairs with read()'s fence): a
+    // reader that sees any of these stores then sees the head past the slot's previous sample.
+    std::atomic_thread_fence(std::memory_order_release);
+    std::atomic<std::uint64_t>* w = slot(index);
+    w[0].store(static_cast<std::uint64_t>(time.count()), std::memory_order_relaxed);
+    w[1].store(key, std::memory_order_relaxed);
+    for (std::size_t i = 0; i < width_; ++i) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &values[i], sizeof bits);  // std::bit_cast, in C++17
+      w[kHeader + i].store(bits, std::memory_order_relaxed);
+    }
+    head_.store(index + 1, std::memory_order_release);
+  }
 
-  /// Index the next push will take; samples [end() - capacity(), end()) may be readable.
+  /// Index the next push will take: samples [end() - capacity(), end()) are readable.
   std::uint64_t end() const noexcept { return head_.load(std::memory_order_acquire); }
 
   /// Copies sample `index` into `out` (width() doubles). Returns false if that sample is not
   /// (yet, or any more) in the buffer. Lock-free, allocation-free.
-  bool read(std::uint64_t index, Time& time, double* out, bool& injected) const noexcept;
+  bool read(std::uint64_t index, Time& time, double* out, std::uint64_t* key = nullptr) const noexcept {
+    const std::uint64_t head = head_.load(std::memory_order_acquire);
+    if (index >= head || head - index > mask_) return false;
+    const std::atomic<std::uint64_t>* w = slot(index);
+    time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
+    if (key != nullptr) *key = w[1].load(std::memory_order_relaxed);
+    for (std::size_t i = 0; i < width_; ++i) {
+      const std::uint64_t bits = w[kHeader + i].load(std::memory_order_relaxed);
+      std::memcpy(&out[i], &bits, sizeof bits);
+    }
+    std::atomic_thread_fence(std::memory_order_acquire);
+    // The slot is rewritten by sample index + mask_ + 1, whose stores start after the head
+    // reached index + mask_ + 1: while the head is below that, the copy is intact.
+    return head_.load(std::memory_order_relaxed) - index <= mask_;
+  }
 
 private:
-  struct Slot {
-    std::atomic<std::uint64_t> seq{0};  ///< 2*index+1 while writing, 2*index+2 when published
-  };
+  static constexpr std::size_t kHeader = 2;  // time, order key
+  std::atomic<std::uint64_t>* slot(std::uint64_t index) const noexcept {
+    return &words_[(index & mask_) * (width_ + kHeader)];
+  }
   std::size_t width_;
   std::size_t mask_;
-  std::unique_ptr<Slot[]> slots_;
-  /// Per slot: time, flags, then width_ doubles, stored as bit patterns in relaxed atomics so
-  /// that a reader racing a writer is well defined (the sequence check discards the copy).
   std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
-  std::atomic<std::uint64_t> head_{0};
+  alignas(64) std::atomic<std::uint64_t> head_{0};
 };
 
-/// A named signal with its history buffer.
+/// A named signal with its history buffer and, after the first deep injection, its injection ring.
 class Signal {
 public:
   Signal(std::string name, ComponentId component, std::size_t size, std::size_t history);
@@ -78,42 +121,83 @@ public:
   NameId name_id() const noexcept { return name_id_; }
   void set_name_id(NameId id) noexcept { name_id_ = id; }
 
-  /// Writes a scalar sample. Lock-free, allocation-free.
+  /// Writes a scalar sample. From the signal's one writer; lock-free, allocation-free.
   void push(Time time, double value) noexcept { buffer_.push(time, &value); }
-  /// Writes a vector sample of size() doubles. Lock-free, allocation-free.
+  /// Writes a vector sample of size() doubles. From the signal's one writer; lock-free,
+  /// allocation-free.
   void push(Time time, const double* values) noexcept { buffer_.push(time, values); }
-  /// Deep fault injection: a sample every consumer sees, marked as injected.
-  void inject(Time time, const double* values) noexcept { buffer_.push(time, values, true); }
+  /// Deep fault injection: a sample every consumer sees, after the samples written so far,
+  /// marked as injected. From any thread (takes a mutex; allocates the injection ring once).
+  void inject(Time time, const double* values);
 
-  HistoryBuffer& buffer() noexcept { return buffer_; }
+  /// The writer's history buffer (without the injected samples).
   const HistoryBuffer& buffer() const noexcept { return buffer_; }
+  /// The injected samples, or nullptr before the first injection. Lock-free.
+  const HistoryBuffer* injections() const noexcept { return injections_.load(std::memory_order_acquire); }
+  /// Samples ever written, injected ones included.
+  std::uint64_t count() const noexcept;
 
-  /// Copies the newest sample into `out`; false when the signal has no sample yet.
-  bool latest(Time& time, double* out) const noexcept;
+  /// Copies the newest sample (written or injected) into `out`; false when the signal has none.
+  bool latest(Time& time, double* out, bool* injected = nullptr) const noexcept;
 
 private:
   std::string name_;
   ComponentId component_;
   NameId name_id_ = kNoName;
   HistoryBuffer buffer_;
+  std::atomic<const HistoryBuffer*> injections_{nullptr};
+  std::unique_ptr<HistoryBuffer> injection_ring_;  ///< owns *injections_
+  std::mutex inject_mutex_;
 };
 
-/// Reads the samples of one signal in order, remembering where it stopped. One cursor per reader.
+/// Reads the samples of one signal in order (written and injected merged), remembering where it
+/// stopped. One cursor per reader; a new cursor starts at the oldest readable sample.
 class SignalCursor {
 public:
   SignalCursor() = default;
   explicit SignalCursor(const Signal* signal);
+
   /// Reads the next unread sample into internal storage; false when there is none. Samples
-  /// overwritten before they were read are skipped and counted in missed().
-  bool next(SampleView& out) noexcept;
+  /// overwritten before they were read are skipped and counted in missed(). Lock-free,
+  /// allocation-free.
+  bool next(SampleView& out) noexcept {
+    if (signal_ == nullptr) return false;
+    if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) {
+      return next_merged(*inj, out);
+    }
+    return next_written(out);
+  }
   /// Skips every sample written so far.
   void skip_to_end() noexcept;
   std::uint64_t missed() const noexcept { return missed_; }
   const Signal* signal() const noexcept { return signal_; }
 
 private:
+  bool next_written(SampleView& out) noexcept {
+    const HistoryBuffer& b = signal_->buffer();
+    for (;;) {
+      const std::uint64_t end = b.end();
+      if (next_ >= end) return false;
+      if (end - next_ > b.capacity()) {
+        missed_ += end - next_ - b.capacity();
+        next_ = end - b.capacity();
+      }
+      if (b.read(next_, out.time, scratch_.data())) {
+        ++next_;
+        out.data = scratch_.data();
+        out.size = scratch_.size();
+        out.injected = false;
+        return true;
+      }
+      ++missed_;  // overwritten while we copied it
+      ++next_;
+    }
+  }
+  bool next_merged(const HistoryBuffer& inj, SampleView& out) noexcept;
+
   const Signal* signal_ = nullptr;
-  std::uint64_t next_ = 0;
+  std::uint64_t next_ = 0;           ///< next sample of the history buffer
+  std::uint64_t injected_next_ = 0;  ///< next sample of the injection ring
   std::uint64_t missed_ = 0;
   std::vector<double> scratch_;
 };
