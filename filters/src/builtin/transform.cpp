@@ -101,7 +101,7 @@ protected:
       slot[i] = s[i];
       sum_[i] += s[i];
     }
-    next_ = (next_ + 1) % window_;
+    if (++next_ == window_) next_ = 0;  // not %: a division costs more than the rest of the update
     if (count_ < window_) ++count_;
     // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
     if (next_ == 0) {
