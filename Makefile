@@ -5,7 +5,7 @@ JOBS ?= $(shell nproc)
 BUILD := build
 CTEST_ARGS ?=
 
-.PHONY: all deps configure build demo test fuzz-smoke bench asan tsan clean
+.PHONY: all deps configure build demo ros-demo test fuzz-smoke bench asan tsan clean
 
 all: build
 
@@ -24,6 +24,12 @@ demo: build
 	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
 	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
 	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
+
+# ROBODOC on ROS 1 (examples/ros_robodoc): roscore, diagnostic_aggregator, the nodes, rosdiagnostic.
+ros-demo: configure
+	@cmake -S . -B $(BUILD) -DSAFECASS_WITH_ROS1=ON >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS) --target ros_robodoc_control ros_robodoc_jr3
+	@./scripts/ros-demo.sh $(BUILD)
 
 test: build fuzz-smoke
 	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)
