@@ -231,8 +231,10 @@ public:
 protected:
   void on_sample(std::size_t input, const SampleView& s) noexcept override {
     if (input == 0) {
+      // A start while an interval is open does not restart it: the deadline runs from the first
+      // unmatched start, so starts that keep coming can never hide a missing end.
+      if (!open_) start_ = s.time;
       open_ = true;
-      start_ = s.time;
       return;
     }
     if (!open_) return;

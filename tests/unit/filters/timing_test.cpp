@@ -302,6 +302,19 @@ TEST_F(DeadlineFilter, StartStillOpenAfterTheDeadlineRaisesOnTick) {
   EXPECT_EQ(times_, at({1.2, 2.02}));
 }
 
+TEST_F(DeadlineFilter, RepeatedStartsWithoutAnEndDoNotRestartTheDeadline) {
+  Signal* start = signal("start");
+  signal("end");  // never written
+  make("Deadline", deadline_params(0.1));
+  // A loop that starts every 50 ms and never reaches its end checkpoint.
+  for (int k = 0; k <= 4; ++k) {
+    push(start, 1.0 + 0.05 * k, 1);
+    run_all(1.0 + 0.05 * k);
+  }
+  EXPECT_EQ(events_, Events{"EVT_X"});
+  EXPECT_EQ(times_, at({1.15})) << "the deadline runs from the first unmatched start";
+}
+
 TEST_F(DeadlineFilter, EndWithoutAStartIsIgnored) {
   signal("start");
   Signal* end = signal("end");
