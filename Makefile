@@ -11,6 +11,8 @@ all: build
 
 deps:
 	@./scripts/install-deps.sh
+	@if [ ! -f web/node_modules/.package-lock.json ] || [ web/package-lock.json -nt web/node_modules/.package-lock.json ]; then \
+	  npm ci --prefix web --no-audit --no-fund --loglevel=error; fi
 
 configure: deps
 	@test -f $(BUILD)/build.ninja || cmake --preset dev >/dev/null
@@ -56,6 +58,7 @@ bench: deps
 	@./$(BUILD)/release/bin/safecass_bench --benchmark_repetitions=5 \
 	  --benchmark_report_aggregates_only=true \
 	  --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
+	@./scripts/bench-middleware $(BUILD)/release/bin/bench_middleware $(BUILD)/bench-middleware.json
 
 asan: deps
 	@test -f $(BUILD)/asan/build.ninja || cmake --preset asan >/dev/null

@@ -16,6 +16,14 @@ packages+=(
   libdiagnostic-msgs-dev python3-diagnostic-msgs libdiagnostic-aggregator-tools rosdiagnostic
   python3-dateutil util-linux iproute2
 )
+# `safecass viewer` (tools/viewer): Boost.Beast; its page is TypeScript compiled with the npm packages
+# of web/package.json (`make deps` runs `npm ci --prefix web`), and its browser test drives Debian's
+# chromium. Debian's Node.js only when no `node` is installed.
+packages+=(libboost-dev libboost-system-dev chromium)
+command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
+# The middleware (middleware/, `safecass run --ice`, `safecass supervisor`, scripts/start-icestorm):
+# ZeroC Ice 3.7 with slice2cpp, and IceBox hosting the IceStorm service.
+packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
 
 missing=()
 for p in "${packages[@]}"; do

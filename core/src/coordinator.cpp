@@ -128,6 +128,7 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
   c->history.items.resize(options_.history_capacity);
   c->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   components_.push_back(std::move(c));
+  component_index_.emplace(std::string(name), id);
   ComponentData& cd = *components_.back();
   cd.framework = add_machine(id, MachineKind::Framework, kNone, cd.name + ".s_F");
   cd.application = add_machine(id, MachineKind::Application, kNone, cd.name + ".s_A");
@@ -168,7 +169,7 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
   c.provided.push_back(id);
   c.services.push_back(ServiceData{});
   ++c.machine_state_count[index(State::Normal)];
-  rebuild_fanout();
+  rebuild_fanout(component);
   return id;
 }
 
@@ -189,7 +190,7 @@ Expected<MachineId> Coordinator::add_required(ComponentId component, std::string
   c.required.push_back(id);
   c.required_connection.push_back(kNoConnection);
   ++c.machine_state_count[index(State::Normal)];
-  rebuild_fanout();
+  rebuild_fanout(component);
   return id;
 }
 
@@ -280,14 +281,15 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
     }
   }
   std::lock_guard lock(mutex_);
-  for (const auto& m : machines_) {
-    if (!m->conditions.empty()) {
+  // Only conditions on this component's own machines can flow through its services.
+  for (MachineId id : component_machines(c)) {
+    if (!machines_[id]->conditions.empty()) {
       return fail(ErrorCode::InvalidState, "service '" + c.name + "." + std::string(provided) +
                                                "': dependencies cannot change while conditions are active");
     }
   }
   c.services[p] = std::move(data);
-  rebuild_fanout();
+  rebuild_fanout(component);
   return {};
 }
 
@@ -344,13 +346,18 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   const auto id = static_cast<ConnectionId>(connections_.size());
   connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
-  rebuild_fanout();
-  // A connection made while faults are active carries them at once (mirrors are defined by reachability).
+  pc.provider_connections.push_back(id);
+  rebuild_fanout(provider->first);
+  // A connection made while faults are active carries them at once (mirrors are defined by
+  // reachability). Whatever it carries is active at one of the provider's machines: when they
+  // are all Normal there is nothing to carry (the common case while a system is being built).
+  if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
   processing_ = true;
   for (MachineId m = 0; m < machines_.size(); ++m) {
     const std::vector<Condition> snapshot = machines_[m]->conditions;
     for (const Condition& c : snapshot) {
-      if (!c.mirror) propagate_onset(c);
+      // Roots, and remote roots at the remote provided interface that holds them.
+      if (!c.mirror || (c.root.remote != kNone && c.root.origin == m)) propagate_onset(c);
     }
   }
   drain_pending();
@@ -374,32 +381,33 @@ bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, cons
   return false;
 }
 
-void Coordinator::rebuild_fanout() {
-  for (auto& m : machines_) m->fanout.clear();
-  for (ConnectionId k = 0; k < connections_.size(); ++k) {
+void Coordinator::rebuild_fanout(ComponentId provider_id) {
+  const ComponentData& provider = *components_[provider_id];
+  const std::vector<MachineId> machines = component_machines(provider);
+  for (MachineId m : machines) machines_[m]->fanout.clear();
+  for (ConnectionId k : provider.provider_connections) {
     const Connection& conn = connections_[k];
-    const ComponentData& provider = *components_[conn.provider];
     const MachineId client_machine = components_[conn.client]->required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
-    // Only the provider's own machines can feed its service.
-    auto add_if_feeding = [&](MachineId m) {
+    for (MachineId m : machines) {
       if (depends_on(conn.provider, conn.provided, *machines_[m])) {
         machines_[m]->fanout.push_back(Edge{client_machine, min_level, k});
       }
-    };
-    add_if_feeding(provider.framework);
-    add_if_feeding(provider.application);
-    for (MachineId m : provider.provided) add_if_feeding(m);
-    for (MachineId m : provider.required) add_if_feeding(m);
+    }
   }
+}
+
+std::vector<MachineId> Coordinator::component_machines(const ComponentData& c) {
+  std::vector<MachineId> out{c.framework, c.application};
+  out.insert(out.end(), c.provided.begin(), c.provided.end());
+  out.insert(out.end(), c.required.begin(), c.required.end());
+  return out;
 }
 
 // ---- lookup ----------------------------------------------------------------------------------
 
 Expected<ComponentId> Coordinator::find_component(std::string_view name) const {
-  for (ComponentId i = 0; i < components_.size(); ++i) {
-    if (components_[i]->name == name) return i;
-  }
+  if (const auto it = component_index_.find(name); it != component_index_.end()) return it->second;
   return fail(ErrorCode::NotFound, "no component '" + std::string(name) + "'");
 }
 
@@ -526,7 +534,9 @@ State Coordinator::service_state(ComponentId component, std::uint32_t provided) 
 
 State Coordinator::coordinator_state() const noexcept {
   State s = State::Normal;
-  for (ComponentId c = 0; c < components_.size(); ++c) s = s * extended_state(c);
+  for (ComponentId c = 0; c < components_.size(); ++c) {
+    if (!components_[c]->remote) s = s * extended_state(c);
+  }
   return s;
 }
 
@@ -750,7 +760,9 @@ std::int32_t Coordinator::find_any_root(const MachineData& m) const noexcept {
 std::int32_t Coordinator::find_mirror(const MachineData& m, const RootCause& root) const noexcept {
   for (std::size_t i = 0; i < m.conditions.size(); ++i) {
     const Condition& c = m.conditions[i];
-    if (c.mirror && c.root.event == root.event && c.root.origin == root.origin) return static_cast<std::int32_t>(i);
+    if (c.mirror && c.root.event == root.event && c.root.origin == root.origin && c.root.remote == root.remote) {
+      return static_cast<std::int32_t>(i);
+    }
   }
   return -1;
 }

@@ -85,6 +85,13 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
     at = from;
   }
   std::reverse(reversed.begin(), reversed.end());
+  if (condition.root.remote != kNone && condition.root.remote < remote_roots_.size()) {
+    // A remote root: its hops in the provider's process, then the local ones after the remote
+    // provided interface (which stands for the provider's machine that feeds the service).
+    std::vector<std::string> full = remote_roots_[condition.root.remote].path;
+    full.insert(full.end(), reversed.begin() + 1, reversed.end());
+    return full;
+  }
   return reversed;
 }
 
@@ -110,7 +117,9 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
     e.first = c->first;
     e.last = c->last;
     e.root_event = events_[c->root.event].name;
-    e.root_origin = machines_[c->root.origin]->address;
+    e.root_origin = c->root.remote != kNone && c->root.remote < remote_roots_.size()
+                        ? remote_roots_[c->root.remote].origin
+                        : machines_[c->root.origin]->address;
     e.root_time = c->root.time;
     e.hazard = events_[c->root.event].hazard;
     if (c->root.sample.filter != kNoName) e.filter = std::string(name_of(c->root.sample.filter));

@@ -15,6 +15,12 @@ struct RunArgs {
   std::string scenario;
   bool json = false;
   std::string record;
+  // Multi-process runs (middleware_commands.hpp): one coordinator of the system, in real time.
+  std::string coordinator;   ///< --coordinator: run only this coordinator's components
+  std::string ice;           ///< --ice HOST:PORT: join the system through IceStorm
+  double duration = 0.0;     ///< --duration SECONDS (0: the scenario's, or until SIGINT/SIGTERM)
+  bool allow_write = false;  ///< --allow-write: serve write operations to holders of the token
+  std::string token_file;    ///< --token-file: where to write the token
 };
 /// `safecass run`: 0 passed, 1 an expectation failed, 2 invalid input.
 int run_run(const RunArgs& args);

@@ -1,6 +1,12 @@
-// `safecass console`: the command executor (Console) and its terminal front end (run_console).
+// `safecass console`: the in-process backend (a system in simulated time) and the terminal front
+// end (run_console). The parser and `help` are in console_shell.cpp; the remote backend is in
+// console_remote.cpp.
 
 #include "console.hpp"
+#include "console_shell.hpp"
+#ifdef SAFECASS_WITH_ICE
+#include "console_remote.hpp"
+#endif
 
 #include "safecass/spec/json.hpp"
 
@@ -29,292 +35,9 @@
 
 namespace safecass::tools {
 
+using namespace console;
+
 namespace {
-
-// ---- small text helpers --------------------------------------------------------------------------
-
-std::string_view trim(std::string_view s) {
-  const auto first = s.find_first_not_of(" \t\r\n");
-  if (first == std::string_view::npos) return {};
-  const auto last = s.find_last_not_of(" \t\r\n");
-  return s.substr(first, last - first + 1);
-}
-
-std::string seconds_text(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
-
-std::string number_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
-  return number_text(v);
-}
-
-std::string json_string(std::string_view s) { return spec::json_quote(s); }
-
-std::string json_list(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + json_string(items[i]);
-  return out + "]";
-}
-
-/// One JSON object, built field by field: Json().str("a", "x").num("b", 1).text() == {"a":"x","b":1}.
-class Json {
-public:
-  Json& raw(std::string_view key, std::string_view value) {
-    text_ += first_ ? "" : ",";
-    first_ = false;
-    text_ += json_string(key);
-    text_ += ':';
-    text_ += value;
-    return *this;
-  }
-  Json& str(std::string_view key, std::string_view value) { return raw(key, json_string(value)); }
-  Json& num(std::string_view key, double value) { return raw(key, json_number(value)); }
-  Json& integer(std::string_view key, long long value) { return raw(key, std::to_string(value)); }
-  Json& boolean(std::string_view key, bool value) { return raw(key, value ? "true" : "false"); }
-  /// A string, or null when empty.
-  Json& opt(std::string_view key, std::string_view value) { return value.empty() ? raw(key, "null") : str(key, value); }
-  std::string text() const { return text_ + "}"; }
-
-private:
-  std::string text_ = "{";
-  bool first_ = true;
-};
-
-/// Left-aligned columns, two spaces apart; the last column is not padded.
-std::string columns(const std::vector<std::vector<std::string>>& rows) {
-  std::vector<std::size_t> width;
-  for (const auto& row : rows) {
-    if (width.size() < row.size()) width.resize(row.size(), 0);
-    for (std::size_t i = 0; i + 1 < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
-  }
-  std::string out;
-  for (const auto& row : rows) {
-    std::string line;
-    for (std::size_t i = 0; i < row.size(); ++i) {
-      line += row[i];
-      if (i + 1 < row.size()) line += std::string(width[i] - row[i].size() + 2, ' ');
-    }
-    line.erase(line.find_last_not_of(' ') + 1);  // an empty last column leaves padding behind
-    out += line + "\n";
-  }
-  return out;
-}
-
-// ---- tokens, numbers and samples -----------------------------------------------------------------
-
-/// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
-/// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
-Expected<std::vector<std::string>> tokenize(std::string_view line) {
-  std::vector<std::string> words;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    const char c = line[i];
-    if (c == ' ' || c == '\t' || c == '\r' || c == '\n') {
-      ++i;
-      continue;
-    }
-    std::string word;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r' && line[i] != '\n') {
-      const char d = line[i];
-      if (d == '[') {
-        const auto close = line.find(']', i);
-        if (close == std::string_view::npos) return fail(ErrorCode::Parse, "'[' without ']'");
-        word.append(line.substr(i, close - i + 1));
-        i = close + 1;
-      } else if (d == '"' || d == '\'') {
-        const auto close = line.find(d, i + 1);
-        if (close == std::string_view::npos) return fail(ErrorCode::Parse, std::string("unterminated ") + d);
-        word.append(line.substr(i + 1, close - i - 1));
-        i = close + 1;
-      } else {
-        word += d;
-        ++i;
-      }
-    }
-    words.push_back(std::move(word));
-  }
-  return words;
-}
-
-std::optional<double> parse_number(std::string_view s) {
-  if (!s.empty() && s.front() == '+') s.remove_prefix(1);
-  if (s.empty()) return std::nullopt;
-  double v = 0.0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc{} || end != s.data() + s.size()) return std::nullopt;
-  return v;
-}
-
-/// Numbers separated by commas and/or blanks. Errors name the offending text.
-Expected<std::vector<double>> parse_numbers(std::string_view text) {
-  std::vector<double> values;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    if (text[i] == ',' || text[i] == ' ' || text[i] == '\t' || text[i] == '\r') {
-      ++i;
-      continue;
-    }
-    std::size_t j = i;
-    while (j < text.size() && text[j] != ',' && text[j] != ' ' && text[j] != '\t' && text[j] != '\r') ++j;
-    const auto v = parse_number(text.substr(i, j - i));
-    if (!v) return fail(ErrorCode::Parse, "'" + std::string(text.substr(i, j - i)) + "' is not a number");
-    values.push_back(*v);
-    i = j;
-  }
-  return values;
-}
-
-/// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector).
-Expected<std::vector<double>> parse_sample(std::string_view word) {
-  if (!word.empty() && word.front() == '[') {
-    if (word.back() != ']') return fail(ErrorCode::Parse, "'" + std::string(word) + "': a vector sample ends with ']'");
-    auto values = parse_numbers(word.substr(1, word.size() - 2));
-    if (!values) return values;
-    if (values->empty()) return fail(ErrorCode::Parse, "'[]': a vector sample needs at least one value");
-    return values;
-  }
-  const auto v = parse_number(word);
-  if (!v) return fail(ErrorCode::Parse, "'" + std::string(word) + "' is not a number or a vector sample [a,b,...]");
-  return std::vector<double>{*v};
-}
-
-std::optional<long> parse_count(std::string_view s) {
-  long v = 0;
-  const auto [end, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-  if (ec != std::errc{} || end != s.data() + s.size() || v <= 0) return std::nullopt;
-  return v;
-}
-
-// ---- the command table ---------------------------------------------------------------------------
-
-/// What a command's argument names, for completion.
-enum class Arg { None, Component, Address, Machine, Event, Filter, FilterOrType, Signal, File, Command };
-
-enum class Id {
-  StateList, StateHistory, FilterList, FilterInfo, FilterInject, FilterDinject, FilterDinload, EventList,
-  EventHistory, EventGenerate, EventBroadcast, ConnectionList, ServiceList, Explain, Watch, Reset, Time,
-  Help, Quit,
-};
-
-struct CommandSpec {
-  Id id;
-  std::string_view name;   ///< one or two words
-  std::string_view usage;
-  std::string_view doc;
-  bool writes;
-  std::size_t min_args;
-  std::size_t max_args;    ///< kMany: no limit
-  std::vector<Arg> args;   ///< completion kind of each argument; the last one repeats
-};
-
-constexpr std::size_t kMany = static_cast<std::size_t>(-1);
-constexpr long kDefaultHistory = 20;
-constexpr double kMaxWatchSeconds = 3600.0;
-
-const std::vector<CommandSpec>& commands() {
-  static const std::vector<CommandSpec> table = {
-      {Id::StateList, "state list", "state list [COMPONENT]",
-       "every component and state machine with its state and outstanding event", false, 0, 1, {Arg::Component}},
-      {Id::StateHistory, "state history", "state history [ADDRESS] [N]",
-       "the last N records (default 20) of a machine, a component or the whole system", false, 0, 2,
-       {Arg::Address, Arg::None}},
-      {Id::FilterList, "filter list", "filter list",
-       "every filter: type, target, execution, detection, enabled, detected, signals", false, 0, 0, {}},
-      {Id::FilterInfo, "filter info", "filter info NAME",
-       "a filter's manifest (parameters with type, value, default, range and doc; inputs; outputs) and its "
-       "current enabled/detected state; NAME may also be a filter type",
-       false, 1, 1, {Arg::FilterOrType}},
-      {Id::FilterInject, "filter inject", "filter inject NAME SAMPLE...",
-       "shallow fault injection: queue samples into one filter's private input, seen by that filter alone on "
-       "its next runs (SAMPLE: 1.5, or [1,2,3] for a vector)",
-       true, 2, kMany, {Arg::Filter, Arg::None}},
-      {Id::FilterDinject, "filter dinject", "filter dinject SIGNAL SAMPLE...",
-       "deep fault injection: write samples into a signal's history buffer at the current time; every "
-       "consumer sees them",
-       true, 2, kMany, {Arg::Signal, Arg::None}},
-      {Id::FilterDinload, "filter dinload", "filter dinload SIGNAL FILE",
-       "deep-inject every sample of a text file: one sample per line, numbers separated by spaces or commas "
-       "('#' starts a comment)",
-       true, 2, 2, {Arg::Signal, Arg::File}},
-      {Id::EventList, "event list", "event list",
-       "every event with its severity, transitions, counterpart, hazard and description", false, 0, 0, {}},
-      {Id::EventHistory, "event history", "event history [N]",
-       "the last N events processed, ignored or masked by any machine (default 20)", false, 0, 1, {Arg::None}},
-      {Id::EventGenerate, "event generate", "event generate EVENT TARGET",
-       "process EVENT on machine TARGET (C.s_F, C.s_A, C.s_P.p or C.s_R.r) and propagate it", true, 2, 2,
-       {Arg::Event, Arg::Machine}},
-      {Id::EventBroadcast, "event broadcast", "event broadcast EVENT",
-       "process a broadcast event (severity 251-255) on s_A of every component", true, 1, 1, {Arg::Event}},
-      {Id::ConnectionList, "connection list", "connection list",
-       "every connection: the client's required interface and state, the provider's service and state", false,
-       0, 0, {}},
-      {Id::ServiceList, "service list", "service list",
-       "every provided interface with its service state and dependency formula", false, 0, 0, {}},
-      {Id::Explain, "explain", "explain ADDRESS",
-       "every active condition at ADDRESS with its root cause and the path it took", false, 1, 1, {Arg::Address}},
-      {Id::Watch, "watch", "watch [SECONDS]",
-       "advance simulated time by SECONDS (default 1), running the scenario and the system and printing each "
-       "transition as it happens",
-       false, 0, 1, {Arg::None}},
-      {Id::Reset, "reset", "reset TARGET [REASON]",
-       "clear every condition (latched ones too) of a machine, a component or SYSTEM, recording the reason", true,
-       1, kMany, {Arg::Address, Arg::None}},
-      {Id::Time, "time", "time", "the current simulated time", false, 0, 0, {}},
-      {Id::Help, "help", "help [COMMAND]", "list the commands, or show one command's usage", false, 0, 2,
-       {Arg::Command, Arg::Command}},
-      {Id::Quit, "quit", "quit", "leave the console (also: exit, or end of input)", false, 0, 0, {}},
-  };
-  return table;
-}
-
-constexpr std::string_view kGroups[] = {"state", "filter", "event", "connection", "service"};
-
-bool is_group(std::string_view word) {
-  return std::find(std::begin(kGroups), std::end(kGroups), word) != std::end(kGroups);
-}
-
-const CommandSpec* find_command(std::string_view name) {
-  if (name == "exit") name = "quit";
-  for (const CommandSpec& c : commands()) {
-    if (c.name == name) return &c;
-  }
-  return nullptr;
-}
-
-/// "state list [COMPONENT] | state history [ADDRESS] [N]".
-std::string group_usage(std::string_view group) {
-  std::string out;
-  for (const CommandSpec& c : commands()) {
-    if (c.name.substr(0, c.name.find(' ')) == group && c.name.find(' ') != std::string_view::npos) {
-      out += (out.empty() ? "" : " | ") + std::string(c.usage);
-    }
-  }
-  return out;
-}
-
-std::vector<std::string> top_words() {
-  std::set<std::string> words{"exit"};
-  for (const CommandSpec& c : commands()) words.emplace(c.name.substr(0, c.name.find(' ')));
-  return {words.begin(), words.end()};
-}
-
-std::vector<std::string> sub_words(std::string_view group) {
-  std::vector<std::string> words;
-  for (const CommandSpec& c : commands()) {
-    const auto space = c.name.find(' ');
-    if (space != std::string_view::npos && c.name.substr(0, space) == group) words.emplace_back(c.name.substr(space + 1));
-  }
-  return words;
-}
 
 std::string_view machine_kind_text(MachineKind k) {
   switch (k) {
@@ -401,11 +124,11 @@ bool shown_record(const Record& r) {
          (r.kind == RecordKind::Event && (r.outcome == Outcome::Masked || r.outcome == Outcome::Ignored));
 }
 
-}  // namespace
+// ---- the in-process backend ----------------------------------------------------------------------
 
-// ---- the executor --------------------------------------------------------------------------------
-
-struct Console::Impl {
+/// A system running in this process in simulated time.
+class InProcessBackend final : public Backend {
+public:
   ConsoleOptions options;
   FilterRegistry registry;  // outlives the runner's monitor
   std::unique_ptr<runner::ScenarioRunner> runner;
@@ -417,7 +140,7 @@ struct Console::Impl {
   std::string system_path;
   std::string scenario_path;
 
-  ~Impl() {
+  ~InProcessBackend() override {
     if (runner && subscription != 0) runner->coordinator().unsubscribe(subscription);
   }
 
@@ -427,25 +150,6 @@ struct Console::Impl {
   const Monitor& monitor() const { return runner->monitor(); }
   Time now() const { return std::max(runner->now(), Time{0}); }
 
-  // ---- output ----
-  struct Out {
-    ConsoleReply reply;
-    void line(std::string text) { reply.out += std::move(text) + "\n"; }
-  };
-
-  /// A failed command: one line on stderr saying what went wrong and how the command is used.
-  ConsoleReply failure(std::string_view command, const std::string& message, std::string_view usage) const {
-    ConsoleReply r;
-    r.ok = false;
-    if (options.json) {
-      r.err = Json().boolean("ok", false).opt("command", command).str("error", message).str("usage", usage).text() + "\n";
-    } else {
-      r.err = (command.empty() ? std::string() : std::string(command) + ": ") + message + " (usage: " + std::string(usage) + ")\n";
-    }
-    return r;
-  }
-  ConsoleReply failure(const CommandSpec& c, const std::string& message) const { return failure(c.name, message, c.usage); }
-
   void flush_captured(Out& out) {
     for (std::string& line : captured) out.line(std::move(line));
     captured.clear();
@@ -453,11 +157,11 @@ struct Console::Impl {
 
   /// The confirmation line of a write command.
   void write_done(Out& out, const CommandSpec& c, Json json, const std::string& text) const {
-    out.line(options.json ? json.boolean("ok", true).str("command", c.name).num("t", to_seconds(now())).text() : text);
+    console::write_done(out, options.json, c, std::move(json), text, to_seconds(now()));
   }
 
   // ---- names for completion ----
-  std::vector<std::string> names(Arg kind) const {
+  std::vector<std::string> names(Arg kind) const override {
     std::vector<std::string> out;
     const Coordinator& c = co();
     switch (kind) {
@@ -490,104 +194,21 @@ struct Console::Impl {
       case Arg::Signal:
         for (const auto& s : monitor().signals().all()) out.push_back(s->name());
         break;
-      case Arg::Command: out = top_words(); break;
+      case Arg::Command:
       case Arg::None:
       case Arg::File: break;
     }
     return out;
   }
 
-  /// The command and argument position the word after `before` belongs to.
-  struct Context {
-    const CommandSpec* command = nullptr;
-    std::vector<std::string> words;
-    std::size_t arg = 0;  ///< index of the argument being typed
-    bool ok = false;
-  };
-  static Context context(std::string_view before) {
-    Context ctx;
-    auto words = tokenize(before);
-    if (!words) return ctx;
-    ctx.words = std::move(*words);
-    ctx.ok = true;
-    if (ctx.words.empty()) return ctx;
-    if (is_group(ctx.words[0])) {
-      if (ctx.words.size() < 2) return ctx;
-      ctx.command = find_command(ctx.words[0] + " " + ctx.words[1]);
-      ctx.arg = ctx.words.size() - 2;
-    } else {
-      ctx.command = find_command(ctx.words[0]);
-      ctx.arg = ctx.words.size() - 1;
-    }
-    return ctx;
-  }
-  static Arg arg_kind(const CommandSpec& c, std::size_t arg) {
-    if (c.args.empty() || arg >= c.max_args) return Arg::None;
-    return arg < c.args.size() ? c.args[arg] : c.args.back();
-  }
-
-  std::vector<std::string> complete(std::string_view before, std::string_view word) const {
-    const Context ctx = context(before);
-    if (!ctx.ok) return {};
-    std::vector<std::string> candidates;
-    if (ctx.words.empty()) {
-      candidates = top_words();
-    } else if (ctx.words.size() == 1 && is_group(ctx.words[0])) {
-      candidates = sub_words(ctx.words[0]);
-    } else if (ctx.command != nullptr && ctx.command->id == Id::Help) {
-      if (ctx.arg == 0) candidates = top_words();
-      else if (ctx.arg == 1 && is_group(ctx.words[1])) candidates = sub_words(ctx.words[1]);
-    } else if (ctx.command != nullptr) {
-      candidates = names(arg_kind(*ctx.command, ctx.arg));
-    }
-    std::vector<std::string> out;
-    for (std::string& c : candidates) {
-      if (c.compare(0, word.size(), word) == 0) out.push_back(std::move(c));
-    }
-    std::sort(out.begin(), out.end());
-    out.erase(std::unique(out.begin(), out.end()), out.end());
-    return out;
-  }
-
-  // ---- commands ----
-  ConsoleReply execute(std::string_view line) {
-    line = trim(line);
-    if (line.empty() || line.front() == '#') return {};
+  void begin() override { captured.clear(); }
+  void end(Out& out, bool ok) override {
+    if (ok) flush_captured(out);
     captured.clear();
-    auto words = tokenize(line);
-    if (!words) return failure("", words.error().message, "help [COMMAND]");
-    std::vector<std::string>& w = *words;
-    const CommandSpec* command = nullptr;
-    std::size_t first_arg = 1;
-    if (is_group(w[0])) {
-      if (w.size() < 2) return failure(w[0], "needs a subcommand", group_usage(w[0]));
-      command = find_command(w[0] + " " + w[1]);
-      if (command == nullptr) return failure(w[0], "unknown subcommand '" + w[1] + "'", group_usage(w[0]));
-      first_arg = 2;
-    } else {
-      command = find_command(w[0]);
-      if (command == nullptr) return failure("", "unknown command '" + w[0] + "'", "help [COMMAND]");
-    }
-    const std::vector<std::string> args(w.begin() + static_cast<std::ptrdiff_t>(first_arg), w.end());
-    if (args.size() < command->min_args || (command->max_args != kMany && args.size() > command->max_args)) {
-      return failure(*command, args.size() < command->min_args ? "missing arguments" : "too many arguments");
-    }
-    if (command->writes && !options.allow_write) {
-      return failure(*command, "refused: this console is read-only; start it with --allow-write to inject, "
-                              "generate, broadcast or reset");
-    }
-    Out out;
-    std::string error = run(*command, args, out);
-    if (!error.empty()) {
-      captured.clear();
-      return failure(*command, error);
-    }
-    flush_captured(out);
-    return std::move(out.reply);
   }
 
   /// Runs one command; returns an error message, or empty on success.
-  std::string run(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
+  std::string run(const CommandSpec& c, const std::vector<std::string>& args, Out& out) override {
     switch (c.id) {
       case Id::StateList: return state_list(args, out);
       case Id::StateHistory: return state_history(args, out);
@@ -606,10 +227,10 @@ struct Console::Impl {
       case Id::Watch: return watch(args, out);
       case Id::Reset: return reset(c, args, out);
       case Id::Time: return time(out);
-      case Id::Help: return help(args, out);
-      case Id::Quit: out.reply.quit = true; return {};
+      case Id::Help:
+      case Id::Quit: break;  // the Console answers these itself
     }
-    return "not implemented";
+    return "not available here";
   }
 
   std::string outstanding_name(EventId e) const { return e == kNoEvent ? std::string() : co().event(e).name; }
@@ -812,20 +433,8 @@ struct Console::Impl {
     return {};
   }
 
-  Expected<std::vector<std::vector<double>>> samples_of(const std::vector<std::string>& words) const {
-    std::vector<std::vector<double>> samples;
-    for (const std::string& w : words) {
-      auto s = parse_sample(w);
-      if (!s) return tl::unexpected(s.error());
-      samples.push_back(std::move(*s));
-    }
-    return samples;
-  }
-
-  static std::string count_text(std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); }
-
   std::string filter_inject(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
-    auto samples = samples_of({args.begin() + 1, args.end()});
+    auto samples = parse_samples({args.begin() + 1, args.end()});
     if (!samples) return samples.error().message;
     if (monitor().find_filter(args[0]) == nullptr) return "no filter '" + args[0] + "' (see filter list)";
     if (auto r = monitor().inject_shallow(args[0], *samples); !r) return r.error().message;
@@ -851,7 +460,7 @@ struct Console::Impl {
   }
 
   std::string filter_dinject(const CommandSpec& c, const std::vector<std::string>& args, Out& out) {
-    auto samples = samples_of({args.begin() + 1, args.end()});
+    auto samples = parse_samples({args.begin() + 1, args.end()});
     if (!samples) return samples.error().message;
     return deep_inject(c, args[0], *samples, out);
   }
@@ -860,19 +469,9 @@ struct Console::Impl {
     std::string text;
     std::string error;
     if (!spec::read_file(args[1], text, error)) return error;
-    std::vector<std::vector<double>> samples;
-    std::istringstream lines(text);
-    std::string line;
-    for (int number = 1; std::getline(lines, line); ++number) {
-      std::string_view body = line;
-      body = trim(body.substr(0, body.find('#')));
-      if (body.empty()) continue;
-      auto values = parse_numbers(body);
-      if (!values) return args[1] + ":" + std::to_string(number) + ": " + values.error().message;
-      samples.push_back(std::move(*values));
-    }
-    if (samples.empty()) return args[1] + ": no samples";
-    return deep_inject(c, args[0], samples, out);
+    auto samples = parse_sample_file(args[1], text);
+    if (!samples) return samples.error().message;
+    return deep_inject(c, args[0], *samples, out);
   }
 
   std::string event_list(Out& out) {
@@ -992,25 +591,7 @@ struct Console::Impl {
   std::string explain(const std::string& address, Out& out) {
     auto a = co().resolve(address);
     if (!a) return a.error().message;
-    const std::vector<Explanation> all = co().explain(*a);
-    const State state = co().state_of(*a);
-    for (const Explanation& e : all) {
-      if (!options.json) {
-        out.line(to_string(e));
-        continue;
-      }
-      Json j;
-      j.str("address", address).str("machine", e.machine).str("event", e.event).str("level", to_string(e.level))
-          .integer("severity", e.severity).boolean("mirror", e.mirror).boolean("outstanding", e.outstanding)
-          .integer("count", e.count).num("first", to_seconds(e.first)).num("last", to_seconds(e.last))
-          .str("root_event", e.root_event).str("root_origin", e.root_origin).num("root_t", to_seconds(e.root_time))
-          .opt("hazard", e.hazard);
-      if (!e.filter.empty()) j.str("filter", e.filter);
-      if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
-      if (e.injected) j.boolean("injected", true);
-      out.line(j.raw("path", json_list(e.path)).text());
-    }
-    if (all.empty() && !options.json) out.line(address + " is " + std::string(to_string(state)) + ": no active condition");
+    print_explanations(co().explain(*a), address, to_string(co().state_of(*a)), options.json, true, out);
     return {};
   }
 
@@ -1074,47 +655,21 @@ struct Console::Impl {
     return {};
   }
 
-  std::string help(const std::vector<std::string>& args, Out& out) {
-    std::vector<const CommandSpec*> selected;
-    std::string asked;
-    for (const std::string& a : args) asked += (asked.empty() ? "" : " ") + a;
-    for (const CommandSpec& c : commands()) {
-      const bool in_group = args.size() == 1 && is_group(args[0]) && c.name.substr(0, c.name.find(' ')) == args[0];
-      if (args.empty() || in_group || c.name == asked || (asked == "exit" && c.id == Id::Quit)) selected.push_back(&c);
-    }
-    if (selected.empty()) return "no command '" + asked + "'";
-    std::vector<std::vector<std::string>> rows;
-    for (const CommandSpec* c : selected) {
-      const std::string doc = std::string(c->doc) + (c->writes ? " [write: needs --allow-write]" : "");
-      if (options.json) {
-        out.line(Json().str("command", c->name).str("usage", c->usage).str("doc", c->doc).boolean("writes", c->writes).text());
-      } else if (selected.size() == 1) {
-        out.line("usage: " + std::string(c->usage));
-        out.line("  " + doc);
-      } else {
-        rows.push_back({std::string(c->usage), doc});
-      }
-    }
-    if (!rows.empty()) {
-      out.reply.out += columns(rows);
-      if (args.empty()) {
-        out.line("ADDRESS: SYSTEM, C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p. TAB completes commands and names.");
-        out.line(options.allow_write ? "Write commands are allowed (--allow-write)."
-                                     : "Read-only: write commands need --allow-write.");
-      }
-    }
-    return {};
+  std::string banner() const override {
+    const Coordinator& c = co();
+    return "safecass console: system " + system_path + " (" + std::to_string(c.component_count()) + " components" +
+           (scenario_path.empty() ? "" : ", scenario " + scenario_path) + "), simulated time t=" + seconds_text(now()) +
+           ", " + (options.allow_write ? "writes allowed" : "read-only") + ". Type help, or TAB to complete.";
   }
 };
 
-// ---- Console -------------------------------------------------------------------------------------
+}  // namespace
 
-Console::Console(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
-Console::~Console() = default;
+// ---- Console -------------------------------------------------------------------------------------
 
 Expected<std::unique_ptr<Console>> Console::open(const std::string& system, const std::string& scenario,
                                                  ConsoleOptions options) {
-  auto impl = std::make_unique<Impl>();
+  auto impl = std::make_unique<InProcessBackend>();
   impl->options = options;
   register_builtin_filters(impl->registry);
   auto errors = [](const std::vector<spec::Diagnostic>& diagnostics) {
@@ -1149,7 +704,7 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
     for (const spec::Diagnostic& d : problems) text += (text.empty() ? "" : "\n") + spec::format(d);
     return fail(ErrorCode::InvalidArgument, text);
   }
-  Impl* self = impl.get();
+  InProcessBackend* self = impl.get();
   impl->subscription = impl->runner->coordinator().subscribe([self](const Record& r) {
     if (!shown_record(r)) return;
     if (r.kind == RecordKind::Transition) ++self->transitions;
@@ -1157,26 +712,7 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
   });
   impl->runner->advance_to(Time{0}, impl->run_result);
   impl->captured.clear();  // what happened at t = 0 is in the histories
-  return std::unique_ptr<Console>(new Console(std::move(impl)));
-}
-
-ConsoleReply Console::execute(std::string_view line) { return impl_->execute(line); }
-
-std::vector<std::string> Console::complete(std::string_view before, std::string_view word) const {
-  return impl_->complete(before, word);
-}
-
-bool Console::completes_file(std::string_view before) const {
-  const Impl::Context ctx = Impl::context(before);
-  return ctx.command != nullptr && Impl::arg_kind(*ctx.command, ctx.arg) == Arg::File;
-}
-
-std::string Console::banner() const {
-  const Coordinator& c = impl_->co();
-  return "safecass console: system " + impl_->system_path + " (" + std::to_string(c.component_count()) +
-         " components" + (impl_->scenario_path.empty() ? "" : ", scenario " + impl_->scenario_path) +
-         "), simulated time t=" + seconds_text(impl_->now()) + ", " +
-         (impl_->options.allow_write ? "writes allowed" : "read-only") + ". Type help, or TAB to complete.";
+  return std::make_unique<Console>(std::move(impl), options);
 }
 
 // ---- terminal front end --------------------------------------------------------------------------
@@ -1283,7 +819,17 @@ int run_console(const ConsoleArgs& args) {
     std::istringstream lines(text);
     for (std::string line; std::getline(lines, line);) script.push_back(line);
   }
-  auto console = Console::open(args.system, args.scenario, ConsoleOptions{args.json, args.allow_write});
+  Expected<std::unique_ptr<Console>> console = fail(ErrorCode::InvalidArgument, "no console");
+  if (!args.ice.empty()) {
+#ifdef SAFECASS_WITH_ICE
+    console = connect_console(args);
+#else
+    std::fprintf(stderr, "console: --ice needs the middleware, and this safecass was built without it (SAFECASS_WITH_ICE)\n");
+    return 2;
+#endif
+  } else {
+    console = Console::open(args.system, args.scenario, ConsoleOptions{args.json, args.allow_write});
+  }
   if (!console) {
     std::fprintf(stderr, "%s\n", console.error().message.c_str());
     return 2;
@@ -1301,20 +847,36 @@ void add_console_command(CLI::App& app, int& code) {
   auto* cmd = app.add_subcommand("console", "Read and write the component model of a system, interactively or from commands");
   cmd->footer(
       "Runs the system in-process in simulated time (as `safecass run` does); with --scenario its steps are "
-      "applied as `watch` advances time. Write commands (filter inject/dinject/dinload, event generate/broadcast, "
-      "reset) are refused unless --allow-write is given; in-process there is no token (tokens apply to remote "
-      "coordinators reached through the middleware). Without -c or --script, commands are read from the terminal "
-      "(line editing, history, TAB completion) or from stdin. Exit code 2 when the system cannot be loaded or, "
-      "with -c/--script/stdin, when any command failed; 0 otherwise. Type `help` inside the console for the commands.");
+      "applied as `watch` advances time. With --ice HOST:PORT --coordinator NAME it works on a live coordinator "
+      "process instead (`safecass run ... --coordinator NAME --ice ...`), found through IceStorm; writes then also "
+      "need the coordinator's token (--token-file), and `watch SECONDS` polls its states. Write commands (filter "
+      "inject/dinject/dinload, event generate/broadcast, reset) are refused unless --allow-write is given. Without "
+      "-c or --script, commands are read from the terminal (line editing, history, TAB completion) or from stdin. "
+      "Exit code 2 when the system cannot be loaded or the coordinator cannot be reached, or, with "
+      "-c/--script/stdin, when any command failed; 0 otherwise. Type `help` inside the console for the commands.");
   cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
   cmd->add_option("--scenario,-s", args->scenario, "scenario file whose steps are applied as simulated time advances");
   auto* commands = cmd->add_option("-c,--command", args->commands, "commands to run, separated by ';'");
   cmd->add_option("--script", args->script, "file of commands, one per line ('#' starts a comment)")->excludes(commands);
   cmd->add_flag("--json", args->json, "print one JSON object per result line");
   cmd->add_flag("--allow-write", args->allow_write, "accept write commands (inject, generate, broadcast, reset)");
+  cmd->add_option("--ice", args->ice, "work on a live coordinator: IceStorm at HOST:PORT (with --coordinator)");
+  cmd->add_option("--coordinator", args->coordinator, "with --ice: the coordinator's name");
+  cmd->add_option("--token-file", args->token_file, "with --ice: the coordinator's token file (writes need it)");
+  cmd->add_option("--timeout", args->timeout_ms, "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")
+      ->check(CLI::Range(100, 600000));
   cmd->callback([args, &code] {
-    if (args->system.empty() && args->scenario.empty()) {
-      std::fprintf(stderr, "console: --system (or --scenario) is required\n");
+    const bool remote = !args->ice.empty() || !args->coordinator.empty() || !args->token_file.empty();
+    std::string usage;
+    if (remote && (args->ice.empty() || args->coordinator.empty())) {
+      usage = "console: --ice HOST:PORT and --coordinator NAME go together";
+    } else if (remote && (!args->system.empty() || !args->scenario.empty())) {
+      usage = "console: --ice works on a live coordinator: --system and --scenario are for the in-process console";
+    } else if (!remote && args->system.empty() && args->scenario.empty()) {
+      usage = "console: --system (or --scenario, or --ice with --coordinator) is required";
+    }
+    if (!usage.empty()) {
+      std::fprintf(stderr, "%s\n", usage.c_str());
       code = 2;
       return;
     }

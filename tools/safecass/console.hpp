@@ -1,16 +1,19 @@
 #pragma once
 // `safecass console`: read and write the Generic Component Model of a system (DESIGN §6).
 //
-// The console is split in two so that its commands can be tested without a terminal:
-// - Console parses and executes one command line against an in-process system running in
-//   simulated time, and returns the output text and whether the command succeeded. It never
-//   prints and never throws for a bad command: a wrong command is a usage line and changes nothing.
+// The console is split so that its commands can be tested without a terminal:
+// - Console parses and executes one command line and returns the output text and whether the
+//   command succeeded. It never prints and never throws for a bad command: a wrong command is a
+//   usage line and changes nothing. The parsing, completion, usage lines and `help` are shared
+//   (console_shell.hpp); a backend runs the commands: an in-process system in simulated time
+//   (Console::open), or a live coordinator process reached through the middleware
+//   (console_remote.hpp, built with SAFECASS_WITH_ICE).
 // - run_console() does the I/O: -c commands, a script, stdin, or an interactive terminal with line
 //   editing, history and TAB completion (libedit).
 //
 // Write operations (filter inject/dinject/dinload, event generate/broadcast, reset) are refused
-// unless the console was opened with write access. In-process there is no token: the token only
-// applies to requests sent to remote coordinators through the middleware.
+// unless the console was opened with write access. In-process there is no token; a remote
+// coordinator also wants its token (--token-file) and refuses writes without it.
 
 #include <memory>
 #include <string>
@@ -25,9 +28,17 @@ class App;
 
 namespace safecass::tools {
 
+namespace console {
+class Backend;
+}
+
 struct ConsoleArgs {
   std::string system;         ///< system file (default: the scenario's "system")
   std::string scenario;       ///< optional: its steps are applied as simulated time advances
+  std::string ice;            ///< remote mode: IceStorm at HOST:PORT (instead of system/scenario)
+  std::string coordinator;    ///< remote mode: the coordinator's name
+  std::string token_file;     ///< remote mode: the coordinator's token file (for writes)
+  int timeout_ms = 2000;      ///< remote mode: how long to wait for the heartbeat and each answer
   std::string commands;       ///< -c: commands separated by ';'
   std::string script;         ///< --script: one command per line ('#' starts a comment)
   bool json = false;          ///< one JSON object per output line
@@ -47,12 +58,18 @@ struct ConsoleOptions {
   bool allow_write = false;
 };
 
-/// An in-process system in simulated time and the commands that read and write it.
+/// The commands that read and write one system, parsed and printed the same way whatever runs
+/// them.
 ///
-/// Lifecycle: open() loads the system (and scenario), builds it and processes the tick at t = 0;
-/// then execute() any number of times from one thread. Simulated time only moves with `watch`.
+/// Lifecycle: open() loads the system (and scenario), builds it and processes the tick at t = 0
+/// (simulated time then only moves with `watch`); or a backend made elsewhere (a live coordinator:
+/// console_remote.hpp) is handed to the constructor. Then execute() any number of times from one
+/// thread.
 class Console {
 public:
+  /// A console whose commands `backend` runs.
+  Console(std::unique_ptr<console::Backend> backend, ConsoleOptions options);
+
   /// Loads and builds the system. `system` may be empty when `scenario` names its system.
   /// Errors: Io/Parse/InvalidArgument with every diagnostic of the system or scenario, one per line.
   static Expected<std::unique_ptr<Console>> open(const std::string& system, const std::string& scenario,
@@ -71,17 +88,20 @@ public:
   /// Whether the word after `before` is a file name (so a terminal may complete file names).
   bool completes_file(std::string_view before) const;
 
-  /// One line describing the system, the simulated time and the write access.
+  /// One line describing the system, the simulated time (or the coordinator) and the write access.
   std::string banner() const;
 
 private:
-  struct Impl;
-  explicit Console(std::unique_ptr<Impl> impl);
-  std::unique_ptr<Impl> impl_;
+  ConsoleReply failure(std::string_view command, const std::string& message, std::string_view usage) const;
+  std::string help(const std::vector<std::string>& args, ConsoleReply& reply) const;
+
+  std::unique_ptr<console::Backend> backend_;
+  ConsoleOptions options_;
 };
 
-/// Runs the console; returns the exit code: 0, or 2 when the system cannot be loaded or (with
-/// -c, --script or a non-terminal stdin) when any command failed.
+/// Runs the console; returns the exit code: 0, or 2 when the system cannot be loaded (or the
+/// coordinator cannot be reached) or (with -c, --script or a non-terminal stdin) when any
+/// command failed.
 int run_console(const ConsoleArgs& args);
 
 /// Adds the `console` subcommand to the `safecass` command; its callback stores the exit code.

@@ -3,10 +3,19 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+
 #include "commands.hpp"
 #include "spec_commands.hpp"
 #include "timeline.hpp"
 #include "console.hpp"
+#ifdef SAFECASS_WITH_ICE
+#include "middleware_commands.hpp"
+#include "console_remote.hpp"
+#endif
+#ifdef SAFECASS_WITH_VIEWER
+#include "viewer_command.hpp"
+#endif
 
 int main(int argc, char** argv) {
   CLI::App app{"SAFECASS: safety architecture for component-based robot systems"};
@@ -30,9 +39,13 @@ int main(int argc, char** argv) {
   safecass::tools::RunArgs run_args;
   auto* run = app.add_subcommand("run", "Run a system in-process in simulated time, driven by a scenario");
   run->add_option("SYSTEM", run_args.system, "system file (default: the scenario's \"system\")");
-  run->add_option("--scenario,-s", run_args.scenario, "scenario file")->required();
+  run->add_option("--scenario,-s", run_args.scenario, "scenario file (required unless --coordinator)");
   run->add_flag("--json", run_args.json, "one JSON object per line (byte-identical across runs)");
   run->add_option("--record", run_args.record, "write the whole history (JSON lines) to this file");
+#ifdef SAFECASS_WITH_ICE
+  safecass::tools::add_middleware_options(*run, run_args);
+  safecass::tools::add_supervisor_command(app, code);
+#endif
   run->callback([&] { code = safecass::tools::run_run(run_args); });
 
   safecass::tools::TestArgs test_args;
@@ -42,13 +55,41 @@ int main(int argc, char** argv) {
   test->callback([&] { code = safecass::tools::run_test(test_args); });
 
   safecass::tools::add_console_command(app, code);
+#ifdef SAFECASS_WITH_VIEWER
+  safecass::tools::add_viewer_command(app, code);
+#endif
 
   std::string timeline_history;
   std::string timeline_html;
   auto* timeline = app.add_subcommand("timeline", "Draw a recorded history as Normal/Warning/Error swimlanes in one static HTML page");
-  timeline->add_option("HISTORY", timeline_history, "history file (JSON lines, from `safecass run --record`)")->required();
+  std::string timeline_ice;
+  std::string timeline_coordinator;
+  timeline->add_option("HISTORY", timeline_history, "history file (JSON lines, from `safecass run --record`); not with --ice");
   timeline->add_option("--html", timeline_html, "write the page to this file")->required();
-  timeline->callback([&] { code = safecass::tools::run_timeline(timeline_history, timeline_html); });
+  timeline->add_option("--ice", timeline_ice, "draw the live history of a coordinator instead: IceStorm at HOST:PORT");
+  timeline->add_option("--coordinator", timeline_coordinator, "with --ice: the coordinator's name");
+  timeline->callback([&] {
+    if (timeline_ice.empty() && timeline_coordinator.empty()) {
+      if (timeline_history.empty()) {
+        std::fprintf(stderr, "timeline: HISTORY (or --ice HOST:PORT --coordinator NAME) is required\n");
+        code = 2;
+        return;
+      }
+      code = safecass::tools::run_timeline(timeline_history, timeline_html);
+      return;
+    }
+    if (timeline_ice.empty() || timeline_coordinator.empty() || !timeline_history.empty()) {
+      std::fprintf(stderr, "timeline: --ice HOST:PORT and --coordinator NAME go together, without HISTORY\n");
+      code = 2;
+      return;
+    }
+#ifdef SAFECASS_WITH_ICE
+    code = safecass::tools::run_timeline_ice(timeline_ice, timeline_coordinator, timeline_html, 2000);
+#else
+    std::fprintf(stderr, "timeline: --ice needs the middleware, and this safecass was built without it (SAFECASS_WITH_ICE)\n");
+    code = 2;
+#endif
+  });
 
   try {
     app.parse(argc, argv);

@@ -5,6 +5,9 @@
 #include <map>
 
 #include "commands.hpp"
+#ifdef SAFECASS_WITH_ICE
+#include "middleware_commands.hpp"
+#endif
 #include "safecass/filters/registry.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 
@@ -27,6 +30,13 @@ std::string xml_escape(const std::string& s) {
 }  // namespace
 
 int run_run(const RunArgs& args) {
+#ifdef SAFECASS_WITH_ICE
+  if (!args.coordinator.empty()) return run_coordinator(args);
+#endif
+  if (args.scenario.empty()) {
+    std::fprintf(stderr, "safecass run: --scenario is required (unless --coordinator runs one coordinator in real time)\n");
+    return 2;
+  }
   FilterRegistry registry;
   register_builtin_filters(registry);
   runner::RunOptions options;

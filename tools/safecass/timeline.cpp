@@ -226,6 +226,7 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
       r.has_root = true;
       r.root.event = rf.string("event", true);
       r.root.origin = rf.string("origin", true);
+      r.root.has_t = root->find("t") != nullptr;
       r.root.t = rf.number("t", false).value_or(0.0);
       r.root.filter = rf.string("filter", false);
       r.root.signal = rf.string("signal", false);
@@ -313,7 +314,8 @@ int severity_rank(std::string_view state) { return state == "Error" ? 2 : state 
 /// The root cause of a record; `clears` when the record ends that condition (an improving transition).
 std::string root_lines(const HistoryRecord& r, bool clears = false) {
   if (!r.has_root) return {};
-  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" + r.root.event + " at " + secs(r.root.t) + " s";
+  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" + r.root.event +
+                    (r.root.has_t ? " at " + secs(r.root.t) + " s" : std::string());
   if (!r.root.filter.empty() || r.root.has_signal || r.root.injected) {
     out += "\n";
     std::string detail;

@@ -38,6 +38,7 @@ struct HistoryRecord {
     std::string event, origin, filter, signal;
     double t = 0.0, value = 0.0, sample_t = 0.0;
     bool has_signal = false;
+    bool has_t = false;   ///< the root's time is known (a live history fetched remotely has none)
     bool injected = false;
   } root;
   std::string text;           ///< reason (ignored, reset "who: why") or injection description

@@ -162,15 +162,24 @@ TEST(ServiceState, ServiceEntryErrorsNameTheServiceAndChangeNothing) {
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
 }
 
-TEST(ServiceState, TheServiceEntryCannotChangeWhileConditionsAreActive) {
+TEST(ServiceState, TheServiceEntryCannotChangeWhileTheComponentHoldsConditions) {
   Comp c;
-  c.gen("WF", "D.s_A");
+  c.gen("WF", "C.s_A");
   const auto r = c.co.set_service(c.comp("C"), "p", ServiceDependency::provided_only());
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidState);
   EXPECT_NE(r.error().message.find("C.p"), std::string::npos) << r.error().message;
   EXPECT_TRUE(c.co.service(c.comp("C"), 0).application) << "the entry is unchanged";
-  c.gen("/WF", "D.s_A");
+  c.gen("/WF", "C.s_A");
+  EXPECT_TRUE(c.co.set_service(c.comp("C"), "p", ServiceDependency::provided_only()));
+  EXPECT_FALSE(c.co.service(c.comp("C"), 0).application);
+}
+
+// Only conditions on C's own machines can flow through C's services (anything that reaches C
+// through a connection is mirrored on C.s_R first), so a fault elsewhere does not block the change.
+TEST(ServiceState, AConditionOnAnotherComponentDoesNotBlockTheChange) {
+  Comp c;
+  c.gen("WF", "D.s_A");
   EXPECT_TRUE(c.co.set_service(c.comp("C"), "p", ServiceDependency::provided_only()));
   EXPECT_FALSE(c.co.service(c.comp("C"), 0).application);
 }

@@ -22,13 +22,15 @@ class Failure(Exception):
 
 
 class Console:
-    def __init__(self, binary, source_dir):
+    """`safecass console ARGS` on a pseudo-terminal (default ARGS: the in-process ROBODOC system)."""
+
+    def __init__(self, binary, source_dir, args=("--system", "examples/robodoc/robodoc.json", "--allow-write")):
         self.pid, self.fd = pty.fork()
         if self.pid == 0:  # child: the console on the pty
             try:
                 os.chdir(source_dir)
                 env = dict(os.environ, TERM="xterm", COLUMNS="200", LINES="50")
-                os.execve(binary, [binary, "console", "--system", "examples/robodoc/robodoc.json", "--allow-write"], env)
+                os.execve(binary, [binary, "console", *args], env)
             finally:
                 os._exit(127)
         self.raw = b""

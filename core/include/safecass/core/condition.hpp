@@ -27,6 +27,11 @@ struct RootCause {
   MachineId origin = kNoMachine;  ///< the machine it was generated on
   Time time{};                    ///< when it was processed at the origin
   SampleCause sample;             ///< filter data, for filter events
+  /// kNone for a root that originated in this process. Otherwise the root originated in another
+  /// process and arrived through the remote provided interface `origin`
+  /// (Coordinator::add_remote_provided); this is the index of its remote data (origin address,
+  /// hop path), read with Coordinator::root_origin() and explain().
+  std::uint32_t remote = kNone;
 };
 
 /// An active condition of a state machine.

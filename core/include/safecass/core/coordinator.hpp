@@ -32,6 +32,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "safecass/core/clock.hpp"
@@ -133,6 +134,32 @@ struct Explanation {
 /// One line: "CONTROL.s_R.ForceData Error EVT_SERVICE_FAILURE ← JR3.s_A:EVT_FORCE_ERROR (...) via ...".
 std::string to_string(const Explanation& e);
 
+/// A root condition reported by another process for one of its provided interfaces: one element
+/// of the full state that replaces the set held by a remote provided interface (apply_remote()).
+/// Identity across processes is (origin, event, time).
+struct RemoteRoot {
+  std::string event;              ///< the root onset's name (events are system-wide names)
+  std::string origin;             ///< address of the origin machine in the provider's process
+  Time time{};                    ///< onset time at the origin (the provider's clock)
+  State level = State::Error;     ///< the root's level (Warning or Error)
+  std::string filter;             ///< empty unless a filter fired the root
+  std::string signal;
+  double value = 0.0;
+  Time sample_time{};
+  bool injected = false;
+  /// Hops from the origin to the provider's machine that feeds the service (as explain() writes
+  /// them); the path-vector rule drops a root whose path already contains a receiving machine.
+  std::vector<std::string> path;
+};
+
+/// What apply_remote() changed.
+struct RemoteApplyResult {
+  std::size_t added = 0;    ///< roots new in this update
+  std::size_t removed = 0;  ///< roots no longer reported
+  std::size_t kept = 0;     ///< roots reported again (their path may have changed)
+  std::size_t dropped = 0;  ///< roots dropped by the path-vector rule (a cycle across processes)
+};
+
 struct CoordinatorOptions {
   std::size_t history_capacity = 256;  ///< records kept per machine and per component
   std::size_t pending_capacity = 256;  ///< events generated from callbacks, reserved up front
@@ -161,12 +188,42 @@ public:
   /// `completes`/`latched` on the wrong kind of event, completion with no onset name).
   Expected<EventId> add_event(const EventDef& def);
   /// Sets the service dependency entry of a provided interface.
-  /// Errors: NotFound (component, provided or required interface), InvalidArgument (propagate Normal).
+  /// Errors: NotFound (component, provided or required interface), InvalidArgument (propagate
+  /// Normal), InvalidState (a machine of the component holds a condition: the mirrors it feeds
+  /// would no longer match the entry).
   Expected<void> set_service(ComponentId component, std::string_view provided,
                              const ServiceDependency& dependency);
   /// Connects `client_required` ("C.r") to `provider_provided` ("P.p").
   /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected).
   Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
+
+  // ---- remote providers (cross-process propagation, DESIGN §2.6 and §4) --------------------
+  /// Declares provided interface `provider_provided` ("P.p") of a component that runs in another
+  /// process, so that connect() accepts it as a provider. The first call for P adds a *remote
+  /// component* P (is_remote(); left out of coordinator_state()) whose machine P.s_P.p holds the
+  /// roots the provider reports and whose service state is that machine alone; `propagate` is
+  /// the provider's propagation level for the service. Configuration call.
+  /// Errors: InvalidArgument (malformed, propagate Normal), Duplicate (P is a local component, or
+  /// P.p was declared already).
+  Expected<MachineId> add_remote_provided(std::string_view provider_provided, State propagate = State::Error);
+  /// True when `id` was added by add_remote_provided().
+  bool is_remote(ComponentId id) const noexcept;
+  /// Replaces, as a whole, the set of roots held by remote provided interface `remote_provided`
+  /// (a machine returned by add_remote_provided()) with `roots`, then propagates locally exactly
+  /// as for a local change: roots no longer reported clear their mirrors, new roots are mirrored
+  /// into every reachable machine (EVT_SERVICE_FAILURE / EVT_SERVICE_DEGRADED). A root whose path
+  /// already contains a machine this interface feeds is dropped (path-vector rule: a cycle across
+  /// processes cannot latch). Takes the lock; callbacks and observers run as for generate().
+  /// Errors (nothing is changed): NotFound (not a remote provided interface), InvalidArgument
+  /// (unknown or non-onset event, level Normal, empty origin), InvalidState (called from a
+  /// callback or observer).
+  Expected<RemoteApplyResult> apply_remote(MachineId remote_provided, const std::vector<RemoteRoot>& roots);
+  /// The full state another process needs for service `service` (a provided interface index of a
+  /// local component): one RemoteRoot per root active at s_S.p (any level), with the shortest
+  /// hop path that brings it to a machine feeding the service. Takes the lock; allocates.
+  std::vector<RemoteRoot> service_roots(ComponentId component, std::uint32_t service) const;
+  /// The address of a root's origin machine; for a remote root, the address in its process.
+  std::string root_origin(const RootCause& root) const;
 
   // ---- lookup --------------------------------------------------------------------------------
   Expected<ComponentId> find_component(std::string_view name) const;
@@ -306,12 +363,14 @@ private:
   };
   struct ComponentData {
     std::string name;
+    bool remote = false;  ///< a stand-in for a component of another process (add_remote_provided)
     MachineId framework;
     MachineId application;
     std::vector<MachineId> provided;
     std::vector<MachineId> required;
     std::vector<ServiceData> services;            ///< one per provided interface
     std::vector<ConnectionId> required_connection;///< one per required interface
+    std::vector<ConnectionId> provider_connections;///< connections to its provided interfaces
     std::array<std::uint32_t, 3> machine_state_count{};
     State state = State::Normal;
     EventId outstanding = kNoEvent;
@@ -338,7 +397,10 @@ private:
 
   EventId add_event_unchecked(Event event);
   MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
-  void rebuild_fanout();
+  /// Recomputes the fan-out edges of `provider`'s machines (its connections as a provider).
+  void rebuild_fanout(ComponentId provider);
+  /// s_F, s_A, then every s_P and s_R of `c`.
+  static std::vector<MachineId> component_machines(const ComponentData& c);
   bool depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept;
 
   // Processing (lock held).
@@ -376,6 +438,11 @@ private:
 
   std::vector<std::unique_ptr<MachineData>> machines_;
   std::vector<std::unique_ptr<ComponentData>> components_;
+  struct NameHash {
+    using is_transparent = void;
+    std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
+  };
+  std::unordered_map<std::string, ComponentId, NameHash, std::equal_to<>> component_index_;  ///< by name
   std::deque<Event> events_;
   std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
@@ -391,6 +458,14 @@ private:
   std::uint64_t visit_epoch_ = 0;
   std::vector<std::pair<SubscriptionId, std::function<void(const Record&)>>> observers_;
   SubscriptionId next_subscription_ = 1;
+
+  struct RemoteRootData {
+    std::string origin;
+    std::vector<std::string> path;
+    bool used = false;
+  };
+  std::vector<RemoteRootData> remote_roots_;  ///< indexed by RootCause::remote; slots are reused
+  std::vector<std::uint32_t> free_remote_;
 
   mutable std::mutex names_mutex_;
   std::deque<std::string> names_;

@@ -1,0 +1,207 @@
+// Remote provided interfaces: the stand-ins through which roots of other processes enter the local
+// propagation (DESIGN §2.6 across processes, §4 middleware).
+
+#include <algorithm>
+#include <string>
+#include <tuple>
+
+#include "safecass/core/coordinator.hpp"
+
+namespace safecass {
+
+Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_provided, State propagate) {
+  const std::string text(provider_provided);
+  const auto dot = provider_provided.find('.');
+  if (dot == std::string_view::npos || dot == 0 || dot + 1 == provider_provided.size() ||
+      provider_provided.find('.', dot + 1) != std::string_view::npos) {
+    return fail(ErrorCode::InvalidArgument, "remote provided interface '" + text + "' must be written Component.Interface");
+  }
+  if (propagate == State::Normal) {
+    return fail(ErrorCode::InvalidArgument, "remote provided interface '" + text + "': propagate must be Warning or Error");
+  }
+  const std::string_view component = provider_provided.substr(0, dot);
+  const std::string_view iface = provider_provided.substr(dot + 1);
+  ComponentId id = kNoComponent;
+  if (auto found = find_component(component)) {
+    if (!components_[*found]->remote) {
+      return fail(ErrorCode::Duplicate, "remote provided interface '" + text + "': component '" +
+                                            std::string(component) + "' runs in this process");
+    }
+    id = *found;
+  } else {
+    auto added = add_component(component);
+    if (!added) return tl::unexpected(added.error());
+    id = *added;
+    components_[id]->remote = true;
+  }
+  auto machine = add_provided(id, iface);
+  if (!machine) return tl::unexpected(machine.error());
+  ServiceDependency dependency = ServiceDependency::provided_only();
+  dependency.propagate = propagate;
+  if (auto r = set_service(id, iface, dependency); !r) return tl::unexpected(r.error());
+  return *machine;
+}
+
+bool Coordinator::is_remote(ComponentId id) const noexcept {
+  return id < components_.size() && components_[id]->remote;
+}
+
+std::string Coordinator::root_origin(const RootCause& root) const {
+  std::lock_guard lock(mutex_);
+  if (root.remote != kNone && root.remote < remote_roots_.size()) return remote_roots_[root.remote].origin;
+  if (root.origin < machines_.size()) return machines_[root.origin]->address;
+  return {};
+}
+
+Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std::vector<RemoteRoot>& roots) {
+  if (proxy >= machines_.size() || machines_[proxy]->kind != MachineKind::Provided ||
+      !components_[machines_[proxy]->component]->remote) {
+    return fail(ErrorCode::NotFound, "machine " + std::to_string(proxy) + " is not a remote provided interface");
+  }
+  const std::string& where = machines_[proxy]->address;
+  // Check everything before changing anything.
+  std::vector<EventId> ids;
+  ids.reserve(roots.size());
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    const RemoteRoot& r = roots[i];
+    const std::string what = "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
+    auto e = find_event(r.event);
+    if (!e) return fail(ErrorCode::InvalidArgument, what + ": no event '" + r.event + "' in this system");
+    if (!events_[*e].is_onset) return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
+    if (r.level == State::Normal) return fail(ErrorCode::InvalidArgument, what + ": level Normal is not a condition");
+    if (r.origin.empty()) return fail(ErrorCode::InvalidArgument, what + ": empty origin");
+    for (std::size_t j = 0; j < i; ++j) {
+      if (roots[j].origin == r.origin && roots[j].event == r.event && roots[j].time == r.time) {
+        return fail(ErrorCode::InvalidArgument, what + ": reported twice");
+      }
+    }
+    ids.push_back(*e);
+  }
+  std::vector<SampleCause> samples(roots.size());
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    if (!roots[i].filter.empty()) samples[i].filter = intern(roots[i].filter);
+    if (!roots[i].signal.empty()) samples[i].signal = intern(roots[i].signal);
+    samples[i].value = roots[i].value;
+    samples[i].sample_time = roots[i].sample_time;
+    samples[i].injected = roots[i].injected;
+  }
+
+  std::lock_guard lock(mutex_);
+  if (processing_) return fail(ErrorCode::InvalidState, "apply_remote() called from a callback or observer");
+  processing_ = true;
+  RemoteApplyResult result;
+  const Time now = clock_->now();
+  MachineData& m = *machines_[proxy];
+
+  // Path-vector rule: a root that has already passed through a machine this interface feeds is
+  // coming back around a cycle of processes; mirroring it again would keep it alive forever.
+  std::vector<bool> wanted(roots.size(), true);
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    for (const Edge& e : m.fanout) {
+      const std::string& receiver = machines_[e.to]->address;
+      if (std::find(roots[i].path.begin(), roots[i].path.end(), receiver) != roots[i].path.end()) {
+        wanted[i] = false;
+        ++result.dropped;
+        break;
+      }
+    }
+  }
+  auto same = [&](const Condition& c, std::size_t i) {
+    const RemoteRootData& d = remote_roots_[c.root.remote];
+    return c.root.event == ids[i] && c.root.time == roots[i].time && d.origin == roots[i].origin;
+  };
+
+  // Roots no longer reported: clear them and everything they reached.
+  for (std::size_t k = m.conditions.size(); k-- > 0;) {
+    if (k >= m.conditions.size()) continue;  // propagation around a cycle may have shrunk the set
+    const Condition c = m.conditions[k];
+    if (c.root.remote == kNone || c.root.origin != proxy) continue;
+    std::size_t match = roots.size();
+    for (std::size_t i = 0; i < roots.size(); ++i) {
+      if (wanted[i] && same(c, i)) match = i;
+    }
+    if (match < roots.size()) {
+      RemoteRootData& d = remote_roots_[c.root.remote];
+      d.path = roots[match].path.empty() ? std::vector<std::string>{roots[match].origin} : roots[match].path;
+      wanted[match] = false;  // already held
+      ++result.kept;
+      continue;
+    }
+    remove_condition(proxy, k, framework_event::completion_of(c.event), now, "no longer reported by the provider");
+    propagate_clear(c.root, c.level, now);
+    remote_roots_[c.root.remote].used = false;
+    remote_roots_[c.root.remote].path.clear();
+    free_remote_.push_back(c.root.remote);
+    ++result.removed;
+  }
+
+  // New roots: hold them here and mirror them wherever they reach.
+  for (std::size_t i = 0; i < roots.size(); ++i) {
+    if (!wanted[i]) continue;
+    std::uint32_t slot;
+    if (!free_remote_.empty()) {
+      slot = free_remote_.back();
+      free_remote_.pop_back();
+    } else {
+      slot = static_cast<std::uint32_t>(remote_roots_.size());
+      remote_roots_.emplace_back();
+    }
+    RemoteRootData& d = remote_roots_[slot];
+    d.used = true;
+    d.origin = roots[i].origin;
+    d.path = roots[i].path.empty() ? std::vector<std::string>{roots[i].origin} : roots[i].path;
+    const EventId mirror_event =
+        roots[i].level == State::Error ? framework_event::kServiceFailure : framework_event::kServiceDegraded;
+    Condition c;
+    c.event = mirror_event;
+    c.level = roots[i].level;
+    c.severity = event_table_[mirror_event]->severity;
+    c.mirror = true;
+    c.first = c.last = now;
+    c.seq = ++condition_seq_;
+    c.root = RootCause{ids[i], proxy, roots[i].time, samples[i], slot};
+    add_condition(proxy, c, now);
+    propagate_onset(c);
+    ++result.added;
+  }
+  drain_pending();
+  processing_ = false;
+  return result;
+}
+
+}  // namespace safecass
+
+namespace safecass {
+
+std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::uint32_t service) const {
+  Address a;
+  a.kind = Address::Kind::Service;
+  a.component = component;
+  a.service = service;
+  const std::vector<Explanation> why = explain(a);
+  std::vector<RemoteRoot> out;
+  for (const Explanation& e : why) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const RemoteRoot& r) {
+      return r.event == e.root_event && r.origin == e.root_origin && r.time == e.root_time;
+    });
+    if (it != out.end()) {
+      if (e.path.size() < it->path.size()) it->path = e.path;
+      continue;
+    }
+    RemoteRoot r;
+    r.event = e.root_event;
+    r.origin = e.root_origin;
+    r.time = e.root_time;
+    r.level = e.level;
+    r.filter = e.filter;
+    r.signal = e.signal;
+    r.value = e.value;
+    r.sample_time = e.sample_time;
+    r.injected = e.injected;
+    r.path = e.path;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace safecass

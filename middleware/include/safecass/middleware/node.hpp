@@ -1,0 +1,120 @@
+#pragma once
+/// @file node.hpp
+/// A coordinator process on the middleware (DESIGN §4): CoordinatorNode connects one Coordinator
+/// (and its Monitor) to ZeroC IceStorm. It
+/// - publishes, for every provided interface of the local components, a full-state update (the
+///   roots active at s_S.p with their hop paths) whenever that set changes, plus every record of
+///   the observer stream and a heartbeat;
+/// - applies the updates of the remote providers this coordinator's components require
+///   (Coordinator::apply_remote), checking sequence numbers and asking for a republish (resync)
+///   when it detects a loss, a provider restart or a reconnection;
+/// - serves the remote operations of the console (state, filter, event, connection, service,
+///   reset, explain); write operations need --allow-write and the token.
+///
+/// Threads: the coordinator's threads only copy records into a bounded queue (never the network);
+/// a publisher thread turns them into messages; a link thread (re)connects to IceStorm, sends
+/// heartbeats and watches that its own heartbeat comes back; Ice's dispatch thread applies
+/// incoming updates and serves requests. Local safety never waits on the network: while IceStorm
+/// is down everything local keeps working and the node reconnects and resynchronises when it
+/// returns.
+///
+/// Lifecycle: configure the coordinator (spec::instantiate + connect_remote_providers), create
+/// the node, start(), ... , stop() (or the destructor), which shuts the Ice communicator down.
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/core/expected.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/spec/system.hpp"
+
+namespace safecass::middleware {
+
+/// Where IceStorm listens: "HOST:PORT" (its TopicManager endpoint). Host defaults to 127.0.0.1.
+struct IceEndpoint {
+  std::string host = "127.0.0.1";
+  int port = 0;
+};
+/// Parses "HOST:PORT" or "PORT". Errors: Parse (with what was wrong).
+Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
+
+/// The host's monotonic clock (CLOCK_MONOTONIC, epoch: boot), the same in every process of the
+/// host: root times and latencies can be compared across the processes of one machine.
+class HostClock final : public Clock {
+public:
+  Time now() const noexcept override {
+    return std::chrono::duration_cast<Time>(std::chrono::steady_clock::now().time_since_epoch());
+  }
+};
+
+/// The IceStorm instance name scripts/start-icestorm configures.
+inline constexpr std::string_view kIceStormInstance = "SafecassIceStorm";
+
+/// Declares, in `coordinator`, every provided interface of another coordinator of `system` that a
+/// component of `coordinator_name` requires (Coordinator::add_remote_provided, with the
+/// provider's propagation level) and makes those connections. Call after spec::instantiate(...,
+/// coordinator_name). Errors: NotFound (no such coordinator), as the coordinator reports.
+Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
+                                        Coordinator& coordinator);
+
+struct NodeOptions {
+  IceEndpoint ice;                       ///< IceStorm
+  std::string listen_host = "127.0.0.1"; ///< the node's own endpoint (subscribers, Control)
+  int control_port = 0;                  ///< 0: any free port (advertised in the heartbeat)
+  std::chrono::milliseconds heartbeat{100};
+  bool allow_write = false;              ///< accept write operations
+  std::string token;                     ///< the secret write requests must carry
+  /// Receives every log line (errors about bad messages, reconnections). Default: stderr.
+  std::function<void(const std::string&)> log;
+};
+
+/// Counters, readable at any time (thread-safe).
+struct NodeStats {
+  std::uint64_t updates_published = 0;
+  std::uint64_t updates_applied = 0;
+  std::uint64_t updates_rejected = 0;   ///< malformed, unknown interface or stale sequence number
+  std::uint64_t updates_missed = 0;     ///< gaps seen in sequence numbers
+  std::uint64_t events_published = 0;
+  std::uint64_t events_dropped = 0;     ///< observer queue overflow (never silent: counted here)
+  std::uint64_t resyncs_requested = 0;
+  std::uint64_t connects = 0;           ///< successful (re)connections to IceStorm
+  bool connected = false;
+};
+
+class CoordinatorNode {
+public:
+  /// `coordinator`, `monitor`, `registry` and `system` must outlive the node; `coordinator_name`
+  /// names this process in the system's "coordinators". Nothing touches the network before
+  /// start(). Errors: NotFound (unknown coordinator name), InvalidArgument (bad options).
+  static Expected<std::unique_ptr<CoordinatorNode>> create(Coordinator& coordinator, Monitor& monitor,
+                                                           const FilterRegistry& registry,
+                                                           const spec::SystemSpec& system,
+                                                           std::string coordinator_name, NodeOptions options);
+  ~CoordinatorNode();
+  CoordinatorNode(const CoordinatorNode&) = delete;
+  CoordinatorNode& operator=(const CoordinatorNode&) = delete;
+
+  /// Creates the Ice communicator and its adapter and starts the threads; the node connects to
+  /// IceStorm in the background (and keeps retrying). Errors: Io (the adapter cannot listen).
+  Expected<void> start();
+  /// Stops the threads and shuts the communicator down. Idempotent.
+  void stop() noexcept;
+
+  NodeStats stats() const;
+  /// The stringified proxy of this node's Control object (empty before start()).
+  std::string control_proxy() const;
+
+  struct Impl;
+
+private:
+  explicit CoordinatorNode(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace safecass::middleware

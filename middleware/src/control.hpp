@@ -1,0 +1,30 @@
+#pragma once
+// Internal: the Control servant (remote operations served by every coordinator process).
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "ice_util.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+
+namespace safecass::middleware::detail {
+
+struct ControlContext {
+  Coordinator& co;
+  Monitor& monitor;
+  const FilterRegistry& registry;
+  std::string name;
+  bool allow_write;
+  std::string token;
+  std::function<void(const std::string&)> log;
+};
+
+std::shared_ptr<wire::Control> make_control(ControlContext context);
+
+/// Explanation <-> wire (shared with the client).
+wire::ExplainEntry to_wire(const Explanation& e);
+Explanation from_wire(const wire::ExplainEntry& w);
+
+}  // namespace safecass::middleware::detail

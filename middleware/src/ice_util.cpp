@@ -1,0 +1,127 @@
+#include "ice_util.hpp"
+
+#include <chrono>
+
+namespace safecass::middleware::detail {
+
+std::shared_ptr<Ice::Communicator> make_communicator() {
+  Ice::InitializationData init;
+  init.properties = Ice::createProperties();
+  init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
+  init.properties->setProperty("Ice.Override.ConnectTimeout", "500");
+  init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
+  init.properties->setProperty("Ice.RetryIntervals", "-1");
+  init.properties->setProperty("Ice.Warn.Connections", "0");
+  init.properties->setProperty("Ice.ThreadPool.Server.Size", "1");
+  init.properties->setProperty("Ice.ThreadPool.Server.SizeMax", "1");
+  init.properties->setProperty("Ice.ACM.Client.Timeout", "0");
+  init.properties->setProperty("Ice.MessageSizeMax", "4096");
+  return Ice::initialize(init);
+}
+
+std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
+                                                         const IceEndpoint& ice) {
+  const std::string text = std::string(kIceStormInstance) + "/TopicManager:tcp -h " + ice.host + " -p " +
+                           std::to_string(ice.port) + " -t 2000";
+  return Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(text));
+}
+
+std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicManagerPrx>& manager,
+                                          const std::string& name) {
+  try {
+    return manager->retrieve(name);
+  } catch (const IceStorm::NoSuchTopic&) {
+    try {
+      return manager->create(name);
+    } catch (const IceStorm::TopicExists&) {
+      return manager->retrieve(name);
+    }
+  }
+}
+
+void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
+               Delivery delivery) {
+  IceStorm::QoS qos;
+  if (delivery == Delivery::Ordered) qos["reliability"] = "ordered";  // needs a twoway subscriber
+  try {
+    topic->subscribeAndGetPublisher(qos, delivery == Delivery::Ordered ? subscriber->ice_twoway()
+                                                                       : subscriber->ice_oneway());
+  } catch (const IceStorm::AlreadySubscribed&) {
+    // IceStorm kept the subscription (its database survived a restart): nothing to do.
+  }
+}
+
+wire::Level to_wire(State s) noexcept {
+  switch (s) {
+    case State::Normal: return wire::Level::Normal;
+    case State::Warning: return wire::Level::Warning;
+    case State::Error: break;
+  }
+  return wire::Level::Error;
+}
+
+bool from_wire(wire::Level l, State& out) noexcept {
+  switch (l) {
+    case wire::Level::Normal: out = State::Normal; return true;
+    case wire::Level::Warning: out = State::Warning; return true;
+    case wire::Level::Error: out = State::Error; return true;
+  }
+  return false;
+}
+
+std::string_view kind_text(RecordKind k) noexcept {
+  switch (k) {
+    case RecordKind::Event: return "event";
+    case RecordKind::Transition: return "transition";
+    case RecordKind::ComponentTransition: return "component-transition";
+    case RecordKind::Reset: return "reset";
+    case RecordKind::Injection: return "injection";
+  }
+  return "unknown";
+}
+
+std::string_view outcome_text(Outcome o) noexcept {
+  switch (o) {
+    case Outcome::None: return "";
+    case Outcome::Raised: return "raised";
+    case Outcome::Override: return "override";
+    case Outcome::Joined: return "joined";
+    case Outcome::Masked: return "masked";
+    case Outcome::Cleared: return "cleared";
+    case Outcome::Ignored: return "ignored";
+  }
+  return "";
+}
+
+std::int64_t steady_ns() noexcept {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+}  // namespace safecass::middleware::detail
+
+namespace safecass::middleware::detail {
+
+void Link::connect(const std::vector<std::string>& publish_on) {
+  manager_ = topic_manager(ic_, ice_);
+  manager_->ice_ping();
+  for (const Subscription& s : subscriptions_) subscribe(topic(manager_, s.topic), s.subscriber, s.delivery);
+  publishers_.clear();
+  for (const std::string& name : publish_on) {
+    publishers_.emplace_back(name, topic(manager_, name)->getPublisher()->ice_oneway());
+  }
+}
+
+std::shared_ptr<Ice::ObjectPrx> Link::publisher(const std::string& name) const {
+  for (const auto& [n, p] : publishers_) {
+    if (n == name) return p;
+  }
+  return nullptr;
+}
+
+void Link::ping() const {
+  if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
+  manager_->ice_ping();
+}
+
+}  // namespace safecass::middleware::detail

@@ -1,0 +1,82 @@
+#pragma once
+// Internal: Ice helpers shared by the node, the supervisor and the client. Only .cpp files of
+// this module include it (public headers include no third-party headers).
+
+#include <Ice/Ice.h>
+#include <IceStorm/IceStorm.h>
+
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "safecass.h"
+#include "safecass/core/coordinator.hpp"
+#include "safecass/middleware/node.hpp"
+
+namespace safecass::middleware::detail {
+
+inline constexpr const char* kStateTopic = "safecass.state";
+inline constexpr const char* kEventTopic = "safecass.events";
+inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
+inline constexpr const char* kResyncTopic = "safecass.resync";
+
+/// A communicator that fails fast (short connect and invocation timeouts, no retries) so that a
+/// dead IceStorm is noticed quickly; one dispatch thread keeps updates in order.
+std::shared_ptr<Ice::Communicator> make_communicator();
+/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT".
+std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
+                                                         const IceEndpoint& ice);
+/// Retrieves a topic, creating it when it does not exist yet.
+std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicManagerPrx>& manager,
+                                          const std::string& name);
+/// How IceStorm delivers to a subscriber.
+enum class Delivery {
+  Ordered,  ///< twoway subscriber, "ordered" reliability: one event at a time, in order (heartbeats, resync)
+  Stream,   ///< oneway subscriber: batched, in order over one connection; a loss shows as a gap in
+            ///< sequence numbers and is repaired by a resync (state updates, event records)
+};
+/// Subscribes `subscriber`; an existing subscription is kept.
+void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
+               Delivery delivery = Delivery::Ordered);
+
+wire::Level to_wire(State s) noexcept;
+/// Errors: a value outside the enum (a malformed message).
+bool from_wire(wire::Level l, State& out) noexcept;
+std::string_view kind_text(RecordKind k) noexcept;
+std::string_view outcome_text(Outcome o) noexcept;
+std::int64_t steady_ns() noexcept;
+
+}  // namespace safecass::middleware::detail
+
+namespace safecass::middleware::detail {
+
+/// A connection to IceStorm: the topics a process subscribes to and publishes on. connect() may
+/// be called again after a failure (IceStorm restarted): it resubscribes and refreshes publishers.
+class Link {
+public:
+  Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice) : ic_(std::move(ic)), ice_(std::move(ice)) {}
+  /// Registers a subscriber of `topic` (used by every connect()).
+  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber, Delivery delivery = Delivery::Ordered) {
+    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery});
+  }
+  /// Throws Ice exceptions when IceStorm cannot be reached.
+  void connect(const std::vector<std::string>& publish_on);
+  /// The oneway publisher of a topic given to connect().
+  std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
+  /// Throws when IceStorm does not answer.
+  void ping() const;
+
+private:
+  std::shared_ptr<Ice::Communicator> ic_;
+  IceEndpoint ice_;
+  std::shared_ptr<IceStorm::TopicManagerPrx> manager_;
+  struct Subscription {
+    std::string topic;
+    std::shared_ptr<Ice::ObjectPrx> subscriber;
+    Delivery delivery;
+  };
+  std::vector<Subscription> subscriptions_;
+  std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
+};
+
+}  // namespace safecass::middleware::detail

@@ -1,0 +1,629 @@
+// CoordinatorNode: one coordinator process on IceStorm (see node.hpp for the design).
+
+#include "safecass/middleware/node.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstdio>
+#include <deque>
+#include <map>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include "control.hpp"
+#include "ice_util.hpp"
+
+namespace safecass::middleware {
+
+using namespace detail;
+
+Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
+  IceEndpoint e;
+  std::string_view port = text;
+  if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
+    e.host = std::string(text.substr(0, colon));
+    port = text.substr(colon + 1);
+    if (e.host.empty()) return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': empty host (write HOST:PORT)");
+  }
+  int value = 0;
+  if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string_view::npos) {
+    return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': the port must be a number (write HOST:PORT)");
+  }
+  for (char c : port) value = value * 10 + (c - '0');
+  if (value < 1 || value > 65535) return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': port outside 1-65535");
+  e.port = value;
+  return e;
+}
+
+namespace {
+std::string component_of(std::string_view address) { return std::string(address.substr(0, address.find('.'))); }
+
+const spec::ComponentSpec* find_spec(const spec::SystemSpec& system, std::string_view name) {
+  for (const auto& c : system.components) {
+    if (c.name == name) return &c;
+  }
+  return nullptr;
+}
+
+/// Which coordinator runs each component ("" when the system declares no coordinators).
+std::map<std::string, std::string, std::less<>> placement(const spec::SystemSpec& system) {
+  std::map<std::string, std::string, std::less<>> where;
+  for (const auto& [coordinator, components] : system.coordinators) {
+    for (const std::string& c : components) where[c] = coordinator;
+  }
+  return where;
+}
+
+bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const wire::Root& x = a[i];
+    const wire::Root& y = b[i];
+    if (x.event != y.event || x.origin != y.origin || x.time != y.time || x.level != y.level || x.path != y.path) {
+      return false;
+    }
+  }
+  return true;
+}
+}  // namespace
+
+Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
+                                        Coordinator& coordinator) {
+  const auto where = placement(system);
+  if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
+                   [&](const auto& c) { return c.first == coordinator_name; })) {
+    return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + std::string(coordinator_name) + "'");
+  }
+  for (const spec::ConnectionSpec& k : system.connections) {
+    const std::string client = component_of(k.required);
+    const std::string provider = component_of(k.provided);
+    const auto c = where.find(client);
+    const auto p = where.find(provider);
+    if (c == where.end() || p == where.end() || c->second != coordinator_name || p->second == coordinator_name) continue;
+    State propagate = State::Error;
+    if (const spec::ComponentSpec* spec = find_spec(system, provider)) {
+      const std::string iface = k.provided.substr(k.provided.find('.') + 1);
+      for (const spec::ServiceSpec& s : spec->services) {
+        if (s.provided == iface) propagate = s.dependency.propagate;
+      }
+    }
+    if (!coordinator.find_machine(provider + ".s_P." + k.provided.substr(k.provided.find('.') + 1))) {
+      if (auto r = coordinator.add_remote_provided(k.provided, propagate); !r) return tl::unexpected(r.error());
+    }
+    if (auto r = coordinator.connect(k.required, k.provided); !r) return tl::unexpected(r.error());
+  }
+  return {};
+}
+
+// ---- the node ---------------------------------------------------------------------------------
+
+struct CoordinatorNode::Impl {
+  Coordinator& co;
+  Monitor& monitor;
+  const FilterRegistry& registry;
+  const spec::SystemSpec& system;
+  std::string name;
+  NodeOptions options;
+  std::int64_t incarnation = 0;
+  std::map<std::string, std::string, std::less<>> where;
+
+  /// A provided interface of a local component: one state stream.
+  struct Stream {
+    ComponentId component;
+    std::uint32_t provided;
+    std::string iface;  ///< "C.p"
+    std::atomic<std::int64_t> seq{0};
+    wire::RootSeq last;  ///< publisher thread only
+    bool dirty = true;   ///< under queue_mutex
+    bool force = true;
+  };
+  std::vector<std::unique_ptr<Stream>> streams;
+  std::vector<std::vector<std::size_t>> streams_of;  ///< by ComponentId
+
+  /// A remote provided interface held here (dispatch thread only).
+  struct Held {
+    MachineId proxy;
+    std::string provider;  ///< the coordinator that runs the provider
+    std::int64_t incarnation = 0;
+    std::int64_t last_seq = 0;
+    bool behind = false;  ///< a heartbeat said we missed its last update
+  };
+  std::map<std::string, Held, std::less<>> held;
+  struct Peer {
+    std::int64_t incarnation = 0;
+    std::int64_t last_resync = 0;
+  };
+  std::map<std::string, Peer, std::less<>> peers;
+
+  std::mutex queue_mutex;
+  std::condition_variable queue_cv;
+  std::deque<Record> records;
+  bool any_dirty = true;
+  static constexpr std::size_t kQueueCapacity = 65536;
+
+  std::shared_ptr<Ice::Communicator> ic;
+  std::shared_ptr<Ice::ObjectAdapter> adapter;
+  std::unique_ptr<Link> link;
+  std::mutex link_mutex;  ///< guards the publisher proxies while the link thread reconnects
+  std::shared_ptr<wire::StateTopicPrx> state_pub;
+  std::shared_ptr<wire::EventTopicPrx> event_pub;
+  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
+  std::shared_ptr<wire::ResyncTopicPrx> resync_pub;
+  std::string control;
+
+  std::atomic<bool> running{false};
+  std::atomic<bool> connected{false};
+  std::atomic<std::int64_t> last_own_heartbeat{0};
+  std::atomic<std::int64_t> event_seq{0};
+  std::thread publisher_thread;
+  std::thread link_thread;
+  Coordinator::SubscriptionId subscription = 0;
+
+  std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
+      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0};
+
+  Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
+      : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)) {}
+
+  void log(const std::string& line) const {
+    if (options.log) {
+      options.log(line);
+    } else {
+      std::fprintf(stderr, "%s\n", line.c_str());
+      std::fflush(stderr);
+    }
+  }
+
+  // -- coordinator side (under the coordinator's lock: no network, no blocking) --
+  void on_record(const Record& r) {
+    {
+      std::lock_guard lock(queue_mutex);
+      // Records of stand-ins for remote components are that component's process's to publish.
+      if (r.kind != RecordKind::Event && !(r.component < co.component_count() && co.is_remote(r.component))) {
+        if (records.size() < kQueueCapacity) {
+          records.push_back(r);
+        } else {
+          events_dropped.fetch_add(1, std::memory_order_relaxed);
+        }
+      }
+      if (r.component < streams_of.size()) {
+        for (std::size_t i : streams_of[r.component]) {
+          streams[i]->dirty = true;
+          any_dirty = true;
+        }
+      }
+    }
+    queue_cv.notify_one();
+  }
+
+  void mark_all(bool force) {
+    {
+      std::lock_guard lock(queue_mutex);
+      for (auto& s : streams) {
+        s->dirty = true;
+        s->force = s->force || force;
+      }
+      any_dirty = true;
+    }
+    queue_cv.notify_one();
+  }
+
+  // -- publisher thread --
+  wire::EventMessage to_message(const Record& r) {
+    wire::EventMessage m;
+    m.coordinator = name;
+    m.incarnation = incarnation;
+    m.seq = ++event_seq;
+    m.kind = std::string(kind_text(r.kind));
+    m.outcome = std::string(outcome_text(r.outcome));
+    if (r.machine != kNoMachine) {
+      m.address = co.address_of(r.machine);
+    } else if (r.component != kNoComponent) {
+      m.address = std::string(co.component_name(r.component));
+    }
+    if (r.event != kNoEvent) m.event = co.event(r.event).name;
+    m.from = to_wire(r.from);
+    m.to = to_wire(r.to);
+    m.level = to_wire(r.level);
+    m.mirror = r.mirror;
+    if (r.root.event != kNoEvent) {
+      m.rootEvent = co.event(r.root.event).name;
+      m.rootOrigin = co.root_origin(r.root);
+    }
+    m.time = r.time.count();
+    m.text = std::string(r.text);
+    return m;
+  }
+
+  void publish_stream(Stream& s, bool force, const std::shared_ptr<wire::StateTopicPrx>& pub) {
+    wire::RootSeq roots;
+    for (const RemoteRoot& r : co.service_roots(s.component, s.provided)) {
+      roots.push_back(wire::Root{r.event, r.origin, r.time.count(), to_wire(r.level), r.filter, r.signal, r.value,
+                                 r.sample_time.count(), r.injected, r.path});
+    }
+    if (!force && same_roots(roots, s.last)) return;
+    wire::StateUpdate u;
+    u.coordinator = name;
+    u.incarnation = incarnation;
+    u.seq = s.seq.load() + 1;
+    u.iface = s.iface;
+    u.state = to_wire(co.service_state(s.component, s.provided));
+    u.roots = roots;
+    u.sent = steady_ns();
+    pub->update(u);
+    s.seq.store(u.seq);
+    s.last = std::move(roots);
+    updates_published.fetch_add(1, std::memory_order_relaxed);
+  }
+
+  void publisher_loop() {
+    while (running.load()) {
+      std::deque<Record> batch;
+      std::vector<std::pair<std::size_t, bool>> todo;
+      {
+        std::unique_lock lock(queue_mutex);
+        if (!connected.load()) {
+          queue_cv.wait_for(lock, std::chrono::milliseconds(20));
+          continue;  // records and dirty marks wait (bounded) for the reconnection
+        }
+        queue_cv.wait_for(lock, std::chrono::milliseconds(50),
+                          [&] { return !running.load() || !records.empty() || any_dirty; });
+        batch.swap(records);
+        if (any_dirty) {
+          for (std::size_t i = 0; i < streams.size(); ++i) {
+            if (!streams[i]->dirty) continue;
+            todo.emplace_back(i, streams[i]->force);
+            streams[i]->dirty = false;
+            streams[i]->force = false;
+          }
+          any_dirty = false;
+        }
+      }
+      std::shared_ptr<wire::StateTopicPrx> spub;
+      std::shared_ptr<wire::EventTopicPrx> epub;
+      {
+        std::lock_guard lock(link_mutex);
+        spub = state_pub;
+        epub = event_pub;
+      }
+      if (spub == nullptr || epub == nullptr) continue;
+      std::size_t done = 0;
+      try {
+        // State first: it is what other processes' safety depends on.
+        for (; done < todo.size(); ++done) publish_stream(*streams[todo[done].first], todo[done].second, spub);
+        for (const Record& r : batch) {
+          epub->record(to_message(r));
+          events_published.fetch_add(1, std::memory_order_relaxed);
+        }
+      } catch (const Ice::Exception& e) {
+        log("middleware: " + name + ": publishing failed (" + std::string(e.ice_id()) + "); will reconnect and resync");
+        connected.store(false);
+        std::lock_guard lock(queue_mutex);
+        for (std::size_t i = done; i < todo.size(); ++i) streams[todo[i].first]->dirty = true;
+        any_dirty = true;
+      }
+    }
+  }
+
+  // -- link thread --
+  void link_loop() {
+    bool reported_down = false;
+    std::int64_t connected_at = 0;
+    const auto period = options.heartbeat;
+    while (running.load()) {
+      if (!connected.load()) {
+        try {
+          link->connect({kStateTopic, kEventTopic, kHeartbeatTopic, kResyncTopic});
+          {
+            std::lock_guard lock(link_mutex);
+            state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(kStateTopic));
+            event_pub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kEventTopic));
+            heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(kHeartbeatTopic));
+            resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
+          }
+          connected_at = steady_ns();
+          last_own_heartbeat.store(connected_at);
+          connected.store(true);
+          connects.fetch_add(1);
+          log("middleware: " + name + ": connected to IceStorm at " + options.ice.host + ":" +
+              std::to_string(options.ice.port) + "; resynchronising");
+          reported_down = false;
+          mark_all(true);
+          resync_pub->resync(name, "");
+          resyncs_requested.fetch_add(1);
+        } catch (const Ice::Exception& e) {
+          if (!reported_down) {
+            log("middleware: " + name + ": IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port) +
+                " unreachable (" + std::string(e.ice_id()) + "); running locally, retrying");
+            reported_down = true;
+          }
+          sleep_for(std::chrono::milliseconds(200));
+          continue;
+        }
+      }
+      try {
+        link->ping();
+        heartbeat_pub->beat(heartbeat());
+        const std::int64_t now = steady_ns();
+        const std::int64_t silent = now - last_own_heartbeat.load();
+        if (now - connected_at > 5 * std::chrono::nanoseconds(period).count() &&
+            silent > 5 * std::chrono::nanoseconds(period).count()) {
+          log("middleware: " + name + ": own heartbeat did not come back; resubscribing");
+          connected.store(false);
+          continue;
+        }
+      } catch (const Ice::Exception& e) {
+        log("middleware: " + name + ": lost IceStorm (" + std::string(e.ice_id()) + "); running locally, reconnecting");
+        connected.store(false);
+        reported_down = true;
+        continue;
+      }
+      sleep_for(period);
+    }
+  }
+
+  void sleep_for(std::chrono::milliseconds d) {
+    const auto until = std::chrono::steady_clock::now() + d;
+    while (running.load() && std::chrono::steady_clock::now() < until) {
+      std::this_thread::sleep_for(std::min<std::chrono::milliseconds>(d, std::chrono::milliseconds(20)));
+    }
+  }
+
+  wire::Heartbeat heartbeat() {
+    wire::Heartbeat h;
+    h.coordinator = name;
+    h.incarnation = incarnation;
+    h.time = steady_ns();
+    for (const auto& s : streams) h.lastSeq["state:" + s->iface] = s->seq.load();
+    h.lastSeq["events"] = event_seq.load();
+    for (ComponentId c = 0; c < co.component_count(); ++c) {
+      if (!co.is_remote(c)) h.components.emplace_back(co.component_name(c));
+    }
+    for (const auto& [iface, _] : held) h.clients.push_back(iface);
+    h.control = control;
+    return h;
+  }
+
+  // -- Ice dispatch thread --
+  void on_update(const wire::StateUpdate& u) {
+    if (u.coordinator == name) return;
+    const auto it = held.find(u.iface);
+    if (it == held.end()) return;  // every process sees every update; this one is not for us
+    Held& h = it->second;
+    const std::string what = "middleware: " + name + ": state update " + u.iface + " seq " + std::to_string(u.seq) +
+                             " from coordinator '" + u.coordinator + "'";
+    if (u.coordinator != h.provider) {
+      updates_rejected.fetch_add(1);
+      log(what + " rejected: " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
+      return;
+    }
+    if (u.incarnation != h.incarnation) {
+      h.incarnation = u.incarnation;
+      h.last_seq = 0;
+    }
+    if (u.seq <= h.last_seq) {
+      updates_rejected.fetch_add(1);
+      log(what + " ignored: stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
+      return;
+    }
+    if (h.last_seq != 0 && u.seq != h.last_seq + 1) {
+      updates_missed.fetch_add(static_cast<std::uint64_t>(u.seq - h.last_seq - 1));
+      log(what + ": " + std::to_string(u.seq - h.last_seq - 1) + " update(s) missed; this full state supersedes them");
+    }
+    h.last_seq = u.seq;
+    h.behind = false;
+    std::vector<RemoteRoot> roots;
+    roots.reserve(u.roots.size());
+    for (const wire::Root& w : u.roots) {
+      RemoteRoot r;
+      r.event = w.event;
+      r.origin = w.origin;
+      r.time = Time{w.time};
+      if (!from_wire(w.level, r.level)) {
+        updates_rejected.fetch_add(1);
+        log(what + " rejected: root '" + w.event + "' has an invalid level");
+        return;
+      }
+      r.filter = w.filter;
+      r.signal = w.signal;
+      r.value = w.value;
+      r.sample_time = Time{w.sampleTime};
+      r.injected = w.injected;
+      r.path = w.path;
+      roots.push_back(std::move(r));
+    }
+    auto applied = co.apply_remote(h.proxy, roots);
+    if (!applied) {
+      updates_rejected.fetch_add(1);
+      log(what + " rejected, nothing changed: " + applied.error().message);
+      return;
+    }
+    updates_applied.fetch_add(1);
+  }
+
+  void on_heartbeat(const wire::Heartbeat& hb) {
+    const std::int64_t now = steady_ns();
+    if (hb.coordinator == name) {
+      if (hb.incarnation == incarnation) last_own_heartbeat.store(now);
+      return;
+    }
+    Peer& peer = peers[hb.coordinator];
+    bool need = peer.incarnation != 0 && peer.incarnation != hb.incarnation;
+    peer.incarnation = hb.incarnation;
+    for (auto& [iface, h] : held) {
+      if (h.provider != hb.coordinator) continue;
+      const auto s = hb.lastSeq.find("state:" + iface);
+      if (s == hb.lastSeq.end()) continue;
+      const bool behind = h.incarnation != hb.incarnation ? s->second > 0 : s->second > h.last_seq;
+      // Two heartbeats in a row: the update may simply be on its way on the other topic.
+      if (behind && h.behind) need = true;
+      h.behind = behind;
+    }
+    if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
+    peer.last_resync = now;
+    std::shared_ptr<wire::ResyncTopicPrx> pub;
+    {
+      std::lock_guard lock(link_mutex);
+      pub = resync_pub;
+    }
+    if (pub == nullptr) return;
+    try {
+      pub->resync(name, hb.coordinator);
+      resyncs_requested.fetch_add(1);
+      log("middleware: " + name + ": missed state of coordinator '" + hb.coordinator + "'; asked it to republish");
+    } catch (const Ice::Exception&) {
+      // The link thread notices and reconnects.
+    }
+  }
+
+  void on_resync(const std::string& requester, const std::string& target) {
+    if (!target.empty() && target != name) return;
+    if (requester != name) mark_all(true);
+  }
+};
+
+namespace {
+
+class StateServant final : public wire::StateTopic {
+public:
+  explicit StateServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
+  void update(wire::StateUpdate u, const Ice::Current&) override { impl_.on_update(u); }
+
+private:
+  CoordinatorNode::Impl& impl_;
+};
+
+class HeartbeatServant final : public wire::HeartbeatTopic {
+public:
+  explicit HeartbeatServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
+  void beat(wire::Heartbeat h, const Ice::Current&) override { impl_.on_heartbeat(h); }
+
+private:
+  CoordinatorNode::Impl& impl_;
+};
+
+class ResyncServant final : public wire::ResyncTopic {
+public:
+  explicit ResyncServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
+  void resync(std::string requester, std::string target, const Ice::Current&) override {
+    impl_.on_resync(requester, target);
+  }
+
+private:
+  CoordinatorNode::Impl& impl_;
+};
+
+}  // namespace
+
+Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& coordinator, Monitor& monitor,
+                                                                   const FilterRegistry& registry,
+                                                                   const spec::SystemSpec& system,
+                                                                   std::string coordinator_name, NodeOptions options) {
+  if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "middleware: no IceStorm port given");
+  if (options.heartbeat.count() <= 0) return fail(ErrorCode::InvalidArgument, "middleware: heartbeat period must be positive");
+  auto impl = std::make_unique<Impl>(coordinator, monitor, registry, system, std::move(coordinator_name), std::move(options));
+  impl->where = placement(system);
+  if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
+                   [&](const auto& c) { return c.first == impl->name; })) {
+    return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + impl->name + "'");
+  }
+  std::random_device random;
+  impl->incarnation = (static_cast<std::int64_t>(random()) << 31) ^ static_cast<std::int64_t>(random()) ^ steady_ns();
+  if (impl->incarnation == 0) impl->incarnation = 1;
+  impl->streams_of.resize(coordinator.component_count());
+  for (ComponentId c = 0; c < coordinator.component_count(); ++c) {
+    if (coordinator.is_remote(c)) {
+      for (MachineId m : coordinator.provided_machines(c)) {
+        const std::string iface = std::string(coordinator.component_name(c)) + "." +
+                                  std::string(coordinator.interface_name(m));
+        const auto w = impl->where.find(coordinator.component_name(c));
+        impl->held.emplace(iface, Impl::Held{m, w == impl->where.end() ? std::string() : w->second});
+      }
+      continue;
+    }
+    const auto& provided = coordinator.provided_machines(c);
+    for (std::uint32_t p = 0; p < provided.size(); ++p) {
+      auto s = std::make_unique<Impl::Stream>();
+      s->component = c;
+      s->provided = p;
+      s->iface = std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(provided[p]));
+      impl->streams_of[c].push_back(impl->streams.size());
+      impl->streams.push_back(std::move(s));
+    }
+  }
+  return std::unique_ptr<CoordinatorNode>(new CoordinatorNode(std::move(impl)));
+}
+
+CoordinatorNode::CoordinatorNode(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+CoordinatorNode::~CoordinatorNode() { stop(); }
+
+Expected<void> CoordinatorNode::start() {
+  Impl& d = *impl_;
+  if (d.running.load()) return {};
+  try {
+    d.ic = make_communicator();
+    const std::string endpoint = "tcp -h " + d.options.listen_host +
+                                 (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
+    d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);
+    const std::string id = "safecass-" + d.name + "-" + std::to_string(d.incarnation);
+    auto state = d.adapter->add(std::make_shared<StateServant>(d), Ice::Identity{"state", id});
+    auto heartbeat = d.adapter->add(std::make_shared<HeartbeatServant>(d), Ice::Identity{"heartbeat", id});
+    auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
+    ControlContext context{d.co, d.monitor, d.registry, d.name, d.options.allow_write, d.options.token,
+                           [&d](const std::string& line) { d.log(line); }};
+    auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
+    d.control = control->ice_toString();
+    d.link = std::make_unique<Link>(d.ic, d.options.ice);
+    d.link->subscribe_to(kStateTopic, state, Delivery::Stream);
+    d.link->subscribe_to(kHeartbeatTopic, heartbeat);
+    d.link->subscribe_to(kResyncTopic, resync);
+    d.adapter->activate();
+  } catch (const Ice::Exception& e) {
+    if (d.ic) d.ic->destroy();
+    d.ic = nullptr;
+    return fail(ErrorCode::Io, "middleware: " + d.name + ": cannot listen on " + d.options.listen_host + ": " + e.what());
+  }
+  d.subscription = d.co.subscribe([&d](const Record& r) { d.on_record(r); });
+  d.running.store(true);
+  d.publisher_thread = std::thread([&d] { d.publisher_loop(); });
+  d.link_thread = std::thread([&d] { d.link_loop(); });
+  return {};
+}
+
+void CoordinatorNode::stop() noexcept {
+  Impl& d = *impl_;
+  if (!d.running.exchange(false)) return;
+  d.co.unsubscribe(d.subscription);
+  d.queue_cv.notify_all();
+  if (d.publisher_thread.joinable()) d.publisher_thread.join();
+  if (d.link_thread.joinable()) d.link_thread.join();
+  try {
+    d.ic->shutdown();
+    d.ic->waitForShutdown();
+    d.ic->destroy();
+  } catch (...) {
+  }
+  d.connected.store(false);
+}
+
+NodeStats CoordinatorNode::stats() const {
+  const Impl& d = *impl_;
+  NodeStats s;
+  s.updates_published = d.updates_published.load();
+  s.updates_applied = d.updates_applied.load();
+  s.updates_rejected = d.updates_rejected.load();
+  s.updates_missed = d.updates_missed.load();
+  s.events_published = d.events_published.load();
+  s.events_dropped = d.events_dropped.load();
+  s.resyncs_requested = d.resyncs_requested.load();
+  s.connects = d.connects.load();
+  s.connected = d.connected.load();
+  return s;
+}
+
+std::string CoordinatorNode::control_proxy() const { return impl_->control; }
+
+}  // namespace safecass::middleware

@@ -1,0 +1,371 @@
+// Multi-process SAFECASS through a real IceStorm (DESIGN §2.6 across processes, §4, §7): the
+// robodoc example split into its two coordinators (robot, ui), each a `safecass run` process,
+// driven and observed through the remote operations (RemoteClient).
+//
+// Environment (set by tests/integration/middleware/CMakeLists.txt):
+//   SAFECASS_BIN             the safecass command
+//   SAFECASS_SOURCE_DIR      the repository (examples, scripts)
+//   SAFECASS_ICESTORM_ENV    file written by the fixture's scripts/start-icestorm --env
+//   SAFECASS_SCRATCH         a directory for logs and token files
+// Every process a test starts is stopped by PID when the test ends, whatever its outcome.
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/middleware/client.hpp"
+#include "safecass/middleware/token.hpp"
+#include "safecass/spec/load.hpp"
+
+namespace safecass {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v != nullptr ? v : "";
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string env_file_value(const std::string& file, const std::string& key) {
+  std::istringstream lines(slurp(file));
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind(key + "=", 0) == 0) return line.substr(key.size() + 1);
+  }
+  return "";
+}
+
+/// A child process with its output in a log file; killed by PID when it goes out of scope.
+class Process {
+public:
+  Process(std::vector<std::string> argv, std::string log) : log_(std::move(log)) {
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int fd = ::open(log_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(fd, 1);
+      ::dup2(fd, 2);
+      std::vector<char*> args;
+      for (std::string& a : argv) args.push_back(a.data());
+      args.push_back(nullptr);
+      ::execv(args[0], args.data());
+      std::_Exit(127);
+    }
+  }
+  ~Process() { stop(SIGTERM); }
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+
+  /// Sends `sig` and waits for the process (SIGKILL after 3 s).
+  void stop(int sig) {
+    if (pid_ <= 0) return;
+    ::kill(pid_, sig);
+    for (int i = 0; i < 300; ++i) {
+      if (::waitpid(pid_, nullptr, WNOHANG) == pid_) {
+        pid_ = -1;
+        return;
+      }
+      std::this_thread::sleep_for(10ms);
+    }
+    ::kill(pid_, SIGKILL);
+    ::waitpid(pid_, nullptr, 0);
+    pid_ = -1;
+  }
+  std::string output() const { return slurp(log_); }
+  pid_t pid() const { return pid_; }
+
+private:
+  pid_t pid_ = -1;
+  std::string log_;
+};
+
+/// Polls `ok` every 20 ms until it holds or `timeout` passes.
+bool eventually(const std::function<bool()>& ok, std::chrono::milliseconds timeout = 5000ms) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < until) {
+    if (ok()) return true;
+    std::this_thread::sleep_for(20ms);
+  }
+  return ok();
+}
+
+struct Paths {
+  std::string bin = env("SAFECASS_BIN");
+  std::string source = env("SAFECASS_SOURCE_DIR");
+  std::string scratch = env("SAFECASS_SCRATCH");
+  std::string system = source + "/examples/robodoc/robodoc.json";
+  std::string feed = source + "/tests/integration/middleware/robot_feed.json";
+};
+
+/// The robodoc system as two processes on one IceStorm.
+struct TwoProcesses {
+  Paths p;
+  std::string ice;
+  std::string tag;
+  std::unique_ptr<Process> robot, ui;
+
+  TwoProcesses(std::string ice_endpoint, std::string test_tag) : ice(std::move(ice_endpoint)), tag(std::move(test_tag)) {}
+
+  std::string token_file() const { return p.scratch + "/" + tag + "-robot.token"; }
+  void start_robot() {
+    robot = std::make_unique<Process>(
+        std::vector<std::string>{p.bin, "run", p.system, "--coordinator", "robot", "--scenario", p.feed, "--ice", ice,
+                                 "--allow-write", "--token-file", token_file(), "--duration", "40"},
+        p.scratch + "/" + tag + "-robot.log");
+  }
+  void start_ui() {
+    ui = std::make_unique<Process>(
+        std::vector<std::string>{p.bin, "run", p.system, "--coordinator", "ui", "--ice", ice, "--duration", "40"},
+        p.scratch + "/" + tag + "-ui.log");
+  }
+  std::unique_ptr<middleware::RemoteClient> client(const std::string& coordinator, const std::string& token = {}) {
+    middleware::ClientOptions o;
+    o.ice = *middleware::parse_ice_endpoint(ice);
+    o.coordinator = coordinator;
+    o.token = token;
+    o.timeout = 3000ms;
+    std::unique_ptr<middleware::RemoteClient> c;
+    eventually([&] {
+      auto r = middleware::RemoteClient::connect(o);
+      if (r) c = std::move(*r);
+      return c != nullptr;
+    }, 10000ms);
+    return c;
+  }
+  std::string logs() const {
+    return "--- robot ---\n" + (robot ? robot->output() : "") + "--- ui ---\n" + (ui ? ui->output() : "");
+  }
+};
+
+State state_of(middleware::RemoteClient& c, const std::string& address) {
+  const auto component = address.substr(0, address.find('.'));
+  auto rows = c.state_list(component);
+  if (!rows) return State::Normal;
+  for (const auto& r : *rows) {
+    if (r.address == address) return r.state;
+  }
+  return State::Normal;
+}
+
+std::string causes(const std::vector<Explanation>& why) {
+  std::string out;
+  for (const Explanation& e : why) {
+    out += e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin + ":" + e.root_event + " path";
+    for (const std::string& hop : e.path) out += " " + hop;
+    out += "\n";
+  }
+  return out;
+}
+
+/// explain(address) in one process running the whole system, after `setup`.
+std::string in_process(const std::function<void(Coordinator&)>& setup, const std::string& address) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  auto load = spec::load_system(Paths{}.system, registry);
+  EXPECT_TRUE(load.ok());
+  SimulatedClock clock;
+  Coordinator co("robodoc", &clock);
+  Monitor monitor(co, registry);
+  EXPECT_TRUE(spec::instantiate(*load.system, co, monitor));
+  setup(co);
+  return causes(*co.explain(address));
+}
+
+std::string ice_of_fixture() {
+  const std::string file = env("SAFECASS_ICESTORM_ENV");
+  return "127.0.0.1:" + env_file_value(file, "ICESTORM_PORT");
+}
+
+TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInProcess) {
+  TwoProcesses sys(ice_of_fixture(), "propagation");
+  sys.start_robot();
+  sys.start_ui();
+  auto token = middleware::read_token_file(sys.token_file());
+  ASSERT_TRUE(eventually([&] { return (token = middleware::read_token_file(sys.token_file())).has_value(); }))
+      << sys.logs();
+  auto robot = sys.client("robot", *token);
+  auto ui = sys.client("ui");
+  ASSERT_TRUE(robot && ui) << sys.logs();
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal && state_of(*robot, "CONTROL") == State::Normal; }))
+      << sys.logs();
+
+  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A")) << sys.logs();
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Error; })) << sys.logs();
+  EXPECT_EQ(state_of(*ui, "PENDANT.s_R.Status"), State::Error);
+  EXPECT_EQ(state_of(*robot, "SERVO"), State::Error);
+
+  const std::string expected = in_process([](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
+  auto remote = ui->explain("PENDANT");
+  ASSERT_TRUE(remote) << remote.error().message;
+  EXPECT_EQ(causes(*remote), expected);
+  EXPECT_NE(expected.find("JR3.s_A:EVT_FORCE_ERROR path JR3.s_A JR3.s_S.ForceData CONTROL.s_R.ForceData "
+                          "CONTROL.s_S.Status PENDANT.s_R.Status"),
+            std::string::npos)
+      << expected;
+
+  ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A"));
+  EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
+  EXPECT_TRUE(ui->explain("PENDANT")->empty());
+}
+
+TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {
+  TwoProcesses sys(ice_of_fixture(), "token");
+  sys.start_robot();
+  sys.start_ui();
+  std::optional<std::string> token;
+  ASSERT_TRUE(eventually([&] {
+    auto t = middleware::read_token_file(sys.token_file());
+    if (t) token = *t;
+    return token.has_value();
+  })) << sys.logs();
+  struct stat st {};
+  ASSERT_EQ(::stat(sys.token_file().c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u) << "the token file is readable by its owner only";
+
+  auto anonymous = sys.client("robot");
+  auto wrong = sys.client("robot", std::string(64, '0'));
+  auto ui = sys.client("ui", *token);
+  auto robot = sys.client("robot", *token);
+  ASSERT_TRUE(anonymous && wrong && ui && robot) << sys.logs();
+
+  for (auto* c : {anonymous.get(), wrong.get()}) {
+    auto r = c->generate("EVT_FORCE_ERROR", "JR3.s_A");
+    ASSERT_FALSE(r);
+    EXPECT_EQ(r.error().code, ErrorCode::Denied) << r.error().message;
+    EXPECT_FALSE(c->reset("SYSTEM", "test", "no token"));
+    EXPECT_FALSE(c->filter_inject("force_limit", {{50.0}}));
+  }
+  auto read_only = ui->generate("EVT_TRACKING_ERROR", "PENDANT.s_R.Status");
+  ASSERT_FALSE(read_only);
+  EXPECT_NE(read_only.error().message.find("read-only"), std::string::npos) << read_only.error().message;
+  EXPECT_EQ(state_of(*robot, "JR3"), State::Normal) << "refused writes changed nothing";
+
+  auto bad = robot->generate("EVT_NO_SUCH_EVENT", "JR3.s_A");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().code, ErrorCode::NotFound);
+  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A"));
+  EXPECT_EQ(state_of(*robot, "JR3.s_A"), State::Error);
+  ASSERT_TRUE(robot->reset("JR3", "test", "operator reset"));
+  EXPECT_EQ(state_of(*robot, "JR3.s_A"), State::Normal);
+  // Reads work for everyone.
+  EXPECT_TRUE(anonymous->state_list());
+  EXPECT_TRUE(anonymous->filter_info("force_limit"));
+  EXPECT_TRUE(anonymous->connection_list());
+  EXPECT_TRUE(anonymous->service_list());
+  EXPECT_TRUE(anonymous->event_list());
+  EXPECT_TRUE(anonymous->event_history(10));
+}
+
+TEST(MultiProcess, TheSupervisorDetectsAKilledCoordinatorAndItsRecovery) {
+  TwoProcesses sys(ice_of_fixture(), "supervisor");
+  sys.start_robot();
+  sys.start_ui();
+  Process supervisor({sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "500", "--duration", "40"},
+                     sys.p.scratch + "/supervisor-supervisor.log");
+  auto robot = sys.client("robot");
+  auto ui = sys.client("ui");
+  ASSERT_TRUE(robot && ui) << sys.logs();
+  ASSERT_TRUE(eventually([&] {
+    const std::string out = supervisor.output();
+    return out.find("coordinator 'robot' is up") != std::string::npos && out.find("coordinator 'ui' is up") != std::string::npos;
+  })) << supervisor.output();
+
+  sys.robot->stop(SIGKILL);
+  ASSERT_TRUE(eventually([&] { return supervisor.output().find("coordinator 'robot' lost") != std::string::npos; }))
+      << supervisor.output();
+  EXPECT_TRUE(eventually([&] {
+    const std::string out = supervisor.output();
+    const auto at = out.find("supervisor: PENDANT.s_R.Status Normal -> Error EVT_SERVICE_FAILURE (root ");
+    return at != std::string::npos && out.find(".s_F:EVT_COORDINATOR_LOST)", at) == out.find('\n', at) - 26;
+  })) << supervisor.output();
+  EXPECT_NE(supervisor.output().find("supervisor: JR3.s_F Normal -> Error EVT_COORDINATOR_LOST"), std::string::npos);
+  EXPECT_EQ(supervisor.output().find("coordinator 'ui' lost"), std::string::npos) << supervisor.output();
+
+  sys.start_robot();
+  EXPECT_TRUE(eventually([&] { return supervisor.output().find("coordinator 'robot' recovered") != std::string::npos; }, 10000ms))
+      << supervisor.output();
+  EXPECT_TRUE(eventually([&] {
+    return supervisor.output().find("supervisor: PENDANT.s_R.Status Error -> Normal") != std::string::npos;
+  })) << supervisor.output();
+}
+
+TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
+  Paths p;
+  const std::string dir = p.scratch + "/restart-icestorm";
+  const std::string env_file = p.scratch + "/restart-icestorm.env";
+  const std::string start = p.source + "/scripts/start-icestorm";
+  ASSERT_EQ(std::system((start + " --port 0 --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
+  const std::string port = env_file_value(env_file, "ICESTORM_PORT");
+  pid_t icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
+  struct Kill {
+    pid_t* pid;
+    ~Kill() {
+      if (*pid > 0) ::kill(*pid, SIGKILL);
+    }
+  } kill_icestorm{&icestorm};
+
+  TwoProcesses sys("127.0.0.1:" + port, "restart");
+  sys.start_robot();
+  sys.start_ui();
+  std::optional<std::string> token;
+  ASSERT_TRUE(eventually([&] {
+    auto t = middleware::read_token_file(sys.token_file());
+    if (t) token = *t;
+    return token.has_value();
+  }));
+  auto robot = sys.client("robot", *token);
+  auto ui = sys.client("ui");
+  ASSERT_TRUE(robot && ui) << sys.logs();
+  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A"));
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Error; })) << sys.logs();
+
+  ::kill(icestorm, SIGKILL);
+  ::waitpid(icestorm, nullptr, 0);
+  icestorm = -1;
+  // IceStorm is down: each process keeps detecting and propagating locally.
+  ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A")) << "remote operations do not go through IceStorm";
+  ASSERT_TRUE(robot->generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
+  EXPECT_EQ(state_of(*robot, "JR3"), State::Normal);
+  EXPECT_EQ(state_of(*robot, "SERVO"), State::Error) << "local propagation does not wait for the network";
+  std::this_thread::sleep_for(300ms);
+
+  ASSERT_EQ(std::system((start + " --port " + port + " --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
+  icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
+  const std::string expected = in_process(
+      [](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A")); }, "PENDANT");
+  EXPECT_TRUE(eventually([&] {
+    auto why = ui->explain("PENDANT");
+    return why && causes(*why) == expected;
+  }, 10000ms)) << "after resync the ui holds exactly the robot's current roots\n" << causes(*ui->explain("PENDANT")) << sys.logs();
+  EXPECT_NE(sys.ui->output().find("connected to IceStorm"), std::string::npos);
+
+  ASSERT_TRUE(robot->generate("/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
+  EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << "propagation works again\n"
+                                                                                   << sys.logs();
+}
+
+}  // namespace
+}  // namespace safecass

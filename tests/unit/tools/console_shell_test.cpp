@@ -1,0 +1,194 @@
+// The console's shared parser, completion and printers (console_shell.hpp) with a fake backend:
+// what reaches a backend, what never does, and how its answers are printed.
+
+#include <gtest/gtest.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "console.hpp"
+#include "console_shell.hpp"
+
+namespace safecass::tools {
+namespace {
+
+using console::Arg;
+using console::CommandSpec;
+using console::Out;
+
+/// Records every command it is asked to run; fails with `error` when set.
+struct Calls {
+  std::vector<std::string> commands;             ///< "name|arg|arg..."
+  std::vector<std::string> frames;               ///< "begin", "end ok", "end failed"
+  std::string error;
+};
+
+class FakeBackend final : public console::Backend {
+public:
+  explicit FakeBackend(Calls& calls) : calls_(calls) {}
+  std::string run(const CommandSpec& c, const std::vector<std::string>& args, Out& out) override {
+    std::string call(c.name);
+    for (const std::string& a : args) call += "|" + a;
+    calls_.commands.push_back(call);
+    if (calls_.error.empty()) out.line("ran " + call);
+    return calls_.error;
+  }
+  std::vector<std::string> names(Arg kind) const override {
+    switch (kind) {
+      case Arg::Event: return {"EVT_B", "EVT_A", "/EVT_A"};
+      case Arg::Machine: return {"ARM.s_A", "ARM.s_F"};
+      case Arg::Component: return {"ARM"};
+      default: return {};
+    }
+  }
+  std::string banner() const override { return "fake"; }
+  void begin() override { calls_.frames.emplace_back("begin"); }
+  void end(Out& /*out*/, bool ok) override { calls_.frames.emplace_back(ok ? "end ok" : "end failed"); }
+
+private:
+  Calls& calls_;
+};
+
+std::unique_ptr<Console> fake_console(Calls& calls, bool allow_write, bool json = false) {
+  return std::make_unique<Console>(std::make_unique<FakeBackend>(calls), ConsoleOptions{json, allow_write});
+}
+
+TEST(ConsoleShell, ACommandReachesTheBackendWithItsWordsParsedQuotedAndBracketed) {
+  Calls calls;
+  auto console = fake_console(calls, true);
+  const ConsoleReply r = console->execute("  filter inject force_limit [1, 2 3] 'a b' 4  ");
+  EXPECT_TRUE(r.ok) << r.err;
+  ASSERT_EQ(calls.commands.size(), 1u);
+  EXPECT_EQ(calls.commands[0], "filter inject|force_limit|[1, 2 3]|a b|4");
+  EXPECT_EQ(r.out, "ran filter inject|force_limit|[1, 2 3]|a b|4\n");
+  EXPECT_EQ(calls.frames, (std::vector<std::string>{"begin", "end ok"}));
+}
+
+TEST(ConsoleShell, AWriteOnAReadOnlyConsoleIsRefusedBeforeTheBackend) {
+  Calls calls;
+  auto console = fake_console(calls, false);
+  for (const char* line : {"event generate EVT_A ARM.s_A", "event broadcast EVT_B", "reset ARM", "filter inject f 1",
+                           "filter dinject ARM.x 1", "filter dinload ARM.x file.txt"}) {
+    const ConsoleReply r = console->execute(line);
+    EXPECT_FALSE(r.ok) << line;
+    EXPECT_NE(r.err.find("refused: this console is read-only"), std::string::npos) << r.err;
+  }
+  EXPECT_TRUE(calls.commands.empty());
+  EXPECT_TRUE(console->execute("state list").ok) << "reads still reach the backend";
+  EXPECT_EQ(calls.commands, (std::vector<std::string>{"state list"}));
+}
+
+TEST(ConsoleShell, BadCommandLinesAreUsageLinesThatNeverReachTheBackend) {
+  Calls calls;
+  auto console = fake_console(calls, true);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"frobnicate", "unknown command 'frobnicate' (usage: help [COMMAND])"},
+      {"state", "state: needs a subcommand (usage: state list [COMPONENT] | state history [ADDRESS] [N])"},
+      {"state lst", "state: unknown subcommand 'lst'"},
+      {"explain", "explain: missing arguments (usage: explain ADDRESS)"},
+      {"event generate A B C", "event generate: too many arguments (usage: event generate EVENT TARGET)"},
+      {"filter inject f [1,2", "'[' without ']'"},
+      {"explain 'ARM", "unterminated '"},
+  };
+  for (const auto& [line, error] : cases) {
+    const ConsoleReply r = console->execute(line);
+    EXPECT_FALSE(r.ok) << line;
+    EXPECT_TRUE(r.out.empty()) << line;
+    EXPECT_NE(r.err.find(error), std::string::npos) << line << ": " << r.err;
+  }
+  EXPECT_TRUE(calls.commands.empty());
+  EXPECT_TRUE(calls.frames.empty());
+  EXPECT_TRUE(console->execute("   ").ok);
+  EXPECT_TRUE(console->execute("# a comment").ok);
+  EXPECT_TRUE(calls.commands.empty());
+}
+
+TEST(ConsoleShell, ABackendErrorIsPrintedWithTheCommandAndItsUsageInTextAndJson) {
+  Calls calls;
+  calls.error = "event generate refused: the request does not carry coordinator 'robot''s token";
+  auto text = fake_console(calls, true);
+  ConsoleReply r = text->execute("event generate EVT_A ARM.s_A");
+  EXPECT_FALSE(r.ok);
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_EQ(r.err, "event generate: " + calls.error + " (usage: event generate EVENT TARGET)\n");
+  EXPECT_EQ(calls.frames.back(), "end failed");
+
+  auto json = fake_console(calls, true, true);
+  r = json->execute("event generate EVT_A ARM.s_A");
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.err, "{\"ok\":false,\"command\":\"event generate\",\"error\":\"event generate refused: the request does "
+                   "not carry coordinator 'robot''s token\",\"usage\":\"event generate EVENT TARGET\"}\n");
+}
+
+TEST(ConsoleShell, HelpAndQuitAreAnsweredWithoutTheBackend) {
+  Calls calls;
+  auto console = fake_console(calls, false);
+  const ConsoleReply help = console->execute("help");
+  EXPECT_TRUE(help.ok);
+  EXPECT_NE(help.out.find("watch [SECONDS]"), std::string::npos);
+  EXPECT_NE(help.out.find("Read-only: write commands need --allow-write."), std::string::npos);
+  EXPECT_EQ(console->execute("help explain").out,
+            "usage: explain ADDRESS\n  every active condition at ADDRESS with its root cause and the path it took\n");
+  EXPECT_FALSE(console->execute("help nothing").ok);
+  EXPECT_TRUE(console->execute("exit").quit);
+  EXPECT_TRUE(console->execute("quit").quit);
+  EXPECT_TRUE(calls.commands.empty());
+  EXPECT_EQ(console->banner(), "fake");
+}
+
+TEST(ConsoleShell, CompletionOffersCommandWordsThenTheBackendsNamesForEachArgument) {
+  Calls calls;
+  auto console = fake_console(calls, true);
+  EXPECT_EQ(console->complete("", "st"), (std::vector<std::string>{"state"}));
+  EXPECT_EQ(console->complete("event ", "g"), (std::vector<std::string>{"generate"}));
+  EXPECT_EQ(console->complete("event generate ", "EVT"), (std::vector<std::string>{"EVT_A", "EVT_B"}));
+  EXPECT_EQ(console->complete("event generate EVT_A ", ""), (std::vector<std::string>{"ARM.s_A", "ARM.s_F"}));
+  EXPECT_TRUE(console->complete("event generate EVT_A ARM.s_A ", "").empty()) << "no third argument";
+  EXPECT_EQ(console->complete("state list ", "A"), (std::vector<std::string>{"ARM"}));
+  EXPECT_EQ(console->complete("help ", "ser"), (std::vector<std::string>{"service"}));
+  EXPECT_TRUE(console->completes_file("filter dinload ARM.x "));
+  EXPECT_FALSE(console->completes_file("filter dinload "));
+  EXPECT_TRUE(calls.commands.empty()) << "completion runs no command";
+}
+
+TEST(ConsoleShell, ExplanationsPrintTheSameLineAndLeaveOutCountsTheyDoNotHave) {
+  Explanation e;
+  e.machine = "CONTROL.s_R.ForceData";
+  e.event = "EVT_SERVICE_FAILURE";
+  e.level = State::Error;
+  e.severity = 200;
+  e.mirror = true;
+  e.root_event = "EVT_FORCE_ERROR";
+  e.root_origin = "JR3.s_A";
+  e.path = {"JR3.s_A", "JR3.s_S.ForceData", "CONTROL.s_R.ForceData"};
+  Out text;
+  console::print_explanations({e}, "CONTROL", "Error", false, false, text);
+  EXPECT_EQ(text.reply.out, to_string(e) + "\n");
+  Out remote;
+  console::print_explanations({e}, "CONTROL", "", true, false, remote);
+  EXPECT_EQ(remote.reply.out.find("\"count\""), std::string::npos) << remote.reply.out;
+  EXPECT_NE(remote.reply.out.find("\"root_origin\":\"JR3.s_A\""), std::string::npos) << remote.reply.out;
+  Out local;
+  console::print_explanations({e}, "CONTROL", "Error", true, true, local);
+  EXPECT_NE(local.reply.out.find("\"count\":0"), std::string::npos) << local.reply.out;
+  Out none;
+  console::print_explanations({}, "JR3", "Normal", false, false, none);
+  console::print_explanations({}, "JR3", "", false, false, none);
+  EXPECT_EQ(none.reply.out, "JR3 is Normal: no active condition\nJR3: no active condition\n");
+}
+
+TEST(ConsoleShell, ASampleFileIsReadLineByLineAndItsErrorsNameTheLine) {
+  auto good = console::parse_sample_file("f.txt", "# force\n1, 2 3\n\n4 # trailing\n");
+  ASSERT_TRUE(good) << good.error().message;
+  EXPECT_EQ(*good, (std::vector<std::vector<double>>{{1, 2, 3}, {4}}));
+  auto bad = console::parse_sample_file("f.txt", "1\n2 x\n");
+  ASSERT_FALSE(bad);
+  EXPECT_EQ(bad.error().message, "f.txt:2: 'x' is not a number");
+  auto empty = console::parse_sample_file("f.txt", "# nothing\n");
+  ASSERT_FALSE(empty);
+  EXPECT_EQ(empty.error().message, "f.txt: no samples");
+}
+
+}  // namespace
+}  // namespace safecass::tools

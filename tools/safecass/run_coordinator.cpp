@@ -1,0 +1,307 @@
+// `safecass run SYSTEM --coordinator NAME [--scenario S] [--ice HOST:PORT] [--duration SECONDS]`:
+// one coordinator of a system in real time, as one process of a multi-process system.
+//
+// The coordinator runs only its own components (spec::instantiate with only_coordinator); the
+// providers of other coordinators its components require are remote provided interfaces fed by
+// the middleware. A scenario is applied in real time: only the steps that name this coordinator's
+// signals, filters and machines (the others belong to another process); an expectation is met
+// when it holds at its time or within the next 200 ms (propagation across processes is
+// asynchronous).
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+#include <unistd.h>
+
+#include "middleware_commands.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/middleware/node.hpp"
+#include "safecass/middleware/token.hpp"
+#include "safecass/native/runtime.hpp"
+#include "safecass/spec/load.hpp"
+#include "safecass/spec/scenario.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop.store(true); }
+
+std::mutex g_print;
+void say(const std::string& line) {
+  std::lock_guard lock(g_print);
+  std::printf("%s\n", line.c_str());
+  std::fflush(stdout);
+}
+
+struct Driver {
+  Coordinator& co;
+  Monitor& monitor;
+  const spec::Scenario& scenario;
+  Time start;
+  int failures = 0;
+  int checks = 0;
+
+  bool local_machine(const std::string& address) const {
+    auto a = co.resolve(address);
+    if (!a) return false;
+    if (a->kind == Address::Kind::System) return true;
+    return !co.is_remote(a->component);
+  }
+
+  std::string check(const spec::ScenarioStep& s, const std::string& address, const std::string& expected) const {
+    const Address a = *co.resolve(address);
+    if (s.kind == spec::ScenarioStep::Kind::Expect) {
+      const auto want = parse_state(expected);
+      const State got = co.state_of(a);
+      if (want && got == *want) return {};
+      return address + " is " + std::string(to_string(got)) + ", expected " + expected;
+    }
+    if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
+      if (a.kind != Address::Kind::Component && a.kind != Address::Kind::Machine) return {};
+      const StateSnapshot snap = a.kind == Address::Kind::Component ? co.extended(a.component) : co.snapshot(a.machine);
+      const std::string got = snap.outstanding == kNoEvent ? "none" : co.event(snap.outstanding).name;
+      return got == expected ? std::string() : "outstanding event of " + address + " is " + got + ", expected " + expected;
+    }
+    const State level = co.state_of(a);
+    for (const Explanation& e : co.explain(a)) {
+      if (e.level == level && e.root_origin + ":" + e.root_event == expected) return {};
+    }
+    return "no condition of " + address + " at its level has root cause " + expected;
+  }
+
+  void run_step(const spec::ScenarioStep& s) {
+    const Time now = co.clock().now();
+    switch (s.kind) {
+      case spec::ScenarioStep::Kind::Sample:
+        for (const auto& [name, values] : s.samples) {
+          if (Signal* signal = monitor.signals().find(name)) signal->push(now, values.data());
+        }
+        break;
+      case spec::ScenarioStep::Kind::Ramp:
+        break;  // handled by the ramp thread
+      case spec::ScenarioStep::Kind::Generate:
+        if (local_machine(s.target)) {
+          if (auto r = co.generate(s.event, s.target); !r) say("scenario: generate: " + r.error().message);
+        }
+        break;
+      case spec::ScenarioStep::Kind::Inject:
+        if (!s.deep) {
+          if (monitor.find_filter(s.filter) != nullptr) (void)monitor.inject_shallow(s.filter, s.values);
+        } else {
+          std::string signal = s.signal;
+          if (!s.filter.empty() && monitor.find_filter(s.filter) != nullptr) signal = monitor.find_filter(s.filter)->inputs()[0]->name();
+          if (monitor.signals().find(signal) != nullptr) (void)monitor.inject_deep(signal, s.values, now);
+        }
+        break;
+      case spec::ScenarioStep::Kind::Reset:
+        if (local_machine(s.target)) (void)co.reset(s.target, "scenario", s.reason);
+        break;
+      default: {
+        for (const auto& [address, expected] : s.expectations) {
+          if (!local_machine(address)) continue;
+          std::string failure = check(s, address, expected);
+          for (int i = 0; !failure.empty() && i < 20; ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            failure = check(s, address, expected);
+          }
+          ++checks;
+          if (!failure.empty()) {
+            ++failures;
+            say("scenario: expectation failed at t=" + std::to_string(s.at) + ": " + failure);
+          }
+        }
+      }
+    }
+  }
+
+  /// Applies the steps at their times; ramps write a sample every scenario period.
+  void run(const std::atomic<bool>& stop) {
+    struct Ramp {
+      Signal* signal;
+      double from_t, until, from, to;
+    };
+    std::vector<Ramp> ramps;
+    const double period = scenario.period > 0 ? scenario.period : 0.001;
+    std::size_t next = 0;
+    for (std::int64_t tick = 0; !stop.load(); ++tick) {
+      const double t = static_cast<double>(tick) * period;
+      if (next >= scenario.steps.size() && ramps.empty()) return;
+      std::this_thread::sleep_until(std::chrono::steady_clock::time_point(
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(start + seconds_to_time(t))));
+      for (; next < scenario.steps.size() && scenario.steps[next].at <= t + 1e-9; ++next) {
+        const spec::ScenarioStep& s = scenario.steps[next];
+        if (s.kind == spec::ScenarioStep::Kind::Ramp) {
+          if (Signal* signal = monitor.signals().find(s.signal)) ramps.push_back(Ramp{signal, s.at, s.until, s.from, s.to});
+        }
+        run_step(s);
+      }
+      const Time now = co.clock().now();
+      for (const Ramp& r : ramps) {
+        const double f = r.until > r.from_t ? (t - r.from_t) / (r.until - r.from_t) : 1.0;
+        r.signal->push(now, r.from + (r.to - r.from) * std::min(1.0, std::max(0.0, f)));
+      }
+      std::erase_if(ramps, [&](const Ramp& r) { return t >= r.until; });
+    }
+  }
+};
+
+}  // namespace
+
+void add_middleware_options(CLI::App& run, RunArgs& args) {
+  run.add_option("--coordinator", args.coordinator,
+                 "run only this coordinator's components, in real time (a process of a multi-process system)");
+  run.add_option("--ice", args.ice, "with --coordinator: join the system through IceStorm at HOST:PORT");
+  run.add_option("--duration", args.duration, "with --coordinator: stop after SECONDS (default: the scenario's, else until SIGINT/SIGTERM)");
+  run.add_flag("--allow-write", args.allow_write,
+               "with --ice: serve write operations (inject, generate, broadcast, reset) to holders of the token");
+  run.add_option("--token-file", args.token_file, "with --allow-write: where to write the token (mode 0600)");
+}
+
+int run_coordinator(const RunArgs& args) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  std::optional<spec::Scenario> scenario;
+  if (!args.scenario.empty()) {
+    spec::ScenarioLoad loaded = spec::load_scenario(args.scenario);
+    for (const auto& d : loaded.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+    if (!loaded.scenario) return 2;
+    scenario = std::move(loaded.scenario);
+  }
+  std::string system_path = args.system;
+  if (system_path.empty() && scenario) system_path = scenario->system;
+  if (system_path.empty()) {
+    std::fprintf(stderr, "safecass run: --coordinator needs a SYSTEM file (or a scenario that names one)\n");
+    return 2;
+  }
+  spec::LoadResult load = spec::load_system(system_path, registry);
+  for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+  if (!load.ok()) return 2;
+  const spec::SystemSpec& system = *load.system;
+
+  middleware::HostClock clock;
+  Coordinator co(args.coordinator, &clock);
+  Monitor monitor(co, registry);
+  if (auto r = spec::instantiate(system, co, monitor, args.coordinator); !r) {
+    std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+    return 2;
+  }
+  if (auto r = middleware::connect_remote_providers(system, args.coordinator, co); !r) {
+    std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+    return 2;
+  }
+  co.subscribe([&co](const Record& r) {
+    if (r.kind != RecordKind::Transition && r.kind != RecordKind::ComponentTransition) return;
+    std::string line = "[" + std::string(co.name()) + "] " +
+                       (r.machine != kNoMachine ? co.address_of(r.machine) : std::string(co.component_name(r.component))) +
+                       " " + std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
+    if (r.event != kNoEvent) line += " " + co.event(r.event).name;
+    if (r.root.event != kNoEvent) {
+      // root_origin() takes the coordinator's lock, which this thread holds (it is recursive).
+      line += " (root " + co.root_origin(r.root) + ":" + co.event(r.root.event).name + ")";
+    }
+    say(line);
+  });
+
+  const double default_period = scenario ? scenario->period : 0.005;
+  native::Runtime runtime(monitor);
+  for (const spec::ComponentSpec& c : system.components) {
+    auto id = co.find_component(c.name);
+    if (!id || co.is_remote(*id)) continue;
+    if (auto r = runtime.add_task(*id, seconds_to_time(c.period.value_or(default_period))); !r) {
+      std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+      return 2;
+    }
+  }
+
+  std::string token;
+  std::string token_path;
+  std::unique_ptr<middleware::CoordinatorNode> node;
+  if (!args.ice.empty()) {
+    auto endpoint = middleware::parse_ice_endpoint(args.ice);
+    if (!endpoint) {
+      std::fprintf(stderr, "safecass run: %s\n", endpoint.error().message.c_str());
+      return 2;
+    }
+    if (args.allow_write) {
+      token_path = args.token_file.empty() ? middleware::default_token_path(args.coordinator) : args.token_file;
+      auto t = middleware::create_token_file(token_path);
+      if (!t) {
+        std::fprintf(stderr, "safecass run: %s\n", t.error().message.c_str());
+        return 2;
+      }
+      token = *t;
+    }
+    middleware::NodeOptions options;
+    options.ice = *endpoint;
+    options.allow_write = args.allow_write;
+    options.token = token;
+    options.log = [](const std::string& line) { say(line); };
+    auto created = middleware::CoordinatorNode::create(co, monitor, registry, system, args.coordinator, options);
+    if (!created) {
+      std::fprintf(stderr, "safecass run: %s\n", created.error().message.c_str());
+      return 2;
+    }
+    node = std::move(*created);
+    if (auto r = node->start(); !r) {
+      std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+      return 2;
+    }
+  } else if (args.allow_write) {
+    std::fprintf(stderr, "safecass run: --allow-write needs --ice (write operations come through the middleware)\n");
+    return 2;
+  }
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::size_t local = 0;
+  for (ComponentId c = 0; c < co.component_count(); ++c) local += co.is_remote(c) ? 0 : 1;
+  say("safecass run: coordinator '" + args.coordinator + "' of system '" + system.name + "', " + std::to_string(local) +
+      " components, pid " + std::to_string(::getpid()) +
+      (args.ice.empty() ? std::string(", no middleware") : ", IceStorm " + args.ice) +
+      (args.allow_write ? ", write access (token file " + token_path + ")" : ", read-only"));
+  if (node) say("safecass run: control " + node->control_proxy());
+
+  runtime.start();
+  const double duration = args.duration > 0 ? args.duration : (scenario ? scenario->duration : 0.0);
+  const Time start = clock.now();
+  int failures = 0;
+  int checks = 0;
+  std::thread driver;
+  std::unique_ptr<Driver> d;
+  if (scenario) {
+    d = std::make_unique<Driver>(Driver{co, monitor, *scenario, start});
+    driver = std::thread([&] { d->run(g_stop); });
+  }
+  while (!g_stop.load() && (duration <= 0 || clock.now() - start < seconds_to_time(duration))) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  g_stop.store(true);
+  if (driver.joinable()) driver.join();
+  if (d) {
+    failures = d->failures;
+    checks = d->checks;
+  }
+  runtime.stop();
+  if (node) {
+    const middleware::NodeStats s = node->stats();
+    node->stop();
+    say("safecass run: middleware: " + std::to_string(s.updates_published) + " updates published, " +
+        std::to_string(s.updates_applied) + " applied, " + std::to_string(s.updates_rejected) + " rejected, " +
+        std::to_string(s.updates_missed) + " missed, " + std::to_string(s.resyncs_requested) + " resyncs, " +
+        std::to_string(s.connects) + " connections, " + std::to_string(s.events_dropped) + " event records dropped");
+  }
+  if (!token_path.empty()) ::unlink(token_path.c_str());
+  say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
+      std::string(to_string(co.coordinator_state())) +
+      (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed" : ""));
+  return failures == 0 ? 0 : 1;
+}
+
+}  // namespace safecass::tools

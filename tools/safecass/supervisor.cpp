@@ -1,0 +1,99 @@
+// `safecass supervisor SYSTEM --ice HOST:PORT [--lost-after MS] [--duration SECONDS]`: the
+// system-wide view of a multi-process system (DESIGN §4). Prints every transition as it arrives,
+// marks a coordinator whose heartbeat stops as lost (EVT_COORDINATOR_LOST on its components and,
+// by propagation, on everything connected to them) and its recovery, and prints the view at exit.
+
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+#include <unistd.h>
+
+#include "middleware_commands.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/middleware/supervisor.hpp"
+#include "safecass/spec/load.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+std::atomic<bool> g_supervisor_stop{false};
+void on_supervisor_signal(int) { g_supervisor_stop.store(true); }
+
+struct SupervisorArgs {
+  std::string system;
+  std::string ice;
+  int lost_after_ms = 600;
+  double duration = 0.0;
+};
+
+int run_supervisor(const SupervisorArgs& args) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  spec::LoadResult load = spec::load_system(args.system, registry);
+  for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+  if (!load.ok()) return 2;
+  auto endpoint = middleware::parse_ice_endpoint(args.ice);
+  if (!endpoint) {
+    std::fprintf(stderr, "safecass supervisor: %s\n", endpoint.error().message.c_str());
+    return 2;
+  }
+  if (args.lost_after_ms <= 0) {
+    std::fprintf(stderr, "safecass supervisor: --lost-after must be positive\n");
+    return 2;
+  }
+  static std::mutex print_mutex;
+  middleware::SupervisorOptions options;
+  options.ice = *endpoint;
+  options.lost_after = std::chrono::milliseconds(args.lost_after_ms);
+  options.print = [](const std::string& line) {
+    std::lock_guard lock(print_mutex);
+    std::printf("%s\n", line.c_str());
+    std::fflush(stdout);
+  };
+  auto supervisor = middleware::Supervisor::create(*load.system, options);
+  if (!supervisor) {
+    std::fprintf(stderr, "safecass supervisor: %s\n", supervisor.error().message.c_str());
+    return 2;
+  }
+  if (auto r = (*supervisor)->start(); !r) {
+    std::fprintf(stderr, "safecass supervisor: %s\n", r.error().message.c_str());
+    return 2;
+  }
+  options.print("safecass supervisor: system '" + load.system->name + "', IceStorm " + args.ice + ", pid " +
+                std::to_string(::getpid()));
+  std::signal(SIGINT, on_supervisor_signal);
+  std::signal(SIGTERM, on_supervisor_signal);
+  const auto start = std::chrono::steady_clock::now();
+  while (!g_supervisor_stop.load() &&
+         (args.duration <= 0 || std::chrono::steady_clock::now() - start < std::chrono::duration<double>(args.duration))) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  (*supervisor)->stop();
+  options.print("safecass supervisor: system-wide view");
+  for (const middleware::ViewRow& row : (*supervisor)->view()) {
+    options.print("  [" + row.coordinator + "] " + row.address + " " + std::string(to_string(row.state)) +
+                  (row.cause.empty() ? "" : " (" + row.cause + ")"));
+  }
+  for (const std::string& lost : (*supervisor)->lost()) options.print("  coordinator '" + lost + "' lost");
+  return 0;
+}
+
+}  // namespace
+
+void add_supervisor_command(CLI::App& app, int& code) {
+  static SupervisorArgs args;
+  auto* cmd = app.add_subcommand("supervisor",
+                                 "Watch a multi-process system through IceStorm: transitions, lost coordinators, system view");
+  cmd->add_option("SYSTEM", args.system, "the system file its coordinators run")->required();
+  cmd->add_option("--ice", args.ice, "IceStorm at HOST:PORT")->required();
+  cmd->add_option("--lost-after", args.lost_after_ms, "milliseconds without a heartbeat before a coordinator is lost (default 600)");
+  cmd->add_option("--duration", args.duration, "stop after SECONDS (default: until SIGINT/SIGTERM)");
+  cmd->callback([&code] { code = run_supervisor(args); });
+}
+
+}  // namespace safecass::tools

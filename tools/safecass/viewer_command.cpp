@@ -1,0 +1,135 @@
+// `safecass viewer`: loads a system (and scenario), runs it in real time in this process and
+// serves the live view until Ctrl-C / SIGTERM.
+
+#include "viewer_command.hpp"
+
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "safecass/viewer/in_process_source.hpp"
+#include "safecass/viewer/server.hpp"
+
+extern char** environ;
+
+namespace safecass::tools {
+
+namespace {
+
+struct ViewerArgs {
+  std::string system;
+  std::string scenario;
+  int port = 8765;
+  std::string bind = "127.0.0.1";
+  double speed = 1.0;
+  bool allow_write = false;
+  bool open = false;
+};
+
+/// Starts the desktop's browser on `url` without waiting for it (and without a shell).
+void open_browser(const std::string& url) {
+  pid_t pid = 0;
+  const char* argv[] = {"xdg-open", url.c_str(), nullptr};
+  if (posix_spawnp(&pid, "xdg-open", nullptr, nullptr, const_cast<char* const*>(argv), environ) != 0) {
+    std::fprintf(stderr, "safecass viewer: cannot start xdg-open: open %s yourself\n", url.c_str());
+    return;
+  }
+  // xdg-open hands the URL to the browser and exits; reap it so it does not linger.
+  int status = 0;
+  waitpid(pid, &status, 0);
+}
+
+int run_viewer(const ViewerArgs& args) {
+  if (args.port < 0 || args.port > 65535) {
+    std::fprintf(stderr, "safecass viewer: --port must be 0 to 65535 (0: pick a free port)\n");
+    return 2;
+  }
+  viewer::InProcessOptions source_options;
+  source_options.system = args.system;
+  source_options.scenario = args.scenario;
+  source_options.speed = args.speed;
+  auto source = viewer::InProcessSource::open(source_options);
+  if (!source) {
+    std::fprintf(stderr, "%s\n", source.error().message.c_str());
+    return 2;
+  }
+
+  viewer::ProtocolOptions protocol;
+  protocol.allow_write = args.allow_write;
+  std::string token_file;
+  if (args.allow_write) {
+    auto token = viewer::make_token();
+    if (!token) {
+      std::fprintf(stderr, "safecass viewer: %s\n", token.error().message.c_str());
+      return 2;
+    }
+    auto file = viewer::write_token_file(*token);
+    if (!file) {
+      std::fprintf(stderr, "safecass viewer: %s\n", file.error().message.c_str());
+      return 2;
+    }
+    protocol.token = *token;
+    token_file = *file;
+  }
+
+  viewer::ServerOptions server_options;
+  server_options.bind = args.bind;
+  server_options.port = static_cast<std::uint16_t>(args.port);
+  server_options.handle_signals = true;
+  auto server = viewer::Server::open(**source, protocol, server_options);
+  if (!server) {
+    std::fprintf(stderr, "safecass viewer: %s\n", server.error().message.c_str());
+    viewer::remove_token_file(token_file);
+    return 2;
+  }
+  const std::string url = (*server)->url();
+  const viewer::SystemView v = (*source)->view();
+  std::printf("safecass viewer: %s (%s)\n", v.system.c_str(), v.description.c_str());
+  std::printf("  open %s\n", url.c_str());
+  if (args.allow_write) {
+    std::printf("  write access: the token is in %s (mode 0600); or open %s#token=%s\n", token_file.c_str(),
+                url.c_str(), protocol.token.c_str());
+  } else {
+    std::printf("  read-only (start with --allow-write to generate, inject and reset)\n");
+  }
+  const std::string& bind = args.bind;
+  if (bind != "127.0.0.1" && bind != "::1" && bind.rfind("127.", 0) != 0) {
+    std::printf("  warning: listening on %s: everyone who can reach this address sees the system\n", bind.c_str());
+  }
+  std::printf("  Ctrl-C stops it.\n");
+  std::fflush(stdout);
+  if (args.open) open_browser(args.allow_write ? url + "#token=" + protocol.token : url);
+
+  (*server)->run();
+  viewer::remove_token_file(token_file);
+  std::printf("safecass viewer: stopped\n");
+  return 0;
+}
+
+}  // namespace
+
+void add_viewer_command(CLI::App& app, int& code) {
+  auto args = std::make_shared<ViewerArgs>();
+  auto* cmd = app.add_subcommand("viewer", "Serve a live web view of a system: states, causes and the last transitions");
+  cmd->footer(
+      "The system runs in this process in real time (its simulated clock follows the wall clock times --speed), "
+      "driven by the scenario if one is given; when the scenario ends the system stays up. The page shows every "
+      "coordinator, component and state machine coloured Normal/Warning/Error; click a state for its cause. "
+      "Read-only unless --allow-write: then every write request must carry the token written to a private file "
+      "whose path is printed at start.");
+  cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
+  cmd->add_option("--scenario,-s", args->scenario, "scenario file: timed samples, events, injections and resets");
+  cmd->add_option("--port,-p", args->port, "TCP port (0: pick a free one)")->capture_default_str();
+  cmd->add_option("--bind", args->bind, "address to listen on")->capture_default_str();
+  cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")->capture_default_str();
+  cmd->add_flag("--allow-write", args->allow_write, "accept generate, inject and reset requests that carry the token");
+  cmd->add_flag("--open", args->open, "open the page in the desktop's browser (xdg-open)");
+  cmd->callback([args, &code] { code = run_viewer(*args); });
+}
+
+}  // namespace safecass::tools

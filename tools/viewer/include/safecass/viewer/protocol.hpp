@@ -1,0 +1,84 @@
+#pragma once
+/// @file protocol.hpp
+/// The viewer's WebSocket protocol, independent of any network code so that it can be tested on
+/// its own. Every message is one JSON object (text frame).
+///
+/// Server → page:
+///   {"type":"hello","write":bool,"max_message":N,"view":VIEW,"recent":[RECORD...]}   on connect
+///   {"type":"update","t":T,"running":B,"states":{ADDRESS:[STATE,OUTSTANDING]...},"records":[RECORD...]}
+///   {"type":"time","t":T,"running":B}                                   clock only, ≤ 4 per second
+///   {"type":"reply","id":ID,"op":OP,...}  /  {"type":"error","id":ID,"error":TEXT}
+/// Page → server ("id", a number or string, is optional and echoed in the reply):
+///   {"op":"view"}                       → reply with "view"
+///   {"op":"explain","address":A}        → reply with "address","state","conditions":[...]
+///   {"op":"generate","event":E,"target":MACHINE,"token":K}
+///   {"op":"broadcast","event":E,"token":K}
+///   {"op":"inject","filter":F,"samples":[[...]...],"token":K}        shallow injection
+///   {"op":"inject","signal":S,"samples":[[...]...],"token":K}        deep injection
+///   {"op":"reset","target":A,"reason":TEXT,"token":K}
+/// VIEW = {"system","description","t","running","state","coordinators":[{"name","address","state",
+/// "components":[{"name","address","state","outstanding","machines":[{"address","kind","name",
+/// "state","outstanding"}]}]}]}. STATES holds only the addresses whose state or outstanding event
+/// changed since the previous update; coordinator addresses are "coordinator:NAME".
+/// RECORD is record_to_json()'s format.
+///
+/// A malformed message (not JSON, not an object, unknown op or key, wrong type, too long) gets an
+/// error reply saying what is wrong and changes nothing. Write operations are refused unless the
+/// protocol was created with write access, and then unless the message carries the token.
+
+#include <cstddef>
+#include <deque>
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+
+#include "safecass/viewer/source.hpp"
+
+namespace safecass::viewer {
+
+struct ProtocolOptions {
+  bool allow_write = false;
+  std::string token;                  ///< required in every write request when allow_write
+  std::size_t max_message = 64 * 1024;///< longer messages are refused
+  std::size_t recent = 100;           ///< records kept for the "recent" list of new pages
+};
+
+/// The records shown in the page's side list (transitions, resets, injections); events without
+/// a transition are left out.
+bool listed_record(std::string_view record_json);
+
+class Protocol {
+public:
+  /// `source` must outlive the protocol. A write-enabled protocol needs a non-empty token.
+  Protocol(ViewSource& source, ProtocolOptions options);
+
+  /// The first message to a new page.
+  std::string hello() const;
+  /// Handles one message from a page and returns the reply (never throws; a bad message gets an
+  /// "error" reply and changes nothing).
+  std::string handle(std::string_view message);
+  /// Polls the source and returns the message to push to every page: an "update" when states
+  /// changed or records arrived, else a "time" message when the last message is 250 ms old, else
+  /// "" (nothing to say). `now_ms` is a monotonic wall-clock time in milliseconds.
+  std::string update(long long now_ms);
+
+  /// The VIEW object of the current picture.
+  std::string view_json() const;
+
+  bool write_enabled() const noexcept { return options_.allow_write; }
+
+private:
+  std::string refuse_write(std::string_view id, std::string_view op, std::string_view token) const;
+
+  ViewSource& source_;
+  ProtocolOptions options_;
+  std::map<std::string, std::pair<State, std::string>> sent_;  ///< last state pushed per address
+  std::deque<std::string> recent_;
+  long long last_time_ms_ = -1000000;
+};
+
+/// Compares two secrets in time independent of where they differ.
+bool same_secret(std::string_view a, std::string_view b) noexcept;
+
+}  // namespace safecass::viewer

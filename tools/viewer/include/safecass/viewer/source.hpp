@@ -1,0 +1,96 @@
+#pragma once
+/// @file source.hpp
+/// Where the viewer's data comes from. The server only talks to a ViewSource: an in-process
+/// system driven by a scenario (InProcessSource) today, a live system reached through the
+/// middleware later. A source gives a picture of the Generic Component Model (coordinators →
+/// components → machines, with their states), the records of the observer stream since the last
+/// call, the cause of any state (explain), and the write operations of DESIGN §6.
+///
+/// Threading: the server calls every member from one thread (its event loop), so a source needs
+/// no locking of its own against the server. A source fed by other threads (middleware callbacks)
+/// buffers what they deliver and hands it over in poll().
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/core/expected.hpp"
+#include "safecass/core/state.hpp"
+
+namespace safecass::viewer {
+
+/// What a machine (or derived state) of a component is, as the page groups them.
+enum class NodeKind : std::uint8_t { Framework, Application, Provided, Required, Service };
+
+/// "framework", "application", "provided", "required", "service".
+std::string_view to_string(NodeKind kind) noexcept;
+
+/// One state machine (s_F, s_A, s_P.p, s_R.r) or service state (s_S.p) of a component.
+struct MachineView {
+  std::string address;      ///< "CONTROL.s_R.ForceData"
+  NodeKind kind = NodeKind::Framework;
+  std::string name;         ///< "s_F", "s_A" or the interface name
+  State state = State::Normal;
+  std::string outstanding;  ///< the outstanding event; empty when Normal or derived
+};
+
+struct ComponentView {
+  std::string name;
+  State state = State::Normal;  ///< extended component state ŝ_ext
+  std::string outstanding;
+  std::vector<MachineView> machines;  ///< s_F, s_A, then s_P.*, s_R.*, s_S.* in declaration order
+};
+
+struct CoordinatorView {
+  std::string name;
+  State state = State::Normal;  ///< product over its components
+  std::vector<ComponentView> components;
+};
+
+/// The whole picture at one moment.
+struct SystemView {
+  std::string system;       ///< system name
+  std::string description;  ///< where it comes from ("in-process, scenario story.json, speed 1")
+  double t = 0.0;           ///< the system's clock, seconds
+  bool running = true;      ///< a scenario still has steps to apply (false without one)
+  State state = State::Normal;
+  std::vector<CoordinatorView> coordinators;
+};
+
+/// A fault-injection request: shallow into one filter's private input, or deep into a signal's
+/// history (seen by every consumer).
+struct InjectRequest {
+  bool deep = false;
+  std::string target;  ///< filter name (shallow) or signal "Component.signal" (deep)
+  std::vector<std::vector<double>> samples;
+};
+
+class ViewSource {
+public:
+  virtual ~ViewSource() = default;
+
+  /// Lets the source catch up (advance its clock, collect what arrived). Called about every
+  /// 10 ms. Must not block for long: it runs on the server's event loop.
+  virtual void poll() = 0;
+  /// The current picture.
+  virtual SystemView view() const = 0;
+  /// The system's clock in seconds, and whether its scenario is still running: cheap, unlike view().
+  virtual double now() const = 0;
+  virtual bool running() const = 0;
+  /// The observer-stream records since the last call, oldest first, each one JSON object in the
+  /// format of record_to_json() (the history-file format).
+  virtual std::vector<std::string> take_records() = 0;
+  /// Every active condition at `address` (SYSTEM, a coordinator name, C, C.s_F, …) with its
+  /// root cause and hop path. Errors: NotFound / Parse for an unknown or malformed address.
+  virtual Expected<std::vector<Explanation>> explain(std::string_view address) const = 0;
+
+  // Write operations. The server checks write access and the token before calling them; each
+  // returns one line saying what was done, or an error that says what is wrong and changes nothing.
+  virtual Expected<std::string> generate(std::string_view event, std::string_view target) = 0;
+  virtual Expected<std::string> broadcast(std::string_view event) = 0;
+  virtual Expected<std::string> inject(const InjectRequest& request) = 0;
+  virtual Expected<std::string> reset(std::string_view target, std::string_view reason) = 0;
+};
+
+}  // namespace safecass::viewer

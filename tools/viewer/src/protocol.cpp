@@ -1,0 +1,375 @@
+#include "safecass/viewer/protocol.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <utility>
+
+#include "safecass/spec/json.hpp"
+
+namespace safecass::viewer {
+
+namespace {
+
+constexpr std::size_t kMaxString = 256;       ///< longest name, address or reason accepted
+constexpr std::size_t kMaxSamples = 1000;     ///< samples in one injection
+constexpr std::size_t kMaxSampleSize = 64;    ///< doubles in one sample
+constexpr long long kTimeIntervalMs = 250;    ///< clock-only messages at most this often
+
+std::string quote(std::string_view s) { return spec::json_quote(s); }
+
+std::string number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+std::string seconds(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6f", v);
+  return buf;
+}
+
+std::string state_text(State s) { return quote(to_string(s)); }
+
+/// A JSON object written member by member.
+class Object {
+public:
+  Object& str(std::string_view key, std::string_view value) { return raw(key, quote(value)); }
+  Object& num(std::string_view key, double value) { return raw(key, number(value)); }
+  Object& integer(std::string_view key, long long value) { return raw(key, std::to_string(value)); }
+  Object& boolean(std::string_view key, bool value) { return raw(key, value ? "true" : "false"); }
+  Object& raw(std::string_view key, std::string_view json) {
+    text_ += text_.size() == 1 ? "" : ",";
+    text_ += quote(key);
+    text_ += ':';
+    text_ += json;
+    return *this;
+  }
+  std::string done() { return text_ + "}"; }
+
+private:
+  std::string text_ = "{";
+};
+
+template <class Range, class F>
+std::string array(const Range& items, F&& each) {
+  std::string out = "[";
+  for (const auto& item : items) {
+    if (out.size() > 1) out += ',';
+    out += each(item);
+  }
+  return out + "]";
+}
+
+using StateMap = std::map<std::string, std::pair<State, std::string>>;
+
+StateMap states_of(const SystemView& v) {
+  StateMap m;
+  m["SYSTEM"] = {v.state, {}};
+  for (const CoordinatorView& co : v.coordinators) {
+    m["coordinator:" + co.name] = {co.state, {}};
+    for (const ComponentView& c : co.components) {
+      m[c.name] = {c.state, c.outstanding};
+      for (const MachineView& mv : c.machines) m[mv.address] = {mv.state, mv.outstanding};
+    }
+  }
+  return m;
+}
+
+std::string view_to_json(const SystemView& v) {
+  const std::string coordinators = array(v.coordinators, [](const CoordinatorView& co) {
+    const std::string components = array(co.components, [](const ComponentView& c) {
+      const std::string machines = array(c.machines, [](const MachineView& m) {
+        return Object().str("address", m.address).str("kind", to_string(m.kind)).str("name", m.name)
+            .raw("state", state_text(m.state)).str("outstanding", m.outstanding).done();
+      });
+      return Object().str("name", c.name).str("address", c.name).raw("state", state_text(c.state))
+          .str("outstanding", c.outstanding).raw("machines", machines).done();
+    });
+    return Object().str("name", co.name).str("address", "coordinator:" + co.name).raw("state", state_text(co.state))
+        .raw("components", components).done();
+  });
+  return Object().str("system", v.system).str("description", v.description).raw("t", seconds(v.t))
+      .boolean("running", v.running).raw("state", state_text(v.state)).raw("coordinators", coordinators).done();
+}
+
+std::string explanation_to_json(const Explanation& e) {
+  Object o;
+  o.str("machine", e.machine).str("event", e.event).raw("level", state_text(e.level)).integer("severity", e.severity)
+      .boolean("mirror", e.mirror).boolean("outstanding", e.outstanding).integer("count", e.count)
+      .raw("first", seconds(to_seconds(e.first))).raw("last", seconds(to_seconds(e.last)))
+      .str("root_event", e.root_event).str("root_origin", e.root_origin).raw("root_t", seconds(to_seconds(e.root_time)));
+  if (!e.hazard.empty()) o.str("hazard", e.hazard);
+  if (!e.filter.empty()) o.str("filter", e.filter);
+  if (!e.signal.empty()) o.str("signal", e.signal).num("value", e.value).raw("sample_t", seconds(to_seconds(e.sample_time)));
+  if (e.injected) o.boolean("injected", true);
+  o.raw("path", array(e.path, [](const std::string& hop) { return quote(hop); }));
+  return o.done();
+}
+
+/// A request being checked: the parsed object, its echoed id and op, and the first error found.
+struct Request {
+  const spec::JsonValue* object = nullptr;
+  std::string id;  ///< the id as JSON, or empty
+  std::string op;
+};
+
+std::string error_reply(const std::string& id, std::string_view op, std::string_view message) {
+  Object o;
+  o.str("type", "error");
+  if (!id.empty()) o.raw("id", id);
+  if (!op.empty()) o.str("op", op);
+  return o.str("error", message).done();
+}
+
+Object reply(const Request& r) {
+  Object o;
+  o.str("type", "reply");
+  if (!r.id.empty()) o.raw("id", r.id);
+  o.str("op", r.op);
+  return o;
+}
+
+/// Checks that every key of the request is one of `allowed` (and appears once).
+std::string check_keys(const spec::JsonValue& object, std::initializer_list<std::string_view> allowed) {
+  std::set<std::string_view> seen;
+  for (const spec::JsonMember& m : object.object) {
+    bool ok = false;
+    for (const std::string_view a : allowed) ok = ok || m.key == a;
+    if (!ok) {
+      std::string list;
+      for (const std::string_view a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
+      return "unknown key '" + m.key + "' (this op takes " + list + ")";
+    }
+    if (!seen.insert(m.key).second) return "key '" + m.key + "' given twice";
+  }
+  return {};
+}
+
+/// A required (or optional, when `required` is false) non-empty string member.
+std::string get_string(const spec::JsonValue& object, std::string_view key, std::string& out, bool required = true) {
+  const spec::JsonValue* v = object.find(key);
+  if (v == nullptr) return required ? "missing key '" + std::string(key) + "'" : std::string();
+  if (!v->is_string()) return "'" + std::string(key) + "' must be a string, not " + std::string(spec::type_name(v->type));
+  if (v->string.empty()) return "'" + std::string(key) + "' must not be empty";
+  if (v->string.size() > kMaxString) return "'" + std::string(key) + "' is longer than " + std::to_string(kMaxString) + " characters";
+  out = v->string;
+  return {};
+}
+
+std::string get_samples(const spec::JsonValue& object, std::vector<std::vector<double>>& out) {
+  const spec::JsonValue* v = object.find("samples");
+  if (v == nullptr) return "missing key 'samples' (an array of samples, each a number or an array of numbers)";
+  if (!v->is_array() || v->array.empty()) return "'samples' must be a non-empty array of samples";
+  if (v->array.size() > kMaxSamples) return "'samples' holds more than " + std::to_string(kMaxSamples) + " samples";
+  for (std::size_t i = 0; i < v->array.size(); ++i) {
+    const spec::JsonValue& s = v->array[i];
+    const std::string where = "samples[" + std::to_string(i) + "]";
+    std::vector<double> sample;
+    if (s.is_number()) {
+      sample.push_back(s.number);
+    } else if (s.is_array() && !s.array.empty() && s.array.size() <= kMaxSampleSize) {
+      for (const spec::JsonValue& x : s.array) {
+        if (!x.is_number()) return where + " must hold numbers only";
+        sample.push_back(x.number);
+      }
+    } else {
+      return where + " must be a number or an array of 1 to " + std::to_string(kMaxSampleSize) + " numbers";
+    }
+    for (const double x : sample) {
+      if (!std::isfinite(x)) return where + " holds a number out of range";
+    }
+    out.push_back(std::move(sample));
+  }
+  return {};
+}
+
+}  // namespace
+
+bool same_secret(std::string_view a, std::string_view b) noexcept {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  const std::size_t n = a.size() < b.size() ? a.size() : b.size();
+  for (std::size_t i = 0; i < n; ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
+  return diff == 0;
+}
+
+bool listed_record(std::string_view record_json) {
+  const spec::JsonParse p = spec::parse_json(record_json, 8);
+  if (!p.value || !p.value->is_object()) return false;
+  const spec::JsonValue* kind = p.value->find("kind");
+  if (kind == nullptr || !kind->is_string()) return false;
+  if (kind->string == "event") {
+    const spec::JsonValue* outcome = p.value->find("outcome");
+    return outcome != nullptr && outcome->is_string() && (outcome->string == "masked" || outcome->string == "ignored");
+  }
+  return true;  // transitions, component transitions, resets, injections, overflow
+}
+
+Protocol::Protocol(ViewSource& source, ProtocolOptions options) : source_(source), options_(std::move(options)) {
+  sent_ = states_of(source_.view());
+}
+
+std::string Protocol::view_json() const { return view_to_json(source_.view()); }
+
+std::string Protocol::hello() const {
+  return Object().str("type", "hello").boolean("write", options_.allow_write)
+      .integer("max_message", static_cast<long long>(options_.max_message)).raw("view", view_json())
+      .raw("recent", array(recent_, [](const std::string& r) { return r; })).done();
+}
+
+std::string Protocol::update(long long now_ms) {
+  source_.poll();
+  std::vector<std::string> records = source_.take_records();
+  std::string listed = "[";
+  for (std::string& r : records) {
+    if (!listed_record(r)) continue;
+    if (listed.size() > 1) listed += ',';
+    listed += r;
+    recent_.push_back(std::move(r));
+    if (recent_.size() > options_.recent) recent_.pop_front();
+  }
+  listed += ']';
+  std::string changed = "{";
+  if (!records.empty()) {  // every change of state comes with a record
+    StateMap now = states_of(source_.view());
+    for (const auto& [address, state] : now) {
+      const auto it = sent_.find(address);
+      if (it != sent_.end() && it->second == state) continue;
+      if (changed.size() > 1) changed += ',';
+      changed += quote(address) + ":[" + state_text(state.first) + "," + quote(state.second) + "]";
+    }
+    sent_ = std::move(now);
+  }
+  changed += '}';
+  if (changed.size() > 2 || listed.size() > 2) {
+    last_time_ms_ = now_ms;
+    return Object().str("type", "update").raw("t", seconds(source_.now())).boolean("running", source_.running()).raw("states", changed)
+        .raw("records", listed).done();
+  }
+  if (now_ms - last_time_ms_ >= kTimeIntervalMs) {
+    last_time_ms_ = now_ms;
+    return Object().str("type", "time").raw("t", seconds(source_.now())).boolean("running", source_.running()).done();
+  }
+  return {};
+}
+
+std::string Protocol::refuse_write(std::string_view id, std::string_view op, std::string_view token) const {
+  if (!options_.allow_write) {
+    return error_reply(std::string(id), op, "refused: this viewer is read-only (start it with --allow-write to " + std::string(op) + ")");
+  }
+  if (token.empty()) return error_reply(std::string(id), op, "refused: a write needs the token (key 'token'), printed when the viewer started");
+  if (!same_secret(token, options_.token)) return error_reply(std::string(id), op, "refused: wrong token");
+  return {};
+}
+
+std::string Protocol::handle(std::string_view message) {
+  if (message.size() > options_.max_message) {
+    return error_reply({}, {}, "message too long (" + std::to_string(message.size()) + " bytes; at most " +
+                                   std::to_string(options_.max_message) + ")");
+  }
+  const spec::JsonParse parsed = spec::parse_json(message, 8);
+  if (!parsed.value) {
+    const spec::JsonError& e = *parsed.error;
+    return error_reply({}, {}, "not JSON: " + std::to_string(e.position.line) + ":" + std::to_string(e.position.column) +
+                                   ": " + e.message);
+  }
+  const spec::JsonValue& object = *parsed.value;
+  if (!object.is_object()) return error_reply({}, {}, "a message must be a JSON object, not " + std::string(spec::type_name(object.type)));
+  Request r;
+  r.object = &object;
+  if (const spec::JsonValue* id = object.find("id")) {
+    if (id->is_number() && std::isfinite(id->number)) {
+      r.id = number(id->number);
+    } else if (id->is_string() && id->string.size() <= 64) {
+      r.id = quote(id->string);
+    } else {
+      return error_reply({}, {}, "'id' must be a number or a string of at most 64 characters");
+    }
+  }
+  const spec::JsonValue* op = object.find("op");
+  if (op == nullptr) return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset)");
+  if (!op->is_string()) return error_reply(r.id, {}, "'op' must be a string");
+  r.op = op->string;
+  std::string problem;
+  std::string token;
+  auto token_of = [&]() -> std::string {
+    const spec::JsonValue* t = object.find("token");
+    if (t == nullptr) return {};
+    if (!t->is_string()) {
+      problem = "'token' must be a string";
+      return {};
+    }
+    return t->string;
+  };
+
+  if (r.op == "view") {
+    if (problem = check_keys(object, {"id", "op"}); !problem.empty()) return error_reply(r.id, r.op, problem);
+    return reply(r).raw("view", view_json()).done();
+  }
+  if (r.op == "explain") {
+    std::string address;
+    if (problem = check_keys(object, {"id", "op", "address"}); !problem.empty()) return error_reply(r.id, r.op, problem);
+    if (problem = get_string(object, "address", address); !problem.empty()) return error_reply(r.id, r.op, problem);
+    auto conditions = source_.explain(address);
+    if (!conditions) return error_reply(r.id, r.op, conditions.error().message);
+    const StateMap states = states_of(source_.view());
+    const auto it = states.find(address);
+    Object o = reply(r);
+    o.str("address", address);
+    if (it != states.end()) o.raw("state", state_text(it->second.first)).str("outstanding", it->second.second);
+    return o.raw("conditions", array(*conditions, explanation_to_json)).done();
+  }
+  if (r.op == "generate" || r.op == "broadcast") {
+    std::string event;
+    std::string target;
+    const bool broadcast = r.op == "broadcast";
+    problem = broadcast ? check_keys(object, {"id", "op", "event", "token"})
+                        : check_keys(object, {"id", "op", "event", "target", "token"});
+    if (problem.empty()) problem = get_string(object, "event", event);
+    if (problem.empty() && !broadcast) problem = get_string(object, "target", target);
+    if (problem.empty()) token = token_of();
+    if (!problem.empty()) return error_reply(r.id, r.op, problem);
+    if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
+    auto done = broadcast ? source_.broadcast(event) : source_.generate(event, target);
+    if (!done) return error_reply(r.id, r.op, done.error().message);
+    return reply(r).str("text", *done).done();
+  }
+  if (r.op == "inject") {
+    InjectRequest request;
+    problem = check_keys(object, {"id", "op", "filter", "signal", "samples", "token"});
+    const bool has_filter = object.find("filter") != nullptr;
+    const bool has_signal = object.find("signal") != nullptr;
+    if (problem.empty() && has_filter == has_signal) {
+      problem = "give either 'filter' (shallow injection into one filter) or 'signal' (deep injection into a signal's history)";
+    }
+    if (problem.empty()) {
+      request.deep = has_signal;
+      problem = get_string(object, has_signal ? "signal" : "filter", request.target);
+    }
+    if (problem.empty()) problem = get_samples(object, request.samples);
+    if (problem.empty()) token = token_of();
+    if (!problem.empty()) return error_reply(r.id, r.op, problem);
+    if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
+    auto done = source_.inject(request);
+    if (!done) return error_reply(r.id, r.op, done.error().message);
+    return reply(r).str("text", *done).done();
+  }
+  if (r.op == "reset") {
+    std::string target;
+    std::string reason = "reset from the viewer";
+    problem = check_keys(object, {"id", "op", "target", "reason", "token"});
+    if (problem.empty()) problem = get_string(object, "target", target);
+    if (problem.empty()) problem = get_string(object, "reason", reason, false);
+    if (problem.empty()) token = token_of();
+    if (!problem.empty()) return error_reply(r.id, r.op, problem);
+    if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
+    auto done = source_.reset(target, reason);
+    if (!done) return error_reply(r.id, r.op, done.error().message);
+    return reply(r).str("text", *done).done();
+  }
+  return error_reply(r.id, r.op, "unknown op '" + r.op + "' (view, explain, generate, broadcast, inject, reset)");
+}
+
+}  // namespace safecass::viewer
