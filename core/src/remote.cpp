@@ -174,32 +174,56 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
 namespace safecass {
 
 std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::uint32_t service) const {
-  Address a;
-  a.kind = Address::Kind::Service;
-  a.component = component;
-  a.service = service;
-  const std::vector<Explanation> why = explain(a);
+  // The same roots, levels and shortest paths as explain() of the service address gives, built
+  // straight from the conditions: no Explanation (machine, event and hazard texts) per condition.
+  std::lock_guard lock(mutex_);
   std::vector<RemoteRoot> out;
-  for (const Explanation& e : why) {
-    auto it = std::find_if(out.begin(), out.end(), [&](const RemoteRoot& r) {
-      return r.event == e.root_event && r.origin == e.root_origin && r.time == e.root_time;
+  if (component >= components_.size() || service >= components_[component]->provided.size()) return out;
+  const ComponentData& c = *components_[component];
+  std::vector<EventId> ids;  // out[i]'s root event, compared by id rather than by name
+  std::vector<const Condition*> sorted;
+  auto visit = [&](MachineId id) {
+    const MachineData& m = *machines_[id];
+    if (m.conditions.empty()) return;
+    sorted.clear();
+    for (const Condition& k : m.conditions) sorted.push_back(&k);
+    // explain()'s order within a machine: the first condition seen gives a root its level.
+    std::sort(sorted.begin(), sorted.end(), [](const Condition* a, const Condition* b) {
+      if (a->level != b->level) return a->level > b->level;
+      if (a->severity != b->severity) return a->severity > b->severity;
+      return a->seq > b->seq;
     });
-    if (it != out.end()) {
-      if (e.path.size() < it->path.size()) it->path = e.path;
-      continue;
+    for (const Condition* k : sorted) {
+      const bool remote = k->root.remote != kNone && k->root.remote < remote_roots_.size();
+      const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin]->address;
+      std::size_t i = 0;
+      while (i < out.size() && !(ids[i] == k->root.event && out[i].time == k->root.time && out[i].origin == origin)) ++i;
+      if (i < out.size()) {
+        std::vector<std::string> path = hop_path(id, *k);
+        if (path.size() < out[i].path.size()) out[i].path = std::move(path);
+        continue;
+      }
+      RemoteRoot r;
+      r.event = events_[k->root.event].name;
+      r.origin = origin;
+      r.time = k->root.time;
+      r.level = k->level;
+      if (k->root.sample.filter != kNoName) r.filter = std::string(name_of(k->root.sample.filter));
+      if (k->root.sample.signal != kNoName) r.signal = std::string(name_of(k->root.sample.signal));
+      r.value = k->root.sample.value;
+      r.sample_time = k->root.sample.sample_time;
+      r.injected = k->root.sample.injected;
+      r.path = hop_path(id, *k);
+      out.push_back(std::move(r));
+      ids.push_back(k->root.event);
     }
-    RemoteRoot r;
-    r.event = e.root_event;
-    r.origin = e.root_origin;
-    r.time = e.root_time;
-    r.level = e.level;
-    r.filter = e.filter;
-    r.signal = e.signal;
-    r.value = e.value;
-    r.sample_time = e.sample_time;
-    r.injected = e.injected;
-    r.path = e.path;
-    out.push_back(std::move(r));
+  };
+  for (MachineId m : {c.framework, c.application}) {
+    if (depends_on(component, service, *machines_[m])) visit(m);
+  }
+  visit(c.provided[service]);
+  for (MachineId m : c.required) {
+    if (depends_on(component, service, *machines_[m])) visit(m);
   }
   return out;
 }

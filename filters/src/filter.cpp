@@ -38,15 +38,24 @@ std::uint64_t Filter::missed_samples() const noexcept {
 
 [[gnu::always_inline]] inline void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
   current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
-  bool finite = true;
-  for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
-  if (!finite) {
-    invalid_sample(input, sample.time, true);
-    return;
-  }
-  if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
   double* held = &held_[held_offset_[input]];
-  for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
+  if (sample.size == 1) {  // scalars: no loops
+    if (!std::isfinite(sample.data[0])) {
+      invalid_sample(input, sample.time, true);
+      return;
+    }
+    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+    held[0] = sample.data[0];
+  } else {
+    bool finite = true;
+    for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
+    if (!finite) {
+      invalid_sample(input, sample.time, true);
+      return;
+    }
+    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+    for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
+  }
   has_held_[input] = 1;
   on_sample(input, sample);
 }
@@ -63,9 +72,7 @@ void Filter::run(Time now) noexcept {
   const bool injected_run = injection_pending_.load(std::memory_order_acquire) && run_injection(now);
   if (inputs_.size() == 1) {
     // The hot path: one input, its new samples in order.
-    SignalCursor& cursor = cursors_[0];
-    SampleView sample;
-    while (!injected_run && cursor.next(sample)) deliver(0, sample);
+    if (!injected_run) cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
   } else if (!inputs_.empty()) {
     run_merged(injected_run);
   }

@@ -12,6 +12,7 @@ std::size_t round_up_pow2(std::size_t n) {
 
 HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity)
     : width_(width),
+      stride_(width + kHeader),
       mask_(round_up_pow2(capacity < 2 ? 2 : capacity) - 1),
       words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * (width + kHeader))) {}
 

@@ -1,7 +1,7 @@
 // Cross-process propagation through a real IceStorm (DESIGN §7: p99 ≤ 1 ms, ≥ 50k updates/s on
 // loopback).
 //
-//   bench_middleware --ice HOST:PORT --out FILE [--samples N] [--seconds S]
+//   bench_middleware --ice HOST:PORT --out FILE [--samples N] [--seconds S] [--interfaces K]
 //
 // Two processes: this one forks a provider ("sensor": JR3 provides ForceData) and runs the client
 // ("robot": CONTROL requires JR3.ForceData through a remote provided interface). Both use the
@@ -9,8 +9,14 @@
 // moment the client's CONTROL.s_R.ForceData changes state are on one time line.
 //   1. latency: N onsets, each followed by its completion, 1 ms apart; latency = onset →
 //      CONTROL.s_R.ForceData entering Error in the other process (its transition callback).
-//   2. throughput: the provider toggles the fault as fast as it can for S seconds; the client
-//      counts the full-state updates it applies per second.
+//   2. throughput: JR3 also provides K interfaces D0..D{K-1} (CONTROL requires each); for S
+//      seconds the provider changes the root set of each s_P.Di in turn, as fast as it can (one
+//      generate() = one state change of one interface; a pause of 50 µs after each round over
+//      the K interfaces). The client counts the interface updates it applied (each one a full
+//      state that differed from the previous one sent); state changes the publisher coalesced
+//      (a newer full state of the same interface superseded them before they were sent) are
+//      reported as "superseded", and at the end the client must hold exactly the provider's
+//      final state (every Di Normal).
 // Writes {"p50_us", "p99_us", "max_us", "samples", "updates_per_s", ...} to FILE.
 
 #include <signal.h>
@@ -21,6 +27,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <mutex>
@@ -38,17 +45,28 @@ using namespace std::chrono_literals;
 
 namespace {
 
-constexpr const char* kSystem = R"({
+/// JR3 provides ForceData (latency) and D0..D{k-1} (throughput); CONTROL requires all of them.
+std::string system_text(int k) {
+  std::string provided = "\"ForceData\"", required = "\"ForceData\"";
+  std::string connections = R"({ "required": "CONTROL.ForceData", "provided": "JR3.ForceData" })";
+  for (int i = 0; i < k; ++i) {
+    const std::string d = "D" + std::to_string(i);
+    provided += ", \"" + d + "\"";
+    required += ", \"" + d + "\"";
+    connections += R"(, { "required": "CONTROL.)" + d + R"(", "provided": "JR3.)" + d + "\" }";
+  }
+  return R"({
   "safecass": 1, "system": "bench",
   "components": [
-    { "component": "JR3", "interfaces": { "provided": ["ForceData"], "required": [] },
+    { "component": "JR3", "interfaces": { "provided": [)" + provided + R"(], "required": [] },
       "event": [ { "name": "EVT_FORCE_ERROR", "severity": 50, "state_transition": ["N2E", "W2E"] },
                  { "name": "/EVT_FORCE_ERROR", "severity": 50, "state_transition": ["E2N", "E2W"] },
                  { "name": "EVT_JR3_FAULT", "severity": 60, "state_transition": ["N2E", "W2E"] },
                  { "name": "/EVT_JR3_FAULT", "severity": 60, "state_transition": ["E2N", "E2W"] } ] },
-    { "component": "CONTROL", "interfaces": { "provided": [], "required": ["ForceData"] } } ],
-  "connections": [ { "required": "CONTROL.ForceData", "provided": "JR3.ForceData" } ],
+    { "component": "CONTROL", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
+  "connections": [ )" + connections + R"( ],
   "coordinators": { "sensor": ["JR3"], "robot": ["CONTROL"] } })";
+}
 
 struct Process {
   FilterRegistry registry;
@@ -58,9 +76,9 @@ struct Process {
   std::unique_ptr<Monitor> monitor;
   std::unique_ptr<middleware::CoordinatorNode> node;
 
-  bool build(const std::string& name, const middleware::IceEndpoint& ice) {
+  bool build(const std::string& name, const middleware::IceEndpoint& ice, int interfaces) {
     register_builtin_filters(registry);
-    auto load = spec::load_system_from_text(kSystem, "bench.json", registry);
+    auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
     if (!load.ok()) return false;
     system = *load.system;
     co = std::make_unique<Coordinator>(name, &clock);
@@ -86,16 +104,29 @@ char read_byte(int fd) {
   char c = 0;
   return ::read(fd, &c, 1) == 1 ? c : '\0';
 }
+void write_counts(int fd, const std::uint64_t (&v)[3]) { (void)!::write(fd, v, sizeof v); }
+bool read_counts(int fd, std::uint64_t (&v)[3]) {
+  std::size_t got = 0;
+  auto* p = reinterpret_cast<char*>(v);
+  while (got < sizeof v) {
+    const ssize_t n = ::read(fd, p + got, sizeof v - got);
+    if (n <= 0) return false;
+    got += static_cast<std::size_t>(n);
+  }
+  return true;
+}
 
-/// The provider: waits for 'L' (latency phase) and 'T' (throughput phase), answers 'd' when done.
-int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, double seconds) {
+/// The provider: waits for 'L' (latency phase) and 'T' (throughput phase), answers 'd' when done;
+/// after 'T' it also sends {state changes made, updates published, Ice messages for them}.
+int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, double seconds, int interfaces) {
   Process p;
-  if (!p.build("sensor", ice) || !p.wait_connected()) return 2;
+  if (!p.build("sensor", ice, interfaces) || !p.wait_connected()) return 2;
   const EventId onset = *p.co->find_event("EVT_FORCE_ERROR");
   const EventId completion = *p.co->find_event("/EVT_FORCE_ERROR");
   const MachineId target = *p.co->find_machine("JR3.s_A");
   write_byte(out, 'r');
   for (char c = read_byte(in); c == 'L' || c == 'T'; c = read_byte(in)) {
+    std::uint64_t counts[3] = {0, 0, 0};
     if (c == 'L') {
       for (int i = 0; i < samples; ++i) {
         p.co->generate(onset, target);
@@ -104,21 +135,36 @@ int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, d
         std::this_thread::sleep_for(1ms);
       }
     } else {
-      // The root set is never empty and differs after every step ({A}, {A,B}, {B}, {B,A'}, ...),
-      // so every snapshot the publisher takes is a new full state worth sending.
+      // Each Di's root set is never empty and differs after every step ({A}, {A,B}, {B}, {B,A'},
+      // {A'}, ...): every generate() below is one state change of one interface.
       const EventId other = *p.co->find_event("EVT_JR3_FAULT");
       const EventId other_done = *p.co->find_event("/EVT_JR3_FAULT");
+      const EventId steps[4] = {other, completion, onset, other_done};
+      std::vector<MachineId> targets;
+      for (int i = 0; i < interfaces; ++i) targets.push_back(*p.co->find_machine("JR3.s_P.D" + std::to_string(i)));
+      for (MachineId t : targets) p.co->generate(onset, t);
+      std::this_thread::sleep_for(100ms);
+      const auto before = p.node->stats();
       const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-      p.co->generate(onset, target);
-      while (std::chrono::steady_clock::now() < until) {
-        p.co->generate(other, target);
-        p.co->generate(completion, target);
-        std::this_thread::sleep_for(2us);
-        p.co->generate(onset, target);
-        p.co->generate(other_done, target);
-        std::this_thread::sleep_for(2us);
+      std::uint64_t changes = 0;
+      for (std::size_t step = 0; std::chrono::steady_clock::now() < until; step = (step + 1) % 4) {
+        for (MachineId t : targets) p.co->generate(steps[step], t);
+        changes += targets.size();
+        std::this_thread::sleep_for(50us);
       }
-      p.co->generate(completion, target);
+      std::this_thread::sleep_for(200ms);  // let the last updates out
+      const auto after = p.node->stats();
+      counts[0] = changes;
+      counts[1] = after.updates_published - before.updates_published;
+      counts[2] = after.state_messages_published - before.state_messages_published;
+      write_byte(out, 'd');
+      write_counts(out, counts);
+      // Then back to Normal everywhere (the client checks that this final state arrives).
+      for (MachineId t : targets) {
+        p.co->generate(completion, t);
+        p.co->generate(other_done, t);
+      }
+      continue;
     }
     std::this_thread::sleep_for(200ms);  // let the last updates out
     write_byte(out, 'd');
@@ -140,12 +186,14 @@ int main(int argc, char** argv) {
   std::string ice_text, out_path = "bench-middleware.json";
   int samples = 2000;
   double seconds = 2.0;
+  int interfaces = 16;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice") ice_text = argv[i + 1];
     else if (key == "--out") out_path = argv[i + 1];
     else if (key == "--samples") samples = std::max(10, std::atoi(argv[i + 1]));
     else if (key == "--seconds") seconds = std::max(0.2, std::atof(argv[i + 1]));
+    else if (key == "--interfaces") interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
     else {
       std::fprintf(stderr, "bench_middleware: unknown option %s\n", key.c_str());
       return 2;
@@ -162,7 +210,7 @@ int main(int argc, char** argv) {
   if (child == 0) {
     ::close(to_child[1]);
     ::close(to_parent[0]);
-    std::_Exit(provider(*ice, to_child[0], to_parent[1], samples, seconds));
+    std::_Exit(provider(*ice, to_child[0], to_parent[1], samples, seconds, interfaces));
   }
   ::close(to_child[0]);
   ::close(to_parent[1]);
@@ -178,7 +226,7 @@ int main(int argc, char** argv) {
   } reap{child, to_child[1]};
 
   Process client;
-  if (!client.build("robot", *ice) || !client.wait_connected()) {
+  if (!client.build("robot", *ice, interfaces) || !client.wait_connected()) {
     std::fprintf(stderr, "bench_middleware: the client cannot join IceStorm at %s\n", ice_text.c_str());
     return 1;
   }
@@ -205,13 +253,22 @@ int main(int argc, char** argv) {
   if (read_byte(to_parent[0]) != 'd') return 1;
   measuring.store(false);
 
-  const auto applied_before = client.node->stats().updates_applied;
-  const auto start = std::chrono::steady_clock::now();
+  const auto before = client.node->stats();
   write_byte(to_child[1], 'T');
-  if (read_byte(to_parent[0]) != 'd') return 1;
-  const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() - 0.2;
+  std::uint64_t counts[3] = {0, 0, 0};
+  if (read_byte(to_parent[0]) != 'd' || !read_counts(to_parent[0], counts)) return 1;
+  // Applied while the provider was changing its roots (its last updates had 200 ms to arrive).
   const auto stats = client.node->stats();
-  const double updates_per_s = static_cast<double>(stats.updates_applied - applied_before) / elapsed;
+  const std::uint64_t applied = stats.updates_applied - before.updates_applied;
+  const double updates_per_s = static_cast<double>(applied) / seconds;
+  const std::uint64_t changes = counts[0], published = counts[1], messages = counts[2];
+  // The final state arrived: every Di back to Normal at the client.
+  bool final_ok = true;
+  for (int i = 0; i < interfaces; ++i) {
+    const MachineId m = *client.co->find_machine("CONTROL.s_R.D" + std::to_string(i));
+    for (int wait = 0; wait < 200 && client.co->state(m) != State::Normal; ++wait) std::this_thread::sleep_for(5ms);
+    final_ok = final_ok && client.co->state(m) == State::Normal;
+  }
 
   std::vector<double> copy;
   {
@@ -220,15 +277,22 @@ int main(int argc, char** argv) {
   }
   const double p50 = percentile(copy, 0.50), p99 = percentile(copy, 0.99);
   const double max = copy.empty() ? 0.0 : *std::max_element(copy.begin(), copy.end());
-  char json[512];
+  char json[1024];
   std::snprintf(json, sizeof json,
                 "{\n  \"p50_us\": %.1f,\n  \"p99_us\": %.1f,\n  \"max_us\": %.1f,\n  \"samples\": %zu,\n"
-                "  \"onsets_sent\": %d,\n  \"updates_per_s\": %.0f,\n  \"updates_missed\": %llu,\n"
+                "  \"onsets_sent\": %d,\n  \"updates_per_s\": %.0f,\n  \"interfaces\": %d,\n  \"seconds\": %.2f,\n"
+                "  \"state_changes\": %llu,\n  \"updates_published\": %llu,\n  \"updates_applied\": %llu,\n"
+                "  \"superseded\": %llu,\n  \"state_messages\": %llu,\n  \"updates_missed\": %llu,\n"
+                "  \"final_state_ok\": %s,\n"
                 "  \"transport\": \"IceStorm (icebox) on loopback, two processes\"\n}\n",
-                p50, p99, max, copy.size(), samples, updates_per_s,
-                static_cast<unsigned long long>(stats.updates_missed));
+                p50, p99, max, copy.size(), samples, updates_per_s, interfaces, seconds,
+                static_cast<unsigned long long>(changes), static_cast<unsigned long long>(published),
+                static_cast<unsigned long long>(applied),
+                static_cast<unsigned long long>(changes > published ? changes - published : 0),
+                static_cast<unsigned long long>(messages), static_cast<unsigned long long>(stats.updates_missed),
+                final_ok ? "true" : "false");
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   client.node->stop();
-  return copy.size() >= static_cast<std::size_t>(samples) * 9 / 10 ? 0 : 1;
+  return copy.size() >= static_cast<std::size_t>(samples) * 9 / 10 && final_ok ? 0 : 1;
 }

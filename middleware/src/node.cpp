@@ -142,6 +142,10 @@ struct CoordinatorNode::Impl {
   std::deque<Record> records;
   bool any_dirty = true;
   static constexpr std::size_t kQueueCapacity = 65536;
+  /// Updates (or records) per Ice message: one message carries every interface that changed.
+  static constexpr std::size_t kMaxBatch = 256;
+  /// How long event records may wait behind state updates.
+  static constexpr std::chrono::milliseconds kEventDelay{5};
 
   std::shared_ptr<Ice::Communicator> ic;
   std::shared_ptr<Ice::ObjectAdapter> adapter;
@@ -162,7 +166,8 @@ struct CoordinatorNode::Impl {
   Coordinator::SubscriptionId subscription = 0;
 
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
-      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0};
+      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, state_messages_published{0},
+      event_messages_published{0};
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
       : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)) {}
@@ -237,11 +242,16 @@ struct CoordinatorNode::Impl {
     return m;
   }
 
-  void publish_stream(Stream& s, bool force, const std::shared_ptr<wire::StateTopicPrx>& pub) {
+  /// Appends to `out` the full state of `s` when it differs from the last one sent (or `force`).
+  /// Nothing about the stream changes until the batch is sent (commit()).
+  void snapshot_stream(Stream& s, bool force, wire::StateUpdateSeq& out, std::vector<Stream*>& of) {
     wire::RootSeq roots;
-    for (const RemoteRoot& r : co.service_roots(s.component, s.provided)) {
-      roots.push_back(wire::Root{r.event, r.origin, r.time.count(), to_wire(r.level), r.filter, r.signal, r.value,
-                                 r.sample_time.count(), r.injected, r.path});
+    std::vector<RemoteRoot> now = co.service_roots(s.component, s.provided);
+    roots.reserve(now.size());
+    for (RemoteRoot& r : now) {
+      roots.push_back(wire::Root{std::move(r.event), std::move(r.origin), r.time.count(), to_wire(r.level),
+                                 std::move(r.filter), std::move(r.signal), r.value, r.sample_time.count(), r.injected,
+                                 std::move(r.path)});
     }
     if (!force && same_roots(roots, s.last)) return;
     wire::StateUpdate u;
@@ -250,27 +260,91 @@ struct CoordinatorNode::Impl {
     u.seq = s.seq.load() + 1;
     u.iface = s.iface;
     u.state = to_wire(co.service_state(s.component, s.provided));
-    u.roots = roots;
-    u.sent = steady_ns();
-    pub->update(u);
-    s.seq.store(u.seq);
-    s.last = std::move(roots);
-    updates_published.fetch_add(1, std::memory_order_relaxed);
+    u.roots = std::move(roots);
+    out.push_back(std::move(u));
+    of.push_back(&s);
+  }
+
+  /// Publishes the state updates of one cycle, kMaxBatch per message, stamped with the send time.
+  /// A stream's sequence number and last state advance only once its message is sent.
+  void send_states(wire::StateUpdateSeq& updates, const std::vector<Stream*>& of,
+                   const std::shared_ptr<wire::StateTopicPrx>& pub) {
+    for (std::size_t first = 0; first < updates.size(); first += kMaxBatch) {
+      const std::size_t last = std::min(updates.size(), first + kMaxBatch);
+      wire::StateUpdateSeq part(std::make_move_iterator(updates.begin() + static_cast<std::ptrdiff_t>(first)),
+                                std::make_move_iterator(updates.begin() + static_cast<std::ptrdiff_t>(last)));
+      const std::int64_t sent = steady_ns();
+      for (wire::StateUpdate& u : part) u.sent = sent;
+      pub->updates(part);
+      state_messages_published.fetch_add(1, std::memory_order_relaxed);
+      for (std::size_t i = 0; i < part.size(); ++i) {
+        Stream& s = *of[first + i];
+        s.seq.store(part[i].seq);
+        s.last = std::move(part[i].roots);
+        updates_published.fetch_add(1, std::memory_order_relaxed);
+      }
+    }
+  }
+
+  /// Publishes the queued event records, kMaxBatch per message; those sent leave `pending`.
+  void send_events(std::vector<Record>& pending, const std::shared_ptr<wire::EventTopicPrx>& pub) {
+    std::size_t sent = 0;
+    try {
+      while (sent < pending.size()) {
+        const std::size_t n = std::min(pending.size() - sent, kMaxBatch);
+        wire::EventMessageSeq part;
+        part.reserve(n);
+        const std::int64_t seq_before = event_seq.load();
+        for (std::size_t i = 0; i < n; ++i) part.push_back(to_message(pending[sent + i]));
+        try {
+          pub->records(part);
+        } catch (...) {
+          event_seq.store(seq_before);  // not sent: the same numbers go out after the reconnection
+          throw;
+        }
+        event_messages_published.fetch_add(1, std::memory_order_relaxed);
+        events_published.fetch_add(n, std::memory_order_relaxed);
+        sent += n;
+      }
+    } catch (...) {
+      pending.erase(pending.begin(), pending.begin() + static_cast<std::ptrdiff_t>(sent));
+      throw;
+    }
+    pending.clear();
   }
 
   void publisher_loop() {
+    // Event records wait here between cycles; state updates always go first (other processes'
+    // safety depends on them) and the records follow when no state is waiting, or at the latest
+    // kEventDelay after the oldest was queued.
+    std::vector<Record> events;
+    std::int64_t oldest_event = 0;
+    std::vector<std::pair<std::size_t, bool>> todo;
+    wire::StateUpdateSeq updates;
+    std::vector<Stream*> updated;
     while (running.load()) {
-      std::deque<Record> batch;
-      std::vector<std::pair<std::size_t, bool>> todo;
+      todo.clear();
+      bool state_waiting = false;
       {
         std::unique_lock lock(queue_mutex);
         if (!connected.load()) {
           queue_cv.wait_for(lock, std::chrono::milliseconds(20));
           continue;  // records and dirty marks wait (bounded) for the reconnection
         }
-        queue_cv.wait_for(lock, std::chrono::milliseconds(50),
+        const bool idle = events.empty();
+        queue_cv.wait_for(lock, idle ? std::chrono::milliseconds(50) : kEventDelay,
                           [&] { return !running.load() || !records.empty() || any_dirty; });
-        batch.swap(records);
+        if (!records.empty()) {
+          if (events.empty()) oldest_event = steady_ns();
+          for (const Record& r : records) {
+            if (events.size() < kQueueCapacity) {
+              events.push_back(r);
+            } else {
+              events_dropped.fetch_add(1, std::memory_order_relaxed);
+            }
+          }
+          records.clear();
+        }
         if (any_dirty) {
           for (std::size_t i = 0; i < streams.size(); ++i) {
             if (!streams[i]->dirty) continue;
@@ -288,23 +362,38 @@ struct CoordinatorNode::Impl {
         spub = state_pub;
         epub = event_pub;
       }
-      if (spub == nullptr || epub == nullptr) continue;
-      std::size_t done = 0;
+      if (spub == nullptr || epub == nullptr) {
+        redo(todo);
+        continue;
+      }
+      updates.clear();
+      updated.clear();
       try {
-        // State first: it is what other processes' safety depends on.
-        for (; done < todo.size(); ++done) publish_stream(*streams[todo[done].first], todo[done].second, spub);
-        for (const Record& r : batch) {
-          epub->record(to_message(r));
-          events_published.fetch_add(1, std::memory_order_relaxed);
+        for (const auto& [i, force] : todo) snapshot_stream(*streams[i], force, updates, updated);
+        send_states(updates, updated, spub);
+        todo.clear();
+        {
+          std::lock_guard lock(queue_mutex);
+          state_waiting = any_dirty;
         }
+        const bool overdue = steady_ns() - oldest_event >= std::chrono::nanoseconds(kEventDelay).count();
+        if (!events.empty() && (!state_waiting || overdue || events.size() >= kMaxBatch)) send_events(events, epub);
       } catch (const Ice::Exception& e) {
         log("middleware: " + name + ": publishing failed (" + std::string(e.ice_id()) + "); will reconnect and resync");
         connected.store(false);
-        std::lock_guard lock(queue_mutex);
-        for (std::size_t i = done; i < todo.size(); ++i) streams[todo[i].first]->dirty = true;
-        any_dirty = true;
+        redo(todo);
       }
     }
+  }
+
+  /// Marks streams dirty again after a cycle that could not send them.
+  void redo(const std::vector<std::pair<std::size_t, bool>>& todo) {
+    std::lock_guard lock(queue_mutex);
+    for (const auto& [i, force] : todo) {
+      streams[i]->dirty = true;
+      streams[i]->force = streams[i]->force || force;
+    }
+    any_dirty = any_dirty || !todo.empty();
   }
 
   // -- link thread --
@@ -392,11 +481,14 @@ struct CoordinatorNode::Impl {
     const auto it = held.find(u.iface);
     if (it == held.end()) return;  // every process sees every update; this one is not for us
     Held& h = it->second;
-    const std::string what = "middleware: " + name + ": state update " + u.iface + " seq " + std::to_string(u.seq) +
-                             " from coordinator '" + u.coordinator + "'";
+    // Built only when something is logged: the accepted path allocates no text.
+    const auto what = [&] {
+      return "middleware: " + name + ": state update " + u.iface + " seq " + std::to_string(u.seq) +
+             " from coordinator '" + u.coordinator + "'";
+    };
     if (u.coordinator != h.provider) {
       updates_rejected.fetch_add(1);
-      log(what + " rejected: " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
+      log(what() + " rejected: " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
       return;
     }
     if (u.incarnation != h.incarnation) {
@@ -405,12 +497,12 @@ struct CoordinatorNode::Impl {
     }
     if (u.seq <= h.last_seq) {
       updates_rejected.fetch_add(1);
-      log(what + " ignored: stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
+      log(what() + " ignored: stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
       return;
     }
     if (h.last_seq != 0 && u.seq != h.last_seq + 1) {
       updates_missed.fetch_add(static_cast<std::uint64_t>(u.seq - h.last_seq - 1));
-      log(what + ": " + std::to_string(u.seq - h.last_seq - 1) + " update(s) missed; this full state supersedes them");
+      log(what() + ": " + std::to_string(u.seq - h.last_seq - 1) + " update(s) missed; this full state supersedes them");
     }
     h.last_seq = u.seq;
     h.behind = false;
@@ -423,7 +515,7 @@ struct CoordinatorNode::Impl {
       r.time = Time{w.time};
       if (!from_wire(w.level, r.level)) {
         updates_rejected.fetch_add(1);
-        log(what + " rejected: root '" + w.event + "' has an invalid level");
+        log(what() + " rejected: root '" + w.event + "' has an invalid level");
         return;
       }
       r.filter = w.filter;
@@ -437,7 +529,7 @@ struct CoordinatorNode::Impl {
     auto applied = co.apply_remote(h.proxy, roots);
     if (!applied) {
       updates_rejected.fetch_add(1);
-      log(what + " rejected, nothing changed: " + applied.error().message);
+      log(what() + " rejected, nothing changed: " + applied.error().message);
       return;
     }
     updates_applied.fetch_add(1);
@@ -490,6 +582,9 @@ class StateServant final : public wire::StateTopic {
 public:
   explicit StateServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
   void update(wire::StateUpdate u, const Ice::Current&) override { impl_.on_update(u); }
+  void updates(wire::StateUpdateSeq batch, const Ice::Current&) override {
+    for (const wire::StateUpdate& u : batch) impl_.on_update(u);
+  }
 
 private:
   CoordinatorNode::Impl& impl_;
@@ -620,6 +715,8 @@ NodeStats CoordinatorNode::stats() const {
   s.events_dropped = d.events_dropped.load();
   s.resyncs_requested = d.resyncs_requested.load();
   s.connects = d.connects.load();
+  s.state_messages_published = d.state_messages_published.load();
+  s.event_messages_published = d.event_messages_published.load();
   s.connected = d.connected.load();
   return s;
 }

@@ -193,6 +193,9 @@ class EventServant final : public wire::EventTopic {
 public:
   explicit EventServant(Supervisor::Impl& d) : d_(d) {}
   void record(wire::EventMessage e, const Ice::Current&) override { d_.on_event(e); }
+  void records(wire::EventMessageSeq batch, const Ice::Current&) override {
+    for (const wire::EventMessage& e : batch) d_.on_event(e);
+  }
 
 private:
   Supervisor::Impl& d_;
@@ -201,6 +204,9 @@ class StateServant final : public wire::StateTopic {
 public:
   explicit StateServant(Supervisor::Impl& d) : d_(d) {}
   void update(wire::StateUpdate u, const Ice::Current&) override { d_.on_update(u); }
+  void updates(wire::StateUpdateSeq batch, const Ice::Current&) override {
+    for (const wire::StateUpdate& u : batch) d_.on_update(u);
+  }
 
 private:
   Supervisor::Impl& d_;

@@ -21,6 +21,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -30,6 +31,7 @@
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
+#include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/spec/load.hpp"
 
@@ -365,6 +367,110 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   ASSERT_TRUE(robot->generate("/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << "propagation works again\n"
                                                                                    << sys.logs();
+}
+
+
+/// One coordinator of a system on the fixture's IceStorm, in this process.
+struct Node {
+  FilterRegistry registry;
+  spec::SystemSpec system;
+  middleware::HostClock clock;
+  std::unique_ptr<Coordinator> co;
+  std::unique_ptr<Monitor> monitor;
+  std::unique_ptr<middleware::CoordinatorNode> node;
+
+  Node(const std::string& text, const std::string& name) {
+    register_builtin_filters(registry);
+    auto load = spec::load_system_from_text(text, "burst.json", registry);
+    EXPECT_TRUE(load.ok());
+    if (!load.ok()) return;
+    system = *load.system;
+    co = std::make_unique<Coordinator>(name, &clock);
+    monitor = std::make_unique<Monitor>(*co, registry);
+    EXPECT_TRUE(spec::instantiate(system, *co, *monitor, name));
+    EXPECT_TRUE(middleware::connect_remote_providers(system, name, *co));
+    middleware::NodeOptions options;
+    options.ice = *middleware::parse_ice_endpoint(ice_of_fixture());
+    options.log = [](const std::string&) {};
+    auto n = middleware::CoordinatorNode::create(*co, *monitor, registry, system, name, options);
+    EXPECT_TRUE(n);
+    if (!n) return;
+    node = std::move(*n);
+    EXPECT_TRUE(node->start());
+  }
+  ~Node() {
+    if (node) node->stop();
+  }
+};
+
+TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactState) {
+  // S (coordinator "burst-s") provides D0..D23; A (coordinator "burst-a") requires each of them.
+  constexpr int kInterfaces = 24;
+  std::string provided, required, connections;
+  for (int i = 0; i < kInterfaces; ++i) {
+    const std::string d = "D" + std::to_string(i);
+    provided += std::string(i ? ", " : "") + "\"" + d + "\"";
+    required += std::string(i ? ", " : "") + "\"" + d + "\"";
+    connections += std::string(i ? ", " : "") + R"({ "required": "A.)" + d + R"(", "provided": "S.)" + d + "\" }";
+  }
+  const std::string text = R"({ "safecass": 1, "system": "burst",
+    "components": [
+      { "component": "S", "interfaces": { "provided": [)" + provided + R"(], "required": [] },
+        "event": [ { "name": "EVT_E", "severity": 50, "state_transition": ["N2E", "W2E"] },
+                   { "name": "/EVT_E", "severity": 50, "state_transition": ["E2N", "E2W"] },
+                   { "name": "EVT_F", "severity": 60, "state_transition": ["N2E", "W2E"] },
+                   { "name": "/EVT_F", "severity": 60, "state_transition": ["E2N", "E2W"] } ] },
+      { "component": "A", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
+    "connections": [ )" + connections + R"( ],
+    "coordinators": { "burst-s": ["S"], "burst-a": ["A"] } })";
+  Node provider(text, "burst-s"), client(text, "burst-a");
+  ASSERT_TRUE(provider.node && client.node);
+  ASSERT_TRUE(eventually([&] { return provider.node->stats().connected && client.node->stats().connected; }, 10000ms));
+  std::this_thread::sleep_for(300ms);  // subscriptions settle, initial resync done
+
+  std::vector<MachineId> targets;
+  for (int i = 0; i < kInterfaces; ++i) targets.push_back(*provider.co->find_machine("S.s_P.D" + std::to_string(i)));
+  const std::vector<EventId> events{*provider.co->find_event("EVT_E"), *provider.co->find_event("/EVT_E"),
+                                    *provider.co->find_event("EVT_F"), *provider.co->find_event("/EVT_F")};
+  const auto before = provider.node->stats();
+  const auto applied_before = client.node->stats().updates_applied;
+  std::mt19937 random(7);
+  for (int round = 0; round < 400; ++round) {
+    for (int k = 0; k < kInterfaces; ++k) provider.co->generate(events[random() % 4], targets[random() % targets.size()]);
+    if (round % 20 == 0) std::this_thread::sleep_for(1ms);
+  }
+  // Every interface ends in the provider's exact final state: the same roots (origin, event, onset
+  // time) at the client's stand-in S.s_P.Di as at the provider's service S.s_S.Di.
+  const ComponentId s = *provider.co->find_component("S");
+  auto same_everywhere = [&] {
+    for (int i = 0; i < kInterfaces; ++i) {
+      std::string want, got;
+      for (const RemoteRoot& r : provider.co->service_roots(s, static_cast<std::uint32_t>(i))) {
+        want += r.origin + ":" + r.event + "@" + std::to_string(r.time.count()) + " ";
+      }
+      auto why = client.co->explain("S.s_P.D" + std::to_string(i));
+      if (!why) return false;
+      for (const Explanation& e : *why) got += e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()) + " ";
+      if (want != got) return false;
+      if (client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i))) !=
+          provider.co->service_state(s, static_cast<std::uint32_t>(i))) {
+        return false;
+      }
+    }
+    return true;
+  };
+  EXPECT_TRUE(eventually(same_everywhere, 10000ms));
+  const auto after = provider.node->stats();
+  const std::uint64_t updates = after.updates_published - before.updates_published;
+  const std::uint64_t messages = after.state_messages_published - before.state_messages_published;
+  EXPECT_GT(updates, static_cast<std::uint64_t>(kInterfaces));
+  EXPECT_LT(messages, updates) << "several interfaces' updates share one message";
+  EXPECT_TRUE(eventually([&] {
+    return client.node->stats().updates_applied - applied_before == updates;
+  })) << "every update sent was applied, in order";
+  const auto received = client.node->stats();
+  EXPECT_EQ(received.updates_rejected, 0u);
+  EXPECT_EQ(received.updates_missed, 0u) << "batched updates keep consecutive sequence numbers";
 }
 
 }  // namespace

@@ -6,7 +6,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
+#include <random>
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
@@ -131,6 +133,128 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   auto node = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
   ASSERT_TRUE(node);
   EXPECT_FALSE((*node)->stats().connected);
+}
+
+
+// ---- the publisher's snapshot: service_roots() built from the conditions ----------------------
+
+/// The full state of a service as the publisher used to build it: from explain() of the service
+/// address, one root per (event, origin, time), the level of its first explanation and the
+/// shortest path.
+std::vector<RemoteRoot> roots_from_explain(const Coordinator& co, ComponentId component, std::uint32_t service) {
+  Address a;
+  a.kind = Address::Kind::Service;
+  a.component = component;
+  a.service = service;
+  std::vector<RemoteRoot> out;
+  for (const Explanation& e : co.explain(a)) {
+    auto it = std::find_if(out.begin(), out.end(), [&](const RemoteRoot& r) {
+      return r.event == e.root_event && r.origin == e.root_origin && r.time == e.root_time;
+    });
+    if (it != out.end()) {
+      if (e.path.size() < it->path.size()) it->path = e.path;
+      continue;
+    }
+    out.push_back(RemoteRoot{e.root_event, e.root_origin, e.root_time, e.level, e.filter, e.signal, e.value,
+                             e.sample_time, e.injected, e.path});
+  }
+  return out;
+}
+
+std::string text_of(const std::vector<RemoteRoot>& roots) {
+  std::string out;
+  for (const RemoteRoot& r : roots) {
+    out += r.origin + ":" + r.event + "@" + std::to_string(r.time.count()) + " " + std::string(to_string(r.level)) +
+           " filter=" + r.filter + " signal=" + r.signal + "=" + std::to_string(r.value) + "@" +
+           std::to_string(r.sample_time.count()) + (r.injected ? " injected" : "") + " path";
+    for (const std::string& hop : r.path) out += " " + hop;
+    out += "\n";
+  }
+  return out;
+}
+
+// S runs in "left"; A and B in "right", which holds S.out as a remote provided interface.
+constexpr const char* kChain = R"({
+  "safecass": 1, "system": "chain",
+  "components": [
+    { "component": "S", "interfaces": { "provided": ["out"], "required": [] },
+      "event": [ { "name": "EVT_E", "severity": 50, "state_transition": ["N2E", "W2E"] },
+                 { "name": "/EVT_E", "severity": 50, "state_transition": ["E2N", "E2W"] },
+                 { "name": "EVT_F", "severity": 70, "state_transition": ["N2E", "W2E"] },
+                 { "name": "/EVT_F", "severity": 70, "state_transition": ["E2N", "E2W"] },
+                 { "name": "EVT_W", "severity": 30, "state_transition": ["N2W"] },
+                 { "name": "/EVT_W", "severity": 30, "state_transition": ["W2N"] } ],
+      "service": [ { "name": "out", "dependency": { "s_F": true, "s_A": true }, "propagate": "warning" } ] },
+    { "component": "A", "interfaces": { "provided": ["p", "q"], "required": ["in"] },
+      "service": [ { "name": "p", "dependency": { "s_F": true, "s_A": true, "s_R": ["in"] }, "propagate": "warning" },
+                   { "name": "q", "dependency": { "s_A": true } } ] },
+    { "component": "B", "interfaces": { "provided": ["r"], "required": ["a"] },
+      "service": [ { "name": "r", "dependency": { "s_A": true, "s_R": ["a"] } } ] } ],
+  "connections": [ { "required": "A.in", "provided": "S.out" }, { "required": "B.a", "provided": "A.p" } ],
+  "coordinators": { "left": ["S"], "right": ["A", "B"] } })";
+
+TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  auto load = spec::load_system_from_text(kChain, "chain.json", registry);
+  ASSERT_TRUE(load.ok());
+  SimulatedClock clock;
+  Coordinator co("right", &clock);
+  Monitor monitor(co, registry);
+  ASSERT_TRUE(spec::instantiate(*load.system, co, monitor, "right"));
+  ASSERT_TRUE(connect_remote_providers(*load.system, "right", co));
+  const MachineId remote = *co.find_machine("S.s_P.out");
+  const std::vector<std::string> onsets{"EVT_E", "EVT_F", "EVT_W"};
+  const std::vector<std::string> events{"EVT_E", "/EVT_E", "EVT_F", "/EVT_F", "EVT_W", "/EVT_W"};
+  std::vector<MachineId> local;
+  for (const char* m : {"A.s_F", "A.s_A", "A.s_P.p", "A.s_P.q", "A.s_R.in", "B.s_A", "B.s_P.r", "B.s_R.a"}) {
+    local.push_back(*co.find_machine(m));
+  }
+  std::mt19937 random(20261121);
+  std::size_t mixed = 0;  // steps where A.p held a remote and a local root together
+  for (int step = 0; step < 3000; ++step) {
+    clock.advance(std::chrono::milliseconds(1));
+    if (random() % 4 == 0) {
+      // A new full state of S.out: up to three roots of S's process, Warning or Error.
+      std::vector<RemoteRoot> roots;
+      const std::size_t n = random() % 4;
+      for (std::size_t i = 0; i < n; ++i) {
+        RemoteRoot r;
+        r.event = onsets[random() % onsets.size()];
+        r.origin = random() % 2 == 0 ? "S.s_A" : "S.s_F";
+        r.time = Time{static_cast<std::int64_t>(random() % 3) * 1000};
+        r.level = r.event == "EVT_W" ? State::Warning : State::Error;
+        r.path = {r.origin, "S.s_S.out"};
+        if (random() % 2 == 0) {
+          r.filter = "f";
+          r.signal = "force";
+          r.value = 1.5;
+        }
+        if (std::none_of(roots.begin(), roots.end(), [&](const RemoteRoot& x) {
+              return x.event == r.event && x.origin == r.origin && x.time == r.time;
+            })) {
+          roots.push_back(r);
+        }
+      }
+      ASSERT_TRUE(co.apply_remote(remote, roots));
+    } else {
+      co.generate(*co.find_event(events[random() % events.size()]), local[random() % local.size()]);
+    }
+    for (const char* name : {"A", "B"}) {
+      const ComponentId c = *co.find_component(name);
+      for (std::uint32_t p = 0; p < co.provided_machines(c).size(); ++p) {
+        const auto got = co.service_roots(c, p);
+        ASSERT_EQ(text_of(got), text_of(roots_from_explain(co, c, p)))
+            << "step " << step << ", service " << name << " #" << p;
+        if (std::string(name) == "A" && p == 0) {
+          const bool any_remote = std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] == 'S'; });
+          const bool any_local = std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] != 'S'; });
+          mixed += any_remote && any_local ? 1 : 0;
+        }
+      }
+    }
+  }
+  EXPECT_GT(mixed, 100u) << "the sequence must exercise remote and local roots together";
 }
 
 }  // namespace

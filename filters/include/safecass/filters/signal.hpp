@@ -24,6 +24,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "safecass/core/clock.hpp"
@@ -68,10 +69,10 @@ public:
     std::atomic<std::uint64_t>* w = slot(index);
     w[0].store(static_cast<std::uint64_t>(time.count()), std::memory_order_relaxed);
     w[1].store(key, std::memory_order_relaxed);
-    for (std::size_t i = 0; i < width_; ++i) {
-      std::uint64_t bits;
-      std::memcpy(&bits, &values[i], sizeof bits);  // std::bit_cast, in C++17
-      w[kHeader + i].store(bits, std::memory_order_relaxed);
+    if (width_ == 1) {
+      store(w[kHeader], values[0]);  // scalars: no loop
+    } else {
+      for (std::size_t i = 0; i < width_; ++i) store(w[kHeader + i], values[i]);
     }
     head_.store(index + 1, std::memory_order_release);
   }
@@ -87,22 +88,45 @@ public:
     const std::atomic<std::uint64_t>* w = slot(index);
     time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
     if (key != nullptr) *key = w[1].load(std::memory_order_relaxed);
-    for (std::size_t i = 0; i < width_; ++i) {
-      const std::uint64_t bits = w[kHeader + i].load(std::memory_order_relaxed);
-      std::memcpy(&out[i], &bits, sizeof bits);
-    }
+    for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[kHeader + i]);
     std::atomic_thread_fence(std::memory_order_acquire);
     // The slot is rewritten by sample index + mask_ + 1, whose stores start after the head
     // reached index + mask_ + 1: while the head is below that, the copy is intact.
     return head_.load(std::memory_order_relaxed) - index <= mask_;
   }
 
+  /// read() for a sample known to be published (index < a head loaded earlier); `head` is updated
+  /// to the head seen after the copy.
+  bool read_published(std::uint64_t index, Time& time, double* out, std::uint64_t& head) const noexcept {
+    const std::atomic<std::uint64_t>* w = slot(index);
+    time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
+    if (width_ == 1) {
+      out[0] = load(w[kHeader]);
+    } else {
+      for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[kHeader + i]);
+    }
+    std::atomic_thread_fence(std::memory_order_acquire);
+    head = head_.load(std::memory_order_relaxed);
+    return head - index <= mask_;
+  }
+
 private:
   static constexpr std::size_t kHeader = 2;  // time, order key
-  std::atomic<std::uint64_t>* slot(std::uint64_t index) const noexcept {
-    return &words_[(index & mask_) * (width_ + kHeader)];
+  std::atomic<std::uint64_t>* slot(std::uint64_t index) const noexcept { return &words_[(index & mask_) * stride_]; }
+  // A double as the bits of a relaxed atomic word (std::bit_cast, in C++17).
+  static void store(std::atomic<std::uint64_t>& word, double value) noexcept {
+    std::uint64_t bits;
+    std::memcpy(&bits, &value, sizeof bits);
+    word.store(bits, std::memory_order_relaxed);
+  }
+  static double load(const std::atomic<std::uint64_t>& word) noexcept {
+    const std::uint64_t bits = word.load(std::memory_order_relaxed);
+    double value;
+    std::memcpy(&value, &bits, sizeof value);
+    return value;
   }
   std::size_t width_;
+  std::size_t stride_;  ///< words per slot
   std::size_t mask_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
   alignas(64) std::atomic<std::uint64_t> head_{0};
@@ -166,6 +190,36 @@ public:
       return next_merged(*inj, out);
     }
     return next_written(out);
+  }
+  /// Calls `f(sample)` for every unread sample, in order: the same samples as repeated next()
+  /// calls, with the history buffer's head read once per sample instead of twice. Lock-free,
+  /// allocation-free as long as `f` is.
+  template <class F>
+  void read_new(F&& f) noexcept(noexcept(f(std::declval<const SampleView&>()))) {
+    if (signal_ == nullptr) return;
+    SampleView sample;
+    if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) {
+      while (next(sample)) f(static_cast<const SampleView&>(sample));
+      return;
+    }
+    const HistoryBuffer& b = signal_->buffer();
+    std::uint64_t end = b.end();
+    if (next_ >= end) return;
+    if (end - next_ > b.capacity()) {
+      missed_ += end - next_ - b.capacity();
+      next_ = end - b.capacity();
+    }
+    sample.data = scratch_.data();
+    sample.size = scratch_.size();
+    while (next_ < end) {
+      if (b.read_published(next_, sample.time, scratch_.data(), end)) {
+        ++next_;
+        f(static_cast<const SampleView&>(sample));
+      } else {
+        ++missed_;  // overwritten while we copied it
+        ++next_;
+      }
+    }
   }
   /// Skips every sample written so far.
   void skip_to_end() noexcept;

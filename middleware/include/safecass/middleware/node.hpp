@@ -76,11 +76,13 @@ struct NodeOptions {
 
 /// Counters, readable at any time (thread-safe).
 struct NodeStats {
-  std::uint64_t updates_published = 0;
+  std::uint64_t updates_published = 0;   ///< interface full states sent (each differs from the last one sent)
+  std::uint64_t state_messages_published = 0;  ///< Ice messages carrying them (one per publishing cycle)
   std::uint64_t updates_applied = 0;
   std::uint64_t updates_rejected = 0;   ///< malformed, unknown interface or stale sequence number
   std::uint64_t updates_missed = 0;     ///< gaps seen in sequence numbers
   std::uint64_t events_published = 0;
+  std::uint64_t event_messages_published = 0;  ///< Ice messages carrying the event records
   std::uint64_t events_dropped = 0;     ///< observer queue overflow (never silent: counted here)
   std::uint64_t resyncs_requested = 0;
   std::uint64_t connects = 0;           ///< successful (re)connections to IceStorm
