@@ -36,31 +36,7 @@ std::uint64_t Filter::missed_samples() const noexcept {
   return n;
 }
 
-[[gnu::always_inline]] inline void Filter::deliver(std::size_t input, const SampleView& sample) noexcept {
-  current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
-  double* held = &held_[held_offset_[input]];
-  if (sample.size == 1) {  // scalars: no loops
-    if (!std::isfinite(sample.data[0])) {
-      invalid_sample(input, sample.time, true);
-      return;
-    }
-    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
-    held[0] = sample.data[0];
-  } else {
-    bool finite = true;
-    for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
-    if (!finite) {
-      invalid_sample(input, sample.time, true);
-      return;
-    }
-    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
-    for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
-  }
-  has_held_[input] = 1;
-  on_sample(input, sample);
-}
-
-void Filter::run(Time now) noexcept {
+void Filter::run_general(Time now) noexcept {
   if (!enabled()) {
     was_enabled_ = false;
     return;

@@ -95,6 +95,10 @@ public:
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
+    if (size_ == 1) {
+      on_scalar(s);
+      return;
+    }
     double* slot = &ring_[next_ * size_];
     for (std::size_t i = 0; i < size_; ++i) {
       if (count_ == window_) sum_[i] -= slot[i];
@@ -118,6 +122,22 @@ protected:
   }
 
 private:
+  /// on_sample() for a scalar input: the same arithmetic, without the element loops.
+  void on_scalar(const SampleView& s) noexcept {
+    const double x = s[0];
+    if (count_ == window_) sum_[0] -= ring_[next_];
+    ring_[next_] = x;
+    sum_[0] += x;
+    if (++next_ == window_) next_ = 0;
+    if (count_ < window_) ++count_;
+    if (next_ == 0) {
+      double sum = 0.0;
+      for (std::size_t k = 0; k < count_; ++k) sum += ring_[k];
+      sum_[0] = sum;
+    }
+    write(0, s.time, sum_[0] / static_cast<double>(count_));
+  }
+
   std::size_t size_;
   std::size_t window_;
   std::vector<double> ring_;
@@ -147,13 +167,15 @@ public:
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
     double n = 0.0;
-    for (std::size_t i = 0; i < s.size; ++i) {
-      const double a = std::fabs(s[i]);
-      if (kind_ == 0) n += a * a;
-      else if (kind_ == 1) n += a;
-      else n = std::max(n, a);
+    if (kind_ == 0) {
+      for (std::size_t i = 0; i < s.size; ++i) n += s[i] * s[i];
+      n = std::sqrt(n);
+    } else if (kind_ == 1) {
+      for (std::size_t i = 0; i < s.size; ++i) n += std::fabs(s[i]);
+    } else {
+      for (std::size_t i = 0; i < s.size; ++i) n = std::max(n, std::fabs(s[i]));
     }
-    write(0, s.time, kind_ == 0 ? std::sqrt(n) : n);
+    write(0, s.time, n);
   }
 
 private:

@@ -20,6 +20,7 @@
 /// (with several inputs: on every input whose last sample was not finite).
 
 #include <atomic>
+#include <cmath>
 #include <cstddef>
 #include <deque>
 #include <mutex>
@@ -94,7 +95,16 @@ public:
   std::uint64_t missed_samples() const noexcept;
 
   /// Processes the new samples of every input, then on_tick(now). Call from one thread only.
-  void run(Time now) noexcept;
+  void run(Time now) noexcept {
+    // The hot path, inlined into the caller: enabled, no shallow injection queued, one input.
+    if (!enabled() || !was_enabled_ || injection_pending_.load(std::memory_order_acquire) || inputs_.size() != 1) {
+      run_general(now);
+      return;
+    }
+    cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
+    current_injected_ = false;
+    on_tick(now);
+  }
   /// Shallow fault injection: each queued sample replaces the first input's samples for one run,
   /// seen by this filter alone. Errors: InvalidArgument when a sample's size is not the input's.
   Expected<void> inject(const std::vector<std::vector<double>>& samples);
@@ -136,7 +146,33 @@ protected:
 private:
   void report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept;
   void invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept;
-  void deliver(std::size_t input, const SampleView& sample) noexcept;
+  /// One sample of input `input`: checked (a non-finite sample raises EVT_INVALID_SAMPLE and is
+  /// not passed on), held, then handed to on_sample().
+  void deliver(std::size_t input, const SampleView& sample) noexcept {
+    current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
+    double* held = &held_[held_offset_[input]];
+    if (sample.size == 1) {  // scalars: no loops
+      if (!std::isfinite(sample.data[0])) {
+        invalid_sample(input, sample.time, true);
+        return;
+      }
+      if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+      held[0] = sample.data[0];
+    } else {
+      bool finite = true;
+      for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
+      if (!finite) {
+        invalid_sample(input, sample.time, true);
+        return;
+      }
+      if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+      for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
+    }
+    has_held_[input] = 1;
+    on_sample(input, sample);
+  }
+  /// run() for everything but the hot path: disabled, re-enabled, injected, several inputs.
+  void run_general(Time now) noexcept;
   void run_merged(bool injected_run) noexcept;
   bool run_injection(Time now) noexcept;
 
