@@ -159,9 +159,10 @@ private:
       if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
       held[0] = sample.data[0];
     } else {
-      bool finite = true;
-      for (std::size_t k = 0; k < sample.size; ++k) finite = finite && std::isfinite(sample.data[k]);
-      if (!finite) {
+      // x * 0 is 0 for a finite x and NaN for NaN or ±inf: one test for the whole vector.
+      double zero = 0.0;
+      for (std::size_t k = 0; k < sample.size; ++k) zero += sample.data[k] * 0.0;
+      if (zero != 0.0) {
         invalid_sample(input, sample.time, true);
         return;
       }
