@@ -2,6 +2,7 @@
 // loopback).
 //
 //   bench_middleware --ice HOST:PORT --out FILE [--samples N] [--seconds S] [--interfaces K]
+//                    [--pause-us P]
 //
 // Two processes: this one forks a provider ("sensor": JR3 provides ForceData) and runs the client
 // ("robot": CONTROL requires JR3.ForceData through a remote provided interface). Both use the
@@ -11,8 +12,8 @@
 //      CONTROL.s_R.ForceData entering Error in the other process (its transition callback).
 //   2. throughput: JR3 also provides K interfaces D0..D{K-1} (CONTROL requires each); for S
 //      seconds the provider changes the root set of each s_P.Di in turn, as fast as it can (one
-//      generate() = one state change of one interface; a pause of 50 µs after each round over
-//      the K interfaces). The client counts the interface updates it applied (each one a full
+//      generate() = one state change of one interface; a pause of P µs, default 50, after each
+//      round over the K interfaces). The client counts the interface updates it applied (each one a full
 //      state that differed from the previous one sent); state changes the publisher coalesced
 //      (a newer full state of the same interface superseded them before they were sent) are
 //      reported as "superseded", and at the end the client must hold exactly the provider's
@@ -49,11 +50,14 @@ namespace {
 std::string system_text(int k) {
   std::string provided = "\"ForceData\"", required = "\"ForceData\"";
   std::string connections = R"({ "required": "CONTROL.ForceData", "provided": "JR3.ForceData" })";
+  // Di's service is s_P.Di alone: the latency phase's faults on JR3.s_A change ForceData only.
+  std::string services = R"({ "name": "ForceData", "dependency": { "s_F": true, "s_A": true } })";
   for (int i = 0; i < k; ++i) {
     const std::string d = "D" + std::to_string(i);
     provided += ", \"" + d + "\"";
     required += ", \"" + d + "\"";
     connections += R"(, { "required": "CONTROL.)" + d + R"(", "provided": "JR3.)" + d + "\" }";
+    services += R"(, { "name": ")" + d + R"(", "dependency": {} })";
   }
   return R"({
   "safecass": 1, "system": "bench",
@@ -62,7 +66,8 @@ std::string system_text(int k) {
       "event": [ { "name": "EVT_FORCE_ERROR", "severity": 50, "state_transition": ["N2E", "W2E"] },
                  { "name": "/EVT_FORCE_ERROR", "severity": 50, "state_transition": ["E2N", "E2W"] },
                  { "name": "EVT_JR3_FAULT", "severity": 60, "state_transition": ["N2E", "W2E"] },
-                 { "name": "/EVT_JR3_FAULT", "severity": 60, "state_transition": ["E2N", "E2W"] } ] },
+                 { "name": "/EVT_JR3_FAULT", "severity": 60, "state_transition": ["E2N", "E2W"] } ],
+      "service": [ )" + services + R"( ] },
     { "component": "CONTROL", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
   "connections": [ )" + connections + R"( ],
   "coordinators": { "sensor": ["JR3"], "robot": ["CONTROL"] } })";
@@ -118,7 +123,8 @@ bool read_counts(int fd, std::uint64_t (&v)[3]) {
 
 /// The provider: waits for 'L' (latency phase) and 'T' (throughput phase), answers 'd' when done;
 /// after 'T' it also sends {state changes made, updates published, Ice messages for them}.
-int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, double seconds, int interfaces) {
+int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, double seconds, int interfaces,
+             std::chrono::microseconds pause) {
   Process p;
   if (!p.build("sensor", ice, interfaces) || !p.wait_connected()) return 2;
   const EventId onset = *p.co->find_event("EVT_FORCE_ERROR");
@@ -144,13 +150,16 @@ int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, d
       for (int i = 0; i < interfaces; ++i) targets.push_back(*p.co->find_machine("JR3.s_P.D" + std::to_string(i)));
       for (MachineId t : targets) p.co->generate(onset, t);
       std::this_thread::sleep_for(100ms);
+      // The client counts from here: these first onsets are not part of the measurement.
+      write_byte(out, 's');
+      if (read_byte(in) != 'g') return 2;
       const auto before = p.node->stats();
       const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
       std::uint64_t changes = 0;
       for (std::size_t step = 0; std::chrono::steady_clock::now() < until; step = (step + 1) % 4) {
         for (MachineId t : targets) p.co->generate(steps[step], t);
         changes += targets.size();
-        std::this_thread::sleep_for(50us);
+        if (pause.count() > 0) std::this_thread::sleep_for(pause);
       }
       std::this_thread::sleep_for(200ms);  // let the last updates out
       const auto after = p.node->stats();
@@ -187,6 +196,7 @@ int main(int argc, char** argv) {
   int samples = 2000;
   double seconds = 2.0;
   int interfaces = 16;
+  std::chrono::microseconds pause{50};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice") ice_text = argv[i + 1];
@@ -194,6 +204,7 @@ int main(int argc, char** argv) {
     else if (key == "--samples") samples = std::max(10, std::atoi(argv[i + 1]));
     else if (key == "--seconds") seconds = std::max(0.2, std::atof(argv[i + 1]));
     else if (key == "--interfaces") interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
+    else if (key == "--pause-us") pause = std::chrono::microseconds(std::clamp(std::atoi(argv[i + 1]), 0, 1000000));
     else {
       std::fprintf(stderr, "bench_middleware: unknown option %s\n", key.c_str());
       return 2;
@@ -210,7 +221,7 @@ int main(int argc, char** argv) {
   if (child == 0) {
     ::close(to_child[1]);
     ::close(to_parent[0]);
-    std::_Exit(provider(*ice, to_child[0], to_parent[1], samples, seconds, interfaces));
+    std::_Exit(provider(*ice, to_child[0], to_parent[1], samples, seconds, interfaces, pause));
   }
   ::close(to_child[0]);
   ::close(to_parent[1]);
@@ -253,8 +264,10 @@ int main(int argc, char** argv) {
   if (read_byte(to_parent[0]) != 'd') return 1;
   measuring.store(false);
 
-  const auto before = client.node->stats();
   write_byte(to_child[1], 'T');
+  if (read_byte(to_parent[0]) != 's') return 1;
+  const auto before = client.node->stats();
+  write_byte(to_child[1], 'g');
   std::uint64_t counts[3] = {0, 0, 0};
   if (read_byte(to_parent[0]) != 'd' || !read_counts(to_parent[0], counts)) return 1;
   // Applied while the provider was changing its roots (its last updates had 200 ms to arrive).
@@ -280,12 +293,13 @@ int main(int argc, char** argv) {
   char json[1024];
   std::snprintf(json, sizeof json,
                 "{\n  \"p50_us\": %.1f,\n  \"p99_us\": %.1f,\n  \"max_us\": %.1f,\n  \"samples\": %zu,\n"
-                "  \"onsets_sent\": %d,\n  \"updates_per_s\": %.0f,\n  \"interfaces\": %d,\n  \"seconds\": %.2f,\n"
+                "  \"onsets_sent\": %d,\n  \"updates_per_s\": %.0f,\n  \"interfaces\": %d,\n  \"pause_us\": %lld,\n"
+                "  \"seconds\": %.2f,\n"
                 "  \"state_changes\": %llu,\n  \"updates_published\": %llu,\n  \"updates_applied\": %llu,\n"
                 "  \"superseded\": %llu,\n  \"state_messages\": %llu,\n  \"updates_missed\": %llu,\n"
                 "  \"final_state_ok\": %s,\n"
                 "  \"transport\": \"IceStorm (icebox) on loopback, two processes\"\n}\n",
-                p50, p99, max, copy.size(), samples, updates_per_s, interfaces, seconds,
+                p50, p99, max, copy.size(), samples, updates_per_s, interfaces, static_cast<long long>(pause.count()), seconds,
                 static_cast<unsigned long long>(changes), static_cast<unsigned long long>(published),
                 static_cast<unsigned long long>(applied),
                 static_cast<unsigned long long>(changes > published ? changes - published : 0),

@@ -15,7 +15,10 @@
 
 namespace safecass::middleware::detail {
 
+/// State updates go to one topic per coordinator, "safecass.state.<coordinator>": a process
+/// receives only the streams of the providers it holds, never its own.
 inline constexpr const char* kStateTopic = "safecass.state";
+inline std::string state_topic(std::string_view coordinator) { return std::string(kStateTopic) + "." + std::string(coordinator); }
 inline constexpr const char* kEventTopic = "safecass.events";
 inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
 inline constexpr const char* kResyncTopic = "safecass.resync";

@@ -141,6 +141,7 @@ struct CoordinatorNode::Impl {
   std::condition_variable queue_cv;
   std::deque<Record> records;
   bool any_dirty = true;
+  bool publisher_holds_events = false;  ///< the publisher has event records it has not sent yet
   static constexpr std::size_t kQueueCapacity = 65536;
   /// Updates (or records) per Ice message: one message carries every interface that changed.
   static constexpr std::size_t kMaxBatch = 256;
@@ -183,24 +184,30 @@ struct CoordinatorNode::Impl {
 
   // -- coordinator side (under the coordinator's lock: no network, no blocking) --
   void on_record(const Record& r) {
+    // Wakes the publisher only when it has something to do now: an interface that was clean
+    // became dirty, the first event record while it holds none (it starts the kEventDelay
+    // clock), or a full batch of records. Every other record only joins the queue.
+    bool wake = false;
     {
       std::lock_guard lock(queue_mutex);
       // Records of stand-ins for remote components are that component's process's to publish.
       if (r.kind != RecordKind::Event && !(r.component < co.component_count() && co.is_remote(r.component))) {
         if (records.size() < kQueueCapacity) {
           records.push_back(r);
+          wake = (records.size() == 1 && !publisher_holds_events) || records.size() == kMaxBatch;
         } else {
           events_dropped.fetch_add(1, std::memory_order_relaxed);
         }
       }
       if (r.component < streams_of.size()) {
         for (std::size_t i : streams_of[r.component]) {
+          wake = wake || !streams[i]->dirty;
           streams[i]->dirty = true;
           any_dirty = true;
         }
       }
     }
-    queue_cv.notify_one();
+    if (wake) queue_cv.notify_one();
   }
 
   void mark_all(bool force) {
@@ -314,26 +321,34 @@ struct CoordinatorNode::Impl {
   }
 
   void publisher_loop() {
-    // Event records wait here between cycles; state updates always go first (other processes'
-    // safety depends on them) and the records follow when no state is waiting, or at the latest
-    // kEventDelay after the oldest was queued.
+    // State updates go out as soon as an interface is dirty (other processes' safety depends on
+    // them). Event records are held here and sent kEventDelay after the oldest was queued, or as
+    // soon as kMaxBatch are waiting: a few messages per second instead of one per record.
     std::vector<Record> events;
     std::int64_t oldest_event = 0;
     std::vector<std::pair<std::size_t, bool>> todo;
     wire::StateUpdateSeq updates;
     std::vector<Stream*> updated;
+    const std::int64_t delay = std::chrono::nanoseconds(kEventDelay).count();
     while (running.load()) {
       todo.clear();
-      bool state_waiting = false;
       {
         std::unique_lock lock(queue_mutex);
         if (!connected.load()) {
           queue_cv.wait_for(lock, std::chrono::milliseconds(20));
           continue;  // records and dirty marks wait (bounded) for the reconnection
         }
-        const bool idle = events.empty();
-        queue_cv.wait_for(lock, idle ? std::chrono::milliseconds(50) : kEventDelay,
-                          [&] { return !running.load() || !records.empty() || any_dirty; });
+        const bool holding = !events.empty();
+        publisher_holds_events = holding;
+        auto ready = [&] {
+          return !running.load() || any_dirty || records.size() >= kMaxBatch || (!holding && !records.empty());
+        };
+        if (holding) {
+          const auto due = std::chrono::steady_clock::time_point(std::chrono::nanoseconds(oldest_event + delay));
+          queue_cv.wait_until(lock, due, ready);
+        } else {
+          queue_cv.wait_for(lock, std::chrono::milliseconds(50), ready);
+        }
         if (!records.empty()) {
           if (events.empty()) oldest_event = steady_ns();
           for (const Record& r : records) {
@@ -345,6 +360,7 @@ struct CoordinatorNode::Impl {
           }
           records.clear();
         }
+        publisher_holds_events = !events.empty();
         if (any_dirty) {
           for (std::size_t i = 0; i < streams.size(); ++i) {
             if (!streams[i]->dirty) continue;
@@ -372,12 +388,9 @@ struct CoordinatorNode::Impl {
         for (const auto& [i, force] : todo) snapshot_stream(*streams[i], force, updates, updated);
         send_states(updates, updated, spub);
         todo.clear();
-        {
-          std::lock_guard lock(queue_mutex);
-          state_waiting = any_dirty;
+        if (!events.empty() && (steady_ns() - oldest_event >= delay || events.size() >= kMaxBatch)) {
+          send_events(events, epub);
         }
-        const bool overdue = steady_ns() - oldest_event >= std::chrono::nanoseconds(kEventDelay).count();
-        if (!events.empty() && (!state_waiting || overdue || events.size() >= kMaxBatch)) send_events(events, epub);
       } catch (const Ice::Exception& e) {
         log("middleware: " + name + ": publishing failed (" + std::string(e.ice_id()) + "); will reconnect and resync");
         connected.store(false);
@@ -404,10 +417,10 @@ struct CoordinatorNode::Impl {
     while (running.load()) {
       if (!connected.load()) {
         try {
-          link->connect({kStateTopic, kEventTopic, kHeartbeatTopic, kResyncTopic});
+          link->connect({state_topic(name), kEventTopic, kHeartbeatTopic, kResyncTopic});
           {
             std::lock_guard lock(link_mutex);
-            state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(kStateTopic));
+            state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(state_topic(name)));
             event_pub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kEventTopic));
             heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(kHeartbeatTopic));
             resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
@@ -672,7 +685,13 @@ Expected<void> CoordinatorNode::start() {
     auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
     d.link = std::make_unique<Link>(d.ic, d.options.ice);
-    d.link->subscribe_to(kStateTopic, state, Delivery::Stream);
+    std::vector<std::string> providers;  // the coordinators whose interfaces this one holds
+    for (const auto& [iface, h] : d.held) {
+      if (!h.provider.empty() && std::find(providers.begin(), providers.end(), h.provider) == providers.end()) {
+        providers.push_back(h.provider);
+      }
+    }
+    for (const std::string& provider : providers) d.link->subscribe_to(state_topic(provider), state, Delivery::Stream);
     d.link->subscribe_to(kHeartbeatTopic, heartbeat);
     d.link->subscribe_to(kResyncTopic, resync);
     d.adapter->activate();

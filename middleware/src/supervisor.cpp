@@ -252,7 +252,8 @@ Expected<void> Supervisor::start() {
     auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor", "tcp -h " + d.options.listen_host);
     d.link = std::make_unique<Link>(d.ic, d.options.ice);
     d.link->subscribe_to(kEventTopic, adapter->addWithUUID(std::make_shared<EventServant>(d)), Delivery::Stream);
-    d.link->subscribe_to(kStateTopic, adapter->addWithUUID(std::make_shared<StateServant>(d)), Delivery::Stream);
+    auto state = adapter->addWithUUID(std::make_shared<StateServant>(d));
+    for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state, Delivery::Stream);
     d.link->subscribe_to(kHeartbeatTopic, adapter->addWithUUID(std::make_shared<HeartbeatServant>(d)));
     adapter->activate();
   } catch (const Ice::Exception& e) {

@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <fstream>
@@ -442,24 +443,30 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   // Every interface ends in the provider's exact final state: the same roots (origin, event, onset
   // time) at the client's stand-in S.s_P.Di as at the provider's service S.s_S.Di.
   const ComponentId s = *provider.co->find_component("S");
+  std::string mismatch;
   auto same_everywhere = [&] {
     for (int i = 0; i < kInterfaces; ++i) {
-      std::string want, got;
+      std::vector<std::string> want, got;
       for (const RemoteRoot& r : provider.co->service_roots(s, static_cast<std::uint32_t>(i))) {
-        want += r.origin + ":" + r.event + "@" + std::to_string(r.time.count()) + " ";
+        want.push_back(r.origin + ":" + r.event + "@" + std::to_string(r.time.count()));
       }
       auto why = client.co->explain("S.s_P.D" + std::to_string(i));
       if (!why) return false;
-      for (const Explanation& e : *why) got += e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()) + " ";
-      if (want != got) return false;
-      if (client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i))) !=
-          provider.co->service_state(s, static_cast<std::uint32_t>(i))) {
+      for (const Explanation& e : *why) got.push_back(e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()));
+      std::sort(want.begin(), want.end());
+      std::sort(got.begin(), got.end());
+      const State client_state = client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i)));
+      const State provider_state = provider.co->service_state(s, static_cast<std::uint32_t>(i));
+      if (want != got || client_state != provider_state) {
+        mismatch = "D" + std::to_string(i) + ": provider " + std::string(to_string(provider_state)) + " " +
+                   std::to_string(want.size()) + " root(s), client " + std::string(to_string(client_state)) + " " +
+                   std::to_string(got.size()) + " root(s)";
         return false;
       }
     }
     return true;
   };
-  EXPECT_TRUE(eventually(same_everywhere, 10000ms));
+  EXPECT_TRUE(eventually(same_everywhere, 10000ms)) << mismatch;
   const auto after = provider.node->stats();
   const std::uint64_t updates = after.updates_published - before.updates_published;
   const std::uint64_t messages = after.state_messages_published - before.state_messages_published;

@@ -3,8 +3,10 @@
 /// A coordinator process on the middleware (DESIGN §4): CoordinatorNode connects one Coordinator
 /// (and its Monitor) to ZeroC IceStorm. It
 /// - publishes, for every provided interface of the local components, a full-state update (the
-///   roots active at s_S.p with their hop paths) whenever that set changes, plus every record of
-///   the observer stream and a heartbeat;
+///   roots active at s_S.p with their hop paths) whenever that set changes — the interfaces that
+///   changed since the last publishing cycle go out together in one message on this
+///   coordinator's state topic — plus every record of the observer stream (batched, after the
+///   state) and a heartbeat;
 /// - applies the updates of the remote providers this coordinator's components require
 ///   (Coordinator::apply_remote), checking sequence numbers and asking for a republish (resync)
 ///   when it detects a loss, a provider restart or a reconnection;
