@@ -55,7 +55,7 @@ wire::RecordEntry entry(const Coordinator& co, const Record& r) {
   wire::RecordEntry e;
   e.seq = static_cast<long long>(r.seq);
   e.time = r.time.count();
-  e.kind = std::string(kind_text(r.kind));
+  e.kind = std::string(to_string(r.kind));
   e.outcome = std::string(outcome_text(r.outcome));
   if (r.machine != kNoMachine) {
     e.address = co.address_of(r.machine);

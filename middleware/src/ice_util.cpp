@@ -69,29 +69,7 @@ bool from_wire(wire::Level l, State& out) noexcept {
   return false;
 }
 
-std::string_view kind_text(RecordKind k) noexcept {
-  switch (k) {
-    case RecordKind::Event: return "event";
-    case RecordKind::Transition: return "transition";
-    case RecordKind::ComponentTransition: return "component-transition";
-    case RecordKind::Reset: return "reset";
-    case RecordKind::Injection: return "injection";
-  }
-  return "unknown";
-}
-
-std::string_view outcome_text(Outcome o) noexcept {
-  switch (o) {
-    case Outcome::None: return "";
-    case Outcome::Raised: return "raised";
-    case Outcome::Override: return "override";
-    case Outcome::Joined: return "joined";
-    case Outcome::Masked: return "masked";
-    case Outcome::Cleared: return "cleared";
-    case Outcome::Ignored: return "ignored";
-  }
-  return "";
-}
+std::string_view outcome_text(Outcome o) noexcept { return o == Outcome::None ? std::string_view{} : to_string(o); }
 
 std::int64_t steady_ns() noexcept {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())

@@ -45,7 +45,7 @@ void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shar
 wire::Level to_wire(State s) noexcept;
 /// Errors: a value outside the enum (a malformed message).
 bool from_wire(wire::Level l, State& out) noexcept;
-std::string_view kind_text(RecordKind k) noexcept;
+/// The core's name of an outcome, empty for Outcome::None (the wire's "no outcome").
 std::string_view outcome_text(Outcome o) noexcept;
 std::int64_t steady_ns() noexcept;
 

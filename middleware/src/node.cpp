@@ -228,7 +228,7 @@ struct CoordinatorNode::Impl {
     m.coordinator = name;
     m.incarnation = incarnation;
     m.seq = ++event_seq;
-    m.kind = std::string(kind_text(r.kind));
+    m.kind = std::string(to_string(r.kind));
     m.outcome = std::string(outcome_text(r.outcome));
     if (r.machine != kNoMachine) {
       m.address = co.address_of(r.machine);

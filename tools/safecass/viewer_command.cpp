@@ -1,5 +1,6 @@
 // `safecass viewer`: loads a system (and scenario), runs it in real time in this process and
-// serves the live view until Ctrl-C / SIGTERM.
+// serves the live view until Ctrl-C / SIGTERM; with --ice, watches a live multi-process system
+// through the middleware instead.
 
 #include "viewer_command.hpp"
 
@@ -9,11 +10,15 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/server.hpp"
+#ifdef SAFECASS_WITH_ICE
+#include "safecass/viewer/middleware_source.hpp"
+#endif
 
 extern char** environ;
 
@@ -29,7 +34,50 @@ struct ViewerArgs {
   double speed = 1.0;
   bool allow_write = false;
   bool open = false;
+  std::string ice;                      ///< --ice HOST:PORT: a live system
+  std::vector<std::string> token_files; ///< --token-file COORD=FILE
+  bool speed_given = false;
 };
+
+/// The source: the system in this process, or (--ice) the live system through the middleware.
+Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
+  if (args.ice.empty()) {
+    if (!args.token_files.empty()) {
+      return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file is for a live system (--ice)");
+    }
+    viewer::InProcessOptions source_options;
+    source_options.system = args.system;
+    source_options.scenario = args.scenario;
+    source_options.speed = args.speed;
+    auto source = viewer::InProcessSource::open(source_options);
+    if (!source) return tl::unexpected(source.error());
+    return std::unique_ptr<viewer::ViewSource>(std::move(*source));
+  }
+#ifdef SAFECASS_WITH_ICE
+  if (!args.scenario.empty() || args.speed_given) {
+    return fail(ErrorCode::InvalidArgument, "safecass viewer: --scenario and --speed drive an in-process system, not a live one (--ice)");
+  }
+  if (args.system.empty()) return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice needs --system SYSTEM (its coordinators)");
+  viewer::MiddlewareOptions options;
+  options.ice = args.ice;
+  options.system = args.system;
+  options.allow_write = args.allow_write;
+  for (const std::string& t : args.token_files) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == t.size()) {
+      return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file '" + t + "': write it COORDINATOR=FILE");
+    }
+    if (!options.token_files.emplace(t.substr(0, eq), t.substr(eq + 1)).second) {
+      return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file: coordinator '" + t.substr(0, eq) + "' given twice");
+    }
+  }
+  auto source = viewer::MiddlewareSource::open(options);
+  if (!source) return fail(source.error().code, "safecass viewer: " + source.error().message);
+  return std::unique_ptr<viewer::ViewSource>(std::move(*source));
+#else
+  return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice: this safecass was built without the middleware (ZeroC Ice)");
+#endif
+}
 
 /// Starts the desktop's browser on `url` without waiting for it (and without a shell).
 void open_browser(const std::string& url) {
@@ -49,11 +97,7 @@ int run_viewer(const ViewerArgs& args) {
     std::fprintf(stderr, "safecass viewer: --port must be 0 to 65535 (0: pick a free port)\n");
     return 2;
   }
-  viewer::InProcessOptions source_options;
-  source_options.system = args.system;
-  source_options.scenario = args.scenario;
-  source_options.speed = args.speed;
-  auto source = viewer::InProcessSource::open(source_options);
+  auto source = open_source(args);
   if (!source) {
     std::fprintf(stderr, "%s\n", source.error().message.c_str());
     return 2;
@@ -90,6 +134,9 @@ int run_viewer(const ViewerArgs& args) {
   const std::string url = (*server)->url();
   const viewer::SystemView v = (*source)->view();
   std::printf("safecass viewer: %s (%s)\n", v.system.c_str(), v.description.c_str());
+  for (const viewer::CoordinatorView& co : v.coordinators) {
+    if (!co.status.empty()) std::printf("  coordinator %s: %s (tried again until it answers)\n", co.name.c_str(), co.status.c_str());
+  }
   std::printf("  open %s\n", url.c_str());
   if (args.allow_write) {
     std::printf("  write access: the token is in %s (mode 0600); or open %s#token=%s\n", token_file.c_str(),
@@ -121,12 +168,22 @@ void add_viewer_command(CLI::App& app, int& code) {
       "driven by the scenario if one is given; when the scenario ends the system stays up. The page shows every "
       "coordinator, component and state machine coloured Normal/Warning/Error; click a state for its cause. "
       "Read-only unless --allow-write: then every write request must carry the token written to a private file "
-      "whose path is printed at start.");
+      "whose path is printed at start. With --ice the system is not run here: the viewer follows the live "
+      "coordinators of the --system file through IceStorm (one that does not answer is shown unreachable and "
+      "tried again), and each write goes to the coordinator owning its target with that coordinator's token.");
   cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
   cmd->add_option("--scenario,-s", args->scenario, "scenario file: timed samples, events, injections and resets");
   cmd->add_option("--port,-p", args->port, "TCP port (0: pick a free one)")->capture_default_str();
   cmd->add_option("--bind", args->bind, "address to listen on")->capture_default_str();
-  cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")->capture_default_str();
+  cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")
+      ->capture_default_str()
+      ->each([args](const std::string&) { args->speed_given = true; });
+  cmd->add_option("--ice", args->ice,
+                  "IceStorm HOST:PORT: watch the live system whose coordinators run as processes "
+                  "(`safecass run SYSTEM --coordinator NAME --ice ...`); needs --system");
+  cmd->add_option("--token-file", args->token_files,
+                  "COORDINATOR=FILE (repeatable, with --ice): the token file of a coordinator started with "
+                  "--allow-write; writes to it carry its token");
   cmd->add_flag("--allow-write", args->allow_write, "accept generate, inject and reset requests that carry the token");
   cmd->add_flag("--open", args->open, "open the page in the desktop's browser (xdg-open)");
   cmd->callback([args, &code] { code = run_viewer(*args); });

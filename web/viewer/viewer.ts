@@ -26,6 +26,8 @@ interface CoordinatorView {
   name: string;
   address: string;
   state: StateName;
+  /** '' while current; for a live coordinator 'connecting', 'unreachable' or 'lost'. */
+  status?: string;
   components: ComponentView[];
 }
 
@@ -50,6 +52,7 @@ interface HistoryRecord {
   from?: StateName;
   to?: StateName;
   root?: { event: string; origin: string };
+  coordinator?: string;
   text?: string;
   dropped?: number;
 }
@@ -241,6 +244,8 @@ class Viewer {
   private onUpdate(m: Update): void {
     this.setClock(m.t, m.running);
     let selectedChanged = false;
+    // A state the page has not drawn (a live coordinator now answers with another shape): redraw.
+    if (Object.keys(m.states).some((address) => !this.nodes.has(address))) this.send({ op: 'view' });
     for (const [address, [state, outstanding]] of Object.entries(m.states)) {
       this.setState(address, state, outstanding);
       if (address === this.selected) selectedChanged = true;
@@ -310,7 +315,7 @@ class Viewer {
       const box = element('section', 'coordinator');
       box.dataset.coordinator = co.name;
       const head = element('h2', '');
-      head.append(element('span', '', 'coordinator'), this.stateNode(co.address, co.state, '', '', co.name));
+      head.append(element('span', '', 'coordinator'), this.stateNode(co.address, co.state, co.status ?? '', '', co.name));
       box.append(head);
       for (const c of co.components) {
         const row = element('div', 'component');
@@ -353,7 +358,7 @@ class Viewer {
     const list = byId('transitions');
     const item = element('li', `kind-${r.kind}`);
     item.append(element('span', 't', seconds(r.t)));
-    const where = r.machine ?? r.component ?? '';
+    const where = r.machine ?? r.component ?? r.coordinator ?? '';
     let text: string;
     switch (r.kind) {
       case 'transition':
@@ -366,6 +371,7 @@ class Viewer {
       case 'injection': text = `injection ${r.text ?? ''}`; break;
       case 'event': text = `${r.outcome ?? ''} ${r.event ?? ''}${r.text !== undefined ? ' (' + r.text + ')' : ''}`; break;
       case 'overflow': text = `${r.dropped ?? 0} records dropped`; break;
+      case 'coordinator': text = `coordinator ${r.text ?? ''}`; break;
       default: text = r.kind;
     }
     if (r.to !== undefined && (r.kind === 'transition' || r.kind === 'component-transition')) item.classList.add(`to-${r.to}`);
@@ -413,7 +419,8 @@ class Viewer {
       if (c.hazard !== undefined) root += `; hazard ${c.hazard}`;
       item.append(element('div', 'root', root));
       item.append(element('div', 'path', c.path.join(' → ')));
-      item.append(element('div', 'meta hint', `since t=${seconds(c.first)}, seen ${c.count}×, last t=${seconds(c.last)}`));
+      // A live coordinator's explain does not carry the counts (count 0): no line then.
+      if (c.count > 0) item.append(element('div', 'meta hint', `since t=${seconds(c.first)}, seen ${c.count}×, last t=${seconds(c.last)}`));
       box.append(item);
     }
   }

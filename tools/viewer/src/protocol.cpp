@@ -69,7 +69,7 @@ StateMap states_of(const SystemView& v) {
   StateMap m;
   m["SYSTEM"] = {v.state, {}};
   for (const CoordinatorView& co : v.coordinators) {
-    m["coordinator:" + co.name] = {co.state, {}};
+    m["coordinator:" + co.name] = {co.state, co.status};  // a live coordinator's status as its "event"
     for (const ComponentView& c : co.components) {
       m[c.name] = {c.state, c.outstanding};
       for (const MachineView& mv : c.machines) m[mv.address] = {mv.state, mv.outstanding};
@@ -89,7 +89,7 @@ std::string view_to_json(const SystemView& v) {
           .str("outstanding", c.outstanding).raw("machines", machines).done();
     });
     return Object().str("name", co.name).str("address", "coordinator:" + co.name).raw("state", state_text(co.state))
-        .raw("components", components).done();
+        .str("status", co.status).raw("components", components).done();
   });
   return Object().str("system", v.system).str("description", v.description).raw("t", seconds(v.t))
       .boolean("running", v.running).raw("state", state_text(v.state)).raw("coordinators", coordinators).done();

@@ -17,9 +17,10 @@
 ///   {"op":"inject","signal":S,"samples":[[...]...],"token":K}        deep injection
 ///   {"op":"reset","target":A,"reason":TEXT,"token":K}
 /// VIEW = {"system","description","t","running","state","coordinators":[{"name","address","state",
-/// "components":[{"name","address","state","outstanding","machines":[{"address","kind","name",
-/// "state","outstanding"}]}]}]}. STATES holds only the addresses whose state or outstanding event
-/// changed since the previous update; coordinator addresses are "coordinator:NAME".
+/// "status","components":[{"name","address","state","outstanding","machines":[{"address","kind",
+/// "name","state","outstanding"}]}]}]}. STATES holds only the addresses whose state or outstanding
+/// event changed since the previous update; coordinator addresses are "coordinator:NAME", and a
+/// coordinator's "outstanding" is its status ("" in-process; "unreachable", "lost", ... live).
 /// RECORD is record_to_json()'s format.
 ///
 /// A malformed message (not JSON, not an object, unknown op or key, wrong type, too long) gets an

@@ -1,8 +1,8 @@
 #pragma once
 /// @file source.hpp
 /// Where the viewer's data comes from. The server only talks to a ViewSource: an in-process
-/// system driven by a scenario (InProcessSource) today, a live system reached through the
-/// middleware later. A source gives a picture of the Generic Component Model (coordinators →
+/// system driven by a scenario (InProcessSource), or a live multi-process system reached through
+/// the middleware (MiddlewareSource). A source gives a picture of the Generic Component Model (coordinators →
 /// components → machines, with their states), the records of the observer stream since the last
 /// call, the cause of any state (explain), and the write operations of DESIGN §6.
 ///
@@ -45,6 +45,10 @@ struct ComponentView {
 struct CoordinatorView {
   std::string name;
   State state = State::Normal;  ///< product over its components
+  /// Empty while its states are current (always in-process); for a live coordinator reached
+  /// through the middleware "connecting", "unreachable" (never answered) or "lost" (answered
+  /// before: the states shown are the last it sent).
+  std::string status;
   std::vector<ComponentView> components;
 };
 
@@ -53,7 +57,7 @@ struct SystemView {
   std::string system;       ///< system name
   std::string description;  ///< where it comes from ("in-process, scenario story.json, speed 1")
   double t = 0.0;           ///< the system's clock, seconds
-  bool running = true;      ///< a scenario still has steps to apply (false without one)
+  bool running = true;      ///< a scenario still has steps to apply (false without one); always true live
   State state = State::Normal;
   std::vector<CoordinatorView> coordinators;
 };

@@ -1,0 +1,302 @@
+// `safecass viewer --ice` on a live multi-process system, seen in headless Chromium (Debian's
+// /usr/bin/chromium, driven by playwright-core from web/node_modules, as tests/browser/ does):
+//   IceStorm (scripts/start-icestorm on a free port), the robot coordinator of examples/robodoc
+//   (`safecass run --coordinator robot --allow-write`, the calm scenario of the console tests) and
+//   the viewer start; the ui coordinator is not running yet, so the page shows it unreachable;
+//   then ui starts and the page shows it answering (retried). A fault generated on the robot
+//   process by `safecass console --ice --allow-write` shows as CONTROL (robot) and PENDANT (ui,
+//   the other process) in Error, pushed within 100 ms of the root transition (host clock), and
+//   clicking PENDANT gives the cause JR3.s_A EVT_FORCE_ERROR. The page clears it with a write
+//   through the viewer (the robot's token), is refused a write on ui (no token for it), and shows
+//   ui lost when its process stops. Screenshot: OUT/viewer_ice.png.
+// Everything started is stopped by PID, whatever happens.
+//
+// usage: node viewer_ice_test.mjs SAFECASS SOURCE_DIR OUT_DIR
+
+import { spawn, execFile } from 'node:child_process';
+import { createRequire } from 'node:module';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+
+const [safecass, root, out] = process.argv.slice(2);
+if (!safecass || !root || !out) {
+  console.error('usage: node viewer_ice_test.mjs SAFECASS SOURCE_DIR OUT_DIR');
+  process.exit(2);
+}
+const require = createRequire(path.join(root, 'web', 'package.json'));
+const { chromium } = require('playwright-core');
+
+const kChromium = '/usr/bin/chromium';
+const kFlags = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
+  '--disable-component-update', '--disable-sync', '--no-first-run'];
+const kDeadlineMs = 58000;
+const kSystem = path.join(root, 'examples/robodoc/robodoc.json');
+const kQuiet = path.join(root, 'tests/integration/console_ice/robot_quiet.json');
+
+const children = [];       // every process started, stopped by PID in cleanup()
+let icestormPid = 0;       // IceBox (started detached by scripts/start-icestorm)
+let context = null;
+let userDataDir = '';
+let failures = 0;
+const scratch = path.join(out, 'viewer_ice_scratch');
+
+function check(condition, what) {
+  if (condition) {
+    console.log(`ok: ${what}`);
+  } else {
+    console.log(`FAILED: ${what}`);
+    failures += 1;
+  }
+}
+
+function alive(child) { return child.exitCode === null && child.signalCode === null; }
+
+function sleep(ms) { return new Promise((resolve) => setTimeout(resolve, ms)); }
+
+async function stopPid(pid) {
+  try { process.kill(pid, 'SIGTERM'); } catch { return; }
+  for (let i = 0; i < 50; i += 1) {
+    try { process.kill(pid, 0); } catch { return; }
+    await sleep(100);
+  }
+  try { process.kill(pid, 'SIGKILL'); } catch { /* gone */ }
+}
+
+async function cleanup() {
+  if (context !== null) {
+    await context.close().catch(() => {});
+    context = null;
+  }
+  for (const child of children) {
+    if (alive(child)) await stopPid(child.pid);
+  }
+  if (icestormPid !== 0) {
+    await stopPid(icestormPid);
+    icestormPid = 0;
+  }
+  if (userDataDir !== '') fs.rmSync(userDataDir, { recursive: true, force: true });
+}
+
+const deadline = setTimeout(async () => {
+  console.log(`FAILED: the test did not finish within ${kDeadlineMs / 1000} s`);
+  await cleanup();
+  process.exit(1);
+}, kDeadlineMs);
+
+/** Runs a command to its end; resolves with { code, stdout, stderr }. */
+function run(command, args, timeout = 20000) {
+  return new Promise((resolve) => {
+    execFile(command, args, { cwd: root, timeout }, (error, stdout, stderr) => {
+      resolve({ code: error === null ? 0 : (error.code ?? 1), stdout, stderr });
+    });
+  });
+}
+
+/** Starts a child whose output goes to LOG; it is stopped in cleanup(). */
+function start(name, args) {
+  const log = fs.openSync(path.join(scratch, `${name}.log`), 'w');
+  const child = spawn(safecass, args, { cwd: root, stdio: ['ignore', log, log] });
+  fs.closeSync(log);
+  children.push(child);
+  return child;
+}
+
+function logOf(name) {
+  try { return fs.readFileSync(path.join(scratch, `${name}.log`), 'utf8').slice(-3000); } catch { return '(no log)'; }
+}
+
+async function startIceStorm() {
+  const env = path.join(scratch, 'icestorm.env');
+  fs.rmSync(env, { force: true });
+  fs.rmSync(path.join(scratch, 'icestorm'), { recursive: true, force: true });  // no subscribers of an earlier run
+  const r = await run(path.join(root, 'scripts/start-icestorm'), ['--port', '0', '--dir', path.join(scratch, 'icestorm'), '--env', env]);
+  if (fs.existsSync(env)) {
+    const values = Object.fromEntries(fs.readFileSync(env, 'utf8').split('\n').filter((l) => l.includes('='))
+      .map((l) => [l.slice(0, l.indexOf('=')), l.slice(l.indexOf('=') + 1).trim()]));
+    icestormPid = Number(values.ICESTORM_PID ?? 0);
+    if (r.code === 0 && values.ICESTORM_PORT !== undefined) return `127.0.0.1:${values.ICESTORM_PORT}`;
+  }
+  throw new Error(`start-icestorm failed (${r.code}): ${r.stderr}`);
+}
+
+/** Starts a coordinator of robodoc; with a token file, waits until it has written it. */
+async function startCoordinator(name, ice, tokenFile) {
+  const args = ['run', kSystem, '--coordinator', name, '--ice', ice, '--duration', '55'];
+  if (name === 'robot') args.push('--scenario', kQuiet);
+  if (tokenFile !== '') {
+    fs.rmSync(tokenFile, { force: true });
+    args.push('--allow-write', '--token-file', tokenFile);
+  }
+  const child = start(name, args);
+  if (tokenFile === '') return child;
+  for (const until = Date.now() + 15000; !(fs.existsSync(tokenFile) && fs.statSync(tokenFile).size > 0);) {
+    if (!alive(child) || Date.now() > until) throw new Error(`coordinator ${name} did not start:\n${logOf(name)}`);
+    await sleep(50);
+  }
+  return child;
+}
+
+/** Starts the viewer and resolves when it has printed its URL and token. */
+async function startViewer(ice, robotToken) {
+  const viewer = start('viewer', ['viewer', '--ice', ice, '--system', kSystem, '--port', '0', '--allow-write',
+    '--token-file', `robot=${robotToken}`]);
+  for (const until = Date.now() + 15000; ;) {
+    const text = logOf('viewer');
+    const url = /open (http:\/\/127\.0\.0\.1:\d+\/)\n/.exec(text);
+    const token = /the token is in (\S+) \(mode 0600\); or open \S+#token=([0-9a-f]+)/.exec(text);
+    if (url !== null && token !== null && /Ctrl-C stops it/.test(text)) return { viewer, url: url[1], token: token[2], text };
+    if (!alive(viewer) || Date.now() > until) throw new Error(`the viewer did not start:\n${text}`);
+    await sleep(50);
+  }
+}
+
+/** Sends raw messages over a second WebSocket of the page and returns the replies. */
+async function rawExchange(page, messages) {
+  return page.evaluate(async (msgs) => {
+    const ws = new WebSocket(`ws://${location.host}/ws`);
+    const replies = [];
+    await new Promise((resolve, reject) => {
+      ws.onerror = () => reject(new Error('websocket error'));
+      ws.onmessage = (e) => {
+        const m = JSON.parse(e.data);
+        if (m.type === 'hello') {
+          for (const x of msgs) ws.send(x);
+          return;
+        }
+        if (m.type === 'reply' || m.type === 'error') {
+          replies.push(m);
+          if (replies.length === msgs.length) resolve();
+        }
+      };
+    });
+    ws.close();
+    return replies;
+  }, messages);
+}
+
+const stateOf = (page, address) => page.getAttribute(`[data-address="${address}"]`, 'data-state');
+const statusOf = (page, coordinator) => page.textContent(`[data-address="coordinator:${coordinator}"] .event`);
+
+async function waitStatus(page, coordinator, status, timeout) {
+  await page.waitForFunction(([c, s]) => {
+    const el = document.querySelector(`[data-address="coordinator:${c}"] .event`);
+    return el !== null && el.textContent === s;
+  }, [coordinator, status], { timeout });
+}
+
+async function test() {
+  fs.mkdirSync(scratch, { recursive: true });
+  const ice = await startIceStorm();
+  const robotToken = path.join(scratch, 'robot.token');
+  await startCoordinator('robot', ice, robotToken);
+  const { viewer, url, token, text } = await startViewer(ice, robotToken);
+  check(/live: robodoc\.json through IceStorm 127\.0\.0\.1:\d+, coordinators robot, ui/.test(text), 'the viewer says it watches the live system');
+  check(/coordinator ui: unreachable/.test(text), 'the viewer says ui (not started) is unreachable');
+
+  userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'safecass-chromium-'));
+  context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath: kChromium, headless: true, args: kFlags, viewport: { width: 1280, height: 800 },
+  });
+  const page = await context.newPage();
+  const updates = [];
+  page.on('websocket', (ws) => ws.on('framereceived', (frame) => {
+    try {
+      const m = JSON.parse(frame.payload);
+      if (m.type === 'update') updates.push(m);
+    } catch { /* not ours */ }
+  }));
+  await page.goto(url);
+  await page.waitForSelector('#connection.online', { timeout: 10000 });
+  check(await statusOf(page, 'robot') === '', 'the page shows robot answering');
+  check(await statusOf(page, 'ui') === 'unreachable', 'the page shows ui unreachable');
+  check(await page.isVisible('[data-address="PENDANT.s_A"]'),
+    'the page shows the shape of ui (PENDANT and its machines) from the system file');
+
+  // ui starts: it is tried again and shows as answering.
+  const ui = await startCoordinator('ui', ice, '');
+  await waitStatus(page, 'ui', '', 10000).catch(() => {});
+  check(await statusOf(page, 'ui') === '', 'ui answers once its process runs (retried)');
+  for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal at first`);
+
+  // A fault on the robot process, through the console: CONTROL (robot) and PENDANT (ui) turn Error.
+  const firstUpdate = updates.length;  // (a coordinator joining may cause transient states before)
+  const generated = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--allow-write', '--token-file', robotToken,
+    '-c', 'event generate EVT_FORCE_ERROR JR3.s_A']);
+  check(generated.code === 0, `console event generate EVT_FORCE_ERROR JR3.s_A (exit ${generated.code}) ${generated.stderr}`);
+  await page.waitForSelector('.component-name[data-address="CONTROL"].state-Error', { timeout: 5000 }).catch(() => {});
+  await page.waitForSelector('.component-name[data-address="PENDANT"].state-Error', { timeout: 5000 }).catch(() => {});
+  check(await stateOf(page, 'CONTROL') === 'Error', 'CONTROL (robot process) is Error');
+  check(await stateOf(page, 'PENDANT') === 'Error', 'PENDANT (ui process) is Error');
+  check(await stateOf(page, 'JR3.s_A') === 'Error', 'JR3.s_A is Error');
+  check(/EVT_FORCE_ERROR/.test(await page.textContent('[data-address="JR3.s_A"]')), 'JR3.s_A shows its outstanding EVT_FORCE_ERROR');
+  check(await stateOf(page, 'SYSTEM') === 'Error', 'SYSTEM is Error');
+  const listed = await page.textContent('#transitions');
+  check(/PENDANT/.test(listed) && /Normal → Error/.test(listed), 'the side list shows the transitions');
+
+  // The cause of PENDANT, asked from the ui process: the root is JR3.s_A EVT_FORCE_ERROR on robot.
+  await page.click('.component-name[data-address="PENDANT"]');
+  await page.waitForFunction(() => /root cause/.test(document.getElementById('cause').textContent), null, { timeout: 5000 }).catch(() => {});
+  const cause = await page.textContent('#cause');
+  check(/root cause: EVT_FORCE_ERROR at JR3\.s_A/.test(cause), `the cause of PENDANT names JR3.s_A EVT_FORCE_ERROR (${cause.slice(0, 200)})`);
+  fs.mkdirSync(out, { recursive: true });
+  await page.screenshot({ path: path.join(out, 'viewer_ice.png'), fullPage: true });
+
+  // How late was each transition pushed? The update's clock minus the root transition's time:
+  // both the host's monotonic clock (every process of the host shares it).
+  const why = await rawExchange(page, ['{"op":"explain","address":"PENDANT"}', '{"op":"explain","address":"CONTROL"}']);
+  const rootOf = (reply) => {
+    const c = reply.type === 'reply' ? reply.conditions.find((x) => x.root_origin === 'JR3.s_A') : undefined;
+    return c === undefined ? null : c.root_t;
+  };
+  const roots = { PENDANT: rootOf(why[0]), CONTROL: rootOf(why[1]) };
+  check(roots.PENDANT !== null && roots.CONTROL !== null, `explain through the clients gives the root JR3.s_A for PENDANT and CONTROL (${JSON.stringify(roots)})`);
+  for (const component of ['CONTROL', 'PENDANT']) {
+    const u = updates.slice(firstUpdate).find((x) => x.states[component] !== undefined && x.states[component][0] === 'Error');
+    const lag = u === undefined || roots[component] === null ? null : u.t - roots[component];
+    check(lag !== null && lag >= 0 && lag < 0.1, `${component} Error pushed within 100 ms of the root transition (lag ${lag === null ? '?' : (lag * 1000).toFixed(1)} ms)`);
+  }
+
+  // A write on ui is refused: the viewer has no token for that coordinator; nothing changes.
+  const refused = await rawExchange(page, [`{"op":"reset","target":"PENDANT","token":"${token}"}`,
+    '{"op":"generate","event":"/EVT_FORCE_ERROR","target":"JR3.s_A","token":"0000"}']);
+  check(refused[0].type === 'error' && /no token for coordinator 'ui'/.test(refused[0].error), `a write on ui is refused (${refused[0].error})`);
+  check(refused[1].type === 'error' && /wrong token/.test(refused[1].error), 'a write with a wrong viewer token is refused');
+  await sleep(100);
+  check(await stateOf(page, 'PENDANT') === 'Error' && await stateOf(page, 'JR3.s_A') === 'Error', 'refused writes changed nothing');
+
+  // Cleared from the page: the completion event goes to robot with its token.
+  await page.fill('#token', token);
+  await page.fill('#generate-event', '/EVT_FORCE_ERROR');
+  await page.fill('#generate-target', 'JR3.s_A');
+  await page.click('#generate-form button');
+  await page.waitForSelector('#write-result.ok, #write-result.error', { timeout: 5000 });
+  const result = await page.textContent('#write-result');
+  check(/generated \/EVT_FORCE_ERROR on JR3\.s_A \(coordinator robot\)/.test(result), `the page's write goes to robot (${result})`);
+  await page.waitForSelector('.component-name[data-address="PENDANT"].state-Normal', { timeout: 5000 }).catch(() => {});
+  for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal again`);
+
+  // ui stops: the page shows it lost.
+  await stopPid(ui.pid);
+  await waitStatus(page, 'ui', 'lost', 10000).catch(() => {});
+  check(await statusOf(page, 'ui') === 'lost', 'ui shows as lost when its process stops');
+  check(await statusOf(page, 'robot') === '', 'robot still answers');
+
+  const exited = new Promise((resolve) => viewer.on('exit', (code) => resolve(code)));
+  process.kill(viewer.pid, 'SIGTERM');
+  check(await exited === 0, 'the viewer stops cleanly on SIGTERM');
+  await page.close();
+}
+
+try {
+  await test();
+} catch (e) {
+  console.log(`FAILED: ${e.stack ?? e}`);
+  for (const name of ['viewer', 'robot', 'ui']) console.log(`--- ${name} log:\n${logOf(name)}`);
+  failures += 1;
+} finally {
+  await cleanup();
+  clearTimeout(deadline);
+}
+console.log(failures === 0 ? 'viewer --ice test passed' : `viewer --ice test: ${failures} check(s) failed`);
+process.exit(failures === 0 ? 0 : 1);

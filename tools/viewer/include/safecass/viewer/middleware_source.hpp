@@ -1,0 +1,76 @@
+#pragma once
+/// @file middleware_source.hpp
+/// A ViewSource for a live multi-process system: each coordinator of the system file runs as its
+/// own process (`safecass run SYSTEM --coordinator NAME --ice HOST:PORT`) and is reached through
+/// the middleware, one connection per coordinator. Built only with the middleware (ZeroC Ice).
+///
+/// Each coordinator has a thread of its own that connects (finding the coordinator by its
+/// heartbeat on IceStorm), asks it for its state list every `poll` and turns the differences into
+/// records (live_diff.hpp); the server thread takes them in poll(), which never waits on the
+/// network. A coordinator that does not answer is shown with the status "unreachable" (never
+/// answered) or "lost" (answered before), keeps its last known states, and is tried again every
+/// `retry`. Clicking a state (explain) and the write operations go to the coordinator that owns
+/// the target through a second connection of that coordinator, with the request timeout
+/// `timeout`: they are the only calls that wait on the network, and only for as long as a person's
+/// request takes. Writes carry that coordinator's token (--token-file COORD=FILE).
+///
+/// The clock (t) is the host's monotonic clock in seconds, the clock of the coordinators' records
+/// and causes; running() is always true (no scenario ends; the coordinators' statuses say which
+/// of them answer).
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "safecass/viewer/source.hpp"
+
+namespace safecass::viewer {
+
+struct MiddlewareOptions {
+  std::string ice;     ///< IceStorm, "HOST:PORT" or "PORT"
+  std::string system;  ///< the system file: its coordinators and their components
+  /// Coordinator name → its token file (written by `safecass run ... --allow-write --token-file`).
+  std::map<std::string, std::string> token_files;
+  bool allow_write = false;                     ///< without it every write is refused here too
+  std::chrono::milliseconds poll{20};           ///< state-list period per coordinator, 1..50 ms
+  std::chrono::milliseconds timeout{1500};      ///< one request; also the wait for a heartbeat
+  std::chrono::milliseconds retry{500};         ///< pause before trying an unreachable coordinator again
+  std::chrono::milliseconds first_wait{3000};   ///< open() waits at most this for every first answer
+};
+
+class MiddlewareSource final : public ViewSource {
+public:
+  /// Loads the system file, reads the token files and starts one thread per coordinator; waits
+  /// (at most `first_wait`) until every coordinator has answered or failed once. Coordinators that
+  /// do not answer are not an error. Errors: Parse (--ice, the system file: every diagnostic),
+  /// InvalidArgument (a system without coordinators, a token file for an unknown coordinator,
+  /// poll outside 1..50 ms), Io (a token file that cannot be read).
+  static Expected<std::unique_ptr<MiddlewareSource>> open(const MiddlewareOptions& options);
+  /// Stops the threads (each finishes its request in progress, at most `timeout`).
+  ~MiddlewareSource() override;
+  MiddlewareSource(const MiddlewareSource&) = delete;
+  MiddlewareSource& operator=(const MiddlewareSource&) = delete;
+
+  void poll() override;
+  SystemView view() const override;
+  double now() const override;
+  bool running() const override;
+  std::vector<std::string> take_records() override;
+  Expected<std::vector<Explanation>> explain(std::string_view address) const override;
+  Expected<std::string> generate(std::string_view event, std::string_view target) override;
+  Expected<std::string> broadcast(std::string_view event) override;
+  Expected<std::string> inject(const InjectRequest& request) override;
+  Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+
+  /// The status of a coordinator: "" (answering), "connecting", "unreachable" or "lost".
+  /// For tests and the start-up message.
+  std::string status(std::string_view coordinator) const;
+
+private:
+  struct Impl;
+  explicit MiddlewareSource(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace safecass::viewer

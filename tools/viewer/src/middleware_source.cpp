@@ -1,0 +1,462 @@
+#include "safecass/viewer/middleware_source.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <condition_variable>
+#include <cstdio>
+#include <mutex>
+#include <thread>
+#include <utility>
+
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/middleware/client.hpp"
+#include "safecass/middleware/node.hpp"
+#include "safecass/middleware/token.hpp"
+#include "safecass/spec/load.hpp"
+#include "safecass/viewer/live_diff.hpp"
+
+namespace safecass::viewer {
+
+namespace {
+
+using middleware::RemoteClient;
+
+/// Records waiting for take_records() beyond this are dropped and counted.
+constexpr std::size_t kMaxPendingRecords = 100000;
+
+/// The host's monotonic clock in seconds: the clock of every coordinator process of this host
+/// (middleware::HostClock), so records, causes and the page's clock agree.
+double host_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+std::string seconds_text(double t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.3f", t);
+  return buf;
+}
+
+std::string file_name(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+std::string component_of(std::string_view address) { return std::string(address.substr(0, address.find('.'))); }
+
+}  // namespace
+
+/// One coordinator of the system: its shape (built locally), what its thread last learnt, and
+/// the connection the server thread uses for explain and writes.
+struct MiddlewareLink {
+  std::string name;
+  std::string token;  ///< empty without --token-file for it
+  std::unique_ptr<Coordinator> local;
+  std::unique_ptr<Monitor> monitor;  ///< the local model's filters and signals (for routing)
+  std::vector<std::string> components;
+  std::thread thread;
+
+  // Shared with the thread; guarded by Impl::mutex.
+  std::vector<LiveRow> rows;
+  std::string status = "connecting";
+  bool tried = false;
+  std::shared_ptr<RemoteClient> requests;
+
+  // The server thread's copy, refreshed in poll().
+  std::vector<LiveRow> shown_rows;
+  std::string shown_status = "connecting";
+};
+
+struct MiddlewareSource::Impl {
+  MiddlewareOptions options;
+  middleware::IceEndpoint ice;
+  FilterRegistry registry;  // outlives the local monitors
+  std::string system_name;
+  std::string description;
+  std::vector<std::unique_ptr<MiddlewareLink>> links;
+
+  mutable std::mutex mutex;
+  std::condition_variable wake;  ///< stop requested, or a first answer arrived
+  bool stop = false;
+  std::vector<std::string> pending;
+  std::uint64_t dropped = 0;
+  std::uint64_t version = 0;  ///< bumped whenever a link's rows or status change
+  std::uint64_t shown_version = 0;
+  std::vector<std::string> taken;  ///< server thread: records handed over by poll()
+
+  ~Impl() {
+    {
+      std::lock_guard lock(mutex);
+      stop = true;
+    }
+    wake.notify_all();
+    for (auto& l : links) {
+      if (l->thread.joinable()) l->thread.join();
+    }
+  }
+
+  void push(std::string record) {  // under mutex
+    if (pending.size() >= kMaxPendingRecords) {
+      ++dropped;
+      return;
+    }
+    pending.push_back(std::move(record));
+  }
+
+  void set_status(MiddlewareLink& l, const std::string& status, const std::string& detail) {  // under mutex
+    if (l.status == status) return;
+    l.status = status;
+    ++version;
+    push(coordinator_record(l.name, status.empty() ? "answering" : detail.empty() ? status : status + ": " + detail,
+                            host_seconds()));
+  }
+
+  Expected<std::unique_ptr<RemoteClient>> connect(const MiddlewareLink& l) const {
+    middleware::ClientOptions o;
+    o.ice = ice;
+    o.coordinator = l.name;
+    o.token = l.token;
+    o.timeout = options.timeout;
+    return RemoteClient::connect(o);
+  }
+
+  /// Sleeps `d` unless stopped; returns false when stopped.
+  bool pause(std::chrono::milliseconds d) {
+    std::unique_lock lock(mutex);
+    return !wake.wait_for(lock, d, [&] { return stop; });
+  }
+
+  bool stopping() const {
+    std::lock_guard lock(mutex);
+    return stop;
+  }
+
+  /// The thread of one coordinator: connect, then poll its state list until stopped.
+  void follow(MiddlewareLink& l) {
+    std::unique_ptr<RemoteClient> poller;
+    bool answered = false;
+    while (!stopping()) {
+      if (!poller) {
+        auto c = connect(l);
+        Expected<std::unique_ptr<RemoteClient>> r = c ? connect(l) : Expected<std::unique_ptr<RemoteClient>>(tl::unexpected(c.error()));
+        if (!c || !r) {
+          {
+            std::lock_guard lock(mutex);
+            set_status(l, answered ? "lost" : "unreachable", (!c ? c.error() : r.error()).message);
+            l.tried = true;
+          }
+          wake.notify_all();
+          if (!pause(options.retry)) return;
+          continue;
+        }
+        poller = std::move(*c);
+        std::lock_guard lock(mutex);
+        l.requests = std::shared_ptr<RemoteClient>(std::move(*r));
+      }
+      auto answer = poller->state_list();
+      if (!answer) {
+        poller.reset();
+        std::lock_guard lock(mutex);
+        l.requests.reset();
+        set_status(l, "lost", answer.error().message);
+        continue;
+      }
+      answered = true;
+      std::vector<LiveRow> rows;
+      rows.reserve(answer->size());
+      for (middleware::StateRow& r : *answer) rows.push_back({std::move(r.address), std::move(r.kind), r.state, std::move(r.outstanding)});
+      {
+        std::lock_guard lock(mutex);
+        set_status(l, "", {});
+        if (rows != l.rows) {
+          for (std::string& r : diff_records(l.rows, rows, host_seconds())) push(std::move(r));
+          l.rows = std::move(rows);
+          ++version;
+        }
+        l.tried = true;
+      }
+      wake.notify_all();
+      if (!pause(options.poll)) return;
+    }
+  }
+
+  MiddlewareLink* owner(std::string_view address) const {
+    const std::string component = component_of(address);
+    for (const auto& l : links) {
+      if (std::find(l->components.begin(), l->components.end(), component) != l->components.end()) return l.get();
+    }
+    return nullptr;
+  }
+
+  MiddlewareLink* link_named(std::string_view name) const {
+    for (const auto& l : links) {
+      if (l->name == name) return l.get();
+    }
+    return nullptr;
+  }
+
+  /// The request connection of `l`, or an Io error saying that it does not answer.
+  Expected<std::shared_ptr<RemoteClient>> requests(const MiddlewareLink& l) const {
+    std::lock_guard lock(mutex);
+    if (!l.requests) {
+      return fail(ErrorCode::Io, "coordinator '" + l.name + "' is " + (l.status.empty() ? std::string("not connected") : l.status) +
+                                     " (IceStorm " + options.ice + ")");
+    }
+    return l.requests;
+  }
+
+  /// The request connection of the coordinator owning `target` for a write.
+  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer(std::string_view target, std::string_view what) const {
+    if (!options.allow_write) return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
+    MiddlewareLink* l = owner(target);
+    if (l == nullptr) {
+      return fail(ErrorCode::NotFound, std::string(what) + ": no component '" + component_of(target) + "' in system '" +
+                                           system_name + "' (target '" + std::string(target) + "')");
+    }
+    return writer_of(*l);
+  }
+
+  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer_of(MiddlewareLink& l) const {
+    if (!options.allow_write) return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
+    if (l.token.empty()) {
+      return fail(ErrorCode::Denied, "refused: no token for coordinator '" + l.name + "' (start the viewer with --token-file " +
+                                         l.name + "=FILE, the file its `safecass run --allow-write --token-file` wrote)");
+    }
+    auto c = requests(l);
+    if (!c) return tl::unexpected(c.error());
+    return std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>{&l, *c};
+  }
+};
+
+MiddlewareSource::MiddlewareSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+MiddlewareSource::~MiddlewareSource() = default;
+
+Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const MiddlewareOptions& options) {
+  if (options.poll < std::chrono::milliseconds(1) || options.poll > std::chrono::milliseconds(50)) {
+    return fail(ErrorCode::InvalidArgument, "the poll period must be 1 to 50 ms");
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->options = options;
+  auto ice = middleware::parse_ice_endpoint(options.ice);
+  if (!ice) return fail(ErrorCode::Parse, ice.error().message);  // it names --ice and the text
+  impl->ice = *ice;
+  if (options.system.empty()) return fail(ErrorCode::InvalidArgument, "--ice needs the system file (--system)");
+  register_builtin_filters(impl->registry);
+  spec::LoadResult loaded = spec::load_system(options.system, impl->registry);
+  if (!loaded.ok() || !loaded.system) {
+    std::string text;
+    for (const spec::Diagnostic& d : loaded.diagnostics) {
+      if (d.severity == spec::Diagnostic::Severity::Error) text += (text.empty() ? "" : "\n") + spec::format(d);
+    }
+    return fail(ErrorCode::Parse, text.empty() ? "cannot load system '" + options.system + "'" : text);
+  }
+  const spec::SystemSpec& system = *loaded.system;
+  if (system.coordinators.empty()) {
+    return fail(ErrorCode::InvalidArgument, "system '" + system.name + "' (" + options.system +
+                                                ") has no \"coordinators\": it runs as one process; view it in-process (--system without --ice)");
+  }
+  impl->system_name = system.name;
+  std::string names;
+  for (const auto& [name, components] : system.coordinators) {
+    auto l = std::make_unique<MiddlewareLink>();
+    l->name = name;
+    l->components = components;
+    l->local = std::make_unique<Coordinator>(name);
+    l->monitor = std::make_unique<Monitor>(*l->local, impl->registry);
+    if (auto r = spec::instantiate(system, *l->local, *l->monitor, name); !r) {
+      return fail(r.error().code, "coordinator '" + name + "' of " + options.system + ": " + r.error().message);
+    }
+    l->rows = skeleton_rows(*l->local);
+    l->shown_rows = l->rows;
+    names += (names.empty() ? "" : ", ") + name;
+    impl->links.push_back(std::move(l));
+  }
+  for (const auto& [name, path] : options.token_files) {
+    MiddlewareLink* l = impl->link_named(name);
+    if (l == nullptr) {
+      return fail(ErrorCode::InvalidArgument, "--token-file " + name + "=" + path + ": system '" + system.name +
+                                                  "' has no coordinator '" + name + "' (it has " + names + ")");
+    }
+    auto token = middleware::read_token_file(path);
+    if (!token) return fail(token.error().code, "--token-file " + name + "=" + path + ": " + token.error().message);
+    l->token = *token;
+  }
+  impl->description = "live: " + file_name(options.system) + " through IceStorm " + impl->ice.host + ":" +
+                      std::to_string(impl->ice.port) + ", coordinators " + names;
+
+  Impl* self = impl.get();
+  for (auto& l : impl->links) {
+    MiddlewareLink* link = l.get();
+    l->thread = std::thread([self, link] { self->follow(*link); });
+  }
+  {
+    std::unique_lock lock(impl->mutex);
+    impl->wake.wait_for(lock, options.first_wait, [&] {
+      return std::all_of(impl->links.begin(), impl->links.end(), [](const auto& l) { return l->tried; });
+    });
+  }
+  auto source = std::unique_ptr<MiddlewareSource>(new MiddlewareSource(std::move(impl)));
+  source->poll();
+  return source;
+}
+
+void MiddlewareSource::poll() {
+  Impl& m = *impl_;
+  std::lock_guard lock(m.mutex);
+  if (m.taken.empty()) {
+    m.taken.swap(m.pending);
+  } else {
+    for (std::string& r : m.pending) m.taken.push_back(std::move(r));
+    m.pending.clear();
+  }
+  if (m.dropped != 0) {
+    m.taken.push_back("{\"kind\":\"overflow\",\"dropped\":" + std::to_string(m.dropped) + "}");
+    m.dropped = 0;
+  }
+  if (m.version == m.shown_version) return;
+  for (auto& l : m.links) {
+    l->shown_rows = l->rows;
+    l->shown_status = l->status;
+  }
+  m.shown_version = m.version;
+}
+
+SystemView MiddlewareSource::view() const {
+  SystemView v;
+  v.system = impl_->system_name;
+  v.description = impl_->description;
+  v.t = now();
+  v.running = running();
+  for (const auto& l : impl_->links) {
+    CoordinatorView cv = coordinator_view(l->name, l->shown_rows);
+    cv.status = l->shown_status;
+    v.state = std::max(v.state, cv.state);
+    v.coordinators.push_back(std::move(cv));
+  }
+  return v;
+}
+
+double MiddlewareSource::now() const { return host_seconds(); }
+
+bool MiddlewareSource::running() const { return true; }  // a live system has no scenario that ends
+
+std::vector<std::string> MiddlewareSource::take_records() {
+  std::vector<std::string> out;
+  out.swap(impl_->taken);
+  return out;
+}
+
+std::string MiddlewareSource::status(std::string_view coordinator) const {
+  std::lock_guard lock(impl_->mutex);
+  const MiddlewareLink* l = impl_->link_named(coordinator);
+  return l == nullptr ? std::string("unknown") : l->status;
+}
+
+Expected<std::vector<Explanation>> MiddlewareSource::explain(std::string_view address) const {
+  const Impl& m = *impl_;
+  std::vector<Explanation> all;
+  auto add = [&](const MiddlewareLink& l, const std::string& a) -> Expected<void> {
+    auto c = m.requests(l);
+    if (!c) return tl::unexpected(c.error());
+    auto part = (*c)->explain(a);
+    if (!part) return tl::unexpected(part.error());
+    all.insert(all.end(), part->begin(), part->end());
+    return {};
+  };
+  if (address == "SYSTEM") {  // every coordinator that answers
+    bool any = false;
+    for (const auto& l : m.links) {
+      for (const std::string& c : l->components) {
+        if (auto r = add(*l, c); !r) break;
+        any = true;
+      }
+    }
+    if (!any) return fail(ErrorCode::Io, "no coordinator of system '" + m.system_name + "' answers");
+    return all;
+  }
+  if (address.substr(0, 12) == "coordinator:") {
+    const MiddlewareLink* l = m.link_named(address.substr(12));
+    if (l == nullptr) return fail(ErrorCode::NotFound, "no coordinator '" + std::string(address.substr(12)) + "'");
+    for (const std::string& c : l->components) {
+      if (auto r = add(*l, c); !r) return tl::unexpected(r.error());
+    }
+    return all;
+  }
+  const MiddlewareLink* l = m.owner(address);
+  if (l == nullptr) {
+    return fail(ErrorCode::NotFound, "no component '" + component_of(address) + "' in system '" + m.system_name + "' (address '" +
+                                         std::string(address) + "')");
+  }
+  if (auto r = add(*l, std::string(address)); !r) return tl::unexpected(r.error());
+  return all;
+}
+
+Expected<std::string> MiddlewareSource::generate(std::string_view event, std::string_view target) {
+  auto w = impl_->writer(target, "event generate");
+  if (!w) return tl::unexpected(w.error());
+  if (auto r = w->second->generate(std::string(event), std::string(target)); !r) return tl::unexpected(r.error());
+  return "generated " + std::string(event) + " on " + std::string(target) + " (coordinator " + w->first->name +
+         ") at t=" + seconds_text(now());
+}
+
+Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
+  // Every coordinator defines every event of the system, so the first refusal (an unknown event,
+  // a wrong token) comes before anything was changed.
+  std::string done;
+  std::string failed;
+  for (auto& l : impl_->links) {
+    auto w = impl_->writer_of(*l);
+    auto r = w ? w->second->broadcast(std::string(event)) : Expected<void>(tl::unexpected(w.error()));
+    if (!r) {
+      if (done.empty()) return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message);
+      failed += "; not on " + l->name + ": " + r.error().message;
+      continue;
+    }
+    done += (done.empty() ? "" : ", ") + l->name;
+  }
+  return "broadcast " + std::string(event) + " on coordinators " + done + " at t=" + seconds_text(now()) + failed;
+}
+
+Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
+  if (request.samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
+  const std::string n = std::to_string(request.samples.size()) + (request.samples.size() == 1 ? " sample" : " samples");
+  MiddlewareLink* owner = nullptr;
+  if (request.deep) {
+    owner = impl_->owner(request.target);
+    if (owner == nullptr || owner->monitor->signals().find(request.target) == nullptr) {
+      return fail(ErrorCode::NotFound, "no signal '" + request.target + "' (signals are written Component.signal)");
+    }
+  } else {
+    for (auto& l : impl_->links) {
+      if (l->monitor->find_filter(request.target) != nullptr) owner = l.get();
+    }
+    if (owner == nullptr) return fail(ErrorCode::NotFound, "no filter '" + request.target + "'");
+  }
+  auto w = impl_->writer_of(*owner);
+  if (!w) return tl::unexpected(w.error());
+  auto r = request.deep ? w->second->filter_dinject(request.target, request.samples)
+                        : w->second->filter_inject(request.target, request.samples);
+  if (!r) return tl::unexpected(r.error());
+  return (request.deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + request.target +
+         " (coordinator " + owner->name + ") at t=" + seconds_text(now());
+}
+
+Expected<std::string> MiddlewareSource::reset(std::string_view target, std::string_view reason) {
+  if (target == "SYSTEM") {
+    std::string done;
+    for (auto& l : impl_->links) {
+      auto w = impl_->writer_of(*l);
+      auto r = w ? w->second->reset("SYSTEM", "viewer", std::string(reason)) : Expected<void>(tl::unexpected(w.error()));
+      if (!r) return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message + (done.empty() ? "" : " (reset done on " + done + ")"));
+      done += (done.empty() ? "" : ", ") + l->name;
+    }
+    return "reset SYSTEM (coordinators " + done + ") at t=" + seconds_text(now()) + " (" + std::string(reason) + ")";
+  }
+  auto w = impl_->writer(target, "reset");
+  if (!w) return tl::unexpected(w.error());
+  if (auto r = w->second->reset(std::string(target), "viewer", std::string(reason)); !r) return tl::unexpected(r.error());
+  return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at t=" + seconds_text(now()) + " (" +
+         std::string(reason) + ")";
+}
+
+}  // namespace safecass::viewer
