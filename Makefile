@@ -68,7 +68,8 @@ asan: deps
 tsan: deps
 	@test -f $(BUILD)/tsan/build.ninja || cmake --preset tsan >/dev/null
 	@cmake --build $(BUILD)/tsan -j $(JOBS)
-	@ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+	@TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}" \
+	  ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(CTEST_ARGS)
 
 clean:
 	rm -rf $(BUILD)

@@ -101,7 +101,7 @@ def main():
               "explain CONTROL names the root cause and its path", out)
         code, out, err = system.console("-c", "state history JR3.s_A 5; event history 3; bogus; state list NOPE")
         check(code == 2, "a bad command in -c makes the exit code 2", code, out, err)
-        check("JR3.s_A  Normal -> Error  EVT_FORCE_ERROR" in out, "state history shows the transition", out)
+        check("JR3.s_A  Normal -> Error  EVT_FORCE_ERROR" in out, "state history shows the transition", out, err)
         check("raised EVT_FORCE_ERROR" in out, "event history shows the event", out)
         check("unknown command 'bogus' (usage: help [COMMAND])" in err and "state list: " in err and "NOPE" in err,
               "bad commands get usage lines", err)

@@ -61,8 +61,11 @@ class LiveSystem:
             return "(no log)"
 
     def console(self, *args, timeout=20):
-        """Runs `safecass console --ice ... --coordinator robot ARGS`; returns (code, stdout, stderr)."""
-        command = [self.binary, "console", "--ice", self.ice, "--coordinator", "robot", *args]
+        """Runs `safecass console --ice ... --coordinator robot ARGS`; returns (code, stdout, stderr).
+
+        Waits up to 5 s for each answer (the default 2 s is too short for a loaded machine or a
+        sanitizer build, where a reply can take longer and the console then prints nothing)."""
+        command = [self.binary, "console", "--ice", self.ice, "--coordinator", "robot", "--timeout", "5000", *args]
         done = subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=self.source)
         return done.returncode, done.stdout, done.stderr
 

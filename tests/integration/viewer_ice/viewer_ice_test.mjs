@@ -273,8 +273,14 @@ async function test() {
   await page.waitForSelector('#write-result.ok, #write-result.error', { timeout: 5000 });
   const result = await page.textContent('#write-result');
   check(/generated \/EVT_FORCE_ERROR on JR3\.s_A \(coordinator robot\)/.test(result), `the page's write goes to robot (${result})`);
-  await page.waitForSelector('.component-name[data-address="PENDANT"].state-Normal', { timeout: 5000 }).catch(() => {});
-  for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal again`);
+  // Each coordinator is polled by its own thread: PENDANT (ui) can reach the page before CONTROL
+  // and JR3 (robot) do, so wait for all of them, not for PENDANT alone.
+  const cleared = ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM'];
+  await page.waitForFunction((addresses) => addresses.every((a) => {
+    const el = document.querySelector(`[data-address="${a}"]`);
+    return el !== null && el.getAttribute('data-state') === 'Normal';
+  }), cleared, { timeout: 5000 }).catch(() => {});
+  for (const a of cleared) check(await stateOf(page, a) === 'Normal', `${a} is Normal again`);
 
   // ui stops: the page shows it lost.
   await stopPid(ui.pid);

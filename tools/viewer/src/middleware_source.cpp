@@ -137,8 +137,11 @@ struct MiddlewareSource::Impl {
     bool answered = false;
     while (!stopping()) {
       if (!poller) {
+        // Two clients: `c` polls on this thread, `r` serves explain and writes for the server
+        // thread (a RemoteClient is used by one thread at a time).
         auto c = connect(l);
-        Expected<std::unique_ptr<RemoteClient>> r = c ? connect(l) : Expected<std::unique_ptr<RemoteClient>>(tl::unexpected(c.error()));
+        Expected<std::unique_ptr<RemoteClient>> r =
+            c ? connect(l) : Expected<std::unique_ptr<RemoteClient>>(tl::unexpected(c.error()));
         if (!c || !r) {
           {
             std::lock_guard lock(mutex);
