@@ -10,22 +10,17 @@
 // usage: node browser_test.mjs SAFECASS SOURCE_DIR OUT_DIR
 
 import { spawn, execFileSync } from 'node:child_process';
-import { createRequire } from 'node:module';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
+
+import { launchChromium, rawExchange } from './chromium.mjs';
 
 const [safecass, root, out] = process.argv.slice(2);
 if (!safecass || !root || !out) {
   console.error('usage: node browser_test.mjs SAFECASS SOURCE_DIR OUT_DIR');
   process.exit(2);
 }
-const require = createRequire(path.join(root, 'web', 'package.json'));
-const { chromium } = require('playwright-core');
 
-const kChromium = '/usr/bin/chromium';
-const kFlags = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--no-first-run'];
 const kDeadlineMs = 55000;
 
 let viewer = null;        // the child process
@@ -82,29 +77,6 @@ function startViewer() {
   });
 }
 
-/** Sends raw messages over a second WebSocket of the page and returns the replies. */
-async function rawExchange(page, messages) {
-  return page.evaluate(async (msgs) => {
-    const ws = new WebSocket(`ws://${location.host}/ws`);
-    const replies = [];
-    await new Promise((resolve, reject) => {
-      ws.onerror = () => reject(new Error('websocket error'));
-      ws.onmessage = (e) => {
-        const m = JSON.parse(e.data);
-        if (m.type === 'hello') {
-          for (const x of msgs) ws.send(x);
-          return;
-        }
-        if (m.type === 'reply' || m.type === 'error') {
-          replies.push(m);
-          if (replies.length === msgs.length) resolve();
-        }
-      };
-    });
-    ws.close();
-    return replies;
-  }, messages);
-}
 
 async function testViewer() {
   const { url, tokenFile, fragmentToken } = await startViewer();
@@ -225,10 +197,7 @@ async function testTimeline() {
 }
 
 try {
-  userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'safecass-chromium-'));
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath: kChromium, headless: true, args: kFlags, viewport: { width: 1280, height: 800 },
-  });
+  ({ context, userDataDir } = await launchChromium(root));
   await testViewer();
   await testTimeline();
 } catch (e) {

@@ -14,22 +14,17 @@
 // usage: node viewer_ice_test.mjs SAFECASS SOURCE_DIR OUT_DIR
 
 import { spawn, execFile } from 'node:child_process';
-import { createRequire } from 'node:module';
 import fs from 'node:fs';
-import os from 'node:os';
 import path from 'node:path';
+
+import { launchChromium, rawExchange } from '../../browser/chromium.mjs';
 
 const [safecass, root, out] = process.argv.slice(2);
 if (!safecass || !root || !out) {
   console.error('usage: node viewer_ice_test.mjs SAFECASS SOURCE_DIR OUT_DIR');
   process.exit(2);
 }
-const require = createRequire(path.join(root, 'web', 'package.json'));
-const { chromium } = require('playwright-core');
 
-const kChromium = '/usr/bin/chromium';
-const kFlags = ['--headless', '--no-sandbox', '--disable-gpu', '--disable-background-networking',
-  '--disable-component-update', '--disable-sync', '--no-first-run'];
 const kDeadlineMs = 58000;
 const kSystem = path.join(root, 'examples/robodoc/robodoc.json');
 const kQuiet = path.join(root, 'tests/integration/console_ice/robot_quiet.json');
@@ -151,29 +146,6 @@ async function startViewer(ice, robotToken) {
   }
 }
 
-/** Sends raw messages over a second WebSocket of the page and returns the replies. */
-async function rawExchange(page, messages) {
-  return page.evaluate(async (msgs) => {
-    const ws = new WebSocket(`ws://${location.host}/ws`);
-    const replies = [];
-    await new Promise((resolve, reject) => {
-      ws.onerror = () => reject(new Error('websocket error'));
-      ws.onmessage = (e) => {
-        const m = JSON.parse(e.data);
-        if (m.type === 'hello') {
-          for (const x of msgs) ws.send(x);
-          return;
-        }
-        if (m.type === 'reply' || m.type === 'error') {
-          replies.push(m);
-          if (replies.length === msgs.length) resolve();
-        }
-      };
-    });
-    ws.close();
-    return replies;
-  }, messages);
-}
 
 const stateOf = (page, address) => page.getAttribute(`[data-address="${address}"]`, 'data-state');
 const statusOf = (page, coordinator) => page.textContent(`[data-address="coordinator:${coordinator}"] .event`);
@@ -194,10 +166,7 @@ async function test() {
   check(/live: robodoc\.json through IceStorm 127\.0\.0\.1:\d+, coordinators robot, ui/.test(text), 'the viewer says it watches the live system');
   check(/coordinator ui: unreachable/.test(text), 'the viewer says ui (not started) is unreachable');
 
-  userDataDir = fs.mkdtempSync(path.join(os.tmpdir(), 'safecass-chromium-'));
-  context = await chromium.launchPersistentContext(userDataDir, {
-    executablePath: kChromium, headless: true, args: kFlags, viewport: { width: 1280, height: 800 },
-  });
+  ({ context, userDataDir } = await launchChromium(root));
   const page = await context.newPage();
   const updates = [];
   page.on('websocket', (ws) => ws.on('framereceived', (frame) => {
