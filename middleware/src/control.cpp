@@ -54,24 +54,7 @@ std::string param_text(const ParamValue& v) {
 wire::RecordEntry entry(const Coordinator& co, const Record& r) {
   wire::RecordEntry e;
   e.seq = static_cast<long long>(r.seq);
-  e.time = r.time.count();
-  e.kind = std::string(to_string(r.kind));
-  e.outcome = std::string(outcome_text(r.outcome));
-  if (r.machine != kNoMachine) {
-    e.address = co.address_of(r.machine);
-  } else if (r.component != kNoComponent) {
-    e.address = std::string(co.component_name(r.component));
-  }
-  if (r.event != kNoEvent) e.event = co.event(r.event).name;
-  e.from = to_wire(r.from);
-  e.to = to_wire(r.to);
-  e.level = to_wire(r.level);
-  e.mirror = r.mirror;
-  if (r.root.event != kNoEvent) {
-    e.rootEvent = co.event(r.root.event).name;
-    e.rootOrigin = co.root_origin(r.root);
-  }
-  e.text = std::string(r.text);
+  fill_record(co, r, e);
   return e;
 }
 

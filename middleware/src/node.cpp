@@ -228,24 +228,7 @@ struct CoordinatorNode::Impl {
     m.coordinator = name;
     m.incarnation = incarnation;
     m.seq = ++event_seq;
-    m.kind = std::string(to_string(r.kind));
-    m.outcome = std::string(outcome_text(r.outcome));
-    if (r.machine != kNoMachine) {
-      m.address = co.address_of(r.machine);
-    } else if (r.component != kNoComponent) {
-      m.address = std::string(co.component_name(r.component));
-    }
-    if (r.event != kNoEvent) m.event = co.event(r.event).name;
-    m.from = to_wire(r.from);
-    m.to = to_wire(r.to);
-    m.level = to_wire(r.level);
-    m.mirror = r.mirror;
-    if (r.root.event != kNoEvent) {
-      m.rootEvent = co.event(r.root.event).name;
-      m.rootOrigin = co.root_origin(r.root);
-    }
-    m.time = r.time.count();
-    m.text = std::string(r.text);
+    fill_record(co, r, m);
     return m;
   }
 

@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <set>
 #include <thread>
@@ -654,14 +653,8 @@ int run_timeline_ice(const std::string& ice, const std::string& coordinator, con
     }
     return 2;
   }
-  const std::string page = render_timeline_page(parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")");
-  std::ofstream out(html_out, std::ios::binary | std::ios::trunc);
-  if (out) out.write(page.data(), static_cast<std::streamsize>(page.size()));
-  if (out) out.close();
-  if (!out) {
-    std::fprintf(stderr, "safecass timeline: cannot write '%s'\n", html_out.c_str());
-    return 2;
-  }
+  const int written = write_timeline_page(parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
+  if (written != 0) return written;
   std::fprintf(stderr, "safecass timeline: %zu records of coordinator '%s' drawn in %s\n", parsed.records.size(),
                coordinator.c_str(), html_out.c_str());
   return 0;

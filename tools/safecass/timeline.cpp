@@ -690,7 +690,11 @@ int run_timeline(const std::string& history, const std::string& html_out) {
   }
   std::string title = history;
   if (const auto slash = title.find_last_of('/'); slash != std::string::npos) title.erase(0, slash + 1);
-  const std::string page = render_timeline_page(parsed.records, title);
+  return write_timeline_page(parsed.records, title, html_out);
+}
+
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out) {
+  const std::string page = render_timeline_page(records, title);
   std::ofstream out(html_out, std::ios::binary | std::ios::trunc);
   if (out) out.write(page.data(), static_cast<std::streamsize>(page.size()));
   if (out) out.close();

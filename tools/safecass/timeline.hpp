@@ -77,4 +77,8 @@ std::string render_timeline_page(const std::vector<HistoryRecord>& records, cons
 /// has a malformed line (each printed as "HISTORY:LINE: error: message"), or OUT cannot be written.
 int run_timeline(const std::string& history, const std::string& html_out);
 
+/// Renders `records` and writes the page to `html_out`. Returns 0, or 2 after printing
+/// "safecass timeline: cannot write ..." to stderr.
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out);
+
 }  // namespace safecass::tools
