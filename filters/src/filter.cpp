@@ -14,20 +14,16 @@ Filter::Filter(FilterInit init)
       outputs_(std::move(init.outputs)),
       onset_(init.onset),
       completion_(init.completion),
-      name_id_(init.name_id),
-      enabled_(config_.enabled) {
+      name_id_(init.name_id) {
+  detour_.store(static_cast<std::uint8_t>((config_.enabled ? 0 : kDisabled) | (inputs_.size() == 1 ? 0 : kSeveralInputs)));
   cursors_.reserve(inputs_.size());
   for (Signal* s : inputs_) {
     cursors_.emplace_back(s);
     cursors_.back().skip_to_end();
-    held_offset_.push_back(held_.size());
-    held_.resize(held_.size() + s->size(), 0.0);
   }
-  has_held_.assign(inputs_.size(), 0);
   invalid_.assign(inputs_.size(), 0);
   pending_.resize(inputs_.size());
   has_pending_.assign(inputs_.size(), 0);
-  if (!inputs_.empty()) injected_scratch_.assign(inputs_[0]->size(), 0.0);
 }
 
 std::uint64_t Filter::missed_samples() const noexcept {
@@ -37,15 +33,16 @@ std::uint64_t Filter::missed_samples() const noexcept {
 }
 
 void Filter::run_general(Time now) noexcept {
-  if (!enabled()) {
-    was_enabled_ = false;
+  const std::uint8_t detour = detour_.load(std::memory_order_acquire);
+  if ((detour & kDisabled) != 0) {
+    if ((detour & kReenabled) == 0) detour_.fetch_or(kReenabled, std::memory_order_acq_rel);
     return;
   }
-  if (!was_enabled_) {
+  if ((detour & kReenabled) != 0) {
     for (SignalCursor& c : cursors_) c.skip_to_end();
-    was_enabled_ = true;
+    detour_.fetch_and(static_cast<std::uint8_t>(~kReenabled), std::memory_order_acq_rel);
   }
-  const bool injected_run = injection_pending_.load(std::memory_order_acquire) && run_injection(now);
+  const bool injected_run = (detour & kInjection) != 0 && run_injection(now);
   if (inputs_.size() == 1) {
     // The hot path: one input, its new samples in order.
     if (!injected_run) cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
@@ -53,23 +50,24 @@ void Filter::run_general(Time now) noexcept {
     run_merged(injected_run);
   }
   current_injected_ = false;
-  on_tick(now);
+  if (ticks_) on_tick(now);
 }
 
 bool Filter::run_injection(Time now) noexcept {
+  const double* staged;
   {
     std::lock_guard lock(injection_mutex_);
     if (injections_.empty()) {
-      injection_pending_.store(false, std::memory_order_release);
+      detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
       return false;
     }
-    std::copy(injections_.front().begin(), injections_.front().end(), injected_scratch_.begin());
+    staged = cursors_[0].stage(injections_.front().data());
     injections_.pop_front();
-    injection_pending_.store(!injections_.empty(), std::memory_order_release);
+    if (injections_.empty()) detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
   }
   // A shallow injection replaces the first input's samples for this run.
   cursors_[0].skip_to_end();
-  deliver(0, SampleView{now, injected_scratch_.data(), injected_scratch_.size(), true});
+  deliver(0, SampleView{now, staged, inputs_[0]->size(), true});
   return true;
 }
 
@@ -101,7 +99,7 @@ Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
   }
   std::lock_guard lock(injection_mutex_);
   injections_.insert(injections_.end(), samples.begin(), samples.end());
-  injection_pending_.store(!injections_.empty(), std::memory_order_release);
+  if (!injections_.empty()) detour_.fetch_or(kInjection, std::memory_order_acq_rel);
   return {};
 }
 
@@ -109,7 +107,7 @@ void Filter::reset() noexcept {
   detected_.store(false, std::memory_order_release);
   std::fill(invalid_.begin(), invalid_.end(), 0);
   invalid_count_ = 0;
-  std::fill(has_held_.begin(), has_held_.end(), 0);
+  for (SignalCursor& c : cursors_) c.forget();
   on_reset();
 }
 

@@ -1,5 +1,7 @@
 #include "safecass/filters/signal.hpp"
 
+#include <algorithm>
+
 namespace safecass {
 
 namespace {
@@ -57,7 +59,12 @@ bool Signal::latest(Time& time, double* out, bool* injected) const noexcept {
 }
 
 SignalCursor::SignalCursor(const Signal* signal)
-    : signal_(signal), scratch_(signal != nullptr ? signal->size() : 0) {}
+    : signal_(signal), scratch_(signal != nullptr ? 2 * signal->size() : 0), reading_(scratch_.data()) {}
+
+const double* SignalCursor::stage(const double* values) noexcept {
+  std::copy(values, values + signal_->size(), reading_);
+  return reading_;
+}
 
 bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexcept {
   for (;;) {
@@ -69,7 +76,7 @@ bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexce
     }
     std::uint64_t key = 0;
     Time t{};
-    if (!inj.read(injected_next_, t, scratch_.data(), &key)) {
+    if (!inj.read(injected_next_, t, reading_, &key)) {
       ++missed_;  // overwritten while we copied it
       ++injected_next_;
       continue;
@@ -82,8 +89,8 @@ bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexce
     }
     ++injected_next_;
     out.time = t;
-    out.data = scratch_.data();
-    out.size = scratch_.size();
+    out.data = reading_;
+    out.size = signal_->size();
     out.injected = true;
     return true;
   }

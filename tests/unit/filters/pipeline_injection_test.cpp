@@ -89,6 +89,28 @@ TEST_F(InjectionTest, ShallowInjectionIsSeenByThatFilterAloneAndMarked) {
   EXPECT_EQ(app_state(), State::Normal);
 }
 
+TEST_F(InjectionTest, AShallowInjectedSampleIsHeldLikeAWrittenOneUntilTheNextRealSample) {
+  Signal* a = signal("a");
+  Signal* b = signal("b");
+  FilterConfig c = stage("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
+                                        {"output_signal", std::string("d")}, {"operation", std::string("subtract")}});
+  c.name = "diff";
+  ASSERT_TRUE(monitor_.add_filter(c));
+  a->push(Time{1}, 10.0);
+  b->push(Time{1}, 1.0);
+  monitor_.run_active(component_, Time{1});
+  EXPECT_DOUBLE_EQ(latest("C.d"), 9.0);
+  ASSERT_TRUE(monitor_.inject_shallow("diff", {{100}}));  // replaces a for one run
+  monitor_.run_active(component_, Time{2});
+  EXPECT_DOUBLE_EQ(latest("C.d"), 99.0);
+  b->push(Time{3}, 2.0);  // a's held value is the injected one until a writes again
+  monitor_.run_active(component_, Time{3});
+  EXPECT_DOUBLE_EQ(latest("C.d"), 98.0);
+  a->push(Time{4}, 20.0);
+  monitor_.run_active(component_, Time{4});
+  EXPECT_DOUBLE_EQ(latest("C.d"), 18.0);
+}
+
 TEST_F(InjectionTest, DeepInjectionWritesTheSignalSoEveryConsumerSeesIt) {
   Signal* x = signal("x");
   FilterConfig a = stage("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});

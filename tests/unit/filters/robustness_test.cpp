@@ -292,6 +292,27 @@ TEST_F(NonFiniteSample, StuckNonFiniteInputStaysRaisedWhileAnotherInputIsFine) {
   EXPECT_EQ(values_of("r"), (Values{3, 4, 5, 6, 15, 30}));
 }
 
+TEST_F(NonFiniteSample, VectorsWithANonFiniteElementLeaveTheLastFiniteVectorHeld) {
+  Signal* a = signal("a", 2);
+  Signal* b = signal("b", 2);
+  make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}}, {"output_signal", std::string("r")},
+                      {"operation", std::string("subtract")}});
+  push(a, 1.0, Values{10, 20});
+  push(b, 1.0, Values{1, 2});
+  run_all(1.0);
+  // Several bad vectors in a row, each read where the one before it was: the held vector survives.
+  push(a, 2.0, Values{kNaN, 0});
+  push(a, 2.5, Values{0, kInf});
+  push(a, 2.75, Values{-kInf, kNaN});
+  push(b, 3.0, Values{3, 4});
+  run_all(3.0);
+  EXPECT_EQ(latest_vector("r"), (Values{7, 16}));
+  push(a, 4.0, Values{30, 40});
+  run_all(4.0);
+  EXPECT_EQ(latest_vector("r"), (Values{27, 36}));
+  EXPECT_EQ(events_, (Events{"EVT_INVALID_SAMPLE", "/EVT_INVALID_SAMPLE"}));
+}
+
 TEST_F(NonFiniteSample, ShallowInjectedNaNIsMarkedAsInjected) {
   Signal* x = signal("x");
   Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")},

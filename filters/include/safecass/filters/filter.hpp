@@ -8,6 +8,7 @@
 /// - `on_sample(input, sample)`: one new sample of input `input` (in order, none skipped unless
 ///   the history buffer overflowed);
 /// - `on_tick(now)`: once per run, after the new samples (timing filters: Watchdog, Deadline);
+///   an override must not call the default (it is private: the default stops the calls);
 /// - `on_reset()`: forget internal state.
 /// They call `report(detected, value, sample_time)` to turn a detection into events according to
 /// the detection mode, and `write(output, time, values)` to feed output signals.
@@ -86,9 +87,15 @@ public:
   const std::vector<Signal*>& inputs() const noexcept { return inputs_; }
   const std::vector<Signal*>& outputs() const noexcept { return outputs_; }
 
-  bool enabled() const noexcept { return enabled_.load(std::memory_order_acquire); }
+  bool enabled() const noexcept { return (detour_.load(std::memory_order_acquire) & kDisabled) == 0; }
   /// A disabled filter skips its runs; its unread samples are dropped when it is enabled again.
-  void set_enabled(bool enabled) noexcept { enabled_.store(enabled, std::memory_order_release); }
+  void set_enabled(bool enabled) noexcept {
+    if (enabled) {
+      detour_.fetch_and(static_cast<std::uint8_t>(~kDisabled), std::memory_order_acq_rel);
+    } else {
+      detour_.fetch_or(kDisabled, std::memory_order_acq_rel);
+    }
+  }
   /// True while the filter's detection is active (an onset sent, its completion not yet).
   bool detected() const noexcept { return detected_.load(std::memory_order_acquire); }
   /// Samples lost to history-buffer overflow since creation.
@@ -97,13 +104,13 @@ public:
   /// Processes the new samples of every input, then on_tick(now). Call from one thread only.
   void run(Time now) noexcept {
     // The hot path, inlined into the caller: enabled, no shallow injection queued, one input.
-    if (!enabled() || !was_enabled_ || injection_pending_.load(std::memory_order_acquire) || inputs_.size() != 1) {
+    if (detour_.load(std::memory_order_acquire) != 0) {
       run_general(now);
       return;
     }
     cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
     current_injected_ = false;
-    on_tick(now);
+    if (ticks_) on_tick(now);
   }
   /// Shallow fault injection: each queued sample replaces the first input's samples for one run,
   /// seen by this filter alone. Errors: InvalidArgument when a sample's size is not the input's.
@@ -116,7 +123,6 @@ protected:
   explicit Filter(FilterInit init);
 
   virtual void on_sample(std::size_t input, const SampleView& sample) noexcept = 0;
-  virtual void on_tick(Time /*now*/) noexcept {}
   virtual void on_reset() noexcept {}
 
   /// Turns a detection into events (EDGE/LEVEL), carrying the filter, signal and value as the
@@ -133,7 +139,7 @@ protected:
   bool has_output(std::size_t output) const noexcept { return output < outputs_.size() && outputs_[output] != nullptr; }
   /// The newest value of input `input` seen by this filter (zero-order hold), or nullptr.
   const double* held(std::size_t input) const noexcept {
-    return input < has_held_.size() && has_held_[input] != 0 ? &held_[held_offset_[input]] : nullptr;
+    return input < cursors_.size() ? cursors_[input].kept() : nullptr;
   }
   /// Whether the sample being processed was injected.
   bool current_injected() const noexcept { return current_injected_; }
@@ -144,32 +150,31 @@ protected:
   bool flag(std::string_view param) const;
 
 private:
+  /// Once per run, after the new samples: for filters that watch time (Watchdog, Deadline).
+  /// The default does nothing and tells run() to stop calling it. It is private so that an
+  /// override, which may be protected, cannot call it.
+  virtual void on_tick(Time /*now*/) noexcept { ticks_ = false; }
   void report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept;
   void invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept;
-  /// One sample of input `input`: checked (a non-finite sample raises EVT_INVALID_SAMPLE and is
-  /// not passed on), held, then handed to on_sample().
+  /// One sample of input `input`, as just read (or staged) by its cursor: checked (a non-finite
+  /// sample raises EVT_INVALID_SAMPLE and is not passed on), held, then handed to on_sample().
   void deliver(std::size_t input, const SampleView& sample) noexcept {
     current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
-    double* held = &held_[held_offset_[input]];
-    if (sample.size == 1) {  // scalars: no loops
-      if (!std::isfinite(sample.data[0])) {
-        invalid_sample(input, sample.time, true);
-        return;
-      }
-      if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
-      held[0] = sample.data[0];
+    bool finite;
+    if (sample.size == 1) {  // scalars: no loop
+      finite = std::isfinite(sample.data[0]);
     } else {
       // x * 0 is 0 for a finite x and NaN for NaN or ±inf: one test for the whole vector.
       double zero = 0.0;
       for (std::size_t k = 0; k < sample.size; ++k) zero += sample.data[k] * 0.0;
-      if (zero != 0.0) {
-        invalid_sample(input, sample.time, true);
-        return;
-      }
-      if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
-      for (std::size_t k = 0; k < sample.size; ++k) held[k] = sample.data[k];
+      finite = zero == 0.0;
     }
-    has_held_[input] = 1;
+    if (!finite) {
+      invalid_sample(input, sample.time, true);
+      return;
+    }
+    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+    cursors_[input].keep();
     on_sample(input, sample);
   }
   /// run() for everything but the hot path: disabled, re-enabled, injected, several inputs.
@@ -183,26 +188,27 @@ private:
   ComponentId component_;
   std::vector<Signal*> inputs_;
   std::vector<Signal*> outputs_;
-  std::vector<SignalCursor> cursors_;
-  std::vector<double> held_;               ///< newest finite sample of each input, side by side
-  std::vector<std::size_t> held_offset_;   ///< where each input's sample starts in held_
-  std::vector<char> has_held_;
+  std::vector<SignalCursor> cursors_;  ///< per input; each keeps the input's newest finite sample
   std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
   std::vector<char> has_pending_;
   EventId onset_;
   EventId completion_;
   NameId name_id_;
-  std::atomic<bool> enabled_;
+  // Why run() leaves its hot path, as bits of detour_: set_enabled() and inject() set them from
+  // any thread; run_general() sets and clears kReenabled; kSeveralInputs is set at creation.
+  static constexpr std::uint8_t kDisabled = 1;       ///< set_enabled(false)
+  static constexpr std::uint8_t kInjection = 2;      ///< shallow injections queued
+  static constexpr std::uint8_t kReenabled = 4;      ///< ran disabled: skip the samples it missed
+  static constexpr std::uint8_t kSeveralInputs = 8;  ///< not exactly one input: merge
+  std::atomic<std::uint8_t> detour_{0};
   std::atomic<bool> detected_{false};
   std::vector<char> invalid_;       ///< per input: its last sample was not finite
   std::size_t invalid_count_ = 0;   ///< inputs marked in invalid_
   bool current_injected_ = false;
-  bool was_enabled_ = true;
+  bool ticks_ = true;  ///< on_tick is overridden (cleared by the default on its first call)
 
-  std::atomic<bool> injection_pending_{false};
-  std::mutex injection_mutex_;
+  std::mutex injection_mutex_;  ///< guards injections_ and kInjection
   std::deque<std::vector<double>> injections_;
-  std::vector<double> injected_scratch_;
 };
 
 }  // namespace safecass

@@ -180,6 +180,10 @@ class SignalCursor {
 public:
   SignalCursor() = default;
   explicit SignalCursor(const Signal* signal);
+  SignalCursor(const SignalCursor&) = delete;
+  SignalCursor& operator=(const SignalCursor&) = delete;
+  SignalCursor(SignalCursor&&) noexcept = default;
+  SignalCursor& operator=(SignalCursor&&) noexcept = default;
 
   /// Reads the next unread sample into internal storage; false when there is none. Samples
   /// overwritten before they were read are skipped and counted in missed(). Lock-free,
@@ -209,11 +213,11 @@ public:
       missed_ += end - next_ - b.capacity();
       next_ = end - b.capacity();
     }
-    sample.data = scratch_.data();
-    sample.size = scratch_.size();
+    sample.size = signal_->size();
     while (next_ < end) {
-      if (b.read_published(next_, sample.time, scratch_.data(), end)) {
+      if (b.read_published(next_, sample.time, reading_, end)) {
         ++next_;
+        sample.data = reading_;
         f(static_cast<const SampleView&>(sample));
       } else {
         ++missed_;  // overwritten while we copied it
@@ -223,6 +227,21 @@ public:
   }
   /// Skips every sample written so far.
   void skip_to_end() noexcept;
+
+  /// Samples are read into one of two buffers. keep() makes the sample just read (or staged)
+  /// stay readable, as kept(), until the next keep(): the samples after it are read into the
+  /// other buffer. A filter holds the last valid sample of an input this way, without a copy.
+  void keep() noexcept {
+    kept_ = reading_;
+    reading_ = reading_ == scratch_.data() ? scratch_.data() + signal_->size() : scratch_.data();
+  }
+  /// The sample of the last keep(), or nullptr.
+  const double* kept() const noexcept { return kept_; }
+  /// Forgets the kept sample.
+  void forget() noexcept { kept_ = nullptr; }
+  /// Copies `values` (size() doubles from elsewhere, e.g. a shallow injection) to where the next
+  /// sample would be read, so that it can be kept like one; returns that copy.
+  const double* stage(const double* values) noexcept;
   std::uint64_t missed() const noexcept { return missed_; }
   const Signal* signal() const noexcept { return signal_; }
 
@@ -236,10 +255,10 @@ private:
         missed_ += end - next_ - b.capacity();
         next_ = end - b.capacity();
       }
-      if (b.read(next_, out.time, scratch_.data())) {
+      if (b.read(next_, out.time, reading_)) {
         ++next_;
-        out.data = scratch_.data();
-        out.size = scratch_.size();
+        out.data = reading_;
+        out.size = signal_->size();
         out.injected = false;
         return true;
       }
@@ -253,7 +272,9 @@ private:
   std::uint64_t next_ = 0;           ///< next sample of the history buffer
   std::uint64_t injected_next_ = 0;  ///< next sample of the injection ring
   std::uint64_t missed_ = 0;
-  std::vector<double> scratch_;
+  std::vector<double> scratch_;     ///< two samples: the kept one and the one being read
+  double* reading_ = nullptr;       ///< the half of scratch_ the next sample is read into
+  const double* kept_ = nullptr;    ///< the other half once keep() was called
 };
 
 /// The signals of one coordinator, by name. Signals are created during configuration; their
