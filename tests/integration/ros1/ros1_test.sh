@@ -82,6 +82,25 @@ missing_node_missing_topic_and_bad_messages_are_reported)
   ros_start jr3 "$bin/ros_robodoc_jr3" --fz 5
   probe wait /diagnostics "safecass: JR3.s_F" 0 Normal 10
   ;;
+timing_checks_fire_when_a_topic_stops_and_when_it_slows_down)
+  ros_master 11711
+  ros_start safecass "$bin/safecass_ros1_node" tests/integration/ros1/timing_mapping.json
+  ros_start jr3 "$bin/ros_robodoc_jr3" --rate 200 --fz 5
+  step "200 Hz: JR3.s_F Normal (after a second, when the start-up is over)"
+  probe wait /diagnostics "safecass: bridge" 0 "" 15
+  sleep 1
+  probe wait /diagnostics "safecass: JR3.s_F" 0 Normal 5
+  step "the publisher stops: the watchdog on the topic's arrivals raises EVT_WRENCH_TOPIC_STALE"
+  ros_stop "$pid_jr3"
+  probe wait /diagnostics "safecass: JR3.s_F" 2 "EVT_WRENCH_TOPIC_STALE (cause JR3.s_F:EVT_WRENCH_TOPIC_STALE, ros/jr3/wrench:watchdog" 10
+  step "it comes back at 30 Hz, under min_rate 50: the watchdogs clear, the frequency check warns"
+  ros_start jr3 "$bin/ros_robodoc_jr3" --rate 30 --fz 5
+  probe wait /diagnostics "safecass: JR3.s_F" 1 "EVT_ROS_TOPIC_RATE (cause JR3.s_F:EVT_ROS_TOPIC_RATE, ros/jr3/wrench:frequency" 10
+  step "back at 200 Hz: Normal again"
+  ros_stop "$pid_jr3"
+  ros_start jr3 "$bin/ros_robodoc_jr3" --rate 200 --fz 5
+  probe wait /diagnostics "safecass: JR3.s_F" 0 Normal 10
+  ;;
 *)
   echo "unknown case $case_name" >&2
   exit 2
