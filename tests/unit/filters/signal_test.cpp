@@ -27,6 +27,32 @@ TEST(HistoryBuffer, ReadsBackWhatWasPushedWithTimeAndInjectionMark) {
   EXPECT_FALSE(cursor.next(v));
 }
 
+TEST(SignalCursor, AKeptSampleStaysReadableWhileLaterSamplesAreReadUntilTheNextKeep) {
+  Signal s("C.v", 0, 2, 8);
+  const double a[] = {1, 2};
+  const double b[] = {3, 4};
+  const double c[] = {5, 6};
+  s.push(Time{1}, a);
+  s.push(Time{2}, b);
+  s.push(Time{3}, c);
+  SignalCursor cursor(&s);
+  EXPECT_EQ(cursor.kept(), nullptr);
+  SampleView v;
+  ASSERT_TRUE(cursor.next(v));
+  cursor.keep();
+  ASSERT_TRUE(cursor.next(v));  // read, not kept: the kept sample is untouched
+  ASSERT_TRUE(cursor.next(v));
+  ASSERT_NE(cursor.kept(), nullptr);
+  EXPECT_EQ((std::vector<double>(cursor.kept(), cursor.kept() + 2)), (std::vector<double>{1, 2}));
+  cursor.keep();
+  EXPECT_EQ((std::vector<double>(cursor.kept(), cursor.kept() + 2)), (std::vector<double>{5, 6}));
+  const double staged[] = {7, 8};
+  EXPECT_EQ((std::vector<double>(cursor.stage(staged), cursor.stage(staged) + 2)), (std::vector<double>{7, 8}));
+  EXPECT_EQ((std::vector<double>(cursor.kept(), cursor.kept() + 2)), (std::vector<double>{5, 6}));
+  cursor.forget();
+  EXPECT_EQ(cursor.kept(), nullptr);
+}
+
 TEST(HistoryBuffer, RingIsRoundedUpToAPowerOfTwoAndAllButTheSlotBeingWrittenAreReadable) {
   HistoryBuffer b(1, 1000);
   EXPECT_EQ(b.capacity(), 1023u);
