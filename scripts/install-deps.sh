@@ -24,6 +24,8 @@ command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 # The middleware (middleware/, `safecass run --ice`, `safecass supervisor`, scripts/start-icestorm):
 # ZeroC Ice 3.7 with slice2cpp, and IceBox hosting the IceStorm service.
 packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
+# Every bus message is signed (Ed25519, libsodium).
+packages+=(libsodium-dev)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -50,6 +50,7 @@ constexpr FrameworkEventSpec kFrameworkEvents[] = {
     {"EVT_CALLBACK_EXCEPTION", 210, kToError, kFromError, "a SAFECASS callback threw an exception"},
     {"EVT_COORDINATOR_LOST", 240, kToError, kFromError, "a connected coordinator stopped sending heartbeats"},
     {"EVT_INVALID_SAMPLE", 225, kToError, kFromError, "a filter received a NaN or infinite sample"},
+    {"EVT_SUPERVISOR_LOST", 235, kToWarning, kFromWarning, "the supervisor stopped sending heartbeats"},
 };
 
 }  // namespace

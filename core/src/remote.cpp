@@ -48,6 +48,7 @@ bool Coordinator::is_remote(ComponentId id) const noexcept {
 
 std::string Coordinator::root_origin(const RootCause& root) const {
   std::lock_guard lock(mutex_);
+  if (root.remote_origin != kNoName) return std::string(name_of(root.remote_origin));
   if (root.remote != kNone && root.remote < remote_roots_.size()) return remote_roots_[root.remote].origin;
   if (root.origin < machines_.size()) return machines_[root.origin]->address;
   return {};
@@ -159,7 +160,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     c.mirror = true;
     c.first = c.last = now;
     c.seq = ++condition_seq_;
-    c.root = RootCause{ids[i], proxy, roots[i].time, samples[i], slot};
+    c.root = RootCause{ids[i], proxy, roots[i].time, samples[i], slot, intern(roots[i].origin)};
     add_condition(proxy, c, now);
     propagate_onset(c);
     ++result.added;

@@ -125,15 +125,24 @@ void Filter::report_change(bool detected, double value, Time sample_time, std::s
   if (completion_ != kNoEvent) coordinator_->generate(completion_, target_, cause);
 }
 
-void Filter::invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept {
+void Filter::invalid_sample(std::size_t input, const SampleView& sample, bool invalid) noexcept {
   if ((invalid_[input] != 0) == invalid) return;
   invalid_[input] = invalid ? 1 : 0;
   const bool was_raised = invalid_count_ > 0;
   invalid_count_ = invalid ? invalid_count_ + 1 : invalid_count_ - 1;
   // One condition for the filter: raised by the first bad input, cleared when none is left.
   if (was_raised == (invalid_count_ > 0)) return;
-  const SampleCause cause{name_id_, inputs_[input]->name_id(), invalid ? std::numeric_limits<double>::quiet_NaN() : 0.0,
-                          sample_time, current_injected_};
+  double value = 0.0;
+  if (invalid) {
+    value = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t k = 0; k < sample.size; ++k) {
+      if (!std::isfinite(sample.data[k])) {
+        value = sample.data[k];  // the value as it came: NaN, +inf or -inf
+        break;
+      }
+    }
+  }
+  const SampleCause cause{name_id_, inputs_[input]->name_id(), value, sample.time, current_injected_};
   const EventId event = invalid ? framework_event::kInvalidSample
                                 : framework_event::completion_of(framework_event::kInvalidSample);
   coordinator_->generate(event, coordinator_->framework_machine(component_), cause);

@@ -1,5 +1,7 @@
 #include "safecass/filters/monitor.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 #include <cstdio>
 
@@ -278,11 +280,32 @@ std::string samples_text(const std::vector<std::vector<double>>& samples) {
   }
   return out;
 }
+
+std::string value_text(double v) {
+  if (std::isnan(v)) return "nan";
+  return v > 0 ? "inf" : "-inf";
+}
+
+/// The rule of every injection path (console, scenario, middleware, viewer): injected values are
+/// finite. A NaN or infinite value is refused as a whole, naming the first one.
+Expected<void> check_finite(std::string_view what, const std::vector<std::vector<double>>& samples) {
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    for (std::size_t k = 0; k < samples[i].size(); ++k) {
+      if (std::isfinite(samples[i][k])) continue;
+      std::string where = "sample " + std::to_string(i + 1);
+      if (samples[i].size() != 1) where += " value " + std::to_string(k + 1);
+      return fail(ErrorCode::InvalidArgument, std::string(what) + ": " + where + " is " + value_text(samples[i][k]) +
+                                                  ", not a finite number: injected values must be finite");
+    }
+  }
+  return {};
+}
 }  // namespace
 
 Expected<void> Monitor::inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples) {
   Filter* f = find_filter(filter);
   if (f == nullptr) return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "'");
+  if (auto finite = check_finite("shallow injection into filter " + f->name(), samples); !finite) return finite;
   auto r = f->inject(samples);
   if (!r) return r;
   record_injection(f->target(), "shallow injection into filter " + f->name() + ": " + samples_text(samples));
@@ -299,6 +322,7 @@ Expected<void> Monitor::inject_deep(std::string_view signal, const std::vector<s
                                                   std::to_string(s->size()));
     }
   }
+  if (auto finite = check_finite("deep injection into signal " + s->name(), samples); !finite) return finite;
   for (const auto& v : samples) s->inject(at, v.data());
   const std::string text = "deep injection into signal " + s->name() + ": " + samples_text(samples);
   bool recorded = false;

@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <cstdint>
 #include <cstring>
@@ -38,10 +39,15 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/spec/load.hpp"
 
 using namespace safecass;
+
+namespace {
+std::string g_keys;  ///< the bus keys of the benchmark's system (a private temporary directory)
+}
 using namespace std::chrono_literals;
 
 namespace {
@@ -92,6 +98,7 @@ struct Process {
     if (!middleware::connect_remote_providers(system, name, *co)) return false;
     middleware::NodeOptions options;
     options.ice = ice;
+    options.keys_dir = g_keys;
     options.log = [](const std::string& line) { std::fprintf(stderr, "%s\n", line.c_str()); };
     auto n = middleware::CoordinatorNode::create(*co, *monitor, registry, system, name, options);
     if (!n) return false;
@@ -215,6 +222,22 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_middleware: %s\n", ice.error().message.c_str());
     return 2;
   }
+  // The bus is authenticated: keys for the benchmark's system, in a private directory.
+  char keys_template[] = "/tmp/safecass-bench-keys.XXXXXX";
+  if (::mkdtemp(keys_template) == nullptr) return 2;
+  g_keys = keys_template;
+  {
+    FilterRegistry registry;
+    register_builtin_filters(registry);
+    auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
+    if (!load.ok() || !middleware::create_bus_keys(*load.system, g_keys, true)) {
+      std::fprintf(stderr, "bench_middleware: cannot create bus keys in %s\n", g_keys.c_str());
+      return 2;
+    }
+  }
+  struct RemoveKeys {
+    ~RemoveKeys() { std::filesystem::remove_all(g_keys); }
+  } remove_keys;
   int to_child[2], to_parent[2];
   if (::pipe(to_child) != 0 || ::pipe(to_parent) != 0) return 2;
   const pid_t child = ::fork();

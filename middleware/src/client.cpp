@@ -5,8 +5,10 @@
 #include <condition_variable>
 #include <mutex>
 
+#include "auth.hpp"
 #include "control.hpp"
 #include "ice_util.hpp"
+#include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
 
@@ -24,15 +26,28 @@ ErrorCode code_of(const std::string& text) {
   return ErrorCode::InvalidArgument;
 }
 
-/// Waits for the heartbeat of one coordinator and keeps its Control proxy.
+/// Waits for an authenticated heartbeat of one coordinator and keeps its Control proxy: the
+/// proxy a write token is sent to comes only from a message signed by that coordinator's key
+/// (a spoofed heartbeat naming it is refused here, so the token cannot be lured elsewhere).
 class Finder final : public wire::HeartbeatTopic {
 public:
-  explicit Finder(std::string coordinator) : coordinator_(std::move(coordinator)) {}
-  void beat(wire::Heartbeat h, const Ice::Current&) override {
-    if (h.coordinator != coordinator_ || h.control.empty()) return;
+  Finder(std::string coordinator, const Keyring& keys, std::shared_ptr<Ice::Communicator> ic)
+      : coordinator_(std::move(coordinator)), keys_(keys), ic_(std::move(ic)) {}
+  void beat(wire::Signed m, const Ice::Current&) override {
+    if (m.signer != coordinator_) return;  // other coordinators' heartbeats, or forgeries of them
+    wire::Heartbeat h;
     std::lock_guard lock(mutex_);
+    if (const std::string why = open_signed(keys_, ic_, m, kKindHeartbeat, h); !why.empty()) {
+      ++refused_;
+      return;
+    }
+    if (h.coordinator != coordinator_ || h.control.empty()) return;
     control_ = h.control;
     cv_.notify_all();
+  }
+  std::uint64_t refused() {
+    std::lock_guard lock(mutex_);
+    return refused_;
   }
   std::string wait(std::chrono::milliseconds timeout) {
     std::unique_lock lock(mutex_);
@@ -42,6 +57,9 @@ public:
 
 private:
   std::string coordinator_;
+  const Keyring& keys_;
+  std::shared_ptr<Ice::Communicator> ic_;
+  std::uint64_t refused_ = 0;
   std::mutex mutex_;
   std::condition_variable cv_;
   std::string control_;
@@ -103,30 +121,49 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   const ClientOptions& o = impl->options;
+  if (!o.insecure && !is_loopback_host(o.ice.host)) {
+    return fail(ErrorCode::InvalidArgument, "IceStorm at '" + o.ice.host + "' is not a loopback address: the bus is "
+                                            "signed but not encrypted (docs/security.md); pass --insecure to accept that");
+  }
+  auto dir = bus_keys_dir(o.keys_dir);
+  if (!dir) return tl::unexpected(dir.error());
+  auto keys = Keyring::load(*dir);
+  if (!keys) return tl::unexpected(keys.error());
+  if (!keys->knows(o.coordinator)) {
+    return fail(ErrorCode::NotFound, "coordinator '" + o.coordinator + "' has no key in " + *dir + "/keyring");
+  }
   try {
     impl->ic = make_communicator();
-    std::string control = o.control;
+    auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", "tcp -h 127.0.0.1");
+    auto finder = std::make_shared<Finder>(o.coordinator, *keys, impl->ic);
+    auto proxy = adapter->addWithUUID(finder);
+    adapter->activate();
+    auto heartbeat = topic(topic_manager(impl->ic, o.ice), kHeartbeatTopic);
+    subscribe(heartbeat, proxy);
+    const std::string control = finder->wait(o.timeout);
+    try {
+      heartbeat->unsubscribe(proxy);
+    } catch (const Ice::Exception&) {
+    }
+    adapter->destroy();
     if (control.empty()) {
-      auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", "tcp -h 127.0.0.1");
-      auto finder = std::make_shared<Finder>(o.coordinator);
-      auto proxy = adapter->addWithUUID(finder);
-      adapter->activate();
-      auto heartbeat = topic(topic_manager(impl->ic, o.ice), kHeartbeatTopic);
-      subscribe(heartbeat, proxy);
-      control = finder->wait(o.timeout);
-      try {
-        heartbeat->unsubscribe(proxy);
-      } catch (const Ice::Exception&) {
-      }
-      adapter->destroy();
-      if (control.empty()) {
-        return fail(ErrorCode::Io, "no heartbeat from coordinator '" + o.coordinator + "' on IceStorm " + o.ice.host +
-                                       ":" + std::to_string(o.ice.port) + " within " +
-                                       std::to_string(o.timeout.count()) + " ms");
+      const std::uint64_t refused = finder->refused();
+      return fail(ErrorCode::Io, "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " +
+                                     o.ice.host + ":" + std::to_string(o.ice.port) + " within " +
+                                     std::to_string(o.timeout.count()) + " ms" +
+                                     (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
+    }
+    auto prx = impl->ic->stringToProxy(control);
+    // A token travels in clear over TCP: only to this host unless the user accepts otherwise.
+    for (const auto& endpoint : prx->ice_getEndpoints()) {
+      const auto info = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(endpoint->getInfo());
+      if (info == nullptr || (!o.insecure && !is_loopback_host(info->host))) {
+        return fail(ErrorCode::Denied, "coordinator '" + o.coordinator + "' serves its operations at '" +
+                                           printable(control) + "', which is not on this host: refused without "
+                                           "--insecure (requests and the token would cross the network unencrypted)");
       }
     }
-    impl->control = Ice::uncheckedCast<wire::ControlPrx>(impl->ic->stringToProxy(control))
-                        ->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
+    impl->control = Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
     impl->control->ice_ping();
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io, "cannot reach coordinator '" + o.coordinator + "': " + e.what());

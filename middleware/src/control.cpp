@@ -175,8 +175,10 @@ public:
         char* end = nullptr;
         const double v = std::strtod(word.c_str(), &end);
         if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
+          // Injected values are finite (Monitor's rule, docs/filters.md), said with the line.
           raise(ErrorCode::Parse, "filter dinload " + signal + ": line " + std::to_string(number) + ": '" + word +
-                                      "' is not a finite number");
+                                      (end == word.c_str() || *end != '\0' ? "' is not a number"
+                                                                             : "' is not a finite number: injected values must be finite"));
         }
         values.push_back(v);
       }

@@ -9,11 +9,13 @@
 #include <deque>
 #include <map>
 #include <mutex>
-#include <random>
+#include <optional>
 #include <thread>
 
+#include "auth.hpp"
 #include "control.hpp"
 #include "ice_util.hpp"
+#include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
 
@@ -122,7 +124,7 @@ struct CoordinatorNode::Impl {
   std::vector<std::unique_ptr<Stream>> streams;
   std::vector<std::vector<std::size_t>> streams_of;  ///< by ComponentId
 
-  /// A remote provided interface held here (dispatch thread only).
+  /// A remote provided interface held here (under peer_mutex).
   struct Held {
     MachineId proxy;
     std::string provider;  ///< the coordinator that runs the provider
@@ -131,11 +133,23 @@ struct CoordinatorNode::Impl {
     bool behind = false;  ///< a heartbeat said we missed its last update
   };
   std::map<std::string, Held, std::less<>> held;
+  /// Another signer on the bus (a coordinator, or the supervisor), as its authenticated
+  /// messages describe it (under peer_mutex).
   struct Peer {
-    std::int64_t incarnation = 0;
-    std::int64_t last_resync = 0;
+    std::int64_t incarnation = 0;     ///< the newest seen; older ones are replays or a duplicate
+    std::int64_t heartbeat_seq = 0;   ///< last accepted heartbeat of that incarnation
+    std::int64_t resync_seq = 0;      ///< last accepted resync request of that incarnation
+    std::int64_t last_resync = 0;     ///< when we last asked it to republish
+    std::int64_t last_beat = 0;       ///< steady ns of its last accepted heartbeat (0: never)
+    std::int64_t last_honoured = 0;   ///< when we last republished at its request
+    bool resync_pending = false;      ///< a request arrived too soon after the last one
+    bool provider = false;            ///< it runs a provider of an interface held here
+    bool lost = false;                ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
+    std::vector<MachineId> feeds;     ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
+  std::mutex peer_mutex;  ///< held, peers; taken before the coordinator's lock, never after
+  std::int64_t started = 0;
 
   std::mutex queue_mutex;
   std::condition_variable queue_cv;
@@ -143,6 +157,9 @@ struct CoordinatorNode::Impl {
   bool any_dirty = true;
   bool publisher_holds_events = false;  ///< the publisher has event records it has not sent yet
   static constexpr std::size_t kQueueCapacity = 65536;
+  /// The furthest a state stream may jump ahead in one update (even a signed one: a sequence
+  /// number cannot push a stream into the future and freeze it).
+  static constexpr std::int64_t kMaxSeqJump = std::int64_t{1} << 20;
   /// Updates (or records) per Ice message: one message carries every interface that changed.
   static constexpr std::size_t kMaxBatch = 256;
   /// How long event records may wait behind state updates.
@@ -162,13 +179,19 @@ struct CoordinatorNode::Impl {
   std::atomic<bool> connected{false};
   std::atomic<std::int64_t> last_own_heartbeat{0};
   std::atomic<std::int64_t> event_seq{0};
+  std::int64_t heartbeat_seq = 0;  ///< link thread
+  std::atomic<std::int64_t> resync_seq{0};
+  std::optional<Signer> signer;
+  std::optional<Keyring> keyring;
+  std::unique_ptr<DropLog> drops;
+  std::thread watch_thread;
   std::thread publisher_thread;
   std::thread link_thread;
   Coordinator::SubscriptionId subscription = 0;
 
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
       events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, state_messages_published{0},
-      event_messages_published{0};
+      event_messages_published{0}, providers_lost{0}, duplicates_seen{0};
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
       : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)) {}
@@ -265,7 +288,7 @@ struct CoordinatorNode::Impl {
                                 std::make_move_iterator(updates.begin() + static_cast<std::ptrdiff_t>(last)));
       const std::int64_t sent = steady_ns();
       for (wire::StateUpdate& u : part) u.sent = sent;
-      pub->updates(part);
+      pub->updates(signer->sign(kKindState, encode(ic, part)));
       state_messages_published.fetch_add(1, std::memory_order_relaxed);
       for (std::size_t i = 0; i < part.size(); ++i) {
         Stream& s = *of[first + i];
@@ -287,7 +310,7 @@ struct CoordinatorNode::Impl {
         const std::int64_t seq_before = event_seq.load();
         for (std::size_t i = 0; i < n; ++i) part.push_back(to_message(pending[sent + i]));
         try {
-          pub->records(part);
+          pub->records(signer->sign(kKindEvents, encode(ic, part)));
         } catch (...) {
           event_seq.store(seq_before);  // not sent: the same numbers go out after the reconnection
           throw;
@@ -416,7 +439,7 @@ struct CoordinatorNode::Impl {
               std::to_string(options.ice.port) + "; resynchronising");
           reported_down = false;
           mark_all(true);
-          resync_pub->resync(name, "");
+          resync_pub->resync(resync_request(""));
           resyncs_requested.fetch_add(1);
         } catch (const Ice::Exception& e) {
           if (!reported_down) {
@@ -430,7 +453,8 @@ struct CoordinatorNode::Impl {
       }
       try {
         link->ping();
-        heartbeat_pub->beat(heartbeat());
+        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, heartbeat())));
+        honour_pending_resyncs();
         const std::int64_t now = steady_ns();
         const std::int64_t silent = now - last_own_heartbeat.load();
         if (now - connected_at > 5 * std::chrono::nanoseconds(period).count() &&
@@ -456,35 +480,89 @@ struct CoordinatorNode::Impl {
     }
   }
 
+  /// A signed request that `target` (empty: everybody) republish its full state.
+  wire::Signed resync_request(const std::string& target) {
+    const wire::ResyncRequest r{name, incarnation, ++resync_seq, target};
+    return signer->sign(kKindResync, encode(ic, r));
+  }
+
   wire::Heartbeat heartbeat() {
     wire::Heartbeat h;
     h.coordinator = name;
     h.incarnation = incarnation;
     h.time = steady_ns();
+    h.seq = ++heartbeat_seq;
     for (const auto& s : streams) h.lastSeq["state:" + s->iface] = s->seq.load();
     h.lastSeq["events"] = event_seq.load();
     for (ComponentId c = 0; c < co.component_count(); ++c) {
       if (!co.is_remote(c)) h.components.emplace_back(co.component_name(c));
     }
-    for (const auto& [iface, _] : held) h.clients.push_back(iface);
+    {
+      std::lock_guard lock(peer_mutex);
+      for (const auto& [iface, _] : held) h.clients.push_back(iface);
+    }
     h.control = control;
     return h;
   }
 
-  // -- Ice dispatch thread --
-  void on_update(const wire::StateUpdate& u) {
+  // -- Ice dispatch thread: every message is checked before anything in it is believed --
+
+  /// Refuses a message: counted, logged (rate-limited per source).
+  void refuse(const std::string& source, const std::string& what) {
+    drops->drop(source, "middleware: " + name + ": refused " + what);
+  }
+
+  /// The freshness rule shared by every stream: an incarnation older than the newest seen from
+  /// that signer is a replay (or a second process with the same name, which the heartbeat
+  /// reports); a newer one is a restart. Returns false when the message must be dropped.
+  bool fresh_incarnation(Peer& peer, std::int64_t seen, const std::string& from, std::string_view what) {
+    if (seen < peer.incarnation) {
+      refuse(from, std::string(what) + " of '" + printable(from) + "': incarnation " + std::to_string(seen) +
+                         " is older than " + std::to_string(peer.incarnation) + " (a replay, or two processes named '" +
+                         printable(from) + "')");
+      return false;
+    }
+    if (seen > peer.incarnation) {
+      peer.incarnation = seen;
+      peer.heartbeat_seq = 0;
+      peer.resync_seq = 0;
+    }
+    return true;
+  }
+
+  void on_updates(const wire::Signed& m) {
+    wire::StateUpdateSeq batch;
+    if (const std::string why = open_signed(*keyring, ic, m, kKindState, batch); !why.empty()) {
+      updates_rejected.fetch_add(1);
+      refuse(m.signer, "a state message signed '" + printable(m.signer) + "': " + why);
+      return;
+    }
+    std::lock_guard lock(peer_mutex);
+    for (const wire::StateUpdate& u : batch) on_update(m.signer, u);
+  }
+
+  void on_update(const std::string& from, const wire::StateUpdate& u) {
+    const auto what = [&] {
+      return "state update " + printable(u.iface) + " seq " + std::to_string(u.seq) + " from coordinator '" +
+             printable(u.coordinator) + "'";
+    };
+    if (u.coordinator != from) {
+      updates_rejected.fetch_add(1);
+      refuse(from, what() + ": signed by '" + printable(from) + "', not by the coordinator it names");
+      return;
+    }
     if (u.coordinator == name) return;
     const auto it = held.find(u.iface);
     if (it == held.end()) return;  // every process sees every update; this one is not for us
     Held& h = it->second;
-    // Built only when something is logged: the accepted path allocates no text.
-    const auto what = [&] {
-      return "middleware: " + name + ": state update " + u.iface + " seq " + std::to_string(u.seq) +
-             " from coordinator '" + u.coordinator + "'";
-    };
     if (u.coordinator != h.provider) {
       updates_rejected.fetch_add(1);
-      log(what() + " rejected: " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
+      refuse(from, what() + ": " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
+      return;
+    }
+    Peer& peer = peers[u.coordinator];
+    if (!fresh_incarnation(peer, u.incarnation, from, "a state update")) {
+      updates_rejected.fetch_add(1);
       return;
     }
     if (u.incarnation != h.incarnation) {
@@ -493,15 +571,21 @@ struct CoordinatorNode::Impl {
     }
     if (u.seq <= h.last_seq) {
       updates_rejected.fetch_add(1);
-      log(what() + " ignored: stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
+      refuse(from, what() + ": stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
+      return;
+    }
+    if (u.seq - h.last_seq > kMaxSeqJump) {
+      updates_rejected.fetch_add(1);
+      refuse(from, what() + ": jumps more than " + std::to_string(kMaxSeqJump) + " ahead of " +
+                         std::to_string(h.last_seq) + "; asking for a republish instead");
+      h.behind = true;
       return;
     }
     if (h.last_seq != 0 && u.seq != h.last_seq + 1) {
       updates_missed.fetch_add(static_cast<std::uint64_t>(u.seq - h.last_seq - 1));
-      log(what() + ": " + std::to_string(u.seq - h.last_seq - 1) + " update(s) missed; this full state supersedes them");
+      log("middleware: " + name + ": " + what() + ": " + std::to_string(u.seq - h.last_seq - 1) +
+          " update(s) missed; this full state supersedes them");
     }
-    h.last_seq = u.seq;
-    h.behind = false;
     std::vector<RemoteRoot> roots;
     roots.reserve(u.roots.size());
     for (const wire::Root& w : u.roots) {
@@ -511,7 +595,7 @@ struct CoordinatorNode::Impl {
       r.time = Time{w.time};
       if (!from_wire(w.level, r.level)) {
         updates_rejected.fetch_add(1);
-        log(what() + " rejected: root '" + w.event + "' has an invalid level");
+        refuse(from, what() + ": root '" + printable(w.event) + "' has an invalid level; nothing changed");
         return;
       }
       r.filter = w.filter;
@@ -525,40 +609,72 @@ struct CoordinatorNode::Impl {
     auto applied = co.apply_remote(h.proxy, roots);
     if (!applied) {
       updates_rejected.fetch_add(1);
-      log(what() + " rejected, nothing changed: " + applied.error().message);
+      refuse(from, what() + ": nothing changed: " + applied.error().message);
       return;
     }
+    h.last_seq = u.seq;
+    h.behind = false;
     updates_applied.fetch_add(1);
   }
 
-  void on_heartbeat(const wire::Heartbeat& hb) {
-    const std::int64_t now = steady_ns();
-    if (hb.coordinator == name) {
-      if (hb.incarnation == incarnation) last_own_heartbeat.store(now);
+  void on_beat(const wire::Signed& m) {
+    wire::Heartbeat hb;
+    if (const std::string why = open_signed(*keyring, ic, m, kKindHeartbeat, hb); !why.empty()) {
+      refuse(m.signer, "a heartbeat signed '" + printable(m.signer) + "': " + why);
       return;
     }
+    if (hb.coordinator != m.signer) {
+      refuse(m.signer, "a heartbeat naming '" + printable(hb.coordinator) + "' signed by '" + printable(m.signer) + "'");
+      return;
+    }
+    const std::int64_t now = steady_ns();
+    if (hb.coordinator == name) {
+      if (hb.incarnation == incarnation) {
+        last_own_heartbeat.store(now);
+      } else {
+        duplicates_seen.fetch_add(1);
+        drops->drop(name + "/duplicate", "middleware: " + name + ": another process runs coordinator '" + name +
+                                             "' (incarnation " + std::to_string(hb.incarnation) + ", ours " +
+                                             std::to_string(incarnation) + "): two processes with one name; " +
+                                             "receivers follow the newer one");
+      }
+      return;
+    }
+    std::lock_guard lock(peer_mutex);
     Peer& peer = peers[hb.coordinator];
-    bool need = peer.incarnation != 0 && peer.incarnation != hb.incarnation;
-    peer.incarnation = hb.incarnation;
+    const std::int64_t known = peer.incarnation;
+    if (!fresh_incarnation(peer, hb.incarnation, m.signer, "a heartbeat")) return;
+    if (hb.seq <= peer.heartbeat_seq) {
+      refuse(m.signer, "a heartbeat of '" + printable(hb.coordinator) + "': seq " + std::to_string(hb.seq) +
+                           " not above " + std::to_string(peer.heartbeat_seq) + " (replayed)");
+      return;
+    }
+    peer.heartbeat_seq = hb.seq;
+    peer.last_beat = now;
+    bool need = known != 0 && known != hb.incarnation;
+    bool caught_up = true;
     for (auto& [iface, h] : held) {
       if (h.provider != hb.coordinator) continue;
       const auto s = hb.lastSeq.find("state:" + iface);
-      if (s == hb.lastSeq.end()) continue;
-      const bool behind = h.incarnation != hb.incarnation ? s->second > 0 : s->second > h.last_seq;
-      // Two heartbeats in a row: the update may simply be on its way on the other topic.
-      if (behind && h.behind) need = true;
+      const std::int64_t have = h.incarnation == hb.incarnation ? h.last_seq : 0;
+      const bool behind = s == hb.lastSeq.end() || s->second > have;
+      caught_up = caught_up && !behind;
+      // Two heartbeats in a row: the update may simply be on its way on the other topic. A lost
+      // provider is asked at once: its clients stay in Error until they have its state.
+      if (behind && (h.behind || peer.lost)) need = true;
       h.behind = behind;
     }
+    if (peer.lost && caught_up) recover(hb.coordinator, peer);
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
     std::shared_ptr<wire::ResyncTopicPrx> pub;
     {
-      std::lock_guard lock(link_mutex);
+      std::lock_guard link_lock(link_mutex);
       pub = resync_pub;
     }
     if (pub == nullptr) return;
     try {
-      pub->resync(name, hb.coordinator);
+      pub->resync(resync_request(hb.coordinator));
       resyncs_requested.fetch_add(1);
       log("middleware: " + name + ": missed state of coordinator '" + hb.coordinator + "'; asked it to republish");
     } catch (const Ice::Exception&) {
@@ -566,9 +682,113 @@ struct CoordinatorNode::Impl {
     }
   }
 
-  void on_resync(const std::string& requester, const std::string& target) {
-    if (!target.empty() && target != name) return;
-    if (requester != name) mark_all(true);
+  void on_resync(const wire::Signed& m) {
+    wire::ResyncRequest r;
+    if (const std::string why = open_signed(*keyring, ic, m, kKindResync, r); !why.empty()) {
+      refuse(m.signer, "a resync request signed '" + printable(m.signer) + "': " + why);
+      return;
+    }
+    if (r.requester != m.signer) {
+      refuse(m.signer, "a resync request naming '" + printable(r.requester) + "' signed by '" + printable(m.signer) + "'");
+      return;
+    }
+    if (r.requester == name || (!r.coordinator.empty() && r.coordinator != name)) return;
+    bool now_ok = false;
+    {
+      std::lock_guard lock(peer_mutex);
+      Peer& peer = peers[r.requester];
+      if (!fresh_incarnation(peer, r.incarnation, m.signer, "a resync request")) return;
+      if (r.seq <= peer.resync_seq) {
+        refuse(m.signer, "a resync request of '" + printable(r.requester) + "': seq " + std::to_string(r.seq) +
+                             " not above " + std::to_string(peer.resync_seq) + " (replayed)");
+        return;
+      }
+      peer.resync_seq = r.seq;
+      // At most one republish per requester and heartbeat period: a flood of requests costs one
+      // republish per period, and a request inside the period is kept, not lost.
+      const std::int64_t now = steady_ns();
+      if (now - peer.last_honoured >= std::chrono::nanoseconds(options.heartbeat).count()) {
+        peer.last_honoured = now;
+        now_ok = true;
+      } else {
+        peer.resync_pending = true;
+      }
+    }
+    if (now_ok) mark_all(true);
+  }
+
+  /// Link thread, every heartbeat: republishes for the requests that came too soon.
+  void honour_pending_resyncs() {
+    bool any = false;
+    {
+      std::lock_guard lock(peer_mutex);
+      const std::int64_t now = steady_ns();
+      for (auto& [_, peer] : peers) {
+        if (!peer.resync_pending || now - peer.last_honoured < std::chrono::nanoseconds(options.heartbeat).count()) continue;
+        peer.resync_pending = false;
+        peer.last_honoured = now;
+        any = true;
+      }
+    }
+    if (any) mark_all(true);
+  }
+
+  // -- watch thread: fail toward safe on loss (DESIGN §4) --
+
+  /// Raises the loss of a peer (under peer_mutex; the coordinator's lock is taken after it).
+  void declare_lost(const std::string& who, Peer& peer, std::int64_t silent_ns) {
+    peer.lost = true;
+    const std::string silent = std::to_string(silent_ns / 1'000'000) + " ms";
+    if (who == kSupervisorSigner) {
+      log("middleware: " + name + ": the supervisor is gone (no heartbeat for " + silent +
+          "); EVT_SUPERVISOR_LOST on s_F of every component");
+      for (ComponentId c = 0; c < co.component_count(); ++c) {
+        if (!co.is_remote(c)) co.generate(framework_event::kSupervisorLost, co.framework_machine(c));
+      }
+      return;
+    }
+    providers_lost.fetch_add(1);
+    log("middleware: " + name + ": coordinator '" + who + "' lost (no heartbeat for " + silent +
+        "); EVT_COORDINATOR_LOST on the " + std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
+    for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
+  }
+
+  /// Clears the loss of a peer that is back and whose state we hold again (under peer_mutex).
+  void recover(const std::string& who, Peer& peer) {
+    peer.lost = false;
+    if (who == kSupervisorSigner) {
+      log("middleware: " + name + ": the supervisor is back");
+      for (ComponentId c = 0; c < co.component_count(); ++c) {
+        if (!co.is_remote(c)) {
+          co.generate(framework_event::completion_of(framework_event::kSupervisorLost), co.framework_machine(c));
+        }
+      }
+      return;
+    }
+    log("middleware: " + name + ": coordinator '" + who + "' is back and resynchronised; EVT_COORDINATOR_LOST cleared");
+    for (MachineId m : peer.feeds) co.generate(framework_event::completion_of(framework_event::kCoordinatorLost), m);
+  }
+
+  void watch_loop() {
+    const std::int64_t bound = std::chrono::nanoseconds(lost_after()).count();
+    while (running.load()) {
+      sleep_for(std::chrono::milliseconds(10));
+      const std::int64_t now = steady_ns();
+      std::lock_guard lock(peer_mutex);
+      for (auto& [who, peer] : peers) {
+        if (peer.lost) continue;
+        // A provider is watched from the node's start (never heard of is as bad as gone); the
+        // supervisor only once it has been seen (a system may run without one).
+        const bool watched = peer.provider || (who == kSupervisorSigner && peer.last_beat != 0);
+        if (!watched) continue;
+        const std::int64_t since = peer.last_beat != 0 ? peer.last_beat : started;
+        if (now - since > bound) declare_lost(who, peer, now - since);
+      }
+    }
+  }
+
+  std::chrono::milliseconds lost_after() const {
+    return options.lost_after.count() > 0 ? options.lost_after : 3 * options.heartbeat;
   }
 };
 
@@ -577,10 +797,7 @@ namespace {
 class StateServant final : public wire::StateTopic {
 public:
   explicit StateServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void update(wire::StateUpdate u, const Ice::Current&) override { impl_.on_update(u); }
-  void updates(wire::StateUpdateSeq batch, const Ice::Current&) override {
-    for (const wire::StateUpdate& u : batch) impl_.on_update(u);
-  }
+  void updates(wire::Signed batch, const Ice::Current&) override { impl_.on_updates(batch); }
 
 private:
   CoordinatorNode::Impl& impl_;
@@ -589,7 +806,7 @@ private:
 class HeartbeatServant final : public wire::HeartbeatTopic {
 public:
   explicit HeartbeatServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void beat(wire::Heartbeat h, const Ice::Current&) override { impl_.on_heartbeat(h); }
+  void beat(wire::Signed h, const Ice::Current&) override { impl_.on_beat(h); }
 
 private:
   CoordinatorNode::Impl& impl_;
@@ -598,9 +815,7 @@ private:
 class ResyncServant final : public wire::ResyncTopic {
 public:
   explicit ResyncServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void resync(std::string requester, std::string target, const Ice::Current&) override {
-    impl_.on_resync(requester, target);
-  }
+  void resync(wire::Signed request, const Ice::Current&) override { impl_.on_resync(request); }
 
 private:
   CoordinatorNode::Impl& impl_;
@@ -620,9 +835,26 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                    [&](const auto& c) { return c.first == impl->name; })) {
     return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + impl->name + "'");
   }
-  std::random_device random;
-  impl->incarnation = (static_cast<std::int64_t>(random()) << 31) ^ static_cast<std::int64_t>(random()) ^ steady_ns();
-  if (impl->incarnation == 0) impl->incarnation = 1;
+  if (!impl->options.insecure) {
+    for (const std::string& host : {impl->options.ice.host, impl->options.listen_host}) {
+      if (!is_loopback_host(host)) {
+        return fail(ErrorCode::InvalidArgument,
+                    "middleware: '" + host + "' is not a loopback address: the bus is signed but not encrypted "
+                    "(docs/security.md); pass --insecure to accept that");
+      }
+    }
+  }
+  auto dir = bus_keys_dir(impl->options.keys_dir);
+  if (!dir) return tl::unexpected(dir.error());
+  auto keyring = Keyring::load(*dir);
+  if (!keyring) return tl::unexpected(keyring.error());
+  auto signer = Signer::load(*dir, impl->name);
+  if (!signer) return tl::unexpected(signer.error());
+  impl->keyring = std::move(*keyring);
+  impl->signer = std::move(*signer);
+  Impl* d = impl.get();
+  impl->drops = std::make_unique<DropLog>([d](const std::string& line) { d->log(line); });
+  impl->incarnation = new_incarnation();
   impl->streams_of.resize(coordinator.component_count());
   for (ComponentId c = 0; c < coordinator.component_count(); ++c) {
     if (coordinator.is_remote(c)) {
@@ -630,7 +862,9 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
         const std::string iface = std::string(coordinator.component_name(c)) + "." +
                                   std::string(coordinator.interface_name(m));
         const auto w = impl->where.find(coordinator.component_name(c));
-        impl->held.emplace(iface, Impl::Held{m, w == impl->where.end() ? std::string() : w->second});
+        const std::string provider = w == impl->where.end() ? std::string() : w->second;
+        impl->held.emplace(iface, Impl::Held{m, provider});
+        if (!provider.empty()) impl->peers[provider].provider = true;
       }
       continue;
     }
@@ -643,6 +877,13 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
       impl->streams_of[c].push_back(impl->streams.size());
       impl->streams.push_back(std::move(s));
     }
+  }
+  // The required interfaces each provider coordinator feeds: where its loss is raised.
+  for (const Connection& k : coordinator.connections()) {
+    if (!coordinator.is_remote(k.provider) || coordinator.is_remote(k.client)) continue;
+    const auto w = impl->where.find(coordinator.component_name(k.provider));
+    if (w == impl->where.end()) continue;
+    impl->peers[w->second].feeds.push_back(coordinator.required_machines(k.client)[k.required]);
   }
   return std::unique_ptr<CoordinatorNode>(new CoordinatorNode(std::move(impl)));
 }
@@ -684,9 +925,11 @@ Expected<void> CoordinatorNode::start() {
     return fail(ErrorCode::Io, "middleware: " + d.name + ": cannot listen on " + d.options.listen_host + ": " + e.what());
   }
   d.subscription = d.co.subscribe([&d](const Record& r) { d.on_record(r); });
+  d.started = steady_ns();
   d.running.store(true);
   d.publisher_thread = std::thread([&d] { d.publisher_loop(); });
   d.link_thread = std::thread([&d] { d.link_loop(); });
+  d.watch_thread = std::thread([&d] { d.watch_loop(); });
   return {};
 }
 
@@ -697,6 +940,7 @@ void CoordinatorNode::stop() noexcept {
   d.queue_cv.notify_all();
   if (d.publisher_thread.joinable()) d.publisher_thread.join();
   if (d.link_thread.joinable()) d.link_thread.join();
+  if (d.watch_thread.joinable()) d.watch_thread.join();
   try {
     d.ic->shutdown();
     d.ic->waitForShutdown();
@@ -720,6 +964,9 @@ NodeStats CoordinatorNode::stats() const {
   s.state_messages_published = d.state_messages_published.load();
   s.event_messages_published = d.event_messages_published.load();
   s.connected = d.connected.load();
+  s.messages_refused = d.drops ? d.drops->count() : 0;
+  s.providers_lost = d.providers_lost.load();
+  s.duplicates_seen = d.duplicates_seen.load();
   return s;
 }
 

@@ -6,10 +6,13 @@
 #include <cstdio>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <thread>
 
+#include "auth.hpp"
 #include "ice_util.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/load.hpp"
@@ -30,6 +33,7 @@ struct Supervisor::Impl {
     std::int64_t last_heartbeat = 0;
     std::int64_t incarnation = 0;
     std::int64_t last_event_seq = 0;
+    std::int64_t heartbeat_seq = 0;
     bool seen = false;
     bool lost = false;
   };
@@ -40,6 +44,14 @@ struct Supervisor::Impl {
   std::shared_ptr<Ice::Communicator> ic;
   std::unique_ptr<Link> link;
   std::shared_ptr<wire::ResyncTopicPrx> resync_pub;
+  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
+  std::mutex link_mutex;  ///< resync_pub, written by the link thread, read by the dispatch thread
+  std::optional<Signer> signer;
+  std::optional<Keyring> keyring;
+  std::unique_ptr<DropLog> drops;
+  std::int64_t incarnation = new_incarnation();
+  std::int64_t heartbeat_seq = 0;
+  std::atomic<std::int64_t> resync_seq{0};
   std::atomic<bool> running{false};
   std::thread link_thread;
   std::thread watch_thread;
@@ -55,48 +67,132 @@ struct Supervisor::Impl {
     }
   }
 
-  void on_event(const wire::EventMessage& m) {
-    if (m.kind != "transition" && m.kind != "component-transition" && m.kind != "reset") return;
-    State from = State::Normal, to = State::Normal;
-    if (!from_wire(m.from, from) || !from_wire(m.to, to)) {
-      print("supervisor: malformed event message from '" + m.coordinator + "' ignored (invalid level)");
+  void refuse(const std::string& source, const std::string& what) { drops->drop(source, "supervisor: refused " + what); }
+
+  /// Checks a signed message and that every record in it names its signer as its coordinator.
+  template <class Seq>
+  bool open(const wire::Signed& m, std::string_view kind, Seq& out) {
+    if (const std::string why = open_signed(*keyring, ic, m, kind, out); !why.empty()) {
+      refuse(m.signer, "a " + std::string(kind) + " message signed '" + printable(m.signer) + "': " + why);
+      return false;
+    }
+    return true;
+  }
+
+  /// The freshness rule (see node.cpp): an older incarnation is a replay or a duplicate name.
+  /// Under `mutex`. A newer incarnation is a restart: the view of that coordinator is dropped
+  /// (its republished state replaces it) and it is asked to republish.
+  bool fresh(Peer& peer, const std::string& who, std::int64_t seen, std::string_view what) {
+    if (seen < peer.incarnation) {
+      refuse(who, std::string(what) + " of '" + printable(who) + "': incarnation " + std::to_string(seen) +
+                      " is older than " + std::to_string(peer.incarnation) + " (a replay, or two processes named '" +
+                      printable(who) + "')");
+      return false;
+    }
+    if (seen > peer.incarnation) {
+      const bool restart = peer.incarnation != 0;
+      peer.incarnation = seen;
+      peer.last_event_seq = 0;
+      peer.heartbeat_seq = 0;
+      if (restart) {
+        for (auto it = view.begin(); it != view.end();) {
+          it = it->second.coordinator == who ? view.erase(it) : std::next(it);
+        }
+        print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
+        request_resync(who);
+      }
+    }
+    return true;
+  }
+
+  void request_resync(const std::string& who) {
+    std::shared_ptr<wire::ResyncTopicPrx> pub;
+    {
+      std::lock_guard lock(link_mutex);
+      pub = resync_pub;
+    }
+    if (pub == nullptr) return;
+    try {
+      pub->resync(signer->sign(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner),
+                                                                                  incarnation, ++resync_seq, who})));
+    } catch (const Ice::Exception&) {
+      // The link thread notices and reconnects.
+    }
+  }
+
+  void on_events(const wire::Signed& signed_batch) {
+    wire::EventMessageSeq batch;
+    if (!open(signed_batch, kKindEvents, batch)) return;
+    for (const wire::EventMessage& m : batch) on_event(signed_batch.signer, m);
+  }
+
+  void on_event(const std::string& sender, const wire::EventMessage& m) {
+    if (m.coordinator != sender) {
+      refuse(sender, "an event record naming '" + printable(m.coordinator) + "' signed by '" + printable(sender) + "'");
       return;
     }
+    State from = State::Normal, to = State::Normal, level = State::Normal;
+    if (!from_wire(m.from, from) || !from_wire(m.to, to) || !from_wire(m.level, level)) {
+      refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an invalid level");
+      return;
+    }
+    const std::string who = printable(m.coordinator);
+    std::string line;
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(m.coordinator);
       if (p == peers.end()) {
-        print("supervisor: event from unknown coordinator '" + m.coordinator + "' ignored");
+        refuse(sender, "an event record of '" + who + "', which is not a coordinator of the system");
         return;
       }
-      if (p->second.incarnation == m.incarnation && p->second.last_event_seq != 0 && m.seq != p->second.last_event_seq + 1) {
-        print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event message(s) of '" +
-              m.coordinator + "' missed");
+      if (!fresh(p->second, m.coordinator, m.incarnation, "an event record")) return;
+      if (m.seq <= p->second.last_event_seq) {
+        refuse(sender, "an event record of '" + who + "': seq " + std::to_string(m.seq) + " not above " +
+                           std::to_string(p->second.last_event_seq) + " (replayed)");
+        return;
+      }
+      if (p->second.last_event_seq != 0 && m.seq != p->second.last_event_seq + 1) {
+        print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event record(s) of '" + who +
+              "' missed");
       }
       p->second.last_event_seq = m.seq;
+      if (m.kind != "transition" && m.kind != "component-transition" && m.kind != "reset") return;
       if (m.kind == "reset") {
-        print("[" + m.coordinator + "] reset " + m.address + " (" + m.text + ")");
-        return;
+        line = "[" + who + "] reset " + printable(m.address) + " (" + printable(m.text) + ")";
+      } else {
+        ViewRow& row = view[m.address];
+        row.coordinator = m.coordinator;
+        row.address = m.address;
+        row.state = to;
+        row.cause = to == State::Normal ? std::string() : m.rootOrigin + ":" + m.rootEvent;
+        line = "[" + who + "] " + printable(m.address) + " " + std::string(to_string(from)) + " -> " +
+               std::string(to_string(to)) + " " + printable(m.event) +
+               (m.rootEvent.empty() ? "" : " (root " + printable(m.rootOrigin) + ":" + printable(m.rootEvent) + ")");
       }
-      ViewRow& row = view[m.address];
-      row.coordinator = m.coordinator;
-      row.address = m.address;
-      row.state = to;
-      row.cause = to == State::Normal ? std::string() : m.rootOrigin + ":" + m.rootEvent;
     }
-    print("[" + m.coordinator + "] " + m.address + " " + std::string(to_string(from)) + " -> " + std::string(to_string(to)) +
-          " " + m.event + (m.rootEvent.empty() ? "" : " (root " + m.rootOrigin + ":" + m.rootEvent + ")"));
+    print(line);
   }
 
-  void on_update(const wire::StateUpdate& u) {
+  void on_updates(const wire::Signed& signed_batch) {
+    wire::StateUpdateSeq batch;
+    if (!open(signed_batch, kKindState, batch)) return;
+    for (const wire::StateUpdate& u : batch) on_update(signed_batch.signer, u);
+  }
+
+  void on_update(const std::string& from, const wire::StateUpdate& u) {
+    const std::string who = printable(u.coordinator);
+    if (u.coordinator != from) {
+      refuse(from, "a state update naming '" + who + "' signed by '" + printable(from) + "'");
+      return;
+    }
     State s = State::Normal;
     if (!from_wire(u.state, s)) {
-      print("supervisor: malformed state update from '" + u.coordinator + "' ignored (invalid level)");
+      refuse(from, "a state update of '" + who + "' with an invalid level");
       return;
     }
     const auto dot = u.iface.find('.');
     if (dot == std::string::npos) {
-      print("supervisor: malformed state update from '" + u.coordinator + "': interface '" + u.iface + "'");
+      refuse(from, "a state update of '" + who + "': malformed interface '" + printable(u.iface) + "'");
       return;
     }
     const std::string address = u.iface.substr(0, dot) + ".s_S." + u.iface.substr(dot + 1);
@@ -104,31 +200,61 @@ struct Supervisor::Impl {
     for (const wire::Root& r : u.roots) causes += (causes.empty() ? "" : ", ") + r.origin + ":" + r.event;
     {
       std::lock_guard lock(mutex);
-      if (peers.find(u.coordinator) == peers.end()) {
-        print("supervisor: state update from unknown coordinator '" + u.coordinator + "' ignored");
+      const auto p = peers.find(u.coordinator);
+      if (p == peers.end()) {
+        refuse(from, "a state update of '" + who + "', which is not a coordinator of the system");
         return;
       }
+      if (!fresh(p->second, u.coordinator, u.incarnation, "a state update")) return;
       ViewRow& row = view[address];
       if (row.address == address && row.state == s && row.cause == causes) return;
       row = ViewRow{u.coordinator, address, s, causes};
     }
-    print("[" + u.coordinator + "] " + address + " " + std::string(to_string(s)) + (causes.empty() ? "" : " (roots " + causes + ")"));
+    print("[" + who + "] " + printable(address) + " " + std::string(to_string(s)) +
+          (causes.empty() ? "" : " (roots " + printable(causes) + ")"));
   }
 
-  void on_heartbeat(const wire::Heartbeat& h) {
+  void on_beat(const wire::Signed& m) {
+    wire::Heartbeat h;
+    if (!open(m, kKindHeartbeat, h)) return;
+    if (h.coordinator != m.signer) {
+      refuse(m.signer, "a heartbeat naming '" + printable(h.coordinator) + "' signed by '" + printable(m.signer) + "'");
+      return;
+    }
+    if (h.coordinator == kSupervisorSigner) {
+      if (h.incarnation != incarnation) {
+        drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
+                                                std::to_string(h.incarnation) + ", ours " + std::to_string(incarnation) + ")");
+      }
+      return;
+    }
     std::vector<std::string> recovered;
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(h.coordinator);
       if (p == peers.end()) {
-        print("supervisor: heartbeat from unknown coordinator '" + h.coordinator + "' ignored");
+        refuse(m.signer, "a heartbeat of '" + printable(h.coordinator) + "', which is not a coordinator of the system");
         return;
       }
       Peer& peer = p->second;
+      const std::int64_t known = peer.incarnation;
+      if (!fresh(peer, h.coordinator, h.incarnation, "a heartbeat")) {
+        // An older incarnation still beating while a newer one runs: two processes, one name.
+        if (known != 0 && steady_ns() - peer.last_heartbeat <= std::chrono::nanoseconds(options.lost_after).count()) {
+          drops->drop(h.coordinator + "/duplicate", "supervisor: two processes run coordinator '" +
+                                                        printable(h.coordinator) + "' (incarnations " +
+                                                        std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
+        }
+        return;
+      }
+      if (h.seq <= peer.heartbeat_seq) {
+        refuse(m.signer, "a heartbeat of '" + printable(h.coordinator) + "': seq " + std::to_string(h.seq) +
+                             " not above " + std::to_string(peer.heartbeat_seq) + " (replayed)");
+        return;
+      }
+      peer.heartbeat_seq = h.seq;
       if (!peer.seen) print("supervisor: coordinator '" + h.coordinator + "' is up");
-      if (peer.incarnation != h.incarnation) peer.last_event_seq = 0;
       peer.seen = true;
-      peer.incarnation = h.incarnation;
       peer.last_heartbeat = steady_ns();
       if (peer.lost) {
         peer.lost = false;
@@ -169,20 +295,31 @@ struct Supervisor::Impl {
     while (running.load()) {
       try {
         if (!connected) {
-          link->connect({kResyncTopic});
-          resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
-          resync_pub->resync("supervisor", "");
+          link->connect({kResyncTopic, kHeartbeatTopic});
+          heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(kHeartbeatTopic));
+          {
+            std::lock_guard lock(link_mutex);
+            resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
+          }
+          request_resync("");
           connected = true;
           reported = false;
           print("supervisor: connected to IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port));
         }
         link->ping();
+        // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
+        wire::Heartbeat h;
+        h.coordinator = std::string(kSupervisorSigner);
+        h.incarnation = incarnation;
+        h.time = steady_ns();
+        h.seq = ++heartbeat_seq;
+        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, h)));
       } catch (const Ice::Exception& e) {
         if (!reported) print("supervisor: IceStorm unreachable (" + std::string(e.ice_id()) + "); retrying");
         reported = true;
         connected = false;
       }
-      for (int i = 0; i < 10 && running.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      for (int i = 0; i < 5 && running.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
 };
@@ -192,10 +329,7 @@ namespace {
 class EventServant final : public wire::EventTopic {
 public:
   explicit EventServant(Supervisor::Impl& d) : d_(d) {}
-  void record(wire::EventMessage e, const Ice::Current&) override { d_.on_event(e); }
-  void records(wire::EventMessageSeq batch, const Ice::Current&) override {
-    for (const wire::EventMessage& e : batch) d_.on_event(e);
-  }
+  void records(wire::Signed batch, const Ice::Current&) override { d_.on_events(batch); }
 
 private:
   Supervisor::Impl& d_;
@@ -203,10 +337,7 @@ private:
 class StateServant final : public wire::StateTopic {
 public:
   explicit StateServant(Supervisor::Impl& d) : d_(d) {}
-  void update(wire::StateUpdate u, const Ice::Current&) override { d_.on_update(u); }
-  void updates(wire::StateUpdateSeq batch, const Ice::Current&) override {
-    for (const wire::StateUpdate& u : batch) d_.on_update(u);
-  }
+  void updates(wire::Signed batch, const Ice::Current&) override { d_.on_updates(batch); }
 
 private:
   Supervisor::Impl& d_;
@@ -214,7 +345,7 @@ private:
 class HeartbeatServant final : public wire::HeartbeatTopic {
 public:
   explicit HeartbeatServant(Supervisor::Impl& d) : d_(d) {}
-  void beat(wire::Heartbeat h, const Ice::Current&) override { d_.on_heartbeat(h); }
+  void beat(wire::Signed h, const Ice::Current&) override { d_.on_beat(h); }
 
 private:
   Supervisor::Impl& d_;
@@ -223,7 +354,27 @@ private:
 
 Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec& system, SupervisorOptions options) {
   if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "supervisor: no IceStorm port given");
+  if (!options.insecure) {
+    for (const std::string& host : {options.ice.host, options.listen_host}) {
+      if (!is_loopback_host(host)) {
+        return fail(ErrorCode::InvalidArgument, "supervisor: '" + host + "' is not a loopback address: the bus is signed "
+                                                "but not encrypted (docs/security.md); pass --insecure to accept that");
+      }
+    }
+  }
   auto impl = std::make_unique<Impl>(system, std::move(options));
+  auto dir = bus_keys_dir(impl->options.keys_dir);
+  if (!dir) return tl::unexpected(dir.error());
+  auto keyring = Keyring::load(*dir);
+  if (!keyring) return tl::unexpected(keyring.error());
+  auto signer = Signer::load(*dir, kSupervisorSigner);
+  if (!signer) return tl::unexpected(signer.error());
+  impl->keyring = std::move(*keyring);
+  impl->signer = std::move(*signer);
+  {
+    Impl* d = impl.get();
+    impl->drops = std::make_unique<DropLog>([d](const std::string& line) { d->print(line); });
+  }
   register_builtin_filters(impl->registry);
   impl->monitor = std::make_unique<Monitor>(impl->model, impl->registry);
   if (auto r = spec::instantiate(system, impl->model, *impl->monitor); !r) return tl::unexpected(r.error());
@@ -295,6 +446,8 @@ std::vector<std::string> Supervisor::lost() const {
   }
   return out;
 }
+
+std::uint64_t Supervisor::messages_refused() const { return impl_->drops->count(); }
 
 const Coordinator& Supervisor::model() const { return impl_->model; }
 

@@ -1,6 +1,12 @@
 #include "safecass/record/recorder.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 
 namespace safecass {
 
@@ -25,6 +31,16 @@ void append_quoted(std::string& out, std::string_view s) {
     }
   }
   out += '"';
+}
+
+/// A number as JSON; a non-finite one (a NaN or infinite sample) as the string "nan", "inf" or
+/// "-inf", since JSON has no such numbers and the value must not be lost.
+std::string json_num(double v) {
+  if (std::isnan(v)) return "\"nan\"";
+  if (std::isinf(v)) return v > 0 ? "\"inf\"" : "\"-inf\"";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
 }
 
 std::string num(double v) {
@@ -89,7 +105,7 @@ std::string record_to_json(const Record& r, const Coordinator& co) {
     if (r.root.sample.signal != kNoName) {
       out += ",\"signal\":";
       append_quoted(out, co.name_of(r.root.sample.signal));
-      out += ",\"value\":" + num(r.root.sample.value) + ",\"sample_t\":" + secs(r.root.sample.sample_time);
+      out += ",\"value\":" + json_num(r.root.sample.value) + ",\"sample_t\":" + secs(r.root.sample.sample_time);
     }
     if (r.root.sample.injected) out += ",\"injected\":true";
     out += "}";
@@ -137,20 +153,49 @@ std::string record_to_text(const Record& r, const Coordinator& co) {
   return out;
 }
 
-Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (f == nullptr) return fail(ErrorCode::Io, "cannot write history file '" + path + "'");
-  return std::unique_ptr<Recorder>(new Recorder(coordinator, f, capacity));
+std::vector<std::string> describe_losses(const RecordStatus& s) {
+  std::vector<std::string> out;
+  const std::string file = "history file '" + s.path + "': ";
+  if (!s.write_error.empty()) {
+    out.push_back(file + "write error after " + std::to_string(s.written) + " records: " + s.write_error + "; " +
+                  std::to_string(s.unwritten) + (s.unwritten == 1 ? " record was" : " records were") +
+                  " not written (the system kept running; the history is incomplete)");
+  }
+  if (s.dropped != 0) {
+    out.push_back(file + std::to_string(s.dropped) + (s.dropped == 1 ? " record" : " records") +
+                  " dropped: the recorder's queue was full (an \"overflow\" line marks where; the history is incomplete)");
+  }
+  return out;
 }
 
-Recorder::Recorder(Coordinator& coordinator, std::FILE* file, std::size_t capacity)
-    : coordinator_(coordinator), file_(file), capacity_(capacity == 0 ? 1 : capacity) {
+std::string record_status_json(const RecordStatus& s) {
+  std::string out = "{\"kind\":\"recorder\",\"path\":";
+  append_quoted(out, s.path);
+  out += ",\"written\":" + std::to_string(s.written) + ",\"dropped\":" + std::to_string(s.dropped) +
+         ",\"unwritten\":" + std::to_string(s.unwritten) + ",\"write_error\":" + (s.write_error.empty() ? "false" : "true");
+  if (!s.write_error.empty()) {
+    out += ",\"error\":";
+    append_quoted(out, s.write_error);
+  }
+  out += std::string(",\"complete\":") + (s.complete() ? "true" : "false") + "}";
+  return out;
+}
+
+Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return fail(ErrorCode::Io, "cannot write history file '" + path + "': " + std::strerror(errno));
+  return std::unique_ptr<Recorder>(new Recorder(coordinator, fd, path, capacity));
+}
+
+Recorder::Recorder(Coordinator& coordinator, int fd, std::string path, std::size_t capacity)
+    : coordinator_(coordinator), fd_(fd), path_(std::move(path)), capacity_(capacity == 0 ? 1 : capacity) {
   thread_ = std::thread([this] { writer(); });
   subscription_ = coordinator_.subscribe([this](const Record& r) {
     std::lock_guard lock(mutex_);
     if (closing_) return;
     if (queue_.size() >= capacity_) {
       ++dropped_;
+      ready_.notify_one();
       return;
     }
     queue_.push_back(r);
@@ -171,10 +216,31 @@ void Recorder::close() {
     ready_.notify_one();
   }
   if (thread_.joinable()) thread_.join();
-  if (file_ != nullptr) {
-    std::fclose(file_);
-    file_ = nullptr;
+  if (fd_ >= 0) {
+    // close() may report what a write could not (NFS, a delayed I/O error).
+    const bool closed = ::close(fd_) == 0;
+    const int error = errno;
+    fd_ = -1;
+    std::lock_guard lock(mutex_);
+    if (!closed && write_error_.empty()) write_error_ = std::strerror(error);
   }
+}
+
+bool Recorder::write_line(const std::string& line) {
+  std::size_t done = 0;
+  while (done < line.size()) {
+    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return false;
+    }
+    if (n == 0) {
+      errno = EIO;
+      return false;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  return true;
 }
 
 void Recorder::writer() {
@@ -183,22 +249,35 @@ void Recorder::writer() {
     ready_.wait(lock, [this] { return closing_ || !queue_.empty() || dropped_ != dropped_reported_; });
     while (!queue_.empty() || dropped_ != dropped_reported_) {
       std::string line;
+      bool record = false;
       if (dropped_ != dropped_reported_) {
         line = "{\"kind\":\"overflow\",\"dropped\":" + std::to_string(dropped_ - dropped_reported_) + "}";
         dropped_reported_ = dropped_;
       } else {
         const Record r = queue_.front();
         queue_.pop_front();
+        record = true;
+        if (!write_error_.empty()) {  // the file is broken: count what it misses, keep the system going
+          ++unwritten_;
+          continue;
+        }
         lock.unlock();
         line = record_to_json(r, coordinator_);
         lock.lock();
-        ++written_;
       }
+      if (!write_error_.empty()) continue;
+      // One write() per line, newline included: a kill leaves at most the last line torn.
+      line += '\n';
       lock.unlock();
-      std::fputs(line.c_str(), file_);
-      std::fputc('\n', file_);
-      std::fflush(file_);
+      const bool ok = write_line(line);
+      const int error = errno;
       lock.lock();
+      if (ok) {
+        written_ += record ? 1 : 0;
+      } else {
+        write_error_ = std::strerror(error);
+        unwritten_ += record ? 1 : 0;
+      }
     }
     if (closing_) return;
   }
@@ -212,6 +291,11 @@ std::uint64_t Recorder::dropped() const {
 std::uint64_t Recorder::written() const {
   std::lock_guard lock(mutex_);
   return written_;
+}
+
+RecordStatus Recorder::status() const {
+  std::lock_guard lock(mutex_);
+  return RecordStatus{path_, written_, dropped_, unwritten_, write_error_};
 }
 
 }  // namespace safecass

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <set>
 
+#include "safecass/spec/file.hpp"
+
 #include "keys.hpp"
 #include "model.hpp"
 #include "text.hpp"
@@ -300,25 +302,11 @@ private:
     if (given_text != nullptr) {
       text = *given_text;
     } else {
-      const fs::file_status status = fs::status(p, ec);
-      if (status.type() == fs::file_type::not_found) {
-        problem = "cannot read file " + quote_name(path) + ": no such file";
-      } else if (ec || !fs::exists(status)) {
-        problem = "cannot read file " + quote_name(path) + ": " + ec.message();
-      } else if (!fs::is_regular_file(status)) {
-        problem = "cannot read file " + quote_name(path) + ": not a regular file";
+      auto read = read_regular_file(path, kMaxFileBytes);
+      if (read) {
+        text = std::move(*read);
       } else {
-        std::ifstream in(p, std::ios::binary);
-        if (!in) {
-          problem = "cannot read file " + quote_name(path) + ": permission denied or I/O error";
-        } else {
-          std::string buffer(64 * 1024, '\0');
-          while (in && text.size() <= kMaxFileBytes) {
-            in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-            text.append(buffer.data(), static_cast<std::size_t>(in.gcount()));
-          }
-          if (in.bad()) problem = "cannot read file " + quote_name(path) + ": I/O error";
-        }
+        problem = std::move(read.error().message);
       }
     }
     if (problem.empty() && text.size() > kMaxFileBytes) {

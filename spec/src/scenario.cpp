@@ -3,32 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "safecass/core/state.hpp"
+#include "safecass/spec/file.hpp"
 #include "safecass/spec/json.hpp"
 
 namespace safecass::spec {
 
 bool read_file(const std::string& path, std::string& out, std::string& error) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    error = "is a directory";
+  auto text = read_regular_file(path);
+  if (!text) {
+    error = text.error().message;
     return false;
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = "cannot open file";
-    return false;
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  if (in.bad()) {
-    error = "cannot read file";
-    return false;
-  }
-  out = ss.str();
+  out = std::move(*text);
   return true;
 }
 
@@ -298,12 +286,12 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
 ScenarioLoad load_scenario(const std::string& path) {
   ScenarioLoad out;
   Reader r(path, out.diagnostics);
-  std::string text;
-  std::string why;
-  if (!read_file(path, text, why)) {
-    out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, Position{path, 1, 1}, why, ""});
+  auto read = read_regular_file(path);
+  if (!read) {
+    out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, Position{path, 1, 1}, read.error().message, ""});
     return out;
   }
+  const std::string text = std::move(*read);
   const JsonParse parsed = parse_json(text);
   if (parsed.error) {
     r.error(parsed.error->position, "", parsed.error->message);

@@ -37,13 +37,74 @@ case $case_name in
     ;;
   run_missing_scenario_is_an_io_error)
     "$safecass" run --scenario "$tmp/none.json" >/dev/null 2>"$tmp/err"; expect_code 2 $? "missing file"
-    grep -q "none.json:1:1: error: cannot open file" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    grep -q "none.json:1:1: error: cannot read file '$tmp/none.json': no such file" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    ;;
+  run_scenario_must_be_a_regular_file_of_at_most_64_MiB)
+    # A device, a FIFO (no writer: opening it must not wait for one), a directory, a sparse file
+    # over the limit: each refused at once with what and where, exit code 2, nothing run.
+    mkfifo "$tmp/fifo.json"
+    truncate -s $(( (64 << 20) + 1 )) "$tmp/big.json"
+    for input in /dev/zero "$tmp/fifo.json" "$tmp" "$tmp/big.json"; do
+      timeout 20 "$safecass" run --scenario "$input" >"$tmp/out" 2>"$tmp/err"; code=$?
+      [ $code = 124 ] && fail "$input: hung"
+      expect_code 2 $code "$input"
+      [ -s "$tmp/out" ] && fail "$input: something ran: $(cat "$tmp/out")"
+      grep -q "^$input:1:1: error: cannot read file '$input': " "$tmp/err" || fail "$input: $(cat "$tmp/err")"
+    done
+    grep -q "larger than 64 MiB (67108865 bytes)" "$tmp/err" || fail "size: $(cat "$tmp/err")"
+    timeout 20 "$safecass" run --scenario /dev/zero 2>&1 | grep -q "not a regular file (a character device)" || fail "device"
+    timeout 20 "$safecass" run --scenario "$tmp/fifo.json" 2>&1 | grep -q "not a regular file (a FIFO)" || fail "fifo"
+    timeout 20 "$safecass" run --scenario "$tmp" 2>&1 | grep -q "not a regular file (a directory)" || fail "directory"
+    ;;
+  run_injection_of_a_number_out_of_range_is_an_input_error)
+    # JSON has no NaN or infinity; a number too large for a double is refused where it is written.
+    printf '{ "system": "%s/examples/force_sensor/force_sensor.json", "duration": 0.1,\n  "steps": [ { "at": 0.01, "inject": { "filter": "force_limit", "values": [1e999] } } ] }\n' "$PWD" >"$tmp/s.json"
+    "$safecass" run --scenario "$tmp/s.json" >/dev/null 2>"$tmp/err"; expect_code 2 $? "1e999"
+    grep -q "s.json:2:.*: error: number 1e999 is out of range" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    ;;
+  run_record_write_error_is_said_and_fails_after_the_whole_run)
+    "$safecass" run --scenario examples/force_sensor/scenario.json --record /dev/full >"$tmp/out" 2>"$tmp/err"
+    expect_code 2 $? "record to /dev/full"
+    grep -q "history file '/dev/full': write error after 0 records: No space left on device; [1-9][0-9]* records were not written" "$tmp/err" \
+      || fail "message: $(cat "$tmp/err")"
+    grep -q "scenario.json: 10 expectations checked, 0 failed; the history file is incomplete" "$tmp/out" || fail "the run went on: $(cat "$tmp/out")"
+    # --json: the same records, then the recorder's status as a last line.
+    "$safecass" run --scenario examples/force_sensor/scenario.json --json >"$tmp/plain" 2>/dev/null; expect_code 0 $? "plain"
+    "$safecass" run --scenario examples/force_sensor/scenario.json --json --record /dev/full >"$tmp/json" 2>/dev/null
+    expect_code 2 $? "json to /dev/full"
+    head -n -1 "$tmp/json" | cmp -s - "$tmp/plain" || fail "the run's output changed"
+    tail -n 1 "$tmp/json" | grep -q '^{"kind":"recorder","path":"/dev/full","written":0,"dropped":0,"unwritten":[1-9][0-9]*,"write_error":true,"error":"No space left on device","complete":false}$' \
+      || fail "status line: $(tail -n 1 "$tmp/json")"
+    # A history written in full says so too, and changes nothing else.
+    "$safecass" run --scenario examples/force_sensor/scenario.json --json --record "$tmp/h.jsonl" >"$tmp/json" 2>"$tmp/err"
+    expect_code 0 $? "record to a file"
+    [ -s "$tmp/err" ] && fail "stderr: $(cat "$tmp/err")"
+    n=$(wc -l <"$tmp/h.jsonl")
+    tail -n 1 "$tmp/json" | grep -q "^{\"kind\":\"recorder\",\"path\":\"$tmp/h.jsonl\",\"written\":$n,\"dropped\":0,\"unwritten\":0,\"write_error\":false,\"complete\":true}\$" \
+      || fail "status line: $(tail -n 1 "$tmp/json") ($n lines)"
     ;;
   run_records_history_as_json_lines)
     "$safecass" run --scenario examples/force_sensor/scenario.json --record "$tmp/h.jsonl" >/dev/null; expect_code 0 $? "run"
     [ -s "$tmp/h.jsonl" ] || fail "empty history"
     grep -q '"kind":"injection"' "$tmp/h.jsonl" || fail "no injection in history"
     grep -q '"outcome":"raised","component":"FORCE_SENSOR","machine":"FORCE_SENSOR.s_A","event":"EVT_FORCE_ERROR"' "$tmp/h.jsonl" || fail "no onset"
+    ;;
+  run_token_file_is_never_written_over_a_file_that_is_not_ours)
+    # Refused before anything is connected, so no IceStorm is needed (port 1: nothing listens).
+    "$safecass" run --help 2>/dev/null | grep -q -- --coordinator || { echo "skipped: built without the middleware"; exit 0; }
+    printf '{"budget": 12}\n' >"$tmp/important.json"; chmod 0644 "$tmp/important.json"
+    "$safecass" run examples/robodoc/robodoc.json --coordinator robot --ice 127.0.0.1:1 --allow-write \
+      --token-file "$tmp/important.json" >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "token file over important.json"
+    grep -q "token file $tmp/important.json: exists and is not a SAFECASS token file of yours (mode 0644, not 0600): refusing to overwrite it" "$tmp/err" \
+      || fail "message: $(cat "$tmp/err")"
+    [ "$(cat "$tmp/important.json")" = '{"budget": 12}' ] || fail "important.json was changed"
+    ln -s "$tmp/important.json" "$tmp/link.token"
+    "$safecass" run examples/robodoc/robodoc.json --coordinator robot --ice 127.0.0.1:1 --allow-write \
+      --token-file "$tmp/link.token" >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "token file through a link"
+    grep -q "is a symbolic link" "$tmp/err" || fail "link: $(cat "$tmp/err")"
+    [ "$(cat "$tmp/important.json")" = '{"budget": 12}' ] || fail "important.json was changed through the link"
     ;;
   test_reports_pass_fail_coverage_and_junit)
     "$safecass" test examples/force_sensor/scenario.json tests/data/scenarios/failing.json --junit "$tmp/j.xml" >"$tmp/out" 2>/dev/null

@@ -862,6 +862,10 @@ void add_console_command(CLI::App& app, int& code) {
   cmd->add_flag("--allow-write", args->allow_write, "accept write commands (inject, generate, broadcast, reset)");
   cmd->add_option("--ice", args->ice, "work on a live coordinator: IceStorm at HOST:PORT (with --coordinator)");
   cmd->add_option("--coordinator", args->coordinator, "with --ice: the coordinator's name");
+  cmd->add_option("--keys", args->keys,
+                  "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
+  cmd->add_flag("--insecure", args->insecure,
+                "with --ice: accept a coordinator not on this host although requests and the token are not encrypted");
   cmd->add_option("--token-file", args->token_file, "with --ice: the coordinator's token file (writes need it)");
   cmd->add_option("--timeout", args->timeout_ms, "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")
       ->check(CLI::Range(100, 600000));

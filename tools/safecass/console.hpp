@@ -39,6 +39,8 @@ struct ConsoleArgs {
   std::string coordinator;    ///< remote mode: the coordinator's name
   std::string token_file;     ///< remote mode: the coordinator's token file (for writes)
   int timeout_ms = 2000;      ///< remote mode: how long to wait for the heartbeat and each answer
+  std::string keys;           ///< remote mode: the system's bus keys (default $SAFECASS_KEYS)
+  bool insecure = false;      ///< remote mode: accept a coordinator not on this host (unencrypted)
   std::string commands;       ///< -c: commands separated by ';'
   std::string script;         ///< --script: one command per line ('#' starts a comment)
   bool json = false;          ///< one JSON object per output line

@@ -602,13 +602,16 @@ private:
 };
 
 Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, const std::string& coordinator,
-                                                       const std::string& token, int timeout_ms) {
+                                                       const std::string& token, int timeout_ms,
+                                                       const std::string& keys, bool insecure) {
   auto endpoint = middleware::parse_ice_endpoint(ice);
   if (!endpoint) return fail(ErrorCode::Parse, endpoint.error().message);  // names --ice and its text
   middleware::ClientOptions o;
   o.ice = *endpoint;
   o.coordinator = coordinator;
   o.token = token;
+  o.keys_dir = keys;
+  o.insecure = insecure;
   o.timeout = std::chrono::milliseconds(timeout_ms);
   auto client = RemoteClient::connect(o);
   if (!client) return tl::unexpected(client.error());
@@ -624,7 +627,7 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
     if (!t) return fail(t.error().code, "console: --token-file: " + t.error().message);
     token = *t;
   }
-  auto client = connect_client(args.ice, args.coordinator, token, args.timeout_ms);
+  auto client = connect_client(args.ice, args.coordinator, token, args.timeout_ms, args.keys, args.insecure);
   if (!client) return fail(client.error().code, "console: " + client.error().message);
   const ConsoleOptions options{args.json, args.allow_write};
   auto backend = std::make_unique<RemoteBackend>(std::move(*client), options, args.coordinator, args.ice, args.token_file);
@@ -632,7 +635,7 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
 }
 
 int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out, int timeout_ms) {
-  auto client = connect_client(ice, coordinator, {}, timeout_ms);
+  auto client = connect_client(ice, coordinator, {}, timeout_ms, {}, false);
   if (!client) {
     std::fprintf(stderr, "safecass timeline: %s\n", client.error().message.c_str());
     return 2;

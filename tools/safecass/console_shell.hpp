@@ -55,9 +55,11 @@ std::string columns(const std::vector<std::vector<std::string>>& rows);
 /// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
 Expected<std::vector<std::string>> tokenize(std::string_view line);
 std::optional<double> parse_number(std::string_view s);
-/// Numbers separated by commas and/or blanks. Errors name the offending text.
+/// The values of injected samples: numbers separated by commas and/or blanks. Errors name the
+/// offending text: not a number, or not finite (`nan`, `inf`, `-inf`: injected values must be
+/// finite, the rule of every injection path, docs/filters.md).
 Expected<std::vector<double>> parse_numbers(std::string_view text);
-/// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector).
+/// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector) of finite numbers.
 Expected<std::vector<double>> parse_sample(std::string_view word);
 /// Every word as a sample. Errors: the first word that is not one.
 Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words);

@@ -41,10 +41,13 @@ int main(int argc, char** argv) {
   run->add_option("SYSTEM", run_args.system, "system file (default: the scenario's \"system\")");
   run->add_option("--scenario,-s", run_args.scenario, "scenario file (required unless --coordinator)");
   run->add_flag("--json", run_args.json, "one JSON object per line (byte-identical across runs)");
-  run->add_option("--record", run_args.record, "write the whole history (JSON lines) to this file");
+  run->add_option("--record", run_args.record,
+                  "write the whole history (JSON lines) to this file; a write error or dropped records are said on "
+                  "stderr (and with --json in a last {\"kind\":\"recorder\"} line) and make the exit code 2");
 #ifdef SAFECASS_WITH_ICE
   safecass::tools::add_middleware_options(*run, run_args);
   safecass::tools::add_supervisor_command(app, code);
+  safecass::tools::add_keys_command(app, code);
 #endif
   run->callback([&] { code = safecass::tools::run_run(run_args); });
 

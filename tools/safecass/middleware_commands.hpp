@@ -17,5 +17,7 @@ void add_middleware_options(CLI::App& run, RunArgs& args);
 int run_coordinator(const RunArgs& args);
 /// Adds the `supervisor` subcommand; its callback stores the exit code.
 void add_supervisor_command(CLI::App& app, int& code);
+/// Adds the `keys` subcommand (the bus keys of a system, keys.hpp).
+void add_keys_command(CLI::App& app, int& code);
 
 }  // namespace safecass::tools

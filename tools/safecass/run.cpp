@@ -45,10 +45,11 @@ int run_run(const RunArgs& args) {
   options.system_override = args.system;
   runner::RunResult result;
   const int code = runner::run_scenario_file(args.scenario, registry, options, &result);
-  if (code == 2) return 2;
+  if (code == 2 && result.history_complete()) return 2;  // invalid input: nothing ran
   if (!args.json) {
-    std::printf("%s: %d expectation%s checked, %zu failed\n", args.scenario.c_str(), result.checks,
-                result.checks == 1 ? "" : "s", result.failures.size());
+    std::printf("%s: %d expectation%s checked, %zu failed%s\n", args.scenario.c_str(), result.checks,
+                result.checks == 1 ? "" : "s", result.failures.size(),
+                result.history_complete() ? "" : "; the history file is incomplete (see above)");
   }
   return code;
 }

@@ -162,6 +162,12 @@ void add_middleware_options(CLI::App& run, RunArgs& args) {
   run.add_flag("--allow-write", args.allow_write,
                "with --ice: serve write operations (inject, generate, broadcast, reset) to holders of the token");
   run.add_option("--token-file", args.token_file, "with --allow-write: where to write the token (mode 0600)");
+  run.add_option("--keys", args.keys,
+                 "with --ice: the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
+  run.add_option("--lost-after", args.lost_after_ms,
+                 "with --ice: milliseconds without a provider's heartbeat before EVT_COORDINATOR_LOST (default 300)");
+  run.add_flag("--insecure", args.insecure,
+               "with --ice: accept a non-loopback IceStorm or listening address although the bus is not encrypted");
 }
 
 int run_coordinator(const RunArgs& args) {
@@ -222,6 +228,7 @@ int run_coordinator(const RunArgs& args) {
 
   std::string token;
   std::string token_path;
+  std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
   std::unique_ptr<middleware::CoordinatorNode> node;
   if (!args.ice.empty()) {
     auto endpoint = middleware::parse_ice_endpoint(args.ice);
@@ -230,18 +237,24 @@ int run_coordinator(const RunArgs& args) {
       return 2;
     }
     if (args.allow_write) {
-      token_path = args.token_file.empty() ? middleware::default_token_path(args.coordinator) : args.token_file;
-      auto t = middleware::create_token_file(token_path);
+      // Never over a file that is not ours, never shared with a running process (token.hpp).
+      auto t = args.token_file.empty() ? middleware::TokenFile::create_default(args.coordinator)
+                                       : middleware::TokenFile::create(args.token_file);
       if (!t) {
         std::fprintf(stderr, "safecass run: %s\n", t.error().message.c_str());
         return 2;
       }
-      token = *t;
+      token_file = std::move(*t);
+      token = token_file->secret();
+      token_path = token_file->path();
     }
     middleware::NodeOptions options;
     options.ice = *endpoint;
     options.allow_write = args.allow_write;
     options.token = token;
+    options.keys_dir = args.keys;
+    options.insecure = args.insecure;
+    options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
     options.log = [](const std::string& line) { say(line); };
     auto created = middleware::CoordinatorNode::create(co, monitor, registry, system, args.coordinator, options);
     if (!created) {
@@ -297,7 +310,7 @@ int run_coordinator(const RunArgs& args) {
         std::to_string(s.updates_missed) + " missed, " + std::to_string(s.resyncs_requested) + " resyncs, " +
         std::to_string(s.connects) + " connections, " + std::to_string(s.events_dropped) + " event records dropped");
   }
-  if (!token_path.empty()) ::unlink(token_path.c_str());
+  if (token_file) token_file->remove();
   say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
       std::string(to_string(co.coordinator_state())) +
       (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed" : ""));

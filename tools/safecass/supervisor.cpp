@@ -14,6 +14,7 @@
 
 #include "middleware_commands.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/supervisor.hpp"
 #include "safecass/spec/load.hpp"
 
@@ -29,6 +30,8 @@ struct SupervisorArgs {
   std::string ice;
   int lost_after_ms = 600;
   double duration = 0.0;
+  std::string keys;
+  bool insecure = false;
 };
 
 int run_supervisor(const SupervisorArgs& args) {
@@ -50,6 +53,8 @@ int run_supervisor(const SupervisorArgs& args) {
   middleware::SupervisorOptions options;
   options.ice = *endpoint;
   options.lost_after = std::chrono::milliseconds(args.lost_after_ms);
+  options.keys_dir = args.keys;
+  options.insecure = args.insecure;
   options.print = [](const std::string& line) {
     std::lock_guard lock(print_mutex);
     std::printf("%s\n", line.c_str());
@@ -93,7 +98,39 @@ void add_supervisor_command(CLI::App& app, int& code) {
   cmd->add_option("--ice", args.ice, "IceStorm at HOST:PORT")->required();
   cmd->add_option("--lost-after", args.lost_after_ms, "milliseconds without a heartbeat before a coordinator is lost (default 600)");
   cmd->add_option("--duration", args.duration, "stop after SECONDS (default: until SIGINT/SIGTERM)");
+  cmd->add_option("--keys", args.keys, "the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
+  cmd->add_flag("--insecure", args.insecure, "accept a non-loopback IceStorm or listening address although the bus is not encrypted");
   cmd->callback([&code] { code = run_supervisor(args); });
+}
+
+void add_keys_command(CLI::App& app, int& code) {
+  static std::string system;
+  static std::string out;
+  static bool replace = false;
+  auto* cmd = app.add_subcommand(
+      "keys", "Create the bus keys of a multi-process system: a key pair per coordinator and for the supervisor");
+  cmd->add_option("SYSTEM", system, "the system file")->required();
+  cmd->add_option("--out", out, "the key directory (created with mode 0700)")->required();
+  cmd->add_flag("--replace", replace, "replace existing keys (every process must then restart with the new ones)");
+  cmd->callback([&code] {
+    FilterRegistry registry;
+    register_builtin_filters(registry);
+    spec::LoadResult load = spec::load_system(system, registry);
+    for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+    if (!load.ok()) {
+      code = 2;
+      return;
+    }
+    auto names = middleware::create_bus_keys(*load.system, out, replace);
+    if (!names) {
+      std::fprintf(stderr, "safecass keys: %s\n", names.error().message.c_str());
+      code = 2;
+      return;
+    }
+    for (const std::string& n : *names) std::printf("%s/%s.secret\n", out.c_str(), n.c_str());
+    std::printf("%s/keyring\n", out.c_str());
+    code = 0;
+  });
 }
 
 }  // namespace safecass::tools

@@ -2,6 +2,7 @@
 
 #include "timeline.hpp"
 
+#include "safecass/spec/file.hpp"
 #include "safecass/spec/json.hpp"
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <optional>
 
@@ -231,7 +233,14 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
       r.root.filter = rf.string("filter", false);
       r.root.signal = rf.string("signal", false);
       r.root.has_signal = root->find("signal") != nullptr;
-      r.root.value = rf.number("value", false).value_or(0.0);
+      // A non-finite sample (it raised EVT_INVALID_SAMPLE) is written as "nan", "inf" or "-inf".
+      const JsonValue* value = root->find("value");
+      if (value != nullptr && value->is_string() && (value->string == "nan" || value->string == "inf" || value->string == "-inf")) {
+        r.root.value = value->string == "nan" ? std::numeric_limits<double>::quiet_NaN()
+                                              : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
+      } else {
+        r.root.value = rf.number("value", false).value_or(0.0);
+      }
       r.root.sample_t = rf.number("sample_t", false).value_or(0.0);
       r.root.injected = rf.boolean("injected");
       if (rf.error()) f.fail("in \"root\": " + *rf.error());
@@ -418,8 +427,15 @@ HistoryParse parse_history(std::string_view text) {
     }
     spec::JsonParse parsed = spec::parse_json(line, 16);
     if (parsed.error) {
-      out.errors.push_back({line_no, "invalid JSON at column " + std::to_string(parsed.error->position.column) + ": " +
-                                         parsed.error->message});
+      HistoryError e{line_no, "invalid JSON at column " + std::to_string(parsed.error->position.column) + ": " +
+                                  parsed.error->message};
+      // The recorder ends every record with a newline: a last line without one that is not even
+      // JSON was being written when the recording process died.
+      if (eol == text.size()) {
+        out.torn = std::move(e);
+      } else {
+        out.errors.push_back(std::move(e));
+      }
       continue;
     }
     HistoryRecord r;
@@ -614,13 +630,18 @@ std::string summary_text(const Model& m, std::size_t record_count) {
   return s;
 }
 
-std::string warnings_html(const Model& m) {
+std::string warnings_html(const Model& m, const std::optional<HistoryError>& torn) {
   std::string out;
   for (const auto& band : m.overflows) {
     out += "<p class=\"warning\">&#9888; History line " + std::to_string(band.record->line) + ": the recorder dropped " +
            std::to_string(band.record->dropped) + " records between " + secs(band.from) + " s and " +
            (band.to ? secs(*band.to) + " s" : std::string("the end")) +
            "; states in that interval may be incomplete (hatched band).</p>\n";
+  }
+  if (torn) {
+    out += "<p class=\"warning\">&#9888; History line " + std::to_string(torn->line) +
+           " is torn (the recording process stopped in the middle of writing it): it is not drawn; every record "
+           "before it is.</p>\n";
   }
   return out;
 }
@@ -654,12 +675,13 @@ std::string timeline_model_json(const std::vector<HistoryRecord>& records) {
   return model_json(build_model(records), records.size());
 }
 
-std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title) {
+std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title,
+                                 const std::optional<HistoryError>& torn) {
   const Model m = build_model(records);
   const std::map<std::string, std::string, std::less<>> values{
       {"TITLE", html_escape(title)},
       {"SUMMARY", html_escape(summary_text(m, records.size()))},
-      {"WARNINGS", warnings_html(m)},
+      {"WARNINGS", warnings_html(m, torn)},
       {"CSS", std::string(web::kTimelineCss)},
       {"JS", std::string(web::kTimelineJs)},
       {"MODEL", model_json(m, records.size())},
@@ -669,17 +691,12 @@ std::string render_timeline_page(const std::vector<HistoryRecord>& records, cons
 }
 
 int run_timeline(const std::string& history, const std::string& html_out) {
-  std::ifstream in(history, std::ios::binary);
-  if (!in) {
-    std::fprintf(stderr, "safecass timeline: cannot read history file '%s'\n", history.c_str());
+  const auto text = spec::read_regular_file(history);
+  if (!text) {
+    std::fprintf(stderr, "safecass timeline: history: %s\n", text.error().message.c_str());
     return 2;
   }
-  const std::string text{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-  if (in.bad()) {
-    std::fprintf(stderr, "safecass timeline: cannot read history file '%s'\n", history.c_str());
-    return 2;
-  }
-  const HistoryParse parsed = parse_history(text);
+  const HistoryParse parsed = parse_history(*text);
   if (!parsed.errors.empty()) {
     for (const HistoryError& e : parsed.errors) {
       std::fprintf(stderr, "%s:%d: error: %s\n", history.c_str(), e.line, e.message.c_str());
@@ -688,13 +705,20 @@ int run_timeline(const std::string& history, const std::string& html_out) {
                  parsed.errors.size() == 1 ? "line" : "lines", history.c_str());
     return 2;
   }
+  if (parsed.torn) {
+    std::fprintf(stderr,
+                 "%s:%d: warning: the last line is torn (no newline at its end, %s): the recording process was "
+                 "probably killed while writing it; drawing the %zu complete records before it\n",
+                 history.c_str(), parsed.torn->line, parsed.torn->message.c_str(), parsed.records.size());
+  }
   std::string title = history;
   if (const auto slash = title.find_last_of('/'); slash != std::string::npos) title.erase(0, slash + 1);
-  return write_timeline_page(parsed.records, title, html_out);
+  return write_timeline_page(parsed.records, title, html_out, parsed.torn);
 }
 
-int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out) {
-  const std::string page = render_timeline_page(records, title);
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out,
+                        const std::optional<HistoryError>& torn) {
+  const std::string page = render_timeline_page(records, title, torn);
   std::ofstream out(html_out, std::ios::binary | std::ios::trunc);
   if (out) out.write(page.data(), static_cast<std::streamsize>(page.size()));
   if (out) out.close();

@@ -9,6 +9,7 @@
 // run_timeline() reads a file, runs the three and writes the page.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -54,11 +55,16 @@ struct HistoryError {
 struct HistoryParse {
   std::vector<HistoryRecord> records;
   std::vector<HistoryError> errors;  ///< empty when every line is a valid record
+  /// The last line when it was torn: the file does not end with a newline and that line's JSON
+  /// stops short (the recording process was killed in the middle of writing it). Not a record and
+  /// not an error: every complete record before it is drawn, and the command warns about it.
+  std::optional<HistoryError> torn;
 };
 
 /// Reads history text, one JSON object per line. Every line must be a record: an empty line,
 /// invalid JSON, an unknown kind, a missing or mistyped field, or a time earlier than the
-/// previous record's is an error naming its line. Nothing is skipped. Overflow lines
+/// previous record's is an error naming its line. Nothing is skipped, with one exception: a torn
+/// last line (see HistoryParse::torn), which a killed recorder leaves behind. Overflow lines
 /// (`{"kind":"overflow","dropped":N}`) are records too.
 HistoryParse parse_history(std::string_view text);
 
@@ -70,15 +76,20 @@ std::string timeline_model_json(const std::vector<HistoryRecord>& records);
 
 /// The whole page: the embedded template with the model, the history (as a JSON array, one
 /// element per line), a static summary and the overflow warnings. `title` names the history
-/// (usually its file name). Same records and title → same bytes.
-std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title);
+/// (usually its file name); `torn`, when given, is a torn last line, shown as a warning. Same
+/// records and title → same bytes.
+std::string render_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title,
+                                 const std::optional<HistoryError>& torn = std::nullopt);
 
-/// `safecass timeline HISTORY --html OUT`: 0 the page was written; 2 the history cannot be read,
-/// has a malformed line (each printed as "HISTORY:LINE: error: message"), or OUT cannot be written.
+/// `safecass timeline HISTORY --html OUT`: 0 the page was written (after a torn last line too:
+/// then "HISTORY:LINE: warning: ..." on stderr and on the page); 2 the history cannot be read
+/// (not a regular file, larger than 64 MiB), has a malformed line (each printed as
+/// "HISTORY:LINE: error: message"), or OUT cannot be written.
 int run_timeline(const std::string& history, const std::string& html_out);
 
 /// Renders `records` and writes the page to `html_out`. Returns 0, or 2 after printing
 /// "safecass timeline: cannot write ..." to stderr.
-int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out);
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out,
+                        const std::optional<HistoryError>& torn = std::nullopt);
 
 }  // namespace safecass::tools

@@ -1,8 +1,10 @@
 // `safecass validate` and `safecass schema`.
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/spec.hpp"
@@ -27,11 +29,14 @@ std::string quote(const std::string& s) {
   return out + "\"";
 }
 
+/// A regular file that can be opened; opened without blocking, so a FIFO is refused at once.
 bool readable(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return false;
-  std::ifstream in(path, std::ios::binary);
-  return static_cast<bool>(in);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+  if (fd < 0) return false;
+  struct stat st {};
+  const bool regular = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+  ::close(fd);
+  return regular;
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "safecass/middleware/token.hpp"
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/server.hpp"
 #ifdef SAFECASS_WITH_ICE
@@ -35,6 +36,7 @@ struct ViewerArgs {
   bool allow_write = false;
   bool open = false;
   std::string ice;                      ///< --ice HOST:PORT: a live system
+  std::string keys;                     ///< --keys DIR: the system's bus keys
   std::vector<std::string> token_files; ///< --token-file COORD=FILE
   bool speed_given = false;
 };
@@ -60,6 +62,7 @@ Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args
   if (args.system.empty()) return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice needs --system SYSTEM (its coordinators)");
   viewer::MiddlewareOptions options;
   options.ice = args.ice;
+  options.keys_dir = args.keys;
   options.system = args.system;
   options.allow_write = args.allow_write;
   for (const std::string& t : args.token_files) {
@@ -105,20 +108,17 @@ int run_viewer(const ViewerArgs& args) {
 
   viewer::ProtocolOptions protocol;
   protocol.allow_write = args.allow_write;
-  std::string token_file;
+  // The token goes into a private file (mode 0600, middleware/token.hpp), never to stdout: the
+  // output of a server ends up in logs. It is removed when the viewer stops.
+  std::unique_ptr<middleware::TokenFile> token_file;
   if (args.allow_write) {
-    auto token = viewer::make_token();
-    if (!token) {
-      std::fprintf(stderr, "safecass viewer: %s\n", token.error().message.c_str());
-      return 2;
-    }
-    auto file = viewer::write_token_file(*token);
+    auto file = middleware::TokenFile::create_default("viewer");
     if (!file) {
       std::fprintf(stderr, "safecass viewer: %s\n", file.error().message.c_str());
       return 2;
     }
-    protocol.token = *token;
-    token_file = *file;
+    token_file = std::move(*file);
+    protocol.token = token_file->secret();
   }
 
   viewer::ServerOptions server_options;
@@ -128,7 +128,6 @@ int run_viewer(const ViewerArgs& args) {
   auto server = viewer::Server::open(**source, protocol, server_options);
   if (!server) {
     std::fprintf(stderr, "safecass viewer: %s\n", server.error().message.c_str());
-    viewer::remove_token_file(token_file);
     return 2;
   }
   const std::string url = (*server)->url();
@@ -139,8 +138,8 @@ int run_viewer(const ViewerArgs& args) {
   }
   std::printf("  open %s\n", url.c_str());
   if (args.allow_write) {
-    std::printf("  write access: the token is in %s (mode 0600); or open %s#token=%s\n", token_file.c_str(),
-                url.c_str(), protocol.token.c_str());
+    std::printf("  write access: the token is in %s (mode 0600): paste it into the page, or open %s#token=<the token>\n",
+                token_file->path().c_str(), url.c_str());
   } else {
     std::printf("  read-only (start with --allow-write to generate, inject and reset)\n");
   }
@@ -150,10 +149,11 @@ int run_viewer(const ViewerArgs& args) {
   }
   std::printf("  Ctrl-C stops it.\n");
   std::fflush(stdout);
-  if (args.open) open_browser(args.allow_write ? url + "#token=" + protocol.token : url);
+  // Without the token: a command line is visible to every local user (ps, /proc/PID/cmdline).
+  if (args.open) open_browser(url);
 
   (*server)->run();
-  viewer::remove_token_file(token_file);
+  if (token_file) token_file->remove();
   std::printf("safecass viewer: stopped\n");
   return 0;
 }
@@ -178,6 +178,7 @@ void add_viewer_command(CLI::App& app, int& code) {
   cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")
       ->capture_default_str()
       ->each([args](const std::string&) { args->speed_given = true; });
+  cmd->add_option("--keys", args->keys, "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
   cmd->add_option("--ice", args->ice,
                   "IceStorm HOST:PORT: watch the live system whose coordinators run as processes "
                   "(`safecass run SYSTEM --coordinator NAME --ice ...`); needs --system");

@@ -160,6 +160,24 @@ def main():
         errors = err.splitlines()
         check(len(errors) == 4 and f"{bad}:2: 'x' is not a number" in errors[0] and "NOPE" in errors[1]
               and "JR3.NoSuch" in errors[2] and "'x' is not a number" in errors[3], "each bad injection says why", err)
+        # Injected values are finite on this path too, and a sample file must be a regular file (read
+        # here, by the console): refused before anything is sent, never a hang.
+        infinite = os.path.join(scratch, "infinite.txt")
+        with open(infinite, "w") as f:
+            f.write("3\n-inf\n")
+        fifo = os.path.join(scratch, "samples.fifo")
+        if os.path.lexists(fifo):
+            os.unlink(fifo)
+        os.mkfifo(fifo)
+        code, out, err = system.console("--allow-write", *token, "-c", "filter inject force_limit inf; filter dinject "
+                                        f"JR3.ForceNorm nan; filter dinload JR3.ForceNorm {infinite}; "
+                                        f"filter dinload JR3.ForceNorm /dev/zero; filter dinload JR3.ForceNorm {fifo}")
+        check(code == 2 and out == "", "non-finite values and unreadable files are refused", code, out, err)
+        errors = err.splitlines()
+        check(len(errors) == 5 and "'inf' is not a finite number: injected values must be finite" in errors[0]
+              and "'nan' is not a finite number" in errors[1] and f"{infinite}:2: '-inf' is not a finite number" in errors[2]
+              and "cannot read file '/dev/zero': not a regular file (a character device)" in errors[3]
+              and f"cannot read file '{fifo}': not a regular file (a FIFO)" in errors[4], "each refusal says why", err)
 
         # Unreachable: exit 2 with a message, never a hang.
         for args, what in [(["--coordinator", "nobody"], "no such coordinator"),

@@ -39,6 +39,11 @@ class LiveSystem:
         values = dict(line.strip().split("=", 1) for line in open(env_file) if "=" in line)
         self.icestorm_pid = int(values["ICESTORM_PID"])
         self.port = int(values["ICESTORM_PORT"])
+        # The bus is authenticated: the system's keys, inherited by every process started here.
+        keys = os.path.join(self.scratch, "keys")
+        subprocess.run([self.binary, "keys", os.path.join(self.source, "examples/robodoc/robodoc.json"), "--out", keys,
+                        "--replace"], check=True, stdout=subprocess.DEVNULL, timeout=20)
+        os.environ["SAFECASS_KEYS"] = keys
         if os.path.exists(self.token_file):
             os.unlink(self.token_file)
         with open(self.log, "w") as log:

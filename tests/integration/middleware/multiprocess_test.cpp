@@ -32,6 +32,7 @@
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/spec/load.hpp"
@@ -315,6 +316,31 @@ TEST(MultiProcess, TheSupervisorDetectsAKilledCoordinatorAndItsRecovery) {
   })) << supervisor.output();
 }
 
+TEST(MultiProcess, AClientSeesErrorWhileItsProviderProcessIsKilledAndClearsWhenItIsBack) {
+  // DESIGN §4, fail toward safe on loss: the ui must not keep showing the robot's last state.
+  TwoProcesses sys(ice_of_fixture(), "lost");
+  sys.start_robot();
+  sys.start_ui();
+  auto robot = sys.client("robot");
+  auto ui = sys.client("ui");
+  ASSERT_TRUE(robot && ui) << sys.logs();
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT.s_R.Status") == State::Normal; }, 5000ms)) << sys.logs();
+
+  sys.robot->stop(SIGKILL);
+  const auto killed = std::chrono::steady_clock::now();
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT.s_R.Status") == State::Error; }, 3000ms)) << sys.logs();
+  const auto seen = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - killed);
+  EXPECT_LT(seen.count(), 1500) << "the default bound is 3 heartbeats (300 ms)";
+  auto why = ui->explain("PENDANT");
+  ASSERT_TRUE(why);
+  EXPECT_NE(causes(*why).find("EVT_COORDINATOR_LOST"), std::string::npos) << causes(*why);
+  EXPECT_NE(sys.ui->output().find("coordinator 'robot' lost"), std::string::npos) << sys.logs();
+
+  sys.start_robot();
+  EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT.s_R.Status") == State::Normal; }, 10000ms)) << sys.logs();
+  EXPECT_NE(sys.ui->output().find("coordinator 'robot' is back and resynchronised"), std::string::npos) << sys.logs();
+}
+
 TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   Paths p;
   const std::string dir = p.scratch + "/restart-icestorm";
@@ -380,7 +406,7 @@ struct Node {
   std::unique_ptr<Monitor> monitor;
   std::unique_ptr<middleware::CoordinatorNode> node;
 
-  Node(const std::string& text, const std::string& name) {
+  Node(const std::string& text, const std::string& name, const std::string& keys) {
     register_builtin_filters(registry);
     auto load = spec::load_system_from_text(text, "burst.json", registry);
     EXPECT_TRUE(load.ok());
@@ -392,6 +418,7 @@ struct Node {
     EXPECT_TRUE(middleware::connect_remote_providers(system, name, *co));
     middleware::NodeOptions options;
     options.ice = *middleware::parse_ice_endpoint(ice_of_fixture());
+    options.keys_dir = keys;
     options.log = [](const std::string&) {};
     auto n = middleware::CoordinatorNode::create(*co, *monitor, registry, system, name, options);
     EXPECT_TRUE(n);
@@ -424,7 +451,15 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
       { "component": "A", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
     "connections": [ )" + connections + R"( ],
     "coordinators": { "burst-s": ["S"], "burst-a": ["A"] } })";
-  Node provider(text, "burst-s"), client(text, "burst-a");
+  const std::string keys = Paths{}.scratch + "/burst-keys";
+  {
+    FilterRegistry registry;
+    register_builtin_filters(registry);
+    auto load = spec::load_system_from_text(text, "burst.json", registry);
+    ASSERT_TRUE(load.ok());
+    ASSERT_TRUE(middleware::create_bus_keys(*load.system, keys, true));
+  }
+  Node provider(text, "burst-s", keys), client(text, "burst-a", keys);
   ASSERT_TRUE(provider.node && client.node);
   ASSERT_TRUE(eventually([&] { return provider.node->stats().connected && client.node->stats().connected; }, 10000ms));
   std::this_thread::sleep_for(300ms);  // subscriptions settle, initial resync done

@@ -1,28 +1,44 @@
-// Crafted wire messages against a real coordinator node (DESIGN §7 "bad input"): a batch of state
-// updates published straight to IceStorm, some of them malformed. Each update of a batch is
-// checked on its own: a bad one is refused alone and changes nothing, the others apply.
+// Crafted wire messages against a real coordinator node (DESIGN §7 "bad input", "nothing let in",
+// §4 "fail toward safe on loss"), published straight to IceStorm. The test plays the provider
+// coordinator "wire-p" (with its real key), an attacker (with a key of its own, or another
+// coordinator's), and the supervisor:
+// - each update of a signed batch is checked on its own: a bad one is refused alone;
+// - forged, re-signed, replayed, mis-attributed and far-future messages are refused, counted and
+//   change nothing;
+// - a provider whose heartbeat stops is lost: its client's required interfaces go to Error
+//   (EVT_COORDINATOR_LOST), and clear once it is back and resynchronised;
+// - a supervisor that stops is reported as a framework warning (EVT_SUPERVISOR_LOST);
+// - a client sends its token only to a coordinator found through an authenticated heartbeat.
 //
 // Environment (set by tests/integration/middleware/CMakeLists.txt):
 //   SAFECASS_ICESTORM_ENV    file written by the fixture's scripts/start-icestorm --env
+//   SAFECASS_SCRATCH         a directory for key files
 
 #include <gtest/gtest.h>
 
 #include <Ice/Ice.h>
 #include <IceStorm/IceStorm.h>
 
+#include <atomic>
 #include <chrono>
+#include <map>
+#include <optional>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "auth.hpp"
 #include "safecass.h"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/middleware/client.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/spec/load.hpp"
 
@@ -61,83 +77,327 @@ constexpr const char* kSystem = R"({ "safecass": 1, "system": "wire",
                    { "required": "C.D2", "provided": "P.D2" }, { "required": "C.D3", "provided": "P.D3" } ],
   "coordinators": { "wire-p": ["P"], "wire-c": ["C"] } })";
 
-wire::StateUpdate update(const std::string& iface, std::int64_t seq, const std::string& event, wire::Level level) {
+
+using middleware::detail::Keyring;
+using middleware::detail::Signer;
+using middleware::detail::encode;
+
+constexpr std::int64_t kIncarnation = 42;
+
+wire::StateUpdate update(const std::string& iface, std::int64_t seq, const std::string& event, wire::Level level,
+                         std::int64_t incarnation = kIncarnation) {
   wire::StateUpdate u;
   u.coordinator = "wire-p";
-  u.incarnation = 42;
+  u.incarnation = incarnation;
   u.seq = seq;
   u.iface = iface;
   u.state = level;
-  u.roots.push_back(wire::Root{event, "P.s_A", 1000, level, "", "", 0.0, 0, false, {"P.s_A", "P.s_S." + iface.substr(2)}});
+  if (!event.empty()) {
+    u.roots.push_back(wire::Root{event, "P.s_A", 1000, level, "", "", 0.0, 0, false, {"P.s_A", "P.s_S." + iface.substr(2)}});
+  }
   return u;
 }
 
-TEST(Wire, ABadUpdateInABatchIsRefusedAloneAndTheOthersApply) {
-  const std::string port = fixture_port();
-  ASSERT_FALSE(port.empty()) << "no IceStorm fixture";
+Signer load_signer(const std::string& dir, const std::string& name) {
+  auto s = Signer::load(dir, name);
+  EXPECT_TRUE(s) << (s ? "" : s.error().message);
+  return *s;
+}
+
+/// The coordinator node "wire-c" on the fixture's IceStorm, and the test as everybody else: the
+/// real "wire-p" and supervisor (the system's keys), and an attacker (keys of its own).
+struct Bus {
+  std::string port = fixture_port();
+  std::string scratch = std::getenv("SAFECASS_SCRATCH") != nullptr ? std::getenv("SAFECASS_SCRATCH") : "/tmp";
+  std::string keys = scratch + "/wire-keys";
+  std::string attacker_keys = scratch + "/wire-attacker-keys";
   FilterRegistry registry;
-  register_builtin_filters(registry);
-  auto load = spec::load_system_from_text(kSystem, "wire.json", registry);
-  ASSERT_TRUE(load.ok());
+  spec::LoadResult load;
   middleware::HostClock clock;
-  Coordinator co("wire-c", &clock);
-  Monitor monitor(co, registry);
-  ASSERT_TRUE(spec::instantiate(*load.system, co, monitor, "wire-c"));
-  ASSERT_TRUE(middleware::connect_remote_providers(*load.system, "wire-c", co));
+  Coordinator co{"wire-c", &clock};
+  std::unique_ptr<Monitor> monitor;
+  std::unique_ptr<middleware::CoordinatorNode> node;
   std::mutex mutex;
   std::vector<std::string> log;
-  middleware::NodeOptions options;
-  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + port);
-  options.log = [&](const std::string& line) {
-    std::lock_guard lock(mutex);
-    log.push_back(line);
-  };
-  auto node = middleware::CoordinatorNode::create(co, monitor, registry, *load.system, "wire-c", options);
-  ASSERT_TRUE(node);
-  ASSERT_TRUE((*node)->start());
-  ASSERT_TRUE(eventually([&] { return (*node)->stats().connected; }, 10000ms));
+  Ice::CommunicatorHolder ice{Ice::initialize()};
+  std::shared_ptr<wire::StateTopicPrx> state_pub;
+  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
+  std::optional<Signer> provider, other, supervisor, attacker;
+  // The provider's heartbeat, sent by a thread while `beating`: the last seq of each stream.
+  std::map<std::string, std::int64_t> last_sent;
+  std::atomic<bool> beating{true};
+  std::atomic<bool> running{true};
+  std::int64_t beat_seq = 0;
+  std::thread beat_thread;
 
-  Ice::CommunicatorHolder ice(Ice::initialize());
-  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-      ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
-  std::shared_ptr<IceStorm::TopicPrx> topic;
-  try {
-    topic = manager->retrieve("safecass.state.wire-p");
-  } catch (const IceStorm::NoSuchTopic&) {
-    topic = manager->create("safecass.state.wire-p");
+  Bus() {
+    register_builtin_filters(registry);
+    load = spec::load_system_from_text(kSystem, "wire.json", registry);
+    EXPECT_TRUE(load.ok());
+    EXPECT_TRUE(middleware::create_bus_keys(*load.system, keys, true));
+    EXPECT_TRUE(middleware::create_bus_keys(*load.system, attacker_keys, true));
+    provider = load_signer(keys, "wire-p");
+    other = load_signer(keys, "wire-c");
+    supervisor = load_signer(keys, "supervisor");
+    attacker = load_signer(attacker_keys, "wire-p");
+    monitor = std::make_unique<Monitor>(co, registry);
+    EXPECT_TRUE(spec::instantiate(*load.system, co, *monitor, "wire-c"));
+    EXPECT_TRUE(middleware::connect_remote_providers(*load.system, "wire-c", co));
+    for (const char* d : {"P.D0", "P.D1", "P.D2", "P.D3"}) last_sent[d] = 0;
+
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+        ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
+    auto topic = [&](const std::string& name) {
+      try {
+        return manager->retrieve(name);
+      } catch (const IceStorm::NoSuchTopic&) {
+        return manager->create(name);
+      }
+    };
+    state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(topic("safecass.state.wire-p")->getPublisher()->ice_oneway());
+    heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(topic("safecass.heartbeat")->getPublisher());
+    beat_thread = std::thread([this] {
+      while (running.load()) {
+        if (beating.load()) beat(*provider, "wire-p", kIncarnation);
+        std::this_thread::sleep_for(100ms);
+      }
+    });
+
+    middleware::NodeOptions options;
+    options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + port);
+    options.keys_dir = keys;
+    options.log = [this](const std::string& line) {
+      std::lock_guard lock(mutex);
+      log.push_back(line);
+    };
+    auto n = middleware::CoordinatorNode::create(co, *monitor, registry, *load.system, "wire-c", options);
+    EXPECT_TRUE(n) << (n ? "" : n.error().message);
+    if (!n) return;
+    node = std::move(*n);
+    EXPECT_TRUE(node->start());
+    EXPECT_TRUE(eventually([&] { return node->stats().connected; }, 10000ms));
+    std::this_thread::sleep_for(300ms);  // the node's subscriptions are in place
   }
-  auto publisher = Ice::uncheckedCast<wire::StateTopicPrx>(topic->getPublisher()->ice_oneway());
-  std::this_thread::sleep_for(300ms);  // the node's subscription is in place
+  ~Bus() {
+    running.store(false);
+    if (beat_thread.joinable()) beat_thread.join();
+    if (node) node->stop();
+  }
 
-  wire::StateUpdateSeq batch{update("P.D0", 1, "EVT_E", wire::Level::Error),
-                             update("P.D1", 1, "EVT_UNKNOWN", wire::Level::Error),            // unknown event
-                             update("P.D2", 1, "EVT_E", wire::Level::Normal),                 // a Normal root
-                             update("P.D3", 1, "EVT_E", wire::Level::Error)};
-  publisher->updates(batch);
-  auto state = [&](const char* m) { return co.state(*co.find_machine(m)); };
-  ASSERT_TRUE(eventually([&] { return (*node)->stats().updates_applied + (*node)->stats().updates_rejected >= 4; }));
-  EXPECT_EQ(state("C.s_R.D0"), State::Error);
-  EXPECT_EQ(state("C.s_R.D1"), State::Normal) << "refused: nothing changed";
-  EXPECT_EQ(state("C.s_R.D2"), State::Normal) << "refused: nothing changed";
-  EXPECT_EQ(state("C.s_R.D3"), State::Error);
-  EXPECT_EQ((*node)->stats().updates_applied, 2u);
-  EXPECT_EQ((*node)->stats().updates_rejected, 2u);
-  {
+  /// A heartbeat of `name` signed by `key`, listing the streams' last numbers.
+  void beat(const Signer& key, const std::string& name, std::int64_t incarnation, std::string control = {}) {
+    wire::Heartbeat h;
+    h.coordinator = name;
+    h.incarnation = incarnation;
+    h.time = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    h.control = std::move(control);
+    {
+      std::lock_guard lock(mutex);
+      h.seq = ++beat_seq;
+      if (name == "wire-p") {
+        for (const auto& [iface, seq] : last_sent) h.lastSeq["state:" + iface] = seq;
+      }
+    }
+    heartbeat_pub->beat(key.sign(middleware::detail::kKindHeartbeat, encode(ice.communicator(), h)));
+  }
+  /// Publishes `batch` signed by `key`; a genuine batch also advances what the heartbeat lists.
+  void send(const Signer& key, const wire::StateUpdateSeq& batch) {
+    state_pub->updates(key.sign(middleware::detail::kKindState, encode(ice.communicator(), batch)));
+    if (&key != &*provider) return;
+    std::lock_guard lock(mutex);
+    for (const wire::StateUpdate& u : batch) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.seq);
+  }
+  State state(const std::string& machine) { return co.state(*co.find_machine(machine)); }
+  std::string all_log() {
     std::lock_guard lock(mutex);
     std::string all;
     for (const std::string& line : log) all += line + "\n";
-    EXPECT_NE(all.find("state update P.D1 seq 1 from coordinator 'wire-p' rejected, nothing changed"), std::string::npos) << all;
-    EXPECT_NE(all.find("no event 'EVT_UNKNOWN'"), std::string::npos) << all;
-    EXPECT_NE(all.find("state update P.D2 seq 1 from coordinator 'wire-p' rejected, nothing changed"), std::string::npos)
-        << all;
-    EXPECT_NE(all.find("level Normal is not a condition"), std::string::npos) << all;
+    return all;
   }
+  bool explains(const std::string& machine, const std::string& event) {
+    auto why = co.explain(machine);
+    if (!why) return false;
+    for (const Explanation& e : *why) {
+      if (e.event == event || e.root_event == event) return true;
+    }
+    return false;
+  }
+};
+
+TEST(Wire, ABadUpdateInABatchIsRefusedAloneAndTheOthersApply) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error),
+                           update("P.D1", 1, "EVT_UNKNOWN", wire::Level::Error),  // unknown event
+                           update("P.D2", 1, "EVT_E", wire::Level::Normal),       // a Normal root
+                           update("P.D3", 1, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return bus.node->stats().updates_applied + bus.node->stats().updates_rejected >= 4; }));
+  EXPECT_EQ(bus.state("C.s_R.D0"), State::Error);
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Normal) << "refused: nothing changed";
+  EXPECT_EQ(bus.state("C.s_R.D2"), State::Normal) << "refused: nothing changed";
+  EXPECT_EQ(bus.state("C.s_R.D3"), State::Error);
+  EXPECT_EQ(bus.node->stats().updates_applied, 2u);
+  EXPECT_EQ(bus.node->stats().updates_rejected, 2u);
+  // Refusals are logged at most once per second per source (and always counted).
+  EXPECT_NE(bus.all_log().find("refused state update P.D1 seq 1 from coordinator 'wire-p': nothing changed"),
+            std::string::npos) << bus.all_log();
+  EXPECT_NE(bus.all_log().find("no event 'EVT_UNKNOWN'"), std::string::npos) << bus.all_log();
 
   // The refused streams are not stuck: their next update applies; a repeated number is ignored.
-  publisher->updates({update("P.D1", 2, "EVT_E", wire::Level::Error), update("P.D0", 1, "EVT_E", wire::Level::Error)});
-  EXPECT_TRUE(eventually([&] { return state("C.s_R.D1") == State::Error; }));
-  EXPECT_TRUE(eventually([&] { return (*node)->stats().updates_rejected == 3u; })) << "P.D0 seq 1 again: stale";
-  (*node)->stop();
+  bus.send(*bus.provider, {update("P.D1", 2, "EVT_E", wire::Level::Error), update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }));
+  EXPECT_TRUE(eventually([&] { return bus.node->stats().updates_rejected == 3u; })) << "P.D0 seq 1 again: stale";
+}
+
+TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNothing) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  const wire::StateUpdateSeq raise{update("P.D0", 1, "EVT_E", wire::Level::Error)};
+  bus.send(*bus.provider, raise);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }));
+  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Normal; }));
+  const auto before = bus.node->stats();
+
+  auto ic = bus.ice.communicator();
+  // 1. Signed with a key that is not wire-p's (an attacker who read the heartbeat topic).
+  bus.send(*bus.attacker, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  // 2. The one-message freeze: a sequence number near 2^63, forged.
+  bus.send(*bus.attacker, {update("P.D0", std::numeric_limits<std::int64_t>::max() - 1, "", wire::Level::Normal)});
+  // 3. Signed by another coordinator of the system (a real key) but naming wire-p.
+  bus.send(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  // 4. Claiming wire-p as signer with another key's signature, and with no signature at all.
+  wire::Signed relabelled = bus.other->sign(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
+  relabelled.signer = "wire-p";
+  bus.state_pub->updates(relabelled);
+  wire::Signed unsigned_message = relabelled;
+  unsigned_message.signature.clear();
+  bus.state_pub->updates(unsigned_message);
+  // 5. A replay of wire-p's genuine first message.
+  bus.send(*bus.provider, raise);
+  // 6. A genuine key, an older incarnation.
+  bus.send(*bus.provider, {update("P.D0", 100, "EVT_E", wire::Level::Error, kIncarnation - 1)});
+  // 7. A genuine key, a jump far into the future (a stream must not be frozen even by its owner).
+  bus.send(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "EVT_E", wire::Level::Error)});
+  // 8. A heartbeat kind sent on the state topic.
+  wire::Heartbeat hb;
+  hb.coordinator = "wire-p";
+  bus.state_pub->updates(bus.provider->sign(middleware::detail::kKindHeartbeat, encode(ic, hb)));
+
+  EXPECT_TRUE(eventually([&] { return bus.node->stats().messages_refused - before.messages_refused >= 9; }))
+      << bus.all_log();
+  std::this_thread::sleep_for(200ms);
+  EXPECT_EQ(bus.state("C.s_R.D0"), State::Normal) << "nothing forged or replayed changed the state\n" << bus.all_log();
+  EXPECT_EQ(bus.node->stats().updates_applied, before.updates_applied);
+  EXPECT_EQ(bus.node->stats().messages_refused - before.messages_refused, 9u);
+  EXPECT_NE(bus.all_log().find("bad signature"), std::string::npos) << bus.all_log();
+
+  // The stream is not frozen: wire-p's next genuine update applies at once.
+  bus.send(*bus.provider, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; })) << bus.all_log();
+}
+
+TEST(Wire, AClientRaisesCoordinatorLostWhenItsProviderFallsSilentAndClearsOnceItIsBackAndResynchronised) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }));
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Normal);
+
+  bus.beating.store(false);  // wire-p dies (kill -9: no goodbye)
+  // Forged heartbeats naming wire-p must not keep it alive.
+  const auto until = std::chrono::steady_clock::now() + 1000ms;
+  while (std::chrono::steady_clock::now() < until && bus.state("C.s_R.D1") != State::Error) {
+    bus.beat(*bus.attacker, "wire-p", kIncarnation);
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << "lost within the bound (3 heartbeats) + one check\n" << bus.all_log();
+  for (const char* r : {"C.s_R.D0", "C.s_R.D1", "C.s_R.D2", "C.s_R.D3"}) {
+    EXPECT_TRUE(bus.explains(r, "EVT_COORDINATOR_LOST")) << r;
+  }
+  EXPECT_EQ(bus.co.extended_state(*bus.co.find_component("C")), State::Error) << "dispatch() in the client sees Error";
+  EXPECT_EQ(bus.node->stats().providers_lost, 1u);
+
+  // Back, but with a state the client has not received yet (seq 2): still lost.
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.last_sent["P.D0"] = 2;
+  }
+  bus.beating.store(true);
+  std::this_thread::sleep_for(400ms);
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << "not resynchronised yet";
+  // Resynchronised: the loss clears and the client holds exactly the provider's state.
+  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  EXPECT_EQ(bus.state("C.s_R.D0"), State::Normal);
+  EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+TEST(Wire, ACoordinatorRaisesAFrameworkWarningWhenTheSupervisorFallsSilent) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  for (int i = 0; i < 3; ++i) {
+    bus.beat(*bus.supervisor, "supervisor", kIncarnation);
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_EQ(bus.state("C.s_F"), State::Normal);
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Warning; }, 2000ms)) << bus.all_log();
+  EXPECT_TRUE(bus.explains("C.s_F", "EVT_SUPERVISOR_LOST"));
+  bus.beat(*bus.supervisor, "supervisor", kIncarnation);
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 2000ms)) << bus.all_log();
+}
+
+TEST(Wire, AClientSendsItsTokenOnlyToACoordinatorFoundThroughAnAuthenticatedHeartbeatOnThisHost) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(false);
+  std::atomic<bool> spoofing{true};
+  std::atomic<bool> remote_control{false};
+  std::thread spoofer([&] {
+    while (spoofing.load()) {
+      // Forged: "wire-p" with an attacker's Control proxy on this host.
+      bus.beat(*bus.attacker, "wire-p", kIncarnation, "control-wire-p -t:tcp -h 127.0.0.1 -p 1");
+      // Genuine, but its Control endpoint is on another host.
+      if (remote_control.load()) bus.beat(*bus.provider, "wire-p", kIncarnation, "control-wire-p -t:tcp -h 10.1.2.3 -p 9");
+      std::this_thread::sleep_for(50ms);
+    }
+  });
+  middleware::ClientOptions o;
+  o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  o.coordinator = "wire-p";
+  o.token = std::string(64, 'a');
+  o.keys_dir = bus.keys;
+  o.timeout = 800ms;
+  auto lured = middleware::RemoteClient::connect(o);
+  ASSERT_FALSE(lured);
+  EXPECT_EQ(lured.error().code, ErrorCode::Io);
+  EXPECT_NE(lured.error().message.find("forged heartbeat(s) naming it refused"), std::string::npos)
+      << lured.error().message;
+
+  remote_control.store(true);
+  auto far = middleware::RemoteClient::connect(o);
+  ASSERT_FALSE(far);
+  EXPECT_EQ(far.error().code, ErrorCode::Denied) << far.error().message;
+  EXPECT_NE(far.error().message.find("not on this host"), std::string::npos) << far.error().message;
+  spoofing.store(false);
+  spoofer.join();
+
+  // The real coordinator, found through its own signed heartbeat, answers.
+  o.coordinator = "wire-c";
+  o.timeout = 2000ms;
+  auto real = middleware::RemoteClient::connect(o);
+  ASSERT_TRUE(real) << real.error().message;
+  EXPECT_EQ(*(*real)->coordinator(), "wire-c");
+}
+
+TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {
+  EXPECT_EQ(middleware::detail::printable("robot"), "robot");
+  EXPECT_EQ(middleware::detail::printable("a\nb\rc\x1b[2J\\"), "a\\x0ab\\x0dc\\x1b[2J\\\\");
 }
 
 }  // namespace

@@ -139,8 +139,13 @@ async function startViewer(ice, robotToken) {
   for (const until = Date.now() + 15000; ;) {
     const text = logOf('viewer');
     const url = /open (http:\/\/127\.0\.0\.1:\d+\/)\n/.exec(text);
-    const token = /the token is in (\S+) \(mode 0600\); or open \S+#token=([0-9a-f]+)/.exec(text);
-    if (url !== null && token !== null && /Ctrl-C stops it/.test(text)) return { viewer, url: url[1], token: token[2], text };
+    const file = /the token is in (\S+) \(mode 0600\)/.exec(text);
+    if (url !== null && file !== null && /Ctrl-C stops it/.test(text)) {
+      // The token is in the file only: it is never printed (the output lands in logs).
+      const token = fs.readFileSync(file[1], 'utf8').trim();
+      if (text.includes(token)) throw new Error('the viewer printed its token');
+      return { viewer, url: url[1], token, text };
+    }
     if (!alive(viewer) || Date.now() > until) throw new Error(`the viewer did not start:\n${text}`);
     await sleep(50);
   }
@@ -160,6 +165,11 @@ async function waitStatus(page, coordinator, status, timeout) {
 async function test() {
   fs.mkdirSync(scratch, { recursive: true });
   const ice = await startIceStorm();
+  // The bus is authenticated: the system's keys, inherited by every process started here.
+  const keys = path.join(scratch, 'keys');
+  const made = await run(safecass, ['keys', kSystem, '--out', keys, '--replace']);
+  if (made.code !== 0) throw new Error(`safecass keys failed (${made.code}): ${made.stderr}`);
+  process.env.SAFECASS_KEYS = keys;
   const robotToken = path.join(scratch, 'robot.token');
   await startCoordinator('robot', ice, robotToken);
   const { viewer, url, token, text } = await startViewer(ice, robotToken);

@@ -277,5 +277,26 @@ TEST(RemoteProvider, ARootWhosePathContainsTheReceivingMachineIsDropped) {
   EXPECT_EQ(two.robot.at("JR3.s_P.ForceData"), N);
 }
 
+TEST(RemoteProvider, AHistoryRecordKeepsTheRootCauseItWasMadeWithAfterItsRemoteSlotIsReused) {
+  // Finding: the client's history named the root of a later fault, because records kept only
+  // the index of a remote root's slot, which the next remote root reused.
+  Split two;
+  two.sensor.gen("EVT_FORCE_ERROR", "JR3.s_A");
+  two.sync();
+  two.sensor.gen("/EVT_FORCE_ERROR", "JR3.s_A");
+  two.sync();
+  two.sensor.gen("EVT_FORCE_WARNING", "JR3.s_P.ForceData");
+  two.sensor.gen("EVT_FORCE_ERROR", "JR3.s_P.ForceData");
+  two.sync();
+  std::vector<std::string> causes;
+  for (const Record& r : two.robot.co.history(two.robot.machine("CONTROL.s_R.ForceData"))) {
+    if (r.kind != RecordKind::Transition) continue;
+    causes.push_back(std::string(to_string(r.to)) + " <- " + two.robot.co.root_origin(r.root) + ":" +
+                     two.robot.co.event(r.root.event).name);
+  }
+  EXPECT_EQ(causes, (std::vector<std::string>{"Error <- JR3.s_A:EVT_FORCE_ERROR", "Normal <- JR3.s_A:EVT_FORCE_ERROR",
+                                              "Error <- JR3.s_P.ForceData:EVT_FORCE_ERROR"}));
+}
+
 }  // namespace
 }  // namespace safecass

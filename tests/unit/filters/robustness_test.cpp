@@ -313,12 +313,65 @@ TEST_F(NonFiniteSample, VectorsWithANonFiniteElementLeaveTheLastFiniteVectorHeld
   EXPECT_EQ(events_, (Events{"EVT_INVALID_SAMPLE", "/EVT_INVALID_SAMPLE"}));
 }
 
+TEST_F(NonFiniteSample, AnInfiniteSampleIsReportedAsInfiniteNotAsNaN) {
+  Signal* x = signal("x");
+  Signal* v = signal("v", 3);
+  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* n = make("Norm", {{"input_signal", std::string("v")}, {"output_signal", std::string("vn")}});
+  feed(x, f, 1.0, kInf);
+  std::vector<Condition> conditions = co_.conditions(framework());
+  ASSERT_EQ(conditions.size(), 1u);
+  EXPECT_EQ(conditions[0].root.sample.value, kInf);
+  feed(x, f, 1.1, 0);
+  feed(x, f, 1.2, -kInf);
+  conditions = co_.conditions(framework());
+  ASSERT_EQ(conditions.size(), 1u);
+  EXPECT_EQ(conditions[0].root.sample.value, -kInf);
+  feed(x, f, 1.3, 0);
+  // A vector: the first value that is not finite.
+  const double bad[] = {1.0, -kInf, kNaN};
+  v->push(seconds_to_time(1.4), bad);
+  n->run(seconds_to_time(1.4));
+  conditions = co_.conditions(framework());
+  ASSERT_EQ(conditions.size(), 1u);
+  EXPECT_EQ(conditions[0].root.sample.value, -kInf);
+}
+
+TEST_F(NonFiniteSample, TheMonitorRefusesToInjectANonFiniteValueAndChangesNothing) {
+  Signal* x = signal("x");
+  signal("v", 2);
+  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
+  std::size_t injections = 0;
+  co_.subscribe([&injections](const Record& r) { injections += r.kind == RecordKind::Injection ? 1 : 0; });
+  const struct {
+    double value;
+    const char* text;
+  } cases[] = {{kNaN, "nan"}, {kInf, "inf"}, {-kInf, "-inf"}};
+  for (const auto& c : cases) {
+    auto shallow = monitor_.inject_shallow(f->name(), {{5.0}, {c.value}});
+    ASSERT_FALSE(shallow) << c.text;
+    EXPECT_EQ(shallow.error().code, ErrorCode::InvalidArgument);
+    EXPECT_EQ(shallow.error().message, "shallow injection into filter " + f->name() + ": sample 2 is " + c.text +
+                                           ", not a finite number: injected values must be finite");
+    auto deep = monitor_.inject_deep("C.v", {{1.0, c.value}}, seconds_to_time(1.0));
+    ASSERT_FALSE(deep) << c.text;
+    EXPECT_EQ(deep.error().message, std::string("deep injection into signal C.v: sample 1 value 2 is ") + c.text +
+                                        ", not a finite number: injected values must be finite");
+  }
+  EXPECT_EQ(injections, 0u) << "a refused injection is not recorded";
+  EXPECT_TRUE(written("v").empty()) << "nothing was written";
+  feed(x, f, 1.0, 0);
+  EXPECT_TRUE(events_.empty()) << "nothing was queued into the filter";
+}
+
 TEST_F(NonFiniteSample, ShallowInjectedNaNIsMarkedAsInjected) {
+  // Below the monitor's rule (injected values are finite), the filter's own mechanism still marks
+  // an invalid sample that came from an injection.
   Signal* x = signal("x");
   Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")},
                                  {"output_signal", std::string("out")}});
   feed(x, f, 1.0, 0);
-  ASSERT_TRUE(monitor_.inject_shallow(f->name(), {{kNaN}}));
+  ASSERT_TRUE(f->inject({{kNaN}}));
   tick(f, 1.1);
   EXPECT_EQ(events_, Events{"EVT_INVALID_SAMPLE"});
   const std::vector<Condition> conditions = co_.conditions(framework());

@@ -12,8 +12,8 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
-#include "safecass/middleware/token.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::middleware {
@@ -36,44 +36,6 @@ TEST(IceEndpoint, MalformedEndpointsAreParseErrorsThatSayWhy) {
     EXPECT_EQ(e.error().code, ErrorCode::Parse);
     EXPECT_NE(e.error().message.find("--ice"), std::string::npos);
   }
-}
-
-std::string temp_path(const char* name) { return ::testing::TempDir() + "/" + name + std::to_string(::getpid()); }
-
-TEST(Token, TokenFileIsPrivateAndReadsBack) {
-  const std::string path = temp_path("token");
-  auto secret = create_token_file(path);
-  ASSERT_TRUE(secret) << secret.error().message;
-  EXPECT_EQ(secret->size(), 64u);
-  struct stat st {};
-  ASSERT_EQ(::stat(path.c_str(), &st), 0);
-  EXPECT_EQ(st.st_mode & 0777, 0600u);
-  auto read = read_token_file(path);
-  ASSERT_TRUE(read);
-  EXPECT_EQ(*read, *secret);
-  auto again = create_token_file(path);
-  ASSERT_TRUE(again);
-  EXPECT_NE(*again, *secret) << "every start makes a new secret";
-  ::unlink(path.c_str());
-}
-
-TEST(Token, AFileThatIsNotATokenIsRefused) {
-  const std::string path = temp_path("not-a-token");
-  std::ofstream(path) << "hello\n";
-  auto r = read_token_file(path);
-  ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().code, ErrorCode::Parse);
-  ::unlink(path.c_str());
-  EXPECT_EQ(read_token_file(path).error().code, ErrorCode::Io);
-  EXPECT_FALSE(create_token_file("/nonexistent-dir/x.token"));
-}
-
-TEST(Token, OnlyTheExactTokenMatches) {
-  const std::string t(64, 'a');
-  EXPECT_TRUE(token_matches(t, t));
-  EXPECT_FALSE(token_matches(t, std::string(64, 'b')));
-  EXPECT_FALSE(token_matches(t, t.substr(1)));
-  EXPECT_FALSE(token_matches("", "")) << "no token configured: nothing matches";
 }
 
 struct Robodoc {
@@ -130,9 +92,65 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   auto unknown = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "nowhere", options);
   ASSERT_FALSE(unknown);
   EXPECT_EQ(unknown.error().code, ErrorCode::NotFound);
+
+  const std::string keys = ::testing::TempDir() + "safecass-node-keys-" + std::to_string(::getpid());
+  options.keys_dir = keys + "-missing";
+  auto no_keys = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
+  ASSERT_FALSE(no_keys) << "the bus is authenticated: no keys, no node";
+  EXPECT_NE(no_keys.error().message.find("safecass keys"), std::string::npos) << no_keys.error().message;
+
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, true));
+  options.keys_dir = keys;
+  options.ice.host = "192.0.2.7";
+  auto far = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
+  ASSERT_FALSE(far) << "a non-loopback IceStorm without --insecure";
+  EXPECT_EQ(far.error().code, ErrorCode::InvalidArgument);
+  options.ice.host = "127.0.0.1";
+
+  ASSERT_EQ(::chmod((keys + "/robot.secret").c_str(), 0640), 0);
+  auto exposed = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
+  ASSERT_FALSE(exposed) << "a secret key others can read is refused";
+  EXPECT_EQ(exposed.error().code, ErrorCode::Denied);
+  ASSERT_EQ(::chmod((keys + "/robot.secret").c_str(), 0600), 0);
+
   auto node = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
-  ASSERT_TRUE(node);
+  ASSERT_TRUE(node) << node.error().message;
   EXPECT_FALSE((*node)->stats().connected);
+}
+
+TEST(BusKeys, AreCreatedPrivateOncePerSignerAndNeverOverwriteAForeignFile) {
+  Robodoc r;
+  const std::string keys = ::testing::TempDir() + "safecass-keys-" + std::to_string(::getpid());
+  auto names = create_bus_keys(*r.load.system, keys, true);
+  ASSERT_TRUE(names) << names.error().message;
+  EXPECT_EQ(*names, (std::vector<std::string>{"robot", "ui", "supervisor"}));
+  struct stat st {};
+  ASSERT_EQ(::stat(keys.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0700u);
+  ASSERT_EQ(::stat((keys + "/robot.secret").c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+  auto again = create_bus_keys(*r.load.system, keys, false);
+  ASSERT_FALSE(again) << "existing keys are kept unless replaced";
+  EXPECT_EQ(again.error().code, ErrorCode::Duplicate);
+  // A file that is not a key is never overwritten, even with replace.
+  ::unlink((keys + "/ui.secret").c_str());
+  { std::ofstream(keys + "/ui.secret") << "my notes\n"; }
+  auto foreign = create_bus_keys(*r.load.system, keys, true);
+  ASSERT_FALSE(foreign);
+  std::ifstream in(keys + "/ui.secret");
+  std::string line;
+  std::getline(in, line);
+  EXPECT_EQ(line, "my notes");
+}
+
+TEST(BusKeys, LoopbackHostsAreRecognised) {
+  EXPECT_TRUE(is_loopback_host("127.0.0.1"));
+  EXPECT_TRUE(is_loopback_host("127.1.2.3"));
+  EXPECT_TRUE(is_loopback_host("localhost"));
+  EXPECT_TRUE(is_loopback_host("::1"));
+  EXPECT_FALSE(is_loopback_host("10.0.0.1"));
+  EXPECT_FALSE(is_loopback_host("0.0.0.0"));
+  EXPECT_FALSE(is_loopback_host("robot.example"));
 }
 
 

@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <string>
@@ -359,6 +364,58 @@ TEST_F(ConsoleTest, ABadDinloadFileNamesTheLineAndInjectsNothing) {
   const std::string sizes = write_file("console_bad_sizes.txt", "0 0 50\n1\n");
   EXPECT_FALSE(console->execute("filter dinload JR3.Force " + sizes).ok);
   EXPECT_FALSE(contains(console->execute("watch 0.01").out, "EVT_FORCE_ERROR"));
+}
+
+TEST_F(ConsoleTest, DinloadReadsRegularFilesOnlyAndRefusesDevicesFifosDirectoriesAndHugeFilesAtOnce) {
+  std::string pattern = ::testing::TempDir() + "/console-dinload-XXXXXX";
+  ASSERT_NE(::mkdtemp(pattern.data()), nullptr);
+  const std::string dir = pattern;
+  const std::string fifo = dir + "/samples.fifo";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string big = dir + "/big.txt";
+  std::ofstream(big).close();
+  ASSERT_EQ(::truncate(big.c_str(), (off_t{64} << 20) + 1), 0);  // sparse: nothing on the disk
+  const std::string before = observable(*console);
+  const auto started = std::chrono::steady_clock::now();
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"/dev/zero", "cannot read file '/dev/zero': not a regular file (a character device)"},
+      {fifo, "cannot read file '" + fifo + "': not a regular file (a FIFO)"},
+      {dir, "cannot read file '" + dir + "': not a regular file (a directory)"},
+      {big, "cannot read file '" + big + "': larger than 64 MiB (67108865 bytes)"},
+  };
+  for (const auto& [file, message] : cases) {
+    const ConsoleReply r = console->execute("filter dinload JR3.Force " + file);
+    EXPECT_FALSE(r.ok) << file;
+    EXPECT_TRUE(contains(r.err, message)) << r.err;
+    EXPECT_EQ(count_lines(r.err), 1u) << r.err;
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - started, std::chrono::seconds(5)) << "nothing hung";
+  EXPECT_EQ(observable(*console), before);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(ConsoleTest, InjectingANonFiniteValueIsRefusedOnEveryPathAndChangesNothing) {
+  const std::string before = observable(*console);
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"filter inject force_limit inf", "'inf' is not a finite number: injected values must be finite"},
+      {"filter inject force_limit 10 -inf", "'-inf' is not a finite number: injected values must be finite"},
+      {"filter inject force_limit nan", "'nan' is not a finite number: injected values must be finite"},
+      {"filter dinject JR3.Force [0,0,inf]", "'inf' is not a finite number: injected values must be finite"},
+      {"filter dinject JR3.Force [NaN 0 0]", "'NaN' is not a finite number: injected values must be finite"},
+      {"filter dinject JR3.Force [0,0,1e999]", "'1e999' is not a number"},
+  };
+  for (const auto& [line, message] : cases) {
+    const ConsoleReply r = console->execute(line);
+    EXPECT_FALSE(r.ok) << line;
+    EXPECT_TRUE(contains(r.err, message)) << line << ": " << r.err;
+  }
+  const std::string file = write_file("console_infinite_dinload.txt", "0 0 10\n0, 0, -inf\n");
+  const ConsoleReply r = console->execute("filter dinload JR3.Force " + file);
+  EXPECT_FALSE(r.ok);
+  EXPECT_TRUE(contains(r.err, "console_infinite_dinload.txt:2: '-inf' is not a finite number: injected values must be finite"))
+      << r.err;
+  EXPECT_EQ(observable(*console), before);
+  EXPECT_FALSE(contains(console->execute("watch 0.05").out, "EVT_INVALID_SAMPLE"));
 }
 
 TEST_F(ConsoleTest, UsageNamesTheCommandThatWasMistyped) {

@@ -7,6 +7,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -188,11 +189,60 @@ TEST(Timeline, MalformedLinesAreErrorsNamingTheirLineNumbers) {
   EXPECT_EQ(p.records[0].line, 1);
 }
 
-TEST(Timeline, TruncatedLastLineOfAKilledProcessIsAnErrorNotSkipped) {
+TEST(Timeline, TornLastLineOfAKilledProcessIsSetAsideAndEveryCompleteRecordIsKept) {
   const std::string good = read_text(kSmall);
+  const HistoryParse complete = parse_history(good);
   const HistoryParse p = parse_history(good + "{\"seq\":99,\"t\":0.6,\"ki");
+  EXPECT_TRUE(p.errors.empty());
+  ASSERT_TRUE(p.torn.has_value());
+  EXPECT_EQ(p.torn->line, 28);
+  EXPECT_THAT(p.torn->message, HasSubstr("invalid JSON at column 19: unterminated string"));
+  EXPECT_EQ(p.records.size(), complete.records.size());
+  EXPECT_EQ(timeline_model_json(p.records), timeline_model_json(complete.records));
+}
+
+TEST(Timeline, AMalformedLineThatIsNotTheLastIsStillAnErrorWhenTheLastIsTorn) {
+  const HistoryParse p = parse_history(
+      "{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
+      "{\"t\":0.2,\"kind\":\"res\n"  // cut short, but a line follows: an error, not a torn line
+      "{\"t\":0.3,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
+      "{\"t\":0.4,\"ki");
   ASSERT_EQ(p.errors.size(), 1u);
-  EXPECT_EQ(p.errors[0].line, 28);
+  EXPECT_EQ(p.errors[0].line, 2);
+  ASSERT_TRUE(p.torn.has_value());
+  EXPECT_EQ(p.torn->line, 4);
+  EXPECT_EQ(p.records.size(), 2u);
+}
+
+TEST(Timeline, ALastLineWithoutNewlineThatIsCompleteIsARecordAndABadOneAnError) {
+  const HistoryParse good = parse_history("{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}");
+  EXPECT_TRUE(good.errors.empty());
+  EXPECT_FALSE(good.torn.has_value());
+  EXPECT_EQ(good.records.size(), 1u);
+  const HistoryParse bad = parse_history("{\"t\":0.1,\"kind\":\"heartbeat\"}");
+  ASSERT_EQ(bad.errors.size(), 1u) << "valid JSON is not torn: a wrong record stays an error";
+  EXPECT_FALSE(bad.torn.has_value());
+}
+
+TEST(Timeline, CommandDrawsAHistoryWithATornLastLineAndWarnsOnceNamingFileAndLine) {
+  const auto dir = temp_dir();
+  const auto history = dir / "killed.jsonl";
+  const std::string good = read_text(kSmall);
+  std::ofstream(history, std::ios::binary) << good << "{\"seq\":99,\"t\":0.6,\"kind\":\"trans";
+  const auto page = dir / "killed.html";
+  ::testing::internal::CaptureStderr();
+  const int code = run_timeline(history.string(), page.string());
+  const std::string err = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(code, 0);
+  EXPECT_THAT(err, HasSubstr(history.string() + ":28: warning: the last line is torn"));
+  EXPECT_THAT(err, HasSubstr("drawing the 27 complete records before it"));
+  EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  const std::string html = read_text(page.string());
+  EXPECT_THAT(html, HasSubstr("History line 28 is torn"));
+  const HistoryParse complete = parse_history(good);
+  EXPECT_EQ(script_data(html, "timeline-model"), script_data(render_timeline_page(complete.records, "killed.jsonl"), "timeline-model"))
+      << "every complete record is drawn";
+  std::filesystem::remove_all(dir);
 }
 
 TEST(Timeline, CommandExitsTwoWithFileAndLineForABadHistoryAndWritesNoPage) {
@@ -214,8 +264,10 @@ TEST(Timeline, CommandExitsTwoWhenTheHistoryCannotBeReadOrThePageCannotBeWritten
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(run_timeline("tests/data/timeline/no-such-history.jsonl", "/dev/null"), 2);
   EXPECT_EQ(run_timeline(kSmall, "tests/data/timeline/no-such-dir/page.html"), 2);
+  EXPECT_EQ(run_timeline("/dev/zero", "/dev/null"), 2);
   const std::string err = ::testing::internal::GetCapturedStderr();
-  EXPECT_THAT(err, HasSubstr("cannot read history file 'tests/data/timeline/no-such-history.jsonl'"));
+  EXPECT_THAT(err, HasSubstr("cannot read file '/dev/zero': not a regular file (a character device)"));
+  EXPECT_THAT(err, HasSubstr("history: cannot read file 'tests/data/timeline/no-such-history.jsonl': no such file"));
   EXPECT_THAT(err, HasSubstr("cannot write 'tests/data/timeline/no-such-dir/page.html'"));
 }
 

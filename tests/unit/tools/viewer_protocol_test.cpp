@@ -321,14 +321,6 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   EXPECT_THAT(str(shallow, "text"), HasSubstr("queued 2 samples into filter force_limit"));
 }
 
-TEST(ViewerProtocol, SameSecretComparesWholeStrings) {
-  EXPECT_TRUE(same_secret("abc", "abc"));
-  EXPECT_FALSE(same_secret("abc", "abd"));
-  EXPECT_FALSE(same_secret("abc", "ab"));
-  EXPECT_FALSE(same_secret("", "a"));
-  EXPECT_TRUE(same_secret("", ""));
-}
-
 TEST(ViewerInProcessSource, OpenReportsWhatIsMissingOrWrong) {
   InProcessOptions none;
   none.log = nullptr;

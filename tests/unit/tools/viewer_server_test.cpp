@@ -1,6 +1,6 @@
 // `safecass viewer`, its server (tools/viewer/server.hpp) through real sockets on 127.0.0.1 with a
 // port picked by the system: the embedded page, the JSON view, refused hosts, methods and
-// origins, the WebSocket protocol with its push of updates, and the write token file.
+// origins, the WebSocket protocol with its push of updates, and the backoff after a failed accept.
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <boost/asio/connect.hpp>
 #include <boost/asio/ip/tcp.hpp>
@@ -237,32 +238,32 @@ TEST(ViewerServer, OpenReportsABusyPortAndABadAddress) {
   EXPECT_FALSE(Server::open(**source, no_token, bad).has_value());
 }
 
-TEST(ViewerToken, IsRandomHexWrittenToAPrivateFileThatIsRemovedAfterwards) {
-  const auto a = make_token();
-  const auto b = make_token();
-  ASSERT_TRUE(a && b);
-  EXPECT_EQ(a->size(), 64u);
-  EXPECT_EQ(a->find_first_not_of("0123456789abcdef"), std::string::npos);
-  EXPECT_NE(*a, *b);
+TEST(ViewerAcceptBackoff, WaitsTenMillisecondsDoublingToOneSecondAndStartsAgainAfterASuccess) {
+  AcceptBackoff b;
+  const auto t0 = AcceptBackoff::Clock::now();
+  std::vector<long> delays;
+  for (int i = 0; i < 10; ++i) delays.push_back(static_cast<long>(b.failed(t0).delay.count()));
+  EXPECT_EQ(delays, (std::vector<long>{10, 20, 40, 80, 160, 320, 640, 1000, 1000, 1000}));
+  b.succeeded();
+  EXPECT_EQ(b.failed(t0).delay.count(), 10);
+  EXPECT_EQ(b.failed(t0).delay.count(), 20);
+}
 
-  const std::filesystem::path dir = std::filesystem::temp_directory_path();
-  const auto path = write_token_file(*a, dir.string());
-  ASSERT_TRUE(path.has_value()) << path.error().message;
-  struct stat st {};
-  ASSERT_EQ(::stat(path->c_str(), &st), 0);
-  EXPECT_EQ(st.st_mode & 0777, 0600u);
-  const std::filesystem::path parent = std::filesystem::path(*path).parent_path();
-  ASSERT_EQ(::stat(parent.c_str(), &st), 0);
-  EXPECT_EQ(st.st_mode & 0077, 0u) << "the token's directory is private";
-  std::ifstream in(*path);
-  std::string text;
-  std::getline(in, text);
-  EXPECT_EQ(text, *a);
-  remove_token_file(*path);
-  EXPECT_FALSE(std::filesystem::exists(*path));
-  EXPECT_FALSE(std::filesystem::exists(parent));
-
-  EXPECT_FALSE(write_token_file(*a, "/nonexistent/dir").has_value());
+TEST(ViewerAcceptBackoff, LogsTheFirstFailureThenAtMostOnceEveryTenSecondsWithTheCountNotLogged) {
+  AcceptBackoff b;
+  const auto t0 = AcceptBackoff::Clock::now();
+  const AcceptBackoff::Step first = b.failed(t0);
+  EXPECT_TRUE(first.log);
+  EXPECT_EQ(first.not_logged, 0u);
+  int logged = 0;
+  for (int ms = 1; ms < 10000; ms += 10) logged += b.failed(t0 + std::chrono::milliseconds(ms)).log ? 1 : 0;
+  EXPECT_EQ(logged, 0) << "nothing more within ten seconds";
+  b.succeeded();  // a success does not reopen the log: a flapping error is not logged more often
+  EXPECT_FALSE(b.failed(t0 + std::chrono::milliseconds(9995)).log);
+  const AcceptBackoff::Step later = b.failed(t0 + std::chrono::seconds(10));
+  EXPECT_TRUE(later.log);
+  EXPECT_EQ(later.not_logged, 1001u);
+  EXPECT_FALSE(b.failed(t0 + std::chrono::seconds(11)).log);
 }
 
 }  // namespace

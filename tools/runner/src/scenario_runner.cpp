@@ -1,5 +1,6 @@
 #include "safecass/runner/scenario_runner.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "safecass/record/recorder.hpp"
@@ -75,6 +76,13 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
         break;
       }
       case spec::ScenarioStep::Kind::Inject:
+        // JSON has no NaN or infinity; a scenario built in C++ follows the same rule (docs/filters.md).
+        if (std::any_of(s.values.begin(), s.values.end(), [](const std::vector<double>& v) {
+              return std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); });
+            })) {
+          out.push_back(error_at(s, "an injected value is not a finite number: injected values must be finite"));
+          break;
+        }
         if (!s.filter.empty()) {
           Filter* f = monitor_->find_filter(s.filter);
           if (f == nullptr) {
@@ -229,7 +237,10 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
                               ": expectation at t=" + secs(seconds_to_time(s.at)) + " is after the scenario's duration");
   }
   coordinator_.unsubscribe(subscription);
-  if (recorder) recorder->close();
+  if (recorder) {
+    recorder->close();
+    result.record = recorder->status();
+  }
   for (EventId e = framework_event::kCount; e < coordinator_.event_count(); ++e) {
     const Event& ev = coordinator_.event(e);
     for (Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
@@ -291,7 +302,13 @@ int run_scenario_file(const std::string& path, const FilterRegistry& registry, c
   if (!problems.empty()) return 2;
   RunResult r = runner.run(options);
   for (const std::string& f : r.failures) std::fprintf(err, "%s\n", f.c_str());
-  const int code = r.passed() ? 0 : 1;
+  int code = r.passed() ? 0 : 1;
+  if (r.record) {
+    // Nothing lost silently: a history that misses records is said, and fails the command.
+    for (const std::string& loss : describe_losses(*r.record)) std::fprintf(err, "%s\n", loss.c_str());
+    if (options.json) std::fprintf(options.out, "%s\n", record_status_json(*r.record).c_str());
+    if (!r.record->complete()) code = 2;
+  }
   if (result != nullptr) *result = std::move(r);
   return code;
 }

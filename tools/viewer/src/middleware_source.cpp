@@ -116,6 +116,7 @@ struct MiddlewareSource::Impl {
     o.ice = ice;
     o.coordinator = l.name;
     o.token = l.token;
+    o.keys_dir = options.keys_dir;
     o.timeout = options.timeout;
     return RemoteClient::connect(o);
   }

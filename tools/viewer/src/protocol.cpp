@@ -1,5 +1,7 @@
 #include "safecass/viewer/protocol.hpp"
 
+#include "safecass/middleware/token.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -188,13 +190,6 @@ std::string get_samples(const spec::JsonValue& object, std::vector<std::vector<d
 
 }  // namespace
 
-bool same_secret(std::string_view a, std::string_view b) noexcept {
-  unsigned char diff = a.size() == b.size() ? 0 : 1;
-  const std::size_t n = a.size() < b.size() ? a.size() : b.size();
-  for (std::size_t i = 0; i < n; ++i) diff |= static_cast<unsigned char>(a[i] ^ b[i]);
-  return diff == 0;
-}
-
 bool listed_record(std::string_view record_json) {
   const spec::JsonParse p = spec::parse_json(record_json, 8);
   if (!p.value || !p.value->is_object()) return false;
@@ -259,8 +254,10 @@ std::string Protocol::refuse_write(std::string_view id, std::string_view op, std
   if (!options_.allow_write) {
     return error_reply(std::string(id), op, "refused: this viewer is read-only (start it with --allow-write to " + std::string(op) + ")");
   }
-  if (token.empty()) return error_reply(std::string(id), op, "refused: a write needs the token (key 'token'), printed when the viewer started");
-  if (!same_secret(token, options_.token)) return error_reply(std::string(id), op, "refused: wrong token");
+  if (token.empty()) {
+    return error_reply(std::string(id), op, "refused: a write needs the token (key 'token'), in the token file named when the viewer started");
+  }
+  if (!middleware::token_matches(options_.token, token)) return error_reply(std::string(id), op, "refused: wrong token");
   return {};
 }
 

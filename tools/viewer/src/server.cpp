@@ -1,17 +1,10 @@
 #include "safecass/viewer/server.hpp"
 
-#include <fcntl.h>
-#include <sys/random.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <atomic>
 #include <cctype>
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <deque>
 #include <optional>
 #include <set>
@@ -64,13 +57,15 @@ class WebSocketSession;
 
 struct ServerCore {
   ServerCore(ViewSource& s, const ProtocolOptions& p, const ServerOptions& o)
-      : source(s), protocol(s, p), options(o), acceptor(ioc), timer(ioc), signals(ioc) {}
+      : source(s), protocol(s, p), options(o), acceptor(ioc), accept_timer(ioc), timer(ioc), signals(ioc) {}
 
   asio::io_context ioc{1};  // first member: destroyed last, after the sessions its handlers hold
   ViewSource& source;
   Protocol protocol;
   ServerOptions options;
   tcp::acceptor acceptor;
+  asio::steady_timer accept_timer;  ///< the wait before accepting again after a failed accept
+  AcceptBackoff backoff;
   asio::steady_timer timer;
   asio::signal_set signals;
   std::vector<std::weak_ptr<WebSocketSession>> sessions;
@@ -262,14 +257,42 @@ struct Server::Impl : ServerCore {
   using ServerCore::ServerCore;
 };
 
+AcceptBackoff::Step AcceptBackoff::failed(Clock::time_point now) noexcept {
+  Step step{delay_, false, 0};
+  delay_ = std::min(delay_ * 2, kMaxDelay);
+  if (!last_log_ || now - *last_log_ >= kLogInterval) {
+    step.log = true;
+    step.not_logged = not_logged_;
+    not_logged_ = 0;
+    last_log_ = now;
+  } else {
+    ++not_logged_;
+  }
+  return step;
+}
+
 void ServerCore::accept() {
   acceptor.async_accept([this](beast::error_code ec, tcp::socket socket) {
     if (ec) {
       if (ec == asio::error::operation_aborted || stopped) return;
-      log_line("accept: " + ec.message());
-    } else {
-      std::make_shared<HttpSession>(std::move(socket), *this)->read();
+      // Out of file descriptors (EMFILE) and the like: the pending connection stays in the
+      // backlog, so accepting again at once fails again at once. Wait, and say so rarely.
+      const AcceptBackoff::Step step = backoff.failed(AcceptBackoff::Clock::now());
+      if (step.log) {
+        log_line("accept: " + ec.message() + "; trying again in " + std::to_string(step.delay.count()) + " ms, up to every " +
+                 std::to_string(AcceptBackoff::kMaxDelay.count()) + " ms" +
+                 (step.not_logged == 0 ? std::string()
+                                       : " (" + std::to_string(step.not_logged) + " failed accepts not logged since the last line)"));
+      }
+      accept_timer.expires_after(step.delay);
+      accept_timer.async_wait([this](beast::error_code e) {
+        if (e || stopped) return;
+        accept();
+      });
+      return;
     }
+    backoff.succeeded();
+    std::make_shared<HttpSession>(std::move(socket), *this)->read();
     accept();
   });
 }
@@ -311,6 +334,7 @@ void ServerCore::shutdown() {
   asio::post(ioc, [this] {
     beast::error_code ignored;
     acceptor.close(ignored);
+    accept_timer.cancel();
     timer.cancel();
     signals.cancel(ignored);
     for (const auto& w : sessions) {
@@ -377,60 +401,5 @@ void Server::run() {
 }
 
 void Server::stop() { impl_->shutdown(); }
-
-// ---- token ------------------------------------------------------------------------------------------
-
-Expected<std::string> make_token() {
-  unsigned char bytes[32];
-  std::size_t got = 0;
-  while (got < sizeof bytes) {
-    const ssize_t n = getrandom(bytes + got, sizeof bytes - got, 0);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return fail(ErrorCode::Io, "no random source for the write token");
-    }
-    got += static_cast<std::size_t>(n);
-  }
-  static constexpr char kHex[] = "0123456789abcdef";
-  std::string token;
-  for (const unsigned char b : bytes) {
-    token += kHex[b >> 4];
-    token += kHex[b & 15];
-  }
-  return token;
-}
-
-Expected<std::string> write_token_file(const std::string& token, const std::string& dir) {
-  std::string base = dir;
-  if (base.empty()) {
-    const char* tmp = std::getenv("TMPDIR");
-    base = tmp != nullptr && *tmp != '\0' ? tmp : "/tmp";
-  }
-  std::string pattern = base + "/safecass-viewer-XXXXXX";
-  if (mkdtemp(pattern.data()) == nullptr) {
-    return fail(ErrorCode::Io, "cannot create a private directory in " + base + " for the write token");
-  }
-  const std::string path = pattern + "/token";
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
-  if (fd < 0) {
-    ::rmdir(pattern.c_str());
-    return fail(ErrorCode::Io, "cannot create " + path);
-  }
-  const std::string text = token + "\n";
-  const bool ok = ::fchmod(fd, 0600) == 0 && ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size());
-  ::close(fd);
-  if (!ok) {
-    remove_token_file(path);
-    return fail(ErrorCode::Io, "cannot write " + path);
-  }
-  return path;
-}
-
-void remove_token_file(const std::string& path) noexcept {
-  if (path.empty()) return;
-  ::unlink(path.c_str());
-  const auto slash = path.find_last_of('/');
-  if (slash != std::string::npos && slash > 0) ::rmdir(path.substr(0, slash).c_str());
-}
 
 }  // namespace safecass::viewer

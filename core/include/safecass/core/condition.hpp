@@ -32,6 +32,11 @@ struct RootCause {
   /// (Coordinator::add_remote_provided); this is the index of its remote data (origin address,
   /// hop path), read with Coordinator::root_origin() and explain().
   std::uint32_t remote = kNone;
+  /// For a remote root: its origin address in its own process, interned when it arrived. A record
+  /// keeps it by value, so the record names its true root cause for ever, even after `remote`'s
+  /// slot has been freed and reused by another root (the audit trail resolves causes when a
+  /// record is made, never later).
+  NameId remote_origin = kNoName;
 };
 
 /// An active condition of a state machine.

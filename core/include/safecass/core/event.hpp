@@ -65,7 +65,10 @@ inline constexpr EventId kStale = 8;               ///< EVT_STALE (230)
 inline constexpr EventId kCallbackException = 10;  ///< EVT_CALLBACK_EXCEPTION (210)
 inline constexpr EventId kCoordinatorLost = 12;    ///< EVT_COORDINATOR_LOST (240)
 inline constexpr EventId kInvalidSample = 14;      ///< EVT_INVALID_SAMPLE (225): NaN or infinite input
-inline constexpr EventId kCount = 16;
+/// EVT_SUPERVISOR_LOST (235, a warning): the supervisor that watches the whole system stopped
+/// sending heartbeats, so nothing system-wide watches this process (DESIGN §4).
+inline constexpr EventId kSupervisorLost = 16;
+inline constexpr EventId kCount = 18;
 constexpr EventId completion_of(EventId onset) noexcept { return onset + 1; }
 }  // namespace framework_event
 

@@ -155,7 +155,9 @@ private:
   /// override, which may be protected, cannot call it.
   virtual void on_tick(Time /*now*/) noexcept { ticks_ = false; }
   void report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept;
-  void invalid_sample(std::size_t input, Time sample_time, bool invalid) noexcept;
+  /// Raises (invalid) or clears EVT_INVALID_SAMPLE; `sample` is the offending one when raising:
+  /// its first non-finite value is the root cause's value (an inf is reported as inf, not NaN).
+  void invalid_sample(std::size_t input, const SampleView& sample, bool invalid) noexcept;
   /// One sample of input `input`, as just read (or staged) by its cursor: checked (a non-finite
   /// sample raises EVT_INVALID_SAMPLE and is not passed on), held, then handed to on_sample().
   void deliver(std::size_t input, const SampleView& sample) noexcept {
@@ -170,10 +172,10 @@ private:
       finite = zero == 0.0;
     }
     if (!finite) {
-      invalid_sample(input, sample.time, true);
+      invalid_sample(input, sample, true);
       return;
     }
-    if (invalid_[input] != 0) invalid_sample(input, sample.time, false);
+    if (invalid_[input] != 0) invalid_sample(input, sample, false);
     cursors_[input].keep();
     on_sample(input, sample);
   }

@@ -62,9 +62,12 @@ public:
   bool running() const noexcept { return thread_.joinable(); }
 
   /// Shallow injection into one filter (see Filter::inject); recorded on the observer stream.
+  /// Errors: NotFound (no such filter), InvalidArgument (a wrong size, or a NaN or infinite value:
+  /// injected values must be finite, docs/filters.md); then nothing is queued.
   Expected<void> inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples);
   /// Deep injection: `samples` written into the signal's history buffer at time `at`, marked as
-  /// injected; every consumer sees them; recorded on the observer stream.
+  /// injected; every consumer sees them; recorded on the observer stream. Errors: NotFound,
+  /// InvalidArgument (a wrong size, or a non-finite value); then nothing is written.
   Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples, Time at);
 
   /// Resolves a signal name as a filter of `component` would: bare names belong to it.

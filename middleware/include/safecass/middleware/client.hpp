@@ -12,8 +12,9 @@
 ///   auto why = (*client)->explain("PENDANT");               // Expected<std::vector<Explanation>>
 ///   auto done = (*client)->generate("EVT_FORCE_ERROR", "JR3.s_A");  // a write: needs the token
 /// ```
-/// connect() finds the coordinator by listening to the heartbeats on IceStorm (each carries the
-/// coordinator's Control endpoint); `control` skips that and names the endpoint directly.
+/// connect() finds the coordinator by listening to the heartbeats on IceStorm: the first one
+/// signed by that coordinator's key (the system's keyring) gives its Control endpoint, which must
+/// be on this host unless `insecure`. Requests and the token go only there.
 ///
 /// Every call is a synchronous request/reply with a timeout. Errors carry the coordinator's
 /// answer: Denied (a write without --allow-write or with a wrong token), NotFound / Parse /
@@ -35,8 +36,11 @@ namespace safecass::middleware {
 struct ClientOptions {
   IceEndpoint ice;           ///< IceStorm, to find the coordinator by its heartbeat
   std::string coordinator;   ///< the coordinator's name
-  std::string control;       ///< optional: its Control proxy ("SafecassControl-robot:tcp -h ... -p ...")
   std::string token;         ///< the write token (from its token file); empty: read-only
+  /// The system's bus keys (keys.hpp); only the keyring is read. Empty: $SAFECASS_KEYS.
+  std::string keys_dir;
+  /// Accept IceStorm or a coordinator that is not on this host although nothing is encrypted.
+  bool insecure = false;
   std::chrono::milliseconds timeout{2000};
 };
 

@@ -72,6 +72,16 @@ struct NodeOptions {
   std::chrono::milliseconds heartbeat{100};
   bool allow_write = false;              ///< accept write operations
   std::string token;                     ///< the secret write requests must carry
+  /// The system's bus keys (keys.hpp): this node signs with DIR/<coordinator>.secret and checks
+  /// every message it receives against DIR/keyring. Empty: $SAFECASS_KEYS.
+  std::string keys_dir;
+  /// A provider coordinator whose heartbeat stopped for this long is lost (EVT_COORDINATOR_LOST
+  /// on every required interface it feeds); likewise the supervisor (EVT_SUPERVISOR_LOST on s_F).
+  /// Zero: 3 heartbeat periods.
+  std::chrono::milliseconds lost_after{0};
+  /// Accept an IceStorm or listening endpoint that is not loopback although the bus is not
+  /// encrypted (IceSSL is not configured by SAFECASS; docs/security.md).
+  bool insecure = false;
   /// Receives every log line (errors about bad messages, reconnections). Default: stderr.
   std::function<void(const std::string&)> log;
 };
@@ -88,6 +98,9 @@ struct NodeStats {
   std::uint64_t events_dropped = 0;     ///< observer queue overflow (never silent: counted here)
   std::uint64_t resyncs_requested = 0;
   std::uint64_t connects = 0;           ///< successful (re)connections to IceStorm
+  std::uint64_t messages_refused = 0;   ///< unauthenticated, forged, replayed or malformed bus messages
+  std::uint64_t providers_lost = 0;     ///< times a provider coordinator was declared lost
+  std::uint64_t duplicates_seen = 0;    ///< heartbeats of another process using this node's name
   bool connected = false;
 };
 
@@ -95,7 +108,8 @@ class CoordinatorNode {
 public:
   /// `coordinator`, `monitor`, `registry` and `system` must outlive the node; `coordinator_name`
   /// names this process in the system's "coordinators". Nothing touches the network before
-  /// start(). Errors: NotFound (unknown coordinator name), InvalidArgument (bad options).
+  /// start(). Errors: NotFound (unknown coordinator name, no keys), InvalidArgument (bad options,
+  /// a non-loopback endpoint without `insecure`), Denied/Parse/Io (the keys, as keys.hpp says).
   static Expected<std::unique_ptr<CoordinatorNode>> create(Coordinator& coordinator, Monitor& monitor,
                                                            const FilterRegistry& registry,
                                                            const spec::SystemSpec& system,

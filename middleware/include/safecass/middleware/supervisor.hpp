@@ -28,6 +28,10 @@ struct SupervisorOptions {
   std::string listen_host = "127.0.0.1";
   /// A coordinator is lost when no heartbeat arrived for this long.
   std::chrono::milliseconds lost_after{600};
+  /// The system's bus keys (keys.hpp; the supervisor signs as "supervisor"). Empty: $SAFECASS_KEYS.
+  std::string keys_dir;
+  /// Accept a non-loopback endpoint although the bus is not encrypted (docs/security.md).
+  bool insecure = false;
   /// Receives each output line (transitions as they arrive, lost/recovered). Default: stdout.
   std::function<void(const std::string&)> print;
 };
@@ -54,6 +58,8 @@ public:
 
   /// The last known state of every address a coordinator reported, sorted by address.
   std::vector<ViewRow> view() const;
+  /// Bus messages refused (unauthenticated, forged, replayed or malformed).
+  std::uint64_t messages_refused() const;
   /// Names of the coordinators currently lost.
   std::vector<std::string> lost() const;
   /// The supervisor's model of the system (EVT_COORDINATOR_LOST lives here). Read it with the

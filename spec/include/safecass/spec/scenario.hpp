@@ -56,7 +56,8 @@ struct ScenarioLoad {
 /// Reads and checks a scenario file (format only; names are checked against the system when it runs).
 ScenarioLoad load_scenario(const std::string& path);
 
-/// Reads a whole file; false with a message when it cannot be read.
+/// read_regular_file() (file.hpp) with its default limit, for callers that want a flag and a
+/// message: false with the message ("cannot read file 'PATH': why") when it cannot be read.
 bool read_file(const std::string& path, std::string& out, std::string& error);
 
 }  // namespace safecass::spec

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <map>
 #include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/record/recorder.hpp"
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
 #include "safecass/spec/system.hpp"
@@ -45,7 +47,11 @@ struct RunResult {
   int checks = 0;                       ///< expectations checked
   std::vector<std::string> failures;    ///< "file:line:col: expectation failed at t=...: ..."
   Coverage coverage;
+  /// With RunOptions::record_path: what the recorder wrote and lost (after the run).
+  std::optional<RecordStatus> record;
   bool passed() const noexcept { return failures.empty(); }
+  /// No history was asked for, or every record is in it (no write error, nothing dropped).
+  bool history_complete() const noexcept { return !record || record->complete(); }
 };
 
 class ScenarioRunner {
@@ -105,7 +111,11 @@ private:
 };
 
 /// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,
-/// 1 an expectation failed, 2 invalid input. `result` (optional) receives the run's details.
+/// 1 an expectation failed, 2 invalid input, or a history file (RunOptions::record_path) that is
+/// incomplete: a write error or dropped records, each said on `err` with the file, the count and
+/// the system's reason (and, with RunOptions::json, as a last {"kind":"recorder",...} line on
+/// `out`). The run itself is never cut short by the recorder. `result` (optional) receives the
+/// run's details.
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,
                       RunResult* result = nullptr, std::FILE* err = stderr);
 

@@ -79,7 +79,4 @@ private:
   long long last_time_ms_ = -1000000;
 };
 
-/// Compares two secrets in time independent of where they differ.
-bool same_secret(std::string_view a, std::string_view b) noexcept;
-
 }  // namespace safecass::viewer

@@ -11,11 +11,16 @@
 /// checked by the Protocol (write access and token). A page that does not read its updates is
 /// disconnected rather than buffered without limit.
 ///
+/// Resources: when accept() fails (no file descriptor left), it waits before trying again
+/// (AcceptBackoff) and logs the failure at most once every 10 s.
+///
 /// Lifecycle: construct (binds and listens: port() is known), then run() on one thread until
 /// stop() is called from any thread (or SIGINT/SIGTERM when handle_signals is set).
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "safecass/core/expected.hpp"
@@ -23,6 +28,34 @@
 #include "safecass/viewer/source.hpp"
 
 namespace safecass::viewer {
+
+/// What the server does when accept() fails, e.g. when the process has no file descriptor left
+/// (EMFILE): it waits before trying again instead of retrying at once (which would spin a core
+/// and flood the log while the error lasts). The wait is 10 ms, doubling after each failure up to
+/// 1 s, and back to 10 ms once a connection is accepted. A failure is logged at most once every
+/// 10 s, with the number of failures not logged since the line before.
+class AcceptBackoff {
+public:
+  using Clock = std::chrono::steady_clock;
+  static constexpr std::chrono::milliseconds kFirstDelay{10};
+  static constexpr std::chrono::milliseconds kMaxDelay{1000};
+  static constexpr std::chrono::seconds kLogInterval{10};
+
+  struct Step {
+    std::chrono::milliseconds delay;  ///< how long to wait before accepting again
+    bool log;                         ///< whether to log this failure
+    std::uint64_t not_logged;         ///< with log: failures not logged since the last line
+  };
+  /// A failed accept at `now`.
+  Step failed(Clock::time_point now) noexcept;
+  /// A connection was accepted: the next failure waits kFirstDelay again.
+  void succeeded() noexcept { delay_ = kFirstDelay; }
+
+private:
+  std::chrono::milliseconds delay_ = kFirstDelay;
+  std::optional<Clock::time_point> last_log_;
+  std::uint64_t not_logged_ = 0;
+};
 
 struct ServerOptions {
   std::string bind = "127.0.0.1";  ///< IPv4 or IPv6 address
@@ -56,16 +89,5 @@ private:
   explicit Server(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
 };
-
-/// A token for write access: 32 random bytes as 64 hex digits (from the operating system's
-/// random source). Errors: Io when no random source is available.
-Expected<std::string> make_token();
-
-/// Writes `token` to a new file readable by its owner alone (mode 0600) in a new private
-/// directory under `dir` (default: $TMPDIR or /tmp) and returns the file's path. The caller
-/// removes it with remove_token_file(). Errors: Io.
-Expected<std::string> write_token_file(const std::string& token, const std::string& dir = {});
-/// Removes the file and its directory; ignores errors.
-void remove_token_file(const std::string& path) noexcept;
 
 }  // namespace safecass::viewer

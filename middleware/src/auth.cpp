@@ -1,0 +1,325 @@
+// Bus keys and signed messages (see keys.hpp, auth.hpp and docs/security.md).
+
+#include "auth.hpp"
+
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <sodium.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "safecass/middleware/keys.hpp"
+
+namespace safecass::middleware {
+
+namespace {
+
+constexpr std::string_view kContext = "safecass.bus.v1";
+constexpr std::string_view kSecretTag = "ed25519-secret";
+constexpr std::size_t kMaxKeyFile = 64 * 1024;
+
+bool sodium_ready() noexcept {
+  static const bool ready = ::sodium_init() >= 0;
+  return ready;
+}
+
+std::string to_hex(const unsigned char* data, std::size_t size) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  std::string out;
+  out.reserve(size * 2);
+  for (std::size_t i = 0; i < size; ++i) {
+    out += kHex[data[i] >> 4];
+    out += kHex[data[i] & 0xf];
+  }
+  return out;
+}
+
+bool from_hex(std::string_view hex, std::string& out, std::size_t size) {
+  if (hex.size() != size * 2) return false;
+  out.assign(size, '\0');
+  for (std::size_t i = 0; i < size; ++i) {
+    int v = 0;
+    for (int k = 0; k < 2; ++k) {
+      const char c = hex[2 * i + static_cast<std::size_t>(k)];
+      int d = -1;
+      if (c >= '0' && c <= '9') d = c - '0';
+      if (c >= 'a' && c <= 'f') d = c - 'a' + 10;
+      if (d < 0) return false;
+      v = v * 16 + d;
+    }
+    out[i] = static_cast<char>(v);
+  }
+  return true;
+}
+
+/// The bytes a signature covers.
+std::string signed_bytes(std::string_view kind, std::string_view signer, const Ice::ByteSeq& body) {
+  std::string text;
+  text.reserve(kContext.size() + kind.size() + signer.size() + body.size() + 3);
+  text.append(kContext).push_back('\0');
+  text.append(kind).push_back('\0');
+  text.append(signer).push_back('\0');
+  text.append(reinterpret_cast<const char*>(body.data()), body.size());
+  return text;
+}
+
+/// Reads a small regular file (no FIFO, no device: a key file is never either).
+Expected<std::string> read_small_file(const std::string& path, struct stat* info = nullptr) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) {
+    const ErrorCode code = errno == ENOENT ? ErrorCode::NotFound : ErrorCode::Io;
+    return fail(code, path + ": " + std::strerror(errno));
+  }
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || static_cast<std::size_t>(st.st_size) > kMaxKeyFile) {
+    ::close(fd);
+    return fail(ErrorCode::Io, path + ": not a regular file of at most 64 KiB");
+  }
+  std::string text(static_cast<std::size_t>(st.st_size), '\0');
+  const ssize_t n = ::read(fd, text.data(), text.size());
+  ::close(fd);
+  if (n != static_cast<ssize_t>(text.size())) return fail(ErrorCode::Io, path + ": short read");
+  if (info != nullptr) *info = st;
+  return text;
+}
+
+bool valid_signer_name(std::string_view name) {
+  return !name.empty() && name.size() <= 128 &&
+         std::all_of(name.begin(), name.end(), [](char c) {
+           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+         });
+}
+
+/// Writes `text` to a new file `path` with `mode`; an existing file is replaced only when
+/// `replace` and it is a regular file of ours that `is_ours` recognises.
+Expected<void> write_new_file(const std::string& path, const std::string& text, mode_t mode, bool replace,
+                              std::string_view what) {
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) == 0) {
+    if (!replace) return fail(ErrorCode::Duplicate, path + ": exists (pass --replace to create new keys)");
+    auto old = read_small_file(path);
+    const bool ours = S_ISREG(st.st_mode) && st.st_uid == ::geteuid() && old &&
+                      (old->rfind(std::string(kSecretTag), 0) == 0 || old->rfind("# SAFECASS bus keyring", 0) == 0);
+    if (!ours) return fail(ErrorCode::Io, path + ": exists and is not a SAFECASS " + std::string(what) + "; not replaced");
+    if (::unlink(path.c_str()) != 0) return fail(ErrorCode::Io, path + ": " + std::strerror(errno));
+  }
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, mode);
+  if (fd < 0) return fail(ErrorCode::Io, "cannot create " + path + ": " + std::strerror(errno));
+  const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fchmod(fd, mode) == 0 &&
+                  ::fsync(fd) == 0;
+  ::close(fd);
+  if (!ok) return fail(ErrorCode::Io, "cannot write " + path + ": " + std::strerror(errno));
+  return {};
+}
+
+}  // namespace
+
+// ---- public: keys.hpp -------------------------------------------------------------------------
+
+Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
+                                                   bool replace) {
+  if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
+  std::vector<std::string> names;
+  for (const auto& [name, _] : system.coordinators) {
+    if (name == kSupervisorSigner) {
+      return fail(ErrorCode::InvalidArgument, "coordinator name '" + name + "' is reserved for the supervisor's key");
+    }
+    if (!valid_signer_name(name)) {
+      return fail(ErrorCode::InvalidArgument, "coordinator name '" + detail::printable(name) +
+                                                  "' cannot name a key (letters, digits, '_' and '-' only)");
+    }
+    names.push_back(name);
+  }
+  if (names.empty()) return fail(ErrorCode::InvalidArgument, "system '" + system.name + "' declares no coordinators");
+  names.emplace_back(kSupervisorSigner);
+  if (::mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST) {
+    return fail(ErrorCode::Io, "cannot create " + dir + ": " + std::strerror(errno));
+  }
+  struct stat st {};
+  if (::stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) return fail(ErrorCode::Io, dir + ": not a directory");
+  if (!replace) {
+    for (const std::string& name : names) {
+      const std::string path = dir + "/" + name + ".secret";
+      if (::lstat(path.c_str(), &st) == 0) {
+        return fail(ErrorCode::Duplicate, path + ": exists (pass --replace to create new keys)");
+      }
+    }
+  }
+  std::string keyring = "# SAFECASS bus keyring of system '" + system.name + "': NAME ed25519 PUBLIC-KEY\n";
+  for (const std::string& name : names) {
+    unsigned char pk[crypto_sign_PUBLICKEYBYTES];
+    unsigned char sk[crypto_sign_SECRETKEYBYTES];
+    ::crypto_sign_keypair(pk, sk);
+    std::string secret = std::string(kSecretTag) + " " + to_hex(sk, sizeof sk) + "\n";
+    ::sodium_memzero(sk, sizeof sk);
+    auto written = write_new_file(dir + "/" + name + ".secret", secret, 0600, replace, "secret key");
+    ::sodium_memzero(secret.data(), secret.size());
+    if (!written) return tl::unexpected(written.error());
+    keyring += name + " ed25519 " + to_hex(pk, sizeof pk) + "\n";
+  }
+  if (auto r = write_new_file(dir + "/keyring", keyring, 0644, true, "keyring"); !r) return tl::unexpected(r.error());
+  return names;
+}
+
+Expected<std::string> bus_keys_dir(std::string_view given) {
+  if (!given.empty()) return std::string(given);
+  const char* env = std::getenv("SAFECASS_KEYS");
+  if (env != nullptr && *env != '\0') return std::string(env);
+  return fail(ErrorCode::NotFound,
+              "the bus is authenticated and no keys were given: create them with `safecass keys SYSTEM --out DIR` "
+              "(or scripts/setup-keys) and pass --keys DIR or set SAFECASS_KEYS=DIR");
+}
+
+bool is_loopback_host(std::string_view host) noexcept {
+  if (host == "localhost" || host == "::1" || host == "[::1]") return true;
+  in_addr addr{};
+  const std::string text(host);
+  return ::inet_pton(AF_INET, text.c_str(), &addr) == 1 && (ntohl(addr.s_addr) >> 24) == 127;
+}
+
+// ---- internal: auth.hpp -----------------------------------------------------------------------
+
+namespace detail {
+
+Expected<Keyring> Keyring::load(const std::string& dir) {
+  if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
+  const std::string path = dir + "/keyring";
+  auto text = read_small_file(path);
+  if (!text) {
+    return fail(text.error().code, "bus keyring: " + text.error().message +
+                                       " (create keys with `safecass keys SYSTEM --out DIR`)");
+  }
+  Keyring ring;
+  std::istringstream lines(*text);
+  std::string line;
+  int number = 0;
+  while (std::getline(lines, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream words(line);
+    std::string name, algorithm, hex, extra;
+    words >> name >> algorithm >> hex;
+    std::string key;
+    if (!valid_signer_name(name) || algorithm != "ed25519" || (words >> extra) ||
+        !from_hex(hex, key, crypto_sign_PUBLICKEYBYTES)) {
+      return fail(ErrorCode::Parse, path + ":" + std::to_string(number) + ": expected 'NAME ed25519 HEX-PUBLIC-KEY'");
+    }
+    if (!ring.keys_.emplace(name, std::move(key)).second) {
+      return fail(ErrorCode::Parse, path + ":" + std::to_string(number) + ": '" + name + "' listed twice");
+    }
+  }
+  return ring;
+}
+
+bool Keyring::verify(std::string_view signer, std::string_view kind, const Ice::ByteSeq& body,
+                     const Ice::ByteSeq& signature) const noexcept {
+  const auto key = keys_.find(signer);
+  if (key == keys_.end() || signature.size() != crypto_sign_BYTES) return false;
+  try {
+    const std::string bytes = signed_bytes(kind, signer, body);
+    return ::crypto_sign_verify_detached(signature.data(), reinterpret_cast<const unsigned char*>(bytes.data()),
+                                         bytes.size(), reinterpret_cast<const unsigned char*>(key->second.data())) == 0;
+  } catch (...) {
+    return false;
+  }
+}
+
+Expected<Signer> Signer::load(const std::string& dir, std::string_view name) {
+  if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
+  const std::string path = dir + "/" + std::string(name) + ".secret";
+  struct stat st {};
+  auto text = read_small_file(path, &st);
+  if (!text) {
+    if (text.error().code == ErrorCode::NotFound) {
+      return fail(ErrorCode::NotFound, "no bus key for '" + std::string(name) + "': " + path +
+                                           " does not exist (create keys with `safecass keys SYSTEM --out DIR`)");
+    }
+    return tl::unexpected(text.error());
+  }
+  if (st.st_uid != ::geteuid() || (st.st_mode & 077) != 0) {
+    ::sodium_memzero(text->data(), text->size());
+    return fail(ErrorCode::Denied, path + ": a secret key must be owned by its user and have mode 0600");
+  }
+  Signer s;
+  s.name_ = std::string(name);
+  const std::string_view body(*text);
+  const bool ok = body.rfind(kSecretTag, 0) == 0 && body.size() >= kSecretTag.size() + 1 &&
+                  from_hex(body.substr(kSecretTag.size() + 1, crypto_sign_SECRETKEYBYTES * 2), s.secret_,
+                           crypto_sign_SECRETKEYBYTES);
+  ::sodium_memzero(text->data(), text->size());
+  if (!ok) return fail(ErrorCode::Parse, path + ": not a SAFECASS secret key");
+  return s;
+}
+
+wire::Signed Signer::sign(std::string_view kind, Ice::ByteSeq body) const {
+  wire::Signed m;
+  m.signer = name_;
+  m.kind = std::string(kind);
+  const std::string bytes = signed_bytes(kind, name_, body);
+  m.signature.resize(crypto_sign_BYTES);
+  ::crypto_sign_detached(m.signature.data(), nullptr, reinterpret_cast<const unsigned char*>(bytes.data()),
+                         bytes.size(), reinterpret_cast<const unsigned char*>(secret_.data()));
+  m.body = std::move(body);
+  return m;
+}
+
+void DropLog::drop(const std::string& source, const std::string& what) {
+  const std::int64_t now =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  std::string line;
+  {
+    std::lock_guard lock(mutex_);
+    ++count_;
+    // Sources are signer names taken from messages: bounded, so forged names cannot grow the map.
+    Source& s = sources_.size() < 256 || sources_.count(source) != 0 ? sources_[source] : sources_["(other)"];
+    if (s.last_logged != 0 && now - s.last_logged < 1'000'000'000) {
+      ++s.suppressed;
+      return;
+    }
+    line = what;
+    if (s.suppressed > 0) line += " (" + std::to_string(s.suppressed) + " more from this source in the last second)";
+    s.last_logged = now;
+    s.suppressed = 0;
+  }
+  if (log_) log_(line);
+}
+
+std::uint64_t DropLog::count() const {
+  std::lock_guard lock(mutex_);
+  return count_;
+}
+
+std::string printable(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    if (c == '\\') {
+      out += "\\\\";
+    } else if (u < 0x20 || u == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += "\\x";
+      out += kHex[u >> 4];
+      out += kHex[u & 0xf];
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
+std::int64_t new_incarnation() noexcept {
+  const auto now = std::chrono::system_clock::now().time_since_epoch();
+  const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now).count();
+  return ns > 0 ? ns : 1;
+}
+
+}  // namespace detail
+}  // namespace safecass::middleware

@@ -1,0 +1,94 @@
+// The scenario runner (tools/runner): a history that cannot be written fails the run after the
+// whole run, and a scenario built in C++ follows the injection rule of every path.
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <string>
+
+#include "safecass/filters/registry.hpp"
+#include "safecass/runner/scenario_runner.hpp"
+#include "safecass/spec/load.hpp"
+
+namespace safecass::runner {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::string kForceSensor = std::string(SAFECASS_SOURCE_DIR) + "/examples/force_sensor/scenario.json";
+
+/// What run_scenario_file() printed on its `err`.
+struct Captured {
+  char* text = nullptr;
+  std::size_t size = 0;
+  std::FILE* file = ::open_memstream(&text, &size);
+  std::string str() {
+    std::fflush(file);
+    return std::string(text, size);
+  }
+  ~Captured() {
+    std::fclose(file);
+    std::free(text);
+  }
+};
+
+TEST(ScenarioRunner, AHistoryThatCannotBeWrittenFailsTheRunAfterTheWholeRunAndSaysWhy) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  RunOptions options;
+  options.quiet = true;
+  options.record_path = "/dev/full";
+  RunResult result;
+  Captured err;
+  const int code = run_scenario_file(kForceSensor, registry, options, &result, err.file);
+  EXPECT_EQ(code, 2);
+  EXPECT_TRUE(result.passed()) << "every expectation was still checked and met";
+  EXPECT_EQ(result.checks, 10);
+  ASSERT_TRUE(result.record.has_value());
+  EXPECT_FALSE(result.history_complete());
+  EXPECT_EQ(result.record->write_error, "No space left on device");
+  EXPECT_GT(result.record->unwritten, 0u);
+  EXPECT_THAT(err.str(), HasSubstr("history file '/dev/full': write error after 0 records: No space left on device"));
+}
+
+TEST(ScenarioRunner, ACompleteHistoryIsSaidCompleteAndChangesNothing) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  RunOptions options;
+  options.quiet = true;
+  options.record_path = ::testing::TempDir() + "/runner_history.jsonl";
+  RunResult result;
+  Captured err;
+  EXPECT_EQ(run_scenario_file(kForceSensor, registry, options, &result, err.file), 0);
+  ASSERT_TRUE(result.record.has_value());
+  EXPECT_TRUE(result.history_complete());
+  EXPECT_GT(result.record->written, 0u);
+  EXPECT_EQ(err.str(), "");
+  std::remove(options.record_path.c_str());
+}
+
+TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  spec::ScenarioLoad load = spec::load_scenario(kForceSensor);
+  ASSERT_TRUE(load.scenario);
+  spec::LoadResult system = spec::load_system(load.scenario->system, registry);
+  ASSERT_TRUE(system.ok());
+  spec::ScenarioStep step;
+  step.kind = spec::ScenarioStep::Kind::Inject;
+  step.at = 0.5;
+  step.filter = "force_limit";
+  step.values = {{10.0}, {std::numeric_limits<double>::infinity()}};
+  step.where = spec::Position{"made.json", 3, 7};
+  load.scenario->steps.push_back(step);
+  ScenarioRunner runner(std::move(*load.scenario), std::move(*system.system), registry);
+  const auto problems = runner.prepare();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(spec::format(problems[0]), "made.json:3:7: error: an injected value is not a finite number: injected values must be finite");
+}
+
+}  // namespace
+}  // namespace safecass::runner
