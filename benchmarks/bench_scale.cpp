@@ -5,6 +5,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <malloc.h>
+
+#include <memory>
 #include <string>
 
 #include "safecass/filters/monitor.hpp"
@@ -91,6 +94,37 @@ void BM_ScalePropagate(benchmark::State& state) {
   state.SetComplexityN(n);
 }
 BENCHMARK(BM_ScalePropagate)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// The memory of a built system: the heap in use (mallinfo2: small blocks and mmapped ones) after
+// the coordinator and its monitor are built, minus before, per component. Issue target: at most
+// 10 KB per component at 10,000 components.
+std::size_t heap_in_use() {
+  const struct mallinfo2 m = ::mallinfo2();
+  return m.uordblks + m.hblkhd;
+}
+
+void BM_ScaleMemory(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  Tree tree(n);
+  spec::LoadResult r = spec::load_system_from_text(tree.text, "tree.json", tree.registry);
+  double bytes = 0;
+  for (auto _ : state) {
+    const std::size_t before = heap_in_use();
+    SimulatedClock clock;
+    auto co = std::make_unique<Coordinator>("tree", &clock);
+    auto monitor = std::make_unique<Monitor>(*co, tree.registry);
+    if (!spec::instantiate(*r.system, *co, *monitor)) state.SkipWithError("instantiate failed");
+    bytes = static_cast<double>(heap_in_use() - before);
+    benchmark::DoNotOptimize(co);
+  }
+  state.counters["bytes_per_component"] = bytes / n;
+  state.counters["history_records"] = 0;
+  SimulatedClock clock;
+  Coordinator co("tree", &clock);
+  Monitor monitor(co, tree.registry);
+  if (spec::instantiate(*r.system, co, monitor)) state.counters["history_records"] = static_cast<double>(co.history_size());
+}
+BENCHMARK(BM_ScaleMemory)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 }  // namespace
 }  // namespace safecass

@@ -3,7 +3,8 @@
 #
 # Defines:
 #   Ice_FOUND, Ice_SLICE2CPP_EXECUTABLE, Ice_SLICE_DIR
-#   Ice::Ice++11, Ice::IceStorm++11 (imported targets; ICE_CPP11_MAPPING is defined for users)
+#   Ice::Ice++11, Ice::IceStorm++11, Ice::IceSSL++11 (imported targets; ICE_CPP11_MAPPING is
+#   defined for users)
 #   ice_slice2cpp(OUTPUT_VAR <var> SLICE <file.ice>... [OUTPUT_DIR <dir>])
 #     runs slice2cpp as a custom command and sets <var> to the generated .cpp and .h files.
 
@@ -12,10 +13,11 @@ find_path(Ice_INCLUDE_DIR Ice/Ice.h)
 find_path(Ice_SLICE_DIR Ice/BuiltinSequences.ice PATHS /usr/share/ice/slice /usr/share/slice NO_DEFAULT_PATH)
 find_library(Ice_CPP11_LIBRARY NAMES Ice++11)
 find_library(Ice_ICESTORM_CPP11_LIBRARY NAMES IceStorm++11)
+find_library(Ice_ICESSL_CPP11_LIBRARY NAMES IceSSL++11)
 
 include(FindPackageHandleStandardArgs)
 find_package_handle_standard_args(Ice REQUIRED_VARS Ice_SLICE2CPP_EXECUTABLE Ice_INCLUDE_DIR Ice_SLICE_DIR
-                                  Ice_CPP11_LIBRARY Ice_ICESTORM_CPP11_LIBRARY)
+                                  Ice_CPP11_LIBRARY Ice_ICESTORM_CPP11_LIBRARY Ice_ICESSL_CPP11_LIBRARY)
 
 if(Ice_FOUND AND NOT TARGET Ice::Ice++11)
   add_library(Ice::Ice++11 UNKNOWN IMPORTED)
@@ -27,6 +29,10 @@ if(Ice_FOUND AND NOT TARGET Ice::Ice++11)
   add_library(Ice::IceStorm++11 UNKNOWN IMPORTED)
   set_target_properties(Ice::IceStorm++11 PROPERTIES
     IMPORTED_LOCATION ${Ice_ICESTORM_CPP11_LIBRARY}
+    INTERFACE_LINK_LIBRARIES Ice::Ice++11)
+  add_library(Ice::IceSSL++11 UNKNOWN IMPORTED)
+  set_target_properties(Ice::IceSSL++11 PROPERTIES
+    IMPORTED_LOCATION ${Ice_ICESSL_CPP11_LIBRARY}
     INTERFACE_LINK_LIBRARIES Ice::Ice++11)
 endif()
 

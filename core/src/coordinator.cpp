@@ -66,6 +66,25 @@ void Coordinator::Ring::push(const Record& r) noexcept {
   if (size < capacity) ++size;
 }
 
+void Coordinator::Ring::grow(std::size_t capacity) {
+  if (capacity <= items.size()) return;
+  std::vector<Record> kept = ordered();
+  items = std::move(kept);
+  size = items.size();
+  next = size;
+  items.resize(capacity);
+  if (next == capacity) next = 0;
+}
+
+void Coordinator::size_history() {
+  const std::size_t addresses = machines_.size() + components_.size();
+  const std::size_t wanted = std::max(options_.history_records, options_.history_per_address * addresses);
+  const std::size_t most = std::max<std::size_t>(options_.history_records_max, 1);
+  if (wanted <= history_.items.size() || history_.items.size() >= most) return;
+  // Geometric growth: configuring n addresses stays O(n); the cap is never exceeded.
+  history_.grow(std::min(std::max(wanted, 2 * history_.items.size()), most));
+}
+
 std::vector<Record> Coordinator::Ring::ordered() const {
   std::vector<Record> out;
   out.reserve(size);
@@ -126,9 +145,9 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
   const auto id = static_cast<ComponentId>(components_.size());
   auto c = std::make_unique<ComponentData>();
   c->name = std::string(name);
-  c->history.items.resize(options_.history_capacity);
   c->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   components_.push_back(std::move(c));
+  size_history();
   component_index_.emplace(std::string(name), id);
   ComponentData& cd = *components_.back();
   cd.framework = add_machine(id, MachineKind::Framework, kNone, cd.name + ".s_F");
@@ -144,9 +163,9 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   m->component = component;
   m->iface = iface;
   m->address = std::move(address);
-  m->history.items.resize(options_.history_capacity);
   m->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   machines_.push_back(std::move(m));
+  size_history();
   // Propagation scratch space grows with the model here, never while processing.
   visit_marks_.resize(machines_.size(), 0);
   if (work_.capacity() < machines_.size()) work_.reserve(2 * machines_.size());
@@ -563,14 +582,40 @@ std::optional<Condition> Coordinator::outstanding(MachineId id) const {
   return m.conditions[static_cast<std::size_t>(m.outstanding)];
 }
 
+namespace {
+/// The newest `limit` records of `ring` (oldest first) that `keep` selects: one backwards pass.
+template <class Items, class Keep>
+std::vector<Record> newest(const Items& items, std::size_t next, std::size_t size, std::size_t limit, Keep keep) {
+  std::vector<Record> out;
+  const std::size_t capacity = items.size();
+  for (std::size_t k = 0; k < size && out.size() < limit; ++k) {
+    const Record& r = items[(next + capacity - 1 - k) % capacity];
+    if (keep(r)) out.push_back(r);
+  }
+  std::reverse(out.begin(), out.end());
+  return out;
+}
+}  // namespace
+
 std::vector<Record> Coordinator::history(MachineId id) const {
   std::lock_guard lock(mutex_);
-  return machines_[id]->history.ordered();
+  return newest(history_.items, history_.next, history_.size, options_.history_capacity,
+                [id](const Record& r) { return r.machine == id; });
 }
 
 std::vector<Record> Coordinator::component_history(ComponentId id) const {
   std::lock_guard lock(mutex_);
-  return components_[id]->history.ordered();
+  return newest(history_.items, history_.next, history_.size, options_.history_capacity, [id](const Record& r) {
+    return r.machine == kNoMachine && r.kind == RecordKind::ComponentTransition && r.component == id;
+  });
+}
+
+std::vector<Record> Coordinator::history(const Address& scope) const {
+  if (scope.kind == Address::Kind::Machine) return history(scope.machine);
+  std::lock_guard lock(mutex_);
+  const bool system = scope.kind == Address::Kind::System;
+  return newest(history_.items, history_.next, history_.size, history_.size,
+                [&](const Record& r) { return system || r.component == scope.component; });
 }
 
 // ---- callbacks and observers -----------------------------------------------------------------
@@ -620,7 +665,7 @@ void Coordinator::emit(const Record& r) noexcept {
 
 void Coordinator::record_machine(MachineId id, Record& r) noexcept {
   r.seq = ++record_seq_;
-  machines_[id]->history.push(r);
+  history_.push(r);
   if (!observers_.empty()) emit(r);
 }
 
@@ -955,7 +1000,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   r.from = old;
   r.to = c.state;
   if (root != nullptr) r.root = *root;
-  c.history.push(r);
+  history_.push(r);
   if (!observers_.empty()) emit(r);
   if (c.callbacks.empty()) return;
   const TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};

@@ -121,10 +121,8 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   const ClientOptions& o = impl->options;
-  if (!o.insecure && !is_loopback_host(o.ice.host)) {
-    return fail(ErrorCode::InvalidArgument, "IceStorm at '" + o.ice.host + "' is not a loopback address: the bus is "
-                                            "signed but not encrypted (docs/security.md); pass --insecure to accept that");
-  }
+  if (impl->options.tls.enabled() && impl->options.tls.name.empty()) impl->options.tls.name = "console";
+  if (auto r = check_transport("console", o.tls, o.insecure, {o.ice.host}); !r) return tl::unexpected(r.error());
   auto dir = bus_keys_dir(o.keys_dir);
   if (!dir) return tl::unexpected(dir.error());
   auto keys = Keyring::load(*dir);
@@ -133,12 +131,12 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     return fail(ErrorCode::NotFound, "coordinator '" + o.coordinator + "' has no key in " + *dir + "/keyring");
   }
   try {
-    impl->ic = make_communicator();
-    auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", "tcp -h 127.0.0.1");
+    impl->ic = make_communicator(o.tls);
+    auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", protocol(o.tls) + " -h 127.0.0.1");
     auto finder = std::make_shared<Finder>(o.coordinator, *keys, impl->ic);
     auto proxy = adapter->addWithUUID(finder);
     adapter->activate();
-    auto heartbeat = topic(topic_manager(impl->ic, o.ice), kHeartbeatTopic);
+    auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), kHeartbeatTopic);
     subscribe(heartbeat, proxy);
     const std::string control = finder->wait(o.timeout);
     try {
@@ -154,16 +152,23 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
                                      (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
     }
     auto prx = impl->ic->stringToProxy(control);
-    // A token travels in clear over TCP: only to this host unless the user accepts otherwise.
+    // Requests and the token go in clear over TCP: only to this host, unless the endpoint is TLS
+    // (mutual, with this system's CA) or the user accepts otherwise.
     for (const auto& endpoint : prx->ice_getEndpoints()) {
-      const auto info = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(endpoint->getInfo());
-      if (info == nullptr || (!o.insecure && !is_loopback_host(info->host))) {
+      auto info = endpoint->getInfo();
+      const bool secure = info != nullptr && info->secure();
+      while (info != nullptr && std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info) == nullptr) info = info->underlying;
+      const auto ip = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info);
+      const bool allowed = ip != nullptr && (is_loopback_host(ip->host) || o.insecure || (secure && o.tls.enabled()));
+      if (!allowed) {
         return fail(ErrorCode::Denied, "coordinator '" + o.coordinator + "' serves its operations at '" +
-                                           printable(control) + "', which is not on this host: refused without "
-                                           "--insecure (requests and the token would cross the network unencrypted)");
+                                           printable(control) + "', which is not on this host and not TLS: refused "
+                                           "without --insecure (requests and the token would cross the network unencrypted)");
       }
     }
     impl->control = Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
+    const std::string& credential = o.read_token.empty() ? o.token : o.read_token;
+    if (!credential.empty()) impl->control = impl->control->ice_context({{kReadCredentialKey, credential}});
     impl->control->ice_ping();
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io, "cannot reach coordinator '" + o.coordinator + "': " + e.what());

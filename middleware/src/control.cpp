@@ -62,9 +62,13 @@ class ControlServant final : public wire::Control {
 public:
   explicit ControlServant(ControlContext c) : c_(std::move(c)) {}
 
-  std::string coordinator(const Ice::Current&) override { return c_.name; }
+  std::string coordinator(const Ice::Current& current) override {
+    check_read(current);
+    return c_.name;
+  }
 
-  wire::StateEntrySeq stateList(std::string component, const Ice::Current&) override {
+  wire::StateEntrySeq stateList(std::string component, const Ice::Current& current) override {
+    check_read(current);
     wire::StateEntrySeq out;
     const Coordinator& co = c_.co;
     auto outstanding_name = [&](EventId e) { return e == kNoEvent ? std::string() : co.event(e).name; };
@@ -91,14 +95,13 @@ public:
     return out;
   }
 
-  wire::RecordEntrySeq stateHistory(std::string address, int last, const Ice::Current&) override {
+  wire::RecordEntrySeq stateHistory(std::string address, int last, const Ice::Current& current) override {
+    check_read(current);
     const Coordinator& co = c_.co;
     std::vector<Record> records;
     if (address.empty()) {
-      for (ComponentId id = 0; id < co.component_count(); ++id) {
-        auto h = co.component_history(id);
-        records.insert(records.end(), h.begin(), h.end());
-      }
+      records = co.history(Address{});  // every component's transitions, in stream order
+      std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::ComponentTransition; });
     } else {
       auto a = co.resolve(address);
       if (!a) raise(a.error());
@@ -113,13 +116,15 @@ public:
     return tail(records, last);
   }
 
-  wire::FilterEntrySeq filterList(const Ice::Current&) override {
+  wire::FilterEntrySeq filterList(const Ice::Current& current) override {
+    check_read(current);
     wire::FilterEntrySeq out;
     for (const auto& f : c_.monitor.filters()) out.push_back(filter_entry(*f));
     return out;
   }
 
-  wire::FilterDetails filterInfo(std::string name, const Ice::Current&) override {
+  wire::FilterDetails filterInfo(std::string name, const Ice::Current& current) override {
+    check_read(current);
     const Filter* f = c_.monitor.find_filter(name);
     const FilterRegistry::Entry* e = c_.registry.find(f != nullptr ? std::string_view(f->type()) : std::string_view(name));
     if (e == nullptr) raise(ErrorCode::NotFound, "no filter or filter type '" + name + "' in coordinator '" + c_.name + "'");
@@ -188,7 +193,8 @@ public:
     deep(signal, samples);
   }
 
-  wire::EventEntrySeq eventList(const Ice::Current&) override {
+  wire::EventEntrySeq eventList(const Ice::Current& current) override {
+    check_read(current);
     wire::EventEntrySeq out;
     const Coordinator& co = c_.co;
     for (EventId id = 0; id < co.event_count(); ++id) {
@@ -210,14 +216,13 @@ public:
     return out;
   }
 
-  wire::RecordEntrySeq eventHistory(int last, const Ice::Current&) override {
+  wire::RecordEntrySeq eventHistory(int last, const Ice::Current& current) override {
+    check_read(current);
     const Coordinator& co = c_.co;
-    std::vector<Record> records;
-    for (MachineId m = 0; m < co.machine_count(); ++m) {
-      for (const Record& r : co.history(m)) {
-        if (r.kind == RecordKind::Event || r.kind == RecordKind::Reset || r.kind == RecordKind::Injection) records.push_back(r);
-      }
-    }
+    std::vector<Record> records = co.history(Address{});  // in stream order
+    std::erase_if(records, [](const Record& r) {
+      return r.kind != RecordKind::Event && r.kind != RecordKind::Reset && r.kind != RecordKind::Injection;
+    });
     return tail(records, last);
   }
 
@@ -233,7 +238,8 @@ public:
     c_.log("middleware: " + c_.name + ": event broadcast " + event);
   }
 
-  wire::ConnectionEntrySeq connectionList(const Ice::Current&) override {
+  wire::ConnectionEntrySeq connectionList(const Ice::Current& current) override {
+    check_read(current);
     wire::ConnectionEntrySeq out;
     const Coordinator& co = c_.co;
     for (const Connection& k : co.connections()) {
@@ -246,7 +252,8 @@ public:
     return out;
   }
 
-  wire::ServiceEntrySeq serviceList(const Ice::Current&) override {
+  wire::ServiceEntrySeq serviceList(const Ice::Current& current) override {
+    check_read(current);
     wire::ServiceEntrySeq out;
     const Coordinator& co = c_.co;
     for (ComponentId id = 0; id < co.component_count(); ++id) {
@@ -282,7 +289,8 @@ public:
     c_.log("middleware: " + c_.name + ": reset " + target + " by " + who + ": " + why);
   }
 
-  wire::ExplainEntrySeq explain(std::string address, const Ice::Current&) override {
+  wire::ExplainEntrySeq explain(std::string address, const Ice::Current& current) override {
+    check_read(current);
     auto why = c_.co.explain(address);
     if (!why) raise(why.error());
     wire::ExplainEntrySeq out;
@@ -291,6 +299,20 @@ public:
   }
 
 private:
+  /// Reads need the read credential when the process has one (in the request context, key
+  /// kReadCredentialKey); the write token is accepted too.
+  void check_read(const Ice::Current& current) {
+    if (c_.read_token.empty()) return;
+    const auto given = current.ctx.find(kReadCredentialKey);
+    if (given != current.ctx.end() &&
+        (token_matches(c_.read_token, given->second) || token_matches(c_.token, given->second))) {
+      return;
+    }
+    c_.log("middleware: " + c_.name + ": refused " + current.operation + ": no read credential");
+    raise(ErrorCode::Denied, current.operation + " refused: coordinator '" + c_.name +
+                                 "' needs its read credential (--read-token-file)");
+  }
+
   void check_write(const std::string& token, const char* what) {
     if (!c_.allow_write) {
       c_.log("middleware: " + c_.name + ": refused " + what + ": read-only");

@@ -19,7 +19,11 @@ struct ControlContext {
   bool allow_write;
   std::string token;
   std::function<void(const std::string&)> log;
+  std::string read_token;  ///< empty: reads are open to every local client
 };
+
+/// The request-context key that carries the read credential.
+inline constexpr const char* kReadCredentialKey = "safecass-read";
 
 std::shared_ptr<wire::Control> make_control(ControlContext context);
 

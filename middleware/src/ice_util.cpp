@@ -1,12 +1,58 @@
 #include "ice_util.hpp"
 
+#include <IceSSL/IceSSL.h>
+#include <sys/stat.h>
+
 #include <chrono>
+
+#include "safecass/middleware/keys.hpp"
+
+namespace safecass::middleware {
+
+Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
+                               std::initializer_list<std::string_view> hosts) {
+  if (tls.enabled()) {
+    for (const std::string& file : {tls.dir + "/ca.pem", tls.dir + "/" + tls.name + ".pem", tls.dir + "/" + tls.name + ".key"}) {
+      struct stat st {};
+      if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
+        return fail(ErrorCode::NotFound, std::string(who) + ": TLS: " + file +
+                                             " is missing (create certificates with scripts/setup-tls DIR NAME...)");
+      }
+    }
+    return {};
+  }
+  if (insecure) return {};
+  for (std::string_view host : hosts) {
+    if (!is_loopback_host(host)) {
+      return fail(ErrorCode::InvalidArgument,
+                  std::string(who) + ": '" + std::string(host) + "' is not a loopback address and the bus would cross "
+                  "the network unencrypted: use --tls DIR (mutual TLS, docs/security.md), or --insecure to accept that");
+    }
+  }
+  return {};
+}
+
+}  // namespace safecass::middleware
 
 namespace safecass::middleware::detail {
 
-std::shared_ptr<Ice::Communicator> make_communicator() {
+std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
+  if (tls.enabled()) {
+    static const bool registered = [] {
+      Ice::registerIceSSL(false);  // linked in; loaded only by the property below
+      return true;
+    }();
+    (void)registered;
+    init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
+    init.properties->setProperty("IceSSL.DefaultDir", tls.dir);
+    init.properties->setProperty("IceSSL.CAs", "ca.pem");
+    init.properties->setProperty("IceSSL.CertFile", tls.name + ".pem");
+    init.properties->setProperty("IceSSL.KeyFile", tls.name + ".key");
+    init.properties->setProperty("IceSSL.VerifyPeer", "2");  // mutual: every peer shows a CA-signed certificate
+    init.properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
+  }
   init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
   init.properties->setProperty("Ice.Override.ConnectTimeout", "500");
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
@@ -20,8 +66,8 @@ std::shared_ptr<Ice::Communicator> make_communicator() {
 }
 
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
-                                                         const IceEndpoint& ice) {
-  const std::string text = std::string(kIceStormInstance) + "/TopicManager:tcp -h " + ice.host + " -p " +
+                                                         const IceEndpoint& ice, const TlsOptions& tls) {
+  const std::string text = std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " + ice.host + " -p " +
                            std::to_string(ice.port) + " -t 2000";
   return Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(text));
 }
@@ -81,7 +127,7 @@ std::int64_t steady_ns() noexcept {
 namespace safecass::middleware::detail {
 
 void Link::connect(const std::vector<std::string>& publish_on) {
-  manager_ = topic_manager(ic_, ice_);
+  manager_ = topic_manager(ic_, ice_, tls_);
   manager_->ice_ping();
   for (const Subscription& s : subscriptions_) subscribe(topic(manager_, s.topic), s.subscriber, s.delivery);
   publishers_.clear();

@@ -25,10 +25,14 @@ inline constexpr const char* kResyncTopic = "safecass.resync";
 
 /// A communicator that fails fast (short connect and invocation timeouts, no retries) so that a
 /// dead IceStorm is noticed quickly; one dispatch thread keeps updates in order.
-std::shared_ptr<Ice::Communicator> make_communicator();
-/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT".
+/// With `tls` enabled, IceSSL is loaded with the CA and the process's certificate, and every peer
+/// must present a certificate signed by that CA (IceSSL.VerifyPeer=2).
+std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls = {});
+/// "ssl" with TLS, else "tcp": the protocol of every endpoint the process creates or names.
+inline std::string protocol(const TlsOptions& tls) { return tls.enabled() ? "ssl" : "tcp"; }
+/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS).
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
-                                                         const IceEndpoint& ice);
+                                                         const IceEndpoint& ice, const TlsOptions& tls = {});
 /// Retrieves a topic, creating it when it does not exist yet.
 std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicManagerPrx>& manager,
                                           const std::string& name);
@@ -82,7 +86,8 @@ namespace safecass::middleware::detail {
 /// be called again after a failure (IceStorm restarted): it resubscribes and refreshes publishers.
 class Link {
 public:
-  Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice) : ic_(std::move(ic)), ice_(std::move(ice)) {}
+  Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice, TlsOptions tls = {})
+      : ic_(std::move(ic)), ice_(std::move(ice)), tls_(std::move(tls)) {}
   /// Registers a subscriber of `topic` (used by every connect()).
   void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber, Delivery delivery = Delivery::Ordered) {
     subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery});
@@ -97,6 +102,7 @@ public:
 private:
   std::shared_ptr<Ice::Communicator> ic_;
   IceEndpoint ice_;
+  TlsOptions tls_;
   std::shared_ptr<IceStorm::TopicManagerPrx> manager_;
   struct Subscription {
     std::string topic;

@@ -111,15 +111,24 @@ struct CoordinatorNode::Impl {
   std::int64_t incarnation = 0;
   std::map<std::string, std::string, std::less<>> where;
 
+  /// Log lines about messages too large to send whole (publisher thread): at most one per second
+  /// per interface (and one for event records), with the number of similar ones in between. The
+  /// counters in NodeStats count every one.
+  struct OversizeLog {
+    std::int64_t logged = 0;  ///< steady ns of the last line
+    std::uint64_t quiet = 0;  ///< similar cases since then, not logged
+  };
+
   /// A provided interface of a local component: one state stream.
   struct Stream {
     ComponentId component;
     std::uint32_t provided;
     std::string iface;  ///< "C.p"
     std::atomic<std::int64_t> seq{0};
-    wire::RootSeq last;  ///< publisher thread only
+    wire::RootSeq last;  ///< publisher thread only: the full state last sent (all its roots)
     bool dirty = true;   ///< under queue_mutex
     bool force = true;
+    OversizeLog oversize;  ///< publisher thread only
   };
   std::vector<std::unique_ptr<Stream>> streams;
   std::vector<std::vector<std::size_t>> streams_of;  ///< by ComponentId
@@ -191,7 +200,8 @@ struct CoordinatorNode::Impl {
 
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
       events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, state_messages_published{0},
-      event_messages_published{0}, providers_lost{0}, duplicates_seen{0};
+      event_messages_published{0}, providers_lost{0}, duplicates_seen{0}, oversized_messages{0}, roots_truncated{0};
+  OversizeLog record_oversize;  ///< publisher thread only
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
       : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)) {}
@@ -278,39 +288,192 @@ struct CoordinatorNode::Impl {
     of.push_back(&s);
   }
 
-  /// Publishes the state updates of one cycle, kMaxBatch per message, stamped with the send time.
-  /// A stream's sequence number and last state advance only once its message is sent.
+  // -- message size (publisher thread): every body is measured before it is signed and sent --
+
+  /// Bytes of the size prefix of a sequence (or string) of `n` elements in the Ice encoding.
+  static std::size_t size_prefix(std::size_t n) noexcept { return n < 255 ? 1 : 5; }
+
+  /// The Ice encoding of items [first, first + n) as one sequence: the bytes encode() gives for a
+  /// sequence holding only them, without copying them into one.
+  template <class T>
+  Ice::ByteSeq encode_range(const std::vector<T>& items, std::size_t first, std::size_t n) const {
+    Ice::OutputStream out(ic);
+    out.writeSize(static_cast<Ice::Int>(n));
+    for (std::size_t i = first; i < first + n; ++i) out.write(items[i]);
+    Ice::ByteSeq bytes;
+    out.finished(bytes);
+    return bytes;
+  }
+
+  /// How many of the `n` items from `first` fit in one message (at least one: an item too large
+  /// on its own is cut down by the caller). Measured item by item, only for a batch that does
+  /// not fit as a whole.
+  template <class T>
+  std::size_t fitting(const std::vector<T>& items, std::size_t first, std::size_t n) const {
+    std::size_t total = 0;
+    std::size_t k = 0;
+    for (; k < n; ++k) {
+      const std::size_t size = encode(ic, items[first + k]).size();
+      if (k > 0 && size_prefix(k + 1) + total + size > options.max_message_bytes) break;
+      total += size;
+    }
+    return std::max<std::size_t>(k, 1);
+  }
+
+  /// Logs `line`, at most once per second per `log_of`, saying how many similar cases were not.
+  void log_oversize(OversizeLog& log_of, const std::string& line) {
+    const std::int64_t now = steady_ns();
+    if (log_of.logged != 0 && now - log_of.logged < 1'000'000'000) {
+      ++log_of.quiet;
+      return;
+    }
+    const std::uint64_t quiet = log_of.quiet;
+    log_of.logged = now;
+    log_of.quiet = 0;
+    log(line + (quiet == 0 ? std::string()
+                           : " (and " + std::to_string(quiet) + " similar case(s) since the last such line)"));
+  }
+
+  /// A state update too large for one message on its own: keeps the roots that fit, the most
+  /// severe first (Error, then Warning, each in the provider's order, skipping a root too large
+  /// while a smaller one still fits), so the client's view is never better than the provider's;
+  /// `full` receives the whole state (what the stream records as sent). Logs and counts it.
+  /// Returns false, and sends nothing, when no root of the service's level fits (a root or a
+  /// name of megabytes): a cut without one would show the client a better state.
+  bool cut_roots(Stream& s, wire::StateUpdate& u, std::size_t size, wire::RootSeq& full) {
+    const std::size_t limit = options.max_message_bytes;
+    full = std::move(u.roots);
+    u.roots.clear();
+    // One update in a sequence, with an empty root sequence (whose size is one byte).
+    const std::size_t base = size_prefix(1) + encode(ic, u).size() - size_prefix(0);
+    std::vector<std::size_t> order(full.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return full[a].level > full[b].level; });
+    std::size_t used = base + size_prefix(0);
+    for (std::size_t i : order) {
+      const std::size_t root = encode(ic, full[i]).size();
+      const std::size_t grown = used - size_prefix(u.roots.size()) + size_prefix(u.roots.size() + 1) + root;
+      if (grown > limit) continue;
+      used = grown;
+      u.roots.push_back(full[i]);
+    }
+    const std::size_t left_out = full.size() - u.roots.size();
+    oversized_messages.fetch_add(1, std::memory_order_relaxed);
+    roots_truncated.fetch_add(left_out, std::memory_order_relaxed);
+    const std::string what = "middleware: " + name + ": state update of " + s.iface + " (seq " + std::to_string(u.seq) +
+                             ") is " + std::to_string(size) + " bytes, over the " + std::to_string(limit) +
+                             "-byte message limit: ";
+    wire::Level kept = wire::Level::Normal;
+    for (const wire::Root& r : u.roots) kept = std::max(kept, r.level);
+    if (used > limit || (!full.empty() && kept < u.state)) {
+      // Sending fewer roots than the service's level needs would show the client a better state
+      // than the provider's: nothing is sent instead (a root or a name of megabytes).
+      State level = State::Error;
+      from_wire(u.state, level);
+      log_oversize(s.oversize, what + "not sent: no root of its level (" + std::string(to_string(level)) +
+                                   ") fits in a message; clients keep its previous state");
+      u.roots = std::move(full);
+      return false;
+    }
+    log_oversize(s.oversize, what + "sent with " + std::to_string(u.roots.size()) + " of its " +
+                                 std::to_string(full.size()) + " roots, the most severe first; " +
+                                 std::to_string(left_out) + " left out");
+    return true;
+  }
+
+  /// An event record too large for one message on its own: its text is cut to what fits, on a
+  /// UTF-8 boundary, and marked; logged and counted. False when it does not fit even without its
+  /// text: then it is not sent (logged, counted as dropped).
+  bool cut_text(wire::EventMessage& m, std::size_t size) {
+    const std::size_t limit = options.max_message_bytes;
+    oversized_messages.fetch_add(1, std::memory_order_relaxed);
+    const std::string what = "middleware: " + name + ": event record seq " + std::to_string(m.seq) + " (" + m.kind +
+                             " of " + printable(m.address) + ") is " + std::to_string(size) + " bytes, over the " +
+                             std::to_string(limit) + "-byte message limit: ";
+    std::string text = std::move(m.text);
+    const std::string mark = " [cut: " + std::to_string(text.size()) + " bytes]";
+    m.text.clear();
+    // One record in a sequence; its text's size prefix may grow from 1 to 5 bytes.
+    const std::size_t base = size_prefix(1) + encode(ic, m).size() + 4 + mark.size();
+    if (base > limit) {
+      events_dropped.fetch_add(1, std::memory_order_relaxed);
+      log_oversize(record_oversize, what + "dropped: it does not fit even without its " + std::to_string(text.size()) +
+                                        "-byte text");
+      return false;
+    }
+    std::size_t keep = std::min(text.size(), limit - base);
+    while (keep > 0 && keep < text.size() && (static_cast<unsigned char>(text[keep]) & 0xC0) == 0x80) --keep;
+    m.text = text.substr(0, keep) + mark;
+    log_oversize(record_oversize, what + "sent with its text cut from " + std::to_string(text.size()) + " to " +
+                                      std::to_string(keep) + " bytes");
+    return true;
+  }
+
+  /// Publishes the state updates of one cycle, at most kMaxBatch and max_message_bytes per
+  /// message (a batch that does not fit is split, an update that does not fit alone is cut down,
+  /// cut_roots()), stamped with the send time. A stream's sequence number and last state advance
+  /// only once its message is sent.
   void send_states(wire::StateUpdateSeq& updates, const std::vector<Stream*>& of,
                    const std::shared_ptr<wire::StateTopicPrx>& pub) {
-    for (std::size_t first = 0; first < updates.size(); first += kMaxBatch) {
-      const std::size_t last = std::min(updates.size(), first + kMaxBatch);
-      wire::StateUpdateSeq part(std::make_move_iterator(updates.begin() + static_cast<std::ptrdiff_t>(first)),
-                                std::make_move_iterator(updates.begin() + static_cast<std::ptrdiff_t>(last)));
+    std::size_t first = 0;
+    while (first < updates.size()) {
+      std::size_t n = std::min(updates.size() - first, kMaxBatch);
       const std::int64_t sent = steady_ns();
-      for (wire::StateUpdate& u : part) u.sent = sent;
-      pub->updates(signer->sign(kKindState, encode(ic, part)));
+      for (std::size_t i = first; i < first + n; ++i) updates[i].sent = sent;
+      Ice::ByteSeq body = encode_range(updates, first, n);
+      wire::RootSeq full;  // the whole state of an update sent cut down
+      bool cut = false;
+      if (body.size() > options.max_message_bytes) {
+        n = fitting(updates, first, n);
+        body = encode_range(updates, first, n);
+        if (body.size() > options.max_message_bytes) {  // n == 1: one update too large on its own
+          if (!cut_roots(*of[first], updates[first], body.size(), full)) {
+            ++first;  // not sent: its stream stays where it was
+            continue;
+          }
+          cut = true;
+          body = encode_range(updates, first, 1);
+        }
+      }
+      pub->updates(signer->sign(kKindState, std::move(body)));
       state_messages_published.fetch_add(1, std::memory_order_relaxed);
-      for (std::size_t i = 0; i < part.size(); ++i) {
-        Stream& s = *of[first + i];
-        s.seq.store(part[i].seq);
-        s.last = std::move(part[i].roots);
+      for (std::size_t i = first; i < first + n; ++i) {
+        Stream& s = *of[i];
+        s.seq.store(updates[i].seq);
+        s.last = cut ? std::move(full) : std::move(updates[i].roots);
         updates_published.fetch_add(1, std::memory_order_relaxed);
       }
+      first += n;
     }
   }
 
-  /// Publishes the queued event records, kMaxBatch per message; those sent leave `pending`.
+  /// Publishes the queued event records, at most kMaxBatch and max_message_bytes per message (a
+  /// record too large on its own goes out with its text cut, cut_text()); those sent leave
+  /// `pending`.
   void send_events(std::vector<Record>& pending, const std::shared_ptr<wire::EventTopicPrx>& pub) {
     std::size_t sent = 0;
     try {
       while (sent < pending.size()) {
-        const std::size_t n = std::min(pending.size() - sent, kMaxBatch);
+        std::size_t n = std::min(pending.size() - sent, kMaxBatch);
         wire::EventMessageSeq part;
         part.reserve(n);
         const std::int64_t seq_before = event_seq.load();
         for (std::size_t i = 0; i < n; ++i) part.push_back(to_message(pending[sent + i]));
+        Ice::ByteSeq body = encode(ic, part);
+        if (body.size() > options.max_message_bytes) {
+          n = fitting(part, 0, n);
+          part.resize(n);
+          event_seq.store(seq_before + static_cast<std::int64_t>(n));  // the others go next, with these numbers
+          body = encode(ic, part);
+          if (body.size() > options.max_message_bytes && !cut_text(part[0], body.size())) {
+            sent += 1;  // dropped (logged, counted): its number stays used, a gap receivers see
+            continue;
+          }
+          body = encode(ic, part);
+        }
         try {
-          pub->records(signer->sign(kKindEvents, encode(ic, part)));
+          pub->records(signer->sign(kKindEvents, std::move(body)));
         } catch (...) {
           event_seq.store(seq_before);  // not sent: the same numbers go out after the reconnection
           throw;
@@ -835,14 +998,11 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                    [&](const auto& c) { return c.first == impl->name; })) {
     return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + impl->name + "'");
   }
-  if (!impl->options.insecure) {
-    for (const std::string& host : {impl->options.ice.host, impl->options.listen_host}) {
-      if (!is_loopback_host(host)) {
-        return fail(ErrorCode::InvalidArgument,
-                    "middleware: '" + host + "' is not a loopback address: the bus is signed but not encrypted "
-                    "(docs/security.md); pass --insecure to accept that");
-      }
-    }
+  if (impl->options.tls.enabled() && impl->options.tls.name.empty()) impl->options.tls.name = impl->name;
+  if (auto r = check_transport("middleware: " + impl->name, impl->options.tls, impl->options.insecure,
+                               {impl->options.ice.host, impl->options.listen_host});
+      !r) {
+    return tl::unexpected(r.error());
   }
   auto dir = bus_keys_dir(impl->options.keys_dir);
   if (!dir) return tl::unexpected(dir.error());
@@ -896,8 +1056,8 @@ Expected<void> CoordinatorNode::start() {
   Impl& d = *impl_;
   if (d.running.load()) return {};
   try {
-    d.ic = make_communicator();
-    const std::string endpoint = "tcp -h " + d.options.listen_host +
+    d.ic = make_communicator(d.options.tls);
+    const std::string endpoint = protocol(d.options.tls) + " -h " + d.options.listen_host +
                                  (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);
     const std::string id = "safecass-" + d.name + "-" + std::to_string(d.incarnation);
@@ -905,10 +1065,10 @@ Expected<void> CoordinatorNode::start() {
     auto heartbeat = d.adapter->add(std::make_shared<HeartbeatServant>(d), Ice::Identity{"heartbeat", id});
     auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
     ControlContext context{d.co, d.monitor, d.registry, d.name, d.options.allow_write, d.options.token,
-                           [&d](const std::string& line) { d.log(line); }};
+                           [&d](const std::string& line) { d.log(line); }, d.options.read_token};
     auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
-    d.link = std::make_unique<Link>(d.ic, d.options.ice);
+    d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
     std::vector<std::string> providers;  // the coordinators whose interfaces this one holds
     for (const auto& [iface, h] : d.held) {
       if (!h.provider.empty() && std::find(providers.begin(), providers.end(), h.provider) == providers.end()) {
@@ -967,6 +1127,8 @@ NodeStats CoordinatorNode::stats() const {
   s.messages_refused = d.drops ? d.drops->count() : 0;
   s.providers_lost = d.providers_lost.load();
   s.duplicates_seen = d.duplicates_seen.load();
+  s.oversized_messages = d.oversized_messages.load();
+  s.roots_truncated = d.roots_truncated.load();
   return s;
 }
 

@@ -354,13 +354,9 @@ private:
 
 Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec& system, SupervisorOptions options) {
   if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "supervisor: no IceStorm port given");
-  if (!options.insecure) {
-    for (const std::string& host : {options.ice.host, options.listen_host}) {
-      if (!is_loopback_host(host)) {
-        return fail(ErrorCode::InvalidArgument, "supervisor: '" + host + "' is not a loopback address: the bus is signed "
-                                                "but not encrypted (docs/security.md); pass --insecure to accept that");
-      }
-    }
+  if (options.tls.enabled() && options.tls.name.empty()) options.tls.name = std::string(kSupervisorSigner);
+  if (auto r = check_transport("supervisor", options.tls, options.insecure, {options.ice.host, options.listen_host}); !r) {
+    return tl::unexpected(r.error());
   }
   auto impl = std::make_unique<Impl>(system, std::move(options));
   auto dir = bus_keys_dir(impl->options.keys_dir);
@@ -399,9 +395,10 @@ Expected<void> Supervisor::start() {
   Impl& d = *impl_;
   if (d.running.load()) return {};
   try {
-    d.ic = make_communicator();
-    auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor", "tcp -h " + d.options.listen_host);
-    d.link = std::make_unique<Link>(d.ic, d.options.ice);
+    d.ic = make_communicator(d.options.tls);
+    auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor",
+                                                          protocol(d.options.tls) + " -h " + d.options.listen_host);
+    d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
     d.link->subscribe_to(kEventTopic, adapter->addWithUUID(std::make_shared<EventServant>(d)), Delivery::Stream);
     auto state = adapter->addWithUUID(std::make_shared<StateServant>(d));
     for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state, Delivery::Stream);

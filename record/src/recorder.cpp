@@ -59,6 +59,15 @@ std::string event_name(const Coordinator& co, EventId e) {
   return e == kNoEvent || e >= co.event_count() ? std::string() : co.event(e).name;
 }
 
+/// The address of a record's root origin. A root that came from another process (a live
+/// coordinator's remote provided interface) names its origin in that process, interned when it
+/// arrived (RootCause::remote_origin), not the local stand-in machine it arrived through: a live
+/// client's history names the same root cause as an in-process run.
+std::string root_origin_text(const Record& r, const Coordinator& co) {
+  if (r.root.remote_origin != kNoName) return std::string(co.name_of(r.root.remote_origin));
+  return co.address_of(r.root.origin);
+}
+
 }  // namespace
 
 std::string record_to_json(const Record& r, const Coordinator& co) {
@@ -96,7 +105,7 @@ std::string record_to_json(const Record& r, const Coordinator& co) {
     out += ",\"root\":{\"event\":";
     append_quoted(out, event_name(co, r.root.event));
     out += ",\"origin\":";
-    append_quoted(out, co.address_of(r.root.origin));
+    append_quoted(out, root_origin_text(r, co));
     out += ",\"t\":" + secs(r.root.time);
     if (r.root.sample.filter != kNoName) {
       out += ",\"filter\":";
@@ -138,7 +147,7 @@ std::string record_to_text(const Record& r, const Coordinator& co) {
   }
   if (r.root.event != kNoEvent && r.root.origin != kNoMachine && r.root.origin < co.machine_count() &&
       !(r.root.origin == r.machine && r.root.event == r.event)) {
-    out += "  <- " + co.address_of(r.root.origin) + ":" + event_name(co, r.root.event);
+    out += "  <- " + root_origin_text(r, co) + ":" + event_name(co, r.root.event);
   }
   if (r.root.sample.filter != kNoName || r.root.sample.signal != kNoName) {
     out += "  [";

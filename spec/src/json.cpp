@@ -36,6 +36,9 @@ namespace {
 class Parser {
 public:
   Parser(std::string_view text, int max_depth) : text_(text), max_depth_(max_depth) {}
+  /// Hands the elements of the root object's first `key` list to `element` (parse_json_streaming).
+  Parser(std::string_view text, int max_depth, std::string_view key, const JsonElementHandler& element)
+      : text_(text), max_depth_(max_depth), stream_key_(key), element_(&element) {}
 
   JsonParse run() {
     JsonParse out;
@@ -273,6 +276,38 @@ private:
     }
   }
 
+  /// An array whose elements go to `element_` as they are parsed; `v` stays an empty array.
+  bool streamed_array(JsonValue& v, int depth) {
+    if (depth > max_depth_) return fail_here("nesting deeper than " + std::to_string(max_depth_) + " levels");
+    v.type = JsonValue::Type::Array;
+    advance();
+    skip_space();
+    if (failed_) return false;
+    if (peek() == ']') {
+      advance();
+      return true;
+    }
+    for (std::size_t index = 0;; ++index) {
+      JsonValue item;
+      if (!value(item, depth + 1)) return false;
+      (*element_)(index, std::move(item));
+      skip_space();
+      if (failed_) return false;
+      if (peek() == ',') {
+        advance();
+        skip_space();
+        if (failed_) return false;
+        if (peek() == ']') return fail_here("trailing comma before ']'");
+        continue;
+      }
+      if (peek() == ']') {
+        advance();
+        return true;
+      }
+      return fail_here(at_end() ? "unexpected end of file: expected ',' or ']'" : "expected ',' or ']'");
+    }
+  }
+
   bool array(JsonValue& v, int depth) {
     v.type = JsonValue::Type::Array;
     advance();
@@ -325,7 +360,13 @@ private:
       advance();
       skip_space();
       if (failed_) return false;
-      if (!value(m.value, depth + 1)) return false;
+      if (depth == 0 && element_ != nullptr && !streamed_ && m.key == stream_key_ && peek() == '[') {
+        streamed_ = true;
+        m.value.position = here();
+        if (!streamed_array(m.value, depth + 1)) return false;
+      } else if (!value(m.value, depth + 1)) {
+        return false;
+      }
       v.object.push_back(std::move(m));
       skip_space();
       if (failed_) return false;
@@ -346,6 +387,9 @@ private:
 
   std::string_view text_;
   int max_depth_;
+  std::string_view stream_key_;
+  const JsonElementHandler* element_ = nullptr;
+  bool streamed_ = false;  ///< the streamed list has been met (only the first one streams)
   std::size_t pos_ = 0;
   int line_ = 1;
   std::size_t line_start_ = 0;
@@ -356,6 +400,11 @@ private:
 }  // namespace
 
 JsonParse parse_json(std::string_view text, int max_depth) { return Parser(text, max_depth).run(); }
+
+JsonParse parse_json_streaming(std::string_view text, std::string_view key, const JsonElementHandler& element,
+                               int max_depth) {
+  return Parser(text, max_depth, key, element).run();
+}
 
 std::string json_quote(std::string_view text) {
   std::string out = "\"";

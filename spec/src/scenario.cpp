@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include "safecass/core/state.hpp"
 #include "safecass/spec/file.hpp"
@@ -20,6 +22,120 @@ bool read_file(const std::string& path, std::string& out, std::string& error) {
   return true;
 }
 
+// ---- SampleList ------------------------------------------------------------------------------
+
+namespace {
+
+constexpr std::size_t kWord = sizeof(double);
+
+void put_counts(double* word, std::uint32_t a, std::uint32_t b) noexcept {
+  const std::uint32_t pair[2] = {a, b};
+  static_assert(sizeof pair == kWord);
+  std::memcpy(word, pair, kWord);
+}
+
+void get_counts(const double* word, std::uint32_t& a, std::uint32_t& b) noexcept {
+  std::uint32_t pair[2];
+  std::memcpy(pair, word, kWord);
+  a = pair[0];
+  b = pair[1];
+}
+
+std::size_t name_words(std::size_t length) noexcept { return (length + kWord - 1) / kWord; }
+
+template <class Samples>
+std::unique_ptr<double[]> build_block(const Samples& samples) {
+  if (samples.size() == 0) return nullptr;
+  std::size_t words = 1;
+  for (const auto& [name, values] : samples) words += 1 + name_words(name.size()) + values.size();
+  if (samples.size() > std::numeric_limits<std::uint32_t>::max() || words > std::numeric_limits<std::uint32_t>::max()) {
+    throw std::length_error("SampleList: too many samples");
+  }
+  std::unique_ptr<double[]> block(new double[words]());
+  double* at = block.get();
+  put_counts(at++, static_cast<std::uint32_t>(samples.size()), static_cast<std::uint32_t>(words));
+  for (const auto& [name, values] : samples) {
+    put_counts(at++, static_cast<std::uint32_t>(name.size()), static_cast<std::uint32_t>(values.size()));
+    std::memcpy(at, name.data(), name.size());
+    at += name_words(name.size());
+    for (const double v : values) *at++ = v;
+  }
+  return block;
+}
+
+}  // namespace
+
+SampleList::SampleList(const std::vector<std::pair<std::string_view, std::vector<double>>>& samples)
+    : block_(build_block(samples)) {}
+
+SampleList::SampleList(std::initializer_list<std::pair<std::string_view, std::vector<double>>> samples)
+    : block_(build_block(samples)) {}
+
+SampleList::SampleList(const SampleList& other) { *this = other; }
+
+SampleList& SampleList::operator=(const SampleList& other) {
+  if (this == &other) return *this;
+  if (other.block_ == nullptr) {
+    block_.reset();
+    return *this;
+  }
+  std::uint32_t count = 0;
+  std::uint32_t words = 0;
+  get_counts(other.block_.get(), count, words);
+  std::unique_ptr<double[]> copy(new double[words]);
+  std::memcpy(copy.get(), other.block_.get(), words * kWord);
+  block_ = std::move(copy);
+  return *this;
+}
+
+std::size_t SampleList::size() const noexcept {
+  if (block_ == nullptr) return 0;
+  std::uint32_t count = 0;
+  std::uint32_t words = 0;
+  get_counts(block_.get(), count, words);
+  return count;
+}
+
+SampleList::const_iterator SampleList::begin() const noexcept {
+  const std::size_t n = size();
+  return n == 0 ? end() : const_iterator(block_.get() + 1, n);
+}
+
+Sample SampleList::const_iterator::operator*() const noexcept {
+  std::uint32_t length = 0;
+  std::uint32_t values = 0;
+  get_counts(at_, length, values);
+  const char* name = reinterpret_cast<const char*>(at_ + 1);
+  return Sample{std::string_view(name, length), SampleValues(at_ + 1 + name_words(length), values)};
+}
+
+SampleList::const_iterator& SampleList::const_iterator::operator++() noexcept {
+  std::uint32_t length = 0;
+  std::uint32_t values = 0;
+  get_counts(at_, length, values);
+  at_ += 1 + name_words(length) + values;
+  if (--left_ == 0) at_ = nullptr;
+  return *this;
+}
+
+std::string_view step_key(ScenarioStep::Kind kind) noexcept {
+  switch (kind) {
+    case ScenarioStep::Kind::Sample: return "sample";
+    case ScenarioStep::Kind::Ramp: return "ramp";
+    case ScenarioStep::Kind::Generate: return "generate";
+    case ScenarioStep::Kind::Inject: return "inject";
+    case ScenarioStep::Kind::Reset: return "reset";
+    case ScenarioStep::Kind::Expect: return "expect";
+    case ScenarioStep::Kind::ExpectOutstanding: return "expect_outstanding";
+    case ScenarioStep::Kind::ExpectCause: return "expect_cause";
+  }
+  return "?";
+}
+
+std::string ScenarioStep::pointer() const { return "/steps/" + std::to_string(index) + "/" + std::string(step_key(kind)); }
+
+// ---- reading a scenario ------------------------------------------------------------------------
+
 namespace {
 
 class Reader {
@@ -29,7 +145,6 @@ public:
   void error(const TextPosition& p, const std::string& pointer, std::string message) {
     out_.push_back(Diagnostic{Diagnostic::Severity::Error, Position{file_, p.line, p.column}, std::move(message), pointer});
   }
-  Position at(const TextPosition& p) const { return Position{file_, p.line, p.column}; }
 
   bool number(const JsonValue& v, const std::string& pointer, const char* what, double& out) {
     if (!v.is_number()) {
@@ -90,7 +205,7 @@ std::string escape_pointer(const std::string& key) {
   return out;
 }
 
-void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<ScenarioStep>& steps) {
+void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<ScenarioStep>& steps) {
   const std::string base = "/steps/" + std::to_string(index);
   if (!step.is_object()) {
     r.error(step.position, base, "a step must be an object with \"at\" and one action");
@@ -123,10 +238,11 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
     const JsonValue& v = m.value;
     ScenarioStep s;
     s.at = when;
-    s.index = index;
-    s.where = r.at(v.position);
-    s.pointer = p;
+    s.index = static_cast<std::uint32_t>(index);
+    s.line = v.position.line;
+    s.column = v.position.column;
     s.kind = static_cast<ScenarioStep::Kind>(it - std::begin(kActions));
+    StepAction a;
     bool ok = true;
     switch (s.kind) {
       case ScenarioStep::Kind::Sample:
@@ -135,10 +251,15 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
           ok = false;
           break;
         }
-        for (const JsonMember& sm : v.object) {
-          std::vector<double> vals;
-          ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
-          s.samples.emplace_back(sm.key, std::move(vals));
+        {
+          std::vector<std::pair<std::string_view, std::vector<double>>> samples;
+          samples.reserve(v.object.size());
+          for (const JsonMember& sm : v.object) {
+            std::vector<double> vals;
+            ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
+            samples.emplace_back(sm.key, std::move(vals));
+          }
+          if (ok) s.samples = SampleList(samples);
         }
         break;
       case ScenarioStep::Kind::Ramp: {
@@ -157,11 +278,11 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
           ok = false;
           break;
         }
-        ok = r.text(*sig, p + "/signal", "\"signal\"", s.signal) && ok;
-        ok = r.number(*from, p + "/from", "\"from\"", s.from) && ok;
-        ok = r.number(*to, p + "/to", "\"to\"", s.to) && ok;
-        ok = r.number(*until, p + "/until", "\"until\"", s.until) && ok;
-        if (ok && s.until < when) {
+        ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal) && ok;
+        ok = r.number(*from, p + "/from", "\"from\"", a.from) && ok;
+        ok = r.number(*to, p + "/to", "\"to\"", a.to) && ok;
+        ok = r.number(*until, p + "/until", "\"until\"", a.until) && ok;
+        if (ok && a.until < when) {
           r.error(until->position, p + "/until", "\"until\" must not be before \"at\"");
           ok = false;
         }
@@ -181,8 +302,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
           ok = false;
           break;
         }
-        ok = r.text(*e, p + "/event", "\"event\"", s.event) && ok;
-        if (t != nullptr) ok = r.text(*t, p + "/target", "\"target\"", s.target) && ok;
+        ok = r.text(*e, p + "/event", "\"event\"", a.event) && ok;
+        if (t != nullptr) ok = r.text(*t, p + "/target", "\"target\"", a.target) && ok;
         break;
       }
       case ScenarioStep::Kind::Inject: {
@@ -201,17 +322,17 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
           ok = false;
           break;
         }
-        if (f != nullptr) ok = r.text(*f, p + "/filter", "\"filter\"", s.filter) && ok;
-        if (sig != nullptr) ok = r.text(*sig, p + "/signal", "\"signal\"", s.signal) && ok;
+        if (f != nullptr) ok = r.text(*f, p + "/filter", "\"filter\"", a.filter) && ok;
+        if (sig != nullptr) ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal) && ok;
         if (deep != nullptr) {
           if (!deep->is_bool()) {
             r.error(deep->position, p + "/deep", "\"deep\" must be true or false");
             ok = false;
           } else {
-            s.deep = deep->boolean;
+            a.deep = deep->boolean;
           }
         }
-        if (sig != nullptr && !s.deep) {
+        if (sig != nullptr && !a.deep) {
           r.error(sig->position, p + "/signal", "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
           ok = false;
         }
@@ -223,7 +344,7 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
         for (std::size_t i = 0; i < vals->array.size(); ++i) {
           std::vector<double> sample;
           ok = r.values(vals->array[i], p + "/values/" + std::to_string(i), sample) && ok;
-          s.values.push_back(std::move(sample));
+          a.values.push_back(std::move(sample));
         }
         break;
       }
@@ -241,9 +362,9 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
           ok = false;
           break;
         }
-        ok = r.text(*t, p + "/target", "\"target\"", s.target) && ok;
-        s.reason = "scenario";
-        if (why != nullptr) ok = r.text(*why, p + "/reason", "\"reason\"", s.reason) && ok;
+        ok = r.text(*t, p + "/target", "\"target\"", a.target) && ok;
+        a.reason = "scenario";
+        if (why != nullptr) ok = r.text(*why, p + "/reason", "\"reason\"", a.reason) && ok;
         break;
       }
       case ScenarioStep::Kind::Expect:
@@ -272,11 +393,13 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::vector<
             ok = false;
             continue;
           }
-          s.expectations.emplace_back(em.key, expected);
+          a.expectations.emplace_back(em.key, expected);
         }
         break;
     }
-    if (ok) steps.push_back(std::move(s));
+    if (!ok) continue;
+    if (s.kind != ScenarioStep::Kind::Sample) s.action = std::make_shared<const StepAction>(std::move(a));
+    steps.push_back(std::move(s));
   }
   if (actions == 0) r.error(step.position, base, "step has no action (sample, ramp, generate, inject, reset or expect...)");
 }
@@ -291,9 +414,19 @@ ScenarioLoad load_scenario(const std::string& path) {
     out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, Position{path, 1, 1}, read.error().message, ""});
     return out;
   }
-  const std::string text = std::move(*read);
-  const JsonParse parsed = parse_json(text);
-  if (parsed.error) {
+  std::string text = std::move(*read);
+  // The steps are read one by one as the parser reaches them and their JSON is dropped at once:
+  // a tree of the whole file took ten times its size (docs/spec-format.md, "Memory"). Their
+  // diagnostics come after those of the scenario's other members, as they always did.
+  Scenario sc;
+  sc.path = path;
+  std::vector<Diagnostic> step_diagnostics;
+  Reader step_reader(path, step_diagnostics);
+  const JsonParse parsed = parse_json_streaming(text, "steps", [&](std::size_t index, JsonValue&& step) {
+    read_step(step_reader, step, index, sc.steps);
+  });
+  std::string().swap(text);
+  if (parsed.error) {  // the syntax error alone, as for any file that is not JSON
     r.error(parsed.error->position, "", parsed.error->message);
     return out;
   }
@@ -303,8 +436,6 @@ ScenarioLoad load_scenario(const std::string& path) {
     return out;
   }
   r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
-  Scenario sc;
-  sc.path = path;
   const JsonValue* system = root.find("system");
   if (system == nullptr) {
     r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
@@ -327,14 +458,15 @@ ScenarioLoad load_scenario(const std::string& path) {
     r.error(root.position, "", "duration / period is more than 1e8 ticks");
   }
   const JsonValue* steps = root.find("steps");
-  if (steps != nullptr && !steps->is_array()) {
-    r.error(steps->position, "/steps", "\"steps\" must be a list");
-  } else if (steps != nullptr) {
-    for (std::size_t i = 0; i < steps->array.size(); ++i) read_step(r, steps->array[i], i, sc.steps);
-  }
-  std::stable_sort(sc.steps.begin(), sc.steps.end(),
-                   [](const ScenarioStep& a, const ScenarioStep& b) { return a.at < b.at; });
-  if (out.diagnostics.empty()) out.scenario = std::move(sc);
+  if (steps != nullptr && !steps->is_array()) r.error(steps->position, "/steps", "\"steps\" must be a list");
+  out.diagnostics.insert(out.diagnostics.end(), std::make_move_iterator(step_diagnostics.begin()),
+                         std::make_move_iterator(step_diagnostics.end()));
+  if (!out.diagnostics.empty()) return out;
+  // Scenarios are usually written in time order: then nothing moves (a sort would need a buffer
+  // of half the steps).
+  const auto by_time = [](const ScenarioStep& a, const ScenarioStep& b) { return a.at < b.at; };
+  if (!std::is_sorted(sc.steps.begin(), sc.steps.end(), by_time)) std::stable_sort(sc.steps.begin(), sc.steps.end(), by_time);
+  out.scenario = std::move(sc);
   return out;
 }
 

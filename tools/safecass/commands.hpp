@@ -21,9 +21,12 @@ struct RunArgs {
   double duration = 0.0;     ///< --duration SECONDS (0: the scenario's, or until SIGINT/SIGTERM)
   bool allow_write = false;  ///< --allow-write: serve write operations to holders of the token
   std::string token_file;    ///< --token-file: where to write the token
+  std::string read_token_file;  ///< --read-token-file: reads need the credential written there
   std::string keys;          ///< --keys DIR: the system's bus keys (default $SAFECASS_KEYS)
   int lost_after_ms = 0;     ///< --lost-after MS: a silent provider is lost (0: 3 heartbeats)
   bool insecure = false;     ///< --insecure: accept a non-loopback endpoint without encryption
+  std::string tls;           ///< --tls DIR: mutual TLS with the system's CA and this coordinator's certificate
+  std::string listen;        ///< --listen HOST: the address this process serves on (default 127.0.0.1)
 };
 /// `safecass run`: 0 passed, 1 an expectation failed, 2 invalid input.
 int run_run(const RunArgs& args);

@@ -268,27 +268,8 @@ public:
 
   /// Records of every machine and component history in `scope`, merged in stream order.
   std::vector<Record> merged_history(const Address& scope, bool events_only) const {
-    const Coordinator& c = co();
-    std::vector<Record> all;
-    auto add = [&](const std::vector<Record>& records) {
-      for (const Record& r : records) {
-        if (!events_only || r.kind == RecordKind::Event) all.push_back(r);
-      }
-    };
-    if (scope.kind == Address::Kind::Machine) {
-      add(c.history(scope.machine));
-    } else {
-      for (ComponentId id = 0; id < c.component_count(); ++id) {
-        if (scope.kind != Address::Kind::System && id != scope.component) continue;
-        if (!events_only) add(c.component_history(id));
-      }
-      for (MachineId m = 0; m < c.machine_count(); ++m) {
-        if (scope.kind != Address::Kind::System && c.machine_component(m) != scope.component) continue;
-        add(c.history(m));
-      }
-    }
-    std::sort(all.begin(), all.end(), [](const Record& a, const Record& b) { return a.seq < b.seq; });
-    all.erase(std::unique(all.begin(), all.end(), [](const Record& a, const Record& b) { return a.seq == b.seq; }), all.end());
+    std::vector<Record> all = co().history(scope);
+    if (events_only) std::erase_if(all, [](const Record& r) { return r.kind != RecordKind::Event; });
     return all;
   }
 
@@ -866,6 +847,9 @@ void add_console_command(CLI::App& app, int& code) {
                   "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
   cmd->add_flag("--insecure", args->insecure,
                 "with --ice: accept a coordinator not on this host although requests and the token are not encrypted");
+  cmd->add_option("--read-token-file", args->read_token_file,
+                  "with --ice: the coordinator's read credential file (when it was started with one)");
+  cmd->add_option("--tls", args->tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
   cmd->add_option("--token-file", args->token_file, "with --ice: the coordinator's token file (writes need it)");
   cmd->add_option("--timeout", args->timeout_ms, "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")
       ->check(CLI::Range(100, 600000));

@@ -603,7 +603,8 @@ private:
 
 Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, const std::string& coordinator,
                                                        const std::string& token, int timeout_ms,
-                                                       const std::string& keys, bool insecure) {
+                                                       const std::string& keys, bool insecure,
+                                                       const std::string& tls = {}, const std::string& read_token = {}) {
   auto endpoint = middleware::parse_ice_endpoint(ice);
   if (!endpoint) return fail(ErrorCode::Parse, endpoint.error().message);  // names --ice and its text
   middleware::ClientOptions o;
@@ -612,6 +613,8 @@ Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, c
   o.token = token;
   o.keys_dir = keys;
   o.insecure = insecure;
+  o.tls.dir = tls;
+  o.read_token = read_token;
   o.timeout = std::chrono::milliseconds(timeout_ms);
   auto client = RemoteClient::connect(o);
   if (!client) return tl::unexpected(client.error());
@@ -627,7 +630,14 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
     if (!t) return fail(t.error().code, "console: --token-file: " + t.error().message);
     token = *t;
   }
-  auto client = connect_client(args.ice, args.coordinator, token, args.timeout_ms, args.keys, args.insecure);
+  std::string read_token;
+  if (!args.read_token_file.empty()) {
+    auto t = middleware::read_token_file(args.read_token_file);
+    if (!t) return fail(t.error().code, "console: --read-token-file: " + t.error().message);
+    read_token = *t;
+  }
+  auto client = connect_client(args.ice, args.coordinator, token, args.timeout_ms, args.keys, args.insecure, args.tls,
+                               read_token);
   if (!client) return fail(client.error().code, "console: " + client.error().message);
   const ConsoleOptions options{args.json, args.allow_write};
   auto backend = std::make_unique<RemoteBackend>(std::move(*client), options, args.coordinator, args.ice, args.token_file);

@@ -1,4 +1,4 @@
-// `safecass run SYSTEM --coordinator NAME [--scenario S] [--ice HOST:PORT] [--duration SECONDS]`:
+// `safecass run SYSTEM --coordinator NAME [--scenario S] [--ice HOST:PORT] [--duration SECONDS] [--record FILE]`:
 // one coordinator of a system in real time, as one process of a multi-process system.
 //
 // The coordinator runs only its own components (spec::instantiate with only_coordinator); the
@@ -6,7 +6,11 @@
 // the middleware. A scenario is applied in real time: only the steps that name this coordinator's
 // signals, filters and machines (the others belong to another process); an expectation is met
 // when it holds at its time or within the next 200 ms (propagation across processes is
-// asynchronous).
+// asynchronous). With --record FILE the whole history of this coordinator is written to FILE by the
+// recorder of in-process `safecass run --record` (record/recorder.hpp: a writer thread fed by a
+// bounded queue, so the coordinator's threads never wait for the disk), and its losses are
+// reported the same way: one line each on stderr, the exit code 2, and with --json a last
+// {"kind":"recorder",...} line on stdout.
 
 #include <CLI/CLI.hpp>
 
@@ -23,6 +27,7 @@
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/record/recorder.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
 
@@ -78,6 +83,7 @@ struct Driver {
 
   void run_step(const spec::ScenarioStep& s) {
     const Time now = co.clock().now();
+    const spec::StepAction* a = s.action.get();  // null for a sample step
     switch (s.kind) {
       case spec::ScenarioStep::Kind::Sample:
         for (const auto& [name, values] : s.samples) {
@@ -87,24 +93,24 @@ struct Driver {
       case spec::ScenarioStep::Kind::Ramp:
         break;  // handled by the ramp thread
       case spec::ScenarioStep::Kind::Generate:
-        if (local_machine(s.target)) {
-          if (auto r = co.generate(s.event, s.target); !r) say("scenario: generate: " + r.error().message);
+        if (local_machine(a->target)) {
+          if (auto r = co.generate(a->event, a->target); !r) say("scenario: generate: " + r.error().message);
         }
         break;
       case spec::ScenarioStep::Kind::Inject:
-        if (!s.deep) {
-          if (monitor.find_filter(s.filter) != nullptr) (void)monitor.inject_shallow(s.filter, s.values);
+        if (!a->deep) {
+          if (monitor.find_filter(a->filter) != nullptr) (void)monitor.inject_shallow(a->filter, a->values);
         } else {
-          std::string signal = s.signal;
-          if (!s.filter.empty() && monitor.find_filter(s.filter) != nullptr) signal = monitor.find_filter(s.filter)->inputs()[0]->name();
-          if (monitor.signals().find(signal) != nullptr) (void)monitor.inject_deep(signal, s.values, now);
+          std::string signal = a->signal;
+          if (!a->filter.empty() && monitor.find_filter(a->filter) != nullptr) signal = monitor.find_filter(a->filter)->inputs()[0]->name();
+          if (monitor.signals().find(signal) != nullptr) (void)monitor.inject_deep(signal, a->values, now);
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
-        if (local_machine(s.target)) (void)co.reset(s.target, "scenario", s.reason);
+        if (local_machine(a->target)) (void)co.reset(a->target, "scenario", a->reason);
         break;
       default: {
-        for (const auto& [address, expected] : s.expectations) {
+        for (const auto& [address, expected] : a->expectations) {
           if (!local_machine(address)) continue;
           std::string failure = check(s, address, expected);
           for (int i = 0; !failure.empty() && i < 20; ++i) {
@@ -138,7 +144,9 @@ struct Driver {
       for (; next < scenario.steps.size() && scenario.steps[next].at <= t + 1e-9; ++next) {
         const spec::ScenarioStep& s = scenario.steps[next];
         if (s.kind == spec::ScenarioStep::Kind::Ramp) {
-          if (Signal* signal = monitor.signals().find(s.signal)) ramps.push_back(Ramp{signal, s.at, s.until, s.from, s.to});
+          if (Signal* signal = monitor.signals().find(s.action->signal)) {
+            ramps.push_back(Ramp{signal, s.at, s.action->until, s.action->from, s.action->to});
+          }
         }
         run_step(s);
       }
@@ -167,7 +175,12 @@ void add_middleware_options(CLI::App& run, RunArgs& args) {
   run.add_option("--lost-after", args.lost_after_ms,
                  "with --ice: milliseconds without a provider's heartbeat before EVT_COORDINATOR_LOST (default 300)");
   run.add_flag("--insecure", args.insecure,
-               "with --ice: accept a non-loopback IceStorm or listening address although the bus is not encrypted");
+               "with --ice: accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
+  run.add_option("--tls", args.tls,
+                 "with --ice: mutual TLS; DIR holds ca.pem and <coordinator>.pem/.key (scripts/setup-tls)");
+  run.add_option("--listen", args.listen, "with --ice: the address to serve on (default 127.0.0.1)");
+  run.add_option("--read-token-file", args.read_token_file,
+                 "with --ice: reads (state, history, explain...) need the credential this file will hold (mode 0600)");
 }
 
 int run_coordinator(const RunArgs& args) {
@@ -215,6 +228,17 @@ int run_coordinator(const RunArgs& args) {
     say(line);
   });
 
+  // The durable history: opened before anything runs, so it holds every record of the process.
+  std::unique_ptr<Recorder> recorder;
+  if (!args.record.empty()) {
+    auto opened = Recorder::open(co, args.record);
+    if (!opened) {
+      std::fprintf(stderr, "safecass run: %s\n", opened.error().message.c_str());
+      return 2;
+    }
+    recorder = std::move(*opened);
+  }
+
   const double default_period = scenario ? scenario->period : 0.005;
   native::Runtime runtime(monitor);
   for (const spec::ComponentSpec& c : system.components) {
@@ -229,6 +253,7 @@ int run_coordinator(const RunArgs& args) {
   std::string token;
   std::string token_path;
   std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
+  std::unique_ptr<middleware::TokenFile> read_token_file;
   std::unique_ptr<middleware::CoordinatorNode> node;
   if (!args.ice.empty()) {
     auto endpoint = middleware::parse_ice_endpoint(args.ice);
@@ -248,12 +273,23 @@ int run_coordinator(const RunArgs& args) {
       token = token_file->secret();
       token_path = token_file->path();
     }
+    if (!args.read_token_file.empty()) {
+      auto t = middleware::TokenFile::create(args.read_token_file);
+      if (!t) {
+        std::fprintf(stderr, "safecass run: --read-token-file: %s\n", t.error().message.c_str());
+        return 2;
+      }
+      read_token_file = std::move(*t);
+    }
     middleware::NodeOptions options;
     options.ice = *endpoint;
     options.allow_write = args.allow_write;
     options.token = token;
+    if (read_token_file) options.read_token = read_token_file->secret();
     options.keys_dir = args.keys;
     options.insecure = args.insecure;
+    options.tls.dir = args.tls;
+    if (!args.listen.empty()) options.listen_host = args.listen;
     options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
     options.log = [](const std::string& line) { say(line); };
     auto created = middleware::CoordinatorNode::create(co, monitor, registry, system, args.coordinator, options);
@@ -311,10 +347,26 @@ int run_coordinator(const RunArgs& args) {
         std::to_string(s.connects) + " connections, " + std::to_string(s.events_dropped) + " event records dropped");
   }
   if (token_file) token_file->remove();
+  int code = failures == 0 ? 0 : 1;
+  bool history_complete = true;
+  std::string recorder_status;
+  if (recorder) {
+    // Every thread that makes records has stopped: what is queued is the end of the history.
+    recorder->close();
+    const RecordStatus status = recorder->status();
+    // Nothing lost silently: a history that misses records is said, and fails the command.
+    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
+    std::fflush(stderr);
+    history_complete = status.complete();
+    if (!history_complete) code = 2;
+    if (args.json) recorder_status = record_status_json(status);
+  }
   say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
       std::string(to_string(co.coordinator_state())) +
-      (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed" : ""));
-  return failures == 0 ? 0 : 1;
+      (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed" : "") +
+      (history_complete ? "" : "; the history file is incomplete (see above)"));
+  if (!recorder_status.empty()) say(recorder_status);
+  return code;
 }
 
 }  // namespace safecass::tools

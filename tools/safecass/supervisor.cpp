@@ -32,6 +32,8 @@ struct SupervisorArgs {
   double duration = 0.0;
   std::string keys;
   bool insecure = false;
+  std::string tls;
+  std::string listen;
 };
 
 int run_supervisor(const SupervisorArgs& args) {
@@ -55,6 +57,8 @@ int run_supervisor(const SupervisorArgs& args) {
   options.lost_after = std::chrono::milliseconds(args.lost_after_ms);
   options.keys_dir = args.keys;
   options.insecure = args.insecure;
+  options.tls.dir = args.tls;
+  if (!args.listen.empty()) options.listen_host = args.listen;
   options.print = [](const std::string& line) {
     std::lock_guard lock(print_mutex);
     std::printf("%s\n", line.c_str());
@@ -99,7 +103,9 @@ void add_supervisor_command(CLI::App& app, int& code) {
   cmd->add_option("--lost-after", args.lost_after_ms, "milliseconds without a heartbeat before a coordinator is lost (default 600)");
   cmd->add_option("--duration", args.duration, "stop after SECONDS (default: until SIGINT/SIGTERM)");
   cmd->add_option("--keys", args.keys, "the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
-  cmd->add_flag("--insecure", args.insecure, "accept a non-loopback IceStorm or listening address although the bus is not encrypted");
+  cmd->add_flag("--insecure", args.insecure, "accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
+  cmd->add_option("--tls", args.tls, "mutual TLS; DIR holds ca.pem and supervisor.pem/.key (scripts/setup-tls)");
+  cmd->add_option("--listen", args.listen, "the address to serve on (default 127.0.0.1)");
   cmd->callback([&code] { code = run_supervisor(args); });
 }
 

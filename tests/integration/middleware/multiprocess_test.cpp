@@ -22,6 +22,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <string>
@@ -140,10 +141,10 @@ struct TwoProcesses {
                                  "--allow-write", "--token-file", token_file(), "--duration", "40"},
         p.scratch + "/" + tag + "-robot.log");
   }
-  void start_ui() {
-    ui = std::make_unique<Process>(
-        std::vector<std::string>{p.bin, "run", p.system, "--coordinator", "ui", "--ice", ice, "--duration", "40"},
-        p.scratch + "/" + tag + "-ui.log");
+  void start_ui(std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{p.bin, "run", p.system, "--coordinator", "ui", "--ice", ice, "--duration", "40"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    ui = std::make_unique<Process>(std::move(argv), p.scratch + "/" + tag + "-ui.log");
   }
   std::unique_ptr<middleware::RemoteClient> client(const std::string& coordinator, const std::string& token = {}) {
     middleware::ClientOptions o;
@@ -233,6 +234,160 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
   ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A"));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
   EXPECT_TRUE(ui->explain("PENDANT")->empty());
+}
+
+/// One history record as a line both sides can produce: what happened and its root cause.
+std::string history_line(const std::string& kind, const std::string& outcome, const std::string& event, State from,
+                         State to, const std::string& root_origin, const std::string& root_event) {
+  return kind + " " + outcome + " " + event + " " + std::string(to_string(from)) + "->" + std::string(to_string(to)) +
+         " <- " + root_origin + ":" + root_event;
+}
+
+TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAnInProcessRunCauseByCause) {
+  // A true audit trail (issue finding: after a fault was cleared, the ui's history named the root
+  // of the next fault). A seeded random sequence of faults on the robot; after each, the ui is
+  // given time to hold the same roots; then PENDANT.s_R.Status's history in the ui, and the
+  // supervisor's printed transitions of it, must equal an in-process run's, record by record.
+  TwoProcesses sys(ice_of_fixture(), "audit");
+  sys.start_robot();
+  sys.start_ui({"--lost-after", "3000"});  // this test is about causes: no loss under CI load
+  Process supervisor({sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "3000", "--duration", "40"},
+                     sys.p.scratch + "/audit-supervisor.log");
+  auto token = middleware::read_token_file(sys.token_file());
+  ASSERT_TRUE(eventually([&] { return (token = middleware::read_token_file(sys.token_file())).has_value(); }))
+      << sys.logs();
+  auto robot = sys.client("robot", *token);
+  auto ui = sys.client("ui");
+  ASSERT_TRUE(robot && ui) << sys.logs();
+  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
+  ASSERT_TRUE(eventually([&] { return supervisor.output().find("coordinator 'ui' is up") != std::string::npos; }))
+      << supervisor.output();
+
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  auto load = spec::load_system(sys.p.system, registry);
+  ASSERT_TRUE(load.ok());
+  SimulatedClock clock;
+  Coordinator reference("robodoc", &clock);
+  Monitor monitor(reference, registry);
+  ASSERT_TRUE(spec::instantiate(*load.system, reference, monitor));
+  const MachineId pendant = *reference.find_machine("PENDANT.s_R.Status");
+  const auto history_before = reference.history(pendant).size();
+
+  struct Op {
+    const char* event;
+    const char* target;
+  };
+  const std::vector<Op> ops{{"EVT_FORCE_ERROR", "JR3.s_A"},          {"/EVT_FORCE_ERROR", "JR3.s_A"},
+                            {"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}, {"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
+                            {"EVT_BONE_MOTION", "BMM.s_A"},          {"reset", "BMM"}};
+  auto roots = [](const std::vector<Explanation>& why) {
+    std::vector<std::string> out;
+    for (const Explanation& e : why) out.push_back(e.root_origin + ":" + e.root_event);
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  std::mt19937 random(20261123);
+  for (int step = 0; step < 40; ++step) {
+    const Op op = ops[random() % ops.size()];
+    if (std::string(op.event) == "reset") {
+      ASSERT_TRUE(robot->reset(op.target, "audit test", "step " + std::to_string(step))) << sys.logs();
+      ASSERT_TRUE(reference.reset(op.target, "audit test", "step " + std::to_string(step)));
+    } else {
+      ASSERT_TRUE(robot->generate(op.event, op.target)) << sys.logs();
+      ASSERT_TRUE(reference.generate(op.event, op.target));
+    }
+    clock.advance(std::chrono::milliseconds(10));
+    const auto want = roots(*reference.explain("PENDANT.s_R.Status"));
+    ASSERT_TRUE(eventually([&] {
+      auto got = ui->explain("PENDANT.s_R.Status");
+      return got && roots(*got) == want;
+    })) << "step " << step << " " << op.event << " " << op.target << "\n" << sys.logs();
+  }
+
+  std::vector<std::string> expected, expected_transitions;
+  const auto records = reference.history(pendant);
+  for (std::size_t i = history_before; i < records.size(); ++i) {
+    const Record& r = records[i];
+    const std::string root_event = r.root.event == kNoEvent ? "" : reference.event(r.root.event).name;
+    const std::string root_origin = r.root.event == kNoEvent ? "" : reference.root_origin(r.root);
+    const std::string outcome = r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome));
+    const std::string event = r.event == kNoEvent ? "" : reference.event(r.event).name;
+    expected.push_back(history_line(std::string(to_string(r.kind)), outcome, event, r.from, r.to, root_origin, root_event));
+    if (r.kind == RecordKind::Transition) {
+      expected_transitions.push_back("[ui] PENDANT.s_R.Status " + std::string(to_string(r.from)) + " -> " +
+                                     std::string(to_string(r.to)) + " " + event + " (root " + root_origin + ":" +
+                                     root_event + ")");
+    }
+  }
+  ASSERT_GT(expected_transitions.size(), 4u) << "the sequence exercises the interface";
+  auto rows = ui->state_history("PENDANT.s_R.Status", 1000);
+  ASSERT_TRUE(rows) << rows.error().message;
+  std::vector<std::string> got;
+  for (const auto& r : *rows) {
+    got.push_back(history_line(r.kind, r.outcome, r.event, r.from, r.to, r.root_origin, r.root_event));
+  }
+  ASSERT_GE(got.size(), expected.size());
+  got.erase(got.begin(), got.end() - static_cast<std::ptrdiff_t>(expected.size()));  // the start-up records
+  EXPECT_EQ(got, expected);
+
+  std::vector<std::string> printed;
+  std::istringstream out(supervisor.output());
+  for (std::string line; std::getline(out, line);) {
+    if (line.rfind("[ui] PENDANT.s_R.Status ", 0) == 0) printed.push_back(line);
+  }
+  EXPECT_TRUE(eventually([&] {
+    printed.clear();
+    std::istringstream again(supervisor.output());
+    for (std::string line; std::getline(again, line);) {
+      if (line.rfind("[ui] PENDANT.s_R.Status ", 0) == 0) printed.push_back(line);
+    }
+    return printed.size() >= expected_transitions.size();
+  }));
+  EXPECT_EQ(printed, expected_transitions) << supervisor.output();
+}
+
+TEST(MultiProcess, ReadsAreRefusedWithoutTheReadCredentialWhenTheCoordinatorHasOne) {
+  TwoProcesses sys(ice_of_fixture(), "read");
+  const std::string credential_file = sys.p.scratch + "/read-ui.token";
+  ::unlink(credential_file.c_str());
+  sys.start_ui({"--read-token-file", credential_file});
+  std::optional<std::string> credential;
+  ASSERT_TRUE(eventually([&] { return (credential = middleware::read_token_file(credential_file).value_or("")) &&
+                                      !credential->empty(); }))
+      << sys.logs();
+  struct stat st {};
+  ASSERT_EQ(::stat(credential_file.c_str(), &st), 0);
+  EXPECT_EQ(st.st_mode & 0777, 0600u);
+
+  middleware::ClientOptions o;
+  o.ice = *middleware::parse_ice_endpoint(sys.ice);
+  o.coordinator = "ui";
+  o.timeout = 3000ms;
+  std::unique_ptr<middleware::RemoteClient> anonymous;
+  ASSERT_TRUE(eventually([&] {
+    auto r = middleware::RemoteClient::connect(o);
+    if (r) anonymous = std::move(*r);
+    return anonymous != nullptr;
+  }, 10000ms)) << sys.logs();
+  for (auto refused : {anonymous->state_list("PENDANT").has_value(), anonymous->explain("PENDANT").has_value(),
+                       anonymous->event_history(5).has_value(), anonymous->state_history("PENDANT", 5).has_value()}) {
+    EXPECT_FALSE(refused);
+  }
+  auto why = anonymous->state_list("PENDANT");
+  ASSERT_FALSE(why);
+  EXPECT_EQ(why.error().code, ErrorCode::Denied);
+  EXPECT_NE(why.error().message.find("read credential"), std::string::npos) << why.error().message;
+
+  o.read_token = *credential;
+  auto reader = middleware::RemoteClient::connect(o);
+  ASSERT_TRUE(reader) << reader.error().message;
+  EXPECT_TRUE((*reader)->state_list("PENDANT"));
+  EXPECT_TRUE((*reader)->explain("PENDANT"));
+  o.read_token = std::string(64, '0');
+  auto wrong = middleware::RemoteClient::connect(o);
+  ASSERT_TRUE(wrong);
+  EXPECT_FALSE((*wrong)->state_list("PENDANT")) << "a wrong credential is no credential";
 }
 
 TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {

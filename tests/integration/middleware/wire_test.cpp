@@ -40,6 +40,7 @@
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
+#include "safecass/middleware/supervisor.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass {
@@ -393,6 +394,147 @@ TEST(Wire, AClientSendsItsTokenOnlyToACoordinatorFoundThroughAnAuthenticatedHear
   auto real = middleware::RemoteClient::connect(o);
   ASSERT_TRUE(real) << real.error().message;
   EXPECT_EQ(*(*real)->coordinator(), "wire-c");
+}
+
+TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOneLine) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  std::mutex mutex;
+  std::string printed;
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.lost_after = 300ms;
+  options.print = [&](const std::string& line) {
+    std::lock_guard lock(mutex);
+    printed += line + "\n";
+  };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  ASSERT_TRUE(supervisor) << supervisor.error().message;
+  ASSERT_TRUE((*supervisor)->start());
+  auto output = [&] {
+    std::lock_guard lock(mutex);
+    return printed;
+  };
+  ASSERT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' is up") != std::string::npos; }, 5000ms))
+      << output();
+
+  // Spoofed heartbeats do not keep a dead coordinator alive.
+  bus.beating.store(false);
+  const auto until = std::chrono::steady_clock::now() + 1500ms;
+  while (std::chrono::steady_clock::now() < until && output().find("coordinator 'wire-p' lost") == std::string::npos) {
+    bus.beat(*bus.attacker, "wire-p", kIncarnation);
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_NE(output().find("coordinator 'wire-p' lost"), std::string::npos) << output();
+  EXPECT_EQ((*supervisor)->lost(), std::vector<std::string>{"wire-p"});
+
+  // A forged event record cannot add a line; a genuine one with a newline in it stays on one line.
+  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
+  std::shared_ptr<IceStorm::TopicPrx> topic;
+  try {
+    topic = manager->retrieve("safecass.events");
+  } catch (const IceStorm::NoSuchTopic&) {
+    topic = manager->create("safecass.events");
+  }
+  auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
+  auto record = [](std::int64_t seq, const std::string& kind, const std::string& address, const std::string& text) {
+    wire::EventMessage m;
+    m.coordinator = "wire-p";
+    m.incarnation = kIncarnation;
+    m.seq = seq;
+    m.kind = kind;
+    m.address = address;
+    m.event = "EVT_E";
+    m.from = wire::Level::Error;
+    m.to = wire::Level::Normal;
+    m.level = wire::Level::Error;
+    m.text = text;
+    return m;
+  };
+  auto ic = bus.ice.communicator();
+  events->records(bus.attacker->sign(middleware::detail::kKindEvents,
+                                     encode(ic, wire::EventMessageSeq{record(1, "transition", "P.s_A\n[wire-p] FORGED", "")})));
+  events->records(bus.provider->sign(middleware::detail::kKindEvents,
+                                     encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "operator\n[wire-p] FAKE LINE")})));
+  ASSERT_TRUE(eventually([&] { return output().find("[wire-p] reset P (") != std::string::npos; })) << output();
+  EXPECT_NE(output().find("[wire-p] reset P (operator\\x0a[wire-p] FAKE LINE)"), std::string::npos) << output();
+  EXPECT_EQ(output().find("\n[wire-p] FAKE LINE"), std::string::npos) << output();
+  EXPECT_EQ(output().find("FORGED"), std::string::npos) << output();
+  // The same genuine record again is a replay.
+  events->records(bus.provider->sign(middleware::detail::kKindEvents,
+                                     encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "again")})));
+
+  // Back with a newer incarnation (a restart): its view is refreshed. The old incarnation still
+  // beating beside it is a second process with the same name, and is reported.
+  for (int i = 0; i < 3; ++i) {
+    bus.beat(*bus.provider, "wire-p", kIncarnation + 1);
+    std::this_thread::sleep_for(50ms);
+  }
+  EXPECT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' restarted; its view is refreshed") != std::string::npos; }))
+      << output();
+  EXPECT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' recovered") != std::string::npos; })) << output();
+  bus.beat(*bus.provider, "wire-p", kIncarnation);
+  EXPECT_TRUE(eventually([&] { return output().find("two processes run coordinator 'wire-p'") != std::string::npos; }))
+      << output();
+  EXPECT_EQ(output().find("again"), std::string::npos) << "a replayed record is not printed\n" << output();
+  EXPECT_GE((*supervisor)->messages_refused(), 3u);
+  (*supervisor)->stop();
+}
+
+TEST(Wire, ACoordinatorReportsAnotherProcessRunningUnderItsName) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beat(*bus.other, "wire-c", kIncarnation);  // wire-c's key, another incarnation: a second process
+  EXPECT_TRUE(eventually([&] { return bus.node->stats().duplicates_seen >= 1; })) << bus.all_log();
+  EXPECT_NE(bus.all_log().find("another process runs coordinator 'wire-c'"), std::string::npos) << bus.all_log();
+}
+
+TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(false);  // a real wire-p runs below, with its own heartbeat
+  middleware::HostClock clock;
+  Coordinator provider("wire-p", &clock);
+  Monitor monitor(provider, bus.registry);
+  ASSERT_TRUE(spec::instantiate(*bus.load.system, provider, monitor, "wire-p"));
+  middleware::NodeOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.log = [](const std::string&) {};
+  auto node = middleware::CoordinatorNode::create(provider, monitor, bus.registry, *bus.load.system, "wire-p", options);
+  ASSERT_TRUE(node) << node.error().message;
+  ASSERT_TRUE((*node)->start());
+  ASSERT_TRUE(eventually([&] { return (*node)->stats().connected; }, 10000ms));
+  std::this_thread::sleep_for(500ms);  // start-up republishes done
+
+  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
+  std::shared_ptr<IceStorm::TopicPrx> topic;
+  try {
+    topic = manager->retrieve("safecass.resync");
+  } catch (const IceStorm::NoSuchTopic&) {
+    topic = manager->create("safecass.resync");
+  }
+  auto resync = Ice::uncheckedCast<wire::ResyncTopicPrx>(topic->getPublisher());
+  const auto before = (*node)->stats().updates_published;
+  const auto start = std::chrono::steady_clock::now();
+  for (std::int64_t i = 1; i <= 300; ++i) {
+    resync->resync(bus.supervisor->sign(middleware::detail::kKindResync,
+                                        encode(bus.ice.communicator(), wire::ResyncRequest{"supervisor", kIncarnation, i, "wire-p"})));
+  }
+  const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
+  std::this_thread::sleep_for(400ms);  // the last request kept inside a period is honoured
+  const auto republished = (*node)->stats().updates_published - before;
+  const auto periods = static_cast<std::uint64_t>(elapsed.count() / 100 + 6);
+  EXPECT_GE(republished, 4u) << "the requests are honoured, not lost";
+  EXPECT_LE(republished, 4 * periods) << "at most one republish (4 interfaces) per heartbeat period per requester, "
+                                      << "over " << elapsed.count() << " ms";
+  (*node)->stop();
 }
 
 TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {

@@ -368,3 +368,83 @@ TEST(Configuration, TheCoordinatorReadsTimeFromTheInjectedClock) {
 
 }  // namespace
 }  // namespace safecass
+
+// ---- history: one bounded ring for the whole coordinator (docs/semantics.md §8) ---------------
+
+namespace safecass {
+namespace {
+
+using test::Gcm;
+
+TEST(History, AnAddressReturnsAtMostHistoryCapacityOfItsNewestRecordsOldestFirst) {
+  CoordinatorOptions options;
+  options.history_capacity = 4;
+  Gcm g(options);
+  g.component("JR3");
+  g.pair("EVT_X", 50, State::Error);
+  for (int i = 0; i < 5; ++i) {
+    g.gen("EVT_X", "JR3.s_A");
+    g.gen("/EVT_X", "JR3.s_A");
+  }
+  const auto h = g.co.history(g.machine("JR3.s_A"));
+  ASSERT_EQ(h.size(), 4u);
+  for (std::size_t i = 1; i < h.size(); ++i) EXPECT_LT(h[i - 1].seq, h[i].seq) << "oldest first";
+  EXPECT_EQ(g.co.event(h.back().event).name, "/EVT_X") << "the newest record is last";
+}
+
+TEST(History, AQuietAddressKeepsItsRecordsUntilTheCoordinatorHasProducedARingOfNewerOnes) {
+  CoordinatorOptions options;
+  options.history_records = 16;
+  options.history_per_address = 1;
+  options.history_records_max = 16;
+  Gcm g(options);
+  g.component("QUIET");
+  g.component("BUSY");
+  g.pair("EVT_X", 50, State::Error);
+  ASSERT_EQ(g.co.history_size(), 16u);
+  g.gen("EVT_X", "QUIET.s_A");
+  g.gen("EVT_X", "BUSY.s_A");  // each event adds ~3 records (event, transition, component transition)
+  EXPECT_FALSE(g.co.history(g.machine("QUIET.s_A")).empty()) << "still within the ring";
+  for (int i = 0; i < 10; ++i) g.gen("EVT_X", "BUSY.s_A"), g.gen("/EVT_X", "BUSY.s_A");
+  EXPECT_TRUE(g.co.history(g.machine("QUIET.s_A")).empty()) << "a ring's worth of newer records pushed it out";
+  EXPECT_EQ(g.co.history(Address{}).size(), 16u) << "the ring is full, never larger";
+}
+
+TEST(History, TheRingGrowsWithTheModelWhileConfiguringAndStaysWithinItsCap) {
+  CoordinatorOptions options;
+  options.history_records = 4;
+  options.history_per_address = 2;
+  options.history_records_max = 64;
+  Gcm g(options);
+  for (int i = 0; i < 5; ++i) g.component("C" + std::to_string(i));  // 5 components, 10 machines
+  EXPECT_GE(g.co.history_size(), 30u) << "2 per address";
+  for (int i = 5; i < 100; ++i) g.component("C" + std::to_string(i));
+  EXPECT_EQ(g.co.history_size(), 64u) << "capped";
+}
+
+TEST(History, AScopesHistoryIsEveryRecordInItInStreamOrder) {
+  Gcm g;
+  g.component("JR3", {"ForceData"});
+  g.component("CONTROL", {}, {"ForceData"});
+  g.connect("CONTROL.ForceData", "JR3.ForceData");
+  g.pair("EVT_X", 50, State::Error);
+  g.gen("EVT_X", "JR3.s_A");
+  g.gen("/EVT_X", "JR3.s_A");
+  const auto all = g.co.history(Address{});
+  ASSERT_FALSE(all.empty());
+  for (std::size_t i = 1; i < all.size(); ++i) EXPECT_LT(all[i - 1].seq, all[i].seq);
+  bool control = false, jr3 = false, component_transition = false;
+  for (const Record& r : all) {
+    control = control || r.component == g.comp("CONTROL");
+    jr3 = jr3 || r.component == g.comp("JR3");
+    component_transition = component_transition || r.kind == RecordKind::ComponentTransition;
+  }
+  EXPECT_TRUE(control && jr3 && component_transition);
+  Address control_scope;
+  control_scope.kind = Address::Kind::Component;
+  control_scope.component = g.comp("CONTROL");
+  for (const Record& r : g.co.history(control_scope)) EXPECT_EQ(r.component, g.comp("CONTROL"));
+}
+
+}  // namespace
+}  // namespace safecass

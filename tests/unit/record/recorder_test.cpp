@@ -146,5 +146,23 @@ TEST(Recorder, ANonFiniteSampleValueIsWrittenAsValidJsonThatKeepsItsValue) {
   EXPECT_THAT(record_to_json(r, m.co), HasSubstr("\"value\":\"nan\""));
 }
 
+TEST(Recorder, ARemoteRootIsWrittenWithItsOriginInItsOwnProcessNotTheStandInItArrivedThrough) {
+  // A live client records mirrors of a provider's root: the history names the true root cause
+  // (the origin interned when the root arrived), as an in-process run of the same system does.
+  Robot m;
+  Record r;
+  r.kind = RecordKind::Transition;
+  r.machine = m.machine("JR3.s_A");
+  r.component = m.comp("JR3");
+  r.from = State::Normal;
+  r.to = State::Error;
+  r.root.event = m.id("EVT_FORCE_ERROR");
+  r.root.origin = r.machine;  // the stand-in machine the root arrived through
+  r.root.remote = 0;
+  r.root.remote_origin = m.co.intern("SENSOR.s_A");
+  EXPECT_THAT(record_to_json(r, m.co), HasSubstr("\"root\":{\"event\":\"EVT_FORCE_ERROR\",\"origin\":\"SENSOR.s_A\""));
+  EXPECT_THAT(record_to_text(r, m.co), HasSubstr("<- SENSOR.s_A:EVT_FORCE_ERROR"));
+}
+
 }  // namespace
 }  // namespace safecass

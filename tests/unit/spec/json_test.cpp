@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "safecass/spec/json.hpp"
 
@@ -140,6 +142,41 @@ TEST(JsonReader, ReportsBadLiteralsAndControlBytes) {
 TEST(JsonReader, QuotesStringsForOutput) {
   EXPECT_EQ(json_quote("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\n\\u0001\"");
   EXPECT_EQ(type_name(JsonValue::Type::Object), "object");
+}
+
+TEST(JsonReader, StreamsTheElementsOfOneListOfTheRootObjectAndKeepsTheRestAsATree) {
+  std::vector<std::pair<std::size_t, JsonValue>> seen;
+  const JsonParse p = parse_json_streaming(
+      "{ \"a\": [9],\n  \"steps\": [ {\"x\": [1, 2]},\n 3 ],\n \"steps\": [4], \"o\": { \"steps\": [5] } }", "steps",
+      [&](std::size_t index, JsonValue&& element) { seen.emplace_back(index, std::move(element)); });
+  ASSERT_FALSE(p.error) << p.error->message;
+  ASSERT_EQ(seen.size(), 2u) << "the first root member called steps only, not nested lists";
+  EXPECT_EQ(seen[0].first, 0u);
+  EXPECT_EQ(seen[0].second.find("x")->array.size(), 2u);
+  EXPECT_EQ(seen[1].first, 1u);
+  EXPECT_EQ(seen[1].second.number, 3.0);
+  EXPECT_EQ(seen[1].second.position.line, 3);
+  EXPECT_EQ(seen[1].second.position.column, 2);
+  const JsonValue& root = *p.value;
+  const JsonValue* steps = root.find("steps");
+  ASSERT_TRUE(steps != nullptr && steps->is_array());
+  EXPECT_TRUE(steps->array.empty()) << "its elements were handed over, not kept";
+  EXPECT_EQ(steps->position.line, 2);
+  EXPECT_EQ(steps->position.column, 12);
+  EXPECT_EQ(root.object[2].value.array.size(), 1u) << "a second member of the same name stays in the tree";
+  EXPECT_EQ(root.find("o")->find("steps")->array.size(), 1u);
+  EXPECT_EQ(root.find("a")->array.size(), 1u);
+
+  // Errors are as parse_json's, with their positions; the elements before them were handed.
+  seen.clear();
+  const JsonParse bad = parse_json_streaming("{\"steps\": [1, 2,]}", "steps",
+                                             [&](std::size_t index, JsonValue&& e) { seen.emplace_back(index, std::move(e)); });
+  ASSERT_TRUE(bad.error);
+  EXPECT_EQ(bad.error->message, "trailing comma before ']'");
+  EXPECT_EQ(bad.error->position.column, 17);
+  EXPECT_EQ(seen.size(), 2u);
+  EXPECT_EQ(parse_json_streaming("{\"steps\": [[[1]]]}", "steps", [](std::size_t, JsonValue&&) {}, 2).error->message,
+            "nesting deeper than 2 levels");
 }
 
 }  // namespace

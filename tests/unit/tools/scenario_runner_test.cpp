@@ -80,14 +80,20 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
   spec::ScenarioStep step;
   step.kind = spec::ScenarioStep::Kind::Inject;
   step.at = 0.5;
-  step.filter = "force_limit";
-  step.values = {{10.0}, {std::numeric_limits<double>::infinity()}};
-  step.where = spec::Position{"made.json", 3, 7};
+  auto action = std::make_shared<spec::StepAction>();
+  action->filter = "force_limit";
+  action->values = {{10.0}, {std::numeric_limits<double>::infinity()}};
+  step.action = action;
+  step.index = 9;
+  step.line = 3;
+  step.column = 7;
   load.scenario->steps.push_back(step);
+  const std::string path = load.scenario->path;
   ScenarioRunner runner(std::move(*load.scenario), std::move(*system.system), registry);
   const auto problems = runner.prepare();
   ASSERT_EQ(problems.size(), 1u);
-  EXPECT_EQ(spec::format(problems[0]), "made.json:3:7: error: an injected value is not a finite number: injected values must be finite");
+  EXPECT_EQ(spec::format(problems[0]), path + ":3:7: error: an injected value is not a finite number: injected values "
+                                              "must be finite [/steps/9/inject]");
 }
 
 }  // namespace

@@ -11,10 +11,6 @@ namespace safecass::runner {
 namespace {
 constexpr Time kMonitorPeriod = std::chrono::milliseconds(5);
 
-spec::Diagnostic error_at(const spec::ScenarioStep& s, std::string message) {
-  return spec::Diagnostic{spec::Diagnostic::Severity::Error, s.where, std::move(message), s.pointer};
-}
-
 std::string secs(Time t) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
@@ -33,6 +29,9 @@ ScenarioRunner::~ScenarioRunner() { runtime_->stop(); }
 
 std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
   std::vector<spec::Diagnostic> out;
+  const auto error_at = [this](const spec::ScenarioStep& s, std::string message) {
+    return spec::Diagnostic{spec::Diagnostic::Severity::Error, scenario_.where(s), std::move(message), s.pointer()};
+  };
   const spec::Position at_system{scenario_.system, 1, 1};
   if (auto built = spec::instantiate(system_, coordinator_, *monitor_); !built) {
     out.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, at_system, built.error().message, ""});
@@ -47,69 +46,70 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
     }
   }
   for (const spec::ScenarioStep& s : scenario_.steps) {
+    const spec::StepAction* action = s.action.get();  // null for a sample step
     switch (s.kind) {
       case spec::ScenarioStep::Kind::Sample:
         for (const auto& [name, values] : s.samples) {
           Signal* sig = monitor_->signals().find(name);
           if (sig == nullptr) {
-            out.push_back(error_at(s, "no signal '" + name + "' (signals are written Component.signal)"));
+            out.push_back(error_at(s, "no signal '" + std::string(name) + "' (signals are written Component.signal)"));
           } else if (sig->size() != values.size()) {
-            out.push_back(error_at(s, "signal '" + name + "' has size " + std::to_string(sig->size()) + ", the sample has " +
-                                          std::to_string(values.size()) + " values"));
+            out.push_back(error_at(s, "signal '" + std::string(name) + "' has size " + std::to_string(sig->size()) +
+                                                     ", the sample has " + std::to_string(values.size()) + " values"));
           }
         }
         break;
       case spec::ScenarioStep::Kind::Ramp: {
-        Signal* sig = monitor_->signals().find(s.signal);
-        if (sig == nullptr) out.push_back(error_at(s, "no signal '" + s.signal + "'"));
-        else if (sig->size() != 1) out.push_back(error_at(s, "a ramp needs a scalar signal; '" + s.signal + "' has size " + std::to_string(sig->size())));
+        Signal* sig = monitor_->signals().find(action->signal);
+        if (sig == nullptr) out.push_back(error_at(s, "no signal '" + action->signal + "'"));
+        else if (sig->size() != 1) out.push_back(error_at(s, "a ramp needs a scalar signal; '" + action->signal + "' has size " + std::to_string(sig->size())));
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
-        auto e = coordinator_.find_event(s.event);
+        auto e = coordinator_.find_event(action->event);
         if (!e) {
           out.push_back(error_at(s, e.error().message));
         } else if (!coordinator_.event(*e).is_broadcast()) {
-          if (s.target.empty()) out.push_back(error_at(s, "\"generate\" of '" + s.event + "' needs a \"target\" machine"));
-          else if (auto m = coordinator_.find_machine(s.target); !m) out.push_back(error_at(s, m.error().message));
+          if (action->target.empty()) out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
+          else if (auto m = coordinator_.find_machine(action->target); !m) out.push_back(error_at(s, m.error().message));
         }
         break;
       }
       case spec::ScenarioStep::Kind::Inject:
         // JSON has no NaN or infinity; a scenario built in C++ follows the same rule (docs/filters.md).
-        if (std::any_of(s.values.begin(), s.values.end(), [](const std::vector<double>& v) {
+        if (std::any_of(action->values.begin(), action->values.end(), [](const std::vector<double>& v) {
               return std::any_of(v.begin(), v.end(), [](double x) { return !std::isfinite(x); });
             })) {
           out.push_back(error_at(s, "an injected value is not a finite number: injected values must be finite"));
           break;
         }
-        if (!s.filter.empty()) {
-          Filter* f = monitor_->find_filter(s.filter);
+        if (!action->filter.empty()) {
+          Filter* f = monitor_->find_filter(action->filter);
           if (f == nullptr) {
-            out.push_back(error_at(s, "no filter '" + s.filter + "'"));
+            out.push_back(error_at(s, "no filter '" + action->filter + "'"));
           } else if (f->inputs().empty()) {
-            out.push_back(error_at(s, "filter '" + s.filter + "' has no input"));
+            out.push_back(error_at(s, "filter '" + action->filter + "' has no input"));
           } else {
-            for (const auto& v : s.values) {
+            for (const auto& v : action->values) {
               if (v.size() != f->inputs()[0]->size()) {
-                out.push_back(error_at(s, "filter '" + s.filter + "' reads '" + f->inputs()[0]->name() + "' of size " +
+                out.push_back(error_at(s, "filter '" + action->filter + "' reads '" + f->inputs()[0]->name() + "' of size " +
                                               std::to_string(f->inputs()[0]->size()) + "; an injected sample has " +
                                               std::to_string(v.size()) + " values"));
                 break;
               }
             }
           }
-        } else if (Signal* sig = monitor_->signals().find(s.signal); sig == nullptr) {
-          out.push_back(error_at(s, "no signal '" + s.signal + "'"));
+        } else if (Signal* sig = monitor_->signals().find(action->signal); sig == nullptr) {
+          out.push_back(error_at(s, "no signal '" + action->signal + "'"));
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
-        if (auto a = coordinator_.resolve(s.target); !a) out.push_back(error_at(s, a.error().message));
+        if (auto a = coordinator_.resolve(action->target); !a) out.push_back(error_at(s, a.error().message));
         break;
       case spec::ScenarioStep::Kind::Expect:
       case spec::ScenarioStep::Kind::ExpectOutstanding:
       case spec::ScenarioStep::Kind::ExpectCause:
-        for (const auto& [address, expected] : s.expectations) {
+        for (const auto& [address, expected] : action->expectations) {
           auto a = coordinator_.resolve(address);
           if (!a) {
             out.push_back(error_at(s, a.error().message));
@@ -135,26 +135,27 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
 }
 
 void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
+  const spec::StepAction* action = s.action.get();  // null for a sample step
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Sample:
       for (const auto& [name, values] : s.samples) monitor_->signals().find(name)->push(now, values.data());
       break;
     case spec::ScenarioStep::Kind::Ramp:
-      ramps_.push_back(Ramp{monitor_->signals().find(s.signal), now, seconds_to_time(s.until), s.from, s.to});
+      ramps_.push_back(Ramp{monitor_->signals().find(action->signal), now, seconds_to_time(action->until), action->from, action->to});
       break;
     case spec::ScenarioStep::Kind::Generate:
-      (void)coordinator_.generate(s.event, s.target);
+      (void)coordinator_.generate(action->event, action->target);
       break;
     case spec::ScenarioStep::Kind::Inject:
-      if (!s.deep) {
-        (void)monitor_->inject_shallow(s.filter, s.values);
+      if (!action->deep) {
+        (void)monitor_->inject_shallow(action->filter, action->values);
       } else {
-        const std::string signal = s.filter.empty() ? s.signal : monitor_->find_filter(s.filter)->inputs()[0]->name();
-        (void)monitor_->inject_deep(signal, s.values, now);
+        const std::string signal = action->filter.empty() ? action->signal : monitor_->find_filter(action->filter)->inputs()[0]->name();
+        (void)monitor_->inject_deep(signal, action->values, now);
       }
       break;
     case spec::ScenarioStep::Kind::Reset:
-      (void)coordinator_.reset(s.target, "scenario", s.reason);
+      (void)coordinator_.reset(action->target, "scenario", action->reason);
       break;
     default: break;
   }
@@ -194,12 +195,12 @@ std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::st
 }
 
 void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& result) {
-  for (const auto& [address, expected] : s.expectations) {
+  for (const auto& [address, expected] : s.action->expectations) {
     ++result.checks;
     const std::string problem = check_one(s, address, expected);
     if (problem.empty()) continue;
-    result.failures.push_back(s.where.file + ":" + std::to_string(s.where.line) + ":" + std::to_string(s.where.column) +
-                              ": expectation failed at t=" + secs(now) + ": " + problem + " [" + s.pointer + "]");
+    result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
+                              ": expectation failed at t=" + secs(now) + ": " + problem + " [" + s.pointer() + "]");
   }
 }
 
@@ -233,7 +234,7 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
   advance_to(Time{ticks * seconds_to_time(scenario_.period).count()}, result);
   for (; next_check_ < checks_.size(); ++next_check_) {
     const spec::ScenarioStep& s = *checks_[next_check_];
-    result.failures.push_back(s.where.file + ":" + std::to_string(s.where.line) + ":" + std::to_string(s.where.column) +
+    result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
                               ": expectation at t=" + secs(seconds_to_time(s.at)) + " is after the scenario's duration");
   }
   coordinator_.unsubscribe(subscription);

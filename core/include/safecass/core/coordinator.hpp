@@ -160,9 +160,20 @@ struct RemoteApplyResult {
   std::size_t dropped = 0;  ///< roots dropped by the path-vector rule (a cycle across processes)
 };
 
+/// History (DESIGN §2.4 "every processed, ignored, masked, override and reset event is in the
+/// history"): the coordinator keeps the records of all its machines and components in ONE ring,
+/// allocated while the model is configured (never while events are processed). The ring holds
+/// max(`history_records`, `history_per_address` × (machines + components)) records, at most
+/// `history_records_max`; the oldest record of the whole coordinator goes first. history(id) and
+/// component_history(id) return the newest `history_capacity` records of one address that are
+/// still in the ring. A quiet address keeps its records as long as the whole coordinator has not
+/// produced a ring's worth of newer ones (docs/semantics.md §8).
 struct CoordinatorOptions {
-  std::size_t history_capacity = 256;  ///< records kept per machine and per component
-  std::size_t pending_capacity = 256;  ///< events generated from callbacks, reserved up front
+  std::size_t history_capacity = 256;      ///< at most this many records returned per address
+  std::size_t history_records = 8192;      ///< the ring holds at least this many records
+  std::size_t history_per_address = 8;     ///< ... and this many per machine and component
+  std::size_t history_records_max = std::size_t{1} << 20;  ///< ... and at most this many
+  std::size_t pending_capacity = 256;      ///< events generated from callbacks, reserved up front
 };
 
 class Coordinator {
@@ -308,10 +319,16 @@ public:
   std::vector<Condition> conditions(MachineId id) const;
   /// The machine's outstanding condition, if any.
   std::optional<Condition> outstanding(MachineId id) const;
-  /// The last records of a machine, oldest first.
+  /// The last records of a machine still in the history (at most history_capacity), oldest first.
   std::vector<Record> history(MachineId id) const;
-  /// The last extended-state transitions of a component, oldest first.
+  /// The last extended-state transitions of a component still in the history, oldest first.
   std::vector<Record> component_history(ComponentId id) const;
+  /// Every record in the history about `scope`, oldest first: a machine's records (at most
+  /// history_capacity); for a service, its component and SYSTEM, the records of every machine
+  /// and component transition in scope. One pass over the history.
+  std::vector<Record> history(const Address& scope) const;
+  /// How many records the history can hold (see CoordinatorOptions).
+  std::size_t history_size() const noexcept { return history_.items.size(); }
   /// Every active condition at `address` (machine, service, component, SYSTEM) with its root
   /// cause and hop path. Errors: as resolve().
   Expected<std::vector<Explanation>> explain(std::string_view address) const;
@@ -342,7 +359,12 @@ private:
     std::size_t size = 0;
     void push(const Record& r) noexcept;
     std::vector<Record> ordered() const;
+    /// Grows to `capacity` keeping the records in order (configuration time only).
+    void grow(std::size_t capacity);
   };
+  /// Sizes the history for the model configured so far (CoordinatorOptions).
+  void size_history();
+  Ring history_;  ///< every machine and component record of this coordinator
   struct MachineData {
     MachineKind kind;
     ComponentId component;
@@ -353,7 +375,6 @@ private:
     State state = State::Normal;
     std::int32_t outstanding = -1;  ///< index into conditions
     std::atomic<std::uint64_t> snapshot{0};
-    Ring history;
     std::vector<StateCallbacks> callbacks;
     std::vector<Edge> fanout;
   };
@@ -375,7 +396,6 @@ private:
     State state = State::Normal;
     EventId outstanding = kNoEvent;
     std::atomic<std::uint64_t> snapshot{0};
-    Ring history;
     std::vector<StateCallbacks> callbacks;
   };
   enum class PendingKind : std::uint8_t { Generate, Reset };

@@ -37,9 +37,14 @@ struct ClientOptions {
   IceEndpoint ice;           ///< IceStorm, to find the coordinator by its heartbeat
   std::string coordinator;   ///< the coordinator's name
   std::string token;         ///< the write token (from its token file); empty: read-only
+  /// The read credential (from its read token file), sent with every request; the write token
+  /// is sent as the read credential when this is empty.
+  std::string read_token;
   /// The system's bus keys (keys.hpp); only the keyring is read. Empty: $SAFECASS_KEYS.
   std::string keys_dir;
-  /// Accept IceStorm or a coordinator that is not on this host although nothing is encrypted.
+  /// Mutual TLS; the certificate name defaults to "console".
+  TlsOptions tls;
+  /// Accept IceStorm or a coordinator that is not on this host without TLS.
   bool insecure = false;
   std::chrono::milliseconds timeout{2000};
 };

@@ -24,8 +24,10 @@
 /// the node, start(), ... , stop() (or the destructor), which shuts the Ice communicator down.
 
 #include <chrono>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -46,6 +48,21 @@ struct IceEndpoint {
 /// Parses "HOST:PORT" or "PORT". Errors: Parse (with what was wrong).
 Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
 
+/// Mutual TLS (IceSSL) on every connection of a process: to IceStorm, from IceStorm to its
+/// subscribers, and to and from Control endpoints (docs/security.md). `dir` holds the system's
+/// `ca.pem` and this process's `NAME.pem` / `NAME.key` (scripts/setup-tls); every peer must present
+/// a certificate signed by that CA. Empty `dir`: plain TCP, loopback only unless --insecure.
+struct TlsOptions {
+  std::string dir;
+  std::string name;  ///< the certificate to present (NAME.pem, NAME.key)
+  bool enabled() const noexcept { return !dir.empty(); }
+};
+
+/// Checks the TLS files of `tls` (when enabled) and that `hosts` are loopback unless TLS or
+/// `insecure`. `who` names the caller in the message. Errors: InvalidArgument, NotFound.
+Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
+                               std::initializer_list<std::string_view> hosts);
+
 /// The host's monotonic clock (CLOCK_MONOTONIC, epoch: boot), the same in every process of the
 /// host: root times and latencies can be compared across the processes of one machine.
 class HostClock final : public Clock {
@@ -57,6 +74,11 @@ public:
 
 /// The IceStorm instance name scripts/start-icestorm configures.
 inline constexpr std::string_view kIceStormInstance = "SafecassIceStorm";
+
+/// The default NodeOptions::max_message_bytes: Ice.MessageSizeMax (4096 KiB, set in every
+/// SAFECASS process and in scripts/start-icestorm's IceStorm) less 64 KiB for what is added to a
+/// body on its way (the signature, the Signed envelope, Ice's request headers).
+inline constexpr std::size_t kDefaultMaxMessageBytes = std::size_t{4096 - 64} * 1024;
 
 /// Declares, in `coordinator`, every provided interface of another coordinator of `system` that a
 /// component of `coordinator_name` requires (Coordinator::add_remote_provided, with the
@@ -72,6 +94,9 @@ struct NodeOptions {
   std::chrono::milliseconds heartbeat{100};
   bool allow_write = false;              ///< accept write operations
   std::string token;                     ///< the secret write requests must carry
+  /// When not empty, reads (state, history, filters, events, connections, services, explain)
+  /// must carry this credential (or the write token); empty: reads are open to local clients.
+  std::string read_token;
   /// The system's bus keys (keys.hpp): this node signs with DIR/<coordinator>.secret and checks
   /// every message it receives against DIR/keyring. Empty: $SAFECASS_KEYS.
   std::string keys_dir;
@@ -79,8 +104,16 @@ struct NodeOptions {
   /// on every required interface it feeds); likewise the supervisor (EVT_SUPERVISOR_LOST on s_F).
   /// Zero: 3 heartbeat periods.
   std::chrono::milliseconds lost_after{0};
-  /// Accept an IceStorm or listening endpoint that is not loopback although the bus is not
-  /// encrypted (IceSSL is not configured by SAFECASS; docs/security.md).
+  /// The largest body this node sends in one message: the Ice encoding of one `updates` or
+  /// `records` batch, measured before it is signed (bytes). A batch over it is split; a state
+  /// update too large on its own goes out with as many of its roots as fit, the most severe first
+  /// (a client's view never gets better than the provider's), and an event record too large on
+  /// its own with its text cut; each is logged and counted (NodeStats::oversized_messages,
+  /// roots_truncated). A message over Ice.MessageSizeMax would be dropped by IceStorm unseen.
+  std::size_t max_message_bytes = kDefaultMaxMessageBytes;
+  /// Mutual TLS; the certificate name defaults to the coordinator's name.
+  TlsOptions tls;
+  /// Accept an IceStorm or listening endpoint that is not loopback without TLS (docs/security.md).
   bool insecure = false;
   /// Receives every log line (errors about bad messages, reconnections). Default: stderr.
   std::function<void(const std::string&)> log;
@@ -101,6 +134,11 @@ struct NodeStats {
   std::uint64_t messages_refused = 0;   ///< unauthenticated, forged, replayed or malformed bus messages
   std::uint64_t providers_lost = 0;     ///< times a provider coordinator was declared lost
   std::uint64_t duplicates_seen = 0;    ///< heartbeats of another process using this node's name
+  /// State updates and event records too large for one message on their own
+  /// (NodeOptions::max_message_bytes): sent cut down (roots left out, text cut), each logged. A
+  /// record too large even without its text is dropped and also counted in events_dropped.
+  std::uint64_t oversized_messages = 0;
+  std::uint64_t roots_truncated = 0;    ///< roots left out of those state updates (the least severe)
   bool connected = false;
 };
 

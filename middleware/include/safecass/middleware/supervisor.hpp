@@ -30,7 +30,9 @@ struct SupervisorOptions {
   std::chrono::milliseconds lost_after{600};
   /// The system's bus keys (keys.hpp; the supervisor signs as "supervisor"). Empty: $SAFECASS_KEYS.
   std::string keys_dir;
-  /// Accept a non-loopback endpoint although the bus is not encrypted (docs/security.md).
+  /// Mutual TLS; the certificate name defaults to "supervisor".
+  TlsOptions tls;
+  /// Accept a non-loopback endpoint without TLS (docs/security.md).
   bool insecure = false;
   /// Receives each output line (transitions as they arrive, lost/recovered). Default: stdout.
   std::function<void(const std::string&)> print;

@@ -4,7 +4,9 @@
 /// comments (as the 2016 specifications do), and never crashes on any input: malformed text,
 /// deep nesting, huge numbers and invalid UTF-8 escapes all give an error with a position.
 
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -64,6 +66,18 @@ struct JsonParse {
 
 /// Parses one JSON document (comments allowed). Nesting deeper than `max_depth` is an error.
 JsonParse parse_json(std::string_view text, int max_depth = 64);
+
+/// Receives one element of a streamed array: its index and its value (which it may keep).
+using JsonElementHandler = std::function<void(std::size_t index, JsonValue&& element)>;
+
+/// Parses like parse_json(), but the elements of one large list are handed to `element` one at a
+/// time, as each is parsed, instead of being kept in the tree: the list that is the value of the
+/// first member called `key` of the root object. In the result, that member's value is an empty
+/// array at the list's position. A document's tree takes many times its text's size; a scenario
+/// of millions of steps is read this way (scenario.hpp). Errors are as parse_json()'s; elements
+/// before the error have been handed already (a caller that keeps them discards them on error).
+JsonParse parse_json_streaming(std::string_view text, std::string_view key, const JsonElementHandler& element,
+                               int max_depth = 64);
 
 /// Escapes a string for a JSON document (quotes included).
 std::string json_quote(std::string_view text);
