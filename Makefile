@@ -3,9 +3,11 @@
 
 JOBS ?= $(shell nproc)
 BUILD := build
-CTEST_ARGS ?=
+# Tests labelled known-defect show a defect that is documented and not fixed yet: they fail by
+# design until it is, so `make test` leaves them out and `make known-defects` runs them.
+CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test fuzz-smoke bench asan tsan clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan clean
 
 all: build
 
@@ -35,6 +37,9 @@ ros-demo: configure
 
 test: build fuzz-smoke
 	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+
+known-defects: build
+	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
 # A short libFuzzer run of the spec loader (clang, ASan + UBSan); the long run is in docs/spec-format.md.
 FUZZ := $(BUILD)/fuzz

@@ -54,7 +54,8 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
     init.properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
   }
   init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
-  init.properties->setProperty("Ice.Override.ConnectTimeout", "500");
+  // A TLS handshake costs a few round trips and some CPU: give it longer on a loaded machine.
+  init.properties->setProperty("Ice.Override.ConnectTimeout", tls.enabled() ? "2000" : "500");
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
   init.properties->setProperty("Ice.RetryIntervals", "-1");
   init.properties->setProperty("Ice.Warn.Connections", "0");

@@ -644,8 +644,18 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
   return std::make_unique<Console>(std::move(backend), options);
 }
 
-int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out, int timeout_ms) {
-  auto client = connect_client(ice, coordinator, {}, timeout_ms, {}, false);
+int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out, int timeout_ms,
+                     const std::string& keys, const std::string& tls, const std::string& read_token_file) {
+  std::string read_token;
+  if (!read_token_file.empty()) {
+    auto t = middleware::read_token_file(read_token_file);
+    if (!t) {
+      std::fprintf(stderr, "safecass timeline: --read-token-file: %s\n", t.error().message.c_str());
+      return 2;
+    }
+    read_token = *t;
+  }
+  auto client = connect_client(ice, coordinator, {}, timeout_ms, keys, false, tls, read_token);
   if (!client) {
     std::fprintf(stderr, "safecass timeline: %s\n", client.error().message.c_str());
     return 2;

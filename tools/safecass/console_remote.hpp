@@ -28,7 +28,9 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args);
 /// `safecass timeline` drawn from the live history of one coordinator (every state and event
 /// history it holds, fetched through the middleware). 0 the page was written; 2 the coordinator
 /// cannot be reached or OUT cannot be written.
+/// `keys`, `tls`, `read_token_file`: as the console's --keys, --tls and --read-token-file.
 int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out,
-                     int timeout_ms);
+                     int timeout_ms, const std::string& keys = {}, const std::string& tls = {},
+                     const std::string& read_token_file = {});
 
 }  // namespace safecass::tools

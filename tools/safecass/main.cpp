@@ -67,10 +67,14 @@ int main(int argc, char** argv) {
   auto* timeline = app.add_subcommand("timeline", "Draw a recorded history as Normal/Warning/Error swimlanes in one static HTML page");
   std::string timeline_ice;
   std::string timeline_coordinator;
+  std::string timeline_keys, timeline_tls, timeline_read_token;
   timeline->add_option("HISTORY", timeline_history, "history file (JSON lines, from `safecass run --record`); not with --ice");
   timeline->add_option("--html", timeline_html, "write the page to this file")->required();
   timeline->add_option("--ice", timeline_ice, "draw the live history of a coordinator instead: IceStorm at HOST:PORT");
   timeline->add_option("--coordinator", timeline_coordinator, "with --ice: the coordinator's name");
+  timeline->add_option("--keys", timeline_keys, "with --ice: the system's bus keys (default $SAFECASS_KEYS)");
+  timeline->add_option("--tls", timeline_tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key");
+  timeline->add_option("--read-token-file", timeline_read_token, "with --ice: the coordinator's read credential file");
   timeline->callback([&] {
     if (timeline_ice.empty() && timeline_coordinator.empty()) {
       if (timeline_history.empty()) {
@@ -87,7 +91,8 @@ int main(int argc, char** argv) {
       return;
     }
 #ifdef SAFECASS_WITH_ICE
-    code = safecass::tools::run_timeline_ice(timeline_ice, timeline_coordinator, timeline_html, 2000);
+    code = safecass::tools::run_timeline_ice(timeline_ice, timeline_coordinator, timeline_html, 2000, timeline_keys,
+                                             timeline_tls, timeline_read_token);
 #else
     std::fprintf(stderr, "timeline: --ice needs the middleware, and this safecass was built without it (SAFECASS_WITH_ICE)\n");
     code = 2;

@@ -37,6 +37,8 @@ struct ViewerArgs {
   bool open = false;
   std::string ice;                      ///< --ice HOST:PORT: a live system
   std::string keys;                     ///< --keys DIR: the system's bus keys
+  std::string tls;                      ///< --tls DIR: mutual TLS
+  std::vector<std::string> read_token_files;  ///< --read-token-file COORD=FILE
   std::vector<std::string> token_files; ///< --token-file COORD=FILE
   bool speed_given = false;
 };
@@ -63,7 +65,15 @@ Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args
   viewer::MiddlewareOptions options;
   options.ice = args.ice;
   options.keys_dir = args.keys;
+  options.tls_dir = args.tls;
   options.system = args.system;
+  for (const std::string& t : args.read_token_files) {
+    const auto eq = t.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == t.size()) {
+      return fail(ErrorCode::InvalidArgument, "safecass viewer: --read-token-file '" + t + "': write it COORDINATOR=FILE");
+    }
+    options.read_token_files[t.substr(0, eq)] = t.substr(eq + 1);
+  }
   options.allow_write = args.allow_write;
   for (const std::string& t : args.token_files) {
     const auto eq = t.find('=');
@@ -179,6 +189,9 @@ void add_viewer_command(CLI::App& app, int& code) {
       ->capture_default_str()
       ->each([args](const std::string&) { args->speed_given = true; });
   cmd->add_option("--keys", args->keys, "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
+  cmd->add_option("--tls", args->tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
+  cmd->add_option("--read-token-file", args->read_token_files,
+                  "with --ice: COORDINATOR=FILE, a coordinator's read credential (repeatable)");
   cmd->add_option("--ice", args->ice,
                   "IceStorm HOST:PORT: watch the live system whose coordinators run as processes "
                   "(`safecass run SYSTEM --coordinator NAME --ice ...`); needs --system");

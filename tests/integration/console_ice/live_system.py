@@ -50,7 +50,10 @@ class LiveSystem:
             self.coordinator = subprocess.Popen(
                 [self.binary, "run", os.path.join(self.source, "examples/robodoc/robodoc.json"), "--coordinator", "robot",
                  "--scenario", os.path.join(self.source, "tests/integration/console_ice/robot_quiet.json"),
-                 "--ice", self.ice, "--allow-write", "--token-file", self.token_file, "--duration", "55"],
+                 "--ice", self.ice, "--allow-write", "--token-file", self.token_file, "--duration", "55",
+                 # Not a test of loss detection: a loaded CI machine must not turn a late
+                 # heartbeat into EVT_COORDINATOR_LOST (tests/integration/middleware covers it).
+                 "--lost-after", "2000"],
                 stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
         deadline = time.monotonic() + TOKEN_WAIT
         while not (os.path.exists(self.token_file) and os.path.getsize(self.token_file) > 0):

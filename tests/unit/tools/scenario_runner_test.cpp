@@ -4,6 +4,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
@@ -94,6 +96,38 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(spec::format(problems[0]), path + ":3:7: error: an injected value is not a finite number: injected values "
                                               "must be finite [/steps/9/inject]");
+}
+
+}  // namespace
+}  // namespace safecass::runner
+
+namespace safecass::runner {
+namespace {
+
+TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingRuns) {
+  // A service state is derived (DESIGN §2.2): the coordinator and the console refuse to reset
+  // one. The runner used to accept the step and then do nothing.
+  const std::string path = ::testing::TempDir() + "reset-service-" + std::to_string(::getpid()) + ".json";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f, "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
+                    "  \"steps\": [\n"
+                    "    { \"at\": 0.0, \"reset\": { \"target\": \"JR3.s_S.ForceData\", \"reason\": \"operator\" } } ] }\n",
+                 SAFECASS_SOURCE_DIR);
+    std::fclose(f);
+  }
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  RunOptions options;
+  options.quiet = true;
+  RunResult result;
+  Captured err;
+  const int code = run_scenario_file(path, registry, options, &result, err.file);
+  EXPECT_EQ(code, 2) << err.str();
+  EXPECT_THAT(err.str(), HasSubstr(path + ":3:27: error: cannot reset service state 'JR3.s_S.ForceData': it is derived; reset its component or a machine [/steps/0/reset]"));
+  EXPECT_EQ(result.checks, 0) << "nothing ran";
+  std::remove(path.c_str());
 }
 
 }  // namespace

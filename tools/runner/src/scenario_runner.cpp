@@ -104,7 +104,14 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
-        if (auto a = coordinator_.resolve(action->target); !a) out.push_back(error_at(s, a.error().message));
+        // The same rule as Coordinator::reset() and the console: a service state is derived, so a
+        // reset of one would do nothing. Refused here, at load, rather than silently at run time.
+        if (auto a = coordinator_.resolve(action->target); !a) {
+          out.push_back(error_at(s, a.error().message));
+        } else if (a->kind == Address::Kind::Service) {
+          out.push_back(error_at(s, "cannot reset service state '" + action->target +
+                                        "': it is derived; reset its component or a machine"));
+        }
         break;
       case spec::ScenarioStep::Kind::Expect:
       case spec::ScenarioStep::Kind::ExpectOutstanding:

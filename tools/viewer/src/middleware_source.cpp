@@ -51,6 +51,7 @@ std::string component_of(std::string_view address) { return std::string(address.
 struct MiddlewareLink {
   std::string name;
   std::string token;  ///< empty without --token-file for it
+  std::string read_token;  ///< its read credential, when it has one
   std::unique_ptr<Coordinator> local;
   std::unique_ptr<Monitor> monitor;  ///< the local model's filters and signals (for routing)
   std::vector<std::string> components;
@@ -117,6 +118,8 @@ struct MiddlewareSource::Impl {
     o.coordinator = l.name;
     o.token = l.token;
     o.keys_dir = options.keys_dir;
+    o.tls.dir = options.tls_dir;
+    o.read_token = l.read_token;
     o.timeout = options.timeout;
     return RemoteClient::connect(o);
   }
@@ -284,6 +287,16 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
     auto token = middleware::read_token_file(path);
     if (!token) return fail(token.error().code, "--token-file " + name + "=" + path + ": " + token.error().message);
     l->token = *token;
+  }
+  for (const auto& [name, path] : options.read_token_files) {
+    MiddlewareLink* l = impl->link_named(name);
+    if (l == nullptr) {
+      return fail(ErrorCode::InvalidArgument, "--read-token-file " + name + "=" + path + ": system '" + system.name +
+                                                  "' has no coordinator '" + name + "' (it has " + names + ")");
+    }
+    auto token = middleware::read_token_file(path);
+    if (!token) return fail(token.error().code, "--read-token-file " + name + "=" + path + ": " + token.error().message);
+    l->read_token = *token;
   }
   impl->description = "live: " + file_name(options.system) + " through IceStorm " + impl->ice.host + ":" +
                       std::to_string(impl->ice.port) + ", coordinators " + names;

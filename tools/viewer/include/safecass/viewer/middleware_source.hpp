@@ -34,6 +34,9 @@ struct MiddlewareOptions {
   std::map<std::string, std::string> token_files;
   bool allow_write = false;                     ///< without it every write is refused here too
   std::string keys_dir;                         ///< the system's bus keys (empty: $SAFECASS_KEYS)
+  std::string tls_dir;                          ///< mutual TLS (ca.pem, console.pem/.key); empty: TCP
+  /// Coordinator name → its read credential file (`safecass run ... --read-token-file`).
+  std::map<std::string, std::string> read_token_files;
   std::chrono::milliseconds poll{20};           ///< state-list period per coordinator, 1..50 ms
   std::chrono::milliseconds timeout{1500};      ///< one request; also the wait for a heartbeat
   std::chrono::milliseconds retry{500};         ///< pause before trying an unreachable coordinator again
