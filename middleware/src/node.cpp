@@ -679,10 +679,8 @@ struct CoordinatorNode::Impl {
   /// that signer is a replay (or a second process with the same name, which the heartbeat
   /// reports); a newer one is a restart. Returns false when the message must be dropped.
   bool fresh_incarnation(Peer& peer, std::int64_t seen, const std::string& from, std::string_view what) {
-    if (seen < peer.incarnation) {
-      refuse(from, std::string(what) + " of '" + printable(from) + "': incarnation " + std::to_string(seen) +
-                         " is older than " + std::to_string(peer.incarnation) + " (a replay, or two processes named '" +
-                         printable(from) + "')");
+    if (const std::string why = older_incarnation(what, from, seen, peer.incarnation); !why.empty()) {
+      refuse(from, why);
       return false;
     }
     if (seen > peer.incarnation) {

@@ -84,10 +84,8 @@ struct Supervisor::Impl {
   /// Under `mutex`. A newer incarnation is a restart: the view of that coordinator is dropped
   /// (its republished state replaces it) and it is asked to republish.
   bool fresh(Peer& peer, const std::string& who, std::int64_t seen, std::string_view what) {
-    if (seen < peer.incarnation) {
-      refuse(who, std::string(what) + " of '" + printable(who) + "': incarnation " + std::to_string(seen) +
-                      " is older than " + std::to_string(peer.incarnation) + " (a replay, or two processes named '" +
-                      printable(who) + "')");
+    if (const std::string why = older_incarnation(what, who, seen, peer.incarnation); !why.empty()) {
+      refuse(who, why);
       return false;
     }
     if (seen > peer.incarnation) {

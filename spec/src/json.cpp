@@ -280,6 +280,17 @@ private:
   bool streamed_array(JsonValue& v, int depth) {
     if (depth > max_depth_) return fail_here("nesting deeper than " + std::to_string(max_depth_) + " levels");
     v.type = JsonValue::Type::Array;
+    return elements(depth, [&](std::size_t index, JsonValue&& item) { (*element_)(index, std::move(item)); });
+  }
+
+  bool array(JsonValue& v, int depth) {
+    v.type = JsonValue::Type::Array;
+    return elements(depth, [&](std::size_t, JsonValue&& item) { v.array.push_back(std::move(item)); });
+  }
+
+  /// The elements of the array at '[', each handed to `sink(index, item)` as soon as it is parsed.
+  template <class Sink>
+  bool elements(int depth, Sink&& sink) {
     advance();
     skip_space();
     if (failed_) return false;
@@ -290,37 +301,7 @@ private:
     for (std::size_t index = 0;; ++index) {
       JsonValue item;
       if (!value(item, depth + 1)) return false;
-      (*element_)(index, std::move(item));
-      skip_space();
-      if (failed_) return false;
-      if (peek() == ',') {
-        advance();
-        skip_space();
-        if (failed_) return false;
-        if (peek() == ']') return fail_here("trailing comma before ']'");
-        continue;
-      }
-      if (peek() == ']') {
-        advance();
-        return true;
-      }
-      return fail_here(at_end() ? "unexpected end of file: expected ',' or ']'" : "expected ',' or ']'");
-    }
-  }
-
-  bool array(JsonValue& v, int depth) {
-    v.type = JsonValue::Type::Array;
-    advance();
-    skip_space();
-    if (failed_) return false;
-    if (peek() == ']') {
-      advance();
-      return true;
-    }
-    for (;;) {
-      JsonValue item;
-      if (!value(item, depth + 1)) return false;
-      v.array.push_back(std::move(item));
+      sink(index, std::move(item));
       skip_space();
       if (failed_) return false;
       if (peek() == ',') {
