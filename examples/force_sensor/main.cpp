@@ -6,8 +6,7 @@
 
 #include <cstdio>
 
-#include "safecass/native/runtime.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/runner/system.hpp"
 
 using namespace safecass;
 
@@ -15,21 +14,20 @@ int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : "examples/force_sensor/force_sensor.json";
   FilterRegistry registry;
   register_builtin_filters(registry);
-  spec::LoadResult loaded = spec::load_system(path, registry);
-  for (const auto& d : loaded.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  if (!loaded.ok()) return 2;
-
-  SimulatedClock clock;
-  Coordinator co("force_sensor", &clock);
-  Monitor monitor(co, registry);
-  if (auto built = spec::instantiate(*loaded.system, co, monitor); !built) {
-    std::fprintf(stderr, "%s\n", built.error().message.c_str());
+  // One factory builds the system: coordinator, monitor, filters, and a 1 ms task per component.
+  runner::SystemOptions options;
+  options.component_period = std::chrono::milliseconds(1);
+  auto opened = runner::open_system(path, registry, options);
+  if (!opened) {
+    runner::print(opened.error(), stderr);
     return 2;
   }
+  runner::System& system = **opened;
+  SimulatedClock& clock = *system.simulated_clock();
+  Coordinator& co = system.coordinator();
+  native::Runtime& runtime = system.runtime();
   const ComponentId sensor = *co.find_component("FORCE_SENSOR");
-  Signal* force = monitor.signals().find("FORCE_SENSOR.Force");
-  native::Runtime runtime(monitor);
-  (void)runtime.add_task(sensor, std::chrono::milliseconds(1));
+  Signal* force = system.monitor().signals().find("FORCE_SENSOR.Force");
 
   co.subscribe([&co](const Record& r) {
     if (r.kind == RecordKind::ComponentTransition) {

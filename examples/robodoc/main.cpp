@@ -71,20 +71,12 @@ int main(int argc, char** argv) {
 
   FilterRegistry registry;
   register_builtin_filters(registry);
-  spec::ScenarioLoad sc = spec::load_scenario(scenario_path);
-  for (const auto& d : sc.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  if (!sc.scenario) return 2;
-  spec::LoadResult sys = spec::load_system(sc.scenario->system, registry);
-  for (const auto& d : sys.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  }
-  if (!sys.ok()) return 2;
-
-  runner::ScenarioRunner run(std::move(*sc.scenario), std::move(*sys.system), registry);
-  if (const auto problems = run.prepare(); !problems.empty()) {
-    for (const auto& d : problems) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario_path, ""}, registry);
+  if (!opened) {
+    runner::print(opened.error(), stderr);
     return 2;
   }
+  runner::ScenarioRunner& run = **opened;
   Coordinator& co = run.coordinator();
   ControlTask control(co);
   (void)run.runtime().set_body(*co.find_component("CONTROL"), [&control](Time now) { control(now); });

@@ -106,6 +106,17 @@ case $case_name in
     grep -q "is a symbolic link" "$tmp/err" || fail "link: $(cat "$tmp/err")"
     [ "$(cat "$tmp/important.json")" = '{"budget": 12}' ] || fail "important.json was changed through the link"
     ;;
+  run_coordinator_refuses_a_scenario_with_unknown_names_before_it_starts)
+    # A live coordinator checks every name of its scenario against the whole system first, as a
+    # simulated run does, instead of skipping the steps it cannot apply. Nothing is connected
+    # (port 1: nothing listens), so the refusal comes before the middleware.
+    "$safecass" run --help 2>/dev/null | grep -q -- --coordinator || { echo "skipped: built without the middleware"; exit 0; }
+    "$safecass" run examples/robodoc/robodoc.json --coordinator robot --ice 127.0.0.1:1 --duration 1 \
+      --scenario tests/data/scenarios/unknown_names.json >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "live scenario with unknown names"
+    grep -q "unknown_names.json:5:30: error: no signal 'JR3.Torque'" "$tmp/err" || fail "signal: $(cat "$tmp/err")"
+    grep -q "unknown_names.json:6:32: error: no event 'EVT_NOPE'" "$tmp/err" || fail "event: $(cat "$tmp/err")"
+    ;;
   test_reports_pass_fail_coverage_and_junit)
     "$safecass" test examples/force_sensor/scenario.json tests/data/scenarios/failing.json --junit "$tmp/j.xml" >"$tmp/out" 2>/dev/null
     expect_code 1 $? "one failing scenario"

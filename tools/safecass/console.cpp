@@ -653,38 +653,11 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
   auto impl = std::make_unique<InProcessBackend>();
   impl->options = options;
   register_builtin_filters(impl->registry);
-  auto errors = [](const std::vector<spec::Diagnostic>& diagnostics) {
-    std::string text;
-    for (const spec::Diagnostic& d : diagnostics) {
-      if (d.severity == spec::Diagnostic::Severity::Error) text += (text.empty() ? "" : "\n") + spec::format(d);
-    }
-    return text;
-  };
-  spec::Scenario sc;
-  if (!scenario.empty()) {
-    spec::ScenarioLoad load = spec::load_scenario(scenario);
-    if (!load.scenario) return fail(ErrorCode::Parse, errors(load.diagnostics));
-    sc = std::move(*load.scenario);
-    if (!system.empty()) sc.system = system;
-    impl->scenario_path = scenario;
-  } else {
-    if (system.empty()) return fail(ErrorCode::InvalidArgument, "a system file is needed (--system, or a --scenario that names one)");
-    sc.system = system;
-    sc.period = 0.001;
-    sc.duration = 0.0;
-  }
-  impl->system_path = sc.system;
-  spec::LoadResult loaded = spec::load_system(sc.system, impl->registry);
-  if (!loaded.ok() || !loaded.system) {
-    const std::string text = errors(loaded.diagnostics);
-    return fail(ErrorCode::Parse, text.empty() ? "cannot load system '" + sc.system + "'" : text);
-  }
-  impl->runner = std::make_unique<runner::ScenarioRunner>(std::move(sc), std::move(*loaded.system), impl->registry);
-  if (auto problems = impl->runner->prepare(); !problems.empty()) {
-    std::string text;
-    for (const spec::Diagnostic& d : problems) text += (text.empty() ? "" : "\n") + spec::format(d);
-    return fail(ErrorCode::InvalidArgument, text);
-  }
+  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario, system}, impl->registry);
+  if (!opened) return fail(ErrorCode::InvalidArgument, runner::to_text(opened.error()));
+  impl->runner = std::move(*opened);
+  impl->scenario_path = scenario;
+  impl->system_path = impl->runner->scenario().system;
   InProcessBackend* self = impl.get();
   impl->subscription = impl->runner->coordinator().subscribe([self](const Record& r) {
     if (!shown_record(r)) return;

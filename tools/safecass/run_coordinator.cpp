@@ -28,6 +28,8 @@
 #include "safecass/middleware/token.hpp"
 #include "safecass/native/runtime.hpp"
 #include "safecass/record/recorder.hpp"
+#include "safecass/runner/scenario_runner.hpp"
+#include "safecass/runner/system.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
 
@@ -199,18 +201,32 @@ int run_coordinator(const RunArgs& args) {
     std::fprintf(stderr, "safecass run: --coordinator needs a SYSTEM file (or a scenario that names one)\n");
     return 2;
   }
-  spec::LoadResult load = spec::load_system(system_path, registry);
-  for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  if (!load.ok()) return 2;
-  const spec::SystemSpec& system = *load.system;
-
+  if (scenario) {
+    // Every name the scenario uses is checked against the whole system before anything runs, as
+    // `safecass run` does in simulated time; this process then applies the steps on its part.
+    auto checked = runner::ScenarioRunner::open(runner::ScenarioSource{args.scenario, system_path}, registry);
+    if (!checked) {
+      runner::print(checked.error(), stderr);
+      return 2;
+    }
+  }
   middleware::HostClock clock;
-  Coordinator co(args.coordinator, &clock);
-  Monitor monitor(co, registry);
-  if (auto r = spec::instantiate(system, co, monitor, args.coordinator); !r) {
-    std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+  runner::SystemOptions system_options;
+  system_options.coordinator = args.coordinator;
+  system_options.clock = &clock;
+  if (scenario) system_options.component_period = seconds_to_time(scenario->period);
+  runner::Diagnostics notes;
+  auto opened = runner::open_system(system_path, registry, system_options, &notes);
+  runner::print(notes, stderr);
+  if (!opened) {
+    runner::print(opened.error(), stderr);
     return 2;
   }
+  runner::System& built = **opened;
+  const spec::SystemSpec& system = built.spec();
+  Coordinator& co = built.coordinator();
+  Monitor& monitor = built.monitor();
+  native::Runtime& runtime = built.runtime();
   if (auto r = middleware::connect_remote_providers(system, args.coordinator, co); !r) {
     std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
     return 2;
@@ -237,17 +253,6 @@ int run_coordinator(const RunArgs& args) {
       return 2;
     }
     recorder = std::move(*opened);
-  }
-
-  const double default_period = scenario ? scenario->period : 0.005;
-  native::Runtime runtime(monitor);
-  for (const spec::ComponentSpec& c : system.components) {
-    auto id = co.find_component(c.name);
-    if (!id || co.is_remote(*id)) continue;
-    if (auto r = runtime.add_task(*id, seconds_to_time(c.period.value_or(default_period))); !r) {
-      std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
-      return 2;
-    }
   }
 
   std::string token;

@@ -91,8 +91,9 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
   step.column = 7;
   load.scenario->steps.push_back(step);
   const std::string path = load.scenario->path;
-  ScenarioRunner runner(std::move(*load.scenario), std::move(*system.system), registry);
-  const auto problems = runner.prepare();
+  auto opened = ScenarioRunner::open(std::move(*load.scenario), std::move(*system.system), registry);
+  ASSERT_FALSE(opened) << "a scenario with a bad step is not opened";
+  const Diagnostics& problems = opened.error();
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(spec::format(problems[0]), path + ":3:7: error: an injected value is not a finite number: injected values "
                                               "must be finite [/steps/9/inject]");

@@ -9,8 +9,6 @@
 namespace safecass::runner {
 
 namespace {
-constexpr Time kMonitorPeriod = std::chrono::milliseconds(5);
-
 std::string secs(Time t) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
@@ -18,33 +16,67 @@ std::string secs(Time t) {
 }
 }  // namespace
 
-ScenarioRunner::ScenarioRunner(spec::Scenario scenario, spec::SystemSpec system, const FilterRegistry& registry)
+ScenarioRunner::ScenarioRunner(spec::Scenario scenario, std::unique_ptr<System> system)
     : scenario_(std::move(scenario)),
       system_(std::move(system)),
-      coordinator_(system_.name.empty() ? "system" : system_.name, &clock_),
-      monitor_(std::make_unique<Monitor>(coordinator_, registry)),
-      runtime_(std::make_unique<native::Runtime>(*monitor_, kMonitorPeriod)) {}
+      clock_(*system_->simulated_clock()),
+      coordinator_(system_->coordinator()),
+      monitor_(&system_->monitor()),
+      runtime_(&system_->runtime()) {}
 
 ScenarioRunner::~ScenarioRunner() { runtime_->stop(); }
 
-std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
-  std::vector<spec::Diagnostic> out;
+Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(spec::Scenario scenario, spec::SystemSpec system,
+                                                             const FilterRegistry& registry) {
+  SystemOptions options;
+  options.component_period = seconds_to_time(scenario.period);
+  auto built = build_system(std::move(system), registry, options);
+  if (!built) return tl::unexpected(std::move(built.error()));
+  std::unique_ptr<ScenarioRunner> runner(new ScenarioRunner(std::move(scenario), std::move(*built)));
+  if (Diagnostics problems = runner->check_names(); !problems.empty()) return tl::unexpected(std::move(problems));
+  return runner;
+}
+
+Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSource& source, const FilterRegistry& registry,
+                                                             Diagnostics* notes) {
+  spec::Scenario scenario;
+  if (!source.scenario.empty()) {
+    spec::ScenarioLoad loaded = spec::load_scenario(source.scenario);
+    Diagnostics errors;
+    for (spec::Diagnostic& d : loaded.diagnostics) {
+      if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
+      else if (notes != nullptr) notes->push_back(std::move(d));
+    }
+    if (!errors.empty() || !loaded.scenario) return tl::unexpected(std::move(errors));
+    scenario = std::move(*loaded.scenario);
+  } else {
+    scenario.period = to_seconds(kDefaultTick);
+    scenario.duration = 0.0;
+  }
+  if (!source.system.empty()) scenario.system = source.system;
+  if (scenario.system.empty()) {
+    return tl::unexpected(Diagnostics{spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{source.scenario, 0, 0},
+                                                       "a system file is needed (a SYSTEM, or a scenario that names one)", ""}});
+  }
+  spec::LoadResult loaded = spec::load_system(scenario.system, registry);
+  Diagnostics errors;
+  for (spec::Diagnostic& d : loaded.diagnostics) {
+    if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
+    else if (notes != nullptr) notes->push_back(std::move(d));
+  }
+  if (!errors.empty()) return tl::unexpected(std::move(errors));
+  if (!loaded.system) {
+    return tl::unexpected(Diagnostics{spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{scenario.system, 0, 0},
+                                                       "cannot load system '" + scenario.system + "'", ""}});
+  }
+  return open(std::move(scenario), std::move(*loaded.system), registry);
+}
+
+Diagnostics ScenarioRunner::check_names() {
+  Diagnostics out;
   const auto error_at = [this](const spec::ScenarioStep& s, std::string message) {
     return spec::Diagnostic{spec::Diagnostic::Severity::Error, scenario_.where(s), std::move(message), s.pointer()};
   };
-  const spec::Position at_system{scenario_.system, 1, 1};
-  if (auto built = spec::instantiate(system_, coordinator_, *monitor_); !built) {
-    out.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, at_system, built.error().message, ""});
-    return out;
-  }
-  const Time tick = seconds_to_time(scenario_.period);
-  for (const spec::ComponentSpec& c : system_.components) {
-    const ComponentId id = *coordinator_.find_component(c.name);
-    const Time period = c.period ? seconds_to_time(*c.period) : tick;
-    if (auto r = runtime_->add_task(id, period); !r) {
-      out.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, c.where, r.error().message, ""});
-    }
-  }
   for (const spec::ScenarioStep& s : scenario_.steps) {
     const spec::StepAction* action = s.action.get();  // null for a sample step
     switch (s.kind) {
@@ -295,19 +327,12 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
 
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,
                       RunResult* result, std::FILE* err) {
-  spec::ScenarioLoad sc = spec::load_scenario(path);
-  for (const auto& d : sc.diagnostics) std::fprintf(err, "%s\n", spec::format(d).c_str());
-  if (!sc.scenario) return 2;
-  if (!options.system_override.empty()) sc.scenario->system = options.system_override;
-  spec::LoadResult sys = spec::load_system(sc.scenario->system, registry);
-  for (const auto& d : sys.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(err, "%s\n", spec::format(d).c_str());
+  auto opened = ScenarioRunner::open(ScenarioSource{path, options.system_override}, registry);
+  if (!opened) {
+    print(opened.error(), err);
+    return 2;
   }
-  if (!sys.ok() || !sys.system) return 2;
-  ScenarioRunner runner(std::move(*sc.scenario), std::move(*sys.system), registry);
-  const auto problems = runner.prepare();
-  for (const auto& d : problems) std::fprintf(err, "%s\n", spec::format(d).c_str());
-  if (!problems.empty()) return 2;
+  ScenarioRunner& runner = **opened;
   RunResult r = runner.run(options);
   for (const std::string& f : r.failures) std::fprintf(err, "%s\n", f.c_str());
   int code = r.passed() ? 0 : 1;

@@ -33,14 +33,6 @@ constexpr std::size_t kMaxPendingRecords = 100000;
 /// for long; the clock catches up over the next polls.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
 
-std::string errors_text(const std::vector<spec::Diagnostic>& diagnostics) {
-  std::string text;
-  for (const spec::Diagnostic& d : diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) text += (text.empty() ? "" : "\n") + spec::format(d);
-  }
-  return text;
-}
-
 std::string seconds_text(Time t) {
   char buf[40];
   std::snprintf(buf, sizeof buf, "%.3f", to_seconds(t));
@@ -109,46 +101,23 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   impl->options = options;
   register_builtin_filters(impl->registry);
 
-  spec::Scenario scenario;
-  if (!options.scenario.empty()) {
-    spec::ScenarioLoad load = spec::load_scenario(options.scenario);
-    if (!load.scenario) {
-      const std::string text = errors_text(load.diagnostics);
-      return fail(ErrorCode::Parse, text.empty() ? "cannot load scenario '" + options.scenario + "'" : text);
-    }
-    scenario = std::move(*load.scenario);
-    if (!options.system.empty()) scenario.system = options.system;
-  } else {
-    if (options.system.empty()) {
-      return fail(ErrorCode::InvalidArgument, "a system file is needed (--system, or a --scenario that names one)");
-    }
-    scenario.system = options.system;
-    scenario.period = 0.001;
-    scenario.duration = 0.0;
-  }
-  spec::LoadResult loaded = spec::load_system(scenario.system, impl->registry);
-  if (!loaded.ok() || !loaded.system) {
-    const std::string text = errors_text(loaded.diagnostics);
-    return fail(ErrorCode::Parse, text.empty() ? "cannot load system '" + scenario.system + "'" : text);
-  }
-  impl->system_name = loaded.system->name;
+  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{options.scenario, options.system}, impl->registry);
+  if (!opened) return fail(ErrorCode::InvalidArgument, runner::to_text(opened.error()));
+  impl->runner = std::move(*opened);
+  const spec::SystemSpec& loaded = impl->runner->system().spec();
+  const spec::Scenario& scenario = impl->runner->scenario();
+  impl->system_name = loaded.name;
   impl->duration = seconds_to_time(scenario.duration);
   impl->tick = seconds_to_time(scenario.period);
-  const auto spec_coordinators = loaded.system->coordinators;
+  const auto& spec_coordinators = loaded.coordinators;
   std::vector<std::string> all_components;
-  for (const spec::ComponentSpec& c : loaded.system->components) all_components.push_back(c.name);
+  for (const spec::ComponentSpec& c : loaded.components) all_components.push_back(c.name);
   impl->description = "in-process: " + file_name(scenario.system) +
                       (options.scenario.empty() ? std::string() : ", scenario " + file_name(options.scenario));
   char speed[32];
   std::snprintf(speed, sizeof speed, "%g", options.speed);
   impl->description += std::string(", speed ") + speed;
 
-  impl->runner = std::make_unique<runner::ScenarioRunner>(std::move(scenario), std::move(*loaded.system), impl->registry);
-  if (auto problems = impl->runner->prepare(); !problems.empty()) {
-    std::string text;
-    for (const spec::Diagnostic& d : problems) text += (text.empty() ? "" : "\n") + spec::format(d);
-    return fail(ErrorCode::InvalidArgument, text);
-  }
   Coordinator& co = impl->co();
   auto ids_of = [&co](const std::vector<std::string>& names) {
     std::vector<ComponentId> ids;

@@ -6,8 +6,9 @@
 /// filters at the monitor period) and the components' bodies, (3) check the expectations due at t.
 /// Same inputs → same output, byte for byte.
 ///
-/// Example programs use it with their application code: prepare(), then set task bodies on
-/// runtime(), then run().
+/// It is opened in one step (ScenarioRunner::open): the system is built by the one factory of
+/// system.hpp and every name the scenario uses is checked, or every problem is returned and
+/// nothing runs. Example programs then set task bodies on runtime() and call run().
 
 #include <cstdint>
 #include <cstdio>
@@ -25,6 +26,7 @@
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
 #include "safecass/spec/system.hpp"
+#include "safecass/runner/system.hpp"
 
 namespace safecass::runner {
 
@@ -54,29 +56,43 @@ struct RunResult {
   bool history_complete() const noexcept { return !record || record->complete(); }
 };
 
+/// Where a scenario run comes from.
+struct ScenarioSource {
+  /// A scenario file. Empty: the system runs with no steps, ticking at kDefaultTick.
+  std::string scenario;
+  /// The system file. Empty: the scenario's "system"; otherwise it replaces it.
+  std::string system;
+};
+
 class ScenarioRunner {
 public:
-  ScenarioRunner(spec::Scenario scenario, spec::SystemSpec system, const FilterRegistry& registry);
+  /// Loads the scenario and its system, builds the system (build_system(), components that name
+  /// no period run at the scenario's period) and checks every name the scenario uses (signals,
+  /// sizes, events, filters, addresses). Every problem is returned with its position, and then
+  /// nothing was built. Warnings of the system file are appended to `notes` when given.
+  static Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source, const FilterRegistry& registry,
+                                                      Diagnostics* notes = nullptr);
+  /// The same from parts already loaded. `registry` must outlive the runner.
+  static Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
+                                                      const FilterRegistry& registry);
   ~ScenarioRunner();
+  ScenarioRunner(const ScenarioRunner&) = delete;
+  ScenarioRunner& operator=(const ScenarioRunner&) = delete;
 
-  /// Builds the system and checks every name the scenario uses (signals, sizes, events, filters,
-  /// addresses); every problem is returned with the step's position. Empty = ready.
-  std::vector<spec::Diagnostic> prepare();
-
+  System& system() noexcept { return *system_; }
   Coordinator& coordinator() noexcept { return coordinator_; }
   Monitor& monitor() noexcept { return *monitor_; }
   native::Runtime& runtime() noexcept { return *runtime_; }
   SimulatedClock& clock() noexcept { return clock_; }
   const spec::Scenario& scenario() const noexcept { return scenario_; }
 
-  /// Runs the whole scenario. Precondition: prepare() returned no diagnostics.
+  /// Runs the whole scenario.
   RunResult run(const RunOptions& options);
 
   /// Incremental driving, for interactive tools (the console's `watch`): processes every tick up
   /// to and including `until` not processed yet, exactly as run() does (steps, ramps, filters,
   /// expectations; failed expectations are appended to `result`). Ticks past the scenario's
-  /// duration keep running the system with no more steps. Precondition: prepare() returned no
-  /// diagnostics; do not combine with run().
+  /// duration keep running the system with no more steps. Do not combine with run().
   void advance_to(Time until, RunResult& result);
   /// The time of the last tick processed; negative before the first.
   Time now() const noexcept;
@@ -89,17 +105,20 @@ private:
     double from;
     double to;
   };
+  ScenarioRunner(spec::Scenario scenario, std::unique_ptr<System> system);
+  /// Every name the scenario uses, checked against the built system.
+  Diagnostics check_names();
   void apply(const spec::ScenarioStep& step, Time now);
   void split_steps();
   void check(const spec::ScenarioStep& step, Time now, RunResult& result);
   std::string check_one(const spec::ScenarioStep& step, const std::string& address, const std::string& expected);
 
   spec::Scenario scenario_;
-  spec::SystemSpec system_;
-  SimulatedClock clock_;
-  Coordinator coordinator_;
-  std::unique_ptr<Monitor> monitor_;
-  std::unique_ptr<native::Runtime> runtime_;
+  std::unique_ptr<System> system_;
+  SimulatedClock& clock_;
+  Coordinator& coordinator_;
+  Monitor* monitor_;
+  native::Runtime* runtime_;
   std::vector<Ramp> ramps_;
   // Progress of the tick loop (run() and advance_to()).
   bool split_ = false;

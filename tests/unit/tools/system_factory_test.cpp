@@ -1,0 +1,95 @@
+// The one factory that puts a system together (tools/runner/include/safecass/runner/system.hpp).
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "safecass/runner/scenario_runner.hpp"
+#include "safecass/runner/system.hpp"
+
+namespace safecass::runner {
+namespace {
+
+using ::testing::HasSubstr;
+
+const std::string kRobodoc = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
+const std::string kStory = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/story.json";
+
+FilterRegistry builtin() {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  return registry;
+}
+
+TEST(SystemFactory, OpensTheWholeSystemWithOneTaskPerComponentOnItsOwnSimulatedClock) {
+  const FilterRegistry registry = builtin();
+  auto opened = open_system(kRobodoc, registry);
+  ASSERT_TRUE(opened) << to_text(opened.error());
+  System& system = **opened;
+  EXPECT_EQ(system.runtime().task_count(), system.spec().components.size());
+  ASSERT_NE(system.simulated_clock(), nullptr);
+  for (const char* name : {"JR3", "BMM", "CONTROL", "SERVO", "PENDANT"}) {
+    EXPECT_TRUE(system.coordinator().find_component(name)) << name;
+  }
+}
+
+TEST(SystemFactory, OneCoordinatorOfAMultiProcessSystemBuildsOnlyItsComponentsOnTheGivenClock) {
+  const FilterRegistry registry = builtin();
+  SimulatedClock host;
+  SystemOptions options;
+  options.coordinator = "ui";
+  options.clock = &host;
+  auto opened = open_system(kRobodoc, registry, options);
+  ASSERT_TRUE(opened) << to_text(opened.error());
+  System& system = **opened;
+  EXPECT_EQ(system.coordinator().name(), "ui");
+  EXPECT_EQ(system.simulated_clock(), nullptr) << "the system reads the clock it was given";
+  EXPECT_TRUE(system.coordinator().find_component("PENDANT"));
+  EXPECT_FALSE(system.coordinator().find_component("JR3")) << "another coordinator's component";
+  EXPECT_EQ(system.runtime().task_count(), 1u);
+}
+
+TEST(SystemFactory, AnUnknownCoordinatorIsAnErrorThatNamesItAndNothingIsBuilt) {
+  const FilterRegistry registry = builtin();
+  SystemOptions options;
+  options.coordinator = "nowhere";
+  auto opened = open_system(kRobodoc, registry, options);
+  ASSERT_FALSE(opened);
+  EXPECT_THAT(to_text(opened.error()), HasSubstr("nowhere"));
+}
+
+TEST(SystemFactory, AnInvalidSystemFileReturnsEveryErrorWithItsPosition) {
+  const FilterRegistry registry = builtin();
+  const std::string bad = std::string(SAFECASS_SOURCE_DIR) + "/tests/data/bad_specs/unknown_key.json";
+  auto opened = open_system(bad, registry);
+  ASSERT_FALSE(opened);
+  ASSERT_FALSE(opened.error().empty());
+  EXPECT_THAT(to_text(opened.error()), HasSubstr("unknown_key.json:4:3: error:"));
+}
+
+TEST(SystemFactory, AScenarioRunnerIsOpenedInOneStepAndRunsTheStory) {
+  const FilterRegistry registry = builtin();
+  auto opened = ScenarioRunner::open(ScenarioSource{kStory, ""}, registry);
+  ASSERT_TRUE(opened) << to_text(opened.error());
+  RunOptions options;
+  options.quiet = true;
+  const RunResult result = (*opened)->run(options);
+  EXPECT_GT(result.checks, 0);
+  EXPECT_TRUE(result.passed());
+}
+
+TEST(SystemFactory, ASystemWithNoScenarioTicksAtTheDefaultTickAndSoDoItsComponentsWithNoPeriod) {
+  const FilterRegistry registry = builtin();
+  auto opened = ScenarioRunner::open(ScenarioSource{"", kRobodoc}, registry);
+  ASSERT_TRUE(opened) << to_text(opened.error());
+  EXPECT_EQ(seconds_to_time((*opened)->scenario().period), kDefaultTick);
+  EXPECT_EQ((*opened)->scenario().duration, 0.0);
+}
+
+TEST(SystemFactory, NoSystemAndNoScenarioIsAnErrorThatSaysWhatIsNeeded) {
+  const FilterRegistry registry = builtin();
+  auto opened = ScenarioRunner::open(ScenarioSource{}, registry);
+  ASSERT_FALSE(opened);
+  EXPECT_THAT(to_text(opened.error()), HasSubstr("a system file is needed"));
+}
+
+}  // namespace
+}  // namespace safecass::runner
