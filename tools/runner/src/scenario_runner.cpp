@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include "safecass/record/recorder.hpp"
 #include "safecass/spec/load.hpp"
@@ -16,7 +18,35 @@ std::string secs(Time t) {
   std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
   return buf;
 }
+
+/// "no X 'name'" with the nearest known name, if one is near.
+std::string unknown(const std::string& what, const std::string& name, const std::vector<std::string>& known) {
+  return "no " + what + " '" + name + "'" + spec::did_you_mean(name, known);
+}
 }  // namespace
+
+const std::vector<std::string>* ScenarioRunner::coordinator_components(const std::string& name) const {
+  for (const auto& [coordinator, components] : system_.coordinators) {
+    if (coordinator == name) return &components;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> ScenarioRunner::addresses() const {
+  std::vector<std::string> out{"SYSTEM"};
+  for (const auto& [coordinator, components] : system_.coordinators) out.push_back(coordinator);
+  for (const spec::ComponentSpec& c : system_.components) {
+    out.push_back(c.name);
+    out.push_back(c.name + ".s_F");
+    out.push_back(c.name + ".s_A");
+    for (const std::string& p : c.provided) {
+      out.push_back(c.name + ".s_P." + p);
+      out.push_back(c.name + ".s_S." + p);
+    }
+    for (const std::string& r : c.required) out.push_back(c.name + ".s_R." + r);
+  }
+  return out;
+}
 
 ScenarioRunner::ScenarioRunner(spec::Scenario scenario, spec::SystemSpec system, const FilterRegistry& registry)
     : scenario_(std::move(scenario)),
@@ -45,6 +75,16 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
       out.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, c.where, r.error().message, ""});
     }
   }
+  std::vector<std::string> signal_names;
+  for (const auto& sig : monitor_->signals().all()) signal_names.push_back(sig->name());
+  std::vector<std::string> filter_names;
+  for (const auto& f : monitor_->filters()) filter_names.push_back(f->name());
+  std::vector<std::string> event_names;
+  for (EventId e = 0; e < coordinator_.event_count(); ++e) event_names.push_back(coordinator_.event(e).name);
+  const std::vector<std::string> address_names = addresses();
+  const auto no_address = [&](const std::string& address, const std::string& message) {
+    return message + spec::did_you_mean(address, address_names);
+  };
   for (const spec::ScenarioStep& s : scenario_.steps) {
     const spec::StepAction* action = s.action.get();  // null for a sample step
     switch (s.kind) {
@@ -52,7 +92,9 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
         for (const auto& [name, values] : s.samples) {
           Signal* sig = monitor_->signals().find(name);
           if (sig == nullptr) {
-            out.push_back(error_at(s, "no signal '" + std::string(name) + "' (signals are written Component.signal)"));
+            const std::string suggestion = spec::did_you_mean(name, signal_names);
+            out.push_back(error_at(s, "no signal '" + std::string(name) + "'" +
+                                          (suggestion.empty() ? " (signals are written Component.signal)" : suggestion)));
           } else if (sig->size() != values.size()) {
             out.push_back(error_at(s, "signal '" + std::string(name) + "' has size " + std::to_string(sig->size()) +
                                                      ", the sample has " + std::to_string(values.size()) + " values"));
@@ -61,17 +103,19 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
         break;
       case spec::ScenarioStep::Kind::Ramp: {
         Signal* sig = monitor_->signals().find(action->signal);
-        if (sig == nullptr) out.push_back(error_at(s, "no signal '" + action->signal + "'"));
+        if (sig == nullptr) out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
         else if (sig->size() != 1) out.push_back(error_at(s, "a ramp needs a scalar signal; '" + action->signal + "' has size " + std::to_string(sig->size())));
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
         auto e = coordinator_.find_event(action->event);
         if (!e) {
-          out.push_back(error_at(s, e.error().message));
+          out.push_back(error_at(s, unknown("event", action->event, event_names)));
         } else if (!coordinator_.event(*e).is_broadcast()) {
           if (action->target.empty()) out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
-          else if (auto m = coordinator_.find_machine(action->target); !m) out.push_back(error_at(s, m.error().message));
+          else if (auto m = coordinator_.find_machine(action->target); !m) {
+            out.push_back(error_at(s, no_address(action->target, m.error().message)));
+          }
         }
         break;
       }
@@ -86,7 +130,7 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
         if (!action->filter.empty()) {
           Filter* f = monitor_->find_filter(action->filter);
           if (f == nullptr) {
-            out.push_back(error_at(s, "no filter '" + action->filter + "'"));
+            out.push_back(error_at(s, unknown("filter", action->filter, filter_names)));
           } else if (f->inputs().empty()) {
             out.push_back(error_at(s, "filter '" + action->filter + "' has no input"));
           } else {
@@ -100,14 +144,16 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
             }
           }
         } else if (Signal* sig = monitor_->signals().find(action->signal); sig == nullptr) {
-          out.push_back(error_at(s, "no signal '" + action->signal + "'"));
+          out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
         // The same rule as Coordinator::reset() and the console: a service state is derived, so a
         // reset of one would do nothing. Refused here, at load, rather than silently at run time.
-        if (auto a = coordinator_.resolve(action->target); !a) {
-          out.push_back(error_at(s, a.error().message));
+        if (coordinator_components(action->target) != nullptr) {
+          // A coordinator of the system file: all its components are reset (docs/semantics.md §4.5).
+        } else if (auto a = coordinator_.resolve(action->target); !a) {
+          out.push_back(error_at(s, no_address(action->target, a.error().message)));
         } else if (a->kind == Address::Kind::Service) {
           out.push_back(error_at(s, "cannot reset service state '" + action->target +
                                         "': it is derived; reset its component or a machine"));
@@ -117,22 +163,27 @@ std::vector<spec::Diagnostic> ScenarioRunner::prepare() {
       case spec::ScenarioStep::Kind::ExpectOutstanding:
       case spec::ScenarioStep::Kind::ExpectCause:
         for (const auto& [address, expected] : action->expectations) {
+          if (coordinator_components(address) != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) continue;
           auto a = coordinator_.resolve(address);
           if (!a) {
-            out.push_back(error_at(s, a.error().message));
+            out.push_back(error_at(s, no_address(address, a.error().message)));
             continue;
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
             if (a->kind != Address::Kind::Component && a->kind != Address::Kind::Machine) {
               out.push_back(error_at(s, "expect_outstanding needs a component or a machine, not '" + address + "'"));
             } else if (expected != "none" && !coordinator_.find_event(expected)) {
-              out.push_back(error_at(s, "no event '" + expected + "'"));
+              out.push_back(error_at(s, unknown("event", expected, event_names)));
             }
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectCause) {
             const auto colon = expected.find(':');
-            if (auto m = coordinator_.find_machine(expected.substr(0, colon)); !m) out.push_back(error_at(s, m.error().message));
-            if (!coordinator_.find_event(expected.substr(colon + 1))) out.push_back(error_at(s, "no event '" + expected.substr(colon + 1) + "'"));
+            if (auto m = coordinator_.find_machine(expected.substr(0, colon)); !m) {
+              out.push_back(error_at(s, no_address(expected.substr(0, colon), m.error().message)));
+            }
+            if (!coordinator_.find_event(expected.substr(colon + 1))) {
+              out.push_back(error_at(s, unknown("event", expected.substr(colon + 1), event_names)));
+            }
           }
         }
         break;
@@ -162,13 +213,26 @@ void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
       }
       break;
     case spec::ScenarioStep::Kind::Reset:
-      (void)coordinator_.reset(action->target, "scenario", action->reason);
+      if (const auto* components = coordinator_components(action->target)) {
+        // A coordinator of the system: each of its components, as that coordinator's reset does.
+        for (const std::string& c : *components) (void)coordinator_.reset(c, "scenario", action->reason);
+      } else {
+        (void)coordinator_.reset(action->target, "scenario", action->reason);
+      }
       break;
     default: break;
   }
 }
 
 std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::string& address, const std::string& expected) {
+  if (const auto* components = coordinator_components(address); components != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) {
+    // The state of a coordinator of the system: the product of its components' (DESIGN §2.2).
+    State got = State::Normal;
+    for (const std::string& c : *components) got = std::max(got, coordinator_.state_of(*coordinator_.resolve(c)));
+    const State want = *parse_state(expected);
+    if (got == want) return {};
+    return address + " is " + std::string(to_string(got)) + ", expected " + std::string(to_string(want));
+  }
   const Address a = *coordinator_.resolve(address);
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Expect: {
@@ -293,21 +357,65 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
   }
 }
 
+namespace {
+
+/// The scenario file's problems and the runner built for it (when its system loads).
+struct Checked {
+  std::vector<spec::Diagnostic> diagnostics;
+  std::unique_ptr<ScenarioRunner> runner;  ///< null when the system does not load or the file is unusable
+};
+
+Checked check(const std::string& path, const FilterRegistry& registry, const std::string& system_override) {
+  Checked out;
+  spec::ScenarioLoad sc = spec::load_scenario(path);
+  out.diagnostics = std::move(sc.diagnostics);
+  std::optional<spec::Scenario>& scenario = sc.scenario ? sc.scenario : sc.partial;
+  if (!scenario) return out;  // unreadable, or not JSON: nothing more can be said
+  if (!system_override.empty()) scenario->system = system_override;
+  std::vector<spec::Diagnostic> system_errors;
+  std::optional<spec::SystemSpec> system;
+  if (!scenario->system.empty()) {
+    spec::LoadResult sys = spec::load_system(scenario->system, registry);
+    for (auto& d : sys.diagnostics) {
+      if (d.severity == spec::Diagnostic::Severity::Error) system_errors.push_back(std::move(d));
+    }
+    if (sys.ok() && sys.system) system = std::move(*sys.system);
+  }
+  if (system) {
+    const bool complete = sc.scenario.has_value();
+    auto runner = std::make_unique<ScenarioRunner>(std::move(*scenario), std::move(*system), registry);
+    std::vector<spec::Diagnostic> names = runner->prepare();
+    out.diagnostics.insert(out.diagnostics.end(), std::make_move_iterator(names.begin()), std::make_move_iterator(names.end()));
+    if (complete) out.runner = std::move(runner);
+  }
+  // One list in file order: a format problem and a name problem of the same file are reported
+  // together, where they are (diagnostics without a position, about the whole file, first).
+  std::stable_sort(out.diagnostics.begin(), out.diagnostics.end(), [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
+    const bool a_here = a.where.file == path;
+    const bool b_here = b.where.file == path;
+    if (a_here != b_here) return a_here;
+    if (a.where.line != b.where.line) return a.where.line < b.where.line;
+    return a.where.column < b.where.column;
+  });
+  out.diagnostics.insert(out.diagnostics.end(), std::make_move_iterator(system_errors.begin()),
+                         std::make_move_iterator(system_errors.end()));
+  if (!out.diagnostics.empty()) out.runner.reset();
+  return out;
+}
+
+}  // namespace
+
+std::vector<spec::Diagnostic> check_scenario(const std::string& path, const FilterRegistry& registry,
+                                             const std::string& system_override) {
+  return check(path, registry, system_override).diagnostics;
+}
+
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,
                       RunResult* result, std::FILE* err) {
-  spec::ScenarioLoad sc = spec::load_scenario(path);
-  for (const auto& d : sc.diagnostics) std::fprintf(err, "%s\n", spec::format(d).c_str());
-  if (!sc.scenario) return 2;
-  if (!options.system_override.empty()) sc.scenario->system = options.system_override;
-  spec::LoadResult sys = spec::load_system(sc.scenario->system, registry);
-  for (const auto& d : sys.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(err, "%s\n", spec::format(d).c_str());
-  }
-  if (!sys.ok() || !sys.system) return 2;
-  ScenarioRunner runner(std::move(*sc.scenario), std::move(*sys.system), registry);
-  const auto problems = runner.prepare();
-  for (const auto& d : problems) std::fprintf(err, "%s\n", spec::format(d).c_str());
-  if (!problems.empty()) return 2;
+  Checked checked = check(path, registry, options.system_override);
+  for (const auto& d : checked.diagnostics) std::fprintf(err, "%s\n", spec::format(d).c_str());
+  if (!checked.diagnostics.empty() || !checked.runner) return 2;
+  ScenarioRunner& runner = *checked.runner;
   RunResult r = runner.run(options);
   for (const std::string& f : r.failures) std::fprintf(err, "%s\n", f.c_str());
   int code = r.passed() ? 0 : 1;
