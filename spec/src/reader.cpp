@@ -85,8 +85,7 @@ public:
       if (check(*key, m)) {
         good_.push_back(&m);
         if (key->ignored) {
-          sink_.note(key_site, context_ + ": " + quote_name(m.key) + " is accepted for the 2016 files and ignored (" +
-                                   std::string(key->doc) + ")");
+          sink_.note(key_site, context_ + ": " + quote_name(m.key) + " is accepted for the 2016 files and ignored");
         }
       }
     }

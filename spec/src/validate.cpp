@@ -453,7 +453,7 @@ private:
     }
     e.framework_redefinition = true;
     sink_.note(e.name_site, head + " as it is (severity " + std::to_string(builtin->severity) +
-                                ", as in the 2016 framework filter file): the built-in definition is used");
+                                "): the built-in definition is used");
   }
 
   std::vector<std::string> event_names() const {
