@@ -43,11 +43,22 @@ void Filter::run_general(Time now) noexcept {
     detour_.fetch_and(static_cast<std::uint8_t>(~kReenabled), std::memory_order_acq_rel);
   }
   const bool injected_run = (detour & kInjection) != 0 && run_injection(now);
+  // The first run after a shallow injection ran out (DESIGN §3): the injection stood in for
+  // reality, so its end restores reality even when the real signal has not changed since.
+  const bool restore = !injected_run && (detour & kRestore) != 0;
+  if (restore) detour_.fetch_and(static_cast<std::uint8_t>(~kRestore), std::memory_order_acq_rel);
   if (inputs_.size() == 1) {
     // The hot path: one input, its new samples in order.
-    if (!injected_run) cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
+    if (!injected_run) {
+      bool any = false;
+      cursors_[0].read_new([this, &any](const SampleView& sample) noexcept {
+        any = true;
+        deliver(0, sample);
+      });
+      if (restore && !any) restore_reality(now);
+    }
   } else if (!inputs_.empty()) {
-    run_merged(injected_run);
+    run_merged(injected_run, restore, now);
   }
   current_injected_ = false;
   if (ticks_) on_tick(now);
@@ -63,7 +74,11 @@ bool Filter::run_injection(Time now) noexcept {
     }
     staged = cursors_[0].stage(injections_.front().data());
     injections_.pop_front();
-    if (injections_.empty()) detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
+    if (injections_.empty()) {
+      // The last injected sample: the next run restores reality.
+      detour_.fetch_or(kRestore, std::memory_order_acq_rel);
+      detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
+    }
   }
   // A shallow injection replaces the first input's samples for this run.
   cursors_[0].skip_to_end();
@@ -71,10 +86,23 @@ bool Filter::run_injection(Time now) noexcept {
   return true;
 }
 
-void Filter::run_merged(bool injected_run) noexcept {
+void Filter::restore_reality(Time now) noexcept {
+  SampleView sample;
+  if (!cursors_[0].stage_latest(sample)) return;  // the signal never had a sample: nothing to restore
+  sample.time = now;
+  deliver(0, sample);
+}
+
+void Filter::run_merged(bool injected_run, bool restore, Time now) noexcept {
   // Several inputs: deliver their new samples merged in time order (ties: input order).
   for (std::size_t i = 0; i < inputs_.size(); ++i) {
     has_pending_[i] = !(i == 0 && injected_run) && cursors_[i].next(pending_[i]);
+  }
+  if (restore && !has_pending_[0] && cursors_[0].stage_latest(pending_[0])) {
+    // The end of a shallow injection into the first input: its real value, judged as new, after
+    // the other inputs' samples of this run.
+    pending_[0].time = now;
+    has_pending_[0] = true;
   }
   for (;;) {
     std::size_t best = inputs_.size();

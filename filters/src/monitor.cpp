@@ -51,6 +51,9 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
   }
   if (find_filter(config.name) != nullptr) return fail(ErrorCode::Duplicate, "duplicate " + where);
   const FilterManifest& manifest = entry->manifest;
+  if (manifest.default_output && !manifest.outputs.empty() && config.params.count(manifest.outputs.front()) == 0) {
+    config.params[manifest.outputs.front()] = default_output_name(config.name, config.target.component);
+  }
   auto params = check_params(manifest, config.params, config.name);
   if (!params) return tl::unexpected(params.error());
   config.params = std::move(*params);

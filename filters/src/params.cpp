@@ -109,8 +109,41 @@ std::string number_text(double v) {
 
 }  // namespace
 
-Expected<Params> check_params(const FilterManifest& manifest, const Params& given, std::string_view filter) {
+std::string_view FilterManifest::canonical(std::string_view name) const noexcept {
+  for (const auto& [alias, param] : aliases) {
+    if (alias == name) return param;
+  }
+  return name;
+}
+
+std::string default_output_name(std::string_view filter, std::string_view component) {
+  std::string_view bare = filter;
+  if (bare.size() > component.size() && bare.substr(0, component.size()) == component && bare[component.size()] == '.') {
+    bare.remove_prefix(component.size() + 1);
+  }
+  std::string out(component);
+  out += '.';
+  for (const char c : bare) out += c == '.' ? '_' : c;
+  return out;
+}
+
+Expected<Params> check_params(const FilterManifest& manifest, const Params& given_as_written, std::string_view filter) {
   const std::string where = "filter '" + std::string(filter) + "' (" + manifest.type + ")";
+  // Aliases (the 2016 names) stand for their parameter; both at once is ambiguous.
+  Params renamed;
+  const Params* given_ptr = &given_as_written;
+  if (!manifest.aliases.empty()) {
+    for (const auto& [name, value] : given_as_written) {
+      const std::string_view canonical = manifest.canonical(name);
+      if (canonical != name && given_as_written.count(canonical) > 0) {
+        return fail(ErrorCode::InvalidArgument, where + ": parameters '" + name + "' and '" + std::string(canonical) +
+                                                    "' are the same parameter; give one");
+      }
+      renamed.emplace(std::string(canonical), value);
+    }
+    given_ptr = &renamed;
+  }
+  const Params& given = *given_ptr;
   for (const auto& [name, value] : given) {
     if (manifest.find(name) == nullptr) {
       std::string known;

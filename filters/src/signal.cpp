@@ -66,6 +66,17 @@ const double* SignalCursor::stage(const double* values) noexcept {
   return reading_;
 }
 
+bool SignalCursor::stage_latest(SampleView& out) noexcept {
+  if (signal_ == nullptr) return false;
+  skip_to_end();
+  bool injected = false;
+  if (!signal_->latest(out.time, reading_, &injected)) return false;
+  out.data = reading_;
+  out.size = signal_->size();
+  out.injected = injected;
+  return true;
+}
+
 bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexcept {
   for (;;) {
     const std::uint64_t end = inj.end();

@@ -2,6 +2,8 @@
 
 #include "safecass/spec/json.hpp"
 
+#include "text.hpp"
+
 namespace safecass::spec {
 
 std::string format(const Diagnostic& d) {
@@ -9,18 +11,24 @@ std::string format(const Diagnostic& d) {
   if (d.where.line > 0) {
     out += ':' + std::to_string(d.where.line) + ':' + std::to_string(d.where.column);
   }
-  out += d.severity == Diagnostic::Severity::Error ? ": error: " : ": warning: ";
+  out += d.severity == Diagnostic::Severity::Error ? ": error: " : d.severity == Diagnostic::Severity::Warning ? ": warning: " : ": note: ";
   out += d.message;
   if (!d.pointer.empty()) out += " [" + d.pointer + "]";
   return out;
 }
 
 std::string to_json(const Diagnostic& d) {
-  const bool error = d.severity == Diagnostic::Severity::Error;
+  const char* severity = d.severity == Diagnostic::Severity::Error     ? "\"error\""
+                         : d.severity == Diagnostic::Severity::Warning ? "\"warning\""
+                                                                        : "\"note\"";
   return "{\"file\": " + json_quote(d.where.file) + ", \"line\": " + std::to_string(d.where.line) +
          ", \"column\": " + std::to_string(d.where.column) + ", \"severity\": " +
-         (error ? "\"error\"" : "\"warning\"") + ", \"message\": " + json_quote(d.message) +
+         severity + ", \"message\": " + json_quote(d.message) +
          ", \"pointer\": " + json_quote(d.pointer) + "}";
+}
+
+std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {
+  return detail::did_you_mean(word, candidates);
 }
 
 }  // namespace safecass::spec

@@ -69,6 +69,41 @@ const Key* ObjectKind::find(std::string_view key) const noexcept {
   return nullptr;
 }
 
+const RenamedKey* find_renamed(const ObjectKind& kind, std::string_view key) noexcept {
+  static const std::pair<std::string_view, RenamedKey> kRenamed[] = {
+      {"component", {"component_name", "the original's key for the name: write \"component\""}},
+      {"filter", {"target_component", "the original's key: write \"target\": {\"component\": ...}"}},
+      {"filter", {"Arguments", "the original's key: write \"argument\""}},
+      {"filter", {"category", "the original's filter category: it has no equivalent; remove it"}},
+  };
+  for (const auto& [kind_name, renamed] : kRenamed) {
+    if (kind_name == kind.name && renamed.old_name == key) return &renamed;
+  }
+  return nullptr;
+}
+
+namespace {
+bool same_ignoring_case(std::string_view a, std::string_view b) noexcept {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const auto lower = [](char c) { return c >= 'A' && c <= 'Z' ? static_cast<char>(c - 'A' + 'a') : c; };
+    if (lower(a[i]) != lower(b[i])) return false;
+  }
+  return true;
+}
+}  // namespace
+
+std::string_view canonical_choice(const Key& key, std::string_view value) noexcept {
+  const auto same = [&](std::string_view a, std::string_view b) { return key.any_case ? same_ignoring_case(a, b) : a == b; };
+  for (const std::string_view c : key.choices) {
+    if (same(value, c)) return c;
+  }
+  for (const auto& [synonym, choice] : key.synonyms) {
+    if (same(value, synonym)) return choice;
+  }
+  return {};
+}
+
 const ObjectKind& system_kind() {
   static const ObjectKind kind{
       "system",
@@ -94,7 +129,8 @@ const ObjectKind& component_kind() {
   static const ObjectKind kind{
       "component",
       "a component: its interfaces, signals, events, filters and services",
-      {kSchemaKey, kVersionKey, text("component", "name of the component (no dots or spaces)", true), kDescriptionKey,
+      {kSchemaKey, kVersionKey, text("component", "name of the component (no dots or spaces; \"\" makes the file a framework filter template, "
+                         "applied to every component)", true), kDescriptionKey,
        object("interfaces", "provided and required interfaces", "interfaces"),
        objects("signals", "signals of the component (Component.signal), scalar or vector", "signal"),
        objects("event", "event definitions (names are unique in the system)", "event"),
@@ -166,13 +202,33 @@ const ObjectKind& filter_kind() {
       "a filter: reads signals, may write signals, generates events to a target state machine",
       {text("name", "unique name in the system (default: Component.Type_index)"),
        text("class_name", "filter type, e.g. Threshold (2016 names such as FilterThreshold are accepted)", true),
-       choice("type", "ACTIVE: runs in the component's loop; PASSIVE: runs in the monitor thread",
-              {"ACTIVE", "PASSIVE"}, "\"ACTIVE\""),
-       choice("event_type", "EDGE: one onset per crossing; LEVEL: an onset every sample while detected",
-              {"EDGE", "LEVEL"}, "\"EDGE\""),
+       [] {
+         Key k = choice("type", "ACTIVE: runs in the component's loop; PASSIVE: runs in the monitor thread "
+                                "(any letter case; the 2016 INTERNAL and EXTERNAL mean ACTIVE and PASSIVE)",
+                        {"ACTIVE", "PASSIVE"}, "\"ACTIVE\"");
+         k.any_case = true;
+         k.synonyms = {{"INTERNAL", "ACTIVE"}, {"EXTERNAL", "PASSIVE"}};
+         return k;
+       }(),
+       [] {
+         Key k = choice("event_type", "EDGE: one onset per crossing; LEVEL: an onset every sample while detected (any letter case)",
+                        {"EDGE", "LEVEL"}, "\"EDGE\"");
+         k.any_case = true;
+         return k;
+       }(),
        boolean("enabled", "a disabled filter skips its runs", "true"),
        object("target", "the state machine that receives the events (default: s_A of this component)", "target"),
-       object("argument", "the parameters of the filter type", ""), kDescriptionKey}};
+       object("argument", "the parameters of the filter type", ""), kDescriptionKey,
+       [] {
+         Key k = boolean("debug", "2016: printed the filter's debug log; accepted and ignored (SAFECASS records every event)", "false");
+         k.ignored = true;
+         return k;
+       }(),
+       [] {
+         Key k = boolean("last_filter", "2016: marked the last filter of a chain; accepted and ignored (a \"pipeline\" says it)", "false");
+         k.ignored = true;
+         return k;
+       }()}};
   return kind;
 }
 

@@ -4,6 +4,7 @@
 
 #include <limits>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace safecass::spec::detail {
@@ -31,6 +32,18 @@ struct Key {
   double max = std::numeric_limits<double>::infinity();
   bool exclusive_min = false;
   std::string_view default_json;           ///< the default as JSON text, for the schema
+  /// Choice: other spellings accepted, as in the 2016 loader: any letter case, and
+  /// {synonym, choice} pairs ("INTERNAL" is "ACTIVE").
+  bool any_case = false;
+  std::vector<std::pair<std::string_view, std::string_view>> synonyms;
+  /// Accepted only for the 2016 files and ignored: a note (validate --verbose) says so.
+  bool ignored = false;
+};
+
+/// A key of an older format that has a new name or place: the error says what to write.
+struct RenamedKey {
+  std::string_view old_name;
+  std::string_view advice;  ///< e.g. "write \"target\": {\"component\": ...}"
 };
 
 struct ObjectKind {
@@ -39,6 +52,12 @@ struct ObjectKind {
   std::vector<Key> keys;
   const Key* find(std::string_view key) const noexcept;
 };
+
+/// The older key `key` of an object of `kind` that has a new name or place, or nullptr.
+const RenamedKey* find_renamed(const ObjectKind& kind, std::string_view key) noexcept;
+
+/// The choice `value` stands for under `key`'s spellings, or "" when it is none of them.
+std::string_view canonical_choice(const Key& key, std::string_view value) noexcept;
 
 const ObjectKind& system_kind();
 const ObjectKind& include_kind();

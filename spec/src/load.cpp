@@ -32,6 +32,11 @@ void Sink::add(Diagnostic::Severity severity, const Site& site, std::string mess
   d.where = position(site);
   d.message = std::move(message);
   d.pointer = site.pointer;
+  if (severity == Diagnostic::Severity::Note) {
+    notes.push_back(std::move(d));
+    note_files.push_back(site.file);
+    return;
+  }
   diagnostics.push_back(std::move(d));
   files.push_back(site.file);
 }
@@ -52,6 +57,7 @@ const std::vector<FrameworkEvent>& framework_events() {
       f.name = e.name;
       f.onset = e.is_onset;
       f.severity = e.severity;
+      f.transitions = e.transitions;
       if (e.counterpart != kNoEvent) f.counterpart = probe.event(e.counterpart).name;
       out.push_back(std::move(f));
     }
@@ -64,13 +70,29 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
   SystemSpec system;
   system.name = model.name;
   system.path = model.path;
+  // A framework filter template is not a component: its filters were instantiated for every
+  // component, and its own events (other than repeated framework events) are system events,
+  // given to the first component (event names are system-wide).
+  std::vector<EventDef> template_events;
   for (const ComponentItem& c : model.components) {
+    if (!c.is_template()) continue;
+    for (const EventItem& e : c.events) {
+      if (!e.framework_redefinition) template_events.push_back(e.def);
+    }
+  }
+  for (const ComponentItem& c : model.components) {
+    if (c.is_template() || c.stand_in) continue;
     ComponentSpec out;
     out.name = c.name;
     for (const Name& n : c.provided) out.provided.push_back(n.text);
     for (const Name& n : c.required) out.required.push_back(n.text);
     for (const SignalItem& s : c.signals) out.signals.push_back(SignalSpec{s.name, s.size});
-    for (const EventItem& e : c.events) out.events.push_back(e.def);
+    for (const EventItem& e : c.events) {
+      if (!e.framework_redefinition) out.events.push_back(e.def);
+    }
+    if (system.components.empty()) {
+      out.events.insert(out.events.end(), template_events.begin(), template_events.end());
+    }
     for (const FilterEntryItem& entry : c.filters) {
       FilterSpec f;
       f.pipeline = entry.pipeline;
@@ -128,6 +150,16 @@ LoadResult load(const std::string& path, const std::string* text, const FilterRe
     return x.where.column < y.where.column;
   });
   for (const std::size_t i : order) result.diagnostics.push_back(std::move(sink.diagnostics[i]));
+  std::vector<std::size_t> note_order(sink.notes.size());
+  for (std::size_t i = 0; i < note_order.size(); ++i) note_order[i] = i;
+  std::stable_sort(note_order.begin(), note_order.end(), [&](std::size_t a, std::size_t b) {
+    const Diagnostic& x = sink.notes[a];
+    const Diagnostic& y = sink.notes[b];
+    if (sink.note_files[a] != sink.note_files[b]) return sink.note_files[a] < sink.note_files[b];
+    if (x.where.line != y.where.line) return x.where.line < y.where.line;
+    return x.where.column < y.where.column;
+  });
+  for (const std::size_t i : note_order) result.notes.push_back(std::move(sink.notes[i]));
   return result;
 }
 

@@ -41,9 +41,12 @@ public:
   std::deque<Document> documents;
   std::vector<Diagnostic> diagnostics;
   std::vector<int> files;  ///< file index of each diagnostic, for sorting
+  std::vector<Diagnostic> notes;  ///< what was accepted and ignored (validate --verbose)
+  std::vector<int> note_files;
 
   void error(const Site& site, std::string message) { add(Diagnostic::Severity::Error, site, std::move(message)); }
   void warning(const Site& site, std::string message) { add(Diagnostic::Severity::Warning, site, std::move(message)); }
+  void note(const Site& site, std::string message) { add(Diagnostic::Severity::Note, site, std::move(message)); }
   /// "file:line:col", for "first defined at ...".
   std::string at(const Site& site) const;
   Position position(const Site& site) const;
@@ -78,6 +81,7 @@ struct EventItem {
   bool has_severity = false;
   bool has_transitions = false;
   bool transitions_valid = true;  ///< every listed transition was understood
+  bool framework_redefinition = false;  ///< repeats a framework event's definition: the built-in is used
 };
 
 struct ParamItem {
@@ -105,6 +109,9 @@ struct FilterItem {
   bool has_class = false;
   bool has_target_interface = false;
   bool target_component_given = false;
+  bool argument_misspelled = false;  ///< an unknown key of the filter is a typo of 'argument' (reported)
+  const JsonValue* misspelled_argument = nullptr;  ///< its value: the events it names count as generated
+  bool from_template = false;        ///< instantiated from a framework filter template for `owner`
   std::vector<ParamItem> params;
 };
 
@@ -138,6 +145,10 @@ struct ComponentItem {
   std::vector<FilterEntryItem> filters;
   std::vector<ServiceItem> services;
   std::optional<double> period;
+  /// A framework filter template (`"component": ""`, as the 2016 framework filter file): its
+  /// filters are instantiated for every component of the system, its events are system events.
+  bool is_template() const noexcept { return has_name && name.empty(); }
+  bool stand_in = false;  ///< the component a template loaded alone is checked against (not in the system)
 };
 
 struct ConnectionItem {
@@ -183,6 +194,7 @@ struct FrameworkEvent {
   bool onset = true;
   std::string counterpart;
   int severity = 0;
+  TransitionSet transitions;
 };
 const std::vector<FrameworkEvent>& framework_events();
 

@@ -62,6 +62,11 @@ public:
         continue;
       }
       const Key* key = kind_.find(m.key);
+      if (const RenamedKey* renamed = key == nullptr ? find_renamed(kind_, m.key) : nullptr) {
+        // A key of the original format with a new name or place: say what to write.
+        sink_.error(key_site, context_ + ": unknown key " + quote_name(m.key) + " (" + std::string(renamed->advice) + ")");
+        continue;
+      }
       if (key == nullptr) {
         std::vector<std::string> known;
         for (const Key& k : kind_.keys) known.emplace_back(k.name);
@@ -77,7 +82,12 @@ public:
         sink_.error(key_site, std::move(message));
         continue;
       }
-      if (check(*key, m)) good_.push_back(&m);
+      if (check(*key, m)) {
+        good_.push_back(&m);
+        if (key->ignored) {
+          sink_.note(key_site, context_ + ": " + quote_name(m.key) + " is accepted for the 2016 files and ignored");
+        }
+      }
     }
     for (const Key& k : kind_.keys) {
       if (k.required && object.find_member(k.name) == nullptr) {
@@ -92,6 +102,12 @@ public:
       if (m->key == key) return &m->value;
     }
     return nullptr;
+  }
+  /// A Choice member as its canonical choice ("active" and "INTERNAL" are "ACTIVE"), or "".
+  std::string_view choice(std::string_view key) const noexcept {
+    const JsonValue* v = get(key);
+    const Key* k = kind_.find(key);
+    return v == nullptr || k == nullptr ? std::string_view() : canonical_choice(*k, v->string);
   }
   const JsonMember* member(std::string_view key) const noexcept { return object_.find_member(key); }
   bool has(std::string_view key) const noexcept { return member(key) != nullptr; }
@@ -183,9 +199,7 @@ private:
   }
 
   bool check_choice(const Key& key, const JsonValue& v, const Site& site, const std::string& what) {
-    for (const std::string_view c : key.choices) {
-      if (v.string == c) return true;
-    }
+    if (!canonical_choice(key, v.string).empty()) return true;
     sink_.error(site, what + " must be " + join_or(to_strings(key.choices)) + ", not " + quote_name(v.string) +
                           did_you_mean(v.string, to_strings(key.choices)));
     return false;
@@ -249,6 +263,15 @@ private:
     const bool system = root.find_member("system") != nullptr || root.find_member("components") != nullptr;
     const bool component = root.find_member("component") != nullptr;
     const Site site{doc, root.position, ""};
+    if (const JsonMember* monitor = root.find_member("monitor"); monitor != nullptr && !system && !component) {
+      refuse_monitor_targets(doc, *monitor);
+      return FileKind::Invalid;
+    }
+    if (const JsonMember* old = root.find_member("component_name"); old != nullptr && !system && !component) {
+      sink_.error(Site{doc, old->key_position, "/component_name"},
+                  "'component_name' is the original's key for the component's name: write \"component\"");
+      return FileKind::Invalid;
+    }
     if (root.find_member("steps") != nullptr && !component) {
       sink_.error(site, "this is a scenario (it has \"steps\"), not a system or component file: run it with "
                         "`safecass run` or `safecass test`");
@@ -263,6 +286,49 @@ private:
       return FileKind::Invalid;
     }
     return system ? FileKind::System : FileKind::Component;
+  }
+
+  /// The 2016 monitor-target file ({"monitor": [targets]}) is not loaded: its targets asked the
+  /// framework to stream a measurement (a thread's period or duty cycle) at a sampling rate,
+  /// without any limit, so nothing in it says what is a fault. Each target gets one error that
+  /// names the filter that detects that fault once the limits are written down.
+  void refuse_monitor_targets(int doc, const JsonMember& monitor) {
+    const std::string base = "/monitor";
+    const std::string intro = "the 2016 monitor-target file is not loaded (a target streams a measurement and sets no limit): ";
+    if (!monitor.value.is_array() || monitor.value.array.empty()) {
+      sink_.error(Site{doc, monitor.key_position, base},
+                  intro + "write a Frequency filter for a thread's period and a DutyCycle filter for its duty cycle");
+      return;
+    }
+    for (std::size_t i = 0; i < monitor.value.array.size(); ++i) {
+      const JsonValue& target = monitor.value.array[i];
+      const std::string p = pointer_join(base, i);
+      std::string type;
+      std::string component = "the component";
+      if (target.is_object()) {
+        if (const JsonValue* t = target.find("type"); t != nullptr && t->is_string()) type = t->string;
+        if (const JsonValue* loc = target.find("location"); loc != nullptr && loc->is_object()) {
+          if (const JsonValue* c = loc->find("component"); c != nullptr && c->is_string() && !c->string.empty()) {
+            component = "component " + quote_name(c->string);
+          }
+        }
+      }
+      std::string advice;
+      if (type == "THREAD_PERIOD") {
+        advice = "for the period of " + component + ", write a Frequency filter (min_rate, max_rate, max_jitter) on the "
+                 "signal its framework extension writes every cycle";
+      } else if (type == "THREAD_DUTYCYCLE_TOTAL" || type == "THREAD_DUTYCYCLE_USER") {
+        advice = "for the duty cycle of " + component + ", write a DutyCycle filter (period, max_duty) on its execution "
+                 "time per cycle (" + (type == "THREAD_DUTYCYCLE_USER" ? "the user's code alone" : "the whole cycle") + ")";
+      } else {
+        advice = "for " + (type.empty() ? std::string("this target") : "target " + quote_name(type)) + " of " + component +
+                 ", write a filter on the signal it measures (Threshold, Range, Frequency, DutyCycle...)";
+      }
+      const TextPosition at = target.is_object() && target.find_member("type") != nullptr
+                                  ? target.find_member("type")->key_position : target.position;
+      sink_.error(Site{doc, at, target.is_object() && target.find_member("type") != nullptr ? pointer_join(p, "type") : p},
+                  intro + advice);
+    }
   }
 
   /// Opens and parses a file. Returns its document index (pushed on the include stack), or -1.
@@ -667,11 +733,20 @@ private:
       item.config.type = c->string;
       item.has_class = true;
     }
-    if (const JsonValue* t = f.get("type")) {
-      item.config.execution = t->string == "PASSIVE" ? ExecutionMode::Passive : ExecutionMode::Active;
+    if (f.get("type") != nullptr) {
+      item.config.execution = f.choice("type") == "PASSIVE" ? ExecutionMode::Passive : ExecutionMode::Active;
     }
-    if (const JsonValue* t = f.get("event_type")) {
-      item.config.detection = t->string == "LEVEL" ? DetectionMode::Level : DetectionMode::Edge;
+    if (f.get("event_type") != nullptr) {
+      item.config.detection = f.choice("event_type") == "LEVEL" ? DetectionMode::Level : DetectionMode::Edge;
+    }
+    // A misspelled "argument" is reported once, as the unknown key: the parameters it holds are
+    // then not reported missing as well.
+    for (const JsonMember& m : e.object) {
+      if (filter_kind().find(m.key) != nullptr) continue;
+      if (m.key == "Arguments" || nearest(m.key, {"argument"}).has_value()) {
+        item.argument_misspelled = true;
+        item.misspelled_argument = &m.value;
+      }
     }
     if (const JsonValue* b = f.get("enabled")) item.config.enabled = b->boolean;
     TargetDefault target = inherited;

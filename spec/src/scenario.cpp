@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
@@ -9,6 +10,8 @@
 #include "safecass/core/state.hpp"
 #include "safecass/spec/file.hpp"
 #include "safecass/spec/json.hpp"
+
+#include "text.hpp"
 
 namespace safecass::spec {
 
@@ -181,19 +184,38 @@ public:
     error(v.position, pointer, "a sample must be a number or a non-empty list of numbers");
     return false;
   }
-  void unknown_keys(const JsonValue& obj, const std::string& pointer, std::initializer_list<std::string_view> known) {
+  /// Reports the keys of `obj` that are not `known`, with the nearest known one; returns the
+  /// known keys suggested, so that a typo of a required key is not also reported missing.
+  std::vector<std::string> unknown_keys(const JsonValue& obj, const std::string& pointer,
+                                        std::initializer_list<std::string_view> known) {
+    std::vector<std::string> suggested;
     for (const JsonMember& m : obj.object) {
       if (std::find(known.begin(), known.end(), m.key) == known.end()) {
         std::string list;
-        for (std::string_view k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-        error(m.key_position, pointer + "/" + m.key, "unknown key \"" + m.key + "\" (expected one of: " + list + ")");
+        std::vector<std::string> candidates;
+        for (std::string_view k : known) {
+          list += (list.empty() ? "" : ", ") + std::string(k);
+          candidates.emplace_back(k);
+        }
+        const std::string suggestion = did_you_mean(m.key, candidates);
+        error(m.key_position, pointer + "/" + m.key,
+              "unknown key \"" + m.key + "\"" + (suggestion.empty() ? " (expected one of: " + list + ")" : suggestion));
+        if (const auto near = detail::nearest(m.key, candidates)) suggested.push_back(*near);
       }
     }
+    return suggested;
   }
 
   std::string file_;
   std::vector<Diagnostic>& out_;
 };
+
+/// Seconds as written in messages: "0.5", "0.001", "12".
+std::string seconds_text(double s) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", s);
+  return buf;
+}
 
 std::string escape_pointer(const std::string& key) {
   std::string out;
@@ -211,9 +233,19 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     r.error(step.position, base, "a step must be an object with \"at\" and one action");
     return;
   }
+  static constexpr std::string_view kActions[] = {"sample", "ramp", "generate", "inject", "reset",
+                                                  "expect", "expect_outstanding", "expect_cause"};
   const JsonValue* at = step.find("at");
   double when = 0.0;
   if (at == nullptr) {
+    // A misspelled "at" is one error, the unknown key with its suggestion.
+    for (const JsonMember& m : step.object) {
+      if (std::find(std::begin(kActions), std::end(kActions), m.key) != std::end(kActions)) continue;
+      if (detail::nearest(m.key, {"at"})) {
+        r.error(m.key_position, base + "/" + escape_pointer(m.key), "unknown key \"" + m.key + "\"; did you mean 'at'?");
+        return;
+      }
+    }
     r.error(step.position, base, "step needs \"at\" (seconds)");
     return;
   }
@@ -222,15 +254,18 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     r.error(at->position, base + "/at", "\"at\" must not be negative");
     return;
   }
-  static constexpr std::string_view kActions[] = {"sample", "ramp", "generate", "inject", "reset",
-                                                  "expect", "expect_outstanding", "expect_cause"};
   int actions = 0;
+  bool unknown_action = false;
   for (const JsonMember& m : step.object) {
     if (m.key == "at") continue;
     const auto it = std::find(std::begin(kActions), std::end(kActions), m.key);
     if (it == std::end(kActions)) {
+      const std::string suggestion = did_you_mean(m.key, std::vector<std::string>(std::begin(kActions), std::end(kActions)));
       r.error(m.key_position, base + "/" + escape_pointer(m.key),
-              "unknown step action \"" + m.key + "\" (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)");
+              "unknown step action \"" + m.key + "\"" +
+                  (suggestion.empty() ? " (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)"
+                                      : suggestion));
+      unknown_action = true;
       continue;
     }
     ++actions;
@@ -268,13 +303,16 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
           break;
         }
-        r.unknown_keys(v, p, {"signal", "from", "to", "until"});
+        const auto typos = r.unknown_keys(v, p, {"signal", "from", "to", "until"});
         const JsonValue* sig = v.find("signal");
         const JsonValue* from = v.find("from");
         const JsonValue* to = v.find("to");
         const JsonValue* until = v.find("until");
         if (sig == nullptr || from == nullptr || to == nullptr || until == nullptr) {
-          r.error(v.position, p, "\"ramp\" needs signal, from, to and until");
+          const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
+          const bool all_typos = (sig != nullptr || typo("signal")) && (from != nullptr || typo("from")) &&
+                                 (to != nullptr || typo("to")) && (until != nullptr || typo("until"));
+          if (!all_typos) r.error(v.position, p, "\"ramp\" needs signal, from, to and until");
           ok = false;
           break;
         }
@@ -294,11 +332,11 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
           break;
         }
-        r.unknown_keys(v, p, {"event", "target"});
+        const auto typos = r.unknown_keys(v, p, {"event", "target"});
         const JsonValue* e = v.find("event");
         const JsonValue* t = v.find("target");
         if (e == nullptr) {
-          r.error(v.position, p, "\"generate\" needs \"event\"");
+          if (std::find(typos.begin(), typos.end(), "event") == typos.end()) r.error(v.position, p, "\"generate\" needs \"event\"");
           ok = false;
           break;
         }
@@ -312,13 +350,16 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
           break;
         }
-        r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
+        const auto typos = r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
+        const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
         const JsonValue* f = v.find("filter");
         const JsonValue* sig = v.find("signal");
         const JsonValue* deep = v.find("deep");
         const JsonValue* vals = v.find("values");
         if ((f == nullptr) == (sig == nullptr)) {
-          r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
+          if (f != nullptr || !(typo("filter") || typo("signal"))) {
+            r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
+          }
           ok = false;
           break;
         }
@@ -337,7 +378,9 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
         }
         if (vals == nullptr || !vals->is_array() || vals->array.empty()) {
-          r.error(vals == nullptr ? v.position : vals->position, p + "/values", "\"values\" must be a non-empty list of samples");
+          if (vals != nullptr || !typo("values")) {
+            r.error(vals == nullptr ? v.position : vals->position, p + "/values", "\"values\" must be a non-empty list of samples");
+          }
           ok = false;
           break;
         }
@@ -354,11 +397,11 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
           break;
         }
-        r.unknown_keys(v, p, {"target", "reason"});
+        const auto typos = r.unknown_keys(v, p, {"target", "reason"});
         const JsonValue* t = v.find("target");
         const JsonValue* why = v.find("reason");
         if (t == nullptr) {
-          r.error(v.position, p, "\"reset\" needs \"target\"");
+          if (std::find(typos.begin(), typos.end(), "target") == typos.end()) r.error(v.position, p, "\"reset\" needs \"target\"");
           ok = false;
           break;
         }
@@ -401,7 +444,9 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     if (s.kind != ScenarioStep::Kind::Sample) s.action = std::make_shared<const StepAction>(std::move(a));
     steps.push_back(std::move(s));
   }
-  if (actions == 0) r.error(step.position, base, "step has no action (sample, ramp, generate, inject, reset or expect...)");
+  if (actions == 0 && !unknown_action) {
+    r.error(step.position, base, "step has no action (sample, ramp, generate, inject, reset or expect...)");
+  }
 }
 
 }  // namespace
@@ -435,10 +480,11 @@ ScenarioLoad load_scenario(const std::string& path) {
     r.error(root.position, "", "a scenario must be a JSON object");
     return out;
   }
-  r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
+  const auto typos = r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
+  const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
   const JsonValue* system = root.find("system");
   if (system == nullptr) {
-    r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
+    if (!typo("system")) r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
   } else if (std::string s; r.text(*system, "/system", "\"system\"", s)) {
     const std::filesystem::path base = std::filesystem::path(path).parent_path();
     sc.system = (base / s).lexically_normal().string();
@@ -450,7 +496,7 @@ ScenarioLoad load_scenario(const std::string& path) {
   }
   const JsonValue* duration = root.find("duration");
   if (duration == nullptr) {
-    r.error(root.position, "", "scenario needs \"duration\" (seconds)");
+    if (!typo("duration")) r.error(root.position, "", "scenario needs \"duration\" (seconds)");
   } else if (r.number(*duration, "/duration", "\"duration\"", sc.duration) && !(sc.duration >= 0 && sc.duration <= 1e6)) {
     r.error(duration->position, "/duration", "\"duration\" must be in [0, 1e6] seconds");
   }
@@ -459,13 +505,29 @@ ScenarioLoad load_scenario(const std::string& path) {
   }
   const JsonValue* steps = root.find("steps");
   if (steps != nullptr && !steps->is_array()) r.error(steps->position, "/steps", "\"steps\" must be a list");
+  if (duration != nullptr && duration->is_number() && sc.duration >= 0 && sc.duration <= 1e6) {
+    // An expectation after the end would never be checked: say so now, with its position.
+    for (const ScenarioStep& s : sc.steps) {
+      const bool check = s.kind == ScenarioStep::Kind::Expect || s.kind == ScenarioStep::Kind::ExpectOutstanding ||
+                         s.kind == ScenarioStep::Kind::ExpectCause;
+      if (!check || !(s.at > sc.duration)) continue;
+      step_diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, sc.where(s),
+                                            "expectation at t=" + seconds_text(s.at) + " is after the duration (" +
+                                                seconds_text(sc.duration) +
+                                                " s): it would never be checked; move it or lengthen \"duration\"",
+                                            s.pointer()});
+    }
+  }
   out.diagnostics.insert(out.diagnostics.end(), std::make_move_iterator(step_diagnostics.begin()),
                          std::make_move_iterator(step_diagnostics.end()));
-  if (!out.diagnostics.empty()) return out;
   // Scenarios are usually written in time order: then nothing moves (a sort would need a buffer
   // of half the steps).
   const auto by_time = [](const ScenarioStep& a, const ScenarioStep& b) { return a.at < b.at; };
   if (!std::is_sorted(sc.steps.begin(), sc.steps.end(), by_time)) std::stable_sort(sc.steps.begin(), sc.steps.end(), by_time);
+  if (!out.diagnostics.empty()) {
+    out.partial = std::move(sc);
+    return out;
+  }
   out.scenario = std::move(sc);
   return out;
 }

@@ -129,7 +129,27 @@ Node key_schema(const Key& k) {
       if (std::isfinite(k.min)) n.set(k.exclusive_min ? "exclusiveMinimum" : "minimum", Node::number(k.min));
       if (std::isfinite(k.max)) n.set("maximum", Node::number(k.max));
       break;
-    case Shape::Choice: n.set("enum", strings_of(k.choices)); break;
+    case Shape::Choice: {
+      if (!k.any_case && k.synonyms.empty()) {
+        n.set("enum", strings_of(k.choices));
+        break;
+      }
+      // The spellings the loader accepts: the choices and synonyms, in upper and lower case.
+      std::vector<std::string_view> spellings(k.choices.begin(), k.choices.end());
+      for (const auto& [synonym, choice] : k.synonyms) spellings.push_back(synonym);
+      std::vector<std::string> all;
+      for (const std::string_view s : spellings) {
+        all.emplace_back(s);
+        if (!k.any_case) continue;
+        std::string lower(s);
+        for (char& c : lower) c = (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c;
+        if (lower != s) all.push_back(std::move(lower));
+      }
+      Node e = Node::array();
+      for (const std::string& s : all) e.push(Node::text(s));
+      n.set("enum", std::move(e));
+      break;
+    }
     case Shape::StringList: {
       n.set("type", Node::text("array"));
       Node items;
@@ -262,6 +282,13 @@ Node argument_schema(const FilterManifest& m) {
   Node& properties = n.set("properties", Node{});
   Node required = required_params(m, false);
   for (const ParamSpec& p : m.params) properties.set(p.name, param_schema(p));
+  for (const auto& [alias, param] : m.aliases) {
+    if (const ParamSpec* p = m.find(param)) {
+      Node a = param_schema(*p);
+      *a.member("description") = Node::text("the 2016 name of '" + param + "'");
+      properties.set(alias, std::move(a));
+    }
+  }
   if (!required.items.empty()) n.set("required", std::move(required));
   n.set("additionalProperties", Node::raw("false"));
   return n;

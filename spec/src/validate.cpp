@@ -109,6 +109,7 @@ public:
   Validator(Model& model, const FilterRegistry& registry, Sink& sink) : m_(model), registry_(registry), sink_(sink) {}
 
   void run() {
+    expand_templates();
     check_components();
     for (ComponentItem& c : m_.components) check_interfaces(c);
     for (ComponentItem& c : m_.components) check_signals(c);
@@ -121,10 +122,69 @@ public:
   }
 
 private:
+  // ---- framework filter templates ---------------------------------------------------------------
+  /// A component file with `"component": ""` is a framework filter template (the 2016 framework
+  /// filter file): its filters are instantiated for every component of the system, their target
+  /// component ("" or absent) being that component; its events are system events. Loaded alone,
+  /// it is checked against a stand-in component that is not part of the system.
+  void expand_templates() {
+    std::vector<std::size_t> templates;
+    std::vector<std::size_t> real;
+    for (std::size_t i = 0; i < m_.components.size(); ++i) {
+      (m_.components[i].is_template() ? templates : real).push_back(i);
+    }
+    if (templates.empty()) return;
+    for (const std::size_t t : templates) {
+      const ComponentItem& c = m_.components[t];
+      const auto refuse = [&](const Site& site, const char* what) {
+        sink_.error(site, std::string("framework filter template (\"component\": \"\"): ") + what +
+                              " cannot be applied to every component; a template holds events and filters");
+      };
+      if (c.has_interfaces || !c.provided.empty() || !c.required.empty()) refuse(c.site, "interfaces");
+      if (!c.signals.empty()) refuse(c.signals.front().site, "signals");
+      if (!c.services.empty()) refuse(c.services.front().site, "services");
+    }
+    if (real.empty()) {
+      ComponentItem stand_in;
+      stand_in.name = "COMPONENT";
+      stand_in.has_name = true;
+      stand_in.stand_in = true;
+      stand_in.site = stand_in.name_site = m_.components[templates.front()].site;
+      m_.components.push_back(std::move(stand_in));
+      real.push_back(m_.components.size() - 1);
+    }
+    for (const std::size_t t : templates) {
+      std::vector<FilterEntryItem> entries = std::move(m_.components[t].filters);
+      m_.components[t].filters.clear();
+      for (const std::size_t r : real) {
+        ComponentItem& c = m_.components[r];
+        for (std::size_t k = 0; k < entries.size(); ++k) {
+          FilterEntryItem copy = entries[k];
+          for (FilterItem& stage : copy.stages) {
+            stage.owner = c.name;
+            stage.from_template = true;
+            if (!stage.target_component_given || stage.config.target.component.empty()) stage.config.target.component = c.name;
+            if (stage.named) {
+              stage.config.name = c.name + "." + stage.config.name;
+            } else if (copy.pipeline.empty()) {
+              const FilterRegistry::Entry* e = registry_.find(stage.config.type);
+              stage.config.name = c.name + ".framework." + (e != nullptr ? e->manifest.type : stage.config.type) + "_" +
+                                  std::to_string(k + 1);
+              stage.named = true;  // named here, not by its position in c's list
+            }
+          }
+          if (!copy.pipeline.empty() && copy.pipeline != "?") copy.pipeline = c.name + "_" + copy.pipeline;
+          c.filters.push_back(std::move(copy));
+        }
+      }
+    }
+  }
+
   // ---- components ------------------------------------------------------------------------------
   void check_components() {
     for (std::size_t i = 0; i < m_.components.size(); ++i) {
       ComponentItem& c = m_.components[i];
+      if (c.is_template()) continue;  // its filters were given to every component
       if (!c.has_name) {
         invalid_components_.insert(c.name);  // reported as a missing key
         continue;
@@ -164,6 +224,7 @@ private:
 
   // ---- interfaces and services -----------------------------------------------------------------
   void check_interfaces(ComponentItem& c) {
+    if (c.is_template()) return;  // reported by expand_templates()
     const std::string who = "component " + quote_name(c.name);
     if (!c.has_interfaces) {
       // 2016 files declare no interfaces: the services name the provided ones, their s_R lists
@@ -214,6 +275,7 @@ private:
 
   // ---- signals ---------------------------------------------------------------------------------
   void check_signals(ComponentItem& c) {
+    if (c.is_template()) return;  // reported by expand_templates()
     if (invalid_components_.count(c.name) > 0) return;  // reported with the name
     for (const SignalItem& s : c.signals) {
       const auto dot = s.name.find('.');
@@ -261,7 +323,7 @@ private:
         const auto existing = events_.find(name);
         if (existing != events_.end()) {
           if (existing->second.framework) {
-            sink_.error(e.name_site, "event " + quote_name(name) + " is reserved: it is a framework event");
+            check_framework_redefinition(e);
           } else {
             sink_.error(e.name_site, "duplicate event " + quote_name(name) + " (first defined at " +
                                          sink_.at(existing->second.item->name_site) + ")");
@@ -347,6 +409,51 @@ private:
         }
       }
     }
+  }
+
+  /// A definition of a framework event, as the 2016 framework filter file carries: accepted when
+  /// it means what the built-in means (same kind, severity and level from every state), and then
+  /// the built-in is used (a note says so); refused otherwise, saying what differs. The built-in
+  /// definitions are fixed because extensions, supervision and propagation raise them everywhere.
+  void check_framework_redefinition(EventItem& e) {
+    const std::string& name = e.def.name;
+    const FrameworkEvent* builtin = nullptr;
+    for (const FrameworkEvent& f : framework_events()) {
+      if (f.name == name) builtin = &f;
+    }
+    if (builtin == nullptr) return;
+    const std::string head = "event " + quote_name(name) + " redefines the framework event";
+    if (!e.has_severity || !e.has_transitions || !e.transitions_valid) return;  // reported as such
+    const TransitionSet t = e.def.transitions;
+    const bool onset = t.worsening_only() && !t.empty();
+    const bool completion = t.improving_only() && !t.empty();
+    std::string differs;
+    if (onset != builtin->onset || (!onset && !completion)) {
+      differs = std::string("it is ") + (builtin->onset ? "an onset" : "a completion");
+    } else if (e.def.severity != builtin->severity) {
+      differs = "its severity is " + std::to_string(builtin->severity) + ", not " + std::to_string(e.def.severity);
+    } else if (onset) {
+      for (const State from : {State::Normal, State::Warning}) {
+        if (onset_level(t, from) != onset_level(builtin->transitions, from)) {
+          differs = std::string("from ") + std::string(to_string(from)) + " it leads to " +
+                    std::string(to_string(onset_level(builtin->transitions, from))) + ", not " +
+                    std::string(to_string(onset_level(t, from)));
+          break;
+        }
+      }
+    }
+    if (!differs.empty()) {
+      sink_.error(e.name_site, head + " differently: " + differs +
+                                   "; a framework event cannot be changed: remove this definition, or give your event another name");
+      return;
+    }
+    if (!e.def.completes.empty() || e.def.latched) {
+      sink_.error(e.name_site, head + " with 'completes' or 'latched': a framework event cannot be changed");
+      return;
+    }
+    e.framework_redefinition = true;
+    sink_.note(e.name_site, head + " as it is (severity " + std::to_string(builtin->severity) +
+                                "): the built-in definition is used");
   }
 
   std::vector<std::string> event_names() const {
@@ -570,6 +677,37 @@ private:
     const FilterManifest& manifest = entry->manifest;
     f.config.type = manifest.type;
     ctx += " (" + manifest.type + ")";
+    if (f.misspelled_argument != nullptr && f.misspelled_argument->is_object()) {
+      // The parameters are under a misspelled key (reported): the events they name still count
+      // as generated, so that the one mistake is not reported again as "not generated".
+      for (const JsonMember& m : f.misspelled_argument->object) {
+        const auto mark = [&](const JsonValue& v) {
+          if (!v.is_string()) return;
+          if (const auto e = events_.find(v.string); e != events_.end()) e->second.generated = true;
+        };
+        mark(m.value);
+        for (const JsonValue& item : m.value.array) mark(item);
+      }
+    }
+    // Aliases of parameters (ChangeDetection's 2016 `event`) are checked as the parameter.
+    for (ParamItem& p : f.params) {
+      const std::string_view canonical = manifest.canonical(p.name);
+      if (canonical == p.name) continue;
+      const bool both = std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& q) { return q.name == canonical; });
+      if (both) {
+        sink_.error(p.key_site, ctx + ": parameters " + quote_name(p.name) + " and " + quote_name(canonical) +
+                                    " are the same parameter; give one");
+        p.name = "\x01duplicate";  // reported: not checked again
+        continue;
+      }
+      p.name = std::string(canonical);
+    }
+    // A type that names its own output (the 2016 transforms) writes the signal named after the filter.
+    if (manifest.default_output && !manifest.outputs.empty() && !f.argument_misspelled &&
+        std::none_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == manifest.outputs.front(); })) {
+      f.params.push_back(ParamItem{manifest.outputs.front(), f.argument_site, f.argument_site, nullptr,
+                                   default_output_name(f.config.name, f.config.target.component)});
+    }
 
     // Target.
     const std::string& tc = f.config.target.component;
@@ -604,8 +742,20 @@ private:
     for (const ParamSpec& p : manifest.params) param_names.push_back(p.name);
     std::set<std::string, std::less<>> misspelled;  // known names that an unknown parameter is a typo of
     for (const ParamItem& p : f.params) {
+      if (p.name == "\x01duplicate") {
+        params_ok = false;
+        continue;
+      }
       const ParamSpec* spec = manifest.find(p.name);
       if (spec == nullptr) {
+        if (const std::string_view now = renamed_parameter(p.name); !now.empty() && manifest.find(now) != nullptr) {
+          // A parameter of the original format with a new name: say which.
+          misspelled.insert(std::string(now));
+          sink_.error(p.key_site, ctx + ": unknown parameter " + quote_name(p.name) + " (the original's name): write " +
+                                      quote_name(now));
+          params_ok = false;
+          continue;
+        }
         if (const auto near = nearest(p.name, param_names)) misspelled.insert(*near);
         std::string suggestion = did_you_mean(p.name, param_names);
         if (suggestion.empty()) suggestion = " (known: " + join_list(param_names) + ")";
@@ -638,6 +788,7 @@ private:
       given[p.name] = std::move(*value);
       items[p.name] = &p;
     }
+    if (!has_input_given(f, manifest) && f.argument_misspelled) params_ok = false;
     const std::string pipeline_note =
         f.stage > 0 ? "; the previous stage of pipeline " + quote_name(f.pipeline) + " writes no output it could read" : "";
     bool missing_input = false;
@@ -648,13 +799,14 @@ private:
       missing_input = missing_input || input;
       params_ok = false;
       if (misspelled.count(spec.name) > 0) continue;  // reported as the unknown parameter
+      if (f.argument_misspelled) continue;            // reported as the misspelled 'argument' key
       sink_.error(f.argument_site, ctx + ": missing parameter " + quote_name(spec.name) + " (" + spec.doc + ")" +
                                        (input ? pipeline_note : ""));
     }
     const bool has_input = std::any_of(manifest.inputs.begin(), manifest.inputs.end(), [&](const std::string& n) {
       return std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == n; });
     });
-    if (!manifest.inputs.empty() && !has_input && !missing_input) {
+    if (!manifest.inputs.empty() && !has_input && !missing_input && !f.argument_misspelled) {
       sink_.error(f.argument_site, ctx + ": needs an input (" + join_or(manifest.inputs) + ")" + pipeline_note);
       params_ok = false;
     }
@@ -696,7 +848,7 @@ private:
         }
       }
       for (const auto& [name, site] : names) {
-        const std::size_t size = resolve_input(ctx, input, name, site, tc, coordinator);
+        const std::size_t size = resolve_input(ctx, input, name, site, tc, coordinator, f.from_template);
         if (size == 0) {
           sizes_known = false;
           continue;
@@ -825,6 +977,23 @@ private:
     }
   }
 
+  static bool has_input_given(const FilterItem& f, const FilterManifest& manifest) {
+    return std::any_of(manifest.inputs.begin(), manifest.inputs.end(), [&](const std::string& n) {
+      return std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == n; });
+    });
+  }
+
+  /// Parameters of the original format that have another name now.
+  static std::string_view renamed_parameter(std::string_view name) {
+    static const std::pair<std::string_view, std::string_view> kRenamed[] = {
+        {"margin", "tolerance"},       {"InputSignalName", "input_signal"}, {"output0", "output_below"},
+        {"output1", "output_above"},   {"input", "input_signal"},          {"output", "output_signal"}};
+    for (const auto& [old_name, now] : kRenamed) {
+      if (old_name == name) return now;
+    }
+    return {};
+  }
+
   /// Events named by any parameter of a filter whose type is unknown count as generated.
   void mark_named_events(const FilterItem& f) {
     for (const ParamItem& p : f.params) {
@@ -856,7 +1025,7 @@ private:
 
   /// Resolves an input signal; returns its size, or 0 when it cannot be used.
   std::size_t resolve_input(const std::string& ctx, const std::string& param, const std::string& name, const Site& site,
-                            const std::string& tc, const std::string& coordinator) {
+                            const std::string& tc, const std::string& coordinator, bool from_template) {
     const std::string full = qualify(name, tc);
     const auto dot = full.find('.');
     const std::string what = ctx + ": parameter " + quote_name(param);
@@ -875,6 +1044,13 @@ private:
     check_same_coordinator(ctx, param, full, comp, coordinator, site);
     const auto it = signals_.find(full);
     if (it != signals_.end()) return it->second.size;
+    if (from_template && comp == tc) {
+      // A framework filter template reads signals the framework gives every component (the 2016
+      // ExceptionCount): the component has it, a scalar, whether or not it declares signals.
+      owner->signals.push_back(SignalItem{full, 1, site, true});
+      signals_.emplace(full, SignalInfo{1, {}, site});
+      return 1;
+    }
     if (!owner->has_signals) {
       // 2016 files declare no signals: an input names one of the component's signals.
       sink_.warning(site, "signal " + quote_name(full) + " is not declared; assumed to be a scalar (component " +

@@ -31,7 +31,9 @@ int main(int argc, char** argv) {
   auto* validate = app.add_subcommand("validate", "Check system/component specifications; report every problem as file:line:col");
   validate->add_option("SYSTEM", validate_files, "system or component files")->required();
   validate->add_flag("--json", validate_json, "one JSON object per diagnostic");
-  validate->callback([&] { code = run_validate(validate_files, validate_json); });
+  bool validate_verbose = false;
+  validate->add_flag("-v,--verbose", validate_verbose, "also print notes: what was accepted and ignored (2016 keys)");
+  validate->callback([&] { code = run_validate(validate_files, validate_json, validate_verbose); });
 
   auto* schema = app.add_subcommand("schema", "Print the JSON Schema of specification files");
   schema->callback([&] { code = run_schema(); });

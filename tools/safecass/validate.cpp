@@ -4,7 +4,9 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <map>
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/spec.hpp"
@@ -41,7 +43,7 @@ bool readable(const std::string& path) {
 
 }  // namespace
 
-int run_validate(const std::vector<std::string>& files, bool json_output) {
+int run_validate(const std::vector<std::string>& files, bool json_output, bool verbose) {
   FilterRegistry registry;
   register_builtin_filters(registry);
   std::size_t errors = 0;
@@ -56,10 +58,23 @@ int run_validate(const std::vector<std::string>& files, bool json_output) {
       d.message = "cannot read file '" + file + "'";
       diagnostics.push_back(std::move(d));
     } else {
-      diagnostics = spec::load_system(file, registry).diagnostics;
+      spec::LoadResult loaded = spec::load_system(file, registry);
+      diagnostics = std::move(loaded.diagnostics);
+      if (verbose && !loaded.notes.empty()) {
+        // Notes go among the diagnostics, in file and position order.
+        diagnostics.insert(diagnostics.end(), loaded.notes.begin(), loaded.notes.end());
+        std::map<std::string, std::size_t> rank;  // files in the order they first appear (load order)
+        for (const spec::Diagnostic& d : diagnostics) rank.emplace(d.where.file, rank.size());
+        std::stable_sort(diagnostics.begin(), diagnostics.end(), [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
+          if (a.where.file != b.where.file) return rank[a.where.file] < rank[b.where.file];
+          if (a.where.line != b.where.line) return a.where.line < b.where.line;
+          return a.where.column < b.where.column;
+        });
+      }
     }
     for (const spec::Diagnostic& d : diagnostics) {
-      (d.severity == spec::Diagnostic::Severity::Error ? errors : warnings) += 1;
+      if (d.severity == spec::Diagnostic::Severity::Error) ++errors;
+      if (d.severity == spec::Diagnostic::Severity::Warning) ++warnings;
       std::printf("%s\n", (json_output ? spec::to_json(d) : spec::format(d)).c_str());
     }
   }

@@ -156,6 +156,7 @@ public:
                 ParamSpec::number("tolerance", "largest change that is not a change", 0.0, 0, 1e300),
                 ParamSpec::signal("output_signal", "1 on a sample that changed, else 0", true)};
     add_event_params(m);
+    m.aliases = {{"event", "event_onset"}};  // the 2016 name
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     return m;

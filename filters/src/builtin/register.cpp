@@ -13,6 +13,9 @@ void register_builtin_filters(FilterRegistry& registry) {
   (void)registry.alias("Persistence", "Debounce");
   (void)registry.alias("Heartbeat", "Watchdog");
   (void)registry.alias("Period", "Frequency");
+  // The 2016 trend-velocity filter: a Derivative (its `time_scaling` argument included).
+  (void)registry.alias("TrendVel", "Derivative");
+  (void)registry.alias("FilterTrendVel", "Derivative");
 }
 
 }  // namespace safecass

@@ -31,20 +31,26 @@ Expected<std::vector<std::size_t>> same_size(const FilterShape& s) {
   return same_size_shape(m, s);
 }
 
-/// (x_k − x_{k−1}) / (t_k − t_{k−1}), element-wise; cascade two for acceleration.
+/// (x_k − x_{k−1}) / (t_k − t_{k−1}), element-wise; cascade two for acceleration. Without time
+/// scaling, the difference x_k − x_{k−1} (the 2016 TrendVel's `time_scaling: false`).
 class Derivative final : public Filter {
 public:
   static constexpr const char* kType = "Derivative";
   explicit Derivative(FilterInit init)
-      : Filter(std::move(init)), previous_(inputs()[0]->size(), 0.0), out_(inputs()[0]->size(), 0.0) {}
+      : Filter(std::move(init)),
+        time_scaling_(flag("time_scaling")),
+        previous_(inputs()[0]->size(), 0.0),
+        out_(inputs()[0]->size(), 0.0) {}
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "rate of change of the input per second (element-wise)";
     m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
-                ParamSpec::signal("output_signal", "the derivative, same size as the input")};
+                ParamSpec::boolean("time_scaling", "divide the difference of two samples by their time difference (false: the difference alone)", true),
+                ParamSpec::signal("output_signal", "the derivative, same size as the input (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Derivative>(s); }
@@ -53,7 +59,8 @@ protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
     const double dt = to_seconds(s.time - previous_time_);
     if (has_previous_ && dt > 0) {
-      for (std::size_t i = 0; i < s.size; ++i) out_[i] = (s[i] - previous_[i]) / dt;
+      const double scale = time_scaling_ ? dt : 1.0;
+      for (std::size_t i = 0; i < s.size; ++i) out_[i] = (s[i] - previous_[i]) / scale;
       write(0, s.time, out_.data());
     }
     std::copy(s.data, s.data + s.size, previous_.begin());
@@ -63,6 +70,7 @@ protected:
   void on_reset() noexcept override { has_previous_ = false; }
 
 private:
+  bool time_scaling_;
   std::vector<double> previous_;
   std::vector<double> out_;
   Time previous_time_{};
@@ -85,10 +93,11 @@ public:
     m.doc = "moving average over the last window samples (element-wise)";
     m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
                 ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
-                ParamSpec::signal("output_signal", "the average, same size as the input")};
+                ParamSpec::signal("output_signal", "the average, same size as the input (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<MovingAverage>(s); }
@@ -156,10 +165,11 @@ public:
     m.doc = "norm of a vector signal";
     m.params = {ParamSpec::signal("input_signal", "vector (or scalar) signal"),
                 ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
-                ParamSpec::signal("output_signal", "the norm (scalar)")};
+                ParamSpec::signal("output_signal", "the norm (scalar; default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{1}; }
@@ -195,10 +205,11 @@ public:
                 ParamSpec::signals("input_signals", "two signals of the same size", true),
                 ParamSpec::choice("operation", "the operation", {"add", "subtract", "multiply", "divide", "min", "max"}, "add"),
                 ParamSpec::number("operand", "constant second operand when there is one input", 0.0),
-                ParamSpec::signal("output_signal", "the result, same size as the inputs")};
+                ParamSpec::signal("output_signal", "the result, same size as the inputs (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal", "input_signals"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
@@ -256,14 +267,19 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "combines scalar signals into one vector signal";
-    m.params = {ParamSpec::signals("input_signals", "scalar signals, in vector order"),
-                ParamSpec::signal("output_signal", "vector of the inputs' latest values")};
-    m.inputs = {"input_signals"};
+    m.params = {ParamSpec::signal("input_signal", "one scalar signal (a vector of one)", true),
+                ParamSpec::signals("input_signals", "scalar signals, in vector order", true),
+                ParamSpec::signal("output_signal", "vector of the inputs' latest values (default: the signal named after the filter)", true)};
+    m.inputs = {"input_signal", "input_signals"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    if ((s.params.count("input_signal") > 0) == (s.params.count("input_signals") > 0)) {
+      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Vectorize): give either 'input_signals' or 'input_signal'");
+    }
     for (const Signal* in : s.inputs) {
       if (in->size() != 1) {
         return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Vectorize): input '" + in->name() +
@@ -287,25 +303,34 @@ private:
   std::vector<double> out_;
 };
 
-/// Copies its input to its output unchanged.
+/// Copies its input to its output unchanged; with `event_on`, also reports a non-zero input as
+/// OnOff does (the 2016 Bypass).
 class Bypass final : public Filter {
 public:
   static constexpr const char* kType = "Bypass";
   explicit Bypass(FilterInit init) : Filter(std::move(init)) {}
   static FilterManifest manifest() {
     FilterManifest m;
-    m.doc = "copies the input to the output (a tap for injection and observation)";
+    m.doc = "copies the input to the output (a tap for injection and observation); with event_on, a non-zero input is an onset";
     m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
-                ParamSpec::signal("output_signal", "the same samples")};
+                ParamSpec::signal("output_signal", "the same samples (default: the signal named after the filter)", true),
+                ParamSpec::event("event_on", "event generated when the input turns non-zero (any element)", std::nullopt, true),
+                ParamSpec::event("event_off", "event generated when it is zero again (default: the onset's completion)",
+                                 std::nullopt, true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
-    m.generates_events = false;
+    m.default_output = true;
     return m;
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Bypass>(s); }
 
 protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override { write(0, s.time, s.data); }
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    write(0, s.time, s.data);
+    bool on = false;
+    for (std::size_t i = 0; i < s.size; ++i) on = on || s[i] != 0.0;
+    report(on, s[0], s.time);
+  }
 };
 
 /// Reads its input and does nothing: a placeholder and a carrier for fault-injection tests.

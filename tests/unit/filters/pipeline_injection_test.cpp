@@ -89,7 +89,7 @@ TEST_F(InjectionTest, ShallowInjectionIsSeenByThatFilterAloneAndMarked) {
   EXPECT_EQ(app_state(), State::Normal);
 }
 
-TEST_F(InjectionTest, AShallowInjectedSampleIsHeldLikeAWrittenOneUntilTheNextRealSample) {
+TEST_F(InjectionTest, AShallowInjectedSampleIsHeldForItsRunAndTheEndOfTheInjectionRestoresTheRealValue) {
   Signal* a = signal("a");
   Signal* b = signal("b");
   FilterConfig c = stage("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
@@ -103,9 +103,9 @@ TEST_F(InjectionTest, AShallowInjectedSampleIsHeldLikeAWrittenOneUntilTheNextRea
   ASSERT_TRUE(monitor_.inject_shallow("diff", {{100}}));  // replaces a for one run
   monitor_.run_active(component_, Time{2});
   EXPECT_DOUBLE_EQ(latest("C.d"), 99.0);
-  b->push(Time{3}, 2.0);  // a's held value is the injected one until a writes again
+  b->push(Time{3}, 2.0);  // the injection ran out: a's real value (10) is judged again with it
   monitor_.run_active(component_, Time{3});
-  EXPECT_DOUBLE_EQ(latest("C.d"), 98.0);
+  EXPECT_DOUBLE_EQ(latest("C.d"), 8.0);
   a->push(Time{4}, 20.0);
   monitor_.run_active(component_, Time{4});
   EXPECT_DOUBLE_EQ(latest("C.d"), 18.0);

@@ -47,13 +47,16 @@ TEST(SpecSchema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
     const JsonValue* argument = defs->find("argument_" + m->type);
     ASSERT_NE(argument, nullptr) << m->type;
     EXPECT_EQ(argument->find("additionalProperties")->boolean, false);
-    EXPECT_EQ(argument->find("properties")->object.size(), m->params.size()) << m->type;
+    // Every parameter, and every other name of one (ChangeDetection's 2016 `event`).
+    EXPECT_EQ(argument->find("properties")->object.size(), m->params.size() + m->aliases.size()) << m->type;
+    for (const auto& [alias, param] : m->aliases) EXPECT_NE(argument->find("properties")->find(alias), nullptr) << alias;
   }
   const JsonValue* names = defs->find("filter")->find("properties")->find("class_name")->find("enum");
   ASSERT_NE(names, nullptr);
   std::vector<std::string> all;
   for (const JsonValue& n : names->array) all.push_back(n.string);
-  EXPECT_THAT(all, ::testing::IsSupersetOf({"Threshold", "FilterThreshold", "Persistence", "Heartbeat", "Period"}));
+  EXPECT_THAT(all, ::testing::IsSupersetOf({"Threshold", "FilterThreshold", "Persistence", "Heartbeat", "Period",
+                                            "TrendVel", "FilterTrendVel"}));
   const JsonValue* threshold = defs->find("argument_Threshold")->find("properties")->find("direction");
   EXPECT_EQ(threshold->find("default")->string, "above");
   const JsonValue* severity = defs->find("event")->find("properties")->find("severity");

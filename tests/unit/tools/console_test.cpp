@@ -137,6 +137,26 @@ TEST_F(ConsoleTest, ShallowInjectionIsSeenByThatFilterAlone) {
   EXPECT_FALSE(contains(run("explain JR3.s_A").out, "EVT_FORCE_HIGH"));
 }
 
+TEST(ConsoleInjection, TheEndOfAShallowInjectionFromTheConsoleRestoresTheRealValueOfAnOnChangeSensor) {
+  // A door sensor that publishes once (closed) and then only on change (DESIGN §3).
+  const std::string system = write_file("door_system.json", R"({ "component": "CELL",
+    "signals": [ { "name": "DoorOpen" } ],
+    "event": [ { "name": "EVT_DOOR", "severity": 40, "state_transition": ["N2E"] },
+               { "name": "/EVT_DOOR", "severity": 40, "state_transition": ["E2N"] } ],
+    "filter": [ { "name": "door", "class_name": "OnOff",
+                  "argument": { "input_signal": "DoorOpen", "event_on": "EVT_DOOR" } } ] })");
+  const std::string scenario = write_file("door_scenario.json", R"({ "system": "door_system.json", "duration": 1.0,
+    "steps": [ { "at": 0.0, "sample": { "CELL.DoorOpen": 0 } } ] })");
+  auto console = open_console(true, false, scenario, system);
+  ASSERT_NE(console, nullptr);
+  ASSERT_TRUE(console->execute("watch 0.01").ok);
+  ASSERT_TRUE(console->execute("filter inject door 1").ok);
+  const std::string watched = console->execute("watch 0.01").out;
+  EXPECT_TRUE(contains(watched, "CELL.s_A  Normal -> Error  EVT_DOOR")) << watched;
+  EXPECT_TRUE(contains(watched, "CELL.s_A  Error -> Normal  /EVT_DOOR")) << "the real value, closed, is judged again: " << watched;
+  EXPECT_TRUE(contains(console->execute("state list CELL").out, "Normal"));
+}
+
 TEST_F(ConsoleTest, DeepInjectionIsSeenByEveryConsumerOfTheSignal) {
   const std::string out = run("filter dinject JR3.Force [0, 0, 50]").out;
   EXPECT_TRUE(contains(out, "wrote 1 sample into signal JR3.Force")) << out;

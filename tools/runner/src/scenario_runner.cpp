@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <optional>
 
 #include "safecass/record/recorder.hpp"
 #include "safecass/spec/load.hpp"
@@ -14,7 +16,36 @@ std::string secs(Time t) {
   std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
   return buf;
 }
+
+/// "no X 'name'" with the nearest known name, if one is near.
+std::string unknown(const std::string& what, const std::string& name, const std::vector<std::string>& known) {
+  return "no " + what + " '" + name + "'" + spec::did_you_mean(name, known);
+}
 }  // namespace
+
+const std::vector<std::string>* ScenarioRunner::coordinator_components(const std::string& name) const {
+  for (const auto& [coordinator, components] : system_->spec().coordinators) {
+    if (coordinator == name) return &components;
+  }
+  return nullptr;
+}
+
+std::vector<std::string> ScenarioRunner::addresses() const {
+  const spec::SystemSpec& system = system_->spec();
+  std::vector<std::string> out{"SYSTEM"};
+  for (const auto& [coordinator, components] : system.coordinators) out.push_back(coordinator);
+  for (const spec::ComponentSpec& c : system.components) {
+    out.push_back(c.name);
+    out.push_back(c.name + ".s_F");
+    out.push_back(c.name + ".s_A");
+    for (const std::string& p : c.provided) {
+      out.push_back(c.name + ".s_P." + p);
+      out.push_back(c.name + ".s_S." + p);
+    }
+    for (const std::string& r : c.required) out.push_back(c.name + ".s_R." + r);
+  }
+  return out;
+}
 
 ScenarioRunner::ScenarioRunner(spec::Scenario scenario, std::unique_ptr<System> system)
     : scenario_(std::move(scenario)),
@@ -39,43 +70,95 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(spec::Scenario scen
 
 Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSource& source, const FilterRegistry& registry,
                                                              Diagnostics* notes) {
-  spec::Scenario scenario;
+  // Every problem at once: the scenario's format problems and the names its readable steps use
+  // that the system does not have, in file order, then the system file's errors.
+  Diagnostics problems;
+  Diagnostics system_errors;
+  const auto sort_out = [&](const std::string& here) {
+    if (notes == nullptr) {
+      std::erase_if(problems, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
+      std::erase_if(system_errors, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
+    } else {
+      for (Diagnostics* list : {&problems, &system_errors}) {
+        for (spec::Diagnostic& d : *list) {
+          if (d.severity != spec::Diagnostic::Severity::Error) notes->push_back(std::move(d));
+        }
+        std::erase_if(*list, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
+      }
+    }
+    // Diagnostics of the scenario file first, by position; a format problem and a name problem
+    // of the same file are reported together, where they are.
+    std::stable_sort(problems.begin(), problems.end(), [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
+      const bool a_here = a.where.file == here;
+      const bool b_here = b.where.file == here;
+      if (a_here != b_here) return a_here;
+      if (a.where.line != b.where.line) return a.where.line < b.where.line;
+      return a.where.column < b.where.column;
+    });
+    problems.insert(problems.end(), std::make_move_iterator(system_errors.begin()), std::make_move_iterator(system_errors.end()));
+  };
+
+  std::optional<spec::Scenario> scenario;
+  bool complete = true;  // the scenario file has no format problem (else only its names are checked)
   if (!source.scenario.empty()) {
     spec::ScenarioLoad loaded = spec::load_scenario(source.scenario);
-    Diagnostics errors;
-    for (spec::Diagnostic& d : loaded.diagnostics) {
-      if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
-      else if (notes != nullptr) notes->push_back(std::move(d));
+    problems = std::move(loaded.diagnostics);
+    complete = loaded.scenario.has_value();
+    scenario = complete ? std::move(loaded.scenario) : std::move(loaded.partial);
+    if (!scenario) {  // unreadable, or not JSON: nothing more can be said
+      sort_out(source.scenario);
+      return tl::unexpected(std::move(problems));
     }
-    if (!errors.empty() || !loaded.scenario) return tl::unexpected(std::move(errors));
-    scenario = std::move(*loaded.scenario);
   } else {
-    scenario.period = to_seconds(kDefaultTick);
-    scenario.duration = 0.0;
+    scenario.emplace();
+    scenario->period = to_seconds(kDefaultTick);
+    scenario->duration = 0.0;
   }
-  if (!source.system.empty()) scenario.system = source.system;
-  if (scenario.system.empty()) {
-    return tl::unexpected(Diagnostics{spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{source.scenario, 0, 0},
-                                                       "a system file is needed (a SYSTEM, or a scenario that names one)", ""}});
+  if (!source.system.empty()) scenario->system = source.system;
+  std::unique_ptr<ScenarioRunner> runner;
+  if (scenario->system.empty()) {
+    if (problems.empty()) {
+      problems.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{source.scenario, 0, 0},
+                                          "a system file is needed (a SYSTEM, or a scenario that names one)", ""});
+    }
+  } else {
+    spec::LoadResult loaded = spec::load_system(scenario->system, registry);
+    system_errors = std::move(loaded.diagnostics);
+    if (loaded.ok() && loaded.system) {
+      SystemOptions options;
+      options.component_period = seconds_to_time(scenario->period);
+      auto built = build_system(std::move(*loaded.system), registry, options);
+      if (!built) {
+        system_errors.insert(system_errors.end(), built.error().begin(), built.error().end());
+      } else {
+        runner.reset(new ScenarioRunner(std::move(*scenario), std::move(*built)));
+        Diagnostics names = runner->check_names();
+        problems.insert(problems.end(), std::make_move_iterator(names.begin()), std::make_move_iterator(names.end()));
+      }
+    } else if (loaded.ok()) {
+      system_errors.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{scenario->system, 0, 0},
+                                               "cannot load system '" + scenario->system + "'", ""});
+    }
   }
-  spec::LoadResult loaded = spec::load_system(scenario.system, registry);
-  Diagnostics errors;
-  for (spec::Diagnostic& d : loaded.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
-    else if (notes != nullptr) notes->push_back(std::move(d));
-  }
-  if (!errors.empty()) return tl::unexpected(std::move(errors));
-  if (!loaded.system) {
-    return tl::unexpected(Diagnostics{spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{scenario.system, 0, 0},
-                                                       "cannot load system '" + scenario.system + "'", ""}});
-  }
-  return open(std::move(scenario), std::move(*loaded.system), registry);
+  sort_out(source.scenario);
+  if (!problems.empty() || !complete || !runner) return tl::unexpected(std::move(problems));
+  return runner;
 }
 
 Diagnostics ScenarioRunner::check_names() {
   Diagnostics out;
   const auto error_at = [this](const spec::ScenarioStep& s, std::string message) {
     return spec::Diagnostic{spec::Diagnostic::Severity::Error, scenario_.where(s), std::move(message), s.pointer()};
+  };
+  std::vector<std::string> signal_names;
+  for (const auto& sig : monitor_->signals().all()) signal_names.push_back(sig->name());
+  std::vector<std::string> filter_names;
+  for (const auto& f : monitor_->filters()) filter_names.push_back(f->name());
+  std::vector<std::string> event_names;
+  for (EventId e = 0; e < coordinator_.event_count(); ++e) event_names.push_back(coordinator_.event(e).name);
+  const std::vector<std::string> address_names = addresses();
+  const auto no_address = [&](const std::string& address, const std::string& message) {
+    return message + spec::did_you_mean(address, address_names);
   };
   for (const spec::ScenarioStep& s : scenario_.steps) {
     const spec::StepAction* action = s.action.get();  // null for a sample step
@@ -84,7 +167,9 @@ Diagnostics ScenarioRunner::check_names() {
         for (const auto& [name, values] : s.samples) {
           Signal* sig = monitor_->signals().find(name);
           if (sig == nullptr) {
-            out.push_back(error_at(s, "no signal '" + std::string(name) + "' (signals are written Component.signal)"));
+            const std::string suggestion = spec::did_you_mean(name, signal_names);
+            out.push_back(error_at(s, "no signal '" + std::string(name) + "'" +
+                                          (suggestion.empty() ? " (signals are written Component.signal)" : suggestion)));
           } else if (sig->size() != values.size()) {
             out.push_back(error_at(s, "signal '" + std::string(name) + "' has size " + std::to_string(sig->size()) +
                                                      ", the sample has " + std::to_string(values.size()) + " values"));
@@ -93,17 +178,19 @@ Diagnostics ScenarioRunner::check_names() {
         break;
       case spec::ScenarioStep::Kind::Ramp: {
         Signal* sig = monitor_->signals().find(action->signal);
-        if (sig == nullptr) out.push_back(error_at(s, "no signal '" + action->signal + "'"));
+        if (sig == nullptr) out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
         else if (sig->size() != 1) out.push_back(error_at(s, "a ramp needs a scalar signal; '" + action->signal + "' has size " + std::to_string(sig->size())));
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
         auto e = coordinator_.find_event(action->event);
         if (!e) {
-          out.push_back(error_at(s, e.error().message));
+          out.push_back(error_at(s, unknown("event", action->event, event_names)));
         } else if (!coordinator_.event(*e).is_broadcast()) {
           if (action->target.empty()) out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
-          else if (auto m = coordinator_.find_machine(action->target); !m) out.push_back(error_at(s, m.error().message));
+          else if (auto m = coordinator_.find_machine(action->target); !m) {
+            out.push_back(error_at(s, no_address(action->target, m.error().message)));
+          }
         }
         break;
       }
@@ -118,7 +205,7 @@ Diagnostics ScenarioRunner::check_names() {
         if (!action->filter.empty()) {
           Filter* f = monitor_->find_filter(action->filter);
           if (f == nullptr) {
-            out.push_back(error_at(s, "no filter '" + action->filter + "'"));
+            out.push_back(error_at(s, unknown("filter", action->filter, filter_names)));
           } else if (f->inputs().empty()) {
             out.push_back(error_at(s, "filter '" + action->filter + "' has no input"));
           } else {
@@ -132,14 +219,16 @@ Diagnostics ScenarioRunner::check_names() {
             }
           }
         } else if (Signal* sig = monitor_->signals().find(action->signal); sig == nullptr) {
-          out.push_back(error_at(s, "no signal '" + action->signal + "'"));
+          out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
         // The same rule as Coordinator::reset() and the console: a service state is derived, so a
         // reset of one would do nothing. Refused here, at load, rather than silently at run time.
-        if (auto a = coordinator_.resolve(action->target); !a) {
-          out.push_back(error_at(s, a.error().message));
+        if (coordinator_components(action->target) != nullptr) {
+          // A coordinator of the system file: all its components are reset (docs/semantics.md §4.5).
+        } else if (auto a = coordinator_.resolve(action->target); !a) {
+          out.push_back(error_at(s, no_address(action->target, a.error().message)));
         } else if (a->kind == Address::Kind::Service) {
           out.push_back(error_at(s, "cannot reset service state '" + action->target +
                                         "': it is derived; reset its component or a machine"));
@@ -149,22 +238,27 @@ Diagnostics ScenarioRunner::check_names() {
       case spec::ScenarioStep::Kind::ExpectOutstanding:
       case spec::ScenarioStep::Kind::ExpectCause:
         for (const auto& [address, expected] : action->expectations) {
+          if (coordinator_components(address) != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) continue;
           auto a = coordinator_.resolve(address);
           if (!a) {
-            out.push_back(error_at(s, a.error().message));
+            out.push_back(error_at(s, no_address(address, a.error().message)));
             continue;
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
             if (a->kind != Address::Kind::Component && a->kind != Address::Kind::Machine) {
               out.push_back(error_at(s, "expect_outstanding needs a component or a machine, not '" + address + "'"));
             } else if (expected != "none" && !coordinator_.find_event(expected)) {
-              out.push_back(error_at(s, "no event '" + expected + "'"));
+              out.push_back(error_at(s, unknown("event", expected, event_names)));
             }
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectCause) {
             const auto colon = expected.find(':');
-            if (auto m = coordinator_.find_machine(expected.substr(0, colon)); !m) out.push_back(error_at(s, m.error().message));
-            if (!coordinator_.find_event(expected.substr(colon + 1))) out.push_back(error_at(s, "no event '" + expected.substr(colon + 1) + "'"));
+            if (auto m = coordinator_.find_machine(expected.substr(0, colon)); !m) {
+              out.push_back(error_at(s, no_address(expected.substr(0, colon), m.error().message)));
+            }
+            if (!coordinator_.find_event(expected.substr(colon + 1))) {
+              out.push_back(error_at(s, unknown("event", expected.substr(colon + 1), event_names)));
+            }
           }
         }
         break;
@@ -194,13 +288,26 @@ void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
       }
       break;
     case spec::ScenarioStep::Kind::Reset:
-      (void)coordinator_.reset(action->target, "scenario", action->reason);
+      if (const auto* components = coordinator_components(action->target)) {
+        // A coordinator of the system: each of its components, as that coordinator's reset does.
+        for (const std::string& c : *components) (void)coordinator_.reset(c, "scenario", action->reason);
+      } else {
+        (void)coordinator_.reset(action->target, "scenario", action->reason);
+      }
       break;
     default: break;
   }
 }
 
 std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::string& address, const std::string& expected) {
+  if (const auto* components = coordinator_components(address); components != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) {
+    // The state of a coordinator of the system: the product of its components' (DESIGN §2.2).
+    State got = State::Normal;
+    for (const std::string& c : *components) got = std::max(got, coordinator_.state_of(*coordinator_.resolve(c)));
+    const State want = *parse_state(expected);
+    if (got == want) return {};
+    return address + " is " + std::string(to_string(got)) + ", expected " + std::string(to_string(want));
+  }
   const Address a = *coordinator_.resolve(address);
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Expect: {
@@ -323,6 +430,12 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
     // (3) expectations due at this tick.
     while (next_check_ < checks_.size() && seconds_to_time(checks_[next_check_]->at) <= now) check(*checks_[next_check_++], now, result);
   }
+}
+
+std::vector<spec::Diagnostic> check_scenario(const std::string& path, const FilterRegistry& registry,
+                                             const std::string& system_override) {
+  auto opened = ScenarioRunner::open(ScenarioSource{path, system_override}, registry);
+  return opened ? Diagnostics{} : std::move(opened.error());
 }
 
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,

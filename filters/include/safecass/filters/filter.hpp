@@ -113,7 +113,10 @@ public:
     if (ticks_) on_tick(now);
   }
   /// Shallow fault injection: each queued sample replaces the first input's samples for one run,
-  /// seen by this filter alone. Errors: InvalidArgument when a sample's size is not the input's.
+  /// seen by this filter alone. The end of the injection restores reality (DESIGN §3): the first
+  /// run after the queue ran out judges the first input's newest real sample once, as a new
+  /// sample, even when the signal has not changed since (a sensor that publishes only on change).
+  /// Errors: InvalidArgument when a sample's size is not the input's.
   Expected<void> inject(const std::vector<std::vector<double>>& samples);
   /// Forgets internal state and the detection (no completion is sent: the machine is reset
   /// separately). Call from the thread that runs the filter.
@@ -181,8 +184,10 @@ private:
   }
   /// run() for everything but the hot path: disabled, re-enabled, injected, several inputs.
   void run_general(Time now) noexcept;
-  void run_merged(bool injected_run) noexcept;
+  void run_merged(bool injected_run, bool restore, Time now) noexcept;
   bool run_injection(Time now) noexcept;
+  /// The first input's newest sample, judged again at `now` (the end of a shallow injection).
+  void restore_reality(Time now) noexcept;
 
   FilterConfig config_;
   Coordinator* coordinator_;
@@ -202,6 +207,7 @@ private:
   static constexpr std::uint8_t kInjection = 2;      ///< shallow injections queued
   static constexpr std::uint8_t kReenabled = 4;      ///< ran disabled: skip the samples it missed
   static constexpr std::uint8_t kSeveralInputs = 8;  ///< not exactly one input: merge
+  static constexpr std::uint8_t kRestore = 16;       ///< a shallow injection ended: judge reality once
   std::atomic<std::uint8_t> detour_{0};
   std::atomic<bool> detected_{false};
   std::vector<char> invalid_;       ///< per input: its last sample was not finite

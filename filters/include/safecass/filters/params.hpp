@@ -7,6 +7,8 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -65,9 +67,22 @@ struct FilterManifest {
   std::vector<std::string> inputs;    ///< names of the Signal/SignalList parameters read
   std::vector<std::string> outputs;   ///< names of the Signal parameters written
   bool generates_events = true;
+  /// Without its first output parameter, the filter writes the signal named after the filter
+  /// (default_output_name()), as the 2016 filters named their outputs themselves.
+  bool default_output = false;
+  /// Other names of parameters, as the 2016 files wrote them: {alias, parameter}
+  /// (ChangeDetection's `event` is its `event_onset`).
+  std::vector<std::pair<std::string, std::string>> aliases;
 
   const ParamSpec* find(std::string_view name) const noexcept;
+  /// The parameter `name` stands for: itself, or the parameter it is an alias of.
+  std::string_view canonical(std::string_view name) const noexcept;
 };
+
+/// The output a filter with `default_output` writes when none is given: a signal of the target
+/// component named after the filter (without a leading "component." and with the other dots
+/// made '_': filter "JR3.Derivative_2" of JR3 writes "JR3.Derivative_2", filter "rate" "JR3.rate").
+std::string default_output_name(std::string_view filter, std::string_view component);
 
 /// Checks `given` against `manifest` and fills in defaults: unknown names, wrong types,
 /// out-of-range values and missing required parameters are errors naming the parameter.

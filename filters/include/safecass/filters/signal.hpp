@@ -242,6 +242,10 @@ public:
   /// Copies `values` (size() doubles from elsewhere, e.g. a shallow injection) to where the next
   /// sample would be read, so that it can be kept like one; returns that copy.
   const double* stage(const double* values) noexcept;
+  /// Copies the signal's newest sample (Signal::latest) to where the next sample would be read,
+  /// as stage() does, and skips every sample written so far; false when the signal has none.
+  /// Lock-free, allocation-free.
+  bool stage_latest(SampleView& out) noexcept;
   std::uint64_t missed() const noexcept { return missed_; }
   const Signal* signal() const noexcept { return signal_; }
 

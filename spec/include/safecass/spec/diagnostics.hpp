@@ -4,6 +4,8 @@
 /// and its JSON pointer, formatted the way compilers do so that editors can jump to them.
 
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace safecass::spec {
 
@@ -16,20 +18,26 @@ struct Position {
 };
 
 /// One problem. Errors make a specification unusable; warnings point at something that is
-/// probably not what the author meant but can still be loaded.
+/// probably not what the author meant but can still be loaded. Notes say what the loader did with
+/// something it accepts but does not use (a 2016 key it ignores); they are never among
+/// LoadResult::diagnostics, only in LoadResult::notes (`safecass validate --verbose`).
 struct Diagnostic {
-  enum class Severity { Error, Warning } severity = Severity::Error;
+  enum class Severity { Error, Warning, Note } severity = Severity::Error;
   Position where;
   std::string message;
   std::string pointer;  ///< JSON pointer of the value in its file, e.g. /filter/1/argument/threshold
 };
 
-/// "file:line:col: error: message [pointer]" ("warning:" likewise). The " [pointer]" part is left
+/// "file:line:col: error: message [pointer]" ("warning:", "note:" likewise). The " [pointer]" part is left
 /// out when the pointer is empty (the whole document), the ":line:col" part when line is 0.
 std::string format(const Diagnostic& diagnostic);
 
 /// One diagnostic as a one-line JSON object:
-/// {"file": ..., "line": L, "column": C, "severity": "error"|"warning", "message": ..., "pointer": ...}.
+/// {"file": ..., "line": L, "column": C, "severity": "error"|"warning"|"note", "message": ..., "pointer": ...}.
 std::string to_json(const Diagnostic& diagnostic);
+
+/// "; did you mean 'x'?" when one of `candidates` is near enough to `word` to be a likely typo,
+/// else "". The suggestion rule of every diagnostic (specifications, scenarios).
+std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates);
 
 }  // namespace safecass::spec

@@ -27,6 +27,9 @@ struct LoadResult {
   std::optional<SystemSpec> system;
   /// Sorted by file (the loaded file first, then included files in load order), line, column.
   std::vector<Diagnostic> diagnostics;
+  /// Notes (Severity::Note): what was accepted and ignored, e.g. a 2016 `debug` key; sorted the
+  /// same way. Shown by `safecass validate --verbose`.
+  std::vector<Diagnostic> notes;
 
   /// No Error diagnostics.
   bool ok() const;

@@ -150,11 +150,17 @@ struct Scenario {
 };
 
 struct ScenarioLoad {
-  std::optional<Scenario> scenario;
+  std::optional<Scenario> scenario;     ///< present when there is no diagnostic
   std::vector<Diagnostic> diagnostics;  ///< every problem found, with line:col
+  /// With diagnostics (and no syntax error): what could be read, the steps without a problem,
+  /// so that their names can still be checked against the system in the same pass
+  /// (runner::check_scenario): one run reports every problem of the file.
+  std::optional<Scenario> partial;
 };
 
-/// Reads and checks a scenario file (format only; names are checked against the system when it runs).
+/// Reads and checks a scenario file (format only; names are checked against the system when it
+/// runs, or all at once by runner::check_scenario). An expectation after the duration is an
+/// error: it would never be checked.
 ScenarioLoad load_scenario(const std::string& path);
 
 /// read_regular_file() (file.hpp) with its default limit, for callers that want a flag and a

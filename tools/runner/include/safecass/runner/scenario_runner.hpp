@@ -109,6 +109,10 @@ private:
   /// Every name the scenario uses, checked against the built system.
   Diagnostics check_names();
   void apply(const spec::ScenarioStep& step, Time now);
+  /// The components a coordinator of the system file runs, or nullptr when `name` is none.
+  const std::vector<std::string>* coordinator_components(const std::string& name) const;
+  /// Every address of the system, for suggestions: SYSTEM, coordinators, components, machines, services.
+  std::vector<std::string> addresses() const;
   void split_steps();
   void check(const spec::ScenarioStep& step, Time now, RunResult& result);
   std::string check_one(const spec::ScenarioStep& step, const std::string& address, const std::string& expected);
@@ -137,5 +141,13 @@ private:
 /// run's details.
 int run_scenario_file(const std::string& path, const FilterRegistry& registry, const RunOptions& options,
                       RunResult* result = nullptr, std::FILE* err = stderr);
+
+/// Every problem of a scenario at once, as `safecass run` reports them: the format problems of
+/// the file (spec::load_scenario) and the names its readable steps use that the system does not
+/// have (with "did you mean" suggestions), in file order (line, column),
+/// then the errors of the system file if it does not load. Empty = the scenario can run.
+/// `system_override` replaces the scenario's "system", as RunOptions::system_override does.
+std::vector<spec::Diagnostic> check_scenario(const std::string& path, const FilterRegistry& registry,
+                                             const std::string& system_override = {});
 
 }  // namespace safecass::runner
