@@ -5,12 +5,15 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/record/input_log.hpp"
 #include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 
@@ -184,6 +187,59 @@ TEST(ReplayDiff, ASystemComparedWithItselfNeverDiffers) {
   const Ran r = replay(options(kData + "arm.json", kData + "arm_ok.csv"), kData + "arm.json");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("never differ"));
+}
+
+long peak_rss_kib() {
+  rusage u{};
+  ::getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+/// A log of `ticks` milliseconds of ARM.Force and ARM.Temperature, as a recording and as CSV.
+void write_large_logs(int ticks, const std::string& recording, const std::string& csv) {
+  std::ofstream rec(recording, std::ios::binary);
+  std::FILE* c = std::fopen(csv.c_str(), "w");
+  std::fprintf(c, "time,ARM.Force[0],ARM.Force[1],ARM.Force[2],ARM.Temperature\n");
+  std::string out;
+  InputLogHeader h;
+  h.period = std::chrono::milliseconds(1);
+  input_log::put_header(out, h);
+  input_log::put_signal(out, 0, 3, "ARM.Force");
+  input_log::put_signal(out, 1, 1, "ARM.Temperature");
+  for (int t = 0; t < ticks; ++t) {
+    const double force[3] = {0.0, 0.0, 10.0 + (t % 100) * 0.01};
+    const double temperature = 20.0;
+    input_log::put_time(out, std::chrono::milliseconds(t));
+    input_log::put_sample(out, 0, force, 3);
+    input_log::put_sample(out, 1, &temperature, 1);
+    std::fprintf(c, "%.3f,0,0,%.2f,20\n", t * 0.001, force[2]);
+    if (out.size() > (1 << 20)) {
+      rec << out;
+      out.clear();
+    }
+  }
+  rec << out;
+  std::fclose(c);
+}
+
+TEST(ReplayMemory, ALogIsStreamedMemoryStaysBoundedWhateverItsSize) {
+  const std::string recording = scratch("large.inputs");
+  const std::string csv = scratch("large.csv");
+  write_large_logs(1000000, recording, csv);  // about 47 MB and 24 MB: 1000 s of log
+  const Ran warm = replay(options(kData + "arm.json", kData + "arm_ok.csv"));
+  ASSERT_EQ(warm.code, 0) << warm.err;
+  const long before = peak_rss_kib();
+  const Ran r = replay(options(kData + "arm.json", recording));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("replayed 2000000 samples"));
+  const Ran c = replay(options(kData + "arm.json", csv));
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_THAT(c.err, HasSubstr("replayed 2000000 samples"));
+  const long grown = peak_rss_kib() - before;
+  // Loading either log whole would take tens of megabytes; streaming takes a few buffers.
+  EXPECT_LT(grown, 8 * 1024) << "the peak resident size grew by " << grown << " KiB";
+  std::remove(recording.c_str());
+  std::remove(csv.c_str());
 }
 
 }  // namespace
