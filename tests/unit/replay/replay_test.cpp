@@ -148,6 +148,13 @@ TEST(ReplayRecording, TheRecordingOfARunReplaysToTheSameTransitionsAndTheSameHis
   EXPECT_EQ(read_text(o.record_inputs), read_text(inputs)) << "the replay's own recording differs";
 }
 
+TEST(ReplayCsv, ALogThatCannotBeReadIsAnIoErrorWithThePathAndReason) {
+  const Ran r = replay(options(kData + "arm.json", kData + "no_such_log.csv"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_EQ(r.err, "cannot read log '" + kData + "no_such_log.csv': No such file or directory\n");
+  EXPECT_EQ(r.out, "");
+}
+
 TEST(ReplayRecording, ATruncatedRecordingReplaysUpToItsLastWholeRecordAndSaysSo) {
   const std::string inputs = record_story("cut");
   std::string bytes = read_text(inputs);

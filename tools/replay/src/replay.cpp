@@ -36,7 +36,7 @@ std::string secs(Time t) {
 std::string sniff(const std::string& path) {
   char head[16] = {};
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return "csv";  // opening it again says why it cannot be read
+  if (fd < 0) return "";  // open_input() says why it cannot be read
   const ssize_t n = ::read(fd, head, sizeof head);
   ::close(fd);
   const std::string_view h(head, n > 0 ? static_cast<std::size_t>(n) : 0);
@@ -46,6 +46,12 @@ std::string sniff(const std::string& path) {
 }
 
 Expected<std::unique_ptr<InputSource>> open_input(const ReplayOptions& o, const std::string& format) {
+  if (format.empty()) {
+    const int fd = ::open(o.input.c_str(), O_RDONLY | O_CLOEXEC);
+    const int error = errno;
+    if (fd >= 0) ::close(fd);
+    return fail(ErrorCode::Io, "cannot read log '" + o.input + "': " + std::strerror(fd >= 0 ? EIO : error));
+  }
   if (format == "recording") {
     auto reader = InputLogReader::open(o.input);
     if (!reader) return tl::unexpected(reader.error());
