@@ -9,10 +9,11 @@ packages=(
   libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev
   clang libclang-rt-14-dev
 )
-# ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, the messages,
+# ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (`safecass
+# replay` of a bag), the messages,
 # diagnostic_aggregator and rosdiagnostic; unshare/ip for the loopback-only test namespace.
 packages+=(
-  ros-core libroscpp-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev
+  ros-core libroscpp-dev librosbag-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev
   libdiagnostic-msgs-dev python3-diagnostic-msgs libdiagnostic-aggregator-tools rosdiagnostic
   python3-dateutil util-linux iproute2
 )

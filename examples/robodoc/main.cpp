@@ -123,10 +123,17 @@ int main(int argc, char** argv) {
               result.failures.size());
   for (const std::string& f : result.failures) std::printf("  %s\n", f.c_str());
   if (!history_path.empty()) std::printf("The whole history (every event, transition, reset) is in %s\n", history_path.c_str());
-  // Nothing lost silently: a history with a write error or dropped records is said and fails the run.
+  if (result.inputs) {
+    std::printf("What the system was fed is in %s (safecass replay feeds it through a changed spec)\n",
+                result.inputs->path.c_str());
+  }
+  // Nothing lost silently: a recording with a write error or dropped records is said and fails the run.
+  if (result.inputs) {
+    for (const std::string& loss : describe_losses(*result.inputs)) std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
+  }
   if (result.record) {
     for (const std::string& loss : describe_losses(*result.record)) std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
-    if (!result.history_complete()) return 2;
   }
+  if (!result.history_complete()) return 2;
   return result.passed() ? 0 : 1;
 }

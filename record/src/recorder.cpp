@@ -1,5 +1,7 @@
 #include "safecass/record/recorder.hpp"
 
+#include "segmented_file.hpp"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -190,14 +192,16 @@ std::string record_status_json(const RecordStatus& s) {
   return out;
 }
 
-Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) return fail(ErrorCode::Io, "cannot write history file '" + path + "': " + std::strerror(errno));
-  return std::unique_ptr<Recorder>(new Recorder(coordinator, fd, path, capacity));
+Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity,
+                                                   FileLimits limits) {
+  auto file = detail::SegmentedFile::open(path, limits);
+  if (!file) return fail(ErrorCode::Io, "cannot write history file '" + path + "': " + file.error().message);
+  return std::unique_ptr<Recorder>(
+      new Recorder(coordinator, std::make_unique<detail::SegmentedFile>(std::move(*file)), capacity));
 }
 
-Recorder::Recorder(Coordinator& coordinator, int fd, std::string path, std::size_t capacity)
-    : coordinator_(coordinator), fd_(fd), path_(std::move(path)), capacity_(capacity == 0 ? 1 : capacity) {
+Recorder::Recorder(Coordinator& coordinator, std::unique_ptr<detail::SegmentedFile> file, std::size_t capacity)
+    : coordinator_(coordinator), file_(std::move(file)), path_(file_->path()), capacity_(capacity == 0 ? 1 : capacity) {
   thread_ = std::thread([this] { writer(); });
   subscription_ = coordinator_.subscribe([this](const Record& r) {
     std::lock_guard lock(mutex_);
@@ -225,31 +229,10 @@ void Recorder::close() {
     ready_.notify_one();
   }
   if (thread_.joinable()) thread_.join();
-  if (fd_ >= 0) {
-    // close() may report what a write could not (NFS, a delayed I/O error).
-    const bool closed = ::close(fd_) == 0;
-    const int error = errno;
-    fd_ = -1;
-    std::lock_guard lock(mutex_);
-    if (!closed && write_error_.empty()) write_error_ = std::strerror(error);
-  }
-}
-
-bool Recorder::write_line(const std::string& line) {
-  std::size_t done = 0;
-  while (done < line.size()) {
-    const ssize_t n = ::write(fd_, line.data() + done, line.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return false;
-    }
-    if (n == 0) {
-      errno = EIO;
-      return false;
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  return true;
+  // close() may report what a write could not (NFS, a delayed I/O error).
+  const bool closed = file_->close();
+  std::lock_guard lock(mutex_);
+  if (!closed && write_error_.empty()) write_error_ = file_->error();
 }
 
 void Recorder::writer() {
@@ -278,13 +261,14 @@ void Recorder::writer() {
       // One write() per line, newline included: a kill leaves at most the last line torn.
       line += '\n';
       lock.unlock();
-      const bool ok = write_line(line);
-      const int error = errno;
+      const bool ok = file_->write(line);
       lock.lock();
+      rotations_ = file_->rotations();
+      discarded_ = file_->discarded();
       if (ok) {
         written_ += record ? 1 : 0;
       } else {
-        write_error_ = std::strerror(error);
+        write_error_ = file_->error();
         unwritten_ += record ? 1 : 0;
       }
     }
@@ -304,7 +288,7 @@ std::uint64_t Recorder::written() const {
 
 RecordStatus Recorder::status() const {
   std::lock_guard lock(mutex_);
-  return RecordStatus{path_, written_, dropped_, unwritten_, write_error_};
+  return RecordStatus{path_, written_, dropped_, unwritten_, write_error_, rotations_, discarded_};
 }
 
 }  // namespace safecass

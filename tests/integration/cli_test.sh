@@ -63,14 +63,15 @@ case $case_name in
     grep -q "s.json:2:.*: error: number 1e999 is out of range" "$tmp/err" || fail "message: $(cat "$tmp/err")"
     ;;
   run_record_write_error_is_said_and_fails_after_the_whole_run)
-    "$safecass" run --scenario examples/force_sensor/scenario.json --record /dev/full >"$tmp/out" 2>"$tmp/err"
+    # (--record-inputs -: no inputs recording, which would go next to /dev/full)
+    "$safecass" run --scenario examples/force_sensor/scenario.json --record /dev/full --record-inputs - >"$tmp/out" 2>"$tmp/err"
     expect_code 2 $? "record to /dev/full"
     grep -q "history file '/dev/full': write error after 0 records: No space left on device; [1-9][0-9]* records were not written" "$tmp/err" \
       || fail "message: $(cat "$tmp/err")"
     grep -q "scenario.json: 10 expectations checked, 0 failed; the history file is incomplete" "$tmp/out" || fail "the run went on: $(cat "$tmp/out")"
     # --json: the same records, then the recorder's status as a last line.
     "$safecass" run --scenario examples/force_sensor/scenario.json --json >"$tmp/plain" 2>/dev/null; expect_code 0 $? "plain"
-    "$safecass" run --scenario examples/force_sensor/scenario.json --json --record /dev/full >"$tmp/json" 2>/dev/null
+    "$safecass" run --scenario examples/force_sensor/scenario.json --json --record /dev/full --record-inputs - >"$tmp/json" 2>/dev/null
     expect_code 2 $? "json to /dev/full"
     head -n -1 "$tmp/json" | cmp -s - "$tmp/plain" || fail "the run's output changed"
     tail -n 1 "$tmp/json" | grep -q '^{"kind":"recorder","path":"/dev/full","written":0,"dropped":0,"unwritten":[1-9][0-9]*,"write_error":true,"error":"No space left on device","complete":false}$' \
@@ -82,6 +83,64 @@ case $case_name in
     n=$(wc -l <"$tmp/h.jsonl")
     tail -n 1 "$tmp/json" | grep -q "^{\"kind\":\"recorder\",\"path\":\"$tmp/h.jsonl\",\"written\":$n,\"dropped\":0,\"unwritten\":0,\"write_error\":false,\"complete\":true}\$" \
       || fail "status line: $(tail -n 1 "$tmp/json") ($n lines)"
+    ;;
+  replay_of_a_recorded_run_prints_the_same_transitions_and_history_byte_for_byte)
+    # The demo's story, recorded (history + inputs), replayed through the same system.
+    "$safecass" run --scenario examples/robodoc/story.json --record "$tmp/run.jsonl" >"$tmp/run.txt" 2>"$tmp/err"
+    expect_code 0 $? "run"
+    [ -s "$tmp/run.inputs" ] || fail "no inputs recorded next to the history"
+    head -c 16 "$tmp/run.inputs" | grep -q '^SAFECASS-INPUTS ' || fail "not a recording: $(head -c 40 "$tmp/run.inputs")"
+    "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/run.inputs" --record "$tmp/replay.jsonl" >"$tmp/replay.txt" 2>"$tmp/err"
+    expect_code 0 $? "replay: $(cat "$tmp/err")"
+    grep -q "JR3.s_A  Warning -> Error" "$tmp/replay.txt" || fail "no force error in the replay"
+    head -n -1 "$tmp/run.txt" | cmp - "$tmp/replay.txt" || fail "the replay printed other transitions than the run"
+    cmp "$tmp/run.jsonl" "$tmp/replay.jsonl" || fail "the replay's history differs from the run's"
+    cmp "$tmp/run.inputs" "$tmp/replay.inputs" || fail "the replay's own inputs recording differs from the run's"
+    # The same with --json.
+    "$safecass" run --scenario examples/robodoc/story.json --json --record "$tmp/j.jsonl" >"$tmp/run.json" 2>/dev/null
+    "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/j.inputs" --json >"$tmp/replay.json" 2>/dev/null
+    expect_code 0 $? "replay --json"
+    head -n -2 "$tmp/run.json" | cmp - "$tmp/replay.json" || fail "--json: the replay printed other records than the run"
+    ;;
+  run_killed_leaves_a_recording_every_record_of_which_replays)
+    # A long run killed with SIGKILL while it records: the inputs replay up to their last whole record.
+    printf '{ "system": "%s/examples/robodoc/robodoc.json", "period": 0.001, "duration": 5000,
+  "steps": [ { "at": 0, "ramp": { "signal": "JR3.Fz", "from": 5, "to": 45, "until": 5000 } } ] }
+' "$PWD" >"$tmp/long.json"
+    "$safecass" run --scenario "$tmp/long.json" --record "$tmp/long.jsonl" >/dev/null 2>&1 &
+    pid=$!
+    sleep 1.5
+    kill -9 $pid; wait $pid 2>/dev/null
+    [ -s "$tmp/long.inputs" ] || fail "nothing was recorded before the kill (flushed at least every 100 ms)"
+    "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/long.inputs" >"$tmp/out" 2>"$tmp/err"
+    expect_code 0 $? "replay of a killed run's recording: $(cat "$tmp/err")"
+    grep -Eq "note: .*long.inputs: the recording (ends inside a record|has no end record)" "$tmp/err" || fail "the cut is not said: $(cat "$tmp/err")"
+    grep -q "replayed [1-9][0-9]* samples" "$tmp/err" || fail "nothing replayed: $(cat "$tmp/err")"
+    # The history of the killed run: every line but the last is whole JSON.
+    head -n -1 "$tmp/long.jsonl" | while IFS= read -r line; do
+      case $line in '{'*'}') ;; *) fail "torn history line: $line" ;; esac
+    done
+    ;;
+  run_max_bytes_rotates_the_recordings_instead_of_filling_the_disk)
+    "$safecass" run --scenario examples/robodoc/story.json --record "$tmp/r.jsonl" --max-bytes 16384 --json >"$tmp/out" 2>"$tmp/err"
+    expect_code 0 $? "run with --max-bytes: $(cat "$tmp/err")"
+    for f in "$tmp/r.inputs" "$tmp/r.inputs.1" "$tmp/r.jsonl" "$tmp/r.jsonl.1"; do
+      [ -f "$f" ] || fail "no $f"
+      [ "$(stat -c %s "$f")" -le 16384 ] || fail "$f is larger than 16384 bytes"
+    done
+    [ -e "$tmp/r.inputs.4" ] && fail "more than 3 old segments kept"
+    grep -q '"kind":"input_recorder".*"rotations":[1-9]' "$tmp/out" || fail "rotations not reported: $(grep input_recorder "$tmp/out")"
+    # Each segment replays on its own.
+    "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/r.inputs.1" >/dev/null 2>"$tmp/err"
+    expect_code 0 $? "replay of a rotated segment: $(cat "$tmp/err")"
+    ;;
+  replay_diff_names_where_a_lower_force_limit_changes_the_states)
+    "$safecass" run --scenario examples/robodoc/story.json --record "$tmp/s.jsonl" >/dev/null 2>&1
+    "$safecass" replay --diff tests/data/replay/robodoc_low_limit.json examples/robodoc/robodoc.json --input "$tmp/s.inputs" >"$tmp/out" 2>"$tmp/err"
+    expect_code 1 $? "diff: $(cat "$tmp/err")"
+    grep -q "^  0.452000 .. 0.486000 s  B Error, A Warning  first cause (B): JR3.s_A:EVT_FORCE_ERROR" "$tmp/out" || fail "interval: $(cat "$tmp/out")"
+    "$safecass" replay --diff examples/robodoc/robodoc.json examples/robodoc/robodoc.json --input "$tmp/s.inputs" >"$tmp/out" 2>"$tmp/err"
+    expect_code 0 $? "diff of a system with itself"
     ;;
   run_records_history_as_json_lines)
     "$safecass" run --scenario examples/force_sensor/scenario.json --record "$tmp/h.jsonl" >/dev/null; expect_code 0 $? "run"

@@ -1,8 +1,13 @@
 #pragma once
 // Entry points of the safecass subcommands.
 
+#include <cstdint>
 #include <string>
 #include <vector>
+
+namespace CLI {
+class App;
+}
 
 namespace safecass::tools {
 
@@ -15,6 +20,8 @@ struct RunArgs {
   std::string scenario;
   bool json = false;
   std::string record;
+  std::string record_inputs;  ///< --record-inputs FILE ("-": none; default next to --record)
+  std::uint64_t max_bytes = 0;  ///< --max-bytes: rotate the recordings at this size
   // Multi-process runs (middleware_commands.hpp): one coordinator of the system, in real time.
   std::string coordinator;   ///< --coordinator: run only this coordinator's components
   std::string ice;           ///< --ice HOST:PORT: join the system through IceStorm
@@ -37,5 +44,8 @@ struct TestArgs {
 };
 /// `safecass test`: 0 all passed, 1 some failed, 2 invalid input.
 int run_test(const TestArgs& args);
+
+/// Adds `safecass replay` (replay_command.cpp); its callback stores the exit code in `code`.
+void add_replay_command(CLI::App& app, int& code);
 
 }  // namespace safecass::tools

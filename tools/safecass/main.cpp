@@ -45,7 +45,13 @@ int main(int argc, char** argv) {
   run->add_flag("--json", run_args.json, "one JSON object per line (byte-identical across runs)");
   run->add_option("--record", run_args.record,
                   "write the whole history (JSON lines) to this file; a write error or dropped records are said on "
-                  "stderr (and with --json in a last {\"kind\":\"recorder\"} line) and make the exit code 2");
+                  "stderr (and with --json in a last {\"kind\":\"recorder\"} line) and make the exit code 2; the inputs "
+                  "(samples and actions) are recorded next to it (FILE.jsonl -> FILE.inputs; docs/record-format.md)");
+  run->add_option("--record-inputs", run_args.record_inputs,
+                  "record the inputs to this file instead of next to --record (\"-\": do not record them)");
+  run->add_option("--max-bytes", run_args.max_bytes,
+                  "rotate each recording at this many bytes (FILE -> FILE.1 .. FILE.3, the oldest deleted) instead of filling the disk")
+      ->check(CLI::Range(std::uint64_t{4096}, std::uint64_t{1} << 62));
 #ifdef SAFECASS_WITH_ICE
   safecass::tools::add_middleware_options(*run, run_args);
   safecass::tools::add_supervisor_command(app, code);
@@ -59,6 +65,7 @@ int main(int argc, char** argv) {
   test->add_option("--junit", test_args.junit, "write JUnit XML to this file");
   test->callback([&] { code = safecass::tools::run_test(test_args); });
 
+  safecass::tools::add_replay_command(app, code);
   safecass::tools::add_console_command(app, code);
 #ifdef SAFECASS_WITH_VIEWER
   safecass::tools::add_viewer_command(app, code);

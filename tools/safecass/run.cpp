@@ -42,6 +42,8 @@ int run_run(const RunArgs& args) {
   runner::RunOptions options;
   options.json = args.json;
   options.record_path = args.record;
+  options.inputs_path = args.record_inputs;
+  options.limits.max_bytes = args.max_bytes;
   options.system_override = args.system;
   runner::RunResult result;
   const int code = runner::run_scenario_file(args.scenario, registry, options, &result);

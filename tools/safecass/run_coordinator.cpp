@@ -27,6 +27,7 @@
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/runner/system.hpp"
@@ -54,6 +55,7 @@ struct Driver {
   Time start;
   int failures = 0;
   int checks = 0;
+  InputRecorder* inputs = nullptr;  ///< records the actions it applies (with --record)
 
   bool local_machine(const std::string& address) const {
     auto a = co.resolve(address);
@@ -96,20 +98,30 @@ struct Driver {
         break;  // handled by the ramp thread
       case spec::ScenarioStep::Kind::Generate:
         if (local_machine(a->target)) {
+          if (inputs != nullptr) inputs->generate(a->event, a->target);
           if (auto r = co.generate(a->event, a->target); !r) say("scenario: generate: " + r.error().message);
         }
         break;
       case spec::ScenarioStep::Kind::Inject:
         if (!a->deep) {
-          if (monitor.find_filter(a->filter) != nullptr) (void)monitor.inject_shallow(a->filter, a->values);
+          if (monitor.find_filter(a->filter) != nullptr) {
+            if (inputs != nullptr) inputs->inject_shallow(a->filter, a->values);
+            (void)monitor.inject_shallow(a->filter, a->values);
+          }
         } else {
           std::string signal = a->signal;
           if (!a->filter.empty() && monitor.find_filter(a->filter) != nullptr) signal = monitor.find_filter(a->filter)->inputs()[0]->name();
-          if (monitor.signals().find(signal) != nullptr) (void)monitor.inject_deep(signal, a->values, now);
+          if (monitor.signals().find(signal) != nullptr) {
+            if (inputs != nullptr) inputs->inject_deep(signal, a->values);
+            (void)monitor.inject_deep(signal, a->values, now);
+          }
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
-        if (local_machine(a->target)) (void)co.reset(a->target, "scenario", a->reason);
+        if (local_machine(a->target)) {
+          if (inputs != nullptr) inputs->reset(a->target, "scenario", a->reason);
+          (void)co.reset(a->target, "scenario", a->reason);
+        }
         break;
       default: {
         for (const auto& [address, expected] : a->expectations) {
@@ -247,12 +259,32 @@ int run_coordinator(const RunArgs& args) {
   // The durable history: opened before anything runs, so it holds every record of the process.
   std::unique_ptr<Recorder> recorder;
   if (!args.record.empty()) {
-    auto opened = Recorder::open(co, args.record);
+    auto opened = Recorder::open(co, args.record, 65536, FileLimits{args.max_bytes});
     if (!opened) {
       std::fprintf(stderr, "safecass run: %s\n", opened.error().message.c_str());
       return 2;
     }
     recorder = std::move(*opened);
+  }
+
+  // The inputs (samples of the local input signals, and the scenario's actions) next to the
+  // history: read from the signals' buffers every 10 ms by the recorder's own thread.
+  std::unique_ptr<InputRecorder> inputs;
+  const std::string inputs_path = !args.record_inputs.empty() ? args.record_inputs
+                                  : args.record.empty()       ? std::string()
+                                                              : InputRecorder::path_for_history(args.record);
+  if (!inputs_path.empty() && inputs_path != "-") {
+    InputRecorderOptions o;
+    o.limits.max_bytes = args.max_bytes;
+    o.period = system_options.component_period;
+    o.clock = "steady";
+    auto opened = InputRecorder::open(monitor, inputs_path, o);
+    if (!opened) {
+      std::fprintf(stderr, "safecass run: %s\n", opened.error().message.c_str());
+      return 2;
+    }
+    inputs = std::move(*opened);
+    inputs->start_polling();
   }
 
   std::string token;
@@ -331,6 +363,7 @@ int run_coordinator(const RunArgs& args) {
   std::unique_ptr<Driver> d;
   if (scenario) {
     d = std::make_unique<Driver>(Driver{co, monitor, *scenario, start});
+    d->inputs = inputs.get();
     driver = std::thread([&] { d->run(g_stop); });
   }
   while (!g_stop.load() && (duration <= 0 || clock.now() - start < seconds_to_time(duration))) {
@@ -355,6 +388,17 @@ int run_coordinator(const RunArgs& args) {
   int code = failures == 0 ? 0 : 1;
   bool history_complete = true;
   std::string recorder_status;
+  if (inputs) {
+    inputs->close();
+    const InputRecordStatus status = inputs->status();
+    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
+    std::fflush(stderr);
+    if (!status.complete()) {
+      history_complete = false;
+      code = 2;
+    }
+    if (args.json) recorder_status = record_status_json(status);
+  }
   if (recorder) {
     // Every thread that makes records has stopped: what is queued is the end of the history.
     recorder->close();
@@ -362,9 +406,9 @@ int run_coordinator(const RunArgs& args) {
     // Nothing lost silently: a history that misses records is said, and fails the command.
     for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
     std::fflush(stderr);
-    history_complete = status.complete();
+    history_complete = history_complete && status.complete();
     if (!history_complete) code = 2;
-    if (args.json) recorder_status = record_status_json(status);
+    if (args.json) recorder_status += (recorder_status.empty() ? "" : "\n") + record_status_json(status);
   }
   say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
       std::string(to_string(co.coordinator_state())) +

@@ -1,16 +1,25 @@
-// safecass_ros1_node MAPPING.json [ROS remappings...]
+// safecass_ros1_node MAPPING.json [--record HISTORY.jsonl] [--max-bytes N] [ROS remappings...]
 //
 // A SAFECASS node for a ROS 1 graph: it shadows the nodes named in the mapping file with the
 // Generic Component Model of the system spec, feeds their topics into signals, publishes the GCM
-// states on /diagnostics and turns other nodes' diagnostics into events. Exit status: 0 after a
-// normal shutdown, 2 for a bad mapping or spec, 3 when no master can be reached.
+// states on /diagnostics and turns other nodes' diagnostics into events. With --record, the history
+// goes to HISTORY.jsonl and the samples fed to the spec's signals next to it (HISTORY.inputs,
+// docs/record-format.md), which `safecass replay` feeds through the spec again. Exit status: 0 after
+// a normal shutdown, 2 for a bad mapping or spec or an incomplete recording, 3 when no master can
+// be reached.
 
 #include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <string>
 
 #include <ros/ros.h>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/record/input_recorder.hpp"
+#include "safecass/record/recorder.hpp"
 #include "safecass/ros1/bridge.hpp"
+#include "safecass/spec/load.hpp"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "safecass");
@@ -20,10 +29,51 @@ int main(int argc, char** argv) {
   }
   safecass::FilterRegistry registry;
   safecass::register_builtin_filters(registry);
+  std::string record;
+  safecass::FileLimits limits;
+  for (int i = 2; i + 1 < argc; i += 2) {
+    const std::string flag = argv[i];
+    if (flag == "--record") {
+      record = argv[i + 1];
+    } else if (flag == "--max-bytes") {
+      limits.max_bytes = std::strtoull(argv[i + 1], nullptr, 10);
+    } else {
+      std::fprintf(stderr, "safecass_ros1_node: unknown option '%s'\n", argv[i]);
+      return 2;
+    }
+  }
   auto bridge = safecass::ros1::Bridge::create(argv[1], registry);
   if (!bridge) {
     std::fprintf(stderr, "%s\n", bridge.error().message.c_str());
     return 2;
+  }
+  // The history and the inputs, opened before anything runs. The inputs are the signals of the
+  // spec (not the bridge's own topic rates and ages), so the spec alone replays them.
+  std::unique_ptr<safecass::Recorder> history;
+  std::unique_ptr<safecass::InputRecorder> inputs;
+  if (!record.empty()) {
+    auto h = safecass::Recorder::open((*bridge)->coordinator(), record, 65536, limits);
+    if (!h) {
+      std::fprintf(stderr, "safecass_ros1_node: %s\n", h.error().message.c_str());
+      return 2;
+    }
+    history = std::move(*h);
+    safecass::InputRecorderOptions o;
+    o.limits = limits;
+    o.clock = "steady";
+    const safecass::spec::LoadResult system = safecass::spec::load_system((*bridge)->mapping().system, registry);
+    if (system.system) {
+      for (const auto& c : system.system->components) {
+        for (const auto& sig : c.signals) o.signals.push_back(sig.name);
+      }
+    }
+    auto in = safecass::InputRecorder::open((*bridge)->monitor(), safecass::InputRecorder::path_for_history(record), o);
+    if (!in) {
+      std::fprintf(stderr, "safecass_ros1_node: %s\n", in.error().message.c_str());
+      return 2;
+    }
+    inputs = std::move(*in);
+    inputs->start_polling();
   }
   if (auto r = (*bridge)->start(); !r) {
     std::fprintf(stderr, "safecass_ros1_node: %s\n", r.error().message.c_str());
@@ -33,5 +83,16 @@ int main(int argc, char** argv) {
            std::string((*bridge)->coordinator().name()).c_str());
   ros::spin();
   (*bridge)->stop();
-  return 0;
+  int code = 0;
+  if (inputs) {
+    inputs->close();
+    for (const std::string& loss : safecass::describe_losses(inputs->status())) std::fprintf(stderr, "%s\n", loss.c_str());
+    if (!inputs->status().complete()) code = 2;
+  }
+  if (history) {
+    history->close();
+    for (const std::string& loss : safecass::describe_losses(history->status())) std::fprintf(stderr, "%s\n", loss.c_str());
+    if (!history->status().complete()) code = 2;
+  }
+  return code;
 }

@@ -124,13 +124,27 @@ def history_holds_the_printed_transitions_and_draws_as_a_timeline(live):
         html = f.read()
     if f'"transitions":{len(recorded)},' not in html:
         fail(f"the timeline page does not count the {len(recorded)} transitions of the history")
-    print(f"ok: {len(records)} records, {len(recorded)} transitions, the same as printed; timeline drawn")
+    # The inputs were recorded next to the history, by the recorder's own thread, and nothing was
+    # lost; replayed through the same system in simulated time they raise the same force error.
+    inputs = os.path.join(live.scratch, "robot-history.inputs")
+    lines = out.splitlines()
+    status = json.loads(lines[-2])
+    if status.get("kind") != "input_recorder" or status.get("complete") is not True or status.get("samples", 0) < 100:
+        fail(f"input recorder status {status}")
+    done = subprocess.run([live.binary, "replay", os.path.join(live.source, "examples/robodoc/robodoc.json"),
+                           "--input", inputs], capture_output=True, text=True, timeout=60)
+    if done.returncode != 0:
+        fail(f"replay of the live recording: exit code {done.returncode}: {done.stderr}")
+    if "JR3.s_A  Warning -> Error" not in done.stdout and "JR3.s_A  Normal -> Error" not in done.stdout:
+        fail("the replay of the live recording does not raise the force error:\n" + done.stdout)
+    print(f"ok: {len(records)} records, {len(recorded)} transitions, the same as printed; timeline drawn; "
+          f"{status['samples']} input samples recorded and replayed")
 
 
 def a_write_error_is_said_and_fails_the_run(live):
     # A full disk: the coordinator keeps running to its end, then says what the history misses
     # and fails, as in-process `safecass run --record /dev/full` does.
-    code, out, err = live.run_robot("/dev/full", "--json")
+    code, out, err = live.run_robot("/dev/full", "--json", "--record-inputs", "-")
     if code != 2:
         fail(f"--record /dev/full: exit code {code}, expected 2\nstdout:\n{out}\nstderr:\n{err}")
     if not re.search(r"^history file '/dev/full': write error after 0 records: No space left on device; "

@@ -55,7 +55,15 @@ ScenarioRunner::ScenarioRunner(spec::Scenario scenario, std::unique_ptr<System> 
       monitor_(&system_->monitor()),
       runtime_(&system_->runtime()) {}
 
-ScenarioRunner::~ScenarioRunner() { runtime_->stop(); }
+ScenarioRunner::~ScenarioRunner() {
+  if (printer_ != 0) coordinator_.unsubscribe(printer_);
+  runtime_->stop();
+}
+
+void ScenarioRunner::start_at(Time t) {
+  const Time::rep tick_ns = seconds_to_time(scenario_.period).count();
+  next_tick_ = t.count() <= 0 ? 0 : (t.count() + tick_ns - 1) / tick_ns;
+}
 
 Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(spec::Scenario scenario, spec::SystemSpec system,
                                                              const FilterRegistry& registry) {
@@ -269,6 +277,7 @@ Diagnostics ScenarioRunner::check_names() {
 
 void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
   const spec::StepAction* action = s.action.get();  // null for a sample step
+  InputRecorder* inputs = inputs_.get();  // records each action as it is applied (samples: drained)
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Sample:
       for (const auto& [name, values] : s.samples) monitor_->signals().find(name)->push(now, values.data());
@@ -277,17 +286,21 @@ void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
       ramps_.push_back(Ramp{monitor_->signals().find(action->signal), now, seconds_to_time(action->until), action->from, action->to});
       break;
     case spec::ScenarioStep::Kind::Generate:
+      if (inputs != nullptr) inputs->generate(action->event, action->target);
       (void)coordinator_.generate(action->event, action->target);
       break;
     case spec::ScenarioStep::Kind::Inject:
       if (!action->deep) {
+        if (inputs != nullptr) inputs->inject_shallow(action->filter, action->values);
         (void)monitor_->inject_shallow(action->filter, action->values);
       } else {
         const std::string signal = action->filter.empty() ? action->signal : monitor_->find_filter(action->filter)->inputs()[0]->name();
+        if (inputs != nullptr) inputs->inject_deep(signal, action->values);
         (void)monitor_->inject_deep(signal, action->values, now);
       }
       break;
     case spec::ScenarioStep::Kind::Reset:
+      if (inputs != nullptr) inputs->reset(action->target, "scenario", action->reason);
       if (const auto* components = coordinator_components(action->target)) {
         // A coordinator of the system: each of its components, as that coordinator's reset does.
         for (const std::string& c : *components) (void)coordinator_.reset(c, "scenario", action->reason);
@@ -350,18 +363,29 @@ void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& res
   }
 }
 
-RunResult ScenarioRunner::run(const RunOptions& options) {
-  RunResult result;
-  std::unique_ptr<Recorder> recorder;
+bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
   if (!options.record_path.empty()) {
-    auto r = Recorder::open(coordinator_, options.record_path);
+    auto r = Recorder::open(coordinator_, options.record_path, 65536, options.limits);
     if (!r) {
       result.failures.push_back(r.error().message);
-      return result;
+      return false;
     }
-    recorder = std::move(*r);
+    recorder_ = std::move(*r);
   }
-  const auto subscription = coordinator_.subscribe([&](const Record& r) {
+  std::string inputs_path = options.inputs_path;
+  if (inputs_path.empty() && !options.record_path.empty()) inputs_path = InputRecorder::path_for_history(options.record_path);
+  if (!inputs_path.empty() && inputs_path != "-") {
+    InputRecorderOptions o;
+    o.limits = options.limits;
+    o.period = seconds_to_time(scenario_.period);
+    auto r = InputRecorder::open(*monitor_, inputs_path, o);
+    if (!r) {
+      result.failures.push_back(r.error().message);
+      return false;
+    }
+    inputs_ = std::move(*r);
+  }
+  printer_ = coordinator_.subscribe([this, &result, json = options.json, quiet = options.quiet, out = options.out](const Record& r) {
     if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent) {
       result.coverage.events_fired.insert(coordinator_.event(r.event).name);
       if (r.root.event != kNoEvent) result.coverage.events_fired.insert(coordinator_.event(r.root.event).name);
@@ -371,22 +395,30 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
     }
     const bool shown = r.kind == RecordKind::Transition || r.kind == RecordKind::Reset || r.kind == RecordKind::Injection ||
                        (r.kind == RecordKind::Event && (r.outcome == Outcome::Masked || r.outcome == Outcome::Ignored));
-    if (options.quiet || !shown) return;
-    const std::string line = options.json ? record_to_json(r, coordinator_) : record_to_text(r, coordinator_);
-    std::fprintf(options.out, "%s\n", line.c_str());
+    if (quiet || !shown) return;
+    const std::string line = json ? record_to_json(r, coordinator_) : record_to_text(r, coordinator_);
+    std::fprintf(out, "%s\n", line.c_str());
   });
+  return true;
+}
 
-  const auto ticks = static_cast<std::int64_t>(std::llround(scenario_.duration / scenario_.period));
-  advance_to(Time{ticks * seconds_to_time(scenario_.period).count()}, result);
+void ScenarioRunner::finish(RunResult& result) {
   for (; next_check_ < checks_.size(); ++next_check_) {
     const spec::ScenarioStep& s = *checks_[next_check_];
     result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
                               ": expectation at t=" + secs(seconds_to_time(s.at)) + " is after the scenario's duration");
   }
-  coordinator_.unsubscribe(subscription);
-  if (recorder) {
-    recorder->close();
-    result.record = recorder->status();
+  if (printer_ != 0) {
+    coordinator_.unsubscribe(printer_);
+    printer_ = 0;
+  }
+  if (inputs_) {
+    inputs_->close(now() < Time{0} ? Time{0} : now());
+    result.inputs = inputs_->status();
+  }
+  if (recorder_) {
+    recorder_->close();
+    result.record = recorder_->status();
   }
   for (EventId e = framework_event::kCount; e < coordinator_.event_count(); ++e) {
     const Event& ev = coordinator_.event(e);
@@ -394,6 +426,14 @@ RunResult ScenarioRunner::run(const RunOptions& options) {
       if (ev.transitions.contains(t)) result.coverage.defined.emplace(ev.name, std::string(to_string(t)));
     }
   }
+}
+
+RunResult ScenarioRunner::run(const RunOptions& options) {
+  RunResult result;
+  if (!begin(options, result)) return result;
+  const auto ticks = static_cast<std::int64_t>(std::llround(scenario_.duration / scenario_.period));
+  advance_to(Time{ticks * seconds_to_time(scenario_.period).count()}, result);
+  finish(result);
   return result;
 }
 
@@ -417,6 +457,7 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
   for (; next_tick_ * tick_ns <= until.count(); ++next_tick_) {
     const Time now{next_tick_ * tick_ns};
     clock_.set(now);
+    if (feed_) feed_(now);
     // (1) steps due at this tick, in file order (first tick at or after their time).
     while (next_step_ < actions_.size() && seconds_to_time(actions_[next_step_]->at) <= now) apply(*actions_[next_step_++], now);
     for (auto it = ramps_.begin(); it != ramps_.end();) {
@@ -427,6 +468,7 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
     }
     // (2) filters and component loops due at this tick.
     runtime_->step(now);
+    if (inputs_) inputs_->drain();
     // (3) expectations due at this tick.
     while (next_check_ < checks_.size() && seconds_to_time(checks_[next_check_]->at) <= now) check(*checks_[next_check_++], now, result);
   }
@@ -449,6 +491,12 @@ int run_scenario_file(const std::string& path, const FilterRegistry& registry, c
   RunResult r = runner.run(options);
   for (const std::string& f : r.failures) std::fprintf(err, "%s\n", f.c_str());
   int code = r.passed() ? 0 : 1;
+  // Nothing lost silently: a recording that misses samples or records is said, and fails the command.
+  if (r.inputs) {
+    for (const std::string& loss : describe_losses(*r.inputs)) std::fprintf(err, "%s\n", loss.c_str());
+    if (options.json) std::fprintf(options.out, "%s\n", record_status_json(*r.inputs).c_str());
+    if (!r.inputs->complete()) code = 2;
+  }
   if (r.record) {
     // Nothing lost silently: a history that misses records is said, and fails the command.
     for (const std::string& loss : describe_losses(*r.record)) std::fprintf(err, "%s\n", loss.c_str());

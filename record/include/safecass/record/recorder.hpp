@@ -9,6 +9,9 @@
 /// is taken from the queue, so a killed process leaves a readable history up to its last complete
 /// line (at most the last line is torn).
 ///
+/// With FileLimits::max_bytes the file is rotated instead of filling the disk (file_limits.hpp);
+/// every segment is a readable history on its own, and the rotations are counted in status().
+///
 /// A write error (a full disk, /dev/full, an I/O error) does not stop the monitored system: the
 /// recorder stops writing, remembers the first error and counts every record it could not write;
 /// status() says so, and the tools report it on stderr and in their exit code.
@@ -25,8 +28,13 @@
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/record/file_limits.hpp"
 
 namespace safecass {
+
+namespace detail {
+class SegmentedFile;
+}
 
 /// One record as a JSON object (no trailing newline). Deterministic: same record, same bytes.
 std::string record_to_json(const Record& r, const Coordinator& coordinator);
@@ -41,6 +49,8 @@ struct RecordStatus {
   std::uint64_t dropped = 0;    ///< records dropped because the queue was full
   std::uint64_t unwritten = 0;  ///< records lost because a write had failed
   std::string write_error;      ///< the first write error ("No space left on device"); empty: none
+  std::uint64_t rotations = 0;  ///< times the file was rotated (FileLimits::max_bytes)
+  std::uint64_t discarded = 0;  ///< old segments deleted by rotation (FileLimits::keep)
 
   /// Nothing lost: every record of the stream is in the file.
   bool complete() const noexcept { return dropped == 0 && write_error.empty(); }
@@ -58,7 +68,7 @@ class Recorder {
 public:
   /// Opens `path` for writing (creates or truncates). Errors: Io, with the path and the reason.
   static Expected<std::unique_ptr<Recorder>> open(Coordinator& coordinator, const std::string& path,
-                                                  std::size_t capacity = 65536);
+                                                  std::size_t capacity = 65536, FileLimits limits = {});
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;
@@ -71,13 +81,11 @@ public:
   RecordStatus status() const;
 
 private:
-  Recorder(Coordinator& coordinator, int fd, std::string path, std::size_t capacity);
+  Recorder(Coordinator& coordinator, std::unique_ptr<detail::SegmentedFile> file, std::size_t capacity);
   void writer();
-  /// Writes one line (with its newline); false after a write error.
-  bool write_line(const std::string& line);
 
   Coordinator& coordinator_;
-  int fd_;
+  std::unique_ptr<detail::SegmentedFile> file_;
   std::string path_;
   std::size_t capacity_;
   Coordinator::SubscriptionId subscription_ = 0;
@@ -89,6 +97,8 @@ private:
   std::uint64_t dropped_reported_ = 0;
   std::uint64_t written_ = 0;
   std::uint64_t unwritten_ = 0;
+  std::uint64_t rotations_ = 0;
+  std::uint64_t discarded_ = 0;
   std::string write_error_;
   std::thread thread_;
 };

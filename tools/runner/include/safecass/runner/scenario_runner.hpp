@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -22,6 +23,7 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
@@ -34,6 +36,10 @@ struct RunOptions {
   bool json = false;            ///< one JSON object per line instead of text
   bool quiet = false;           ///< print nothing but failures
   std::string record_path;      ///< write the whole history as JSON lines
+  /// Record the inputs (samples and actions, record/input_log.hpp) to this file; with record_path
+  /// and no inputs_path, next to the history (InputRecorder::path_for_history). "-": none.
+  std::string inputs_path;
+  FileLimits limits;            ///< rotation of both files (--max-bytes)
   std::string system_override;  ///< run this system file instead of the scenario's "system"
   std::FILE* out = stdout;
 };
@@ -51,9 +57,12 @@ struct RunResult {
   Coverage coverage;
   /// With RunOptions::record_path: what the recorder wrote and lost (after the run).
   std::optional<RecordStatus> record;
+  /// With an inputs recording: what the input recorder wrote and lost (after the run).
+  std::optional<InputRecordStatus> inputs;
   bool passed() const noexcept { return failures.empty(); }
-  /// No history was asked for, or every record is in it (no write error, nothing dropped).
-  bool history_complete() const noexcept { return !record || record->complete(); }
+  /// No history or inputs were asked for, or every record is in them (no write error, nothing
+  /// dropped or lost).
+  bool history_complete() const noexcept { return (!record || record->complete()) && (!inputs || inputs->complete()); }
 };
 
 /// Where a scenario run comes from.
@@ -87,7 +96,25 @@ public:
   const spec::Scenario& scenario() const noexcept { return scenario_; }
 
   /// Runs the whole scenario.
+  /// Equivalent to begin(options, result); advance_to(duration); finish(result).
   RunResult run(const RunOptions& options);
+
+  /// Opens the history and inputs recorders of `options` and starts printing records as run()
+  /// does (transitions with their causes, resets, injections, masked and ignored events). A
+  /// recorder that cannot be opened is a failure in `result`; false then.
+  bool begin(const RunOptions& options, RunResult& result);
+  /// Stops printing, reports expectations after the last tick, closes the recorders (their status
+  /// in `result`) and fills the coverage.
+  void finish(RunResult& result);
+
+  /// A feed: called at every tick, after the clock is set and before the scenario's steps, to push
+  /// samples and apply actions (a replay). Set before the first tick.
+  void set_feed(std::function<void(Time now)> feed) { feed_ = std::move(feed); }
+  /// The first tick is the first multiple of the period at or after `t` (default 0). Before the
+  /// first tick.
+  void start_at(Time t);
+  /// The input recorder opened by begin(), or null: a feed records the actions it applies here.
+  InputRecorder* input_recorder() noexcept { return inputs_.get(); }
 
   /// Incremental driving, for interactive tools (the console's `watch`): processes every tick up
   /// to and including `until` not processed yet, exactly as run() does (steps, ramps, filters,
@@ -131,6 +158,10 @@ private:
   std::size_t next_step_ = 0;
   std::size_t next_check_ = 0;
   std::int64_t next_tick_ = 0;
+  std::function<void(Time)> feed_;
+  std::unique_ptr<Recorder> recorder_;
+  std::unique_ptr<InputRecorder> inputs_;
+  Coordinator::SubscriptionId printer_ = 0;
 };
 
 /// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,

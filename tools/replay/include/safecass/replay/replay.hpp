@@ -1,0 +1,48 @@
+#pragma once
+/// @file replay.hpp
+/// `safecass replay`: recorded or field data fed through a system in simulated time
+/// (docs/tools.md, "Replay").
+///
+/// The log is read twice, streaming both times: a first pass checks all of it (names, sizes,
+/// times, numbers, actions) so that bad input is refused with where and why before anything runs
+/// or is written; the second feeds it. At each tick of the replay's period, the samples and actions
+/// whose time has come are applied in the log's order (a sample keeps its own time), then the
+/// filters and component loops due run, exactly as `safecass run` does for a scenario; the
+/// transitions are printed as `run` prints them. A recording replays through the system that made
+/// it to the same transitions, byte for byte.
+
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "safecass/filters/registry.hpp"
+#include "safecass/record/file_limits.hpp"
+
+namespace safecass::replay {
+
+struct ReplayOptions {
+  std::string system;         ///< the system file replayed (with --diff: SYSTEM_A, the reference)
+  std::string input;          ///< the log
+  std::string format;         ///< "recording", "csv", "bag"; empty: from the file's first bytes
+  std::string mapping;        ///< a bag: the ROS extension's mapping file
+  std::optional<double> from; ///< seconds: inputs before are not fed; the replay starts there
+  std::optional<double> to;   ///< seconds: inputs after are not fed; the replay ends there
+  std::optional<double> period;  ///< seconds per tick (default: the recording's, else the smallest component period, else 1 ms)
+  bool json = false;
+  std::string record;         ///< the replay's own history (and inputs next to it)
+  std::string record_inputs;  ///< the replay's own inputs recording ("-": none)
+  FileLimits limits;
+  std::FILE* out = stdout;
+  std::FILE* err = stderr;
+};
+
+/// Replays `options.input` through `options.system`. Returns 0, or 2 for bad input (said on err
+/// with where and why; nothing ran) or an incomplete history of the replay.
+int run_replay(const ReplayOptions& options, const FilterRegistry& registry);
+
+/// Replays the same log through `system_b` and `options.system` (A) in lockstep and prints, per
+/// address, the intervals where their states differ with the first cause of each. Returns 0 when
+/// they never differ, 1 when they do, 2 for bad input.
+int run_replay_diff(const std::string& system_b, const ReplayOptions& options, const FilterRegistry& registry);
+
+}  // namespace safecass::replay

@@ -1,0 +1,591 @@
+// `safecass replay`: a log fed through a system in simulated time, and --diff of two systems.
+
+#include "safecass/replay/replay.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <unordered_map>
+
+#include "safecass/record/recorder.hpp"
+#include "safecass/replay/source.hpp"
+#include "safecass/runner/scenario_runner.hpp"
+#include "safecass/spec/load.hpp"
+
+#ifdef SAFECASS_REPLAY_WITH_ROSBAG
+#include "safecass/replay/bag_source.hpp"
+#endif
+
+namespace safecass::replay {
+
+namespace {
+
+using runner::ScenarioRunner;
+
+std::string secs(Time t) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
+  return buf;
+}
+
+/// The format of a log from its first bytes: a recording's header, a bag's "#ROSBAG", else CSV.
+std::string sniff(const std::string& path) {
+  char head[16] = {};
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return "";  // open_input() says why it cannot be read
+  const ssize_t n = ::read(fd, head, sizeof head);
+  ::close(fd);
+  const std::string_view h(head, n > 0 ? static_cast<std::size_t>(n) : 0);
+  if (h.substr(0, input_log::kMagic.size()) == input_log::kMagic) return "recording";
+  if (h.substr(0, 7) == "#ROSBAG") return "bag";
+  return "csv";
+}
+
+Expected<std::unique_ptr<InputSource>> open_input(const ReplayOptions& o, const std::string& format) {
+  if (format.empty()) {
+    const int fd = ::open(o.input.c_str(), O_RDONLY | O_CLOEXEC);
+    const int error = errno;
+    if (fd >= 0) ::close(fd);
+    return fail(ErrorCode::Io, "cannot read log '" + o.input + "': " + std::strerror(fd >= 0 ? EIO : error));
+  }
+  if (format == "recording") {
+    auto reader = InputLogReader::open(o.input);
+    if (!reader) return tl::unexpected(reader.error());
+    return open_recording(std::move(*reader));
+  }
+  if (format == "csv") return open_csv(o.input);
+  if (format == "bag") {
+#ifdef SAFECASS_REPLAY_WITH_ROSBAG
+    if (o.mapping.empty()) {
+      return fail(ErrorCode::InvalidArgument, o.input + ": a ROS bag needs the ROS extension's mapping file (--mapping FILE)");
+    }
+    return open_bag(o.input, o.mapping);
+#else
+    return fail(ErrorCode::InvalidArgument, o.input + ": a ROS bag needs the ROS 1 extension, and this safecass was built without it (SAFECASS_WITH_ROS1)");
+#endif
+  }
+  return fail(ErrorCode::InvalidArgument, "unknown log format '" + format + "' (recording, csv or bag)");
+}
+
+/// The system, composed as `safecass run` composes it, with no scenario steps.
+std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::optional<Time> period, const std::string& input,
+                                            const FilterRegistry& registry, std::FILE* err) {
+  spec::LoadResult sys = spec::load_system(path, registry);
+  for (const auto& d : sys.diagnostics) {
+    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(err, "%s\n", spec::format(d).c_str());
+  }
+  if (!sys.ok() || !sys.system) return nullptr;
+  spec::Scenario sc;
+  sc.path = input;
+  sc.system = path;
+  if (period) {
+    sc.period = to_seconds(*period);
+  } else {
+    double smallest = 0.0;
+    for (const spec::ComponentSpec& c : sys.system->components) {
+      if (c.period && (smallest == 0.0 || *c.period < smallest)) smallest = *c.period;
+    }
+    sc.period = smallest > 0.0 ? smallest : 0.001;
+  }
+  auto opened = ScenarioRunner::open(std::move(sc), std::move(*sys.system), registry);
+  if (!opened) {
+    runner::print(opened.error(), err);
+    return nullptr;
+  }
+  auto r = std::move(*opened);
+  return r;
+}
+
+std::string check_values(const std::string& what, std::size_t width, const std::vector<std::vector<double>>& values) {
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (values[i].size() != width) {
+      return what + ": sample " + std::to_string(i + 1) + " has " + std::to_string(values[i].size()) + " values, " +
+             std::to_string(width) + " expected";
+    }
+    for (double v : values[i]) {
+      if (!std::isfinite(v)) return what + ": an injected value is not a finite number";
+    }
+  }
+  return {};
+}
+
+/// Why `a` cannot be applied to the system, or "".
+std::string check_action(ScenarioRunner& r, const InputAction& a) {
+  Coordinator& co = r.coordinator();
+  Monitor& m = r.monitor();
+  switch (a.kind) {
+    case InputActionKind::Generate:
+    case InputActionKind::Broadcast: {
+      auto e = co.find_event(a.a);
+      if (!e) return e.error().message;
+      if (a.kind == InputActionKind::Broadcast || co.event(*e).is_broadcast()) return {};
+      if (auto t = co.find_machine(a.b); !t) return t.error().message;
+      return {};
+    }
+    case InputActionKind::Reset: {
+      auto t = co.resolve(a.a);
+      if (!t) return t.error().message;
+      if (t->kind == Address::Kind::Service) return "cannot reset service state '" + a.a + "': it is derived";
+      return {};
+    }
+    case InputActionKind::InjectShallow: {
+      Filter* f = m.find_filter(a.a);
+      if (f == nullptr) return "no filter '" + a.a + "'";
+      if (f->inputs().empty()) return "filter '" + a.a + "' has no input";
+      return check_values("shallow injection into filter " + a.a, f->inputs()[0]->size(), a.values);
+    }
+    case InputActionKind::InjectDeep: {
+      const Signal* s = m.signals().find(a.a);
+      if (s == nullptr) return "no signal '" + a.a + "'";
+      return check_values("deep injection into signal " + a.a, s->size(), a.values);
+    }
+  }
+  return "unknown action";
+}
+
+/// Applies `a` as the scenario runner applies the same step, recording it when the runner records inputs.
+void apply_action(ScenarioRunner& r, const InputAction& a, Time now) {
+  InputRecorder* rec = r.input_recorder();
+  switch (a.kind) {
+    case InputActionKind::Generate:
+      if (rec != nullptr) rec->generate(a.a, a.b);
+      (void)r.coordinator().generate(a.a, a.b);
+      break;
+    case InputActionKind::Broadcast:
+      if (rec != nullptr) rec->broadcast(a.a);
+      (void)r.coordinator().broadcast(a.a);
+      break;
+    case InputActionKind::Reset:
+      if (rec != nullptr) rec->reset(a.a, a.b, a.c);
+      (void)r.coordinator().reset(a.a, a.b, a.c);
+      break;
+    case InputActionKind::InjectShallow:
+      if (rec != nullptr) rec->inject_shallow(a.a, a.values);
+      (void)r.monitor().inject_shallow(a.a, a.values);
+      break;
+    case InputActionKind::InjectDeep:
+      if (rec != nullptr) rec->inject_deep(a.a, a.values);
+      (void)r.monitor().inject_deep(a.a, a.values, now);
+      break;
+  }
+}
+
+struct Window {
+  Time from = Time::min();
+  Time to = Time::max();
+};
+
+/// The first pass: reads the whole log, checking what the source checks and every action.
+/// Returns the time of the first input fed (or nullopt for an empty log); false on error.
+bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, std::optional<Time>& first, std::FILE* err) {
+  for (;;) {
+    const Item item = src.next();
+    switch (item.kind) {
+      case Item::Kind::End: return true;
+      case Item::Kind::Error:
+        std::fprintf(err, "%s\n", src.error().c_str());
+        return false;
+      case Item::Kind::Action:
+        if (const std::string why = check_action(r, *item.action); !why.empty()) {
+          std::fprintf(err, "%s: action at t=%s: %s\n", src.where().c_str(), secs(item.time).c_str(), why.c_str());
+          return false;
+        }
+        [[fallthrough]];
+      case Item::Kind::Sample:
+        if (item.time >= w.from && item.time <= w.to && !first) first = item.time;
+        break;
+    }
+  }
+}
+
+/// Opens, binds and checks the log against `r`; then opens it again, bound, for feeding.
+std::unique_ptr<InputSource> prepare_log(const ReplayOptions& o, const std::string& format, ScenarioRunner& r,
+                                         const Window& w, std::optional<Time>& first) {
+  auto check = open_input(o, format);
+  if (!check) {
+    std::fprintf(o.err, "%s\n", check.error().message.c_str());
+    return nullptr;
+  }
+  if (auto b = (*check)->bind(r.monitor()); !b) {
+    std::fprintf(o.err, "%s\n", b.error().message.c_str());
+    return nullptr;
+  }
+  if (!check_log(**check, r, w, first, o.err)) return nullptr;
+  auto feed = open_input(o, format);
+  if (!feed) {
+    std::fprintf(o.err, "%s\n", feed.error().message.c_str());
+    return nullptr;
+  }
+  if (auto b = (*feed)->bind(r.monitor()); !b) {
+    std::fprintf(o.err, "%s\n", b.error().message.c_str());
+    return nullptr;
+  }
+  return std::move(*feed);
+}
+
+Window window_of(const ReplayOptions& o) {
+  Window w;
+  if (o.from) w.from = seconds_to_time(*o.from);
+  if (o.to) w.to = seconds_to_time(*o.to);
+  return w;
+}
+
+/// Feeds a log into one or two systems tick by tick.
+class Feeder {
+public:
+  Feeder(InputSource& src, Window w) : src_(src), w_(w) { pending_ = src_.next(); }
+
+  /// Applies every input due at `now` to `a` and, when given, to `b` (with `map` from a's signals).
+  void feed(Time now, ScenarioRunner& a, ScenarioRunner* b, const std::unordered_map<const Signal*, Signal*>* map) {
+    while (!done_) {
+      if (pending_.kind == Item::Kind::End || pending_.kind == Item::Kind::Error) {
+        done_ = true;
+        failed_ = pending_.kind == Item::Kind::Error;
+        break;
+      }
+      if (pending_.time > now) break;
+      if (pending_.time > w_.to) {
+        done_ = true;
+        break;
+      }
+      if (pending_.time >= w_.from) {
+        if (pending_.kind == Item::Kind::Sample) {
+          pending_.signal->push(pending_.time, pending_.values);
+          if (b != nullptr) map->at(pending_.signal)->push(pending_.time, pending_.values);
+          ++fed_;
+        } else {
+          apply_action(a, *pending_.action, now);
+          if (b != nullptr) {
+            b->clock().set(now);
+            apply_action(*b, *pending_.action, now);
+          }
+          ++actions_;
+        }
+        last_ = pending_.time;
+      }
+      pending_ = src_.next();
+    }
+  }
+  bool done() const noexcept { return done_; }
+  bool failed() const noexcept { return failed_; }
+  std::optional<Time> last() const noexcept { return last_; }
+  std::uint64_t fed() const noexcept { return fed_; }
+  std::uint64_t actions() const noexcept { return actions_; }
+
+private:
+  InputSource& src_;
+  Window w_;
+  Item pending_;
+  bool done_ = false;
+  bool failed_ = false;
+  std::optional<Time> last_;
+  std::uint64_t fed_ = 0;
+  std::uint64_t actions_ = 0;
+};
+
+/// The replay's first tick: the recording's start, else the first input, never before --from.
+Time start_of(const InputSource& src, const std::optional<Time>& first, const Window& w) {
+  Time start = src.start().value_or(first.value_or(Time{0}));
+  if (first && *first < start) start = *first;
+  if (w.from != Time::min() && w.from > start) start = w.from;
+  return start;
+}
+
+/// The replay's last tick: the recording's end, else the last input fed; never after --to.
+Time end_of(const InputSource& src, const Feeder& f, const Window& w, Time now) {
+  Time end = src.end().value_or(f.last().value_or(now));
+  if (end > w.to) end = w.to;
+  return end;
+}
+
+void print_notes(const InputSource& src, std::FILE* err) {
+  for (const std::string& n : src.notes()) std::fprintf(err, "note: %s\n", n.c_str());
+}
+
+}  // namespace
+
+int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
+  const std::string format = o.format.empty() ? sniff(o.input) : o.format;
+  // The period: asked for, else the recording's, else the system's smallest component period.
+  std::optional<Time> period;
+  if (o.period) period = seconds_to_time(*o.period);
+  if (!period && format == "recording") {
+    if (auto reader = InputLogReader::open(o.input); reader && (*reader)->header().period.count() > 0) {
+      period = (*reader)->header().period;
+    }
+  }
+  auto r = open_system(o.system, period, o.input, registry, o.err);
+  if (!r) return 2;
+  const Window w = window_of(o);
+  std::optional<Time> first;
+  auto src = prepare_log(o, format, *r, w, first);
+  if (!src) return 2;
+
+  runner::RunOptions ro;
+  ro.json = o.json;
+  ro.out = o.out;
+  ro.record_path = o.record;
+  ro.inputs_path = o.record_inputs;
+  ro.limits = o.limits;
+  runner::RunResult result;
+  r->start_at(start_of(*src, first, w));
+  if (!r->begin(ro, result)) {
+    for (const std::string& f : result.failures) std::fprintf(o.err, "%s\n", f.c_str());
+    return 2;
+  }
+  Feeder feeder(*src, w);
+  ScenarioRunner& sys = *r;
+  r->set_feed([&](Time now) { feeder.feed(now, sys, nullptr, nullptr); });
+  const Time tick = seconds_to_time(r->scenario().period);
+  while (!feeder.done()) r->advance_to(r->now() + tick, result);
+  const Time end = end_of(*src, feeder, w, r->now());
+  if (r->now() < end) r->advance_to(end, result);
+  r->finish(result);
+  if (feeder.failed()) {
+    std::fprintf(o.err, "%s\n", src->error().c_str());  // the log changed between the two passes
+    return 2;
+  }
+  print_notes(*src, o.err);
+  std::fprintf(o.err, "%s: replayed %llu samples and %llu actions through %s, %s s to %s s\n", o.input.c_str(),
+               static_cast<unsigned long long>(feeder.fed()), static_cast<unsigned long long>(feeder.actions()),
+               o.system.c_str(), secs(start_of(*src, first, w)).c_str(), secs(r->now()).c_str());
+  int code = 0;
+  if (result.inputs) {
+    for (const std::string& loss : describe_losses(*result.inputs)) std::fprintf(o.err, "%s\n", loss.c_str());
+    if (o.json) std::fprintf(o.out, "%s\n", record_status_json(*result.inputs).c_str());
+  }
+  if (result.record) {
+    for (const std::string& loss : describe_losses(*result.record)) std::fprintf(o.err, "%s\n", loss.c_str());
+    if (o.json) std::fprintf(o.out, "%s\n", record_status_json(*result.record).c_str());
+  }
+  if (!result.history_complete()) code = 2;
+  return code;
+}
+
+namespace {
+
+/// Every address of a system worth comparing: machines, service states, components, SYSTEM.
+std::vector<std::string> addresses_of(const Coordinator& co) {
+  std::vector<std::string> out;
+  for (ComponentId c = 0; c < co.component_count(); ++c) {
+    out.emplace_back(co.component_name(c));
+    out.push_back(co.address_of(co.framework_machine(c)));
+    out.push_back(co.address_of(co.application_machine(c)));
+    for (MachineId m : co.provided_machines(c)) {
+      out.push_back(co.address_of(m));
+      std::string service = co.address_of(m);
+      if (const auto at = service.rfind(".s_P."); at != std::string::npos) service.replace(at, 5, ".s_S.");
+      out.push_back(service);
+    }
+    for (MachineId m : co.required_machines(c)) out.push_back(co.address_of(m));
+  }
+  out.emplace_back("SYSTEM");
+  return out;
+}
+
+struct Cause {
+  std::string origin, event, filter, signal;
+  double value = 0.0;
+  bool injected = false;
+};
+
+/// The cause of `address`'s state: the outstanding condition at its level (else the first there).
+Cause cause_of(const Coordinator& co, const Address& a) {
+  const State level = co.state_of(a);
+  Cause c;
+  bool found = false;
+  for (const Explanation& e : co.explain(a)) {
+    if (e.level != level) continue;
+    if (found && !e.outstanding) continue;
+    c = Cause{e.root_origin, e.root_event, e.filter, e.signal, e.value, e.injected};
+    found = true;
+    if (e.outstanding) break;
+  }
+  return c;
+}
+
+std::string cause_text(const Cause& c) {
+  if (c.event.empty()) return "none";
+  std::string out = c.origin + ":" + c.event;
+  if (!c.filter.empty() || !c.signal.empty()) {
+    char v[40];
+    std::snprintf(v, sizeof v, "%.9g", c.value);
+    out += " [";
+    if (!c.filter.empty()) out += "filter " + c.filter;
+    if (!c.signal.empty()) out += std::string(c.filter.empty() ? "" : ", ") + c.signal + " = " + v;
+    if (c.injected) out += ", injected";
+    out += "]";
+  }
+  return out;
+}
+
+std::string quoted(std::string_view s) {
+  std::string out = "\"";
+  for (char ch : s) {
+    if (ch == '"' || ch == '\\') out += '\\';
+    out += ch;
+  }
+  return out + "\"";
+}
+
+struct Interval {
+  Time from{}, to{};
+  bool open = true;
+  State b = State::Normal, a = State::Normal;
+  char side = 'B';
+  Cause cause;
+};
+
+struct Tracked {
+  std::string name;
+  Address in_b, in_a;
+  std::vector<Interval> intervals;
+};
+
+}  // namespace
+
+int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const FilterRegistry& registry) {
+  const std::string format = o.format.empty() ? sniff(o.input) : o.format;
+  std::optional<Time> period;
+  if (o.period) period = seconds_to_time(*o.period);
+  if (!period && format == "recording") {
+    if (auto reader = InputLogReader::open(o.input); reader && (*reader)->header().period.count() > 0) {
+      period = (*reader)->header().period;
+    }
+  }
+  auto a = open_system(o.system, period, o.input, registry, o.err);
+  if (!a) return 2;
+  auto b = open_system(system_b, seconds_to_time(a->scenario().period), o.input, registry, o.err);
+  if (!b) return 2;
+  const Window w = window_of(o);
+  std::optional<Time> first;
+  {  // The log must fit SYSTEM_B too.
+    std::optional<Time> unused;
+    if (!prepare_log(o, format, *b, w, unused)) return 2;
+  }
+  auto src = prepare_log(o, format, *a, w, first);
+  if (!src) return 2;
+  // Each input signal of A, as B's signal of the same name.
+  std::unordered_map<const Signal*, Signal*> map;
+  for (const std::string& name : input_signal_names(a->monitor())) {
+    if (auto s = find_input_signal(b->monitor(), name); s) map.emplace(a->monitor().signals().find(name), *s);
+  }
+  // Addresses in both systems, in B's order.
+  std::vector<Tracked> tracked;
+  std::vector<std::string> only;
+  for (const std::string& name : addresses_of(b->coordinator())) {
+    auto ab = b->coordinator().resolve(name);
+    auto aa = a->coordinator().resolve(name);
+    if (ab && aa) tracked.push_back(Tracked{name, *ab, *aa, {}});
+    else only.push_back(name + " (only in " + system_b + ")");
+  }
+  for (const std::string& name : addresses_of(a->coordinator())) {
+    if (!b->coordinator().resolve(name)) only.push_back(name + " (only in " + o.system + ")");
+  }
+
+  runner::RunOptions quiet;
+  quiet.quiet = true;
+  runner::RunResult ra, rb;
+  const Time start = start_of(*src, first, w);
+  a->start_at(start);
+  b->start_at(start);
+  (void)a->begin(quiet, ra);
+  (void)b->begin(quiet, rb);
+  bool dirty = true;
+  const auto mark = [&dirty](const Record&) { dirty = true; };
+  const auto sa = a->coordinator().subscribe(mark);
+  const auto sb = b->coordinator().subscribe(mark);
+  Feeder feeder(*src, w);
+  ScenarioRunner& ra_sys = *a;
+  ScenarioRunner* rb_sys = b.get();
+  a->set_feed([&](Time now) { feeder.feed(now, ra_sys, rb_sys, &map); });
+  const Time tick = seconds_to_time(a->scenario().period);
+  const auto compare = [&](Time now) {
+    if (!dirty) return;
+    dirty = false;
+    for (Tracked& t : tracked) {
+      const State sb_state = b->coordinator().state_of(t.in_b);
+      const State sa_state = a->coordinator().state_of(t.in_a);
+      const bool open = !t.intervals.empty() && t.intervals.back().open;
+      if (sb_state != sa_state && !open) {
+        Interval i;
+        i.from = now;
+        i.b = sb_state;
+        i.a = sa_state;
+        i.side = sb_state > sa_state ? 'B' : 'A';
+        i.cause = i.side == 'B' ? cause_of(b->coordinator(), t.in_b) : cause_of(a->coordinator(), t.in_a);
+        t.intervals.push_back(std::move(i));
+      } else if (sb_state == sa_state && open) {
+        t.intervals.back().to = now;
+        t.intervals.back().open = false;
+      }
+    }
+  };
+  const auto step = [&](Time t) {
+    a->advance_to(t, ra);
+    b->advance_to(t, rb);
+    compare(a->now());
+  };
+  while (!feeder.done()) step(a->now() + tick);
+  const Time end = end_of(*src, feeder, w, a->now());
+  while (a->now() < end) step(a->now() + tick);
+  a->coordinator().unsubscribe(sa);
+  b->coordinator().unsubscribe(sb);
+  a->finish(ra);
+  b->finish(rb);
+  if (feeder.failed()) {
+    std::fprintf(o.err, "%s\n", src->error().c_str());
+    return 2;
+  }
+  print_notes(*src, o.err);
+
+  std::size_t addresses = 0;
+  std::size_t intervals = 0;
+  for (const Tracked& t : tracked) {
+    if (t.intervals.empty()) continue;
+    ++addresses;
+    intervals += t.intervals.size();
+    if (!o.json) std::fprintf(o.out, "%s\n", t.name.c_str());
+    for (const Interval& i : t.intervals) {
+      const std::string until = i.open ? secs(a->now()) : secs(i.to);
+      if (o.json) {
+        const Cause& c = i.cause;
+        std::string cause = "{\"system\":" + quoted(i.side == 'B' ? "B" : "A") + ",\"origin\":" + quoted(c.origin) +
+                            ",\"event\":" + quoted(c.event);
+        if (!c.filter.empty()) cause += ",\"filter\":" + quoted(c.filter);
+        if (!c.signal.empty()) {
+          char v[40];
+          std::snprintf(v, sizeof v, "%.9g", c.value);
+          cause += ",\"signal\":" + quoted(c.signal) + ",\"value\":" + (std::isfinite(c.value) ? std::string(v) : quoted(v));
+        }
+        cause += "}";
+        std::fprintf(o.out,
+                     "{\"kind\":\"difference\",\"address\":%s,\"from\":%s,\"to\":%s,\"until_end\":%s,\"b\":\"%s\",\"a\":\"%s\",\"cause\":%s}\n",
+                     quoted(t.name).c_str(), secs(i.from).c_str(), until.c_str(), i.open ? "true" : "false",
+                     std::string(to_string(i.b)).c_str(), std::string(to_string(i.a)).c_str(), cause.c_str());
+      } else {
+        std::fprintf(o.out, "  %s .. %s s%s  B %s, A %s  first cause (%c): %s\n", secs(i.from).c_str(), until.c_str(),
+                     i.open ? " (to the end)" : "", std::string(to_string(i.b)).c_str(),
+                     std::string(to_string(i.a)).c_str(), i.side, cause_text(i.cause).c_str());
+      }
+    }
+  }
+  for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
+  if (o.json) {
+    std::fprintf(o.out, "{\"kind\":\"diff\",\"b\":%s,\"a\":%s,\"addresses\":%zu,\"intervals\":%zu,\"differ\":%s}\n",
+                 quoted(system_b).c_str(), quoted(o.system).c_str(), addresses, intervals, addresses ? "true" : "false");
+  } else if (addresses == 0) {
+    std::fprintf(o.out, "B (%s) and A (%s) never differ on %s\n", system_b.c_str(), o.system.c_str(), o.input.c_str());
+  } else {
+    std::fprintf(o.out, "B (%s) and A (%s) differ at %zu address%s in %zu interval%s on %s\n", system_b.c_str(),
+                 o.system.c_str(), addresses, addresses == 1 ? "" : "es", intervals, intervals == 1 ? "" : "s",
+                 o.input.c_str());
+  }
+  return addresses == 0 ? 0 : 1;
+}
+
+}  // namespace safecass::replay
