@@ -10,9 +10,6 @@ namespace safecass {
 
 namespace {
 
-constexpr std::string_view kIgnoredNotActive = "not active";
-constexpr std::string_view kIgnoredLatched = "latched: needs reset";
-constexpr std::string_view kIgnoredNoOnset = "completes an onset that is not defined";
 
 constexpr std::size_t index(State s) noexcept { return static_cast<std::size_t>(s); }
 
@@ -143,13 +140,11 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
     return fail(ErrorCode::InvalidArgument, "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
   const auto id = static_cast<ComponentId>(components_.size());
-  auto c = std::make_unique<ComponentData>();
-  c->name = std::string(name);
-  c->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
-  components_.push_back(std::move(c));
+  ComponentData& cd = components_.emplace_back();
+  cd.name = std::string(name);
+  cd.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   size_history();
   component_index_.emplace(std::string(name), id);
-  ComponentData& cd = *components_.back();
   cd.framework = add_machine(id, MachineKind::Framework, kNone, cd.name + ".s_F");
   cd.application = add_machine(id, MachineKind::Application, kNone, cd.name + ".s_A");
   cd.machine_state_count[index(State::Normal)] = 2;
@@ -158,15 +153,23 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
 
 MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std::uint32_t iface,
                                    std::string address) {
-  auto m = std::make_unique<MachineData>();
-  m->kind = kind;
-  m->component = component;
-  m->iface = iface;
-  m->address = std::move(address);
-  m->snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
-  machines_.push_back(std::move(m));
+  MachineData& m = machines_.emplace_back();
+  m.kind = kind;
+  m.component = component;
+  m.iface = iface;
+  m.address = std::move(address);
+  m.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
+  const auto id = static_cast<MachineId>(machines_.size() - 1);
+  ComponentData& c = components_[component];
+  if (c.machine_count == 0) {
+    c.first_machine = id;
+  } else if (c.first_machine + c.machine_count != id) {
+    c.contiguous = false;
+  }
+  ++c.machine_count;
   size_history();
   // Propagation scratch space grows with the model here, never while processing.
+  summaries_.resize(machines_.size());
   visit_marks_.resize(machines_.size(), 0);
   if (work_.capacity() < machines_.size()) work_.reserve(2 * machines_.size());
   return static_cast<MachineId>(machines_.size() - 1);
@@ -174,13 +177,13 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
 
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
   if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
-  ComponentData& c = *components_[component];
+  ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
                                                 "' must be non-empty, without dots or spaces");
   }
   for (MachineId m : c.provided) {
-    if (machines_[m]->address == c.name + ".s_P." + std::string(name)) {
+    if (machines_[m].address == c.name + ".s_P." + std::string(name)) {
       return fail(ErrorCode::Duplicate, "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
@@ -195,13 +198,13 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
   if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
-  ComponentData& c = *components_[component];
+  ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
                                                 "' must be non-empty, without dots or spaces");
   }
   for (MachineId m : c.required) {
-    if (machines_[m]->address == c.name + ".s_R." + std::string(name)) {
+    if (machines_[m].address == c.name + ".s_R." + std::string(name)) {
       return fail(ErrorCode::Duplicate, "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
@@ -272,7 +275,7 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
 Expected<void> Coordinator::set_service(ComponentId component, std::string_view provided,
                                         const ServiceDependency& dependency) {
   if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
-  ComponentData& c = *components_[component];
+  ComponentData& c = components_[component];
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
     if (interface_name(c.provided[i]) == provided) p = i;
@@ -300,10 +303,10 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
       data.required.push_back(found);
     }
   }
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   // Only conditions on this component's own machines can flow through its services.
   for (MachineId id : component_machines(c)) {
-    if (!machines_[id]->conditions.empty()) {
+    if (!machines_[id].conditions.empty()) {
       return fail(ErrorCode::InvalidState, "service '" + c.name + "." + std::string(provided) +
                                                "': dependencies cannot change while conditions are active");
     }
@@ -332,8 +335,8 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   if (!client) return tl::unexpected(client.error());
   auto provider = split(provider_provided, "provided interface");
   if (!provider) return tl::unexpected(provider.error());
-  ComponentData& cc = *components_[client->first];
-  ComponentData& pc = *components_[provider->first];
+  ComponentData& cc = components_[client->first];
+  ComponentData& pc = components_[provider->first];
   std::uint32_t r = kNone;
   for (std::uint32_t i = 0; i < cc.required.size(); ++i) {
     if (interface_name(cc.required[i]) == client->second) r = i;
@@ -359,10 +362,10 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   if (cc.required_connection[r] != kNoConnection) {
     const Connection& old = connections_[cc.required_connection[r]];
     return fail(ErrorCode::Duplicate, "required interface " + std::string(client_required) +
-                                          " is already connected to " + components_[old.provider]->name + "." +
-                                          std::string(interface_name(components_[old.provider]->provided[old.provided])));
+                                          " is already connected to " + components_[old.provider].name + "." +
+                                          std::string(interface_name(components_[old.provider].provided[old.provided])));
   }
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   const auto id = static_cast<ConnectionId>(connections_.size());
   connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
@@ -374,7 +377,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
   processing_ = true;
   for (MachineId m = 0; m < machines_.size(); ++m) {
-    const std::vector<Condition> snapshot = machines_[m]->conditions;
+    const std::vector<Condition> snapshot(machines_[m].conditions.begin(), machines_[m].conditions.end());
     for (const Condition& c : snapshot) {
       // Roots, and remote roots at the remote provided interface that holds them.
       if (!c.mirror || (c.root.remote != kNone && c.root.origin == m)) propagate_onset(c);
@@ -387,14 +390,14 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
 
 bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept {
   if (m.component != component) return false;
-  const ServiceDependency& d = components_[component]->services[provided].dependency;
+  const ServiceDependency& d = components_[component].services[provided].dependency;
   switch (m.kind) {
     case MachineKind::Framework: return d.framework;
     case MachineKind::Application: return d.application;
     case MachineKind::Provided: return m.iface == provided;
     case MachineKind::Required: {
       if (d.all_required) return true;
-      const auto& req = components_[component]->services[provided].required;
+      const auto& req = components_[component].services[provided].required;
       return std::find(req.begin(), req.end(), m.iface) != req.end();
     }
   }
@@ -402,16 +405,16 @@ bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, cons
 }
 
 void Coordinator::rebuild_fanout(ComponentId provider_id) {
-  const ComponentData& provider = *components_[provider_id];
+  const ComponentData& provider = components_[provider_id];
   const std::vector<MachineId> machines = component_machines(provider);
-  for (MachineId m : machines) machines_[m]->fanout.clear();
+  for (MachineId m : machines) machines_[m].fanout.clear();
   for (ConnectionId k : provider.provider_connections) {
     const Connection& conn = connections_[k];
-    const MachineId client_machine = components_[conn.client]->required[conn.required];
+    const MachineId client_machine = components_[conn.client].required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
     for (MachineId m : machines) {
-      if (depends_on(conn.provider, conn.provided, *machines_[m])) {
-        machines_[m]->fanout.push_back(Edge{client_machine, min_level, k});
+      if (depends_on(conn.provider, conn.provided, machines_[m])) {
+        machines_[m].fanout.push_back(Edge{client_machine, min_level, k});
       }
     }
   }
@@ -447,7 +450,7 @@ Expected<Address> Coordinator::resolve(std::string_view text) const {
   if (!comp) return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': no component '" +
                                                   std::string(text.substr(0, dot)) + "'");
   a.component = *comp;
-  const ComponentData& c = *components_[*comp];
+  const ComponentData& c = components_[*comp];
   if (dot == std::string_view::npos) {
     a.kind = Address::Kind::Component;
     return a;
@@ -496,17 +499,17 @@ Expected<MachineId> Coordinator::find_machine(std::string_view address) const {
   return a->machine;
 }
 
-std::string_view Coordinator::component_name(ComponentId id) const noexcept { return components_[id]->name; }
-MachineId Coordinator::framework_machine(ComponentId id) const noexcept { return components_[id]->framework; }
-MachineId Coordinator::application_machine(ComponentId id) const noexcept { return components_[id]->application; }
-const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept { return components_[id]->provided; }
-const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept { return components_[id]->required; }
-MachineKind Coordinator::machine_kind(MachineId id) const noexcept { return machines_[id]->kind; }
-ComponentId Coordinator::machine_component(MachineId id) const noexcept { return machines_[id]->component; }
-const std::string& Coordinator::address_of(MachineId id) const noexcept { return machines_[id]->address; }
+std::string_view Coordinator::component_name(ComponentId id) const noexcept { return components_[id].name; }
+MachineId Coordinator::framework_machine(ComponentId id) const noexcept { return components_[id].framework; }
+MachineId Coordinator::application_machine(ComponentId id) const noexcept { return components_[id].application; }
+const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept { return components_[id].provided; }
+const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept { return components_[id].required; }
+MachineKind Coordinator::machine_kind(MachineId id) const noexcept { return machines_[id].kind; }
+ComponentId Coordinator::machine_component(MachineId id) const noexcept { return machines_[id].component; }
+const std::string& Coordinator::address_of(MachineId id) const noexcept { return machines_[id].address; }
 
 std::string_view Coordinator::interface_name(MachineId id) const noexcept {
-  const MachineData& m = *machines_[id];
+  const MachineData& m = machines_[id];
   switch (m.kind) {
     case MachineKind::Framework: return "s_F";
     case MachineKind::Application: return "s_A";
@@ -518,7 +521,7 @@ std::string_view Coordinator::interface_name(MachineId id) const noexcept {
 }
 
 const ServiceDependency& Coordinator::service(ComponentId component, std::uint32_t provided) const noexcept {
-  return components_[component]->services[provided].dependency;
+  return components_[component].services[provided].dependency;
 }
 
 NameId Coordinator::intern(std::string_view text) {
@@ -539,7 +542,7 @@ std::string_view Coordinator::name_of(NameId id) const {
 // ---- reads -----------------------------------------------------------------------------------
 
 State Coordinator::service_state(ComponentId component, std::uint32_t provided) const noexcept {
-  const ComponentData& c = *components_[component];
+  const ComponentData& c = components_[component];
   const ServiceData& s = c.services[provided];
   State st = state(c.provided[provided]);
   if (s.dependency.framework) st = st * state(c.framework);
@@ -555,7 +558,7 @@ State Coordinator::service_state(ComponentId component, std::uint32_t provided) 
 State Coordinator::coordinator_state() const noexcept {
   State s = State::Normal;
   for (ComponentId c = 0; c < components_.size(); ++c) {
-    if (!components_[c]->remote) s = s * extended_state(c);
+    if (!components_[c].remote) s = s * extended_state(c);
   }
   return s;
 }
@@ -571,15 +574,16 @@ State Coordinator::state_of(const Address& a) const noexcept {
 }
 
 std::vector<Condition> Coordinator::conditions(MachineId id) const {
-  std::lock_guard lock(mutex_);
-  return machines_[id]->conditions;
+  Lock lock(*this);
+  const ConditionSet& set = machines_[id].conditions;
+  return std::vector<Condition>(set.begin(), set.end());
 }
 
 std::optional<Condition> Coordinator::outstanding(MachineId id) const {
-  std::lock_guard lock(mutex_);
-  const MachineData& m = *machines_[id];
-  if (m.outstanding < 0) return std::nullopt;
-  return m.conditions[static_cast<std::size_t>(m.outstanding)];
+  Lock lock(*this);
+  const MachineData& m = machines_[id];
+  if (m.conditions.outstanding() == nullptr) return std::nullopt;
+  return *m.conditions.outstanding();
 }
 
 namespace {
@@ -598,13 +602,13 @@ std::vector<Record> newest(const Items& items, std::size_t next, std::size_t siz
 }  // namespace
 
 std::vector<Record> Coordinator::history(MachineId id) const {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   return newest(history_.items, history_.next, history_.size, options_.history_capacity,
                 [id](const Record& r) { return r.machine == id; });
 }
 
 std::vector<Record> Coordinator::component_history(ComponentId id) const {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   return newest(history_.items, history_.next, history_.size, options_.history_capacity, [id](const Record& r) {
     return r.machine == kNoMachine && r.kind == RecordKind::ComponentTransition && r.component == id;
   });
@@ -612,7 +616,7 @@ std::vector<Record> Coordinator::component_history(ComponentId id) const {
 
 std::vector<Record> Coordinator::history(const Address& scope) const {
   if (scope.kind == Address::Kind::Machine) return history(scope.machine);
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   const bool system = scope.kind == Address::Kind::System;
   return newest(history_.items, history_.next, history_.size, history_.size,
                 [&](const Record& r) { return system || r.component == scope.component; });
@@ -621,31 +625,31 @@ std::vector<Record> Coordinator::history(const Address& scope) const {
 // ---- callbacks and observers -----------------------------------------------------------------
 
 void Coordinator::on_machine(MachineId id, StateCallbacks callbacks) {
-  std::lock_guard lock(mutex_);
-  machines_[id]->callbacks.push_back(std::move(callbacks));
+  Lock lock(*this);
+  machines_[id].callbacks.push_back(std::move(callbacks));
 }
 
 void Coordinator::on_component(ComponentId id, StateCallbacks callbacks) {
-  std::lock_guard lock(mutex_);
-  components_[id]->callbacks.push_back(std::move(callbacks));
+  Lock lock(*this);
+  components_[id].callbacks.push_back(std::move(callbacks));
 }
 
 Coordinator::SubscriptionId Coordinator::subscribe(std::function<void(const Record&)> observer) {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   const SubscriptionId id = next_subscription_++;
   observers_.emplace_back(id, std::move(observer));
   return id;
 }
 
 void Coordinator::unsubscribe(SubscriptionId id) {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   std::erase_if(observers_, [id](const auto& o) { return o.first == id; });
 }
 
 void Coordinator::publish(Record record) {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   if (record.machine != kNoMachine && record.machine < machines_.size()) {
-    record.component = machines_[record.machine]->component;
+    record.component = machines_[record.machine].component;
     record_machine(record.machine, record);
   } else {
     record.seq = ++record_seq_;
@@ -674,7 +678,7 @@ void Coordinator::record_machine(MachineId id, Record& r) noexcept {
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
   SAFECASS_ASSERT(event < event_table_.size());
   SAFECASS_ASSERT(target < machines_.size() || event_table_[event]->is_broadcast());
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   if (processing_) {
     pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName});
     return;
@@ -730,7 +734,7 @@ void Coordinator::reset(const Address& target, std::string_view who, std::string
   text += ": ";
   text += why;
   const NameId reason = intern(text);
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   Pending op{PendingKind::Reset, kNoEvent, kNoMachine, SampleCause{}, target, reason};
   if (processing_) {
     pending_.push_back(op);
@@ -766,11 +770,11 @@ void Coordinator::process(EventId event_id, MachineId target, const SampleCause&
   const Event& event = *event_table_[event_id];
   const Time now = clock_->now();
   if (event.is_broadcast()) {
-    for (const auto& c : components_) {
+    for (ComponentId c = 0; c < components_.size(); ++c) {
       if (event.is_onset) {
-        process_onset(event, c->application, cause, now);
+        process_onset(event, components_[c].application, cause, now);
       } else {
-        process_completion(event, c->application, now);
+        process_completion(event, components_[c].application, now);
       }
     }
     return;
@@ -782,60 +786,20 @@ void Coordinator::process(EventId event_id, MachineId target, const SampleCause&
   }
 }
 
-std::int32_t Coordinator::find_root(const MachineData& m, EventId event) const noexcept {
-  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
-    if (!m.conditions[i].mirror && m.conditions[i].event == event) return static_cast<std::int32_t>(i);
-  }
-  return -1;
-}
-
-std::int32_t Coordinator::find_any_root(const MachineData& m) const noexcept {
-  // Lowest level first: a reset that removes roots one by one then drops the state once
-  // (E2N), instead of passing through a Warning that callbacks would react to.
-  std::int32_t found = -1;
-  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
-    const Condition& c = m.conditions[i];
-    if (c.mirror) continue;
-    if (found < 0 || c.level < m.conditions[static_cast<std::size_t>(found)].level) {
-      found = static_cast<std::int32_t>(i);
-    }
-  }
-  return found;
-}
-
-std::int32_t Coordinator::find_mirror(const MachineData& m, const RootCause& root) const noexcept {
-  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
-    const Condition& c = m.conditions[i];
-    if (c.mirror && c.root.event == root.event && c.root.origin == root.origin && c.root.remote == root.remote) {
-      return static_cast<std::int32_t>(i);
-    }
-  }
-  return -1;
-}
-
 void Coordinator::process_onset(const Event& event, MachineId target, const SampleCause& cause, Time now) noexcept {
-  MachineData& m = *machines_[target];
-  if (const std::int32_t i = find_root(m, event.id); i >= 0) {
-    // §2.4 onset rule 1: already active → refresh only.
-    Condition& c = m.conditions[static_cast<std::size_t>(i)];
-    c.last = now;
-    ++c.count;
-    return;
-  }
-  Condition c;
-  c.event = event.id;
-  c.level = onset_level(event.transitions, m.state);
-  c.severity = event.severity;
-  c.first = c.last = now;
-  c.seq = ++condition_seq_;
-  c.root = RootCause{event.id, target, now, cause};
-  add_condition(target, c, now);
+  MachineData& m = machines_[target];
+  const ConditionChange change = m.conditions.onset(event, RootCause{event.id, target, now, cause}, now, condition_seq_);
+  if (change.outcome == Outcome::None) return;  // §2.4 onset rule 1: a refresh, not recorded
+  const Condition c = m.conditions[static_cast<std::size_t>(change.index)];
+  record_added(target, change, now);
   propagate_onset(c);
 }
 
 void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
-  MachineData& m = *machines_[target];
-  auto ignore = [&](std::string_view why, const RootCause* root) {
+  MachineData& m = machines_[target];
+  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[event.counterpart];
+  const ConditionChange change = m.conditions.complete(onset);
+  if (change.outcome == Outcome::Ignored) {
     Record r;
     r.kind = RecordKind::Event;
     r.outcome = Outcome::Ignored;
@@ -843,66 +807,51 @@ void Coordinator::process_completion(const Event& event, MachineId target, Time 
     r.component = m.component;
     r.machine = target;
     r.event = event.id;
-    r.from = r.to = m.state;
+    r.from = r.to = change.from;
     r.severity = event.severity;
-    if (root != nullptr) r.root = *root;
-    r.text = why;
+    if (change.index >= 0) r.root = m.conditions[static_cast<std::size_t>(change.index)].root;
+    r.text = change.reason;
     record_machine(target, r);
-  };
-  if (event.counterpart == kNoEvent) return ignore(kIgnoredNoOnset, nullptr);
-  const std::int32_t i = find_root(m, event.counterpart);
-  if (i < 0) return ignore(kIgnoredNotActive, nullptr);
-  const Condition& found = m.conditions[static_cast<std::size_t>(i)];
-  if (event_table_[event.counterpart]->latched) return ignore(kIgnoredLatched, &found.root);
-  const RootCause root = found.root;
-  const State level = found.level;
-  remove_condition(target, static_cast<std::size_t>(i), event.id, now, {});
-  propagate_clear(root, level, now);
+    return;
+  }
+  record_removed(target, change, event.id, now, {});
+  propagate_clear(change.removed.root, change.removed.level, now);
 }
 
 void Coordinator::add_condition(MachineId id, const Condition& c, Time now) noexcept {
-  MachineData& m = *machines_[id];
-  const State old = m.state;
-  Outcome outcome = Outcome::Masked;
-  if (c.level > old) {
-    outcome = Outcome::Raised;
-  } else if (c.level == old) {
-    const bool overrides = m.outstanding < 0 ||
-                           c.severity >= m.conditions[static_cast<std::size_t>(m.outstanding)].severity;
-    outcome = overrides ? Outcome::Override : Outcome::Joined;
-  }
-  m.conditions.push_back(c);
-  ++m.level_count[index(c.level)];
+  record_added(id, machines_[id].conditions.add(c), now);
+}
+
+void Coordinator::record_added(MachineId id, const ConditionChange& change, Time now) noexcept {
+  MachineData& m = machines_[id];
+  const Condition& c = m.conditions[static_cast<std::size_t>(change.index)];
   Record r;
   r.kind = RecordKind::Event;
-  r.outcome = outcome;
+  r.outcome = change.outcome;
   r.time = now;
   r.component = m.component;
   r.machine = id;
   r.event = c.event;
-  r.from = old;
+  r.from = change.from;
+  r.to = change.to;
   r.level = c.level;
   r.severity = c.severity;
   r.mirror = c.mirror;
   r.via = c.via;
   r.root = c.root;
-  m.state = state_from_counts(m.level_count);
-  refresh_outstanding(m);
-  r.to = m.state;
   record_machine(id, r);
-  update_machine(id, old, c.event, &m.conditions.back().root, now);
+  update_machine(id, change.from, c.event, &c.root, now);
 }
 
 void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now,
                                    std::string_view text) noexcept {
-  MachineData& m = *machines_[id];
-  const State old = m.state;
-  const Condition removed = m.conditions[i];
-  --m.level_count[index(removed.level)];
-  m.conditions[i] = m.conditions.back();
-  m.conditions.pop_back();
-  m.state = state_from_counts(m.level_count);
-  refresh_outstanding(m);
+  record_removed(id, machines_[id].conditions.remove(i), event, now, text);
+}
+
+void Coordinator::record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
+                                 std::string_view text) noexcept {
+  MachineData& m = machines_[id];
+  const Condition& removed = change.removed;
   Record r;
   r.kind = RecordKind::Event;
   r.outcome = Outcome::Cleared;
@@ -910,8 +859,8 @@ void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, T
   r.component = m.component;
   r.machine = id;
   r.event = event;
-  r.from = old;
-  r.to = m.state;
+  r.from = change.from;
+  r.to = change.to;
   r.level = removed.level;
   r.severity = removed.severity;
   r.mirror = removed.mirror;
@@ -919,37 +868,25 @@ void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, T
   r.root = removed.root;
   r.text = text;
   record_machine(id, r);
-  update_machine(id, old, event, &removed.root, now);
-}
-
-void Coordinator::refresh_outstanding(MachineData& m) noexcept {
-  // Outstanding: highest severity at the current level; ties go to the most recent activation.
-  m.outstanding = -1;
-  for (std::size_t i = 0; i < m.conditions.size(); ++i) {
-    const Condition& c = m.conditions[i];
-    if (c.level != m.state) continue;
-    if (m.outstanding < 0) {
-      m.outstanding = static_cast<std::int32_t>(i);
-      continue;
-    }
-    const Condition& best = m.conditions[static_cast<std::size_t>(m.outstanding)];
-    if (c.severity > best.severity || (c.severity == best.severity && c.seq > best.seq)) {
-      m.outstanding = static_cast<std::int32_t>(i);
-    }
-  }
+  update_machine(id, change.from, event, &removed.root, now);
 }
 
 void Coordinator::update_machine(MachineId id, State old_state, EventId event, const RootCause* root,
                                  Time now) noexcept {
-  MachineData& m = *machines_[id];
-  const EventId outstanding =
-      m.outstanding < 0 ? kNoEvent : m.conditions[static_cast<std::size_t>(m.outstanding)].event;
-  m.snapshot.store(pack(StateSnapshot{m.state, outstanding}), std::memory_order_release);
+  MachineData& m = machines_[id];
+  const State state = m.conditions.state();
+  const Condition* outstanding = m.conditions.outstanding();
+  MachineSummary& summary = summaries_[id];
+  summary.state = state;
+  summary.event = outstanding == nullptr ? kNoEvent : outstanding->event;
+  summary.severity = outstanding == nullptr ? 0 : outstanding->severity;
+  summary.seq = outstanding == nullptr ? 0 : outstanding->seq;
+  m.snapshot.store(pack(StateSnapshot{state, summary.event}), std::memory_order_release);
 
-  ComponentData& comp = *components_[m.component];
-  if (old_state != m.state) {
+  ComponentData& comp = components_[m.component];
+  if (old_state != state) {
     --comp.machine_state_count[index(old_state)];
-    ++comp.machine_state_count[index(m.state)];
+    ++comp.machine_state_count[index(state)];
     Record r;
     r.kind = RecordKind::Transition;
     r.time = now;
@@ -957,37 +894,41 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
     r.machine = id;
     r.event = event;
     r.from = old_state;
-    r.to = m.state;
+    r.to = state;
     if (root != nullptr) r.root = *root;
     record_machine(id, r);
     if (!m.callbacks.empty()) {
-      const TransitionInfo info{m.component, id, transition_between(old_state, m.state), event, root, now};
-      fire(m.callbacks, m.component, info, old_state, m.state);
+      const TransitionInfo info{m.component, id, transition_between(old_state, state), event, root, now};
+      fire(m.callbacks, m.component, info, old_state, state);
     }
   }
   update_component(m.component, event, root, now);
 }
 
 void Coordinator::update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept {
-  ComponentData& c = *components_[id];
+  ComponentData& c = components_[id];
   const State old = c.state;
   c.state = state_from_counts(c.machine_state_count);
   // The component's outstanding event: over its machines at the extended level, the outstanding
   // condition of highest severity, most recent on ties.
-  const Condition* best = nullptr;
+  // (Activation orders are unique, so the result does not depend on the order machines are seen.)
+  const MachineSummary* best = nullptr;
   auto consider = [&](MachineId mid) {
-    const MachineData& m = *machines_[mid];
-    if (m.state != c.state || m.outstanding < 0) return;
-    const Condition& cand = m.conditions[static_cast<std::size_t>(m.outstanding)];
+    const MachineSummary& cand = summaries_[mid];
+    if (cand.state != c.state || cand.event == kNoEvent) return;
     if (best == nullptr || cand.severity > best->severity ||
         (cand.severity == best->severity && cand.seq > best->seq)) {
       best = &cand;
     }
   };
-  consider(c.framework);
-  consider(c.application);
-  for (MachineId p : c.provided) consider(p);
-  for (MachineId r : c.required) consider(r);
+  if (c.contiguous) {
+    for (MachineId m = c.first_machine; m < c.first_machine + c.machine_count; ++m) consider(m);
+  } else {
+    consider(c.framework);
+    consider(c.application);
+    for (MachineId p : c.provided) consider(p);
+    for (MachineId r : c.required) consider(r);
+  }
   c.outstanding = best == nullptr ? kNoEvent : best->event;
   c.snapshot.store(pack(StateSnapshot{c.state, c.outstanding}), std::memory_order_release);
   if (old == c.state) return;
@@ -1018,7 +959,7 @@ void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId compo
       // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
       SampleCause cause;
       pending_.push_back(Pending{PendingKind::Generate, framework_event::kCallbackException,
-                                 components_[component]->framework, cause, Address{}, kNoName});
+                                 components_[component].framework, cause, Address{}, kNoName});
     }
   }
 }
@@ -1037,11 +978,11 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
   visit_marks_[root.origin] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
-    for (const Edge& e : machines_[from]->fanout) {
+    for (const Edge& e : machines_[from].fanout) {
       if (level < e.min_level || visit_marks_[e.to] == mark) continue;
       visit_marks_[e.to] = mark;
       work_.push_back(e.to);
-      if (find_mirror(*machines_[e.to], root) >= 0) continue;
+      if (machines_[e.to].conditions.find_mirror(root) >= 0) continue;
       Condition c;
       c.event = mirror_event;
       c.level = level;
@@ -1063,14 +1004,14 @@ void Coordinator::propagate_clear(const RootCause& root, State level, Time now) 
   visit_marks_[root.origin] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
-    for (const Edge& e : machines_[from]->fanout) {
+    for (const Edge& e : machines_[from].fanout) {
       if (level < e.min_level || visit_marks_[e.to] == mark) continue;
       visit_marks_[e.to] = mark;
       work_.push_back(e.to);
-      const std::int32_t i = find_mirror(*machines_[e.to], root);
+      const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
       if (i < 0) continue;
       const EventId completion = framework_event::completion_of(
-          machines_[e.to]->conditions[static_cast<std::size_t>(i)].event);
+          machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
       remove_condition(e.to, static_cast<std::size_t>(i), completion, now, {});
     }
   }
@@ -1085,7 +1026,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
       break;
     case Address::Kind::Component:
     case Address::Kind::Service: {
-      const ComponentData& c = *components_[target.component];
+      const ComponentData& c = components_[target.component];
       targets.push_back(c.framework);
       targets.push_back(c.application);
       targets.insert(targets.end(), c.provided.begin(), c.provided.end());
@@ -1095,13 +1036,13 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
     case Address::Kind::Machine: targets.push_back(target.machine); break;
   }
   for (MachineId id : targets) {
-    MachineData& m = *machines_[id];
+    MachineData& m = machines_[id];
     Record r;
     r.kind = RecordKind::Reset;
     r.time = now;
     r.component = m.component;
     r.machine = id;
-    r.from = r.to = m.state;
+    r.from = r.to = m.conditions.state();
     r.text = text;
     record_machine(id, r);
   }
@@ -1109,10 +1050,10 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
   // once (E2N) instead of passing through a Warning that callbacks would react to.
   for (const State pass : {State::Warning, State::Error}) {
     for (MachineId id : targets) {
-      MachineData& m = *machines_[id];
+      MachineData& m = machines_[id];
       // Propagating a clear may shrink this machine's conditions (a cycle): search afresh each time.
-      for (std::int32_t i = find_any_root(m); i >= 0 && m.conditions[static_cast<std::size_t>(i)].level <= pass;
-           i = find_any_root(m)) {
+      for (std::int32_t i = m.conditions.find_lowest_root();
+           i >= 0 && m.conditions[static_cast<std::size_t>(i)].level <= pass; i = m.conditions.find_lowest_root()) {
         const Condition c = m.conditions[static_cast<std::size_t>(i)];
         remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
         propagate_clear(c.root, c.level, now);

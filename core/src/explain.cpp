@@ -54,7 +54,7 @@ std::string to_string(const Explanation& e) {
 }
 
 std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition& condition) const {
-  if (!condition.mirror) return {machines_[holder]->address};
+  if (!condition.mirror) return {machines_[holder].address};
   // The shortest path of hops the condition's level passes, found by a breadth-first search from
   // the origin along the same edges propagation uses. Walking back from the holder instead can
   // circle a cycle of connections forever (every machine on the cycle holds a mirror).
@@ -67,7 +67,7 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
   seen[origin] = true;
   for (std::size_t head = 0; head < queue.size() && !seen[holder]; ++head) {
     const MachineId from = queue[head];
-    for (const Edge& e : machines_[from]->fanout) {
+    for (const Edge& e : machines_[from].fanout) {
       if (condition.level < e.min_level || seen[e.to]) continue;
       seen[e.to] = true;
       parent_edge[e.to] = edges.size();
@@ -75,13 +75,13 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
       queue.push_back(e.to);
     }
   }
-  std::vector<std::string> reversed{machines_[holder]->address};
+  std::vector<std::string> reversed{machines_[holder].address};
   for (MachineId at = holder; at != origin && parent_edge[at] != kUnseen;) {
     const auto [from, edge] = edges[parent_edge[at]];
     const Connection& conn = connections_[edge->via];
-    const ComponentData& provider = *components_[conn.provider];
+    const ComponentData& provider = components_[conn.provider];
     reversed.push_back(provider.name + ".s_S." + std::string(interface_name(provider.provided[conn.provided])));
-    reversed.push_back(machines_[from]->address);
+    reversed.push_back(machines_[from].address);
     at = from;
   }
   std::reverse(reversed.begin(), reversed.end());
@@ -96,7 +96,7 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
 }
 
 std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
-  const MachineData& m = *machines_[id];
+  const MachineData& m = machines_[id];
   std::vector<const Condition*> sorted;
   for (const Condition& c : m.conditions) sorted.push_back(&c);
   std::sort(sorted.begin(), sorted.end(), [](const Condition* a, const Condition* b) {
@@ -112,14 +112,14 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
     e.level = c->level;
     e.severity = c->severity;
     e.mirror = c->mirror;
-    e.outstanding = m.outstanding >= 0 && &m.conditions[static_cast<std::size_t>(m.outstanding)] == c;
+    e.outstanding = m.conditions.outstanding() == c;
     e.count = c->count;
     e.first = c->first;
     e.last = c->last;
     e.root_event = events_[c->root.event].name;
     e.root_origin = c->root.remote != kNone && c->root.remote < remote_roots_.size()
                         ? remote_roots_[c->root.remote].origin
-                        : machines_[c->root.origin]->address;
+                        : machines_[c->root.origin].address;
     e.root_time = c->root.time;
     e.hazard = events_[c->root.event].hazard;
     if (c->root.sample.filter != kNoName) e.filter = std::string(name_of(c->root.sample.filter));
@@ -134,14 +134,14 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
 }
 
 std::vector<Explanation> Coordinator::explain(const Address& address) const {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   std::vector<MachineId> machines;
   switch (address.kind) {
     case Address::Kind::System:
       for (MachineId m = 0; m < machines_.size(); ++m) machines.push_back(m);
       break;
     case Address::Kind::Component: {
-      const ComponentData& c = *components_[address.component];
+      const ComponentData& c = components_[address.component];
       machines.push_back(c.framework);
       machines.push_back(c.application);
       machines.insert(machines.end(), c.provided.begin(), c.provided.end());
@@ -149,13 +149,13 @@ std::vector<Explanation> Coordinator::explain(const Address& address) const {
       break;
     }
     case Address::Kind::Service: {
-      const ComponentData& c = *components_[address.component];
+      const ComponentData& c = components_[address.component];
       for (MachineId m : {c.framework, c.application}) {
-        if (depends_on(address.component, address.service, *machines_[m])) machines.push_back(m);
+        if (depends_on(address.component, address.service, machines_[m])) machines.push_back(m);
       }
       machines.push_back(c.provided[address.service]);
       for (MachineId m : c.required) {
-        if (depends_on(address.component, address.service, *machines_[m])) machines.push_back(m);
+        if (depends_on(address.component, address.service, machines_[m])) machines.push_back(m);
       }
       break;
     }

@@ -23,7 +23,7 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   const std::string_view iface = provider_provided.substr(dot + 1);
   ComponentId id = kNoComponent;
   if (auto found = find_component(component)) {
-    if (!components_[*found]->remote) {
+    if (!components_[*found].remote) {
       return fail(ErrorCode::Duplicate, "remote provided interface '" + text + "': component '" +
                                             std::string(component) + "' runs in this process");
     }
@@ -32,7 +32,7 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
     auto added = add_component(component);
     if (!added) return tl::unexpected(added.error());
     id = *added;
-    components_[id]->remote = true;
+    components_[id].remote = true;
   }
   auto machine = add_provided(id, iface);
   if (!machine) return tl::unexpected(machine.error());
@@ -43,23 +43,23 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
 }
 
 bool Coordinator::is_remote(ComponentId id) const noexcept {
-  return id < components_.size() && components_[id]->remote;
+  return id < components_.size() && components_[id].remote;
 }
 
 std::string Coordinator::root_origin(const RootCause& root) const {
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   if (root.remote_origin != kNoName) return std::string(name_of(root.remote_origin));
   if (root.remote != kNone && root.remote < remote_roots_.size()) return remote_roots_[root.remote].origin;
-  if (root.origin < machines_.size()) return machines_[root.origin]->address;
+  if (root.origin < machines_.size()) return machines_[root.origin].address;
   return {};
 }
 
 Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std::vector<RemoteRoot>& roots) {
-  if (proxy >= machines_.size() || machines_[proxy]->kind != MachineKind::Provided ||
-      !components_[machines_[proxy]->component]->remote) {
+  if (proxy >= machines_.size() || machines_[proxy].kind != MachineKind::Provided ||
+      !components_[machines_[proxy].component].remote) {
     return fail(ErrorCode::NotFound, "machine " + std::to_string(proxy) + " is not a remote provided interface");
   }
-  const std::string& where = machines_[proxy]->address;
+  const std::string& where = machines_[proxy].address;
   // Check everything before changing anything.
   std::vector<EventId> ids;
   ids.reserve(roots.size());
@@ -87,19 +87,19 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     samples[i].injected = roots[i].injected;
   }
 
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   if (processing_) return fail(ErrorCode::InvalidState, "apply_remote() called from a callback or observer");
   processing_ = true;
   RemoteApplyResult result;
   const Time now = clock_->now();
-  MachineData& m = *machines_[proxy];
+  MachineData& m = machines_[proxy];
 
   // Path-vector rule: a root that has already passed through a machine this interface feeds is
   // coming back around a cycle of processes; mirroring it again would keep it alive forever.
   std::vector<bool> wanted(roots.size(), true);
   for (std::size_t i = 0; i < roots.size(); ++i) {
     for (const Edge& e : m.fanout) {
-      const std::string& receiver = machines_[e.to]->address;
+      const std::string& receiver = machines_[e.to].address;
       if (std::find(roots[i].path.begin(), roots[i].path.end(), receiver) != roots[i].path.end()) {
         wanted[i] = false;
         ++result.dropped;
@@ -177,14 +177,14 @@ namespace safecass {
 std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::uint32_t service) const {
   // The same roots, levels and shortest paths as explain() of the service address gives, built
   // straight from the conditions: no Explanation (machine, event and hazard texts) per condition.
-  std::lock_guard lock(mutex_);
+  Lock lock(*this);
   std::vector<RemoteRoot> out;
-  if (component >= components_.size() || service >= components_[component]->provided.size()) return out;
-  const ComponentData& c = *components_[component];
+  if (component >= components_.size() || service >= components_[component].provided.size()) return out;
+  const ComponentData& c = components_[component];
   std::vector<EventId> ids;  // out[i]'s root event, compared by id rather than by name
   std::vector<const Condition*> sorted;
   auto visit = [&](MachineId id) {
-    const MachineData& m = *machines_[id];
+    const MachineData& m = machines_[id];
     if (m.conditions.empty()) return;
     sorted.clear();
     for (const Condition& k : m.conditions) sorted.push_back(&k);
@@ -196,7 +196,7 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
     });
     for (const Condition* k : sorted) {
       const bool remote = k->root.remote != kNone && k->root.remote < remote_roots_.size();
-      const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin]->address;
+      const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin].address;
       std::size_t i = 0;
       while (i < out.size() && !(ids[i] == k->root.event && out[i].time == k->root.time && out[i].origin == origin)) ++i;
       if (i < out.size()) {
@@ -220,11 +220,11 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
     }
   };
   for (MachineId m : {c.framework, c.application}) {
-    if (depends_on(component, service, *machines_[m])) visit(m);
+    if (depends_on(component, service, machines_[m])) visit(m);
   }
   visit(c.provided[service]);
   for (MachineId m : c.required) {
-    if (depends_on(component, service, *machines_[m])) visit(m);
+    if (depends_on(component, service, machines_[m])) visit(m);
   }
   return out;
 }

@@ -3,7 +3,9 @@
 /// The coordinator: one per process. It owns the Generic Component Model of that process's
 /// components (their state machines, the event definitions, the connections), applies events with
 /// the severity policy of DESIGN §2.4, propagates errors along connections (§2.6), fires callbacks
-/// (§2.5) and publishes everything that happens on one observer stream.
+/// (§2.5) and publishes everything that happens on one observer stream. The severity policy itself
+/// is ConditionSet (condition_set.hpp), one per machine; the coordinator orchestrates: records,
+/// callbacks, propagation, history.
 ///
 /// Lifecycle: configure (add components, interfaces, events, services, connections), then run
 /// (generate, reset, read). Configuration calls are not safe against concurrent readers: finish
@@ -17,8 +19,10 @@
 /// - callbacks and observers must not change the configuration or register callbacks/observers;
 /// - callbacks and observers run on the thread that caused the change, under the lock. They must
 ///   not block. An event they generate (or a reset they ask for) is queued and processed before the
-///   outer call returns. An exception thrown by a callback becomes EVT_CALLBACK_EXCEPTION on the
-///   component's s_F.
+///   outer call returns. They may also read the coordinator (history(), explain(), root_origin(),
+///   ...): the lock is a plain mutex, and a call from the thread that holds it runs under the lock
+///   already held instead of locking again (see "lock discipline" below). An exception thrown by a
+///   callback becomes EVT_CALLBACK_EXCEPTION on the component's s_F.
 
 #include <array>
 #include <atomic>
@@ -37,6 +41,7 @@
 
 #include "safecass/core/clock.hpp"
 #include "safecass/core/condition.hpp"
+#include "safecass/core/condition_set.hpp"
 #include "safecass/core/event.hpp"
 #include "safecass/core/expected.hpp"
 #include "safecass/core/ids.hpp"
@@ -176,6 +181,33 @@ struct CoordinatorOptions {
   std::size_t pending_capacity = 256;      ///< events generated from callbacks, reserved up front
 };
 
+namespace detail {
+/// A growable array whose elements never move: chunks of `kChunk` contiguous elements. Indexing is
+/// a shift, a mask and two loads, without allocation or lock; adding allocates one chunk per
+/// `kChunk` elements. Not thread-safe against a concurrent add.
+template <class T>
+class StableVector {
+public:
+  static constexpr std::size_t kChunkBits = 6;
+  static constexpr std::size_t kChunk = std::size_t{1} << kChunkBits;
+
+  std::size_t size() const noexcept { return size_; }
+  bool empty() const noexcept { return size_ == 0; }
+  T& operator[](std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+  const T& operator[](std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+  T& back() noexcept { return (*this)[size_ - 1]; }
+  /// Appends a default-constructed element and returns it.
+  T& emplace_back() {
+    if ((size_ >> kChunkBits) == chunks_.size()) chunks_.push_back(std::make_unique<T[]>(kChunk));
+    return (*this)[size_++];
+  }
+
+private:
+  std::vector<std::unique_ptr<T[]>> chunks_;
+  std::size_t size_ = 0;
+};
+}  // namespace detail
+
 class Coordinator {
 public:
   /// `clock` must outlive the coordinator; null means an owned SteadyClock.
@@ -284,10 +316,10 @@ public:
   void reset(const Address& target, std::string_view who, std::string_view why);
 
   // ---- lock-free reads -----------------------------------------------------------------------
-  State state(MachineId id) const noexcept { return unpack(machines_[id]->snapshot.load(std::memory_order_acquire)).state; }
-  StateSnapshot snapshot(MachineId id) const noexcept { return unpack(machines_[id]->snapshot.load(std::memory_order_acquire)); }
+  State state(MachineId id) const noexcept { return unpack(machines_[id].snapshot.load(std::memory_order_acquire)).state; }
+  StateSnapshot snapshot(MachineId id) const noexcept { return unpack(machines_[id].snapshot.load(std::memory_order_acquire)); }
   /// The extended component state ŝ_ext(C) and its outstanding event.
-  StateSnapshot extended(ComponentId id) const noexcept { return unpack(components_[id]->snapshot.load(std::memory_order_acquire)); }
+  StateSnapshot extended(ComponentId id) const noexcept { return unpack(components_[id].snapshot.load(std::memory_order_acquire)); }
   State extended_state(ComponentId id) const noexcept { return extended(id).state; }
   /// Service state s_S.p of provided interface `provided` (index) of `component`.
   State service_state(ComponentId component, std::uint32_t provided) const noexcept;
@@ -311,7 +343,7 @@ public:
   /// Events and resets requested from callbacks beyond the chain bound (65536 per outer call) and
   /// therefore not processed. Non-zero means a callback loop: a bug in the application.
   std::uint64_t dropped_requests() const {
-    std::lock_guard lock(mutex_);
+    Lock lock(*this);
     return dropped_requests_;
   }
 
@@ -366,37 +398,50 @@ private:
   void size_history();
   Ring history_;  ///< every machine and component record of this coordinator
   struct MachineData {
-    MachineKind kind;
-    ComponentId component;
-    std::uint32_t iface;  ///< index of the interface for Provided/Required
-    std::string address;
-    std::vector<Condition> conditions;
-    std::array<std::uint32_t, 3> level_count{};
-    State state = State::Normal;
-    std::int32_t outstanding = -1;  ///< index into conditions
+    ComponentId component = kNoComponent;
+    MachineKind kind = MachineKind::Framework;
+    std::uint32_t iface = kNone;  ///< index of the interface for Provided/Required
     std::atomic<std::uint64_t> snapshot{0};
-    std::vector<StateCallbacks> callbacks;
     std::vector<Edge> fanout;
+    ConditionSet conditions;      ///< §2.4: the machine's state and outstanding condition
+    std::vector<StateCallbacks> callbacks;
+    std::string address;
   };
   struct ServiceData {
     ServiceDependency dependency;
     std::vector<std::uint32_t> required;  ///< resolved indices of the required interfaces
   };
   struct ComponentData {
-    std::string name;
+    // Read or written on every change of one of its machines (update_component): first.
+    std::array<std::uint32_t, 3> machine_state_count{};
+    State state = State::Normal;
     bool remote = false;  ///< a stand-in for a component of another process (add_remote_provided)
-    MachineId framework;
-    MachineId application;
+    /// Its machines are ids [first_machine, first_machine + machine_count) when `contiguous` (the
+    /// usual case: interfaces are added right after their component); else see the lists below.
+    bool contiguous = true;
+    EventId outstanding = kNoEvent;
+    MachineId first_machine = kNoMachine;
+    std::uint32_t machine_count = 0;
+    std::atomic<std::uint64_t> snapshot{0};
+    std::vector<StateCallbacks> callbacks;
+    // Configuration and lookups.
+    MachineId framework = kNoMachine;
+    MachineId application = kNoMachine;
     std::vector<MachineId> provided;
     std::vector<MachineId> required;
     std::vector<ServiceData> services;            ///< one per provided interface
     std::vector<ConnectionId> required_connection;///< one per required interface
     std::vector<ConnectionId> provider_connections;///< connections to its provided interfaces
-    std::array<std::uint32_t, 3> machine_state_count{};
+    std::string name;
+  };
+  /// What update_component() reads of each machine, in one dense array by machine id: the
+  /// machines of a component are created together, so their summaries share a cache line and a
+  /// component's outstanding event is found without visiting its machines.
+  struct MachineSummary {
+    std::uint64_t seq = 0;       ///< the outstanding condition's activation order
+    EventId event = kNoEvent;    ///< the outstanding condition's event; kNoEvent in Normal
     State state = State::Normal;
-    EventId outstanding = kNoEvent;
-    std::atomic<std::uint64_t> snapshot{0};
-    std::vector<StateCallbacks> callbacks;
+    std::uint8_t severity = 0;   ///< the outstanding condition's severity
   };
   enum class PendingKind : std::uint8_t { Generate, Reset };
   struct Pending {
@@ -437,11 +482,11 @@ private:
                         std::string_view text) noexcept;
   void propagate_onset(const Condition& root) noexcept;
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
-  std::int32_t find_mirror(const MachineData& m, const RootCause& root) const noexcept;
-  std::int32_t find_root(const MachineData& m, EventId event) const noexcept;
-  /// A root condition of the lowest level, or -1.
-  std::int32_t find_any_root(const MachineData& m) const noexcept;
-  void refresh_outstanding(MachineData& m) noexcept;
+  /// Writes the event record of a condition just added (change.index) and publishes the machine.
+  void record_added(MachineId id, const ConditionChange& change, Time now) noexcept;
+  /// Writes the event record of a condition just removed and publishes the machine.
+  void record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
+                      std::string_view text) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
   void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
@@ -456,8 +501,11 @@ private:
   const Clock* clock_;
   CoordinatorOptions options_;
 
-  std::vector<std::unique_ptr<MachineData>> machines_;
-  std::vector<std::unique_ptr<ComponentData>> components_;
+  // Machines and components live in chunks of contiguous elements: a fault that visits thousands
+  // of machines walks memory in order instead of chasing one heap object per machine, and an
+  // element never moves once added (references handed out stay valid while the model grows).
+  detail::StableVector<MachineData> machines_;
+  detail::StableVector<ComponentData> components_;
   struct NameHash {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
@@ -467,12 +515,48 @@ private:
   std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
 
-  mutable std::recursive_mutex mutex_;
+  // ---- lock discipline ------------------------------------------------------------------------
+  // One plain mutex guards everything that changes at run time (conditions, history, queue,
+  // callbacks, observers); state reads never take it (they read the published atomic words).
+  // - Every public member that needs it takes it exactly once, on entry, through Lock. Private
+  //   members (processing, propagation, records, explain_machine, hop_path, ...) assume it is
+  //   held and never take it; no public member that locks calls another public member that locks.
+  // - Callbacks and observers run under the mutex, on the thread that holds it (docs/semantics.md
+  //   §5.3, §8.2). When one of them calls back into this coordinator, Lock finds `owner_` equal
+  //   to the calling thread and does not lock again: generate(), broadcast() and reset() then see
+  //   `processing_` and queue their request; reads (history(), explain(), root_origin(), ...)
+  //   read under the lock already held. Any other thread blocks until the outer operation ends.
+  // - `owner_` is written only by the thread that holds the mutex (after locking, before
+  //   unlocking), so a thread can find its own id there only while it really holds the mutex.
+  // - names_mutex_ is taken after mutex_ (intern()/name_of() while processing), never before.
+  class Lock {
+  public:
+    explicit Lock(const Coordinator& co) : co_(co) {
+      if (co_.owner_.load(std::memory_order_relaxed) == std::this_thread::get_id()) return;  // re-entry
+      co_.mutex_.lock();
+      co_.owner_.store(std::this_thread::get_id(), std::memory_order_relaxed);
+      locked_ = true;
+    }
+    ~Lock() {
+      if (!locked_) return;
+      co_.owner_.store(std::thread::id{}, std::memory_order_relaxed);
+      co_.mutex_.unlock();
+    }
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+
+  private:
+    const Coordinator& co_;
+    bool locked_ = false;
+  };
+  mutable std::mutex mutex_;
+  mutable std::atomic<std::thread::id> owner_{};
   bool processing_ = false;
   std::uint64_t condition_seq_ = 0;
   std::uint64_t record_seq_ = 0;
   std::uint64_t dropped_requests_ = 0;
   std::vector<Pending> pending_;
+  std::vector<MachineSummary> summaries_;    ///< by machine id, kept by update_machine()
   std::vector<MachineId> work_;              ///< BFS queue for propagation, reserved up front
   std::vector<std::uint64_t> visit_marks_;   ///< per machine: last BFS that visited it
   std::uint64_t visit_epoch_ = 0;
