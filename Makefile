@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers asan tsan clean
 
 all: build
 
@@ -64,6 +64,20 @@ bench: deps
 	  --benchmark_report_aggregates_only=true \
 	  --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	@./scripts/bench-middleware $(BUILD)/release/bin/bench_middleware $(BUILD)/bench-middleware.json
+
+# SAFECASS side by side with its peers (raw IceStorm, roscpp, ROS diagnostics, Boost.MSM and
+# Boost.Statechart) in one run: its own Release tree with ROS 1 (build/peers), results in
+# build/bench-peers.json and a table (docs/benchmarks.md). BENCH_PEERS_ARGS=--quick: a short run
+# (about a minute) that checks the harness and that the JSON has every figure.
+PEERS := $(BUILD)/peers
+PEER_TARGETS := bench_peers_core peer_detection peer_icestorm_raw peer_supervisor_load peer_ros_visibility \
+  peer_ros_watch bench_middleware safecass_bench
+CCACHE_LAUNCHER := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+bench-peers: deps
+	@./scripts/install-deps.sh --bench-peers
+	@test -f $(PEERS)/build.ninja || cmake --preset peers $(CCACHE_LAUNCHER) >/dev/null
+	@cmake --build $(PEERS) -j $(JOBS) --target $(PEER_TARGETS)
+	@./scripts/bench-peers $(PEERS) $(BUILD)/bench-peers.json $(BENCH_PEERS_ARGS)
 
 asan: deps
 	@test -f $(BUILD)/asan/build.ninja || cmake --preset asan >/dev/null

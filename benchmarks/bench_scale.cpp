@@ -9,6 +9,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/spec/load.hpp"
@@ -94,6 +95,32 @@ void BM_ScalePropagate(benchmark::State& state) {
   state.SetComplexityN(n);
 }
 BENCHMARK(BM_ScalePropagate)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Complexity(benchmark::oN);
+
+// Events per second sustained through a system of N components with propagation: an onset at
+// one component's s_A and its completion, for every component in turn. Each onset marks its
+// component and every component below it in the tree (a leaf: itself; C0: all N) and its
+// completion clears them again. Counter items_per_second: events (onsets and completions).
+void BM_ScaleEventRate(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  Tree tree(n);
+  spec::LoadResult r = spec::load_system_from_text(tree.text, "tree.json", tree.registry);
+  Coordinator co("tree");  // steady_clock, as deployed
+  Monitor monitor(co, tree.registry);
+  if (!spec::instantiate(*r.system, co, monitor)) state.SkipWithError("instantiate failed");
+  std::vector<MachineId> targets;
+  for (int k = 0; k < n; ++k) targets.push_back(co.application_machine(*co.find_component("C" + std::to_string(k))));
+  const EventId onset = *co.find_event("EVT_FAULT");
+  const EventId completion = *co.find_event("/EVT_FAULT");
+  std::size_t k = 0;
+  for (auto _ : state) {
+    co.generate(onset, targets[k]);
+    co.generate(completion, targets[k]);
+    k = k + 1 == targets.size() ? 0 : k + 1;
+  }
+  if (co.coordinator_state() != State::Normal) state.SkipWithError("the faults did not clear");
+  state.SetItemsProcessed(2 * state.iterations());
+}
+BENCHMARK(BM_ScaleEventRate)->Arg(1000);
 
 // The memory of a built system: the heap in use (mallinfo2: small blocks and mmapped ones) after
 // the coordinator and its monitor are built, minus before, per component. Issue target: at most

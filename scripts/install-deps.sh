@@ -1,7 +1,15 @@
 #!/usr/bin/env bash
 # Installs every Debian package SAFECASS needs to build, test and run its demo.
 # Idempotent: when everything is present it checks with dpkg and returns in well under a second.
+#   scripts/install-deps.sh [--bench-peers]
+#     --bench-peers  also what only `make bench-peers` needs (the ROS diagnostics peers' headers)
 set -euo pipefail
+bench_peers=0
+case "${1:-}" in
+  '') ;;
+  --bench-peers) bench_peers=1 ;;
+  *) echo "install-deps: unknown argument '$1' (use --bench-peers or nothing)" >&2; exit 2 ;;
+esac
 
 packages=(
   build-essential cmake ninja-build pkg-config git
@@ -27,6 +35,11 @@ command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
 # Every bus message is signed (Ed25519, libsodium).
 packages+=(libsodium-dev)
+# `make bench-peers` (benchmarks/peers): diagnostic_updater for the ROS diagnostics peer; roscpp,
+# diagnostic_aggregator, IceStorm and Boost (MSM, Statechart: header-only) are listed above.
+if [ "$bench_peers" = 1 ]; then
+  packages+=(libdiagnostic-updater-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

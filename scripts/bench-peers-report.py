@@ -1,0 +1,191 @@
+#!/usr/bin/env python3
+"""Composes build/bench-peers.json from the parts scripts/bench-peers measured, and prints the table.
+
+    bench-peers-report.py WORK_DIR OUT.json      (environment: QUICK=0|1, FAILED="part ...")
+
+Exits 1 when a top-level figure the benchmark promises is missing (a part failed or wrote nothing).
+"""
+import json
+import os
+import sys
+
+REQUIRED = [
+    "visibility_p99_ratio_vs_icestorm",
+    "visibility_speedup_vs_ros_diagnostics_default",
+    "supervisor_cpu_ratio_vs_aggregator",
+    "event_ns_ratio_vs_msm",
+    "detection_cpu_percent",
+    "detection_p99_us",
+]
+
+
+def load(work, name):
+    try:
+        with open(os.path.join(work, name + ".json"), encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return None
+
+
+def ratio(a, b):
+    if a is None or b is None or b == 0:
+        return None
+    return a / b
+
+
+def get(part, key):
+    return None if part is None else part.get(key)
+
+
+def gbench(part, name):
+    """(cpu ns per iteration, the entry) of a Google Benchmark result: the median when repeated."""
+    if part is None:
+        return None, None
+    entries = part.get("benchmarks", [])
+    # A repeated run: its median; else the one run. run_name drops "_median" but keeps
+    # "/iterations:N", which a name given without it also matches.
+    for median in (True, False):
+        for e in entries:
+            run = e.get("run_name", e.get("name", ""))
+            if run != name and not run.startswith(name + "/iterations:"):
+                continue
+            if median != (e.get("run_type") == "aggregate" and e.get("aggregate_name") == "median"):
+                continue
+            if not median and e.get("run_type", "iteration") != "iteration":
+                continue
+            scale = {"ns": 1.0, "us": 1e3, "ms": 1e6, "s": 1e9}[e.get("time_unit", "ns")]
+            return e["cpu_time"] * scale, e
+    return None, None
+
+
+def main():
+    work, out = sys.argv[1], sys.argv[2]
+    quick = os.environ.get("QUICK", "0") == "1"
+    failed = os.environ.get("FAILED", "").split()
+
+    vis = {
+        "safecass_over_icestorm": load(work, "safecass_visibility"),
+        "icestorm_raw": load(work, "icestorm_visibility"),
+        "roscpp_raw": load(work, "ros_visibility"),
+        "ros_diagnostics_default": load(work, "diag_default_visibility"),
+        "ros_diagnostics_fastest": load(work, "diag_fastest_visibility"),
+    }
+    watch = {"safecass_supervisor": load(work, "safecass_watch"), "ros_diagnostic_aggregator": load(work, "aggregator_watch")}
+    sm = load(work, "state_machines")
+    safecass_ns, _ = gbench(sm, "BM_PeerSafecassEvent")
+    msm_ns, _ = gbench(sm, "BM_PeerMsmEvent")
+    chart_ns, _ = gbench(sm, "BM_PeerStatechartEvent")
+    per_event = lambda ns: None if ns is None else ns / 2.0  # one iteration: onset + completion
+    machines = {
+        "safecass_ns_per_event": per_event(safecass_ns),
+        "boost_msm_ns_per_event": per_event(msm_ns),
+        "boost_statechart_ns_per_event": per_event(chart_ns),
+    }
+    detection = load(work, "detection")
+    scale_part = load(work, "scale")
+    _, rate_entry = gbench(scale_part, "BM_ScaleEventRate/1000")
+    _, memory_entry = gbench(scale_part, "BM_ScaleMemory/1000")
+    scale = {
+        "components": 1000,
+        "events_per_s": None if rate_entry is None else rate_entry.get("items_per_second"),
+        "bytes_per_component": None if memory_entry is None else memory_entry.get("bytes_per_component"),
+        "aggregator_bytes_per_item": get(watch["ros_diagnostic_aggregator"], "bytes_per_item"),
+    }
+    scale["memory_ratio_vs_aggregator_item"] = ratio(scale["bytes_per_component"], scale["aggregator_bytes_per_item"])
+
+    sc, ice, ros = vis["safecass_over_icestorm"], vis["icestorm_raw"], vis["roscpp_raw"]
+    dd, df = vis["ros_diagnostics_default"], vis["ros_diagnostics_fastest"]
+    sup, agg = watch["safecass_supervisor"], watch["ros_diagnostic_aggregator"]
+    result = {
+        "visibility_p99_ratio_vs_icestorm": ratio(get(sc, "p99_us"), get(ice, "p99_us")),
+        "visibility_speedup_vs_ros_diagnostics_default": ratio(get(dd, "p50_us"), get(sc, "p50_us")),
+        "supervisor_cpu_ratio_vs_aggregator": ratio(get(sup, "cpu_s_per_10k_updates"), get(agg, "cpu_s_per_10k_updates")),
+        "event_ns_ratio_vs_msm": ratio(machines["safecass_ns_per_event"], machines["boost_msm_ns_per_event"]),
+        "detection_cpu_percent": get(detection, "cpu_percent"),
+        "detection_p99_us": get(detection, "p99_us"),
+        # More ratios, same definitions.
+        "visibility_p50_ratio_vs_icestorm": ratio(get(sc, "p50_us"), get(ice, "p50_us")),
+        "visibility_p99_ratio_vs_roscpp": ratio(get(sc, "p99_us"), get(ros, "p99_us")),
+        "visibility_speedup_vs_ros_diagnostics_fastest": ratio(get(df, "p50_us"), get(sc, "p50_us")),
+        "event_ns_ratio_vs_statechart": ratio(machines["safecass_ns_per_event"], machines["boost_statechart_ns_per_event"]),
+        "scale_events_per_s": scale["events_per_s"],
+        "memory_ratio_vs_aggregator_item": scale["memory_ratio_vs_aggregator_item"],
+        "visibility": vis,
+        "watching": watch,
+        "state_machines": machines,
+        "detection": detection,
+        "scale": scale,
+    }
+    period_us = get(detection, "period_us") or 1000.0
+    targets = [
+        ("visibility_p99_ratio_vs_icestorm", "<=", 1.2),
+        ("visibility_speedup_vs_ros_diagnostics_default", ">=", 1000.0),
+        ("supervisor_cpu_ratio_vs_aggregator", "<=", 0.01),
+        ("event_ns_ratio_vs_msm", "<=", 2.0),
+        ("detection_cpu_percent", "<=", 5.0),
+        ("detection_p99_us", "<=", 1000.0 + period_us),
+    ]
+    result["targets"] = {
+        key: {"target": f"{op} {bound:g}", "value": result[key],
+              "met": None if result[key] is None else (result[key] <= bound if op == "<=" else result[key] >= bound)}
+        for key, op, bound in targets
+    }
+    try:
+        with open("/proc/loadavg", encoding="ascii") as f:
+            load_avg = f.read().split()[:3]
+    except OSError:
+        load_avg = []
+    result["machine"] = {"cores": os.cpu_count(), "load_average_at_end": load_avg}
+    result["quick"] = quick
+    result["failed_parts"] = failed
+    with open(out, "w", encoding="utf-8") as f:
+        json.dump(result, f, indent=2)
+        f.write("\n")
+
+    def fmt(v, unit="", digits=1):
+        if v is None:
+            return "—"
+        if isinstance(v, float) and abs(v) >= 1e4:
+            return f"{v:,.0f}{unit}"
+        return f"{v:.{digits}f}{unit}"
+
+    def lat(p):
+        return "—" if p is None else f"{fmt(p.get('p50_us'))} / {fmt(p.get('p99_us'))} / {fmt(p.get('max_us'))} µs (n={p.get('samples')})"
+
+    rows = [
+        ("visibility SAFECASS over IceStorm (p50/p99/max)", lat(sc)),
+        ("visibility raw IceStorm", lat(ice)),
+        ("visibility raw roscpp", lat(ros)),
+        ("visibility ROS diagnostics, defaults", lat(dd)),
+        ("visibility ROS diagnostics, fastest", lat(df)),
+        ("supervisor CPU s / 10k updates, RSS", "—" if sup is None else
+         f"{fmt(sup.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(sup.get('rss_bytes', 0) / 1e6)} MB"),
+        ("aggregator CPU s / 10k updates, RSS", "—" if agg is None else
+         f"{fmt(agg.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(agg.get('rss_bytes', 0) / 1e6)} MB"),
+        ("ns per event: SAFECASS / MSM / Statechart",
+         " / ".join(fmt(machines[k]) for k in ("safecass_ns_per_event", "boost_msm_ns_per_event",
+                                                 "boost_statechart_ns_per_event"))),
+        ("detection 1,000 signals at 1 kHz: CPU %, p99", f"{fmt(result['detection_cpu_percent'], ' %', 2)}, "
+                                                          f"{fmt(result['detection_p99_us'], ' µs')}"),
+        ("1,000 components: events/s, bytes/component", f"{fmt(scale['events_per_s'])}, {fmt(scale['bytes_per_component'], '', 0)}"
+                                                         f" (aggregator: {fmt(scale['aggregator_bytes_per_item'], '', 0)} per item)"),
+    ]
+    print()
+    print("SAFECASS and its peers" + (" (--quick: short runs, not the issue's figures)" if quick else ""))
+    width = max(len(r[0]) for r in rows)
+    for name, value in rows:
+        print(f"  {name:<{width}}  {value}")
+    print()
+    for key, t in result["targets"].items():
+        met = "—" if t["met"] is None else ("met" if t["met"] else "MISSED")
+        print(f"  {key:<{max(len(k) for k in result['targets'])}}  {fmt(t['value'], '', 4):>12}  target {t['target']:<8}  {met}")
+    print(f"\nbench-peers: results in {out} (machine: {os.cpu_count()} cores, load average {' '.join(load_avg)})")
+    missing = [k for k in REQUIRED if result.get(k) is None]
+    if missing:
+        print("bench-peers: missing figures: " + ", ".join(missing), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
