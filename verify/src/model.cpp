@@ -144,7 +144,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       if (co.event(*id).is_broadcast()) {
         add_root(e.name, kNoMachine, "broadcast");
       } else if (generated.count(e.name) == 0) {
-        add_root(e.name, co.application_machine(*comp), "component '" + c.name + "' (its own code)");
+        add_root(e.name, co.application_machine(*comp), "the code of component '" + c.name + "'");
       }
     }
   }

@@ -575,9 +575,10 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
   Verifier verifier(model, options, dir->path());
   std::vector<Check> searched;
   for (Check& c : checks) {
-    if (c.result.kind == PropertyResult::Kind::Reaction && c.reaction.empty()) {
+    if (c.result.kind == PropertyResult::Kind::Reaction && (c.reaction.empty() || c.linked.empty())) {
       c.result.structural = true;
-      c.result.message = "no reaction to check";
+      c.result.message = c.reaction.empty() ? "no reaction to check"
+                                            : "vacuously: no onset of the model is linked to the hazard";
       report.properties.push_back(c.result);
       continue;
     }
