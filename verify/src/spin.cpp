@@ -63,6 +63,14 @@ Expected<std::string> spin_version(const std::string& spin) {
   return v;
 }
 
+Expected<void> compiler_check(const std::string& cc) {
+  auto r = run_command("/", shell_quote(cc) + " --version");
+  if (!r || r->status != 0) {
+    return fail(ErrorCode::Io, "cannot run the C compiler '" + cc + "' that builds SPIN's verifiers: install build-essential");
+  }
+  return {};
+}
+
 namespace {
 
 std::uint64_t number_before(const std::string& text, const std::string& marker) {

@@ -73,6 +73,9 @@ Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
 Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model, unsigned seed,
                                                   std::size_t steps, const std::string& spin);
 
+/// An Io error unless the C compiler `cc` runs.
+Expected<void> compiler_check(const std::string& cc);
+
 /// "Spin Version 6.5.2 -- ..." or an Io error saying SPIN is not installed.
 Expected<std::string> spin_version(const std::string& spin);
 

@@ -571,6 +571,7 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
   if (!dir) return tl::unexpected(dir.error());
   if (!checks.empty()) {
     if (auto v = detail::spin_version(options.spin); !v) return tl::unexpected(v.error());
+    if (auto c = detail::compiler_check(options.cc); !c) return tl::unexpected(c.error());
   }
   Verifier verifier(model, options, dir->path());
   std::vector<Check> searched;

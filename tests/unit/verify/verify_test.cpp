@@ -11,6 +11,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "safecass/filters/registry.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/load.hpp"
@@ -23,9 +25,16 @@ namespace {
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
 
+fs::path test_root() { return fs::temp_directory_path() / ("safecass-verify-test-" + std::to_string(::getpid())); }
+
+/// Runs in the source root; removes the counterexamples written under the temporary directory.
 class SourceRoot : public ::testing::Environment {
 public:
   void SetUp() override { fs::current_path(SAFECASS_SOURCE_DIR); }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(test_root(), ec);
+  }
 };
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 
@@ -52,7 +61,7 @@ spec::SystemSpec load_text(const std::string& text) {
 
 /// A fresh directory for the counterexamples of one test.
 std::string out_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("safecass-verify-test-" + std::to_string(::getpid())) / name;
+  const fs::path dir = test_root() / name;
   fs::remove_all(dir);
   fs::create_directories(dir);
   return dir.string();
@@ -292,6 +301,21 @@ TEST(Verify, InterchangeableOnsetsAreCountedNotTracked) {
   EXPECT_EQ(t->onsets, 3u);
   EXPECT_EQ(m->states, 4u) << "0 to 3 active";
   EXPECT_EQ(t->states, 8u) << "each on or off";
+}
+
+TEST(Verify, WithoutSpinOrACompilerItSaysWhatToInstall) {
+  const spec::SystemSpec system = load("examples/robodoc/robodoc.json");
+  Options no_spin;
+  no_spin.spin = "/nonexistent/spin";
+  auto a = verify(system, registry(), no_spin);
+  ASSERT_FALSE(a);
+  EXPECT_EQ(a.error().code, ErrorCode::Io);
+  EXPECT_THAT(a.error().message, HasSubstr("install the Debian package 'spin'"));
+  Options no_cc;
+  no_cc.cc = "/nonexistent/cc";
+  auto b = verify(system, registry(), no_cc);
+  ASSERT_FALSE(b);
+  EXPECT_THAT(b.error().message, HasSubstr("C compiler"));
 }
 
 // ---- the command ---------------------------------------------------------------------------
