@@ -4,7 +4,8 @@
 // 50-component tree <= 120 s, memory <= 4 GB. Wall-clock times: they include compiling SPIN's
 // verifiers with the system's C compiler, and depend on the machine's load.
 //
-// Usage: bench_verify [OUT.json] [--components N]
+// Usage: bench_verify [OUT.json] [--components N] [--write-tree FILE]
+// (--write-tree writes the generated system file and exits, to run `safecass verify` on it.)
 
 #include <sys/resource.h>
 
@@ -111,8 +112,14 @@ int main(int argc, char** argv) {
   std::string out = "build/bench-verify.json";
   int n = 50;
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--components") == 0 && i + 1 < argc) n = std::atoi(argv[++i]);
-    else out = argv[i];
+    if (std::strcmp(argv[i], "--components") == 0 && i + 1 < argc) {
+      n = std::atoi(argv[++i]);
+    } else if (std::strcmp(argv[i], "--write-tree") == 0 && i + 1 < argc) {
+      std::ofstream(argv[++i]) << hazard_tree(n) << "\n";
+      return 0;
+    } else {
+      out = argv[i];
+    }
   }
   FilterRegistry registry;
   register_builtin_filters(registry);

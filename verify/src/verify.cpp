@@ -276,6 +276,10 @@ private:
     for (std::size_t i = 0; i < sorted.size() && i < 5; ++i) {
       most += (i ? ", " : "") + m_.machine_address(sorted[i].second) + " (" + std::to_string(sorted[i].first) + ")";
     }
+    std::string off;
+    if (!options_.slice) off += " without --no-slice only the onsets that can influence the property stay in its model;";
+    if (!options_.merge) off += " without --no-merge interchangeable onsets are counted, not tracked;";
+    if (!off.empty()) off = " First:" + off;
     return "the property depends on " + std::to_string(classes.size()) +
            " independent classes of onsets (most at: " + most +
            "). What would help: (1) onsets that are interchangeable for every property are counted, not "
@@ -283,7 +287,7 @@ private:
            "mean the same thing the same definition; (2) a property reads fewer onsets when it names fewer "
            "addresses: split an invariant over SYSTEM or many components into one per component; (3) narrower "
            "service dependencies (\"dependency\") and \"propagate\": \"error\" shrink what reaches an address; "
-           "(4) --memory MB raises the bound.";
+           "(4) --memory MB raises the bound." + off;
   }
 
   /// Replays the trail on the coordinator, writes the scenario, and says what failed.
