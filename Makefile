@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers asan tsan clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan clean
 
 all: build
 
@@ -28,6 +28,8 @@ demo: build
 	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
 	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
 	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
+	@echo "Model-checking robodoc's hazard reactions with SPIN (safecass verify):"
+	@./$(BUILD)/bin/safecass verify examples/robodoc/robodoc.json --out $(BUILD)/demo/counterexamples
 
 # ROBODOC on ROS 1 (examples/ros_robodoc): roscore, diagnostic_aggregator, the nodes, rosdiagnostic.
 ros-demo: configure
@@ -78,6 +80,11 @@ bench-peers: deps
 	@test -f $(PEERS)/build.ninja || cmake --preset peers $(CCACHE_LAUNCHER) >/dev/null
 	@cmake --build $(PEERS) -j $(JOBS) --target $(PEER_TARGETS)
 	@./scripts/bench-peers $(PEERS) $(BUILD)/bench-peers.json $(BENCH_PEERS_ARGS)
+
+# `safecass verify` on robodoc and on a generated 50-component tree with hazards: wall-clock time
+# (SPIN and the C compiler included) and memory, written to build/bench-verify.json.
+bench-verify: build
+	@./$(BUILD)/bin/bench_verify $(BUILD)/bench-verify.json
 
 asan: deps
 	@test -f $(BUILD)/asan/build.ninja || cmake --preset asan >/dev/null

@@ -35,6 +35,10 @@ command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
 # Every bus message is signed (Ed25519, libsodium).
 packages+=(libsodium-dev)
+# `safecass verify` translates a system into Promela and model-checks it with SPIN (the verifier
+# it generates is compiled with the system's gcc, from build-essential).
+packages+=(spin)
+
 # `make bench-peers` (benchmarks/peers): diagnostic_updater for the ROS diagnostics peer; roscpp,
 # diagnostic_aggregator, IceStorm and Boost (MSM, Statechart: header-only) are listed above.
 if [ "$bench_peers" = 1 ]; then

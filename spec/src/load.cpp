@@ -74,10 +74,13 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
   // component, and its own events (other than repeated framework events) are system events,
   // given to the first component (event names are system-wide).
   std::vector<EventDef> template_events;
+  std::vector<Position> template_where;  // parallel to template_events
   for (const ComponentItem& c : model.components) {
     if (!c.is_template()) continue;
     for (const EventItem& e : c.events) {
-      if (!e.framework_redefinition) template_events.push_back(e.def);
+      if (e.framework_redefinition) continue;
+      template_events.push_back(e.def);
+      template_where.push_back(sink.position(e.name_site));
     }
   }
   for (const ComponentItem& c : model.components) {
@@ -88,10 +91,13 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
     for (const Name& n : c.required) out.required.push_back(n.text);
     for (const SignalItem& s : c.signals) out.signals.push_back(SignalSpec{s.name, s.size});
     for (const EventItem& e : c.events) {
-      if (!e.framework_redefinition) out.events.push_back(e.def);
+      if (e.framework_redefinition) continue;
+      out.events.push_back(e.def);
+      out.event_where.push_back(sink.position(e.name_site));
     }
     if (system.components.empty()) {
       out.events.insert(out.events.end(), template_events.begin(), template_events.end());
+      out.event_where.insert(out.event_where.end(), template_where.begin(), template_where.end());
     }
     for (const FilterEntryItem& entry : c.filters) {
       FilterSpec f;
@@ -118,6 +124,20 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
     std::vector<std::string> components;
     for (const Name& n : co.components) components.push_back(n.text);
     system.coordinators.emplace_back(co.name.text, std::move(components));
+  }
+  for (const HazardItem& h : model.hazards) {
+    HazardSpec out;
+    out.id = h.id;
+    out.description = h.description;
+    out.where = sink.position(h.id_site);
+    for (const HazardItem::Reaction& r : h.reaction) {
+      out.reaction.emplace_back(r.address, parse_state(r.level).value_or(State::Error));
+      out.reaction_where.push_back(sink.position(r.key_site));
+    }
+    system.hazards.push_back(std::move(out));
+  }
+  for (const InvariantItem& i : model.invariants) {
+    system.invariants.push_back(InvariantSpec{i.name, i.formula, i.description, sink.position(i.name_site)});
   }
   return system;
 }

@@ -9,6 +9,7 @@
 #include "spec_commands.hpp"
 #include "timeline.hpp"
 #include "console.hpp"
+#include "verify_command.hpp"
 #ifdef SAFECASS_WITH_ICE
 #include "middleware_commands.hpp"
 #include "console_remote.hpp"
@@ -67,6 +68,7 @@ int main(int argc, char** argv) {
 
   safecass::tools::add_replay_command(app, code);
   safecass::tools::add_console_command(app, code);
+  safecass::tools::add_verify_command(app, code);
 #ifdef SAFECASS_WITH_VIEWER
   safecass::tools::add_viewer_command(app, code);
 #endif

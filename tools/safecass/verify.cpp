@@ -1,0 +1,157 @@
+// `safecass verify SYSTEM [--property NAME] [--out DIR] [--json]` (docs/verify.md).
+
+#include "verify_command.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "safecass/filters/registry.hpp"
+#include "safecass/spec/load.hpp"
+#include "safecass/verify/verify.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+std::string json_string(std::string_view s) {
+  std::string out = "\"";
+  for (const char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) {
+          char buf[8];
+          std::snprintf(buf, sizeof buf, "\\u%04x", c);
+          out += buf;
+        } else {
+          out += c;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string where_text(const spec::Position& p) {
+  if (p.file.empty()) return {};
+  return p.file + ":" + std::to_string(p.line) + ":" + std::to_string(p.column);
+}
+
+bool checked(const verify::PropertyResult& p) {
+  return p.kind == verify::PropertyResult::Kind::Reaction || p.kind == verify::PropertyResult::Kind::Invariant;
+}
+
+std::string figures(const verify::PropertyResult& p) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%llu states, %.1f MB, %.2f s, %zu of %zu onsets",
+                static_cast<unsigned long long>(p.states), p.memory_mb, p.seconds, p.onsets, p.onsets_total);
+  return buf;
+}
+
+}  // namespace
+
+void add_verify_command(CLI::App& app, int& code) {
+  struct Args {
+    std::string system;
+    verify::Options options;
+    bool json = false;
+  };
+  auto args = std::make_shared<Args>();
+  auto* cmd = app.add_subcommand("verify", "Model-check hazard reactions and invariants with SPIN; counterexamples as scenarios");
+  cmd->add_option("SYSTEM", args->system, "system file")->required();
+  cmd->add_option("--property", args->options.property, "check only this property (a hazard id or an invariant name)");
+  cmd->add_option("--out", args->options.out_dir, "write each violated property's counterexample as DIR/<property>.scenario.json");
+  cmd->add_flag("--json", args->json, "one JSON object per property, then a summary object");
+  cmd->add_option("--memory", args->options.memory_mb, "SPIN's memory bound per property, in MB (default 4096)");
+  cmd->add_flag("--no-slice", [args](std::int64_t) { args->options.slice = false; },
+                "keep every onset in every property's model (no cone of influence)");
+  cmd->add_flag("--no-merge", [args](std::int64_t) { args->options.merge = false; },
+                "track every onset on its own (no counting of interchangeable onsets)");
+  cmd->callback([args, &code] { code = run_verify(args->system, args->options, args->json); });
+}
+
+int run_verify(const std::string& system_path, const verify::Options& options, bool json) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  const spec::LoadResult loaded = spec::load_system(system_path, registry);
+  for (const spec::Diagnostic& d : loaded.diagnostics) {
+    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+  }
+  if (!loaded.ok()) {
+    std::fprintf(stderr, "verify: %s has %zu error(s); `safecass validate` lists every problem\n", system_path.c_str(),
+                 loaded.errors());
+    return 2;
+  }
+  auto report = verify::verify(*loaded.system, registry, options);
+  if (!report) {
+    std::fprintf(stderr, "verify: %s\n", report.error().message.c_str());
+    return 2;
+  }
+  std::size_t holds = 0, violated = 0, undecided = 0, findings = 0;
+  for (const verify::PropertyResult& p : report->properties) {
+    if (!checked(p)) {
+      ++findings;
+    } else if (p.verdict == verify::PropertyResult::Verdict::Holds) {
+      ++holds;
+    } else if (p.verdict == verify::PropertyResult::Verdict::Violated) {
+      ++violated;
+    } else {
+      ++undecided;
+    }
+    if (json) {
+      std::string line = "{\"kind\":" + json_string(verify::to_string(p.kind)) + ",\"name\":" + json_string(p.name) +
+                         ",\"result\":" + json_string(checked(p) ? verify::to_string(p.verdict) : "warning") +
+                         ",\"checks\":" + json_string(p.text);
+      if (!p.where.file.empty()) {
+        line += ",\"file\":" + json_string(p.where.file) + ",\"line\":" + std::to_string(p.where.line) +
+                ",\"column\":" + std::to_string(p.where.column);
+      }
+      if (!p.structural) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, ",\"states\":%llu,\"memory_mb\":%.3f,\"seconds\":%.3f,\"onsets\":%zu,\"onsets_total\":%zu",
+                      static_cast<unsigned long long>(p.states), p.memory_mb, p.seconds, p.onsets, p.onsets_total);
+        line += buf;
+      }
+      if (!p.message.empty()) line += ",\"message\":" + json_string(p.message);
+      if (!p.scenario.empty()) line += ",\"scenario\":" + json_string(p.scenario);
+      if (!p.advice.empty()) line += ",\"advice\":" + json_string(p.advice);
+      std::printf("%s}\n", line.c_str());
+      continue;
+    }
+    if (!checked(p)) {
+      const std::string at = where_text(p.where);
+      std::printf("%s%swarning: %s [%s]\n", at.c_str(), at.empty() ? "" : ": ", p.message.c_str(),
+                  std::string(verify::to_string(p.kind)).c_str());
+      continue;
+    }
+    const std::string label = std::string(verify::to_string(p.kind)) + " " + p.name;
+    if (p.structural) {
+      std::printf("%-32s %-9s (%s)\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(), p.message.c_str());
+      continue;
+    }
+    std::printf("%-32s %-9s %s\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(), figures(p).c_str());
+    if (p.verdict != verify::PropertyResult::Verdict::Holds) {
+      const std::string at = where_text(p.where);
+      std::printf("  %s%s%s\n", at.c_str(), at.empty() ? "" : ": ", p.text.c_str());
+      std::printf("  %s\n", p.message.c_str());
+      if (!p.scenario.empty()) std::printf("  counterexample: %s (safecass run --scenario %s)\n", p.scenario.c_str(), p.scenario.c_str());
+      if (!p.advice.empty()) std::printf("  %s\n", p.advice.c_str());
+    }
+  }
+  const int exit = report->exit_code();
+  if (json) {
+    std::printf("{\"kind\":\"summary\",\"system\":%s,\"holds\":%zu,\"violated\":%zu,\"undecided\":%zu,\"warnings\":%zu,"
+                "\"seconds\":%.3f,\"exit\":%d}\n",
+                json_string(report->system).c_str(), holds, violated, undecided, findings, report->seconds, exit);
+  } else {
+    std::printf("%s: %zu propert%s hold%s, %zu violated, %zu undecided, %zu warning%s about the specification (%.2f s)\n",
+                report->system.c_str(), holds, holds == 1 ? "y" : "ies", holds == 1 ? "s" : "", violated, undecided,
+                findings, findings == 1 ? "" : "s", report->seconds);
+  }
+  return exit;
+}
+
+}  // namespace safecass::tools

@@ -1,0 +1,21 @@
+#pragma once
+// `safecass verify` (docs/verify.md).
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+#include "safecass/verify/verify.hpp"
+
+namespace safecass::tools {
+
+/// Adds the `verify` subcommand; its exit code lands in `code`.
+void add_verify_command(CLI::App& app, int& code);
+
+/// Loads `system_path`, verifies it, prints one line per property (or, with `json`, one JSON
+/// object per property and a summary). Returns 0 every reaction and invariant holds, 1 one is
+/// violated, 2 bad input (errors in the specification, SPIN missing, an unknown property),
+/// 3 one could not be decided within the limits.
+int run_verify(const std::string& system_path, const verify::Options& options, bool json);
+
+}  // namespace safecass::tools

@@ -1,0 +1,82 @@
+#pragma once
+// Running SPIN: the Promela text → pan.c → the verifier (compiled with the system's C compiler)
+// → its verdict, statistics and trail; random simulation; trail replay.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "safecass/core/expected.hpp"
+
+namespace safecass::verify::detail {
+
+/// A command's output (stdout and stderr together) and exit status.
+struct CommandResult {
+  int status = -1;
+  std::string output;
+};
+
+/// Runs `command` with /bin/sh in `dir`. Errors: Io (cannot start it).
+Expected<CommandResult> run_command(const std::string& dir, const std::string& command);
+
+/// Single-quotes a word for /bin/sh.
+std::string shell_quote(const std::string& word);
+
+/// A fresh private directory for SPIN's files (mkdtemp under $TMPDIR or /tmp); removed by the
+/// destructor unless `keep`.
+class WorkDir {
+public:
+  static Expected<WorkDir> create(const std::string& given);
+  WorkDir(WorkDir&& other) noexcept;
+  WorkDir& operator=(WorkDir&&) = delete;
+  WorkDir(const WorkDir&) = delete;
+  ~WorkDir();
+  const std::string& path() const { return path_; }
+
+private:
+  WorkDir(std::string path, bool owned) : path_(std::move(path)), owned_(owned) {}
+  std::string path_;
+  bool owned_ = false;
+};
+
+struct PanOptions {
+  bool ltl = false;            ///< search for acceptance cycles (-a), depth-first; else safety, breadth-first
+  std::size_t memory_mb = 4096;
+  int hash_bits = 20;          ///< -w
+  std::string spin = "spin";
+  std::string cc = "cc";
+};
+
+struct PanResult {
+  enum class Outcome { Holds, Violated, MemoryLimit, Failed } outcome = Outcome::Failed;
+  std::uint64_t states = 0;
+  double memory_mb = 0.0;
+  std::string output;          ///< pan's report, for diagnosis
+  std::vector<std::string> trail;  ///< the "@ ..." lines of the counterexample, in order
+  bool cycle = false;          ///< LTL: the trail ends in a cycle (starting at `cycle_start`)
+  std::size_t cycle_start = 0;
+};
+
+/// Writes `model` as `name`.pml in `dir`, generates SPIN's verifier and compiles it (once for
+/// all the model's claims). Safety verifiers search breadth-first, so a trail is a shortest one.
+/// Returns the verifier's file name in `dir`. Errors: Io (SPIN or the compiler failed).
+Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
+                              const PanOptions& options);
+
+/// Checks claim `claim` with the verifier `binary` of model `name`; on a violation, replays the
+/// trail (pan -r). Errors: Io.
+Expected<PanResult> check_claim(const std::string& dir, const std::string& name, const std::string& binary,
+                                const std::string& claim, const PanOptions& options);
+
+/// SPIN's random simulation of `model` for at most `steps` steps with seed `seed`: the "@ ..."
+/// lines it printed. Errors: Io.
+Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model, unsigned seed,
+                                                  std::size_t steps, const std::string& spin);
+
+/// An Io error unless the C compiler `cc` runs.
+Expected<void> compiler_check(const std::string& cc);
+
+/// "Spin Version 6.5.2 -- ..." or an Io error saying SPIN is not installed.
+Expected<std::string> spin_version(const std::string& spin);
+
+}  // namespace safecass::verify::detail
