@@ -78,7 +78,9 @@ const ObjectKind& system_kind() {
                              "relative to this file) or a component object",
                "component_entry", true),
        objects("connections", "connections from a required interface to a provided interface", "connection"),
-       object("coordinators", "coordinator (process) name -> the components it runs", "coordinators")}};
+       object("coordinators", "coordinator (process) name -> the components it runs", "coordinators"),
+       objects("hazards", "the hazards of the hazard analysis and the reaction each requires", "hazard"),
+       objects("invariants", "named LTL formulas over addresses and levels, checked by safecass verify", "invariant")}};
   return kind;
 }
 
@@ -156,7 +158,7 @@ const ObjectKind& event_kind() {
        }(),
        text("completes", "completion only: the onset it clears (default: the name without its leading '/')"),
        boolean("latched", "onset only: a completion does not clear it, only a reset", "false"),
-       text("hazard", "an id from the hazard analysis"), kDescriptionKey}};
+       text("hazard", "onset: the id of the hazard it detects (from the system's \"hazards\")"), kDescriptionKey}};
   return kind;
 }
 
@@ -225,10 +227,29 @@ const ObjectKind& connection_kind() {
   return kind;
 }
 
+const ObjectKind& hazard_kind() {
+  static const ObjectKind kind{
+      "hazard",
+      "a hazard: events name it in their \"hazard\" field; its reaction is what must hold while one of them is active",
+      {text("id", "the hazard's id, e.g. H-3", true), kDescriptionKey,
+       object("reaction", "address -> the least level it must be at whenever an onset linked to the hazard is active",
+              "reaction")}};
+  return kind;
+}
+
+const ObjectKind& invariant_kind() {
+  static const ObjectKind kind{
+      "invariant",
+      "a named LTL formula over addresses and levels (docs/verify.md)",
+      {text("name", "unique name of the invariant (no spaces)", true),
+       text("formula", "e.g. [] (JR3.s_A == Error -> CONTROL == Error)", true), kDescriptionKey}};
+  return kind;
+}
+
 std::vector<const ObjectKind*> all_kinds() {
   return {&system_kind(), &include_kind(), &component_kind(), &interfaces_kind(), &signal_kind(),
           &event_kind(), &filter_kind(), &pipeline_kind(), &target_kind(), &service_kind(),
-          &dependency_kind(), &connection_kind()};
+          &dependency_kind(), &connection_kind(), &hazard_kind(), &invariant_kind()};
 }
 
 }  // namespace safecass::spec::detail

@@ -52,6 +52,8 @@ const ObjectKind& target_kind();
 const ObjectKind& service_kind();
 const ObjectKind& dependency_kind();
 const ObjectKind& connection_kind();
+const ObjectKind& hazard_kind();
+const ObjectKind& invariant_kind();
 
 /// Every kind, in schema order.
 std::vector<const ObjectKind*> all_kinds();

@@ -70,7 +70,10 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
     for (const Name& n : c.provided) out.provided.push_back(n.text);
     for (const Name& n : c.required) out.required.push_back(n.text);
     for (const SignalItem& s : c.signals) out.signals.push_back(SignalSpec{s.name, s.size});
-    for (const EventItem& e : c.events) out.events.push_back(e.def);
+    for (const EventItem& e : c.events) {
+      out.events.push_back(e.def);
+      out.event_where.push_back(sink.position(e.name_site));
+    }
     for (const FilterEntryItem& entry : c.filters) {
       FilterSpec f;
       f.pipeline = entry.pipeline;
@@ -96,6 +99,20 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
     std::vector<std::string> components;
     for (const Name& n : co.components) components.push_back(n.text);
     system.coordinators.emplace_back(co.name.text, std::move(components));
+  }
+  for (const HazardItem& h : model.hazards) {
+    HazardSpec out;
+    out.id = h.id;
+    out.description = h.description;
+    out.where = sink.position(h.id_site);
+    for (const HazardItem::Reaction& r : h.reaction) {
+      out.reaction.emplace_back(r.address, parse_state(r.level).value_or(State::Error));
+      out.reaction_where.push_back(sink.position(r.key_site));
+    }
+    system.hazards.push_back(std::move(out));
+  }
+  for (const InvariantItem& i : model.invariants) {
+    system.invariants.push_back(InvariantSpec{i.name, i.formula, i.description, sink.position(i.name_site)});
   }
   return system;
 }

@@ -74,6 +74,7 @@ struct EventItem {
   Site transitions_site;
   Site completes_site;
   Site latched_site;
+  Site hazard_site;
   bool has_name = false;
   bool has_severity = false;
   bool has_transitions = false;
@@ -154,6 +155,32 @@ struct CoordinatorItem {
   std::vector<Name> components;
 };
 
+struct HazardItem {
+  std::string id;
+  std::string description;
+  Site site;
+  Site id_site;
+  bool has_id = false;
+  struct Reaction {
+    std::string address;
+    std::string level;  ///< as written; checked by the validator
+    Site key_site;
+    Site value_site;
+  };
+  std::vector<Reaction> reaction;
+};
+
+struct InvariantItem {
+  std::string name;
+  std::string formula;
+  std::string description;
+  Site site;
+  Site name_site;
+  Site formula_site;
+  bool has_name = false;
+  bool has_formula = false;
+};
+
 struct Model {
   std::string name;
   std::string path;
@@ -164,6 +191,9 @@ struct Model {
   std::vector<ConnectionItem> connections;
   std::vector<CoordinatorItem> coordinators;
   bool has_coordinators = false;
+  std::vector<HazardItem> hazards;
+  bool has_hazards = false;  ///< a "hazards" section exists: events' hazard ids are checked against it
+  std::vector<InvariantItem> invariants;
 };
 
 /// Reads the top-level file (from disk when `text` is null) and everything it includes into

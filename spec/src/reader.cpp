@@ -440,6 +440,45 @@ private:
         model_.connections.push_back(std::move(item));
       }
     }
+    if (const JsonValue* list = f.get("hazards")) {
+      model_.has_hazards = true;
+      for (std::size_t i = 0; i < list->array.size(); ++i) {
+        const JsonValue& entry = list->array[i];
+        const std::string p = pointer_join(f.pointer("hazards"), i);
+        if (!entry.is_object()) {
+          sink_.error(Site{doc, entry.position, p}, "a hazard must be an object {\"id\": ..., \"reaction\": {...}}, not " +
+                                                        a_type(entry.type));
+          continue;
+        }
+        model_.hazards.push_back(read_hazard(doc, entry, p));
+      }
+    }
+    if (const JsonValue* list = f.get("invariants")) {
+      for (std::size_t i = 0; i < list->array.size(); ++i) {
+        const JsonValue& entry = list->array[i];
+        const std::string p = pointer_join(f.pointer("invariants"), i);
+        if (!entry.is_object()) {
+          sink_.error(Site{doc, entry.position, p}, "an invariant must be an object {\"name\": ..., \"formula\": ...}, not " +
+                                                        a_type(entry.type));
+          continue;
+        }
+        Fields fi(sink_, doc, entry, p, invariant_kind(), named("invariant", entry, "name"));
+        InvariantItem item;
+        item.site = fi.object_site();
+        item.name_site = fi.site("name");
+        item.formula_site = fi.site("formula");
+        if (const JsonValue* n = fi.get("name")) {
+          item.name = n->string;
+          item.has_name = true;
+        }
+        if (const JsonValue* t = fi.get("formula")) {
+          item.formula = t->string;
+          item.has_formula = true;
+        }
+        if (const JsonValue* d = fi.get("description")) item.description = d->string;
+        model_.invariants.push_back(std::move(item));
+      }
+    }
     if (const JsonValue* coordinators = f.get("coordinators")) {
       const std::string base = f.pointer("coordinators");
       std::set<std::string_view> seen;
@@ -588,6 +627,37 @@ private:
     if (const JsonValue* period = f.get("period")) c.period = period->number;
   }
 
+  HazardItem read_hazard(int doc, const JsonValue& e, const std::string& pointer) {
+    Fields f(sink_, doc, e, pointer, hazard_kind(), named("hazard", e, "id"));
+    HazardItem item;
+    item.site = f.object_site();
+    item.id_site = f.site("id");
+    if (const JsonValue* n = f.get("id")) {
+      item.id = n->string;
+      item.has_id = true;
+    }
+    if (const JsonValue* d = f.get("description")) item.description = d->string;
+    if (const JsonValue* r = f.get("reaction")) {
+      const std::string base = f.pointer("reaction");
+      std::set<std::string_view> seen;
+      for (const JsonMember& m : r->object) {
+        const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
+        if (!seen.insert(m.key).second) {
+          sink_.error(key_site, f.context() + ": reaction: duplicate address " + quote_name(m.key));
+          continue;
+        }
+        const Site value_site{doc, m.value.position, key_site.pointer};
+        if (!m.value.is_string()) {
+          sink_.error(value_site, f.context() + ": reaction of " + quote_name(m.key) +
+                                      " must be a level (\"Warning\" or \"Error\"), not " + a_type(m.value.type));
+          continue;
+        }
+        item.reaction.push_back(HazardItem::Reaction{m.key, m.value.string, key_site, value_site});
+      }
+    }
+    return item;
+  }
+
   EventItem read_event(int doc, const JsonValue& e, const std::string& pointer, const std::string& component) {
     Fields f(sink_, doc, e, pointer, event_kind(), named("event", e, "name"));
     EventItem item;
@@ -598,6 +668,7 @@ private:
     item.transitions_site = f.site("state_transition");
     item.completes_site = f.site("completes");
     item.latched_site = f.site("latched");
+    item.hazard_site = f.site("hazard");
     if (const JsonValue* n = f.get("name")) {
       item.def.name = n->string;
       item.has_name = true;

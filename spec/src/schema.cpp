@@ -367,6 +367,16 @@ std::string json_schema(const FilterRegistry& registry) {
     list.set("uniqueItems", Node::raw("true"));
     defs.set("coordinators", std::move(c));
   }
+  {
+    Node r;
+    r.set("type", Node::text("object"));
+    r.set("description", Node::text("address (SYSTEM, C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p) -> the least level it must be at"));
+    Node& level = r.set("additionalProperties", Node{});
+    Node& choices = level.set("enum", Node::array());
+    choices.push(Node::text("Warning"));
+    choices.push(Node::text("Error"));
+    defs.set("reaction", std::move(r));
+  }
   for (const FilterManifest* m : manifests) defs.set("argument_" + m->type, argument_schema(*m));
 
   std::string out;

@@ -7,6 +7,8 @@
 #include <memory>
 #include <set>
 
+#include "safecass/spec/formula.hpp"
+
 #include "model.hpp"
 #include "text.hpp"
 
@@ -118,6 +120,8 @@ public:
     for (ComponentItem& c : m_.components) check_filters(c);
     check_event_use();
     check_unconnected();
+    check_hazards();
+    check_invariants();
   }
 
 private:
@@ -941,6 +945,120 @@ private:
         if (!simple_name(r.text) || connected_.count(c.name + "." + r.text) > 0) continue;
         sink_.warning(r.site, "required interface " + c.name + "." + r.text +
                                   " is not connected: errors of the service it uses cannot reach it");
+      }
+    }
+  }
+
+  // ---- hazards and invariants ------------------------------------------------------------------
+  /// Why `address` names nothing ("" when it names a state): SYSTEM, C, C.s_F, C.s_A, C.s_P.p,
+  /// C.s_R.r, C.s_S.p.
+  std::string address_problem(const std::string& address) const {
+    if (address == "SYSTEM") return {};
+    const auto dot = address.find('.');
+    const std::string comp = address.substr(0, dot);
+    const ComponentItem* c = component(comp);
+    if (c == nullptr) return "no component " + quote_name(comp) + did_you_mean(comp, component_names());
+    if (dot == std::string::npos) return {};
+    const std::string rest = address.substr(dot + 1);
+    if (rest == "s_F" || rest == "s_A") return {};
+    const auto dot2 = rest.find('.');
+    const std::string kind = rest.substr(0, dot2);
+    if (dot2 == std::string::npos || (kind != "s_P" && kind != "s_R" && kind != "s_S")) {
+      return "expected C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p or SYSTEM";
+    }
+    const std::string iface = rest.substr(dot2 + 1);
+    const std::vector<Name>& list = kind == "s_R" ? c->required : c->provided;
+    if (contains(list, iface)) return {};
+    return "component " + quote_name(comp) + " has no " + (kind == "s_R" ? "required" : "provided") + " interface " +
+           quote_name(iface) + did_you_mean(iface, names_of(list));
+  }
+
+  void check_hazards() {
+    std::map<std::string, Site, std::less<>> ids;
+    std::vector<std::string> id_list;
+    for (const HazardItem& h : m_.hazards) {
+      if (!h.has_id) continue;  // reported as a missing key
+      if (!token_name(h.id)) {
+        sink_.error(h.id_site, "hazard id " + quote_name(h.id) + " must be non-empty, without spaces");
+        continue;
+      }
+      const auto [it, fresh] = ids.emplace(h.id, h.id_site);
+      if (!fresh) {
+        sink_.error(h.id_site, "duplicate hazard " + quote_name(h.id) + " (first at " + sink_.at(it->second) + ")");
+        continue;
+      }
+      id_list.push_back(h.id);
+      const std::string ctx = "hazard " + quote_name(h.id);
+      for (const HazardItem::Reaction& r : h.reaction) {
+        if (const std::string problem = address_problem(r.address); !problem.empty()) {
+          sink_.error(r.key_site, ctx + ": reaction names address " + quote_name(r.address) + ", which does not exist: " + problem);
+        }
+        const auto level = parse_state(r.level);
+        if (!level) {
+          sink_.error(r.value_site, ctx + ": reaction of " + quote_name(r.address) + " must be \"Warning\" or \"Error\", not " +
+                                        quote_name(r.level) + did_you_mean(r.level, {"Warning", "Error"}));
+        } else if (*level == State::Normal) {
+          sink_.error(r.value_site, ctx + ": reaction of " + quote_name(r.address) +
+                                        " is Normal, which every state satisfies: say \"Warning\" or \"Error\"");
+        }
+      }
+    }
+    // Events name hazards. Without a "hazards" section the ids are free text (as in 2016 files).
+    std::set<std::string, std::less<>> linked;
+    for (const ComponentItem& c : m_.components) {
+      for (const EventItem& e : c.events) {
+        if (e.def.hazard.empty()) continue;
+        const auto info = events_.find(e.def.name);
+        const bool onset = info == events_.end() || !info->second.kind_known || info->second.onset;
+        if (onset) linked.insert(e.def.hazard);
+        if (m_.has_hazards && ids.count(e.def.hazard) == 0) {
+          sink_.error(e.hazard_site, "event " + quote_name(e.def.name) + " names hazard " + quote_name(e.def.hazard) +
+                                         ", which the system's \"hazards\" does not declare" +
+                                         did_you_mean(e.def.hazard, id_list));
+        }
+      }
+    }
+    for (const HazardItem& h : m_.hazards) {
+      if (!h.has_id || linked.count(h.id) > 0) continue;
+      if (const auto it = ids.find(h.id); it == ids.end() || it->second.position.line != h.id_site.position.line ||
+                                          it->second.file != h.id_site.file) {
+        continue;  // an invalid or duplicate id: reported
+      }
+      sink_.warning(h.id_site, "hazard " + quote_name(h.id) +
+                                   " has no linked event: no onset names it in its \"hazard\" field, so nothing detects it");
+    }
+  }
+
+  void check_invariants() {
+    std::map<std::string, Site, std::less<>> names;
+    for (const InvariantItem& inv : m_.invariants) {
+      if (inv.has_name) {
+        if (!token_name(inv.name)) {
+          sink_.error(inv.name_site, "invariant name " + quote_name(inv.name) + " must be non-empty, without spaces");
+        } else if (const auto [it, fresh] = names.emplace(inv.name, inv.name_site); !fresh) {
+          sink_.error(inv.name_site, "duplicate invariant " + quote_name(inv.name) + " (first at " + sink_.at(it->second) + ")");
+        }
+      }
+      if (!inv.has_formula) continue;
+      const std::string ctx = "invariant " + quote_name(inv.name);
+      // A position inside the string: one column for the opening quote, then the offset (exact
+      // for formulas without escapes, which the grammar does not need).
+      const auto inside = [&](std::size_t offset) {
+        Site s = inv.formula_site;
+        s.position.column += 1 + static_cast<int>(offset);
+        return s;
+      };
+      auto parsed = parse_formula(inv.formula);
+      if (!parsed) {
+        sink_.error(inside(parsed.error().offset), ctx + ": " + parsed.error().message);
+        continue;
+      }
+      std::vector<const Formula*> atoms;
+      parsed->atoms(atoms);
+      for (const Formula* a : atoms) {
+        if (const std::string problem = address_problem(a->address); !problem.empty()) {
+          sink_.error(inside(a->offset), ctx + ": address " + quote_name(a->address) + " does not exist: " + problem);
+        }
       }
     }
   }

@@ -238,7 +238,7 @@ TEST_F(ConsoleTest, WatchAdvancesSimulatedTimeAndPrintsEachTransition) {
   EXPECT_TRUE(contains(run("time").out, "t=0.000000 s"));
   // No samples at all: the force sensor's watchdog (50 ms) fires.
   const std::string out = run("watch 0.1").out;
-  EXPECT_TRUE(contains(out, "JR3.s_F  Normal -> Error  EVT_STALE")) << out;
+  EXPECT_TRUE(contains(out, "JR3.s_F  Normal -> Error  EVT_FORCE_STALE")) << out;
   EXPECT_TRUE(contains(out, "t=0.100000  watched 0.1 s:")) << out;
   EXPECT_TRUE(contains(run("time").out, "t=0.100000 s"));
   run("watch");

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -36,11 +37,32 @@ struct ServiceSpec {
   ServiceDependency dependency;
 };
 
+/// A hazard of the system file's `"hazards"` section: its id (what events name in their
+/// `"hazard"` field), a description, and its required reaction: whenever an onset linked to the
+/// hazard is active, each listed address is at least at the listed level.
+struct HazardSpec {
+  std::string id;
+  std::string description;
+  std::vector<std::pair<std::string, State>> reaction;  ///< address -> minimum level, in file order
+  Position where;                                       ///< its id
+  std::vector<Position> reaction_where;                 ///< each reaction entry's address
+};
+
+/// A named invariant of the system file's `"invariants"` section: an LTL formula over the states
+/// of addresses (formula.hpp, docs/verify.md), checked by `safecass verify`.
+struct InvariantSpec {
+  std::string name;
+  std::string formula;
+  std::string description;
+  Position where;  ///< its name
+};
+
 struct ComponentSpec {
   std::string name;
   std::vector<std::string> provided, required;
   std::vector<SignalSpec> signals;  ///< declared signals (and, for 2016 files, the implied ones)
   std::vector<EventDef> events;
+  std::vector<Position> event_where;  ///< the name of each event, parallel to `events`
   std::vector<FilterSpec> filters;
   /// One entry per provided interface: the written ones in file order, then the conservative
   /// default (ServiceDependency{}) for every provided interface without an entry.
@@ -63,6 +85,16 @@ struct SystemSpec {
   std::vector<ConnectionSpec> connections;
   /// Coordinator name -> its components, in file order. Empty: one coordinator runs everything.
   std::vector<std::pair<std::string, std::vector<std::string>>> coordinators;
+  std::vector<HazardSpec> hazards;        ///< empty when the system declares none
+  std::vector<InvariantSpec> invariants;
+
+  /// The hazard of that id, or null.
+  const HazardSpec* hazard(std::string_view id) const noexcept {
+    for (const HazardSpec& h : hazards) {
+      if (h.id == id) return &h;
+    }
+    return nullptr;
+  }
 };
 
 }  // namespace safecass::spec
