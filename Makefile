@@ -28,6 +28,12 @@ demo: build
 	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
 	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
 	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
+	@./$(BUILD)/bin/safecass trace examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json \
+	  examples/robodoc/injection.json examples/robodoc/warnings.json examples/robodoc/overload.json --csv $(BUILD)/demo/trace.csv \
+	  --html $(BUILD)/demo/trace.html >$(BUILD)/demo/trace.txt 2>/dev/null \
+	  || { cat $(BUILD)/demo/trace.txt; echo "trace: a gap of error severity (above)"; exit 1; }
+	@grep '^Coverage' $(BUILD)/demo/trace.txt
+	@echo "Hazard trace report (open in a browser, prints to PDF): $(BUILD)/demo/trace.html (matrix: $(BUILD)/demo/trace.txt, CSV: $(BUILD)/demo/trace.csv)"
 
 # ROBODOC on ROS 1 (examples/ros_robodoc): roscore, diagnostic_aggregator, the nodes, rosdiagnostic.
 ros-demo: configure
