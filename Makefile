@@ -30,6 +30,13 @@ demo: build
 	@echo "Timeline of the run (open in a browser): $(BUILD)/demo/timeline.html"
 	@echo "Model-checking robodoc's hazard reactions with SPIN (safecass verify):"
 	@./$(BUILD)/bin/safecass verify examples/robodoc/robodoc.json --out $(BUILD)/demo/counterexamples
+	@./$(BUILD)/bin/safecass verify examples/robodoc/robodoc.json --json >$(BUILD)/demo/verify.jsonl 2>/dev/null
+	@./$(BUILD)/bin/safecass trace examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json \
+	  examples/robodoc/injection.json examples/robodoc/warnings.json examples/robodoc/overload.json --verify $(BUILD)/demo/verify.jsonl --csv $(BUILD)/demo/trace.csv \
+	  --html $(BUILD)/demo/trace.html >$(BUILD)/demo/trace.txt 2>/dev/null \
+	  || { cat $(BUILD)/demo/trace.txt; echo "trace: a gap of error severity (above)"; exit 1; }
+	@grep '^Coverage' $(BUILD)/demo/trace.txt
+	@echo "Hazard trace report (open in a browser, prints to PDF): $(BUILD)/demo/trace.html (matrix: $(BUILD)/demo/trace.txt, CSV: $(BUILD)/demo/trace.csv)"
 
 # ROBODOC on ROS 1 (examples/ros_robodoc): roscore, diagnostic_aggregator, the nodes, rosdiagnostic.
 ros-demo: configure

@@ -33,7 +33,7 @@ command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 # The middleware (middleware/, `safecass run --ice`, `safecass supervisor`, scripts/start-icestorm):
 # ZeroC Ice 3.7 with slice2cpp, and IceBox hosting the IceStorm service.
 packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
-# Every bus message is signed (Ed25519, libsodium).
+# Every bus message is signed (Ed25519, libsodium); `safecass trace` hashes the spec files with it.
 packages+=(libsodium-dev)
 # `safecass verify` translates a system into Promela and model-checks it with SPIN (the verifier
 # it generates is compiled with the system's gcc, from build-essential).
@@ -44,6 +44,9 @@ packages+=(spin)
 if [ "$bench_peers" = 1 ]; then
   packages+=(libdiagnostic-updater-dev)
 fi
+
+# The trace report's browser test prints it to PDF with chromium and reads it back with pdftotext.
+packages+=(poppler-utils)
 
 missing=()
 for p in "${packages[@]}"; do

@@ -188,7 +188,7 @@ case $case_name in
     grep -q '<failure message=' "$tmp/j.xml" || fail "junit failure element"
     ;;
   every_subcommand_has_help)
-    for sub in demo validate schema run test; do
+    for sub in demo validate schema run test trace; do
       "$safecass" "$sub" --help >/dev/null 2>&1; expect_code 0 $? "$sub --help"
     done
     "$safecass" >/dev/null 2>&1; expect_code 2 $? "no subcommand"
@@ -199,6 +199,37 @@ case $case_name in
     bad=$(ls tests/data/bad_specs/*.json | head -1)
     "$safecass" validate "$bad" >/dev/null 2>&1; expect_code 1 $? "bad spec $bad"
     "$safecass" validate "$tmp/none.json" >/dev/null 2>&1; expect_code 2 $? "missing file"
+    ;;
+  trace_robodoc_writes_matrix_csv_and_report_with_no_error_gap)
+    "$safecass" trace examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json examples/robodoc/injection.json \
+      examples/robodoc/warnings.json examples/robodoc/overload.json --csv "$tmp/trace.csv" --html "$tmp/trace.html" >"$tmp/out" 2>"$tmp/err"
+    expect_code 0 $? "robodoc trace: $(cat "$tmp/err")"
+    for h in H-3 H-5 H-6; do
+      grep -q "^$h: " "$tmp/out" || fail "matrix without $h"
+      grep -q "^$h," "$tmp/trace.csv" || fail "CSV without $h"
+      grep -q "data-hazard=\"$h\"" "$tmp/trace.html" || fail "report without $h"
+    done
+    grep -q "report written to $tmp/trace.html" "$tmp/err" || fail "the report's path is not said: $(cat "$tmp/err")"
+    "$safecass" trace examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json --json >"$tmp/json" 2>/dev/null
+    grep -q '"error_gaps":false' "$tmp/json" || fail "--json: $(head -c 300 "$tmp/json")"
+    ;;
+  trace_hazard_nothing_detects_fails_with_the_gap_named)
+    "$safecass" trace tests/data/trace/undetected.json >"$tmp/out" 2>"$tmp/err"; expect_code 1 $? "undetected hazard"
+    grep -q 'tests/data/trace/undetected.json:[0-9]*:[0-9]*: error: hazard H-9 has no detecting filter' "$tmp/out" \
+      || fail "gap: $(cat "$tmp/out")"
+    ;;
+  trace_bad_input_and_strict_exit_codes)
+    "$safecass" trace "$tmp/none.json" >/dev/null 2>"$tmp/err"; expect_code 2 $? "missing system"
+    grep -q "none.json" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    "$safecass" trace tests/data/trace/arm.json --verify tests/data/trace/verify_malformed.jsonl >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "malformed verify result"
+    grep -q "verify_malformed.jsonl:2:" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    "$safecass" trace tests/data/trace/arm.json --scenarios tests/data/trace/unchecked.scenario.json >/dev/null 2>&1
+    expect_code 0 $? "warnings only"
+    "$safecass" trace tests/data/trace/arm.json --scenarios tests/data/trace/unchecked.scenario.json --strict >/dev/null 2>&1
+    expect_code 1 $? "warnings with --strict"
+    "$safecass" trace tests/data/trace/arm.json --scenarios tests/data/trace/covered.scenario.json --html "$tmp/no/such/dir.html" \
+      >/dev/null 2>"$tmp/err"; expect_code 2 $? "unwritable report"
     ;;
   *) fail "unknown case $case_name" ;;
 esac

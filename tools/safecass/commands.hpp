@@ -48,4 +48,17 @@ int run_test(const TestArgs& args);
 /// Adds `safecass replay` (replay_command.cpp); its callback stores the exit code in `code`.
 void add_replay_command(CLI::App& app, int& code);
 
+struct TraceArgs {
+  std::string system;
+  std::vector<std::string> scenarios;
+  std::string html;    ///< --html FILE: the report
+  std::string csv;     ///< --csv FILE: one row per hazard × event × filter
+  std::string verify;  ///< --verify FILE: the output of `safecass verify --json`
+  bool json = false;   ///< the matrix as JSON on stdout instead of text
+  bool strict = false; ///< a gap of warning severity fails too
+};
+/// `safecass trace` (docs/trace.md): 0 no error-severity gap, 1 one exists (with --strict: or a
+/// warning), 2 invalid input or a file that cannot be written.
+int run_trace(const TraceArgs& args);
+
 }  // namespace safecass::tools

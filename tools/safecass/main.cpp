@@ -67,6 +67,18 @@ int main(int argc, char** argv) {
   test->callback([&] { code = safecass::tools::run_test(test_args); });
 
   safecass::tools::add_replay_command(app, code);
+
+  safecass::tools::TraceArgs trace_args;
+  auto* trace = app.add_subcommand("trace", "Hazard traceability: hazard -> events -> filters -> reaction -> scenarios -> verify, with the gaps");
+  trace->add_option("SYSTEM", trace_args.system, "system file")->required();
+  trace->add_option("--scenarios,-s", trace_args.scenarios, "scenario files to run (their \"system\" is replaced by SYSTEM)");
+  trace->add_option("--html", trace_args.html, "write the report (one self-contained page, printable to PDF) to this file");
+  trace->add_option("--csv", trace_args.csv, "write one row per hazard x event x filter (RFC 4180) to this file");
+  trace->add_option("--verify", trace_args.verify, "the output of `safecass verify --json` (default: verification \"not run\")");
+  trace->add_flag("--json", trace_args.json, "the matrix as one JSON document on stdout");
+  trace->add_flag("--strict", trace_args.strict, "exit 1 on a gap of warning severity too");
+  trace->callback([&] { code = safecass::tools::run_trace(trace_args); });
+
   safecass::tools::add_console_command(app, code);
   safecass::tools::add_verify_command(app, code);
 #ifdef SAFECASS_WITH_VIEWER

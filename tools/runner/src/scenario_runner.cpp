@@ -357,6 +357,9 @@ void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& res
   for (const auto& [address, expected] : s.action->expectations) {
     ++result.checks;
     const std::string problem = check_one(s, address, expected);
+    if (s.kind == spec::ScenarioStep::Kind::Expect) {
+      result.coverage.states_checked.push_back(StateCheck{address, *parse_state(expected), now, problem.empty()});
+    }
     if (problem.empty()) continue;
     result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
                               ": expectation failed at t=" + secs(now) + ": " + problem + " [" + s.pointer() + "]");

@@ -44,11 +44,20 @@ struct RunOptions {
   std::FILE* out = stdout;
 };
 
-/// What a run did, for `safecass test`'s coverage summary.
+/// One `expect` of a state, as checked: which address, at what level, when, and whether it held.
+struct StateCheck {
+  std::string address;
+  State expected = State::Normal;
+  Time at{};
+  bool held = false;
+};
+
+/// What a run did, for `safecass test`'s coverage summary and `safecass trace`'s matrix.
 struct Coverage {
   std::set<std::string> events_fired;                       ///< events processed (not ignored)
   std::set<std::pair<std::string, std::string>> taken;      ///< (event, transition) that caused a transition
   std::set<std::pair<std::string, std::string>> defined;    ///< (event, transition) listed by the system's events
+  std::vector<StateCheck> states_checked;                   ///< every `expect` step's checks, in run order
 };
 
 struct RunResult {
