@@ -20,6 +20,7 @@ struct ControlContext {
   std::string token;
   std::function<void(const std::string&)> log;
   std::string read_token;  ///< empty: reads are open to every local client
+  bool simulated = false;  ///< the coordinator runs in simulated time (its times are scenario seconds)
 };
 
 /// The request-context key that carries the read credential.

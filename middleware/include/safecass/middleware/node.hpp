@@ -115,6 +115,9 @@ struct NodeOptions {
   TlsOptions tls;
   /// Accept an IceStorm or listening endpoint that is not loopback without TLS (docs/security.md).
   bool insecure = false;
+  /// The coordinator runs in simulated time (a scenario's seconds): remote tools show its times
+  /// as seconds instead of wall-clock time. Default: the host's monotonic clock (HostClock).
+  bool simulated_clock = false;
   /// Receives every log line (errors about bad messages, reconnections). Default: stderr.
   std::function<void(const std::string&)> log;
 };
