@@ -35,6 +35,11 @@ std::string code_text(ErrorCode c) {
 [[noreturn]] void raise(const Error& e) { throw wire::OperationError(code_text(e.code), e.message); }
 [[noreturn]] void raise(ErrorCode c, std::string message) { raise(Error{c, std::move(message)}); }
 
+introspect::LocalOptions with_name(introspect::LocalOptions o, const std::string& name) {
+  o.name = name;
+  return o;
+}
+
 template <class T>
 T value_or_raise(Expected<T> r) {
   if (!r) raise(r.error());
@@ -59,9 +64,7 @@ class ControlServant final : public wire::Control {
 public:
   explicit ControlServant(ControlContext c)
       : c_(std::move(c)),
-        query_(c_.co, c_.monitor, c_.registry,
-               introspect::LocalOptions{c_.name, c_.simulated ? introspect::TimeBase::Simulated : introspect::TimeBase::Host,
-                                        0.0, {}, 0.0}) {}
+        query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
 
   std::string coordinator(const Ice::Current& current) override {
     check_read(current);

@@ -1065,7 +1065,7 @@ Expected<void> CoordinatorNode::start() {
     auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
     ControlContext context{d.co, d.monitor, d.registry, d.name, d.options.allow_write, d.options.token,
                            [&d](const std::string& line) { d.log(line); }, d.options.read_token,
-                           d.options.simulated_clock};
+                           d.options.clock};
     auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
