@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <ctime>
+
+#include <fmt/format.h>
 #include <variant>
 
 #include "safecass/introspect/json.hpp"
@@ -15,11 +16,7 @@ namespace {
 std::string state_text(State s) { return std::string(to_string(s)); }
 
 /// "%g": the six significant digits explanations have always shown.
-std::string short_number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+std::string short_number(double v) { return fmt::format("{:g}", v); }
 
 /// A sample value in a history line: a number, or "nan"/"inf"/"-inf" as a string.
 std::string sample_json(double v) {
@@ -75,23 +72,15 @@ std::string iso8601_local(std::int64_t unix_ns) {
   const std::time_t tt = static_cast<std::time_t>(secs);
   std::tm tm{};
   localtime_r(&tt, &tm);
-  char date[40];
-  std::strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%S", &tm);
   const long offset = tm.tm_gmtoff;
   const long off = offset < 0 ? -offset : offset;
-  char out[80];
-  std::snprintf(out, sizeof out, "%s.%03d%c%02ld:%02ld", date, static_cast<int>(rest / 1'000'000), offset < 0 ? '-' : '+',
-                off / 3600, (off % 3600) / 60);
-  return out;
+  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}{}{:02}:{:02}", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
+                     tm.tm_hour, tm.tm_min, tm.tm_sec, rest / 1'000'000, offset < 0 ? '-' : '+', off / 3600, (off % 3600) / 60);
 }
 
 std::string seconds_text(Time t) { return json_seconds(t); }
 
-std::string number_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string number_text(double v) { return fmt::format("{:.9g}", v); }
 
 std::string TimeFormat::at(Time t) const {
   if (base_ == TimeBase::Simulated) return "t=" + seconds_text(t);

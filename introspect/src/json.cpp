@@ -1,7 +1,8 @@
 #include "safecass/introspect/json.hpp"
 
 #include <cmath>
-#include <cstdio>
+
+#include <fmt/format.h>
 
 namespace safecass::introspect {
 
@@ -39,16 +40,10 @@ std::string json_string(std::string_view text) {
 
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
+  return fmt::format("{:.9g}", v);
 }
 
-std::string json_seconds(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
+std::string json_seconds(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
 
 std::string json_string_array(const std::vector<std::string>& items) {
   JsonArray a;

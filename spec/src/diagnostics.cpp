@@ -1,5 +1,6 @@
 #include "safecass/spec/diagnostics.hpp"
 
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/json.hpp"
 
 namespace safecass::spec {
@@ -17,10 +18,9 @@ std::string format(const Diagnostic& d) {
 
 std::string to_json(const Diagnostic& d) {
   const bool error = d.severity == Diagnostic::Severity::Error;
-  return "{\"file\": " + json_quote(d.where.file) + ", \"line\": " + std::to_string(d.where.line) +
-         ", \"column\": " + std::to_string(d.where.column) + ", \"severity\": " +
-         (error ? "\"error\"" : "\"warning\"") + ", \"message\": " + json_quote(d.message) +
-         ", \"pointer\": " + json_quote(d.pointer) + "}";
+  return introspect::JsonObject().str("file", d.where.file).integer("line", d.where.line)
+      .integer("column", d.where.column).str("severity", error ? "error" : "warning").str("message", d.message)
+      .str("pointer", d.pointer).text();
 }
 
 }  // namespace safecass::spec

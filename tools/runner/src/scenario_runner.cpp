@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/spec/load.hpp"
 
@@ -11,11 +12,7 @@ namespace safecass::runner {
 namespace {
 constexpr Time kMonitorPeriod = std::chrono::milliseconds(5);
 
-std::string secs(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
+std::string secs(Time t) { return introspect::seconds_text(t); }
 }  // namespace
 
 ScenarioRunner::ScenarioRunner(spec::Scenario scenario, spec::SystemSpec system, const FilterRegistry& registry)

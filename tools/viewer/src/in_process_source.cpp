@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/json.hpp"
@@ -44,11 +46,8 @@ std::string errors_text(const std::vector<spec::Diagnostic>& diagnostics) {
   return text;
 }
 
-std::string seconds_text(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.3f", to_seconds(t));
-  return buf;
-}
+/// Seconds to the millisecond, in the confirmations of writes: "t=1.250".
+std::string seconds_text(Time t) { return fmt::format("{:.3f}", to_seconds(t)); }
 
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');

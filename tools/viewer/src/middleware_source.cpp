@@ -8,6 +8,8 @@
 #include <thread>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
@@ -34,11 +36,8 @@ double host_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string seconds_text(double t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.3f", t);
-  return buf;
-}
+/// Seconds to the millisecond, in the confirmations of writes.
+std::string seconds_text(double t) { return fmt::format("{:.3f}", t); }
 
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
