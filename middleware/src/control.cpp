@@ -252,7 +252,7 @@ std::shared_ptr<wire::Control> make_control(ControlContext context) {
 }
 
 wire::ExplainEntry to_wire(const Explanation& e) {
-  wire::ExplainEntry w;
+  wire::ExplainEntry w{};
   w.machine = e.machine;
   w.event = e.event;
   w.level = to_wire(e.level);

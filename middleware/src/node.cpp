@@ -258,7 +258,7 @@ struct CoordinatorNode::Impl {
 
   // -- publisher thread --
   wire::EventMessage to_message(const Record& r) {
-    wire::EventMessage m;
+    wire::EventMessage m{};  // every field set: no indeterminate enumerator reaches the encoder
     m.coordinator = name;
     m.incarnation = incarnation;
     m.seq = ++event_seq;

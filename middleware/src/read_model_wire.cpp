@@ -50,7 +50,7 @@ ParamType param_type_of(std::string_view text) {
 }
 
 wire::ParamValue value_to_wire(const ParamValue& v) {
-  wire::ParamValue w;
+  wire::ParamValue w{};
   std::visit(
       [&w](const auto& x) {
         using T = std::decay_t<decltype(x)>;
@@ -152,7 +152,7 @@ bool from_wire(const wire::StateEntry& w, in::StateRow& out) {
 }
 
 wire::RecordEntry to_wire(const in::HistoryEntry& e) {
-  wire::RecordEntry w;
+  wire::RecordEntry w{};
   w.seq = static_cast<long long>(e.seq);
   fill(e, w);
   return w;
@@ -174,7 +174,7 @@ bool from_wire(const wire::EventMessage& w, in::HistoryEntry& out) {
 }
 
 wire::FilterEntry to_wire(const in::FilterRow& r) {
-  wire::FilterEntry w;
+  wire::FilterEntry w{};
   w.name = r.name;
   w.type = r.type;
   w.target = r.target;
@@ -212,7 +212,7 @@ in::FilterRow from_wire(const wire::FilterEntry& w) {
 }
 
 wire::FilterDetails to_wire(const in::FilterInfo& i) {
-  wire::FilterDetails w;
+  wire::FilterDetails w{};
   w.instance = i.filter.has_value();
   if (i.filter) w.filter = to_wire(*i.filter);
   w.filter.type = i.type;
@@ -223,7 +223,7 @@ wire::FilterDetails to_wire(const in::FilterInfo& i) {
   w.outputs = i.outputs;
   w.generatesEvents = i.generates_events;
   for (const in::ParamRow& p : i.params) {
-    wire::ParamEntry e;
+    wire::ParamEntry e{};
     e.name = p.name;
     e.type = std::string(to_string(p.type));
     e.doc = p.doc;
@@ -272,7 +272,7 @@ in::FilterInfo from_wire(const wire::FilterDetails& w) {
 }
 
 wire::EventEntry to_wire(const in::EventRow& r) {
-  wire::EventEntry w;
+  wire::EventEntry w{};
   w.name = r.name;
   w.severity = r.severity;
   w.onset = r.onset;
@@ -307,7 +307,7 @@ in::EventRow from_wire(const wire::EventEntry& w) {
 }
 
 wire::ConnectionEntry to_wire(const in::ConnectionRow& r) {
-  wire::ConnectionEntry w;
+  wire::ConnectionEntry w{};
   w.required = r.required;
   w.provided = r.provided;
   w.remote = r.remote;
@@ -345,7 +345,7 @@ in::ServiceRow from_wire(const wire::ServiceEntry& w) {
 }
 
 wire::ExplainReply to_wire(const in::ExplainAnswer& a) {
-  wire::ExplainReply w;
+  wire::ExplainReply w{};
   w.address = a.address;
   w.state = to_wire(a.state);
   for (const Explanation& e : a.conditions) w.conditions.push_back(to_wire(e));
