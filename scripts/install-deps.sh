@@ -14,7 +14,7 @@ esac
 packages=(
   build-essential cmake ninja-build pkg-config git
   libgtest-dev libgmock-dev libbenchmark-dev
-  libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev
+  libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev libfmt-dev
   clang libclang-rt-14-dev
 )
 # ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (`safecass

@@ -2,12 +2,15 @@
 
 #include "safecass/middleware/client.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <condition_variable>
 #include <mutex>
 
 #include "auth.hpp"
 #include "control.hpp"
 #include "ice_util.hpp"
+#include "read_model_wire.hpp"
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
@@ -65,34 +68,15 @@ private:
   std::string control_;
 };
 
-HistoryRow history_row(const wire::RecordEntry& e) {
-  HistoryRow r;
-  r.seq = static_cast<std::uint64_t>(e.seq);
-  r.time = Time{e.time};
-  r.kind = e.kind;
-  r.outcome = e.outcome;
-  r.address = e.address;
-  r.event = e.event;
-  from_wire(e.from, r.from);
-  from_wire(e.to, r.to);
-  from_wire(e.level, r.level);
-  r.mirror = e.mirror;
-  r.root_event = e.rootEvent;
-  r.root_origin = e.rootOrigin;
-  r.text = e.text;
-  return r;
-}
-
-FilterRow filter_row(const wire::FilterEntry& e) {
-  return FilterRow{e.name, e.type, e.target, e.execution, e.detection, e.enabled, e.detected, e.inputs, e.outputs};
-}
-
 }  // namespace
 
 struct RemoteClient::Impl {
   ClientOptions options;
   std::shared_ptr<Ice::Communicator> ic;
   std::shared_ptr<wire::ControlPrx> control;
+  std::unique_ptr<Keyring> keys;
+  std::atomic<std::uint64_t> refused{0};
+  std::atomic<std::uint64_t> gaps{0};
 
   ~Impl() {
     if (ic) ic->destroy();
@@ -170,6 +154,7 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     const std::string& credential = o.read_token.empty() ? o.token : o.read_token;
     if (!credential.empty()) impl->control = impl->control->ice_context({{kReadCredentialKey, credential}});
     impl->control->ice_ping();
+    impl->keys = std::make_unique<Keyring>(std::move(*keys));
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io, "cannot reach coordinator '" + o.coordinator + "': " + e.what());
   }
@@ -183,114 +168,235 @@ Expected<std::string> RemoteClient::coordinator() {
   return impl_->call("coordinator", [&] { return impl_->control->coordinator(); });
 }
 
-Expected<std::vector<StateRow>> RemoteClient::state_list(const std::string& component) {
-  return impl_->call("state list", [&] {
-    std::vector<StateRow> out;
-    for (const auto& e : impl_->control->stateList(component)) {
-      StateRow r{e.address, e.kind, State::Normal, e.outstanding};
-      from_wire(e.state, r.state);
-      out.push_back(std::move(r));
+namespace {
+
+template <class Out, class Seq>
+std::vector<Out> rows_from_wire(const Seq& seq) {
+  std::vector<Out> out;
+  out.reserve(seq.size());
+  for (const auto& w : seq) out.push_back(from_wire(w));
+  return out;
+}
+
+Expected<std::vector<introspect::HistoryEntry>> entries_from_wire(const wire::RecordEntrySeq& seq, const std::string& who) {
+  std::vector<introspect::HistoryEntry> out;
+  out.reserve(seq.size());
+  for (const wire::RecordEntry& w : seq) {
+    introspect::HistoryEntry e;
+    if (!from_wire(w, e)) return fail(ErrorCode::Parse, "coordinator '" + who + "' sent a malformed history record (seq " + std::to_string(w.seq) + ")");
+    out.push_back(std::move(e));
+  }
+  return out;
+}
+
+/// Follows one coordinator's records on the events topic. Runs on the client communicator's one
+/// dispatch thread, so records reach the sink in order.
+class Follower final : public wire::EventTopic {
+public:
+  Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
+      : client_(client), sink_(std::move(sink)), last_(last) {}
+
+  void records(wire::Signed batch, const Ice::Current&) override;
+
+  void stop() {
+    std::lock_guard lock(mutex_);
+    stopped_ = true;
+  }
+
+private:
+  RemoteClient::Impl& client_;
+  introspect::RecordSink sink_;
+  std::mutex mutex_;  // stopped_ and the sink's calls
+  bool stopped_ = false;
+  std::uint64_t last_;            ///< the last record delivered (its coordinator-wide seq)
+  std::int64_t incarnation_ = 0;  ///< of the coordinator process the records come from
+};
+
+class RemoteSubscription final : public introspect::Subscription {
+public:
+  RemoteSubscription(std::shared_ptr<Follower> follower, std::shared_ptr<Ice::ObjectAdapter> adapter,
+                     std::shared_ptr<IceStorm::TopicPrx> topic, std::shared_ptr<Ice::ObjectPrx> proxy)
+      : follower_(std::move(follower)), adapter_(std::move(adapter)), topic_(std::move(topic)), proxy_(std::move(proxy)) {}
+  ~RemoteSubscription() override {
+    follower_->stop();
+    try {
+      topic_->unsubscribe(proxy_);
+    } catch (const Ice::Exception&) {
+      // IceStorm is gone: it drops the subscriber by itself.
     }
-    return out;
+    adapter_->destroy();
+  }
+
+private:
+  std::shared_ptr<Follower> follower_;
+  std::shared_ptr<Ice::ObjectAdapter> adapter_;
+  std::shared_ptr<IceStorm::TopicPrx> topic_;
+  std::shared_ptr<Ice::ObjectPrx> proxy_;
+};
+
+}  // namespace
+
+void Follower::records(wire::Signed batch, const Ice::Current&) {
+  const std::string& coordinator = client_.options.coordinator;
+  if (batch.signer != coordinator) return;  // other coordinators' records
+  wire::EventMessageSeq messages;
+  if (!open_signed(*client_.keys, client_.ic, batch, kKindEvents, messages).empty()) {
+    ++client_.refused;
+    return;
+  }
+  std::lock_guard lock(mutex_);
+  if (stopped_) return;
+  for (const wire::EventMessage& m : messages) {
+    if (m.coordinator != coordinator || m.incarnation < incarnation_) {
+      ++client_.refused;  // misattributed, or a replay from an earlier process
+      continue;
+    }
+    if (m.incarnation > incarnation_) {
+      // A restarted coordinator numbers its records from 1 again.
+      if (incarnation_ != 0) last_ = 0;
+      incarnation_ = m.incarnation;
+    }
+    const auto seq = static_cast<std::uint64_t>(m.recordSeq);
+    if (seq <= last_) continue;  // already delivered (a gap filled from the history had it)
+    if (seq > last_ + 1) {
+      // A gap: a message was lost or a record was too large for the bus. The coordinator's
+      // history has them; deliver them first, in order.
+      ++client_.gaps;
+      try {
+        auto missed = entries_from_wire(client_.control->recordsSince(static_cast<long long>(last_), 0), coordinator);
+        if (missed) {
+          for (const introspect::HistoryEntry& e : *missed) {
+            if (e.seq >= seq) break;
+            sink_(e);
+            last_ = e.seq;
+          }
+        }
+      } catch (const Ice::Exception&) {
+        // The coordinator did not answer: the records after the gap still go out.
+      }
+    }
+    introspect::HistoryEntry e;
+    if (!from_wire(m, e)) {
+      ++client_.refused;
+      continue;
+    }
+    sink_(e);
+    last_ = seq;
+  }
+}
+
+std::string RemoteClient::name() const { return impl_->options.coordinator; }
+
+Expected<introspect::ClockInfo> RemoteClient::clock() {
+  return impl_->call("clock", [&] { return from_wire(impl_->control->clockInfo()); });
+}
+
+Expected<std::vector<introspect::StateRow>> RemoteClient::state_list(std::string_view component) {
+  auto rows = impl_->call("state list", [&] { return impl_->control->stateList(std::string(component)); });
+  if (!rows) return tl::unexpected(rows.error());
+  std::vector<introspect::StateRow> out;
+  for (const wire::StateEntry& w : *rows) {
+    introspect::StateRow r;
+    if (!from_wire(w, r)) return fail(ErrorCode::Parse, "coordinator '" + impl_->options.coordinator + "' sent a malformed state row");
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+Expected<std::vector<introspect::HistoryEntry>> RemoteClient::history(std::string_view scope, std::size_t last,
+                                                                      introspect::HistoryFilter filter) {
+  const int n = static_cast<int>(std::min<std::size_t>(last, 1u << 30));
+  auto seq = impl_->call("history", [&] {
+    return filter == introspect::HistoryFilter::Events ? impl_->control->eventHistory(n)
+                                                       : impl_->control->stateHistory(std::string(scope), n);
   });
+  if (!seq) return tl::unexpected(seq.error());
+  return entries_from_wire(*seq, impl_->options.coordinator);
 }
 
-Expected<std::vector<HistoryRow>> RemoteClient::state_history(const std::string& address, int last) {
-  return impl_->call("state history", [&] {
-    std::vector<HistoryRow> out;
-    for (const auto& e : impl_->control->stateHistory(address, last)) out.push_back(history_row(e));
-    return out;
+Expected<std::vector<introspect::HistoryEntry>> RemoteClient::records_since(std::uint64_t seq, std::size_t max) {
+  auto entries = impl_->call("records", [&] {
+    return impl_->control->recordsSince(static_cast<long long>(seq), static_cast<int>(std::min<std::size_t>(max, 1u << 30)));
   });
+  if (!entries) return tl::unexpected(entries.error());
+  return entries_from_wire(*entries, impl_->options.coordinator);
 }
 
-Expected<std::vector<FilterRow>> RemoteClient::filter_list() {
-  return impl_->call("filter list", [&] {
-    std::vector<FilterRow> out;
-    for (const auto& e : impl_->control->filterList()) out.push_back(filter_row(e));
-    return out;
-  });
+Expected<std::vector<introspect::FilterRow>> RemoteClient::filter_list() {
+  return impl_->call("filter list", [&] { return rows_from_wire<introspect::FilterRow>(impl_->control->filterList()); });
 }
 
-Expected<FilterDetails> RemoteClient::filter_info(const std::string& name) {
-  return impl_->call("filter info", [&] {
-    const wire::FilterDetails d = impl_->control->filterInfo(name);
-    FilterDetails out;
-    out.filter = filter_row(d.filter);
-    out.doc = d.doc;
-    out.missed_samples = static_cast<std::uint64_t>(d.missedSamples);
-    for (const auto& p : d.params) out.params.push_back(ParamRow{p.name, p.type, p.value, p.defaultValue, p.doc});
-    return out;
-  });
+Expected<introspect::FilterInfo> RemoteClient::filter_info(std::string_view name) {
+  return impl_->call("filter info", [&] { return from_wire(impl_->control->filterInfo(std::string(name))); });
 }
 
-Expected<void> RemoteClient::filter_inject(const std::string& filter, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter inject", [&] { impl_->control->filterInject(impl_->options.token, filter, samples); });
+Expected<std::vector<introspect::EventRow>> RemoteClient::event_list() {
+  return impl_->call("event list", [&] { return rows_from_wire<introspect::EventRow>(impl_->control->eventList()); });
 }
 
-Expected<void> RemoteClient::filter_dinject(const std::string& signal, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter dinject", [&] { impl_->control->filterDinject(impl_->options.token, signal, samples); });
+Expected<std::vector<introspect::ConnectionRow>> RemoteClient::connection_list() {
+  return impl_->call("connection list", [&] { return rows_from_wire<introspect::ConnectionRow>(impl_->control->connectionList()); });
+}
+
+Expected<std::vector<introspect::ServiceRow>> RemoteClient::service_list() {
+  return impl_->call("service list", [&] { return rows_from_wire<introspect::ServiceRow>(impl_->control->serviceList()); });
+}
+
+Expected<introspect::ExplainAnswer> RemoteClient::explain(std::string_view address) {
+  return impl_->call("explain", [&] { return from_wire(impl_->control->explain(std::string(address))); });
+}
+
+Expected<introspect::Names> RemoteClient::names() {
+  return impl_->call("names", [&] { return from_wire(impl_->control->names()); });
+}
+
+Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introspect::RecordSink sink) {
+  // Where the stream starts: the last record the coordinator has now; anything after it that
+  // the first message does not carry is a gap, filled from the history.
+  auto newest = history("SYSTEM", 1);
+  if (!newest) return tl::unexpected(newest.error());
+  const std::uint64_t last = newest->empty() ? 0 : newest->back().seq;
+  try {
+    const ClientOptions& o = impl_->options;
+    auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(), protocol(o.tls) + " -h 127.0.0.1");
+    auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
+    auto proxy = adapter->addWithUUID(follower);
+    adapter->activate();
+    auto events = topic(topic_manager(impl_->ic, o.ice, o.tls), kEventTopic);
+    subscribe(events, proxy, Delivery::Stream);
+    return std::unique_ptr<introspect::Subscription>(std::make_unique<RemoteSubscription>(follower, adapter, events, proxy));
+  } catch (const Ice::Exception& e) {
+    return fail(ErrorCode::Io, "cannot follow coordinator '" + impl_->options.coordinator + "' on IceStorm: " + e.what());
+  }
+}
+
+Expected<void> RemoteClient::generate(std::string_view event, std::string_view target) {
+  return impl_->call("event generate", [&] { impl_->control->eventGenerate(impl_->options.token, std::string(event), std::string(target)); });
+}
+
+Expected<void> RemoteClient::broadcast(std::string_view event) {
+  return impl_->call("event broadcast", [&] { impl_->control->eventBroadcast(impl_->options.token, std::string(event)); });
+}
+
+Expected<void> RemoteClient::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
+  return impl_->call("filter inject", [&] { impl_->control->filterInject(impl_->options.token, std::string(filter), samples); });
+}
+
+Expected<void> RemoteClient::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
+  return impl_->call("filter dinject", [&] { impl_->control->filterDinject(impl_->options.token, std::string(signal), samples); });
 }
 
 Expected<void> RemoteClient::filter_dinload(const std::string& signal, const std::string& text) {
   return impl_->call("filter dinload", [&] { impl_->control->filterDinload(impl_->options.token, signal, text); });
 }
 
-Expected<std::vector<EventRow>> RemoteClient::event_list() {
-  return impl_->call("event list", [&] {
-    std::vector<EventRow> out;
-    for (const auto& e : impl_->control->eventList()) {
-      out.push_back(EventRow{e.name, e.severity, e.onset, e.transitions, e.completes, e.latched, e.hazard, e.description});
-    }
-    return out;
+Expected<void> RemoteClient::reset(std::string_view target, std::string_view who, std::string_view why) {
+  return impl_->call("reset", [&] {
+    impl_->control->reset(impl_->options.token, std::string(target), std::string(who), std::string(why));
   });
 }
 
-Expected<std::vector<HistoryRow>> RemoteClient::event_history(int last) {
-  return impl_->call("event history", [&] {
-    std::vector<HistoryRow> out;
-    for (const auto& e : impl_->control->eventHistory(last)) out.push_back(history_row(e));
-    return out;
-  });
-}
-
-Expected<void> RemoteClient::generate(const std::string& event, const std::string& target) {
-  return impl_->call("event generate", [&] { impl_->control->eventGenerate(impl_->options.token, event, target); });
-}
-
-Expected<void> RemoteClient::broadcast(const std::string& event) {
-  return impl_->call("event broadcast", [&] { impl_->control->eventBroadcast(impl_->options.token, event); });
-}
-
-Expected<std::vector<ConnectionRow>> RemoteClient::connection_list() {
-  return impl_->call("connection list", [&] {
-    std::vector<ConnectionRow> out;
-    for (const auto& e : impl_->control->connectionList()) out.push_back(ConnectionRow{e.required, e.provided, e.remote});
-    return out;
-  });
-}
-
-Expected<std::vector<ServiceRow>> RemoteClient::service_list() {
-  return impl_->call("service list", [&] {
-    std::vector<ServiceRow> out;
-    for (const auto& e : impl_->control->serviceList()) {
-      ServiceRow r{e.address, State::Normal, e.propagate, e.dependsOn};
-      from_wire(e.state, r.state);
-      out.push_back(std::move(r));
-    }
-    return out;
-  });
-}
-
-Expected<void> RemoteClient::reset(const std::string& target, const std::string& who, const std::string& why) {
-  return impl_->call("reset", [&] { impl_->control->reset(impl_->options.token, target, who, why); });
-}
-
-Expected<std::vector<Explanation>> RemoteClient::explain(const std::string& address) {
-  return impl_->call("explain", [&] {
-    std::vector<Explanation> out;
-    for (const auto& e : impl_->control->explain(address)) out.push_back(detail::from_wire(e));
-    return out;
-  });
-}
+std::uint64_t RemoteClient::records_refused() const { return impl_->refused.load(); }
+std::uint64_t RemoteClient::gaps_filled() const { return impl_->gaps.load(); }
 
 }  // namespace safecass::middleware

@@ -1,5 +1,6 @@
 // The remote operations (DESIGN §6 console commands) served by every coordinator process.
-// Reads take the coordinator's lock briefly; writes are refused unless the process runs with
+// Every answer comes from the read model (introspect::LocalQuery). Reads take the coordinator's
+// lock briefly; writes are refused unless the process runs with
 // --allow-write and the request carries its token. A bad request changes nothing.
 
 #include "control.hpp"
@@ -8,6 +9,10 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <mutex>
+
+#include "read_model_wire.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/middleware/token.hpp"
 
 namespace safecass::middleware::detail {
@@ -30,37 +35,36 @@ std::string code_text(ErrorCode c) {
 [[noreturn]] void raise(const Error& e) { throw wire::OperationError(code_text(e.code), e.message); }
 [[noreturn]] void raise(ErrorCode c, std::string message) { raise(Error{c, std::move(message)}); }
 
-std::string param_text(const ParamValue& v) {
-  std::ostringstream out;
-  std::visit(
-      [&](const auto& x) {
-        using T = std::decay_t<decltype(x)>;
-        if constexpr (std::is_same_v<T, double>) {
-          out << x;
-        } else if constexpr (std::is_same_v<T, bool>) {
-          out << (x ? "true" : "false");
-        } else if constexpr (std::is_same_v<T, std::string>) {
-          out << x;
-        } else {
-          out << '[';
-          for (std::size_t i = 0; i < x.size(); ++i) out << (i ? ", " : "") << x[i];
-          out << ']';
-        }
-      },
-      v);
-  return out.str();
+introspect::LocalOptions with_name(introspect::LocalOptions o, const std::string& name) {
+  o.name = name;
+  return o;
 }
 
-wire::RecordEntry entry(const Coordinator& co, const Record& r) {
-  wire::RecordEntry e;
-  e.seq = static_cast<long long>(r.seq);
-  fill_record(co, r, e);
-  return e;
+template <class T>
+T value_or_raise(Expected<T> r) {
+  if (!r) raise(r.error());
+  return std::move(*r);
 }
 
+void ok_or_raise(const Expected<void>& r) {
+  if (!r) raise(r.error());
+}
+
+template <class Row>
+auto rows_to_wire(const std::vector<Row>& rows) {
+  std::vector<decltype(to_wire(rows.front()))> out;
+  out.reserve(rows.size());
+  for (const Row& r : rows) out.push_back(to_wire(r));
+  return out;
+}
+
+/// Every answer comes from the read model (introspect::LocalQuery over this process's
+/// coordinator): the servant only checks credentials and converts to the wire.
 class ControlServant final : public wire::Control {
 public:
-  explicit ControlServant(ControlContext c) : c_(std::move(c)) {}
+  explicit ControlServant(ControlContext c)
+      : c_(std::move(c)),
+        query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
 
   std::string coordinator(const Ice::Current& current) override {
     check_read(current);
@@ -69,92 +73,38 @@ public:
 
   wire::StateEntrySeq stateList(std::string component, const Ice::Current& current) override {
     check_read(current);
-    wire::StateEntrySeq out;
-    const Coordinator& co = c_.co;
-    auto outstanding_name = [&](EventId e) { return e == kNoEvent ? std::string() : co.event(e).name; };
-    for (ComponentId id = 0; id < co.component_count(); ++id) {
-      if (co.is_remote(id)) continue;
-      if (!component.empty() && co.component_name(id) != component) continue;
-      const StateSnapshot s = co.extended(id);
-      out.push_back({std::string(co.component_name(id)), "component", to_wire(s.state), outstanding_name(s.outstanding)});
-      auto machine = [&](MachineId m, const char* kind) {
-        const StateSnapshot ms = co.snapshot(m);
-        out.push_back({co.address_of(m), kind, to_wire(ms.state), outstanding_name(ms.outstanding)});
-      };
-      machine(co.framework_machine(id), "s_F");
-      machine(co.application_machine(id), "s_A");
-      for (MachineId m : co.provided_machines(id)) machine(m, "s_P");
-      for (MachineId m : co.required_machines(id)) machine(m, "s_R");
-      const auto& provided = co.provided_machines(id);
-      for (std::uint32_t p = 0; p < provided.size(); ++p) {
-        out.push_back({std::string(co.component_name(id)) + ".s_S." + std::string(co.interface_name(provided[p])), "s_S",
-                       to_wire(co.service_state(id, p)), ""});
-      }
-    }
-    if (!component.empty() && out.empty()) raise(ErrorCode::NotFound, "no component '" + component + "' in coordinator '" + c_.name + "'");
-    return out;
+    return rows_to_wire(value_or_raise(locked([&] { return query_.state_list(component); })));
   }
 
   wire::RecordEntrySeq stateHistory(std::string address, int last, const Ice::Current& current) override {
     check_read(current);
-    const Coordinator& co = c_.co;
-    std::vector<Record> records;
-    if (address.empty()) {
-      records = co.history(Address{});  // every component's transitions, in stream order
-      std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::ComponentTransition; });
-    } else {
-      auto a = co.resolve(address);
-      if (!a) raise(a.error());
-      if (a->kind == Address::Kind::Machine) {
-        records = co.history(a->machine);
-      } else if (a->kind == Address::Kind::Component) {
-        records = co.component_history(a->component);
-      } else {
-        raise(ErrorCode::InvalidArgument, "state history: '" + address + "' is not a component or machine");
-      }
-    }
-    return tail(records, last);
+    return rows_to_wire(value_or_raise(
+        locked([&] { return query_.history(address, last <= 0 ? 0 : static_cast<std::size_t>(last), introspect::HistoryFilter::All); })));
+  }
+
+  wire::RecordEntrySeq recordsSince(long long seq, int max, const Ice::Current& current) override {
+    check_read(current);
+    return rows_to_wire(value_or_raise(locked([&] {
+      return query_.records_since(seq < 0 ? 0 : static_cast<std::uint64_t>(seq), max <= 0 ? 0 : static_cast<std::size_t>(max));
+    })));
   }
 
   wire::FilterEntrySeq filterList(const Ice::Current& current) override {
     check_read(current);
-    wire::FilterEntrySeq out;
-    for (const auto& f : c_.monitor.filters()) out.push_back(filter_entry(*f));
-    return out;
+    return rows_to_wire(value_or_raise(locked([&] { return query_.filter_list(); })));
   }
 
   wire::FilterDetails filterInfo(std::string name, const Ice::Current& current) override {
     check_read(current);
-    const Filter* f = c_.monitor.find_filter(name);
-    const FilterRegistry::Entry* e = c_.registry.find(f != nullptr ? std::string_view(f->type()) : std::string_view(name));
-    if (e == nullptr) raise(ErrorCode::NotFound, "no filter or filter type '" + name + "' in coordinator '" + c_.name + "'");
-    wire::FilterDetails d;
-    if (f != nullptr) {
-      d.filter = filter_entry(*f);
-      d.missedSamples = static_cast<long long>(f->missed_samples());
-    } else {
-      d.filter.type = e->manifest.type;
-    }
-    d.doc = e->manifest.doc;
-    for (const ParamSpec& p : e->manifest.params) {
-      wire::ParamEntry pe;
-      pe.name = p.name;
-      pe.type = std::string(to_string(p.type));
-      if (p.default_value) pe.defaultValue = param_text(*p.default_value);
-      if (f != nullptr) {
-        const auto it = f->config().params.find(p.name);
-        if (it != f->config().params.end()) pe.value = param_text(it->second);
-      }
-      pe.doc = p.doc;
-      d.params.push_back(std::move(pe));
-    }
-    return d;
+    auto info = locked([&] { return query_.filter_info(name); });
+    if (!info) raise(ErrorCode::NotFound, "no filter or filter type '" + name + "' in coordinator '" + c_.name + "'");
+    return to_wire(*info);
   }
 
   void filterInject(std::string token, std::string filter, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter inject");
     if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter inject " + filter + ": no samples");
-    if (auto r = c_.monitor.inject_shallow(filter, samples); !r) raise(r.error());
+    ok_or_raise(locked([&] { return query_.inject(filter, samples); }));
     c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(samples.size()) + " samples)");
   }
 
@@ -195,107 +145,58 @@ public:
 
   wire::EventEntrySeq eventList(const Ice::Current& current) override {
     check_read(current);
-    wire::EventEntrySeq out;
-    const Coordinator& co = c_.co;
-    for (EventId id = 0; id < co.event_count(); ++id) {
-      const Event& e = co.event(id);
-      wire::EventEntry w;
-      w.name = e.name;
-      w.severity = e.severity;
-      w.onset = e.is_onset;
-      for (Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N,
-                           Transition::E2W}) {
-        if (e.transitions.contains(t)) w.transitions.emplace_back(to_string(t));
-      }
-      w.completes = e.completes;
-      w.latched = e.latched;
-      w.hazard = e.hazard;
-      w.description = e.description;
-      out.push_back(std::move(w));
-    }
-    return out;
+    return rows_to_wire(value_or_raise(locked([&] { return query_.event_list(); })));
   }
 
   wire::RecordEntrySeq eventHistory(int last, const Ice::Current& current) override {
     check_read(current);
-    const Coordinator& co = c_.co;
-    std::vector<Record> records = co.history(Address{});  // in stream order
-    std::erase_if(records, [](const Record& r) {
-      return r.kind != RecordKind::Event && r.kind != RecordKind::Reset && r.kind != RecordKind::Injection;
-    });
-    return tail(records, last);
+    return rows_to_wire(value_or_raise(locked([&] {
+      return query_.history("SYSTEM", last <= 0 ? 0 : static_cast<std::size_t>(last), introspect::HistoryFilter::Events);
+    })));
   }
 
   void eventGenerate(std::string token, std::string event, std::string target, const Ice::Current&) override {
     check_write(token, "event generate");
-    if (auto r = c_.co.generate(event, target); !r) raise(r.error());
+    ok_or_raise(locked([&] { return query_.generate(event, target); }));
     c_.log("middleware: " + c_.name + ": event generate " + event + " " + target);
   }
 
   void eventBroadcast(std::string token, std::string event, const Ice::Current&) override {
     check_write(token, "event broadcast");
-    if (auto r = c_.co.broadcast(event); !r) raise(r.error());
+    ok_or_raise(locked([&] { return query_.broadcast(event); }));
     c_.log("middleware: " + c_.name + ": event broadcast " + event);
   }
 
   wire::ConnectionEntrySeq connectionList(const Ice::Current& current) override {
     check_read(current);
-    wire::ConnectionEntrySeq out;
-    const Coordinator& co = c_.co;
-    for (const Connection& k : co.connections()) {
-      out.push_back({std::string(co.component_name(k.client)) + "." +
-                         std::string(co.interface_name(co.required_machines(k.client)[k.required])),
-                     std::string(co.component_name(k.provider)) + "." +
-                         std::string(co.interface_name(co.provided_machines(k.provider)[k.provided])),
-                     co.is_remote(k.provider)});
-    }
-    return out;
+    return rows_to_wire(value_or_raise(locked([&] { return query_.connection_list(); })));
   }
 
   wire::ServiceEntrySeq serviceList(const Ice::Current& current) override {
     check_read(current);
-    wire::ServiceEntrySeq out;
-    const Coordinator& co = c_.co;
-    for (ComponentId id = 0; id < co.component_count(); ++id) {
-      if (co.is_remote(id)) continue;
-      const auto& provided = co.provided_machines(id);
-      for (std::uint32_t p = 0; p < provided.size(); ++p) {
-        const ServiceDependency& d = co.service(id, p);
-        wire::ServiceEntry s;
-        const std::string cname(co.component_name(id));
-        s.address = cname + ".s_S." + std::string(co.interface_name(provided[p]));
-        s.state = to_wire(co.service_state(id, p));
-        s.propagate = std::string(to_string(d.propagate));
-        s.dependsOn.push_back(co.address_of(provided[p]));
-        if (d.framework) s.dependsOn.push_back(cname + ".s_F");
-        if (d.application) s.dependsOn.push_back(cname + ".s_A");
-        const auto& required = co.required_machines(id);
-        for (std::size_t r = 0; r < required.size(); ++r) {
-          if (d.all_required || std::find(d.required.begin(), d.required.end(),
-                                          std::string(co.interface_name(required[r]))) != d.required.end()) {
-            s.dependsOn.push_back(co.address_of(required[r]));
-          }
-        }
-        out.push_back(std::move(s));
-      }
-    }
-    return out;
+    return rows_to_wire(value_or_raise(locked([&] { return query_.service_list(); })));
   }
 
   void reset(std::string token, std::string target, std::string who, std::string why, const Ice::Current&) override {
     check_write(token, "reset");
     if (who.empty()) who = "remote";
-    if (auto r = c_.co.reset(target, who, why); !r) raise(r.error());
+    ok_or_raise(locked([&] { return query_.reset(target, who, why); }));
     c_.log("middleware: " + c_.name + ": reset " + target + " by " + who + ": " + why);
   }
 
-  wire::ExplainEntrySeq explain(std::string address, const Ice::Current& current) override {
+  wire::ExplainReply explain(std::string address, const Ice::Current& current) override {
     check_read(current);
-    auto why = c_.co.explain(address);
-    if (!why) raise(why.error());
-    wire::ExplainEntrySeq out;
-    for (const Explanation& e : *why) out.push_back(to_wire(e));
-    return out;
+    return to_wire(value_or_raise(locked([&] { return query_.explain(address); })));
+  }
+
+  wire::ClockEntry clockInfo(const Ice::Current& current) override {
+    check_read(current);
+    return to_wire(value_or_raise(locked([&] { return query_.clock(); })));
+  }
+
+  wire::NamesEntry names(const Ice::Current& current) override {
+    check_read(current);
+    return to_wire(value_or_raise(locked([&] { return query_.names(); })));
   }
 
 private:
@@ -328,39 +229,20 @@ private:
 
   void deep(const std::string& signal, const wire::SampleSeq& samples) {
     if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter dinject " + signal + ": no samples");
-    const Signal* s = c_.monitor.signals().find(signal);
-    if (s == nullptr) raise(ErrorCode::NotFound, "no signal '" + signal + "' in coordinator '" + c_.name + "'");
-    if (samples.size() > s->buffer().capacity()) {
-      raise(ErrorCode::InvalidArgument, "filter dinject " + signal + ": more samples than its history buffer holds (" +
-                                            std::to_string(s->buffer().capacity()) + ")");
-    }
-    if (auto r = c_.monitor.inject_deep(signal, samples, c_.co.clock().now()); !r) raise(r.error());
+    ok_or_raise(locked([&] { return query_.inject_deep(signal, samples); }));
     c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(samples.size()) + " samples)");
   }
 
-  wire::RecordEntrySeq tail(std::vector<Record>& records, int last) const {
-    std::sort(records.begin(), records.end(), [](const Record& a, const Record& b) { return a.seq < b.seq; });
-    const std::size_t n = last <= 0 ? records.size() : std::min<std::size_t>(records.size(), static_cast<std::size_t>(last));
-    wire::RecordEntrySeq out;
-    for (std::size_t i = records.size() - n; i < records.size(); ++i) out.push_back(entry(c_.co, records[i]));
-    return out;
-  }
-
-  wire::FilterEntry filter_entry(const Filter& f) const {
-    wire::FilterEntry e;
-    e.name = f.name();
-    e.type = f.type();
-    e.target = f.target() == kNoMachine ? "-" : c_.co.address_of(f.target());
-    e.execution = f.execution() == ExecutionMode::Active ? "ACTIVE" : "PASSIVE";
-    e.detection = f.detection() == DetectionMode::Edge ? "EDGE" : "LEVEL";
-    e.enabled = f.enabled();
-    e.detected = f.detected();
-    for (const Signal* s : f.inputs()) if (s != nullptr) e.inputs.push_back(s->name());
-    for (const Signal* s : f.outputs()) if (s != nullptr) e.outputs.push_back(s->name());
-    return e;
+  /// The read model is used by one thread at a time (Ice may dispatch requests on several).
+  template <class F>
+  auto locked(F&& f) -> decltype(f()) {
+    std::lock_guard lock(mutex_);
+    return f();
   }
 
   ControlContext c_;
+  std::mutex mutex_;
+  introspect::LocalQuery query_;
 };
 
 }  // namespace
@@ -370,7 +252,7 @@ std::shared_ptr<wire::Control> make_control(ControlContext context) {
 }
 
 wire::ExplainEntry to_wire(const Explanation& e) {
-  wire::ExplainEntry w;
+  wire::ExplainEntry w{};
   w.machine = e.machine;
   w.event = e.event;
   w.level = to_wire(e.level);
@@ -381,6 +263,9 @@ wire::ExplainEntry to_wire(const Explanation& e) {
                       e.sample_time.count(), e.injected, e.path};
   w.hazard = e.hazard;
   w.line = to_string(e);
+  w.count = static_cast<int>(e.count);
+  w.first = e.first.count();
+  w.last = e.last.count();
   return w;
 }
 
@@ -402,6 +287,9 @@ Explanation from_wire(const wire::ExplainEntry& w) {
   e.sample_time = Time{w.root.sampleTime};
   e.injected = w.root.injected;
   e.path = w.root.path;
+  e.count = static_cast<std::uint32_t>(w.count < 0 ? 0 : w.count);
+  e.first = Time{w.first};
+  e.last = Time{w.last};
   return e;
 }
 

@@ -8,6 +8,7 @@
 #include "ice_util.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/local_query.hpp"
 
 namespace safecass::middleware::detail {
 
@@ -20,6 +21,7 @@ struct ControlContext {
   std::string token;
   std::function<void(const std::string&)> log;
   std::string read_token;  ///< empty: reads are open to every local client
+  introspect::LocalOptions clock;  ///< how its times read (NodeOptions::clock)
 };
 
 /// The request-context key that carries the read credential.

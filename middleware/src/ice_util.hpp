@@ -53,31 +53,6 @@ bool from_wire(wire::Level l, State& out) noexcept;
 std::string_view outcome_text(Outcome o) noexcept;
 std::int64_t steady_ns() noexcept;
 
-/// Fills the fields that a wire record (wire::RecordEntry of a history reply, wire::EventMessage of
-/// the event stream) shares with an observer record: kind, outcome, address, event, states, level,
-/// mirror, root cause, time, text.
-template <class WireRecord>
-void fill_record(const Coordinator& co, const Record& r, WireRecord& out) {
-  out.time = r.time.count();
-  out.kind = std::string(to_string(r.kind));
-  out.outcome = std::string(outcome_text(r.outcome));
-  if (r.machine != kNoMachine) {
-    out.address = co.address_of(r.machine);
-  } else if (r.component != kNoComponent) {
-    out.address = std::string(co.component_name(r.component));
-  }
-  if (r.event != kNoEvent) out.event = co.event(r.event).name;
-  out.from = to_wire(r.from);
-  out.to = to_wire(r.to);
-  out.level = to_wire(r.level);
-  out.mirror = r.mirror;
-  if (r.root.event != kNoEvent) {
-    out.rootEvent = co.event(r.root.event).name;
-    out.rootOrigin = co.root_origin(r.root);
-  }
-  out.text = std::string(r.text);
-}
-
 }  // namespace safecass::middleware::detail
 
 namespace safecass::middleware::detail {

@@ -15,6 +15,7 @@
 #include "auth.hpp"
 #include "control.hpp"
 #include "ice_util.hpp"
+#include "read_model_wire.hpp"
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
@@ -257,11 +258,11 @@ struct CoordinatorNode::Impl {
 
   // -- publisher thread --
   wire::EventMessage to_message(const Record& r) {
-    wire::EventMessage m;
+    wire::EventMessage m{};  // every field set: no indeterminate enumerator reaches the encoder
     m.coordinator = name;
     m.incarnation = incarnation;
     m.seq = ++event_seq;
-    fill_record(co, r, m);
+    fill_message(introspect::history_entry(r, co), m);
     return m;
   }
 
@@ -1063,7 +1064,8 @@ Expected<void> CoordinatorNode::start() {
     auto heartbeat = d.adapter->add(std::make_shared<HeartbeatServant>(d), Ice::Identity{"heartbeat", id});
     auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
     ControlContext context{d.co, d.monitor, d.registry, d.name, d.options.allow_write, d.options.token,
-                           [&d](const std::string& line) { d.log(line); }, d.options.read_token};
+                           [&d](const std::string& line) { d.log(line); }, d.options.read_token,
+                           d.options.clock};
     auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);

@@ -12,9 +12,11 @@
 
 #include "auth.hpp"
 #include "ice_util.hpp"
+#include "read_model_wire.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/model.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::middleware {
@@ -35,6 +37,8 @@ struct Supervisor::Impl {
     std::int64_t last_event_seq = 0;
     std::int64_t heartbeat_seq = 0;
     bool events_behind = false;  ///< the last heartbeat listed event records not received
+    std::string control;         ///< its Control proxy, from its last authenticated heartbeat
+    bool refresh = false;        ///< records were missed: fetch its state list again
     bool seen = false;
     bool lost = false;
   };
@@ -153,6 +157,7 @@ struct Supervisor::Impl {
       if (p->second.last_event_seq != 0 && m.seq != p->second.last_event_seq + 1) {
         print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event record(s) of '" + who +
               "' missed");
+        p->second.refresh = true;  // the missed records may have changed rows: read them again
       }
       p->second.last_event_seq = m.seq;
       if (m.kind != "transition" && m.kind != "component-transition" && m.kind != "reset") return;
@@ -252,6 +257,7 @@ struct Supervisor::Impl {
         return;
       }
       peer.heartbeat_seq = h.seq;
+      peer.control = h.control;
       // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
       // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
       // records may be on their way on the other topic): reported as missed.
@@ -261,6 +267,7 @@ struct Supervisor::Impl {
           print("supervisor: " + std::to_string(sent->second - peer.last_event_seq) + " event record(s) of '" +
                 h.coordinator + "' missed");
           peer.last_event_seq = sent->second;
+          peer.refresh = true;
           peer.events_behind = false;
         } else {
           peer.events_behind = true;
@@ -281,9 +288,64 @@ struct Supervisor::Impl {
     for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", c + ".s_F");
   }
 
+  /// After records of a coordinator were missed, its rows in the view may be stale: read its
+  /// state list (the read model's rows, from its Control object found in its authenticated
+  /// heartbeat) and print every row that differs from the view. Never on the dispatch thread.
+  void refresh_missed() {
+    std::vector<std::pair<std::string, std::string>> due;  // coordinator, Control proxy
+    {
+      std::lock_guard lock(mutex);
+      for (auto& [name, peer] : peers) {
+        if (!peer.refresh || peer.control.empty()) continue;
+        peer.refresh = false;
+        due.emplace_back(name, peer.control);
+      }
+    }
+    for (const auto& [name, control] : due) {
+      const std::string who = printable(name);
+      std::vector<introspect::StateRow> rows;
+      std::map<std::string, std::string> causes;
+      try {
+        auto prx = Ice::uncheckedCast<wire::ControlPrx>(ic->stringToProxy(control))->ice_invocationTimeout(1000);
+        for (const wire::StateEntry& w : prx->stateList("")) {
+          introspect::StateRow r;
+          if (!from_wire(w, r) || r.kind == introspect::RowKind::System || r.kind == introspect::RowKind::Service) continue;
+          if (r.state != State::Normal) {
+            const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
+            for (const Explanation& e : why.conditions) {
+              if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root_origin + ":" + e.root_event;
+            }
+          }
+          rows.push_back(std::move(r));
+        }
+      } catch (const wire::OperationError& e) {
+        print("supervisor: cannot refresh the view of '" + who + "' after missed records: " + printable(e.message));
+        continue;
+      } catch (const Ice::Exception& e) {
+        print("supervisor: cannot refresh the view of '" + who + "' after missed records: " + e.ice_id());
+        continue;
+      }
+      std::vector<std::string> lines;
+      {
+        std::lock_guard lock(mutex);
+        for (const introspect::StateRow& r : rows) {
+          const auto it = view.find(r.address);
+          if (it == view.end() && r.state == State::Normal) continue;  // never reported, still Normal
+          const std::string cause = r.state == State::Normal ? std::string() : causes[r.address];
+          if (it != view.end() && it->second.state == r.state) continue;
+          view[r.address] = ViewRow{name, r.address, r.state, cause};
+          lines.push_back("[" + who + "] " + printable(r.address) + " " + std::string(to_string(r.state)) +
+                          " (refreshed after missed records" + (cause.empty() ? "" : "; root " + printable(cause)) + ")");
+        }
+      }
+      for (const std::string& l : lines) print(l);
+    }
+  }
+
   void watch_loop() {
     while (running.load()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      refresh_missed();
       const std::int64_t now = steady_ns();
       std::vector<std::pair<std::string, std::vector<std::string>>> lost_now;
       {

@@ -1,5 +1,7 @@
 #include "safecass/record/recorder.hpp"
 
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
 #include "segmented_file.hpp"
 
 #include <fcntl.h>
@@ -12,156 +14,12 @@
 
 namespace safecass {
 
-namespace {
-
-void append_quoted(std::string& out, std::string_view s) {
-  out += '"';
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-}
-
-/// A number as JSON; a non-finite one (a NaN or infinite sample) as the string "nan", "inf" or
-/// "-inf", since JSON has no such numbers and the value must not be lost.
-std::string json_num(double v) {
-  if (std::isnan(v)) return "\"nan\"";
-  if (std::isinf(v)) return v > 0 ? "\"inf\"" : "\"-inf\"";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string secs(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
-
-std::string event_name(const Coordinator& co, EventId e) {
-  return e == kNoEvent || e >= co.event_count() ? std::string() : co.event(e).name;
-}
-
-/// The address of a record's root origin. A root that came from another process (a live
-/// coordinator's remote provided interface) names its origin in that process, interned when it
-/// arrived (RootCause::remote_origin), not the local stand-in machine it arrived through: a live
-/// client's history names the same root cause as an in-process run.
-std::string root_origin_text(const Record& r, const Coordinator& co) {
-  if (r.root.remote_origin != kNoName) return std::string(co.name_of(r.root.remote_origin));
-  return co.address_of(r.root.origin);
-}
-
-}  // namespace
-
 std::string record_to_json(const Record& r, const Coordinator& co) {
-  std::string out = "{\"seq\":" + std::to_string(r.seq) + ",\"t\":" + secs(r.time) + ",\"kind\":";
-  append_quoted(out, to_string(r.kind));
-  if (r.outcome != Outcome::None) {
-    out += ",\"outcome\":";
-    append_quoted(out, to_string(r.outcome));
-  }
-  if (r.component != kNoComponent && r.component < co.component_count()) {
-    out += ",\"component\":";
-    append_quoted(out, co.component_name(r.component));
-  }
-  if (r.machine != kNoMachine && r.machine < co.machine_count()) {
-    out += ",\"machine\":";
-    append_quoted(out, co.address_of(r.machine));
-  }
-  if (r.event != kNoEvent) {
-    out += ",\"event\":";
-    append_quoted(out, event_name(co, r.event));
-  }
-  if (r.kind != RecordKind::Injection) {
-    out += ",\"from\":";
-    append_quoted(out, to_string(r.from));
-    out += ",\"to\":";
-    append_quoted(out, to_string(r.to));
-  }
-  if (r.kind == RecordKind::Event) {
-    out += ",\"level\":";
-    append_quoted(out, to_string(r.level));
-    out += ",\"severity\":" + std::to_string(r.severity);
-  }
-  if (r.mirror) out += ",\"mirror\":true";
-  if (r.root.event != kNoEvent && r.root.origin != kNoMachine && r.root.origin < co.machine_count()) {
-    out += ",\"root\":{\"event\":";
-    append_quoted(out, event_name(co, r.root.event));
-    out += ",\"origin\":";
-    append_quoted(out, root_origin_text(r, co));
-    out += ",\"t\":" + secs(r.root.time);
-    if (r.root.sample.filter != kNoName) {
-      out += ",\"filter\":";
-      append_quoted(out, co.name_of(r.root.sample.filter));
-    }
-    if (r.root.sample.signal != kNoName) {
-      out += ",\"signal\":";
-      append_quoted(out, co.name_of(r.root.sample.signal));
-      out += ",\"value\":" + json_num(r.root.sample.value) + ",\"sample_t\":" + secs(r.root.sample.sample_time);
-    }
-    if (r.root.sample.injected) out += ",\"injected\":true";
-    out += "}";
-  }
-  if (!r.text.empty()) {
-    out += ",\"text\":";
-    append_quoted(out, r.text);
-  }
-  out += "}";
-  return out;
+  return introspect::history_json(introspect::history_entry(r, co));
 }
 
 std::string record_to_text(const Record& r, const Coordinator& co) {
-  std::string out = "t=" + secs(r.time) + "  ";
-  const std::string where = r.machine != kNoMachine && r.machine < co.machine_count()
-                                ? co.address_of(r.machine)
-                                : (r.component != kNoComponent ? std::string(co.component_name(r.component)) : std::string("-"));
-  out += where;
-  switch (r.kind) {
-    case RecordKind::Transition:
-    case RecordKind::ComponentTransition:
-      out += "  " + std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
-      if (r.event != kNoEvent) out += "  " + event_name(co, r.event);
-      break;
-    case RecordKind::Event:
-      out += "  " + std::string(to_string(r.outcome)) + " " + event_name(co, r.event);
-      break;
-    case RecordKind::Reset: out += "  reset"; break;
-    case RecordKind::Injection: out += "  injection"; break;
-  }
-  if (r.root.event != kNoEvent && r.root.origin != kNoMachine && r.root.origin < co.machine_count() &&
-      !(r.root.origin == r.machine && r.root.event == r.event)) {
-    out += "  <- " + root_origin_text(r, co) + ":" + event_name(co, r.root.event);
-  }
-  if (r.root.sample.filter != kNoName || r.root.sample.signal != kNoName) {
-    out += "  [";
-    if (r.root.sample.filter != kNoName) out += "filter " + std::string(co.name_of(r.root.sample.filter));
-    if (r.root.sample.signal != kNoName) {
-      out += ", " + std::string(co.name_of(r.root.sample.signal)) + " = " + num(r.root.sample.value);
-    }
-    if (r.root.sample.injected) out += ", injected";
-    out += "]";
-  }
-  if (!r.text.empty()) out += "  (" + std::string(r.text) + ")";
-  return out;
+  return introspect::history_text(introspect::history_entry(r, co), introspect::TimeFormat{});
 }
 
 std::vector<std::string> describe_losses(const RecordStatus& s) {
@@ -180,16 +38,12 @@ std::vector<std::string> describe_losses(const RecordStatus& s) {
 }
 
 std::string record_status_json(const RecordStatus& s) {
-  std::string out = "{\"kind\":\"recorder\",\"path\":";
-  append_quoted(out, s.path);
-  out += ",\"written\":" + std::to_string(s.written) + ",\"dropped\":" + std::to_string(s.dropped) +
-         ",\"unwritten\":" + std::to_string(s.unwritten) + ",\"write_error\":" + (s.write_error.empty() ? "false" : "true");
-  if (!s.write_error.empty()) {
-    out += ",\"error\":";
-    append_quoted(out, s.write_error);
-  }
-  out += std::string(",\"complete\":") + (s.complete() ? "true" : "false") + "}";
-  return out;
+  introspect::JsonObject j;
+  j.str("kind", "recorder").str("path", s.path).integer("written", static_cast<long long>(s.written))
+      .integer("dropped", static_cast<long long>(s.dropped)).integer("unwritten", static_cast<long long>(s.unwritten))
+      .boolean("write_error", !s.write_error.empty());
+  if (!s.write_error.empty()) j.str("error", s.write_error);
+  return j.boolean("complete", s.complete()).text();
 }
 
 Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity,
@@ -243,7 +97,7 @@ void Recorder::writer() {
       std::string line;
       bool record = false;
       if (dropped_ != dropped_reported_) {
-        line = "{\"kind\":\"overflow\",\"dropped\":" + std::to_string(dropped_ - dropped_reported_) + "}";
+        line = introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(dropped_ - dropped_reported_)).text();
         dropped_reported_ = dropped_;
       } else {
         const Record r = queue_.front();

@@ -1,5 +1,6 @@
 #include "safecass/spec/diagnostics.hpp"
 
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/json.hpp"
 
 #include "text.hpp"
@@ -18,13 +19,12 @@ std::string format(const Diagnostic& d) {
 }
 
 std::string to_json(const Diagnostic& d) {
-  const char* severity = d.severity == Diagnostic::Severity::Error     ? "\"error\""
-                         : d.severity == Diagnostic::Severity::Warning ? "\"warning\""
-                                                                        : "\"note\"";
-  return "{\"file\": " + json_quote(d.where.file) + ", \"line\": " + std::to_string(d.where.line) +
-         ", \"column\": " + std::to_string(d.where.column) + ", \"severity\": " +
-         severity + ", \"message\": " + json_quote(d.message) +
-         ", \"pointer\": " + json_quote(d.pointer) + "}";
+  const char* severity = d.severity == Diagnostic::Severity::Error     ? "error"
+                         : d.severity == Diagnostic::Severity::Warning ? "warning"
+                                                                        : "note";
+  return introspect::JsonObject().str("file", d.where.file).integer("line", d.where.line)
+      .integer("column", d.where.column).str("severity", severity).str("message", d.message)
+      .str("pointer", d.pointer).text();
 }
 
 std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {

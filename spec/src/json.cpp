@@ -1,5 +1,7 @@
 #include "safecass/spec/json.hpp"
 
+#include "safecass/introspect/json.hpp"
+
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -387,27 +389,6 @@ JsonParse parse_json_streaming(std::string_view text, std::string_view key, cons
   return Parser(text, max_depth, key, element).run();
 }
 
-std::string json_quote(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  out += '"';
-  return out;
-}
+std::string json_quote(std::string_view text) { return introspect::json_string(text); }
 
 }  // namespace safecass::spec

@@ -23,60 +23,6 @@ std::string_view trim(std::string_view s) {
   return s.substr(first, last - first + 1);
 }
 
-std::string seconds_text(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
-
-std::string number_text(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";  // JSON has no NaN or infinity
-  return number_text(v);
-}
-
-std::string json_string(std::string_view s) { return spec::json_quote(s); }
-
-std::string json_list(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t i = 0; i < items.size(); ++i) out += (i ? "," : "") + json_string(items[i]);
-  return out + "]";
-}
-
-Json& Json::raw(std::string_view key, std::string_view value) {
-  text_ += first_ ? "" : ",";
-  first_ = false;
-  text_ += json_string(key);
-  text_ += ':';
-  text_ += value;
-  return *this;
-}
-
-/// Left-aligned columns, two spaces apart; the last column is not padded.
-std::string columns(const std::vector<std::vector<std::string>>& rows) {
-  std::vector<std::size_t> width;
-  for (const auto& row : rows) {
-    if (width.size() < row.size()) width.resize(row.size(), 0);
-    for (std::size_t i = 0; i + 1 < row.size(); ++i) width[i] = std::max(width[i], row[i].size());
-  }
-  std::string out;
-  for (const auto& row : rows) {
-    std::string line;
-    for (std::size_t i = 0; i < row.size(); ++i) {
-      line += row[i];
-      if (i + 1 < row.size()) line += std::string(width[i] - row[i].size() + 2, ' ');
-    }
-    line.erase(line.find_last_not_of(' ') + 1);  // an empty last column leaves padding behind
-    out += line + "\n";
-  }
-  return out;
-}
-
 // ---- words, numbers and samples -----------------------------------------------------------------
 
 /// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
@@ -302,40 +248,6 @@ std::vector<std::string> sub_words(std::string_view group) {
 }  // namespace
 
 // ---- shared printers -----------------------------------------------------------------------------
-
-void write_done(Out& out, bool json_output, const CommandSpec& c, Json json, const std::string& text,
-                std::optional<double> t) {
-  if (!json_output) {
-    out.line(text);
-    return;
-  }
-  json.boolean("ok", true).str("command", c.name);
-  if (t) json.num("t", *t);
-  out.line(json.text());
-}
-
-void print_explanations(const std::vector<Explanation>& all, const std::string& address, std::string_view state,
-                        bool json_output, bool with_counts, Out& out) {
-  for (const Explanation& e : all) {
-    if (!json_output) {
-      out.line(to_string(e));
-      continue;
-    }
-    Json j;
-    j.str("address", address).str("machine", e.machine).str("event", e.event).str("level", to_string(e.level))
-        .integer("severity", e.severity).boolean("mirror", e.mirror).boolean("outstanding", e.outstanding);
-    if (with_counts) j.integer("count", e.count).num("first", to_seconds(e.first)).num("last", to_seconds(e.last));
-    j.str("root_event", e.root_event).str("root_origin", e.root_origin).num("root_t", to_seconds(e.root_time))
-        .opt("hazard", e.hazard);
-    if (!e.filter.empty()) j.str("filter", e.filter);
-    if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
-    if (e.injected) j.boolean("injected", true);
-    out.line(j.raw("path", json_list(e.path)).text());
-  }
-  if (all.empty() && !json_output) {
-    out.line(address + (state.empty() ? std::string(":") : " is " + std::string(state) + ":") + " no active condition");
-  }
-}
 
 namespace {
 

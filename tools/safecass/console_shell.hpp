@@ -1,11 +1,13 @@
 #pragma once
 // The part of `safecass console` that does not depend on where the system runs: the command table,
 // the parser of command lines, TAB completion, usage and error lines, `help`, and the text and
-// JSON helpers every printer uses. A console::Backend runs the parsed commands: the in-process
-// one (console.cpp) against a system in simulated time, the remote one (console_remote.cpp)
-// against a live coordinator through the middleware. Internal to tools/safecass.
+// JSON helpers every printer uses. One console::Backend runs the parsed commands (console.cpp),
+// over a SystemQuery: a system in this process in simulated time (LocalQuery) or a live
+// coordinator through the middleware (RemoteQuery, console_remote.cpp). Internal to tools/safecass.
 
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,40 +16,22 @@
 #include "console.hpp"
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
+#include "safecass/introspect/query.hpp"
 
 namespace safecass::tools::console {
 
 // ---- text helpers --------------------------------------------------------------------------------
 
 std::string_view trim(std::string_view s);
-/// "%.6f" seconds: "0.301000".
-std::string seconds_text(Time t);
-/// "%.9g": "1.5", "30".
-std::string number_text(double v);
-/// A JSON number, or null for NaN and infinities.
-std::string json_number(double v);
-std::string json_string(std::string_view s);
-std::string json_list(const std::vector<std::string>& items);
-
-/// One JSON object, built field by field: Json().str("a", "x").num("b", 1).text() == {"a":"x","b":1}.
-class Json {
-public:
-  Json& raw(std::string_view key, std::string_view value);
-  Json& str(std::string_view key, std::string_view value) { return raw(key, json_string(value)); }
-  Json& num(std::string_view key, double value) { return raw(key, json_number(value)); }
-  Json& integer(std::string_view key, long long value) { return raw(key, std::to_string(value)); }
-  Json& boolean(std::string_view key, bool value) { return raw(key, value ? "true" : "false"); }
-  /// A string, or null when empty.
-  Json& opt(std::string_view key, std::string_view value) { return value.empty() ? raw(key, "null") : str(key, value); }
-  std::string text() const { return text_ + "}"; }
-
-private:
-  std::string text_ = "{";
-  bool first_ = true;
-};
-
-/// Left-aligned columns, two spaces apart; the last column is not padded.
-std::string columns(const std::vector<std::vector<std::string>>& rows);
+// Times, numbers, tables and JSON: the read model's one formatter and JSON writer.
+using introspect::columns;
+using introspect::number_text;
+using introspect::seconds_text;
+using Json = introspect::JsonObject;
+inline std::string json_string(std::string_view s) { return introspect::json_string(s); }
+inline std::string json_list(const std::vector<std::string>& items) { return introspect::json_string_array(items); }
 
 // ---- words, numbers and samples ------------------------------------------------------------------
 
@@ -108,17 +92,6 @@ struct Out {
   void line(std::string text) { reply.out += std::move(text) + "\n"; }
 };
 
-/// The confirmation line of a write command: `text`, or with --json `json` plus ok, command and
-/// (when known) the time `t` in seconds.
-void write_done(Out& out, bool json_output, const CommandSpec& c, Json json, const std::string& text,
-                std::optional<double> t);
-
-/// The lines of `explain ADDRESS`: one per active condition (to_string(Explanation)), or one JSON
-/// object each. `with_counts`: the explanations carry count/first/last (in-process). With none,
-/// one line "ADDRESS is STATE: no active condition" (STATE may be empty: "ADDRESS: no active ...").
-void print_explanations(const std::vector<Explanation>& all, const std::string& address, std::string_view state,
-                        bool json_output, bool with_counts, Out& out);
-
 /// Runs the commands of one console. Thread-safety: one thread at a time, like the Console.
 class Backend {
 public:
@@ -135,5 +108,24 @@ public:
   virtual void begin() {}
   virtual void end(Out& /*out*/, bool /*ok*/) {}
 };
+
+/// What a console works on: a system read and written through one SystemQuery.
+struct Target {
+  /// Keeps alive what the query reads (an in-process system); destroyed after the query.
+  std::shared_ptr<void> owner;
+  std::unique_ptr<introspect::SystemQuery> query;
+  /// "system robodoc.json (5 components, scenario story.json), simulated time" or
+  /// "coordinator robot on IceStorm 127.0.0.1:14061 (3 components), live": the banner's subject.
+  std::string subject;
+  /// What write access means here, for the banner ("writes allowed" when empty and allowed).
+  std::string write_access;
+  /// In-process: advances simulated time to the given time and returns the scenario's
+  /// expectation failures found on the way. Empty for a live system, whose time runs by itself.
+  std::function<std::vector<std::string>(Time)> advance;
+};
+
+/// The console's one backend: every command runs against `target.query`. Errors: as the query's
+/// (a live coordinator that does not answer while the names are fetched: Io).
+Expected<std::unique_ptr<Backend>> make_backend(Target target, ConsoleOptions options);
 
 }  // namespace safecass::tools::console

@@ -2,6 +2,8 @@
 
 #include "timeline.hpp"
 
+#include "safecass/introspect/json.hpp"
+
 #include "safecass/spec/file.hpp"
 #include "safecass/spec/json.hpp"
 
@@ -49,7 +51,7 @@ std::string secs(double v) {
 /// A JSON string that is also safe inside an HTML <script> element: <, > and & are escaped.
 std::string quote(std::string_view s) {
   std::string out;
-  for (const char c : spec::json_quote(s)) {
+  for (const char c : introspect::json_string(s)) {
     switch (c) {
       case '<': out += "\\u003c"; break;
       case '>': out += "\\u003e"; break;
@@ -382,24 +384,28 @@ public:
   std::string out;
 
   void lane(const Lane& l) {
+    // Each bar and marker is one object of the JSON writer, one a line so that golden diffs read
+    // well; strings go through quote() (JSON, safe inside <script>).
     out += "{\"address\":" + quote(l.address) + ",\"kind\":" + (l.component ? "\"component\"" : "\"machine\"") + ",\"bars\":[";
     for (std::size_t i = 0; i < l.bars.size(); ++i) {
       const Bar& b = l.bars[i];
       out += i == 0 ? "\n" : ",\n";
-      out += "{\"state\":" + quote(b.state) + ",\"from\":" + num(b.from) + ",\"to\":" + (b.to ? num(*b.to) : "null");
+      introspect::JsonObject bar;
+      bar.raw("state", quote(b.state)).raw("from", num(b.from)).raw("to", b.to ? num(*b.to) : "null");
       if (b.entered != nullptr) {
-        out += ",\"line\":" + std::to_string(b.entered->line);
-        if (!b.entered->event.empty()) out += ",\"event\":" + quote(b.entered->event);
+        bar.integer("line", b.entered->line);
+        if (!b.entered->event.empty()) bar.raw("event", quote(b.entered->event));
       }
-      out += ",\"tip\":" + quote(bar_tip(l, b)) + "}";
+      out += bar.raw("tip", quote(bar_tip(l, b))).text();
     }
     out += "],\"markers\":[";
     for (std::size_t i = 0; i < l.markers.size(); ++i) {
       const Marker& m = l.markers[i];
       out += i == 0 ? "\n" : ",\n";
-      out += "{\"kind\":" + quote(m.kind) + ",\"t\":" + num(m.record->t) + ",\"line\":" + std::to_string(m.record->line);
-      if (!m.record->event.empty()) out += ",\"event\":" + quote(m.record->event);
-      out += ",\"tip\":" + quote(marker_tip(l, m)) + "}";
+      introspect::JsonObject marker;
+      marker.raw("kind", quote(m.kind)).raw("t", num(m.record->t)).integer("line", m.record->line);
+      if (!m.record->event.empty()) marker.raw("event", quote(m.record->event));
+      out += marker.raw("tip", quote(marker_tip(l, m))).text();
     }
     out += "]}";
   }
@@ -590,8 +596,8 @@ std::string model_json(const Model& m, std::size_t record_count) {
     const std::string tip = "The recorder dropped " + std::to_string(band.record->dropped) +
                             " records here (history line " + std::to_string(band.record->line) +
                             "): states in this interval may be incomplete.";
-    w.out += "{\"line\":" + std::to_string(band.record->line) + ",\"dropped\":" + std::to_string(band.record->dropped) +
-             ",\"from\":" + num(band.from) + ",\"to\":" + (band.to ? num(*band.to) : "null") + ",\"tip\":" + quote(tip) + "}";
+    w.out += introspect::JsonObject().integer("line", band.record->line).integer("dropped", static_cast<long long>(band.record->dropped))
+                 .raw("from", num(band.from)).raw("to", band.to ? num(*band.to) : "null").raw("tip", quote(tip)).text();
   }
   w.out += "],\n\"groups\":[";
   for (std::size_t gi = 0; gi < m.groups.size(); ++gi) {

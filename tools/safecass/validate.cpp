@@ -9,27 +9,13 @@
 #include <map>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/spec.hpp"
 #include "spec_commands.hpp"
 
 namespace safecass::tools {
 
 namespace {
-
-std::string quote(const std::string& s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-      out += buf;
-      continue;
-    }
-    out += c;
-  }
-  return out + "\"";
-}
 
 /// A regular file that can be opened; opened without blocking, so a FIFO is refused at once.
 bool readable(const std::string& path) {
@@ -79,9 +65,9 @@ int run_validate(const std::vector<std::string>& files, bool json_output, bool v
     }
   }
   if (json_output) {
-    std::string list;
-    for (const std::string& f : files) list += (list.empty() ? "" : ", ") + quote(f);
-    std::printf("{\"files\": [%s], \"errors\": %zu, \"warnings\": %zu}\n", list.c_str(), errors, warnings);
+    const std::string summary = introspect::JsonObject().strings("files", files).integer("errors", static_cast<long long>(errors))
+                                    .integer("warnings", static_cast<long long>(warnings)).text();
+    std::printf("%s\n", summary.c_str());
   } else {
     std::printf("%zu error%s, %zu warning%s\n", errors, errors == 1 ? "" : "s", warnings, warnings == 1 ? "" : "s");
   }

@@ -315,9 +315,10 @@ std::vector<std::string> rows_of(const Coordinator& co, const std::vector<std::s
   return out;
 }
 
-std::vector<std::string> rows_of(const std::vector<middleware::StateRow>& rows) {
+std::vector<std::string> rows_of(const std::vector<introspect::StateRow>& rows) {
   std::vector<std::string> out;
   for (const auto& r : rows) {
+    if (r.kind == introspect::RowKind::System) continue;  // the reference lists the components alone
     out.push_back(r.address + " " + std::string(to_string(r.state)) + (r.outstanding.empty() ? "" : " " + r.outstanding));
   }
   std::sort(out.begin(), out.end());
@@ -338,8 +339,8 @@ std::vector<std::string> causes_of(const std::vector<Explanation>& why) {
   return out;
 }
 
-bool has_root(const Expected<std::vector<Explanation>>& why, const std::string& event) {
-  return why && std::any_of(why->begin(), why->end(), [&](const Explanation& e) { return e.root_event == event; });
+bool has_root(const Expected<introspect::ExplainAnswer>& why, const std::string& event) {
+  return why && std::any_of(why->conditions.begin(), why->conditions.end(), [&](const Explanation& e) { return e.root_event == event; });
 }
 
 /// "- wanted" / "+ got" lines of two sorted lists, empty when they are equal.
@@ -666,7 +667,7 @@ public:
           out += who + ": explain " + c + " failed: " + why.error().message + "\n";
           continue;
         }
-        out += diff(who + " explain " + c, causes_of(*reference_.co->explain(c)), causes_of(*why));
+        out += diff(who + " explain " + c, causes_of(*reference_.co->explain(c)), causes_of(why->conditions));
       }
     }
     const SupervisorLog s(supervisor_->log());

@@ -225,7 +225,7 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
   const std::string expected = in_process([](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
   auto remote = ui->explain("PENDANT");
   ASSERT_TRUE(remote) << remote.error().message;
-  EXPECT_EQ(causes(*remote), expected);
+  EXPECT_EQ(causes(remote->conditions), expected);
   EXPECT_NE(expected.find("JR3.s_A:EVT_FORCE_ERROR path JR3.s_A JR3.s_S.ForceData CONTROL.s_R.ForceData "
                           "CONTROL.s_S.Status PENDANT.s_R.Status"),
             std::string::npos)
@@ -233,7 +233,7 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
 
   ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A"));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
-  EXPECT_TRUE(ui->explain("PENDANT")->empty());
+  EXPECT_TRUE(ui->explain("PENDANT")->conditions.empty());
 }
 
 /// One history record as a line both sides can produce: what happened and its root cause.
@@ -301,7 +301,7 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     const auto want = roots(*reference.explain("PENDANT.s_R.Status"));
     ASSERT_TRUE(eventually([&] {
       auto got = ui->explain("PENDANT.s_R.Status");
-      return got && roots(*got) == want;
+      return got && roots(got->conditions) == want;
     })) << "step " << step << " " << op.event << " " << op.target << "\n" << sys.logs();
   }
 
@@ -321,11 +321,12 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     }
   }
   ASSERT_GT(expected_transitions.size(), 4u) << "the sequence exercises the interface";
-  auto rows = ui->state_history("PENDANT.s_R.Status", 1000);
+  auto rows = ui->history("PENDANT.s_R.Status", 1000);
   ASSERT_TRUE(rows) << rows.error().message;
   std::vector<std::string> got;
   for (const auto& r : *rows) {
-    got.push_back(history_line(r.kind, r.outcome, r.event, r.from, r.to, r.root_origin, r.root_event));
+    got.push_back(history_line(std::string(to_string(r.kind)), r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome)),
+                               r.event, r.from, r.to, r.root ? r.root->origin : "", r.root ? r.root->event : ""));
   }
   ASSERT_GE(got.size(), expected.size());
   got.erase(got.begin(), got.end() - static_cast<std::ptrdiff_t>(expected.size()));  // the start-up records
@@ -371,7 +372,7 @@ TEST(MultiProcess, ReadsAreRefusedWithoutTheReadCredentialWhenTheCoordinatorHasO
     return anonymous != nullptr;
   }, 10000ms)) << sys.logs();
   for (auto refused : {anonymous->state_list("PENDANT").has_value(), anonymous->explain("PENDANT").has_value(),
-                       anonymous->event_history(5).has_value(), anonymous->state_history("PENDANT", 5).has_value()}) {
+                       anonymous->history("SYSTEM", 5, introspect::HistoryFilter::Events).has_value(), anonymous->history("PENDANT", 5).has_value()}) {
     EXPECT_FALSE(refused);
   }
   auto why = anonymous->state_list("PENDANT");
@@ -415,7 +416,7 @@ TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().code, ErrorCode::Denied) << r.error().message;
     EXPECT_FALSE(c->reset("SYSTEM", "test", "no token"));
-    EXPECT_FALSE(c->filter_inject("force_limit", {{50.0}}));
+    EXPECT_FALSE(c->inject("force_limit", {{50.0}}));
   }
   auto read_only = ui->generate("EVT_TRACKING_ERROR", "PENDANT.s_R.Status");
   ASSERT_FALSE(read_only);
@@ -435,7 +436,7 @@ TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {
   EXPECT_TRUE(anonymous->connection_list());
   EXPECT_TRUE(anonymous->service_list());
   EXPECT_TRUE(anonymous->event_list());
-  EXPECT_TRUE(anonymous->event_history(10));
+  EXPECT_TRUE(anonymous->history("SYSTEM", 10, introspect::HistoryFilter::Events));
 }
 
 TEST(MultiProcess, TheSupervisorDetectsAKilledCoordinatorAndItsRecovery) {
@@ -488,7 +489,7 @@ TEST(MultiProcess, AClientSeesErrorWhileItsProviderProcessIsKilledAndClearsWhenI
   EXPECT_LT(seen.count(), 1500) << "the default bound is 3 heartbeats (300 ms)";
   auto why = ui->explain("PENDANT");
   ASSERT_TRUE(why);
-  EXPECT_NE(causes(*why).find("EVT_COORDINATOR_LOST"), std::string::npos) << causes(*why);
+  EXPECT_NE(causes(why->conditions).find("EVT_COORDINATOR_LOST"), std::string::npos) << causes(why->conditions);
   EXPECT_NE(sys.ui->output().find("coordinator 'robot' lost"), std::string::npos) << sys.logs();
 
   sys.start_robot();
@@ -542,8 +543,8 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
       [](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A")); }, "PENDANT");
   EXPECT_TRUE(eventually([&] {
     auto why = ui->explain("PENDANT");
-    return why && causes(*why) == expected;
-  }, 10000ms)) << "after resync the ui holds exactly the robot's current roots\n" << causes(*ui->explain("PENDANT")) << sys.logs();
+    return why && causes(why->conditions) == expected;
+  }, 10000ms)) << "after resync the ui holds exactly the robot's current roots\n" << causes(ui->explain("PENDANT")->conditions) << sys.logs();
   EXPECT_NE(sys.ui->output().find("connected to IceStorm"), std::string::npos);
 
   ASSERT_TRUE(robot->generate("/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));

@@ -3,7 +3,8 @@
 //   IceStorm (scripts/start-icestorm on a free port), the robot coordinator of examples/robodoc
 //   (`safecass run --coordinator robot --allow-write`, the calm scenario of the console tests) and
 //   the viewer start; the ui coordinator is not running yet, so the page shows it unreachable;
-//   then ui starts and the page shows it answering (retried). A fault generated on the robot
+//   then ui starts and the page shows it answering (retried). A warning that lasts about a
+//   millisecond on the robot process shows in the page's transition list (pushed records). A fault generated on the robot
 //   process by `safecass console --ice --allow-write` shows as CONTROL (robot) and PENDANT (ui,
 //   the other process) in Error, pushed within 100 ms of the root transition (host clock), and
 //   clicking PENDANT gives the cause JR3.s_A EVT_FORCE_ERROR. The page clears it with a write
@@ -199,6 +200,24 @@ async function test() {
   await waitStatus(page, 'ui', '', 10000).catch(() => {});
   check(await statusOf(page, 'ui') === '', 'ui answers once its process runs (retried)');
   for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal at first`);
+
+  // A fault that lasts about a millisecond in another process (a warning raised and cleared by two
+  // requests back to back): the robot pushes both records, so both reach the transition list,
+  // although no state list fetched between them would have seen the warning.
+  const glitch = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--allow-write', '--token-file', robotToken,
+    '-c', 'event generate EVT_FORCE_HIGH JR3.s_A; event generate /EVT_FORCE_HIGH JR3.s_A']);
+  check(glitch.code === 0, `console: the glitch EVT_FORCE_HIGH then /EVT_FORCE_HIGH on JR3.s_A (exit ${glitch.code}) ${glitch.stderr}`);
+  const listedNow = (what) => page.waitForFunction((w) => [...document.querySelectorAll('#transitions li')]
+    .some((li) => li.textContent.includes('JR3.s_A') && li.textContent.includes(w)), what, { timeout: 5000 })
+    .then(() => true).catch(() => false);
+  check(await listedNow('Normal → Warning EVT_FORCE_HIGH'), 'the glitch\'s onset is in the transition list');
+  check(await listedNow('Warning → Normal /EVT_FORCE_HIGH'), 'the glitch\'s completion is in the transition list');
+  const lasted = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--json', '-c', 'state history JR3.s_A 10']);
+  const edges = lasted.stdout.split('\n').filter((l) => l.trim() !== '').map((l) => JSON.parse(l))
+    .filter((r) => r.kind === 'transition' && /EVT_FORCE_HIGH$/.test(r.event ?? ''));
+  const width = edges.length >= 2 ? edges[edges.length - 1].t - edges[edges.length - 2].t : null;
+  check(width !== null && width < 0.02, `the glitch lasted less than the 20 ms the states were once polled at (${width === null ? '?' : (width * 1000).toFixed(2)} ms)`);
+  check(await stateOf(page, 'JR3.s_A') === 'Normal', 'after the glitch JR3.s_A is Normal again');
 
   // A fault on the robot process, through the console: CONTROL (robot) and PENDANT (ui) turn Error.
   const firstUpdate = updates.length;  // (a coordinator joining may cause transient states before)

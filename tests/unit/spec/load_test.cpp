@@ -43,7 +43,7 @@ TEST(SpecDiagnostics, FormatLikeACompiler) {
 
 TEST(SpecDiagnostics, ConvertToOneLineJson) {
   const Diagnostic d{Diagnostic::Severity::Error, {"a.json", 3, 7}, "say \"x\"", "/a~1b"};
-  EXPECT_EQ(to_json(d), R"({"file": "a.json", "line": 3, "column": 7, "severity": "error", "message": "say \"x\"", "pointer": "/a~1b"})");
+  EXPECT_EQ(to_json(d), R"({"file":"a.json","line":3,"column":7,"severity":"error","message":"say \"x\"","pointer":"/a~1b"})");
 }
 
 TEST(SpecLoad, TheBaseComponentHasNoDiagnostic) {

@@ -59,7 +59,7 @@ TEST(SpecValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
   ASSERT_TRUE(first.value);
   EXPECT_EQ(first.value->find("line")->number, 4);
   EXPECT_EQ(first.value->find("severity")->string, "error");
-  EXPECT_EQ(lines[1], R"({"files": ["tests/data/bad_specs/unknown_key.json"], "errors": 1, "warnings": 0})");
+  EXPECT_EQ(lines[1], R"({"files":["tests/data/bad_specs/unknown_key.json"],"errors":1,"warnings":0})");
 }
 
 TEST(SpecSchemaCommand, PrintsTheSchema) {

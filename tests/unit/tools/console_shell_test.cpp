@@ -152,30 +152,25 @@ TEST(ConsoleShell, CompletionOffersCommandWordsThenTheBackendsNamesForEachArgume
   EXPECT_TRUE(calls.commands.empty()) << "completion runs no command";
 }
 
-TEST(ConsoleShell, ExplanationsPrintTheSameLineAndLeaveOutCountsTheyDoNotHave) {
+TEST(ConsoleShell, ExplanationsPrintOneLineEachWithEveryFieldInJsonAndSayWhenThereIsNone) {
   Explanation e;
   e.machine = "CONTROL.s_R.ForceData";
   e.event = "EVT_SERVICE_FAILURE";
   e.level = State::Error;
   e.severity = 200;
   e.mirror = true;
+  e.count = 3;
   e.root_event = "EVT_FORCE_ERROR";
   e.root_origin = "JR3.s_A";
   e.path = {"JR3.s_A", "JR3.s_S.ForceData", "CONTROL.s_R.ForceData"};
-  Out text;
-  console::print_explanations({e}, "CONTROL", "Error", false, false, text);
-  EXPECT_EQ(text.reply.out, to_string(e) + "\n");
-  Out remote;
-  console::print_explanations({e}, "CONTROL", "", true, false, remote);
-  EXPECT_EQ(remote.reply.out.find("\"count\""), std::string::npos) << remote.reply.out;
-  EXPECT_NE(remote.reply.out.find("\"root_origin\":\"JR3.s_A\""), std::string::npos) << remote.reply.out;
-  Out local;
-  console::print_explanations({e}, "CONTROL", "Error", true, true, local);
-  EXPECT_NE(local.reply.out.find("\"count\":0"), std::string::npos) << local.reply.out;
-  Out none;
-  console::print_explanations({}, "JR3", "Normal", false, false, none);
-  console::print_explanations({}, "JR3", "", false, false, none);
-  EXPECT_EQ(none.reply.out, "JR3 is Normal: no active condition\nJR3: no active condition\n");
+  const introspect::ExplainAnswer answer{"CONTROL", State::Error, {e}};
+  EXPECT_EQ(introspect::explain_text(answer, introspect::TimeFormat{}), to_string(e) + "\n")
+      << "simulated times read as the core's own line";
+  const std::string json = introspect::explain_json(answer);
+  EXPECT_NE(json.find("\"count\":3"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"root_origin\":\"JR3.s_A\""), std::string::npos) << json;
+  EXPECT_EQ(introspect::explain_text(introspect::ExplainAnswer{"JR3", State::Normal, {}}, introspect::TimeFormat{}),
+            "JR3 is Normal: no active condition\n");
 }
 
 TEST(ConsoleShell, ASampleFileIsReadLineByLineAndItsErrorsNameTheLine) {

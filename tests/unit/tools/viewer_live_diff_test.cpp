@@ -1,6 +1,6 @@
 // The network-free part of `safecass viewer --ice` (tools/viewer/live_diff.hpp): the rows of a
-// coordinator's state list, the picture built from them, the records of what changed between two
-// polls, and how the protocol pushes a live coordinator's status. The live system itself is
+// coordinator's state list (the read model's), the picture built from them, and how the protocol
+// pushes a live coordinator's status. The live system itself is
 // tested in tests/integration/viewer_ice/.
 
 #include <gmock/gmock.h>
@@ -12,6 +12,7 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/spec/json.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/viewer/in_process_source.hpp"
@@ -53,28 +54,29 @@ std::string str(const spec::JsonValue& object, std::string_view key) {
   return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
 }
 
-LiveRow* row(std::vector<LiveRow>& rows, std::string_view address) {
-  for (LiveRow& r : rows) {
-    if (r.address == address) return &r;
-  }
-  ADD_FAILURE() << "no row " << address;
-  static LiveRow none;
-  return &none;
+/// The read model's rows of a locally built coordinator (what a live one answers to state list).
+std::vector<introspect::StateRow> rows_of(LocalCoordinator& local) {
+  introspect::LocalQuery query(local.co, local.monitor, local.registry);
+  auto rows = query.state_list();
+  EXPECT_TRUE(rows.has_value());
+  return rows ? *rows : std::vector<introspect::StateRow>{};
 }
 
-TEST(ViewerLiveDiff, SkeletonRowsListEachLocalComponentThenItsMachinesAndServicesLikeStateList) {
+TEST(ViewerLiveDiff, TheRowsOfACoordinatorListEachLocalComponentThenItsMachinesAndServicesLikeStateList) {
   LocalCoordinator robot("robot");
-  const std::vector<LiveRow> rows = skeleton_rows(robot.co);
+  const std::vector<introspect::StateRow> rows = rows_of(robot);
   ASSERT_GE(rows.size(), 4u);
-  EXPECT_EQ(rows[0], (LiveRow{"JR3", "component", State::Normal, ""}));
-  EXPECT_EQ(rows[1], (LiveRow{"JR3.s_F", "s_F", State::Normal, ""}));
-  EXPECT_EQ(rows[2], (LiveRow{"JR3.s_A", "s_A", State::Normal, ""}));
+  using introspect::RowKind;
+  EXPECT_EQ(rows[0], (introspect::StateRow{"SYSTEM", RowKind::System, State::Normal, ""}));
+  EXPECT_EQ(rows[1], (introspect::StateRow{"JR3", RowKind::Component, State::Normal, ""}));
+  EXPECT_EQ(rows[2], (introspect::StateRow{"JR3.s_F", RowKind::Framework, State::Normal, ""}));
+  EXPECT_EQ(rows[3], (introspect::StateRow{"JR3.s_A", RowKind::Application, State::Normal, ""}));
   std::vector<std::string> components;
   bool required = false, service = false;
-  for (const LiveRow& r : rows) {
-    if (r.kind == "component") components.push_back(r.address);
-    required = required || (r.address == "CONTROL.s_R.ForceData" && r.kind == "s_R");
-    service = service || (r.address == "JR3.s_S.ForceData" && r.kind == "s_S");
+  for (const introspect::StateRow& r : rows) {
+    if (r.kind == RowKind::Component) components.push_back(r.address);
+    required = required || (r.address == "CONTROL.s_R.ForceData" && r.kind == RowKind::Required);
+    service = service || (r.address == "JR3.s_S.ForceData" && r.kind == RowKind::Service);
   }
   EXPECT_THAT(components, ElementsAre("JR3", "BMM", "CONTROL", "SERVO"));  // not PENDANT: the ui process
   EXPECT_TRUE(required);
@@ -90,7 +92,7 @@ TEST(ViewerLiveDiff, PictureFromRowsHasTheShapeOfTheInProcessPicture) {
   const SystemView whole = (*in_process)->view();
   for (const CoordinatorView& expected : whole.coordinators) {
     LocalCoordinator local(expected.name);
-    const CoordinatorView got = coordinator_view(expected.name, skeleton_rows(local.co));
+    const CoordinatorView got = coordinator_view(expected.name, rows_of(local));
     EXPECT_EQ(got.name, expected.name);
     EXPECT_TRUE(got.status.empty());
     ASSERT_EQ(got.components.size(), expected.components.size()) << expected.name;
@@ -109,13 +111,14 @@ TEST(ViewerLiveDiff, PictureFromRowsHasTheShapeOfTheInProcessPicture) {
 }
 
 TEST(ViewerLiveDiff, PictureTakesTheWorstComponentStateAndSkipsRowsItCannotPlace) {
-  const std::vector<LiveRow> rows = {
-      {"JR3", "component", State::Error, "EVT_FORCE_ERROR"},
-      {"JR3.s_A", "s_A", State::Error, "EVT_FORCE_ERROR"},
-      {"JR3.s_X", "bogus", State::Warning, "E"},       // unknown kind
-      {"BMM.s_F", "s_F", State::Warning, "E"},         // no BMM component row before it
-      {"SERVO", "component", State::Warning, "EVT_W"},
-      {"SERVO.s_S.Command", "s_S", State::Warning, ""},
+  using introspect::RowKind;
+  const std::vector<introspect::StateRow> rows = {
+      {"SYSTEM", RowKind::System, State::Error, ""},       // not a component
+      {"JR3", RowKind::Component, State::Error, "EVT_FORCE_ERROR"},
+      {"JR3.s_A", RowKind::Application, State::Error, "EVT_FORCE_ERROR"},
+      {"BMM.s_F", RowKind::Framework, State::Warning, "E"},  // no BMM component row before it
+      {"SERVO", RowKind::Component, State::Warning, "EVT_W"},
+      {"SERVO.s_S.Command", RowKind::Service, State::Warning, ""},
   };
   const CoordinatorView v = coordinator_view("robot", rows);
   EXPECT_EQ(v.state, State::Error);
@@ -127,80 +130,6 @@ TEST(ViewerLiveDiff, PictureTakesTheWorstComponentStateAndSkipsRowsItCannotPlace
   EXPECT_EQ(v.components[1].machines[0].kind, NodeKind::Service);
   EXPECT_EQ(v.components[1].machines[0].name, "Command");
   EXPECT_EQ(v.components[1].machines[0].state, State::Warning);
-}
-
-TEST(ViewerLiveDiff, UnchangedRowsGiveNoRecord) {
-  LocalCoordinator robot("robot");
-  const std::vector<LiveRow> rows = skeleton_rows(robot.co);
-  EXPECT_TRUE(diff_records(rows, rows, 1.0).empty());
-}
-
-TEST(ViewerLiveDiff, ChangedStatesGiveTransitionRecordsInTheHistoryFormat) {
-  LocalCoordinator robot("robot");
-  const std::vector<LiveRow> before = skeleton_rows(robot.co);
-  std::vector<LiveRow> after = before;
-  *row(after, "JR3") = {"JR3", "component", State::Error, "EVT_FORCE_ERROR"};
-  *row(after, "JR3.s_A") = {"JR3.s_A", "s_A", State::Error, "EVT_FORCE_ERROR"};
-  *row(after, "JR3.s_S.ForceData") = {"JR3.s_S.ForceData", "s_S", State::Error, ""};
-  const std::vector<std::string> records = diff_records(before, after, 12.5);
-  ASSERT_EQ(records.size(), 3u);
-  const spec::JsonValue component = parse(records[0]);
-  EXPECT_EQ(str(component, "kind"), "component-transition");
-  EXPECT_EQ(str(component, "component"), "JR3");
-  EXPECT_EQ(component.find("machine"), nullptr);
-  EXPECT_EQ(str(component, "event"), "EVT_FORCE_ERROR");
-  EXPECT_EQ(str(component, "from"), "Normal");
-  EXPECT_EQ(str(component, "to"), "Error");
-  EXPECT_DOUBLE_EQ(component.find("t")->number, 12.5);
-  const spec::JsonValue machine = parse(records[1]);
-  EXPECT_EQ(str(machine, "kind"), "transition");
-  EXPECT_EQ(str(machine, "component"), "JR3");
-  EXPECT_EQ(str(machine, "machine"), "JR3.s_A");
-  EXPECT_EQ(str(machine, "to"), "Error");
-  const spec::JsonValue service = parse(records[2]);
-  EXPECT_EQ(str(service, "machine"), "JR3.s_S.ForceData");
-  EXPECT_EQ(service.find("event"), nullptr);
-  for (const std::string& r : records) EXPECT_TRUE(listed_record(r)) << r;
-
-  // Back to Normal: the record names the event that was outstanding.
-  const std::vector<std::string> back = diff_records(after, before, 13.0);
-  ASSERT_EQ(back.size(), 3u);
-  const spec::JsonValue cleared = parse(back[1]);
-  EXPECT_EQ(str(cleared, "from"), "Error");
-  EXPECT_EQ(str(cleared, "to"), "Normal");
-  EXPECT_EQ(str(cleared, "event"), "EVT_FORCE_ERROR");
-}
-
-TEST(ViewerLiveDiff, ANewOutstandingEventInTheSameStateGivesARecordAndVanishedRowsGoBackToNormal) {
-  const std::vector<LiveRow> before = {{"JR3", "component", State::Error, "EVT_A"}, {"JR3.s_A", "s_A", State::Error, "EVT_A"},
-                                       {"BMM", "component", State::Warning, "EVT_W"}};
-  const std::vector<LiveRow> after = {{"JR3", "component", State::Error, "EVT_A"}, {"JR3.s_A", "s_A", State::Error, "EVT_B"}};
-  const std::vector<std::string> records = diff_records(before, after, 2.0);
-  ASSERT_EQ(records.size(), 2u);
-  const spec::JsonValue same = parse(records[0]);
-  EXPECT_EQ(str(same, "machine"), "JR3.s_A");
-  EXPECT_EQ(str(same, "event"), "EVT_B");
-  EXPECT_EQ(str(same, "from"), "Error");
-  EXPECT_EQ(str(same, "to"), "Error");
-  const spec::JsonValue gone = parse(records[1]);
-  EXPECT_EQ(str(gone, "component"), "BMM");
-  EXPECT_EQ(str(gone, "to"), "Normal");
-}
-
-TEST(ViewerLiveDiff, RowsOfARealTransitionInALocalCoordinatorGiveItsRecords) {
-  LocalCoordinator robot("robot");
-  const std::vector<LiveRow> before = skeleton_rows(robot.co);
-  ASSERT_TRUE(robot.co.generate("EVT_FORCE_ERROR", "JR3.s_A").has_value());
-  std::vector<LiveRow> after = skeleton_rows(robot.co);
-  EXPECT_EQ(row(after, "JR3.s_A")->state, State::Error);
-  EXPECT_EQ(row(after, "JR3.s_A")->outstanding, "EVT_FORCE_ERROR");
-  EXPECT_EQ(row(after, "CONTROL")->state, State::Error);  // through the required interface, same process
-  std::vector<std::string> addresses;
-  for (const std::string& r : diff_records(before, after, 1.0)) {
-    const spec::JsonValue v = parse(r);
-    addresses.push_back(v.find("machine") != nullptr ? str(v, "machine") : str(v, "component"));
-  }
-  EXPECT_THAT(addresses, ::testing::IsSupersetOf({"JR3", "JR3.s_A", "JR3.s_S.ForceData", "CONTROL", "CONTROL.s_R.ForceData"}));
 }
 
 TEST(ViewerLiveDiff, CoordinatorRecordNamesTheCoordinatorAndIsListed) {
@@ -238,7 +167,7 @@ public:
 TEST(ViewerLiveDiff, ProtocolShowsALiveCoordinatorsStatusInTheViewAndPushesItsChanges) {
   FakeSource source;
   source.v.system = "robodoc";
-  source.v.coordinators.push_back(coordinator_view("ui", {{"PENDANT", "component", State::Normal, ""}}));
+  source.v.coordinators.push_back(coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Normal, ""}}));
   source.v.coordinators.back().status = "unreachable";
   Protocol protocol(source, {});
   const spec::JsonValue view = parse(protocol.view_json());

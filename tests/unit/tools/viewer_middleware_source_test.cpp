@@ -83,12 +83,6 @@ TEST(ViewerMiddlewareSource, OpenRefusesBadArgumentsWithWhatIsWrong) {
   r = MiddlewareSource::open(o);
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("--token-file robot=/nonexistent/robot.token"));
-
-  o = options_for(closed_port());
-  o.poll = std::chrono::milliseconds(100);
-  r = MiddlewareSource::open(o);
-  ASSERT_FALSE(r.has_value());
-  EXPECT_THAT(r.error().message, HasSubstr("1 to 50 ms"));
 }
 
 TEST(ViewerMiddlewareSource, CoordinatorsThatDoNotAnswerAreShownUnreachableWithTheShapeOfTheSystemFile) {

@@ -5,17 +5,14 @@
 #include <memory>
 #include <optional>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::runner {
 
 namespace {
-std::string secs(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
+std::string secs(Time t) { return introspect::seconds_text(t); }
 
 /// "no X 'name'" with the nearest known name, if one is near.
 std::string unknown(const std::string& what, const std::string& name, const std::vector<std::string>& known) {

@@ -5,11 +5,16 @@
 #include <cstdio>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "safecass/filters/registry.hpp"
-#include "safecass/record/recorder.hpp"
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
+#include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer {
 
@@ -33,11 +38,8 @@ constexpr std::size_t kMaxPendingRecords = 100000;
 /// for long; the clock catches up over the next polls.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
 
-std::string seconds_text(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.3f", to_seconds(t));
-  return buf;
-}
+/// Seconds to the millisecond, in the confirmations of writes: "t=1.250".
+std::string seconds_text(Time t) { return fmt::format("{:.3f}", to_seconds(t)); }
 
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -60,9 +62,15 @@ struct InProcessSource::Impl {
   // Real-time driving: simulated time = base_sim + (wall - base_wall) * speed.
   std::chrono::steady_clock::time_point base_wall;
   Time base_sim{};
-  Coordinator::SubscriptionId subscription = 0;
+  std::unique_ptr<introspect::LocalQuery> query;  // what the source reads and writes through
+  std::unique_ptr<introspect::Subscription> following;  // the records, for take_records()
   std::vector<std::string> pending;
   std::uint64_t dropped = 0;
+
+  ~Impl() {
+    following.reset();  // before the query and the runner
+    query.reset();
+  }
 
   Coordinator& co() { return runner->coordinator(); }
   const Coordinator& co() const { return runner->coordinator(); }
@@ -89,9 +97,7 @@ struct InProcessSource::Impl {
 
 InProcessSource::InProcessSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 
-InProcessSource::~InProcessSource() {
-  if (impl_ && impl_->runner && impl_->subscription != 0) impl_->co().unsubscribe(impl_->subscription);
-}
+InProcessSource::~InProcessSource() = default;
 
 Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcessOptions& options) {
   if (!std::isfinite(options.speed) || options.speed <= 0.0 || options.speed > 1000.0) {
@@ -132,14 +138,22 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
     for (const auto& [name, components] : spec_coordinators) impl->coordinators.emplace_back(name, ids_of(components));
   }
 
+  introspect::LocalOptions local;
+  local.name = impl->system_name;
+  local.period = to_seconds(impl->tick);
+  local.scenario = options.scenario;
+  local.duration = to_seconds(impl->duration);
+  impl->query = std::make_unique<introspect::LocalQuery>(co, impl->runner->monitor(), impl->registry, local);
   Impl* self = impl.get();
-  impl->subscription = co.subscribe([self](const Record& r) {
+  auto following = impl->query->follow([self](const introspect::HistoryEntry& e) {
     if (self->pending.size() >= kMaxPendingRecords) {
       ++self->dropped;
       return;
     }
-    self->pending.push_back(record_to_json(r, self->co()));
+    self->pending.push_back(introspect::history_json(e));
   });
+  if (!following) return tl::unexpected(following.error());
+  impl->following = std::move(*following);
   impl->runner->advance_to(Time{0}, impl->result);
   impl->base_wall = std::chrono::steady_clock::now();
   impl->base_sim = Time{0};
@@ -165,47 +179,18 @@ double InProcessSource::now() const { return to_seconds(impl_->now()); }
 bool InProcessSource::running() const { return impl_->now() < impl_->duration; }
 
 SystemView InProcessSource::view() const {
-  const Coordinator& co = impl_->co();
   SystemView v;
   v.system = impl_->system_name;
   v.description = impl_->description;
   v.t = now();
   v.running = running();
   for (const auto& [name, ids] : impl_->coordinators) {
-    CoordinatorView cv;
-    cv.name = name;
+    std::vector<introspect::StateRow> rows;
     for (const ComponentId id : ids) {
-      ComponentView c;
-      c.name = std::string(co.component_name(id));
-      const StateSnapshot ext = co.extended(id);
-      c.state = ext.state;
-      if (ext.state != State::Normal && ext.outstanding != kNoEvent) c.outstanding = co.event(ext.outstanding).name;
-      auto machine = [&](MachineId m, NodeKind kind, std::string name_text) {
-        MachineView mv;
-        mv.address = co.address_of(m);
-        mv.kind = kind;
-        mv.name = std::move(name_text);
-        const StateSnapshot s = co.snapshot(m);
-        mv.state = s.state;
-        if (s.state != State::Normal && s.outstanding != kNoEvent) mv.outstanding = co.event(s.outstanding).name;
-        c.machines.push_back(std::move(mv));
-      };
-      machine(co.framework_machine(id), NodeKind::Framework, "s_F");
-      machine(co.application_machine(id), NodeKind::Application, "s_A");
-      for (const MachineId m : co.provided_machines(id)) machine(m, NodeKind::Provided, std::string(co.interface_name(m)));
-      for (const MachineId m : co.required_machines(id)) machine(m, NodeKind::Required, std::string(co.interface_name(m)));
-      const auto& provided = co.provided_machines(id);
-      for (std::uint32_t i = 0; i < provided.size(); ++i) {
-        MachineView mv;
-        mv.name = std::string(co.interface_name(provided[i]));
-        mv.address = c.name + ".s_S." + mv.name;
-        mv.kind = NodeKind::Service;
-        mv.state = co.service_state(id, i);
-        c.machines.push_back(std::move(mv));
-      }
-      cv.state = std::max(cv.state, c.state);
-      cv.components.push_back(std::move(c));
+      std::vector<introspect::StateRow> part = impl_->query->component_rows(id);
+      rows.insert(rows.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
     }
+    CoordinatorView cv = coordinator_view(name, rows);
     v.state = std::max(v.state, cv.state);
     v.coordinators.push_back(std::move(cv));
   }
@@ -216,7 +201,7 @@ std::vector<std::string> InProcessSource::take_records() {
   std::vector<std::string> out;
   out.swap(impl_->pending);
   if (impl_->dropped != 0) {
-    out.push_back("{\"kind\":\"overflow\",\"dropped\":" + std::to_string(impl_->dropped) + "}");
+    out.push_back(introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(impl_->dropped)).text());
     impl_->dropped = 0;
   }
   return out;
@@ -230,47 +215,40 @@ Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view add
     if (ids == nullptr) return fail(ErrorCode::NotFound, "no coordinator '" + std::string(name) + "'");
     std::vector<Explanation> all;
     for (const ComponentId id : *ids) {
-      const std::vector<Explanation> part = co.explain(Address{Address::Kind::Component, id});
-      all.insert(all.end(), part.begin(), part.end());
+      auto part = impl_->query->explain(co.component_name(id));
+      if (!part) return tl::unexpected(part.error());
+      all.insert(all.end(), part->conditions.begin(), part->conditions.end());
     }
     return all;
   }
-  return co.explain(address);
+  auto answer = impl_->query->explain(address);
+  if (!answer) return tl::unexpected(answer.error());
+  return std::move(answer->conditions);
 }
 
 Expected<std::string> InProcessSource::generate(std::string_view event, std::string_view target) {
-  if (auto r = impl_->co().generate(event, target); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->generate(event, target); !r) return tl::unexpected(r.error());
   return "generated " + std::string(event) + " on " + std::string(target) + " at t=" + seconds_text(impl_->now());
 }
 
 Expected<std::string> InProcessSource::broadcast(std::string_view event) {
-  if (auto r = impl_->co().broadcast(event); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->broadcast(event); !r) return tl::unexpected(r.error());
   return "broadcast " + std::string(event) + " at t=" + seconds_text(impl_->now());
 }
 
 Expected<std::string> InProcessSource::inject(const InjectRequest& request) {
-  Monitor& monitor = impl_->runner->monitor();
   if (request.samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
   const std::string n = std::to_string(request.samples.size()) + (request.samples.size() == 1 ? " sample" : " samples");
   if (!request.deep) {
-    if (monitor.find_filter(request.target) == nullptr) {
-      return fail(ErrorCode::NotFound, "no filter '" + request.target + "'");
-    }
-    if (auto r = monitor.inject_shallow(request.target, request.samples); !r) return tl::unexpected(r.error());
+    if (auto r = impl_->query->inject(request.target, request.samples); !r) return tl::unexpected(r.error());
     return "queued " + n + " into filter " + request.target + " at t=" + seconds_text(impl_->now());
   }
-  Signal* s = monitor.signals().find(request.target);
-  if (s == nullptr) return fail(ErrorCode::NotFound, "no signal '" + request.target + "' (signals are written Component.signal)");
-  if (request.samples.size() > s->buffer().capacity()) {
-    return fail(ErrorCode::InvalidArgument, n + " would overflow the history of '" + request.target + "' (" +
-                                                std::to_string(s->buffer().capacity()) + " samples): inject fewer at once");
-  }
-  if (auto r = monitor.inject_deep(request.target, request.samples, impl_->now()); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->inject_deep(request.target, request.samples); !r) return tl::unexpected(r.error());
   return "wrote " + n + " into signal " + request.target + " at t=" + seconds_text(impl_->now());
 }
 
 Expected<std::string> InProcessSource::reset(std::string_view target, std::string_view reason) {
-  if (auto r = impl_->co().reset(target, "viewer", reason); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->reset(target, "viewer", reason); !r) return tl::unexpected(r.error());
   return "reset " + std::string(target) + " at t=" + seconds_text(impl_->now()) + " (" + std::string(reason) + ")";
 }
 

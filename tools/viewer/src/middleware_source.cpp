@@ -8,12 +8,17 @@
 #include <thread>
 #include <utility>
 
+#include <fmt/format.h>
+
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/spec/load.hpp"
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer {
@@ -31,11 +36,8 @@ double host_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-std::string seconds_text(double t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.3f", t);
-  return buf;
-}
+/// Seconds to the millisecond, in the confirmations of writes.
+std::string seconds_text(double t) { return fmt::format("{:.3f}", t); }
 
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -58,13 +60,14 @@ struct MiddlewareLink {
   std::thread thread;
 
   // Shared with the thread; guarded by Impl::mutex.
-  std::vector<LiveRow> rows;
+  std::vector<introspect::StateRow> rows;
+  bool stale = true;  ///< records arrived since the rows were fetched: fetch them again
   std::string status = "connecting";
   bool tried = false;
   std::shared_ptr<RemoteClient> requests;
 
   // The server thread's copy, refreshed in poll().
-  std::vector<LiveRow> shown_rows;
+  std::vector<introspect::StateRow> shown_rows;
   std::string shown_status = "connecting";
 };
 
@@ -135,55 +138,82 @@ struct MiddlewareSource::Impl {
     return stop;
   }
 
-  /// The thread of one coordinator: connect, then poll its state list until stopped.
+  /// The thread of one coordinator: connect, follow its pushed records, and fetch its state list
+  /// once when it answers and again after each batch of records (never on a timer). Every
+  /// `retry` it checks that the coordinator still answers.
   void follow(MiddlewareLink& l) {
-    std::unique_ptr<RemoteClient> poller;
+    std::unique_ptr<RemoteClient> reader;
+    std::unique_ptr<introspect::Subscription> records;
     bool answered = false;
+    auto lose = [&](const std::string& why) {
+      records.reset();  // before the client it belongs to
+      reader.reset();
+      std::lock_guard lock(mutex);
+      l.requests.reset();
+      set_status(l, answered ? "lost" : "unreachable", why);
+      l.tried = true;
+    };
     while (!stopping()) {
-      if (!poller) {
-        // Two clients: `c` polls on this thread, `r` serves explain and writes for the server
-        // thread (a RemoteClient is used by one thread at a time).
+      if (!reader) {
+        // Two clients: `c` follows and fetches on this thread, `r` serves explain and writes for
+        // the server thread (a RemoteClient is used by one thread at a time).
         auto c = connect(l);
         Expected<std::unique_ptr<RemoteClient>> r =
             c ? connect(l) : Expected<std::unique_ptr<RemoteClient>>(tl::unexpected(c.error()));
         if (!c || !r) {
-          {
-            std::lock_guard lock(mutex);
-            set_status(l, answered ? "lost" : "unreachable", (!c ? c.error() : r.error()).message);
-            l.tried = true;
-          }
+          lose((!c ? c.error() : r.error()).message);
           wake.notify_all();
           if (!pause(options.retry)) return;
           continue;
         }
-        poller = std::move(*c);
+        reader = std::move(*c);
+        MiddlewareLink* link = &l;
+        auto sub = reader->follow([this, link](const introspect::HistoryEntry& e) {
+          std::lock_guard lock(mutex);
+          push(introspect::history_json(e));
+          link->stale = true;
+          ++version;
+          wake.notify_all();
+        });
+        if (!sub) {
+          lose(sub.error().message);
+          wake.notify_all();
+          if (!pause(options.retry)) return;
+          continue;
+        }
+        records = std::move(*sub);
         std::lock_guard lock(mutex);
         l.requests = std::shared_ptr<RemoteClient>(std::move(*r));
+        l.stale = true;
       }
-      auto answer = poller->state_list();
-      if (!answer) {
-        poller.reset();
+      {
         std::lock_guard lock(mutex);
-        l.requests.reset();
-        set_status(l, "lost", answer.error().message);
+        l.stale = false;
+      }
+      auto answer = reader->state_list();
+      if (!answer) {
+        lose(answer.error().message);
         continue;
       }
       answered = true;
-      std::vector<LiveRow> rows;
-      rows.reserve(answer->size());
-      for (middleware::StateRow& r : *answer) rows.push_back({std::move(r.address), std::move(r.kind), r.state, std::move(r.outstanding)});
       {
         std::lock_guard lock(mutex);
         set_status(l, "", {});
-        if (rows != l.rows) {
-          for (std::string& r : diff_records(l.rows, rows, host_seconds())) push(std::move(r));
-          l.rows = std::move(rows);
+        if (*answer != l.rows) {
+          l.rows = std::move(*answer);
           ++version;
         }
         l.tried = true;
       }
       wake.notify_all();
-      if (!pause(options.poll)) return;
+      // Wait for records (which make the rows stale) or for the next liveness check.
+      std::unique_lock lock(mutex);
+      const bool woken = wake.wait_for(lock, options.retry, [&] { return stop || l.stale; });
+      if (stop) return;
+      if (!woken) {
+        lock.unlock();
+        if (auto alive = reader->coordinator(); !alive) lose(alive.error().message);
+      }
     }
   }
 
@@ -239,9 +269,6 @@ MiddlewareSource::MiddlewareSource(std::unique_ptr<Impl> impl) : impl_(std::move
 MiddlewareSource::~MiddlewareSource() = default;
 
 Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const MiddlewareOptions& options) {
-  if (options.poll < std::chrono::milliseconds(1) || options.poll > std::chrono::milliseconds(50)) {
-    return fail(ErrorCode::InvalidArgument, "the poll period must be 1 to 50 ms");
-  }
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   auto ice = middleware::parse_ice_endpoint(options.ice);
@@ -273,7 +300,8 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
     if (auto r = spec::instantiate(system, *l->local, *l->monitor, name); !r) {
       return fail(r.error().code, "coordinator '" + name + "' of " + options.system + ": " + r.error().message);
     }
-    l->rows = skeleton_rows(*l->local);
+    introspect::LocalQuery skeleton(*l->local, *l->monitor, impl->registry);
+    l->rows = *skeleton.state_list();
     l->shown_rows = l->rows;
     names += (names.empty() ? "" : ", ") + name;
     impl->links.push_back(std::move(l));
@@ -327,7 +355,7 @@ void MiddlewareSource::poll() {
     m.pending.clear();
   }
   if (m.dropped != 0) {
-    m.taken.push_back("{\"kind\":\"overflow\",\"dropped\":" + std::to_string(m.dropped) + "}");
+    m.taken.push_back(introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(m.dropped)).text());
     m.dropped = 0;
   }
   if (m.version == m.shown_version) return;
@@ -377,7 +405,7 @@ Expected<std::vector<Explanation>> MiddlewareSource::explain(std::string_view ad
     if (!c) return tl::unexpected(c.error());
     auto part = (*c)->explain(a);
     if (!part) return tl::unexpected(part.error());
-    all.insert(all.end(), part->begin(), part->end());
+    all.insert(all.end(), part->conditions.begin(), part->conditions.end());
     return {};
   };
   if (address == "SYSTEM") {  // every coordinator that answers
@@ -451,8 +479,8 @@ Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
   }
   auto w = impl_->writer_of(*owner);
   if (!w) return tl::unexpected(w.error());
-  auto r = request.deep ? w->second->filter_dinject(request.target, request.samples)
-                        : w->second->filter_inject(request.target, request.samples);
+  auto r = request.deep ? w->second->inject_deep(request.target, request.samples)
+                        : w->second->inject(request.target, request.samples);
   if (!r) return tl::unexpected(r.error());
   return (request.deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + request.target +
          " (coordinator " + owner->name + ") at t=" + seconds_text(now());

@@ -7,6 +7,7 @@
 #include <set>
 #include <utility>
 
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/json.hpp"
 
 namespace safecass::viewer {
@@ -18,42 +19,17 @@ constexpr std::size_t kMaxSamples = 1000;     ///< samples in one injection
 constexpr std::size_t kMaxSampleSize = 64;    ///< doubles in one sample
 constexpr long long kTimeIntervalMs = 250;    ///< clock-only messages at most this often
 
-std::string quote(std::string_view s) { return spec::json_quote(s); }
+std::string quote(std::string_view s) { return introspect::json_string(s); }
 
-std::string number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string number(double v) { return introspect::json_number(v); }
 
-std::string seconds(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", v);
-  return buf;
-}
+/// Seconds with six decimals (the history-file format of times).
+std::string seconds(double v) { return introspect::json_seconds(seconds_to_time(v)); }
 
 std::string state_text(State s) { return quote(to_string(s)); }
 
-/// A JSON object written member by member.
-class Object {
-public:
-  Object& str(std::string_view key, std::string_view value) { return raw(key, quote(value)); }
-  Object& num(std::string_view key, double value) { return raw(key, number(value)); }
-  Object& integer(std::string_view key, long long value) { return raw(key, std::to_string(value)); }
-  Object& boolean(std::string_view key, bool value) { return raw(key, value ? "true" : "false"); }
-  Object& raw(std::string_view key, std::string_view json) {
-    text_ += text_.size() == 1 ? "" : ",";
-    text_ += quote(key);
-    text_ += ':';
-    text_ += json;
-    return *this;
-  }
-  std::string done() { return text_ + "}"; }
-
-private:
-  std::string text_ = "{";
-};
+/// The one JSON writer's object (introspect/json.hpp).
+using Object = introspect::JsonObject;
 
 template <class Range, class F>
 std::string array(const Range& items, F&& each) {
@@ -85,16 +61,16 @@ std::string view_to_json(const SystemView& v) {
     const std::string components = array(co.components, [](const ComponentView& c) {
       const std::string machines = array(c.machines, [](const MachineView& m) {
         return Object().str("address", m.address).str("kind", to_string(m.kind)).str("name", m.name)
-            .raw("state", state_text(m.state)).str("outstanding", m.outstanding).done();
+            .raw("state", state_text(m.state)).str("outstanding", m.outstanding).text();
       });
       return Object().str("name", c.name).str("address", c.name).raw("state", state_text(c.state))
-          .str("outstanding", c.outstanding).raw("machines", machines).done();
+          .str("outstanding", c.outstanding).raw("machines", machines).text();
     });
     return Object().str("name", co.name).str("address", "coordinator:" + co.name).raw("state", state_text(co.state))
-        .str("status", co.status).raw("components", components).done();
+        .str("status", co.status).raw("components", components).text();
   });
   return Object().str("system", v.system).str("description", v.description).raw("t", seconds(v.t))
-      .boolean("running", v.running).raw("state", state_text(v.state)).raw("coordinators", coordinators).done();
+      .boolean("running", v.running).raw("state", state_text(v.state)).raw("coordinators", coordinators).text();
 }
 
 std::string explanation_to_json(const Explanation& e) {
@@ -108,7 +84,7 @@ std::string explanation_to_json(const Explanation& e) {
   if (!e.signal.empty()) o.str("signal", e.signal).num("value", e.value).raw("sample_t", seconds(to_seconds(e.sample_time)));
   if (e.injected) o.boolean("injected", true);
   o.raw("path", array(e.path, [](const std::string& hop) { return quote(hop); }));
-  return o.done();
+  return o.text();
 }
 
 /// A request being checked: the parsed object, its echoed id and op, and the first error found.
@@ -123,7 +99,7 @@ std::string error_reply(const std::string& id, std::string_view op, std::string_
   o.str("type", "error");
   if (!id.empty()) o.raw("id", id);
   if (!op.empty()) o.str("op", op);
-  return o.str("error", message).done();
+  return o.str("error", message).text();
 }
 
 Object reply(const Request& r) {
@@ -211,7 +187,7 @@ std::string Protocol::view_json() const { return view_to_json(source_.view()); }
 std::string Protocol::hello() const {
   return Object().str("type", "hello").boolean("write", options_.allow_write)
       .integer("max_message", static_cast<long long>(options_.max_message)).raw("view", view_json())
-      .raw("recent", array(recent_, [](const std::string& r) { return r; })).done();
+      .raw("recent", array(recent_, [](const std::string& r) { return r; })).text();
 }
 
 std::string Protocol::update(long long now_ms) {
@@ -241,11 +217,11 @@ std::string Protocol::update(long long now_ms) {
   if (changed.size() > 2 || listed.size() > 2) {
     last_time_ms_ = now_ms;
     return Object().str("type", "update").raw("t", seconds(source_.now())).boolean("running", source_.running()).raw("states", changed)
-        .raw("records", listed).done();
+        .raw("records", listed).text();
   }
   if (now_ms - last_time_ms_ >= kTimeIntervalMs) {
     last_time_ms_ = now_ms;
-    return Object().str("type", "time").raw("t", seconds(source_.now())).boolean("running", source_.running()).done();
+    return Object().str("type", "time").raw("t", seconds(source_.now())).boolean("running", source_.running()).text();
   }
   return {};
 }
@@ -303,7 +279,7 @@ std::string Protocol::handle(std::string_view message) {
 
   if (r.op == "view") {
     if (problem = check_keys(object, {"id", "op"}); !problem.empty()) return error_reply(r.id, r.op, problem);
-    return reply(r).raw("view", view_json()).done();
+    return reply(r).raw("view", view_json()).text();
   }
   if (r.op == "explain") {
     std::string address;
@@ -316,7 +292,7 @@ std::string Protocol::handle(std::string_view message) {
     Object o = reply(r);
     o.str("address", address);
     if (it != states.end()) o.raw("state", state_text(it->second.first)).str("outstanding", it->second.second);
-    return o.raw("conditions", array(*conditions, explanation_to_json)).done();
+    return o.raw("conditions", array(*conditions, explanation_to_json)).text();
   }
   if (r.op == "generate" || r.op == "broadcast") {
     std::string event;
@@ -331,7 +307,7 @@ std::string Protocol::handle(std::string_view message) {
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
     auto done = broadcast ? source_.broadcast(event) : source_.generate(event, target);
     if (!done) return error_reply(r.id, r.op, done.error().message);
-    return reply(r).str("text", *done).done();
+    return reply(r).str("text", *done).text();
   }
   if (r.op == "inject") {
     InjectRequest request;
@@ -351,7 +327,7 @@ std::string Protocol::handle(std::string_view message) {
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
     auto done = source_.inject(request);
     if (!done) return error_reply(r.id, r.op, done.error().message);
-    return reply(r).str("text", *done).done();
+    return reply(r).str("text", *done).text();
   }
   if (r.op == "reset") {
     std::string target;
@@ -364,7 +340,7 @@ std::string Protocol::handle(std::string_view message) {
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
     auto done = source_.reset(target, reason);
     if (!done) return error_reply(r.id, r.op, done.error().message);
-    return reply(r).str("text", *done).done();
+    return reply(r).str("text", *done).text();
   }
   return error_reply(r.id, r.op, "unknown op '" + r.op + "' (view, explain, generate, broadcast, inject, reset)");
 }

@@ -8,8 +8,8 @@
 ///   auto client = RemoteClient::connect({.ice = *parse_ice_endpoint("127.0.0.1:4061"),
 ///                                        .coordinator = "robot", .token = token});
 ///   if (!client) { print(client.error().message); return; }
-///   auto states = (*client)->state_list("CONTROL");        // Expected<std::vector<StateRow>>
-///   auto why = (*client)->explain("PENDANT");               // Expected<std::vector<Explanation>>
+///   auto states = (*client)->state_list("CONTROL");        // Expected<std::vector<introspect::StateRow>>
+///   auto why = (*client)->explain("PENDANT");               // Expected<introspect::ExplainAnswer>
 ///   auto done = (*client)->generate("EVT_FORCE_ERROR", "JR3.s_A");  // a write: needs the token
 /// ```
 /// connect() finds the coordinator by listening to the heartbeats on IceStorm: the first one
@@ -29,6 +29,7 @@
 
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
+#include "safecass/introspect/query.hpp"
 #include "safecass/middleware/node.hpp"
 
 namespace safecass::middleware {
@@ -49,94 +50,52 @@ struct ClientOptions {
   std::chrono::milliseconds timeout{2000};
 };
 
-/// One machine, service or component state (`state list`).
-struct StateRow {
-  std::string address;
-  std::string kind;          ///< component, s_F, s_A, s_P, s_R, s_S
-  State state = State::Normal;
-  std::string outstanding;   ///< outstanding event, empty when Normal
-};
-
-/// One history record (`state history`, `event history`).
-struct HistoryRow {
-  std::uint64_t seq = 0;
-  Time time{};
-  std::string kind;          ///< event, transition, component-transition, reset, injection
-  std::string outcome;
-  std::string address;
-  std::string event;
-  State from = State::Normal, to = State::Normal, level = State::Normal;
-  bool mirror = false;
-  std::string root_event, root_origin;
-  std::string text;
-};
-
-struct FilterRow {
-  std::string name, type, target, execution, detection;
-  bool enabled = true, detected = false;
-  std::vector<std::string> inputs, outputs;
-};
-
-struct ParamRow {
-  std::string name, type, value, default_value, doc;
-};
-
-struct FilterDetails {
-  FilterRow filter;          ///< name empty when the answer describes a filter type
-  std::string doc;
-  std::uint64_t missed_samples = 0;
-  std::vector<ParamRow> params;
-};
-
-struct EventRow {
-  std::string name;
-  int severity = 0;
-  bool onset = true;
-  std::vector<std::string> transitions;
-  std::string completes;
-  bool latched = false;
-  std::string hazard, description;
-};
-
-struct ConnectionRow {
-  std::string required, provided;
-  bool remote = false;       ///< the provider runs in another process
-};
-
-struct ServiceRow {
-  std::string address;       ///< C.s_S.p
-  State state = State::Normal;
-  std::string propagate;     ///< Warning or Error
-  std::vector<std::string> depends_on;
-};
-
-class RemoteClient {
+/// The SystemQuery of one live coordinator process (the read model's remote implementation):
+/// every read is one request to the coordinator's Control object, answered by the coordinator's
+/// own LocalQuery, so it carries every field an in-process answer has. follow() subscribes to the
+/// coordinator's records on the events topic (pushed, never polled): each signed batch is
+/// checked against the keyring, records are delivered in order and once, and a gap in their
+/// sequence numbers (a lost message, a record too large for the bus) is filled from the
+/// coordinator's history (Control::recordsSince) before the records after it.
+class RemoteClient final : public introspect::SystemQuery {
 public:
   /// Errors: Io (IceStorm or the coordinator unreachable; no heartbeat from it within timeout).
   static Expected<std::unique_ptr<RemoteClient>> connect(ClientOptions options);
-  ~RemoteClient();
+  ~RemoteClient() override;
   RemoteClient(const RemoteClient&) = delete;
   RemoteClient& operator=(const RemoteClient&) = delete;
 
   /// The coordinator's name as it reports it.
   Expected<std::string> coordinator();
-  Expected<std::vector<StateRow>> state_list(const std::string& component = {});
-  Expected<std::vector<HistoryRow>> state_history(const std::string& address, int last = 20);
-  Expected<std::vector<FilterRow>> filter_list();
-  Expected<FilterDetails> filter_info(const std::string& name);
-  Expected<void> filter_inject(const std::string& filter, const std::vector<std::vector<double>>& samples);
-  Expected<void> filter_dinject(const std::string& signal, const std::vector<std::vector<double>>& samples);
-  /// `text`: one sample per line, numbers separated by spaces or commas ('#' comments).
+
+  std::string name() const override;
+  Expected<introspect::ClockInfo> clock() override;
+  Expected<std::vector<introspect::StateRow>> state_list(std::string_view component = {}) override;
+  Expected<std::vector<introspect::HistoryEntry>> history(std::string_view scope, std::size_t last,
+                                                          introspect::HistoryFilter filter = introspect::HistoryFilter::All) override;
+  Expected<std::vector<introspect::HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
+  Expected<std::vector<introspect::FilterRow>> filter_list() override;
+  Expected<introspect::FilterInfo> filter_info(std::string_view name) override;
+  Expected<std::vector<introspect::EventRow>> event_list() override;
+  Expected<std::vector<introspect::ConnectionRow>> connection_list() override;
+  Expected<std::vector<introspect::ServiceRow>> service_list() override;
+  Expected<introspect::ExplainAnswer> explain(std::string_view address) override;
+  Expected<introspect::Names> names() override;
+  /// Errors: Io (IceStorm cannot be reached to subscribe).
+  Expected<std::unique_ptr<introspect::Subscription>> follow(introspect::RecordSink sink) override;
+  Expected<void> generate(std::string_view event, std::string_view target) override;
+  Expected<void> broadcast(std::string_view event) override;
+  Expected<void> inject(std::string_view filter, const std::vector<std::vector<double>>& samples) override;
+  Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override;
+  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
+  /// `text`: one sample per line, numbers separated by spaces or commas ('#' comments), parsed by
+  /// the coordinator.
   Expected<void> filter_dinload(const std::string& signal, const std::string& text);
-  Expected<std::vector<EventRow>> event_list();
-  Expected<std::vector<HistoryRow>> event_history(int last = 20);
-  Expected<void> generate(const std::string& event, const std::string& target);
-  Expected<void> broadcast(const std::string& event);
-  Expected<std::vector<ConnectionRow>> connection_list();
-  Expected<std::vector<ServiceRow>> service_list();
-  Expected<void> reset(const std::string& target, const std::string& who, const std::string& why);
-  /// Each active condition at `address` with its root cause and hop path (Explanation::path).
-  Expected<std::vector<Explanation>> explain(const std::string& address);
+
+  /// Records refused on the events topic (unauthenticated, forged, replayed or malformed) since
+  /// connect(), and gaps filled from the coordinator's history.
+  std::uint64_t records_refused() const;
+  std::uint64_t gaps_filled() const;
 
   struct Impl;
 

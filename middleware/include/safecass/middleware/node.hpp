@@ -36,6 +36,7 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/spec/system.hpp"
 
 namespace safecass::middleware {
@@ -115,6 +116,11 @@ struct NodeOptions {
   TlsOptions tls;
   /// Accept an IceStorm or listening endpoint that is not loopback without TLS (docs/security.md).
   bool insecure = false;
+  /// How remote tools are told to read this coordinator's times (introspect::ClockInfo): the
+  /// host's monotonic clock (HostClock, shown as wall-clock time), or simulated time with its tick,
+  /// scenario and duration (a node over a scenario run, shown as scenario seconds). The name is
+  /// the node's.
+  introspect::LocalOptions clock{{}, introspect::TimeBase::Host, 0.0, {}, 0.0};
   /// Receives every log line (errors about bad messages, reconnections). Default: stderr.
   std::function<void(const std::string&)> log;
 };

@@ -79,7 +79,7 @@ using JsonElementHandler = std::function<void(std::size_t index, JsonValue&& ele
 JsonParse parse_json_streaming(std::string_view text, std::string_view key, const JsonElementHandler& element,
                                int max_depth = 64);
 
-/// Escapes a string for a JSON document (quotes included).
+/// Escapes a string for a JSON document (quotes included): introspect::json_string, the one escaper.
 std::string json_quote(std::string_view text);
 
 }  // namespace safecass::spec

@@ -5,9 +5,13 @@
 /// the middleware, one connection per coordinator. Built only with the middleware (ZeroC Ice).
 ///
 /// Each coordinator has a thread of its own that connects (finding the coordinator by its
-/// heartbeat on IceStorm), asks it for its state list every `poll` and turns the differences into
-/// records (live_diff.hpp); the server thread takes them in poll(), which never waits on the
-/// network. A coordinator that does not answer is shown with the status "unreachable" (never
+/// heartbeat on IceStorm) and follows the records the coordinator pushes on the events topic
+/// (RemoteClient::follow: signed, in order, gaps filled from its history by sequence number), so
+/// every transition reaches the page, however short; it fetches the coordinator's state list
+/// (the read model's rows) when it first answers and again after each batch of records, never on a
+/// timer. The server thread takes the records in poll(), which never waits on the network. Every
+/// `retry` without records the thread checks that the coordinator still answers. A coordinator
+/// that does not answer is shown with the status "unreachable" (never
 /// answered) or "lost" (answered before), keeps its last known states, and is tried again every
 /// `retry`. Clicking a state (explain) and the write operations go to the coordinator that owns
 /// the target through a second connection of that coordinator, with the request timeout
@@ -37,9 +41,8 @@ struct MiddlewareOptions {
   std::string tls_dir;                          ///< mutual TLS (ca.pem, console.pem/.key); empty: TCP
   /// Coordinator name → its read credential file (`safecass run ... --read-token-file`).
   std::map<std::string, std::string> read_token_files;
-  std::chrono::milliseconds poll{20};           ///< state-list period per coordinator, 1..50 ms
   std::chrono::milliseconds timeout{1500};      ///< one request; also the wait for a heartbeat
-  std::chrono::milliseconds retry{500};         ///< pause before trying an unreachable coordinator again
+  std::chrono::milliseconds retry{500};         ///< pause before trying an unreachable coordinator again; liveness check period
   std::chrono::milliseconds first_wait{3000};   ///< open() waits at most this for every first answer
 };
 
@@ -48,8 +51,8 @@ public:
   /// Loads the system file, reads the token files and starts one thread per coordinator; waits
   /// (at most `first_wait`) until every coordinator has answered or failed once. Coordinators that
   /// do not answer are not an error. Errors: Parse (--ice, the system file: every diagnostic),
-  /// InvalidArgument (a system without coordinators, a token file for an unknown coordinator,
-  /// poll outside 1..50 ms), Io (a token file that cannot be read).
+  /// InvalidArgument (a system without coordinators, a token file for an unknown coordinator),
+  /// Io (a token file that cannot be read).
   static Expected<std::unique_ptr<MiddlewareSource>> open(const MiddlewareOptions& options);
   /// Stops the threads (each finishes its request in progress, at most `timeout`).
   ~MiddlewareSource() override;

@@ -1,0 +1,64 @@
+#pragma once
+/// @file local_query.hpp
+/// LocalQuery: the SystemQuery of a system in this process, over its Coordinator, Monitor and
+/// FilterRegistry. The only place where the facts of the read model are derived from the core:
+/// the row order of `state list`, the shape of a history record, the service formulas.
+///
+/// Reads take the coordinator's lock briefly (its introspection calls) and allocate; they never
+/// run on the hot path. follow() converts each record on the thread that produced it.
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+#include "safecass/introspect/query.hpp"
+
+namespace safecass::introspect {
+
+struct LocalOptions {
+  std::string name;  ///< what name() answers (default: the coordinator's name)
+  /// Simulated (in-process runs) or Host (a live coordinator process on HostClock).
+  TimeBase base = TimeBase::Simulated;
+  double period = 0.0;        ///< Simulated: the tick, seconds
+  std::string scenario;       ///< Simulated: the scenario file, if any
+  double duration = 0.0;      ///< Simulated: the scenario's duration, seconds
+};
+
+class LocalQuery final : public SystemQuery {
+public:
+  /// `co`, `monitor` and `registry` must outlive the query.
+  LocalQuery(Coordinator& co, Monitor& monitor, const FilterRegistry& registry, LocalOptions options = {});
+
+  std::string name() const override;
+  Expected<ClockInfo> clock() override;
+  Expected<std::vector<StateRow>> state_list(std::string_view component = {}) override;
+  Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last, HistoryFilter filter) override;
+  Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
+  Expected<std::vector<FilterRow>> filter_list() override;
+  Expected<FilterInfo> filter_info(std::string_view name) override;
+  Expected<std::vector<EventRow>> event_list() override;
+  Expected<std::vector<ConnectionRow>> connection_list() override;
+  Expected<std::vector<ServiceRow>> service_list() override;
+  Expected<ExplainAnswer> explain(std::string_view address) override;
+  Expected<Names> names() override;
+  Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) override;
+  Expected<void> generate(std::string_view event, std::string_view target) override;
+  Expected<void> broadcast(std::string_view event) override;
+  Expected<void> inject(std::string_view filter, const std::vector<std::vector<double>>& samples) override;
+  Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override;
+  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
+
+  /// The rows of one component (its extended state, s_F, s_A, each s_P, s_R and s_S), in the
+  /// order of state_list(). For tools that show a coordinator before it answers.
+  std::vector<StateRow> component_rows(ComponentId id) const;
+
+private:
+  Coordinator& co_;
+  Monitor& monitor_;
+  const FilterRegistry& registry_;
+  LocalOptions options_;
+};
+
+}  // namespace safecass::introspect

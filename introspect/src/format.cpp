@@ -1,0 +1,437 @@
+#include "safecass/introspect/format.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+#include <fmt/format.h>
+#include <variant>
+
+#include "safecass/introspect/json.hpp"
+
+namespace safecass::introspect {
+
+namespace {
+
+std::string state_text(State s) { return std::string(to_string(s)); }
+
+/// "%g": the six significant digits explanations have always shown.
+std::string short_number(double v) { return fmt::format("{:g}", v); }
+
+/// A sample value in a history line: a number, or "nan"/"inf"/"-inf" as a string.
+std::string sample_json(double v) {
+  if (std::isnan(v)) return "\"nan\"";
+  if (std::isinf(v)) return v > 0 ? "\"inf\"" : "\"-inf\"";
+  return json_number(v);
+}
+
+std::string joined(const std::vector<std::string>& items, std::string_view separator) {
+  std::string out;
+  for (const std::string& s : items) {
+    if (!out.empty()) out += separator;
+    out += s;
+  }
+  return out;
+}
+
+std::vector<std::string> names_of(const std::vector<SignalRef>& signals) {
+  std::vector<std::string> out;
+  for (const SignalRef& s : signals) out.push_back(s.name);
+  return out;
+}
+
+std::string propagates_text(State level) { return level == State::Warning ? "Warning and Error" : "Error"; }
+
+std::string range_text(const ParamRow& p) {
+  if (p.type == ParamType::Choice) return joined(p.choices, "|");
+  if (p.type != ParamType::Number && p.type != ParamType::Integer) return {};
+  const bool low = p.min > -1e299;
+  const bool high = p.max < 1e299;
+  if (!low && !high) return {};
+  return "[" + (low ? number_text(p.min) : std::string("-inf")) + ", " + (high ? number_text(p.max) : std::string("+inf")) + "]";
+}
+
+std::string default_text(const ParamRow& p) {
+  if (p.default_value) return param_text(*p.default_value);
+  return p.optional ? "(optional)" : "(required)";
+}
+
+std::string event_kind(const EventRow& e) { return e.broadcast ? "broadcast" : e.onset ? "onset" : "completion"; }
+
+}  // namespace
+
+// ---- times and numbers ------------------------------------------------------------------------
+
+std::string iso8601_local(std::int64_t unix_ns) {
+  std::int64_t secs = unix_ns / 1'000'000'000;
+  std::int64_t rest = unix_ns % 1'000'000'000;
+  if (rest < 0) {
+    rest += 1'000'000'000;
+    --secs;
+  }
+  const std::time_t tt = static_cast<std::time_t>(secs);
+  std::tm tm{};
+  localtime_r(&tt, &tm);
+  const long offset = tm.tm_gmtoff;
+  const long off = offset < 0 ? -offset : offset;
+  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}{}{:02}:{:02}", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
+                     tm.tm_hour, tm.tm_min, tm.tm_sec, rest / 1'000'000, offset < 0 ? '-' : '+', off / 3600, (off % 3600) / 60);
+}
+
+std::string seconds_text(Time t) { return json_seconds(t); }
+
+std::string number_text(double v) { return fmt::format("{:.9g}", v); }
+
+std::string TimeFormat::at(Time t) const {
+  if (base_ == TimeBase::Simulated) return "t=" + seconds_text(t);
+  return iso8601_local(t.count() + wall_offset_ns_);
+}
+
+std::string TimeFormat::stamp(Time t) const {
+  if (base_ == TimeBase::Simulated) return seconds_text(t) + " s";
+  return iso8601_local(t.count() + wall_offset_ns_);
+}
+
+std::string columns(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> width;
+  for (const auto& r : rows) {
+    if (r.size() > width.size()) width.resize(r.size(), 0);
+    for (std::size_t i = 0; i + 1 < r.size(); ++i) width[i] = std::max(width[i], r[i].size());
+  }
+  std::string out;
+  for (const auto& r : rows) {
+    std::string line;
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      line += r[i];
+      if (i + 1 < r.size()) line += std::string(width[i] - r[i].size() + 2, ' ');
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
+}
+
+std::string transitions_text(const std::vector<Transition>& transitions) {
+  std::string out;
+  for (const Transition t : transitions) out += (out.empty() ? "" : ",") + std::string(to_string(t));
+  return out;
+}
+
+std::string param_text(const ParamValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return number_text(x);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return x;
+        } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+          return "[" + joined(x, ", ") + "]";
+        } else {
+          std::vector<std::string> items;
+          for (const double d : x) items.push_back(number_text(d));
+          return "[" + joined(items, ", ") + "]";
+        }
+      },
+      v);
+}
+
+std::string param_json(const ParamValue& v) {
+  return std::visit(
+      [](const auto& x) -> std::string {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, double>) {
+          return json_number(x);
+        } else if constexpr (std::is_same_v<T, bool>) {
+          return x ? "true" : "false";
+        } else if constexpr (std::is_same_v<T, std::string>) {
+          return json_string(x);
+        } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
+          return json_string_array(x);
+        } else {
+          return json_number_array(x);
+        }
+      },
+      v);
+}
+
+// ---- history ----------------------------------------------------------------------------------
+
+std::string history_text(const HistoryEntry& e, const TimeFormat& time) {
+  std::string out = time.at(e.time) + "  " + std::string(e.where());
+  switch (e.kind) {
+    case RecordKind::Transition:
+    case RecordKind::ComponentTransition:
+      out += "  " + state_text(e.from) + " -> " + state_text(e.to);
+      if (!e.event.empty()) out += "  " + e.event;
+      break;
+    case RecordKind::Event: out += "  " + std::string(to_string(e.outcome)) + " " + e.event; break;
+    case RecordKind::Reset: out += "  reset"; break;
+    case RecordKind::Injection: out += "  injection"; break;
+  }
+  if (e.root) {
+    const RootEntry& r = *e.root;
+    if (!(r.origin == e.machine && r.event == e.event)) out += "  <- " + r.origin + ":" + r.event;
+    if (!r.filter.empty() || !r.signal.empty()) {
+      out += "  [";
+      if (!r.filter.empty()) out += "filter " + r.filter;
+      if (!r.signal.empty()) out += ", " + r.signal + " = " + number_text(r.value);
+      if (r.injected) out += ", injected";
+      out += "]";
+    }
+  }
+  if (!e.text.empty()) out += "  (" + e.text + ")";
+  return out;
+}
+
+std::string history_json(const HistoryEntry& e) {
+  JsonObject j;
+  j.integer("seq", static_cast<long long>(e.seq)).seconds("t", e.time).str("kind", to_string(e.kind));
+  if (e.outcome != Outcome::None) j.str("outcome", to_string(e.outcome));
+  if (!e.component.empty()) j.str("component", e.component);
+  if (!e.machine.empty()) j.str("machine", e.machine);
+  if (!e.event.empty()) j.str("event", e.event);
+  if (e.kind != RecordKind::Injection) j.str("from", to_string(e.from)).str("to", to_string(e.to));
+  if (e.kind == RecordKind::Event) j.str("level", to_string(e.level)).integer("severity", e.severity);
+  if (e.mirror) j.boolean("mirror", true);
+  if (e.root) {
+    const RootEntry& r = *e.root;
+    JsonObject root;
+    root.str("event", r.event).str("origin", r.origin).seconds("t", r.time);
+    if (!r.filter.empty()) root.str("filter", r.filter);
+    if (!r.signal.empty()) root.str("signal", r.signal).raw("value", sample_json(r.value)).seconds("sample_t", r.sample_time);
+    if (r.injected) root.boolean("injected", true);
+    j.raw("root", root.text());
+  }
+  if (!e.text.empty()) j.str("text", e.text);
+  return j.text();
+}
+
+bool shown_while_watching(const HistoryEntry& e) noexcept {
+  return e.kind == RecordKind::Transition || e.kind == RecordKind::Reset || e.kind == RecordKind::Injection ||
+         (e.kind == RecordKind::Event && (e.outcome == Outcome::Masked || e.outcome == Outcome::Ignored));
+}
+
+// ---- explanations -----------------------------------------------------------------------------
+
+std::string explanation_text(const Explanation& e, const TimeFormat& time) {
+  std::string out = e.machine + ": " + state_text(e.level) + " " + e.event + " (severity " + std::to_string(e.severity) + ")";
+  if (e.mirror) out += " <- " + e.root_origin + ":" + e.root_event;
+  out += " since " + time.stamp(e.root_time);
+  if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
+  if (!e.filter.empty() || !e.signal.empty()) {
+    out += " [";
+    if (!e.filter.empty()) out += "filter " + e.filter;
+    if (!e.signal.empty()) {
+      if (!e.filter.empty()) out += ", ";
+      out += e.signal + " = " + short_number(e.value) + " at " + time.stamp(e.sample_time);
+    }
+    if (e.injected) out += ", injected";
+    out += "]";
+  }
+  if (e.path.size() > 1) out += " path " + joined(e.path, " -> ");
+  return out;
+}
+
+std::string explanation_json(const std::string& address, const Explanation& e) {
+  JsonObject j;
+  j.str("address", address).str("machine", e.machine).str("event", e.event).str("level", to_string(e.level))
+      .integer("severity", e.severity).boolean("mirror", e.mirror).boolean("outstanding", e.outstanding)
+      .integer("count", e.count).num("first", to_seconds(e.first)).num("last", to_seconds(e.last))
+      .str("root_event", e.root_event).str("root_origin", e.root_origin).num("root_t", to_seconds(e.root_time))
+      .opt("hazard", e.hazard);
+  if (!e.filter.empty()) j.str("filter", e.filter);
+  if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
+  if (e.injected) j.boolean("injected", true);
+  return j.strings("path", e.path).text();
+}
+
+std::string explain_text(const ExplainAnswer& a, const TimeFormat& time) {
+  std::string out;
+  for (const Explanation& e : a.conditions) out += explanation_text(e, time) + "\n";
+  if (a.conditions.empty()) out = a.address + " is " + state_text(a.state) + ": no active condition\n";
+  return out;
+}
+
+std::string explain_json(const ExplainAnswer& a) {
+  std::string out;
+  for (const Explanation& e : a.conditions) out += explanation_json(a.address, e) + "\n";
+  return out;
+}
+
+// ---- lists ------------------------------------------------------------------------------------
+
+std::string state_list_text(const std::vector<StateRow>& rows) {
+  std::vector<std::vector<std::string>> table;
+  for (const StateRow& r : rows) {
+    const bool top = r.kind == RowKind::System || r.kind == RowKind::Component;
+    table.push_back({(top ? "" : "  ") + r.address, state_text(r.state), r.outstanding.empty() ? "-" : r.outstanding});
+  }
+  return columns(table);
+}
+
+std::string state_list_json(const std::vector<StateRow>& rows) {
+  std::string out;
+  for (const StateRow& r : rows) {
+    out += JsonObject().str("address", r.address).str("kind", to_string(r.kind)).str("state", to_string(r.state))
+               .opt("outstanding", r.outstanding).text() + "\n";
+  }
+  return out;
+}
+
+std::string filter_list_text(const std::vector<FilterRow>& rows) {
+  if (rows.empty()) return "no filters\n";
+  std::vector<std::vector<std::string>> table;
+  for (const FilterRow& f : rows) {
+    std::string signals = joined(names_of(f.inputs), ",");
+    if (!f.outputs.empty()) signals += " -> " + joined(names_of(f.outputs), ",");
+    table.push_back({f.name, f.type, f.target.empty() ? "-" : f.target, f.active ? "ACTIVE" : "PASSIVE", f.edge ? "EDGE" : "LEVEL",
+                     f.enabled ? "enabled" : "disabled", f.detected ? "DETECTED" : "-", signals});
+  }
+  return columns(table);
+}
+
+std::string filter_list_json(const std::vector<FilterRow>& rows) {
+  std::string out;
+  for (const FilterRow& f : rows) {
+    out += JsonObject().str("filter", f.name).str("type", f.type).str("target", f.target.empty() ? "-" : f.target)
+               .str("execution", f.active ? "ACTIVE" : "PASSIVE").str("detection", f.edge ? "EDGE" : "LEVEL")
+               .boolean("enabled", f.enabled).boolean("detected", f.detected).strings("inputs", names_of(f.inputs))
+               .strings("outputs", names_of(f.outputs)).text() + "\n";
+  }
+  return out;
+}
+
+std::string filter_info_text(const FilterInfo& info) {
+  std::string out;
+  auto line = [&out](const std::string& s) { out += s + "\n"; };
+  auto sized = [](const std::vector<SignalRef>& signals) {
+    std::vector<std::string> items;
+    for (const SignalRef& s : signals) items.push_back(s.name + " (size " + std::to_string(s.size) + ")");
+    return items.empty() ? std::string("-") : joined(items, ", ");
+  };
+  if (info.filter) {
+    const FilterRow& f = *info.filter;
+    line("filter " + f.name + ": " + info.type + " - " + info.doc);
+    line("  target " + (f.target.empty() ? std::string("-") : f.target) + ", " + (f.active ? "ACTIVE" : "PASSIVE") + ", " +
+         (f.edge ? "EDGE" : "LEVEL"));
+    line(std::string("  ") + (f.enabled ? "enabled" : "disabled") + ", " +
+         (f.detected ? "detected (onset sent, no completion yet)" : "not detected") + ", " +
+         std::to_string(info.missed_samples) + " missed samples");
+    line("  inputs:  " + sized(f.inputs));
+    line("  outputs: " + sized(f.outputs));
+  } else {
+    line("filter type " + info.type + ": " + info.doc);
+    line("  inputs:  " + (info.inputs.empty() ? std::string("-") : joined(info.inputs, ", ")));
+    line("  outputs: " + (info.outputs.empty() ? std::string("-") : joined(info.outputs, ", ")));
+  }
+  line("  parameters:");
+  std::vector<std::vector<std::string>> rows;
+  rows.push_back({"    name", "type", info.filter ? "value" : "", "default", "range", "doc"});
+  for (const ParamRow& p : info.params) {
+    const std::string value = info.filter ? (p.value ? param_text(*p.value) : std::string("-")) : std::string();
+    const std::string range = range_text(p);
+    rows.push_back({"    " + p.name, std::string(to_string(p.type)), value, default_text(p), range.empty() ? "-" : range, p.doc});
+  }
+  if (!info.filter) {
+    for (auto& r : rows) r.erase(r.begin() + 2);
+  }
+  return out + columns(rows);
+}
+
+std::string filter_info_json(const FilterInfo& info) {
+  JsonObject head;
+  head.opt("filter", info.filter ? info.filter->name : std::string()).str("type", info.type).str("doc", info.doc)
+      .strings("inputs", info.inputs).strings("outputs", info.outputs).boolean("generates_events", info.generates_events);
+  if (info.filter) {
+    const FilterRow& f = *info.filter;
+    head.str("target", f.target).str("execution", f.active ? "ACTIVE" : "PASSIVE").str("detection", f.edge ? "EDGE" : "LEVEL")
+        .boolean("enabled", f.enabled).boolean("detected", f.detected)
+        .integer("missed_samples", static_cast<long long>(info.missed_samples))
+        .strings("input_signals", names_of(f.inputs)).strings("output_signals", names_of(f.outputs));
+  }
+  std::string out = head.text() + "\n";
+  for (const ParamRow& p : info.params) {
+    JsonObject j;
+    j.str("param", p.name).str("type", to_string(p.type)).raw("default", p.default_value ? param_json(*p.default_value) : "null")
+        .boolean("required", !p.default_value && !p.optional);
+    if (p.type == ParamType::Number || p.type == ParamType::Integer) {
+      j.raw("min", p.min > -1e299 ? json_number(p.min) : "null").raw("max", p.max < 1e299 ? json_number(p.max) : "null");
+    }
+    if (p.type == ParamType::Choice) j.strings("choices", p.choices);
+    if (info.filter) j.raw("value", p.value ? param_json(*p.value) : "null");
+    out += j.str("doc", p.doc).text() + "\n";
+  }
+  return out;
+}
+
+std::string event_list_text(const std::vector<EventRow>& rows) {
+  std::vector<std::vector<std::string>> table;
+  for (const EventRow& e : rows) {
+    std::string extra;
+    if (!e.counterpart.empty()) extra += (e.onset ? "cleared by " : "clears ") + e.counterpart;
+    if (e.latched) extra += (extra.empty() ? "" : ", ") + std::string("latched");
+    if (e.framework) extra += (extra.empty() ? "" : ", ") + std::string("framework");
+    if (!e.hazard.empty()) extra += (extra.empty() ? "" : ", ") + std::string("hazard ") + e.hazard;
+    if (!e.description.empty()) extra += (extra.empty() ? "" : " - ") + e.description;
+    table.push_back({e.name, std::to_string(e.severity), event_kind(e), transitions_text(e.transitions), extra});
+  }
+  return columns(table);
+}
+
+std::string event_list_json(const std::vector<EventRow>& rows) {
+  std::string out;
+  for (const EventRow& e : rows) {
+    out += JsonObject().str("event", e.name).integer("severity", e.severity).str("kind", event_kind(e))
+               .str("transitions", transitions_text(e.transitions)).opt(e.onset ? "completion" : "completes", e.counterpart)
+               .boolean("latched", e.latched).boolean("framework", e.framework).opt("hazard", e.hazard)
+               .opt("description", e.description).text() + "\n";
+  }
+  return out;
+}
+
+std::string connection_list_text(const std::vector<ConnectionRow>& rows) {
+  if (rows.empty()) return "no connections\n";
+  std::vector<std::vector<std::string>> table;
+  for (const ConnectionRow& k : rows) {
+    table.push_back({k.required, "->", k.provided, "s_R " + (k.required_state ? state_text(*k.required_state) : std::string("?")),
+                     k.service_state ? "s_S " + state_text(*k.service_state) : std::string("s_S ? (in another process)"),
+                     k.propagate ? "propagates " + propagates_text(*k.propagate) : std::string("remote provider")});
+  }
+  return columns(table);
+}
+
+std::string connection_list_json(const std::vector<ConnectionRow>& rows) {
+  std::string out;
+  for (const ConnectionRow& k : rows) {
+    JsonObject j;
+    j.str("required", k.required).str("provided", k.provided);
+    if (k.required_state) j.str("required_state", to_string(*k.required_state)); else j.null("required_state");
+    if (k.service_state) j.str("service_state", to_string(*k.service_state)); else j.null("service_state");
+    if (k.propagate) j.str("propagates", to_string(*k.propagate)); else j.null("propagates");
+    out += j.boolean("remote", k.remote).text() + "\n";
+  }
+  return out;
+}
+
+std::string service_list_text(const std::vector<ServiceRow>& rows) {
+  if (rows.empty()) return "no provided interfaces\n";
+  std::vector<std::vector<std::string>> table;
+  for (const ServiceRow& s : rows) {
+    table.push_back({s.address, state_text(s.state), "= " + joined(s.depends_on, " * "), "(propagates " + propagates_text(s.propagate) + ")"});
+  }
+  return columns(table);
+}
+
+std::string service_list_json(const std::vector<ServiceRow>& rows) {
+  std::string out;
+  for (const ServiceRow& s : rows) {
+    out += JsonObject().str("service", s.address).str("state", to_string(s.state)).strings("depends_on", s.depends_on)
+               .str("propagates", to_string(s.propagate)).text() + "\n";
+  }
+  return out;
+}
+
+}  // namespace safecass::introspect

@@ -1,0 +1,88 @@
+#include "safecass/introspect/json.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace safecass::introspect {
+
+void append_json_string(std::string& out, std::string_view text) {
+  static constexpr char kHex[] = "0123456789abcdef";
+  out += '"';
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\r': out += "\\r"; break;
+      case '\t': out += "\\t"; break;
+      default: {
+        const auto u = static_cast<unsigned char>(c);
+        if (u < 0x20) {
+          out += "\\u00";
+          out += kHex[u >> 4];
+          out += kHex[u & 0xf];
+        } else {
+          out += c;
+        }
+      }
+    }
+  }
+  out += '"';
+}
+
+std::string json_string(std::string_view text) {
+  std::string out;
+  out.reserve(text.size() + 2);
+  append_json_string(out, text);
+  return out;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  return fmt::format("{:.9g}", v);
+}
+
+std::string json_seconds(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
+
+std::string json_string_array(const std::vector<std::string>& items) {
+  JsonArray a;
+  for (const std::string& s : items) a.str(s);
+  return a.text();
+}
+
+std::string json_number_array(const std::vector<double>& items) {
+  JsonArray a;
+  for (const double v : items) a.raw(json_number(v));
+  return a.text();
+}
+
+JsonObject& JsonObject::raw(std::string_view key, std::string_view json) {
+  if (text_.size() > 1) text_ += ',';
+  append_json_string(text_, key);
+  text_ += ':';
+  text_ += json;
+  return *this;
+}
+
+JsonObject& JsonObject::str(std::string_view key, std::string_view value) {
+  if (text_.size() > 1) text_ += ',';
+  append_json_string(text_, key);
+  text_ += ':';
+  append_json_string(text_, value);
+  return *this;
+}
+
+JsonArray& JsonArray::raw(std::string_view json) {
+  if (text_.size() > 1) text_ += ',';
+  text_ += json;
+  return *this;
+}
+
+JsonArray& JsonArray::str(std::string_view value) {
+  if (text_.size() > 1) text_ += ',';
+  append_json_string(text_, value);
+  return *this;
+}
+
+}  // namespace safecass::introspect

@@ -1,0 +1,334 @@
+#include "safecass/introspect/local_query.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+
+namespace safecass::introspect {
+
+namespace {
+
+std::string outstanding_name(const Coordinator& co, StateSnapshot s) {
+  return s.state == State::Normal || s.outstanding == kNoEvent ? std::string() : co.event(s.outstanding).name;
+}
+
+RowKind row_kind(MachineKind k) {
+  switch (k) {
+    case MachineKind::Framework: return RowKind::Framework;
+    case MachineKind::Application: return RowKind::Application;
+    case MachineKind::Provided: return RowKind::Provided;
+    case MachineKind::Required: return RowKind::Required;
+  }
+  return RowKind::Framework;
+}
+
+std::vector<SignalRef> signal_refs(const std::vector<Signal*>& signals) {
+  std::vector<SignalRef> out;
+  for (const Signal* s : signals) {
+    if (s != nullptr) out.push_back({s->name(), s->size()});
+  }
+  return out;
+}
+
+class LocalSubscription final : public Subscription {
+public:
+  LocalSubscription(Coordinator& co, Coordinator::SubscriptionId id) : co_(co), id_(id) {}
+  ~LocalSubscription() override { co_.unsubscribe(id_); }
+
+private:
+  Coordinator& co_;
+  Coordinator::SubscriptionId id_;
+};
+
+std::vector<HistoryEntry> tail(const Coordinator& co, const std::vector<Record>& records, std::size_t last) {
+  const std::size_t n = last == 0 ? records.size() : std::min(records.size(), last);
+  std::vector<HistoryEntry> out;
+  out.reserve(n);
+  for (std::size_t i = records.size() - n; i < records.size(); ++i) out.push_back(history_entry(records[i], co));
+  return out;
+}
+
+}  // namespace
+
+LocalQuery::LocalQuery(Coordinator& co, Monitor& monitor, const FilterRegistry& registry, LocalOptions options)
+    : co_(co), monitor_(monitor), registry_(registry), options_(std::move(options)) {
+  if (options_.name.empty()) options_.name = std::string(co_.name());
+}
+
+std::string LocalQuery::name() const { return options_.name; }
+
+Expected<ClockInfo> LocalQuery::clock() {
+  ClockInfo c;
+  c.base = options_.base;
+  c.now = co_.clock().now();
+  if (c.base == TimeBase::Simulated && c.now < Time{0}) c.now = Time{0};
+  if (c.base == TimeBase::Host) {
+    const auto wall = std::chrono::duration_cast<Time>(std::chrono::system_clock::now().time_since_epoch());
+    const auto steady = std::chrono::duration_cast<Time>(std::chrono::steady_clock::now().time_since_epoch());
+    c.wall_offset_ns = (wall - steady).count();
+  }
+  c.period = options_.period;
+  c.scenario = options_.scenario;
+  c.duration = options_.duration;
+  return c;
+}
+
+std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
+  std::vector<StateRow> out;
+  const std::string name(co_.component_name(id));
+  const StateSnapshot ext = co_.extended(id);
+  out.push_back({name, RowKind::Component, ext.state, outstanding_name(co_, ext)});
+  auto machine = [&](MachineId m) {
+    const StateSnapshot s = co_.snapshot(m);
+    out.push_back({co_.address_of(m), row_kind(co_.machine_kind(m)), s.state, outstanding_name(co_, s)});
+  };
+  machine(co_.framework_machine(id));
+  machine(co_.application_machine(id));
+  for (const MachineId m : co_.provided_machines(id)) machine(m);
+  for (const MachineId m : co_.required_machines(id)) machine(m);
+  const auto& provided = co_.provided_machines(id);
+  for (std::uint32_t p = 0; p < provided.size(); ++p) {
+    out.push_back({name + ".s_S." + std::string(co_.interface_name(provided[p])), RowKind::Service,
+                   co_.service_state(id, p), {}});
+  }
+  return out;
+}
+
+Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view component) {
+  std::vector<StateRow> out;
+  if (!component.empty()) {
+    auto id = co_.find_component(component);
+    if (!id || co_.is_remote(*id)) {
+      return fail(ErrorCode::NotFound, "no component '" + std::string(component) + "' in coordinator '" + options_.name + "'");
+    }
+    return component_rows(*id);
+  }
+  out.push_back({"SYSTEM", RowKind::System, co_.coordinator_state(), {}});
+  for (ComponentId id = 0; id < co_.component_count(); ++id) {
+    if (co_.is_remote(id)) continue;
+    std::vector<StateRow> rows = component_rows(id);
+    out.insert(out.end(), std::make_move_iterator(rows.begin()), std::make_move_iterator(rows.end()));
+  }
+  return out;
+}
+
+Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, std::size_t last, HistoryFilter filter) {
+  Address a;  // SYSTEM
+  if (!scope.empty() && scope != "SYSTEM") {
+    auto r = co_.resolve(scope);
+    if (!r) return tl::unexpected(r.error());
+    a = *r;
+    if (a.kind == Address::Kind::Service) a.kind = Address::Kind::Component;
+  }
+  std::vector<Record> records = co_.history(a);
+  if (filter == HistoryFilter::Events) std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::Event; });
+  return tail(co_, records, last);
+}
+
+Expected<std::vector<HistoryEntry>> LocalQuery::records_since(std::uint64_t seq, std::size_t max) {
+  std::vector<Record> records = co_.history(Address{});
+  std::erase_if(records, [seq](const Record& r) { return r.seq <= seq; });
+  if (max != 0 && records.size() > max) records.resize(max);
+  return tail(co_, records, 0);
+}
+
+Expected<std::vector<FilterRow>> LocalQuery::filter_list() {
+  std::vector<FilterRow> out;
+  for (const auto& f : monitor_.filters()) {
+    FilterRow r;
+    r.name = f->name();
+    r.type = f->type();
+    r.target = f->target() == kNoMachine ? std::string() : co_.address_of(f->target());
+    r.active = f->execution() == ExecutionMode::Active;
+    r.edge = f->detection() == DetectionMode::Edge;
+    r.enabled = f->enabled();
+    r.detected = f->detected();
+    r.inputs = signal_refs(f->inputs());
+    r.outputs = signal_refs(f->outputs());
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
+  const Filter* f = monitor_.find_filter(name);
+  const FilterRegistry::Entry* entry = registry_.find(f != nullptr ? std::string_view(f->type()) : name);
+  if (entry == nullptr) return fail(ErrorCode::NotFound, "no filter or filter type '" + std::string(name) + "' (see filter list)");
+  const FilterManifest& m = entry->manifest;
+  FilterInfo info;
+  info.type = m.type;
+  info.doc = m.doc;
+  info.inputs = m.inputs;
+  info.outputs = m.outputs;
+  info.generates_events = m.generates_events;
+  if (f != nullptr) {
+    auto rows = filter_list();
+    for (FilterRow& r : *rows) {
+      if (r.name == f->name()) info.filter = std::move(r);
+    }
+    info.missed_samples = f->missed_samples();
+  }
+  for (const ParamSpec& p : m.params) {
+    ParamRow row;
+    row.name = p.name;
+    row.type = p.type;
+    row.doc = p.doc;
+    row.default_value = p.default_value;
+    row.optional = p.optional;
+    row.min = p.min;
+    row.max = p.max;
+    row.choices = p.choices;
+    if (f != nullptr) {
+      const auto it = f->config().params.find(p.name);
+      if (it != f->config().params.end()) row.value = it->second;
+    }
+    info.params.push_back(std::move(row));
+  }
+  return info;
+}
+
+Expected<std::vector<EventRow>> LocalQuery::event_list() {
+  std::vector<EventRow> out;
+  for (EventId id = 0; id < co_.event_count(); ++id) {
+    const Event& e = co_.event(id);
+    EventRow r;
+    r.name = e.name;
+    r.severity = e.severity;
+    r.onset = e.is_onset;
+    r.broadcast = e.is_broadcast();
+    for (const Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
+      if (e.transitions.contains(t)) r.transitions.push_back(t);
+    }
+    r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.event(e.counterpart).name;
+    r.latched = e.latched;
+    r.framework = id < framework_event::kCount;
+    r.hazard = e.hazard;
+    r.description = e.description;
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
+  std::vector<ConnectionRow> out;
+  for (const Connection& k : co_.connections()) {
+    const MachineId required = co_.required_machines(k.client)[k.required];
+    const MachineId provided = co_.provided_machines(k.provider)[k.provided];
+    ConnectionRow r;
+    r.required = std::string(co_.component_name(k.client)) + "." + std::string(co_.interface_name(required));
+    r.provided = std::string(co_.component_name(k.provider)) + "." + std::string(co_.interface_name(provided));
+    r.remote = co_.is_remote(k.provider);
+    r.required_state = co_.state(required);
+    if (!r.remote) {
+      r.service_state = co_.service_state(k.provider, k.provided);
+      r.propagate = co_.service(k.provider, k.provided).propagate;
+    }
+    out.push_back(std::move(r));
+  }
+  return out;
+}
+
+Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
+  std::vector<ServiceRow> out;
+  for (ComponentId id = 0; id < co_.component_count(); ++id) {
+    if (co_.is_remote(id)) continue;
+    const auto& provided = co_.provided_machines(id);
+    for (std::uint32_t i = 0; i < provided.size(); ++i) {
+      const std::string p(co_.interface_name(provided[i]));
+      const ServiceDependency& d = co_.service(id, i);
+      ServiceRow r;
+      r.address = std::string(co_.component_name(id)) + ".s_S." + p;
+      r.state = co_.service_state(id, i);
+      r.propagate = d.propagate;
+      r.depends_on.push_back("s_P." + p);
+      if (d.framework) r.depends_on.emplace_back("s_F");
+      if (d.application) r.depends_on.emplace_back("s_A");
+      if (d.all_required) {
+        for (const MachineId m : co_.required_machines(id)) r.depends_on.push_back("s_R." + std::string(co_.interface_name(m)));
+      } else {
+        for (const std::string& name : d.required) r.depends_on.push_back("s_R." + name);
+      }
+      out.push_back(std::move(r));
+    }
+  }
+  return out;
+}
+
+Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
+  ExplainAnswer a;
+  a.address = std::string(address);
+  if (address == "SYSTEM") {
+    a.state = co_.coordinator_state();
+    for (ComponentId id = 0; id < co_.component_count(); ++id) {
+      if (co_.is_remote(id)) continue;
+      std::vector<Explanation> part = co_.explain(Address{Address::Kind::Component, id});
+      a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
+    }
+    return a;
+  }
+  auto resolved = co_.resolve(address);
+  if (!resolved) return tl::unexpected(resolved.error());
+  a.state = co_.state_of(*resolved);
+  a.conditions = co_.explain(*resolved);
+  return a;
+}
+
+Expected<Names> LocalQuery::names() {
+  Names n;
+  n.addresses.emplace_back("SYSTEM");
+  for (ComponentId i = 0; i < co_.component_count(); ++i) {
+    if (co_.is_remote(i)) continue;
+    n.components.emplace_back(co_.component_name(i));
+    n.addresses.emplace_back(co_.component_name(i));
+    for (const MachineId p : co_.provided_machines(i)) {
+      n.addresses.push_back(std::string(co_.component_name(i)) + ".s_S." + std::string(co_.interface_name(p)));
+    }
+  }
+  for (MachineId m = 0; m < co_.machine_count(); ++m) {
+    if (co_.is_remote(co_.machine_component(m))) continue;
+    n.machines.push_back(co_.address_of(m));
+    n.addresses.push_back(co_.address_of(m));
+  }
+  for (EventId e = 0; e < co_.event_count(); ++e) n.events.push_back(co_.event(e).name);
+  for (const auto& f : monitor_.filters()) n.filters.push_back(f->name());
+  for (const FilterManifest* m : registry_.manifests()) n.filter_types.push_back(m->type);
+  for (const auto& s : monitor_.signals().all()) n.signals.push_back(s->name());
+  return n;
+}
+
+Expected<std::unique_ptr<Subscription>> LocalQuery::follow(RecordSink sink) {
+  const Coordinator* co = &co_;
+  const auto id = co_.subscribe([co, sink = std::move(sink)](const Record& r) { sink(history_entry(r, *co)); });
+  return std::unique_ptr<Subscription>(std::make_unique<LocalSubscription>(co_, id));
+}
+
+Expected<void> LocalQuery::generate(std::string_view event, std::string_view target) { return co_.generate(event, target); }
+
+Expected<void> LocalQuery::broadcast(std::string_view event) { return co_.broadcast(event); }
+
+Expected<void> LocalQuery::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
+  if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter inject " + std::string(filter) + ": no samples");
+  if (monitor_.find_filter(filter) == nullptr) return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "' (see filter list)");
+  return monitor_.inject_shallow(filter, samples);
+}
+
+Expected<void> LocalQuery::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
+  if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter dinject " + std::string(signal) + ": no samples");
+  const Signal* s = monitor_.signals().find(signal);
+  if (s == nullptr) return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "' (signals are written Component.signal)");
+  if (samples.size() > s->buffer().capacity()) {
+    return fail(ErrorCode::InvalidArgument, std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples") +
+                                                " would overflow the history of '" + std::string(signal) + "' (" +
+                                                std::to_string(s->buffer().capacity()) + " samples): inject fewer at once");
+  }
+  Time now = co_.clock().now();
+  if (options_.base == TimeBase::Simulated && now < Time{0}) now = Time{0};
+  return monitor_.inject_deep(signal, samples, now);
+}
+
+Expected<void> LocalQuery::reset(std::string_view target, std::string_view who, std::string_view why) {
+  return co_.reset(target, who, why);
+}
+
+}  // namespace safecass::introspect

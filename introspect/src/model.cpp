@@ -1,0 +1,70 @@
+#include "safecass/introspect/model.hpp"
+
+namespace safecass::introspect {
+
+std::string_view to_string(RowKind kind) noexcept {
+  switch (kind) {
+    case RowKind::System: return "system";
+    case RowKind::Component: return "component";
+    case RowKind::Framework: return "framework";
+    case RowKind::Application: return "application";
+    case RowKind::Provided: return "provided";
+    case RowKind::Required: return "required";
+    case RowKind::Service: return "service";
+  }
+  return "?";
+}
+
+bool parse_row_kind(std::string_view text, RowKind& out) noexcept {
+  for (const RowKind k : {RowKind::System, RowKind::Component, RowKind::Framework, RowKind::Application,
+                          RowKind::Provided, RowKind::Required, RowKind::Service}) {
+    if (to_string(k) == text) {
+      out = k;
+      return true;
+    }
+  }
+  return false;
+}
+
+std::string_view HistoryEntry::where() const noexcept {
+  if (!machine.empty()) return machine;
+  if (!component.empty()) return component;
+  return "-";
+}
+
+HistoryEntry history_entry(const Record& r, const Coordinator& co) {
+  HistoryEntry e;
+  e.seq = r.seq;
+  e.time = r.time;
+  e.kind = r.kind;
+  e.outcome = r.outcome;
+  if (r.component != kNoComponent && r.component < co.component_count()) e.component = std::string(co.component_name(r.component));
+  if (r.machine != kNoMachine && r.machine < co.machine_count()) e.machine = co.address_of(r.machine);
+  if (r.event != kNoEvent && r.event < co.event_count()) e.event = co.event(r.event).name;
+  e.from = r.from;
+  e.to = r.to;
+  e.level = r.level;
+  e.severity = r.severity;
+  e.mirror = r.mirror;
+  if (r.root.event != kNoEvent && r.root.event < co.event_count() && r.root.origin != kNoMachine &&
+      r.root.origin < co.machine_count()) {
+    RootEntry root;
+    root.event = co.event(r.root.event).name;
+    // A root from another process names its origin there (interned when it arrived), not the
+    // local stand-in it came through: a live client's history names the same root as in-process.
+    root.origin = r.root.remote_origin != kNoName ? std::string(co.name_of(r.root.remote_origin)) : co.address_of(r.root.origin);
+    root.time = r.root.time;
+    if (r.root.sample.filter != kNoName) root.filter = std::string(co.name_of(r.root.sample.filter));
+    if (r.root.sample.signal != kNoName) {
+      root.signal = std::string(co.name_of(r.root.sample.signal));
+      root.value = r.root.sample.value;
+      root.sample_time = r.root.sample.sample_time;
+    }
+    root.injected = r.root.sample.injected;
+    e.root = std::move(root);
+  }
+  e.text = std::string(r.text);
+  return e;
+}
+
+}  // namespace safecass::introspect
