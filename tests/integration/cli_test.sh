@@ -104,12 +104,18 @@ case $case_name in
     ;;
   run_killed_leaves_a_recording_every_record_of_which_replays)
     # A long run killed with SIGKILL while it records: the inputs replay up to their last whole record.
-    printf '{ "system": "%s/examples/robodoc/robodoc.json", "period": 0.001, "duration": 5000,
-  "steps": [ { "at": 0, "ramp": { "signal": "JR3.Fz", "from": 5, "to": 45, "until": 5000 } } ] }
+    # 9e7 ticks: far longer than the test waits, however fast the machine.
+    printf '{ "system": "%s/examples/robodoc/robodoc.json", "period": 0.001, "duration": 90000,
+  "steps": [ { "at": 0, "ramp": { "signal": "JR3.Fz", "from": 5, "to": 45, "until": 90000 } } ] }
 ' "$PWD" >"$tmp/long.json"
     "$safecass" run --scenario "$tmp/long.json" --record "$tmp/long.jsonl" >/dev/null 2>&1 &
     pid=$!
-    sleep 1.5
+    # Killed once it has recorded something (at most 10 s), while it is still running.
+    for _ in $(seq 100); do
+      [ "$(stat -c %s "$tmp/long.inputs" 2>/dev/null || echo 0)" -gt 65536 ] && break
+      sleep 0.1
+    done
+    kill -0 $pid 2>/dev/null || fail "the run ended before it could be killed"
     kill -9 $pid; wait $pid 2>/dev/null
     [ -s "$tmp/long.inputs" ] || fail "nothing was recorded before the kill (flushed at least every 100 ms)"
     "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/long.inputs" >"$tmp/out" 2>"$tmp/err"
