@@ -7,6 +7,7 @@
 #include <string>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/spec/json.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/verify/verify.hpp"
 
@@ -14,26 +15,8 @@ namespace safecass::tools {
 
 namespace {
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
+/// The one JSON escaper (spec::json_quote, introspect::json_string).
+std::string json_string(std::string_view s) { return spec::json_quote(s); }
 
 std::string where_text(const spec::Position& p) {
   if (p.file.empty()) return {};

@@ -16,6 +16,7 @@
 #include "model.hpp"
 #include "promela.hpp"
 #include "spin.hpp"
+#include "safecass/spec/json.hpp"
 
 namespace safecass::verify {
 
@@ -70,26 +71,8 @@ std::string file_name(const std::string& name) {
   return out;
 }
 
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (const char c : s) {
-    switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\t': out += "\\t"; break;
-      default:
-        if (static_cast<unsigned char>(c) < 0x20) {
-          char buf[8];
-          std::snprintf(buf, sizeof buf, "\\u%04x", c);
-          out += buf;
-        } else {
-          out += c;
-        }
-    }
-  }
-  return out + "\"";
-}
+/// The one JSON escaper (spec::json_quote, introspect::json_string).
+std::string json_string(std::string_view s) { return spec::json_quote(s); }
 
 /// What an atom must tell apart: Error or not (false), or all three levels (true).
 bool needs_warning(spec::Formula::Compare c, State level) {
