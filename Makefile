@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan package clean
 
 all: build
 
@@ -75,6 +75,12 @@ tsan: deps
 	@cmake --build $(BUILD)/tsan -j $(JOBS)
 	@TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}" \
 	  ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+
+# Debian packages (CPack): libsafecass-dev (libraries, headers, CMake config, pkg-config) and
+# safecass (the command and its man pages), in build/packages/ (docs/contributing.md, "Packages").
+package: build
+	@cd $(BUILD) && cpack
+	@ls $(BUILD)/packages/*.deb
 
 clean:
 	rm -rf $(BUILD)
