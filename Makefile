@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan package clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench asan tsan package lint clean
 
 all: build
 
@@ -81,6 +81,12 @@ tsan: deps
 package: build
 	@cd $(BUILD) && cpack
 	@ls $(BUILD)/packages/*.deb
+
+# clang-format (check only) and clang-tidy over build/compile_commands.json (scripts/lint).
+# LINT=format or LINT=tidy runs one of them; CI runs LINT=tidy (docs/contributing.md, "Lint").
+LINT ?= all
+lint: build
+	@./scripts/lint --$(LINT) $(BUILD)
 
 clean:
 	rm -rf $(BUILD)
