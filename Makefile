@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan clean
+.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan package lint clean
 
 all: build
 
@@ -93,16 +93,33 @@ bench-peers: deps
 bench-verify: build
 	@./$(BUILD)/bin/bench_verify $(BUILD)/bench-verify.json
 
+# The sanitizer runs take every test (CTEST_ARGS); with SANITIZER_SUBSET=ci (what .ci/run uses) the
+# named subset of docs/contributing.md, "Continuous integration".
+SANITIZER_CI_ARGS := -LE 'known-defect|packaging' -E '^(browser\.|viewer_ice\.|ViewerBacksOffWhenOutOfFileDescriptors$$)'
+SANITIZER_ARGS = $(if $(filter ci,$(SANITIZER_SUBSET)),$(SANITIZER_CI_ARGS),$(CTEST_ARGS))
+
 asan: deps
 	@test -f $(BUILD)/asan/build.ninja || cmake --preset asan >/dev/null
 	@cmake --build $(BUILD)/asan -j $(JOBS)
-	@ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+	@ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS) $(SANITIZER_ARGS)
 
 tsan: deps
 	@test -f $(BUILD)/tsan/build.ninja || cmake --preset tsan >/dev/null
 	@cmake --build $(BUILD)/tsan -j $(JOBS)
 	@TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}" \
-	  ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+	  ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(SANITIZER_ARGS)
+
+# Debian packages (CPack): libsafecass-dev (libraries, headers, CMake config, pkg-config) and
+# safecass (the command and its man pages), in build/packages/ (docs/contributing.md, "Packages").
+package: build
+	@cd $(BUILD) && cpack
+	@ls $(BUILD)/packages/*.deb
+
+# clang-format (check only) and clang-tidy over build/compile_commands.json (scripts/lint).
+# LINT=format or LINT=tidy runs one of them; CI runs LINT=tidy (docs/contributing.md, "Lint").
+LINT ?= all
+lint: build
+	@./scripts/lint --$(LINT) $(BUILD)
 
 clean:
 	rm -rf $(BUILD)

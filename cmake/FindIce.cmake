@@ -1,24 +1,39 @@
 # FindIce: ZeroC Ice 3.7 with the C++11 mapping, as Debian packages it (libzeroc-ice-dev,
 # zeroc-ice-compilers). Debian ships neither a CMake config nor a pkg-config file.
 #
+# It is installed with the SAFECASS package config: users who link safecass::middleware need the
+# libraries only; building SAFECASS also needs the Slice compiler (component slice2cpp).
+#
+#   find_package(Ice [REQUIRED] [COMPONENTS slice2cpp])
+#
 # Defines:
-#   Ice_FOUND, Ice_SLICE2CPP_EXECUTABLE, Ice_SLICE_DIR
+#   Ice_FOUND; with component slice2cpp also Ice_SLICE2CPP_EXECUTABLE, Ice_SLICE_DIR
 #   Ice::Ice++11, Ice::IceStorm++11, Ice::IceSSL++11 (imported targets; ICE_CPP11_MAPPING is
 #   defined for users)
 #   ice_slice2cpp(OUTPUT_VAR <var> SLICE <file.ice>... [OUTPUT_DIR <dir>])
 #     runs slice2cpp as a custom command and sets <var> to the generated .cpp and .h files.
 
-find_program(Ice_SLICE2CPP_EXECUTABLE slice2cpp)
 find_path(Ice_INCLUDE_DIR Ice/Ice.h)
-find_path(Ice_SLICE_DIR Ice/BuiltinSequences.ice PATHS /usr/share/ice/slice /usr/share/slice NO_DEFAULT_PATH)
 find_library(Ice_CPP11_LIBRARY NAMES Ice++11)
 find_library(Ice_ICESTORM_CPP11_LIBRARY NAMES IceStorm++11)
 find_library(Ice_ICESSL_CPP11_LIBRARY NAMES IceSSL++11)
+set(_ice_required Ice_INCLUDE_DIR Ice_CPP11_LIBRARY Ice_ICESTORM_CPP11_LIBRARY Ice_ICESSL_CPP11_LIBRARY)
+if("slice2cpp" IN_LIST Ice_FIND_COMPONENTS)
+  find_program(Ice_SLICE2CPP_EXECUTABLE slice2cpp)
+  find_path(Ice_SLICE_DIR Ice/BuiltinSequences.ice PATHS /usr/share/ice/slice /usr/share/slice NO_DEFAULT_PATH)
+  list(APPEND _ice_required Ice_SLICE2CPP_EXECUTABLE Ice_SLICE_DIR)
+  if(Ice_SLICE2CPP_EXECUTABLE AND Ice_SLICE_DIR)
+    set(Ice_slice2cpp_FOUND TRUE)
+  endif()
+endif()
 
 include(FindPackageHandleStandardArgs)
-find_package_handle_standard_args(Ice REQUIRED_VARS Ice_SLICE2CPP_EXECUTABLE Ice_INCLUDE_DIR Ice_SLICE_DIR
-                                  Ice_CPP11_LIBRARY Ice_ICESTORM_CPP11_LIBRARY Ice_ICESSL_CPP11_LIBRARY)
+find_package_handle_standard_args(Ice REQUIRED_VARS ${_ice_required} HANDLE_COMPONENTS)
+unset(_ice_required)
 
+if(Ice_FOUND AND NOT TARGET Threads::Threads)
+  find_package(Threads REQUIRED)
+endif()
 if(Ice_FOUND AND NOT TARGET Ice::Ice++11)
   add_library(Ice::Ice++11 UNKNOWN IMPORTED)
   set_target_properties(Ice::Ice++11 PROPERTIES

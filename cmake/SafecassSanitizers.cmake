@@ -1,5 +1,7 @@
 # Sanitizers are global: every target, including tests, must be instrumented alike.
+# SAFECASS_SANITIZER_FLAGS: the flags, for programs built outside the tree that link it (tests/install).
 set(_san "")
+set(SAFECASS_SANITIZER_FLAGS "")
 if(SAFECASS_ENABLE_ASAN)
   list(APPEND _san address)
 endif()
@@ -17,4 +19,5 @@ if(_san)
   add_compile_options(-fsanitize=${_san_list} -fno-omit-frame-pointer -fno-sanitize-recover=all)
   add_link_options(-fsanitize=${_san_list})
   add_compile_definitions(SAFECASS_SANITIZED=1)
+  set(SAFECASS_SANITIZER_FLAGS "-fsanitize=${_san_list} -fno-omit-frame-pointer -fno-sanitize-recover=all")
 endif()

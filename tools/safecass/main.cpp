@@ -21,7 +21,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"SAFECASS: safety architecture for component-based robot systems"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "safecass 0.1.0");
+  app.set_version_flag("--version", "safecass " SAFECASS_VERSION);
   int code = 0;
 
   auto* demo = app.add_subcommand("demo", "Run the demonstration of the core model");

@@ -441,7 +441,7 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   }
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
   auto record = [](std::int64_t seq, const std::string& kind, const std::string& address, const std::string& text) {
-    wire::EventMessage m{};
+    wire::EventMessage m{};  // every field set: an indeterminate bool is undefined behaviour (UBSan)
     m.coordinator = "wire-p";
     m.incarnation = kIncarnation;
     m.seq = seq;
