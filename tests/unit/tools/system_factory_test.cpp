@@ -84,6 +84,16 @@ TEST(SystemFactory, ASystemWithNoScenarioTicksAtTheDefaultTickAndSoDoItsComponen
   EXPECT_EQ((*opened)->scenario().duration, 0.0);
 }
 
+TEST(SystemFactory, AScenarioWhoseSystemHasErrorsReportsThoseErrorsAndNothingElse) {
+  const FilterRegistry registry = builtin();
+  const std::string bad = std::string(SAFECASS_SOURCE_DIR) + "/tests/data/bad_specs/unknown_key.json";
+  auto opened = ScenarioRunner::open(ScenarioSource{"", bad}, registry);
+  ASSERT_FALSE(opened);
+  const std::string text = to_text(opened.error());
+  EXPECT_THAT(text, HasSubstr("unknown_key.json:4:3: error:"));
+  EXPECT_THAT(text, ::testing::Not(HasSubstr("cannot load system"))) << "one mistake, one diagnostic";
+}
+
 TEST(SystemFactory, NoSystemAndNoScenarioIsAnErrorThatSaysWhatIsNeeded) {
   const FilterRegistry registry = builtin();
   auto opened = ScenarioRunner::open(ScenarioSource{}, registry);

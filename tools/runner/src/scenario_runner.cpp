@@ -80,17 +80,8 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
   Diagnostics problems;
   Diagnostics system_errors;
   const auto sort_out = [&](const std::string& here) {
-    if (notes == nullptr) {
-      std::erase_if(problems, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
-      std::erase_if(system_errors, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
-    } else {
-      for (Diagnostics* list : {&problems, &system_errors}) {
-        for (spec::Diagnostic& d : *list) {
-          if (d.severity != spec::Diagnostic::Severity::Error) notes->push_back(std::move(d));
-        }
-        std::erase_if(*list, [](const spec::Diagnostic& d) { return d.severity != spec::Diagnostic::Severity::Error; });
-      }
-    }
+    problems = keep_errors(std::move(problems), notes);
+    system_errors = keep_errors(std::move(system_errors), notes);
     // Diagnostics of the scenario file first, by position; a format problem and a name problem
     // of the same file are reported together, where they are.
     std::stable_sort(problems.begin(), problems.end(), [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
@@ -128,8 +119,9 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
     }
   } else {
     spec::LoadResult loaded = spec::load_system(scenario->system, registry);
+    const bool loaded_ok = loaded.ok();  // read before the diagnostics are moved out
     system_errors = std::move(loaded.diagnostics);
-    if (loaded.ok() && loaded.system) {
+    if (loaded_ok && loaded.system) {
       SystemOptions options;
       options.component_period = seconds_to_time(scenario->period);
       auto built = build_system(std::move(*loaded.system), registry, options);
@@ -140,7 +132,7 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
         Diagnostics names = runner->check_names();
         problems.insert(problems.end(), std::make_move_iterator(names.begin()), std::make_move_iterator(names.end()));
       }
-    } else if (loaded.ok()) {
+    } else if (loaded_ok) {
       system_errors.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{scenario->system, 0, 0},
                                                "cannot load system '" + scenario->system + "'", ""});
     }

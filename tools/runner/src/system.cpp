@@ -54,14 +54,19 @@ Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const Filt
 Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
                                             const SystemOptions& options, Diagnostics* notes) {
   spec::LoadResult loaded = spec::load_system(path, registry);
-  Diagnostics errors;
-  for (spec::Diagnostic& d : loaded.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
-    else if (notes != nullptr) notes->push_back(std::move(d));
-  }
+  Diagnostics errors = keep_errors(std::move(loaded.diagnostics), notes);
   if (!errors.empty()) return tl::unexpected(std::move(errors));
   if (!loaded.system) return tl::unexpected(Diagnostics{at_file(path, "cannot load system '" + path + "'")});
   return build_system(std::move(*loaded.system), registry, options);
+}
+
+Diagnostics keep_errors(Diagnostics diagnostics, Diagnostics* notes) {
+  Diagnostics errors;
+  for (spec::Diagnostic& d : diagnostics) {
+    if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
+    else if (notes != nullptr) notes->push_back(std::move(d));
+  }
+  return errors;
 }
 
 void print(const Diagnostics& diagnostics, std::FILE* out) {

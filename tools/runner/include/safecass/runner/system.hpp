@@ -84,6 +84,10 @@ Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const Filt
 Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
                                             const SystemOptions& options = {}, Diagnostics* notes = nullptr);
 
+/// Keeps the errors of `diagnostics` and moves the others (warnings, notes) to `notes`, or drops
+/// them when `notes` is null. Returns the errors, in their order.
+Diagnostics keep_errors(Diagnostics diagnostics, Diagnostics* notes);
+
 /// Prints each diagnostic on its own line (spec::format) to `out`.
 void print(const Diagnostics& diagnostics, std::FILE* out);
 /// The diagnostics as text, one per line, for an Error message.
