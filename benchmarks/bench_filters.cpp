@@ -36,8 +36,8 @@ struct FilterBench {
 void BM_ThresholdNoEvent(benchmark::State& state) {
   FilterBench b;
   Signal* x = *b.monitor.add_signal("C.x");
-  Filter* f = b.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
-                                  {"event_onset", std::string("EVT_X")}});
+  Filter* f = b.add("Threshold",
+                    {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   std::int64_t t = 0;
   for (auto _ : state) {
     x->push(Time{++t}, 1.0);
@@ -52,8 +52,10 @@ void BM_Pipeline3(benchmark::State& state) {
   FilterBench b;
   Signal* force = *b.monitor.add_signal("C.force", 3);
   b.add("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}});
-  b.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
-  b.add("Threshold", {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  b.add("MovingAverage",
+        {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
+  b.add("Threshold",
+        {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
   const double sample[] = {1.0, 2.0, 3.0};
   std::int64_t t = 0;
   for (auto _ : state) {
@@ -72,8 +74,9 @@ void BM_MonitorTick(benchmark::State& state) {
   std::vector<Signal*> signals;
   for (int s = 0; s < 10; ++s) signals.push_back(*b.monitor.add_signal("C.s" + std::to_string(s)));
   for (int i = 0; i < n; ++i) {
-    b.add("Threshold", {{"input_signal", "s" + std::to_string(i % 10)}, {"threshold", 10.0},
-                        {"event_onset", std::string("EVT_X")}}, ExecutionMode::Passive);
+    b.add("Threshold",
+          {{"input_signal", "s" + std::to_string(i % 10)}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}},
+          ExecutionMode::Passive);
   }
   std::int64_t t = 0;
   for (auto _ : state) {

@@ -52,9 +52,11 @@ const std::string& system_file() {
       const std::string C = "C" + std::to_string(c);
       text += std::string(c ? ",\n" : "") + "{ \"component\": \"" + C + "\", \"period\": 0.001, \"interfaces\": {},\n" +
               "  \"signals\": [";
-      for (int k = 0; k < kPerComponent; ++k) text += std::string(k ? ", " : "") + "{ \"name\": \"s" + std::to_string(k) + "\" }";
-      text += "],\n  \"event\": [ { \"name\": \"EVT_" + C + "\", \"severity\": 50, \"state_transition\": [\"N2E\"] },\n" +
-              "             { \"name\": \"/EVT_" + C + "\", \"severity\": 50, \"state_transition\": [\"E2N\"] } ],\n  \"filter\": [";
+      for (int k = 0; k < kPerComponent; ++k)
+        text += std::string(k ? ", " : "") + "{ \"name\": \"s" + std::to_string(k) + "\" }";
+      text += "],\n  \"event\": [ { \"name\": \"EVT_" + C +
+              "\", \"severity\": 50, \"state_transition\": [\"N2E\"] },\n" + "             { \"name\": \"/EVT_" + C +
+              "\", \"severity\": 50, \"state_transition\": [\"E2N\"] } ],\n  \"filter\": [";
       for (int k = 0; k < kPerComponent; ++k) {
         text += std::string(k ? ",\n" : "\n") + "    { \"name\": \"limit_" + C + "_" + std::to_string(k) +
                 "\", \"class_name\": \"Threshold\", \"target\": { \"type\": \"s_A\", \"component\": \"" + C +
@@ -182,7 +184,8 @@ void replay_whole(benchmark::State& state, const std::string& log) {
   }
   std::fclose(devnull);
   state.SetItemsProcessed(state.iterations() * kSamples);
-  state.counters["samples/s"] = benchmark::Counter(static_cast<double>(state.iterations() * kSamples), benchmark::Counter::kIsRate);
+  state.counters["samples/s"] =
+      benchmark::Counter(static_cast<double>(state.iterations() * kSamples), benchmark::Counter::kIsRate);
   // Seconds to replay one hour of this log (20 signals at 1 kHz) at this rate: an iteration is
   // kSeconds of log.
   state.counters["s_per_hour"] = benchmark::Counter(static_cast<double>(state.iterations()) * kSeconds / 3600.0,

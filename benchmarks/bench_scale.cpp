@@ -22,8 +22,8 @@ std::string tree_system(int n) {
   for (int k = 0; k < n; ++k) {
     const std::string c = "C" + std::to_string(k);
     s += k ? ",\n" : "\n";
-    s += R"({ "component": ")" + c + R"(", "interfaces": { "provided": ["Out"], "required": [)" +
-         (k ? R"("In")" : "") + "] }";
+    s += R"({ "component": ")" + c + R"(", "interfaces": { "provided": ["Out"], "required": [)" + (k ? R"("In")" : "") +
+         "] }";
     if (k == 0) {
       s += R"(, "event": [ { "name": "EVT_FAULT", "severity": 50, "state_transition": ["N2E"] },
                            { "name": "/EVT_FAULT", "severity": 50, "state_transition": ["E2N"] } ])";
@@ -34,7 +34,8 @@ std::string tree_system(int n) {
   s += "],\n\"connections\": [";
   for (int k = 1; k < n; ++k) {
     s += k > 1 ? ",\n" : "\n";
-    s += R"({ "required": "C)" + std::to_string(k) + R"(.In", "provided": "C)" + std::to_string((k - 1) / 4) + R"(.Out" })";
+    s += R"({ "required": "C)" + std::to_string(k) + R"(.In", "provided": "C)" + std::to_string((k - 1) / 4) +
+         R"(.Out" })";
   }
   s += "] }";
   return s;
@@ -149,7 +150,8 @@ void BM_ScaleMemory(benchmark::State& state) {
   SimulatedClock clock;
   Coordinator co("tree", &clock);
   Monitor monitor(co, tree.registry);
-  if (spec::instantiate(*r.system, co, monitor)) state.counters["history_records"] = static_cast<double>(co.history_size());
+  if (spec::instantiate(*r.system, co, monitor))
+    state.counters["history_records"] = static_cast<double>(co.history_size());
 }
 BENCHMARK(BM_ScaleMemory)->Arg(1000)->Arg(10000)->Unit(benchmark::kMillisecond)->Iterations(1);
 

@@ -32,26 +32,37 @@ std::string hazard_tree(int n) {
   for (int k = 0; k < n; ++k) {
     const std::string c = "C" + std::to_string(k);
     s += k ? ",\n" : "\n";
-    s += R"({ "component": ")" + c + R"(", "interfaces": { "provided": ["Out"], "required": [)" + (k ? R"("In")" : "") + "] }";
+    s += R"({ "component": ")" + c + R"(", "interfaces": { "provided": ["Out"], "required": [)" + (k ? R"("In")" : "") +
+         "] }";
     s += R"(, "event": [
-      { "name": "EVT_)" + c + R"(_FAULT", "severity": 50, "state_transition": ["N2E", "W2E"], "hazard": "H-)" + std::to_string(k) + R"(" },
-      { "name": "/EVT_)" + c + R"(_FAULT", "severity": 50, "state_transition": ["E2N", "E2W"] },
-      { "name": "EVT_)" + c + R"(_OVERLOAD", "severity": 50, "state_transition": ["N2E", "W2E"], "hazard": "H-)" + std::to_string(k) + R"(" },
-      { "name": "/EVT_)" + c + R"(_OVERLOAD", "severity": 50, "state_transition": ["E2N", "E2W"] },
-      { "name": "EVT_)" + c + R"(_SLOW", "severity": 20, "state_transition": ["N2W"] },
-      { "name": "/EVT_)" + c + R"(_SLOW", "severity": 20, "state_transition": ["W2N"] } ])";
+      { "name": "EVT_)" +
+         c + R"(_FAULT", "severity": 50, "state_transition": ["N2E", "W2E"], "hazard": "H-)" + std::to_string(k) +
+         R"(" },
+      { "name": "/EVT_)" +
+         c + R"(_FAULT", "severity": 50, "state_transition": ["E2N", "E2W"] },
+      { "name": "EVT_)" +
+         c + R"(_OVERLOAD", "severity": 50, "state_transition": ["N2E", "W2E"], "hazard": "H-)" + std::to_string(k) +
+         R"(" },
+      { "name": "/EVT_)" +
+         c + R"(_OVERLOAD", "severity": 50, "state_transition": ["E2N", "E2W"] },
+      { "name": "EVT_)" +
+         c + R"(_SLOW", "severity": 20, "state_transition": ["N2W"] },
+      { "name": "/EVT_)" +
+         c + R"(_SLOW", "severity": 20, "state_transition": ["W2N"] } ])";
     s += R"(, "service": [ { "name": "Out", "dependency": { "s_F": true, "s_A": true, "s_R": [)" +
          std::string(k ? R"("In")" : "") + "] } } ] }";
   }
   s += "],\n\"connections\": [";
   for (int k = 1; k < n; ++k) {
     s += k > 1 ? ",\n" : "\n";
-    s += R"({ "required": "C)" + std::to_string(k) + R"(.In", "provided": "C)" + std::to_string((k - 1) / 4) + R"(.Out" })";
+    s += R"({ "required": "C)" + std::to_string(k) + R"(.In", "provided": "C)" + std::to_string((k - 1) / 4) +
+         R"(.Out" })";
   }
   s += "],\n\"hazards\": [";
   for (int k = 0; k < n; ++k) {
     s += k ? ",\n" : "\n";
-    s += R"({ "id": "H-)" + std::to_string(k) + R"(", "description": "fault of C)" + std::to_string(k) + R"(", "reaction": {)";
+    s += R"({ "id": "H-)" + std::to_string(k) + R"(", "description": "fault of C)" + std::to_string(k) +
+         R"(", "reaction": {)";
     std::string reaction;
     for (int child = 4 * k + 1; child <= 4 * k + 4 && child < n; ++child) {
       reaction += R"( "C)" + std::to_string(child) + R"(": "Error",)";
@@ -98,11 +109,12 @@ Figures run(const spec::SystemSpec& system, const FilterRegistry& registry) {
 
 std::string json(const char* name, const Figures& f, double target_s) {
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "    { \"name\": \"%s\", \"seconds\": %.3f, \"target_seconds\": %.0f, \"properties\": %zu, \"holds\": %zu, "
-                "\"onsets\": %zu, \"max_states\": %llu, \"max_pan_memory_mb\": %.1f, \"exit\": %d }",
-                name, f.seconds, target_s, f.properties, f.holds, f.onsets, static_cast<unsigned long long>(f.max_states),
-                f.max_pan_mb, f.exit);
+  std::snprintf(
+      buf, sizeof buf,
+      "    { \"name\": \"%s\", \"seconds\": %.3f, \"target_seconds\": %.0f, \"properties\": %zu, \"holds\": %zu, "
+      "\"onsets\": %zu, \"max_states\": %llu, \"max_pan_memory_mb\": %.1f, \"exit\": %d }",
+      name, f.seconds, target_s, f.properties, f.holds, f.onsets, static_cast<unsigned long long>(f.max_states),
+      f.max_pan_mb, f.exit);
   return buf;
 }
 
@@ -133,19 +145,23 @@ int main(int argc, char** argv) {
               r.properties, r.max_pan_mb);
   const spec::LoadResult tree = spec::load_system_from_text(hazard_tree(n), "tree.json", registry);
   if (!tree.ok()) {
-    std::fprintf(stderr, "bench_verify: the generated tree does not load: %s\n", spec::format(tree.diagnostics.at(0)).c_str());
+    std::fprintf(stderr, "bench_verify: the generated tree does not load: %s\n",
+                 spec::format(tree.diagnostics.at(0)).c_str());
     return 2;
   }
   const Figures t = run(*tree.system, registry);
-  std::printf("tree of %d components: %.2f s, %zu/%zu properties hold, %zu onsets, at most %llu states and %.1f MB in SPIN "
-              "(target 120 s, 4 GB)\n",
-              n, t.seconds, t.holds, t.properties, t.onsets, static_cast<unsigned long long>(t.max_states), t.max_pan_mb);
+  std::printf(
+      "tree of %d components: %.2f s, %zu/%zu properties hold, %zu onsets, at most %llu states and %.1f MB in SPIN "
+      "(target 120 s, 4 GB)\n",
+      n, t.seconds, t.holds, t.properties, t.onsets, static_cast<unsigned long long>(t.max_states), t.max_pan_mb);
   rusage usage{};
   getrusage(RUSAGE_CHILDREN, &usage);
-  const double child_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // largest child: SPIN, the compiler or a verifier
+  const double child_mb =
+      static_cast<double>(usage.ru_maxrss) / 1024.0;  // largest child: SPIN, the compiler or a verifier
   std::printf("largest child process (SPIN, the C compiler or a verifier): %.1f MB resident\n", child_mb);
   std::ofstream f(out);
-  f << "{\n  \"context\": { \"note\": \"wall-clock seconds of safecass verify, including compiling SPIN's verifiers; they "
+  f << "{\n  \"context\": { \"note\": \"wall-clock seconds of safecass verify, including compiling SPIN's verifiers; "
+       "they "
        "depend on the machine's load\", \"max_child_resident_mb\": "
     << child_mb << " },\n  \"benchmarks\": [\n"
     << json("robodoc", r, 10) << ",\n"

@@ -52,12 +52,17 @@ std::string system_text(int signals, int components) {
       s += R"({ "name": ")" + sig + R"(" })";
       filters += first ? "\n" : ",\n";
       filters += R"({ "name": "limit_)" + sig + R"(", "class_name": "Threshold", "type": "ACTIVE",
-          "argument": { "input_signal": ")" + sig + R"(", "threshold": 10.0, "hysteresis": 1.0,
+          "argument": { "input_signal": ")" +
+                 sig + R"(", "threshold": 10.0, "hysteresis": 1.0,
                         "event_onset": "EVT_LIMIT", "event_completion": "/EVT_LIMIT" } },
-        { "name": "stale_)" + sig + R"(", "class_name": "Watchdog", "type": "ACTIVE", "target": { "type": "s_F" },
-          "argument": { "input_signal": ")" + sig + R"(", "timeout": 0.05 } },
-        { "name": "mean_)" + sig + R"(", "class_name": "MovingAverage", "type": "ACTIVE",
-          "argument": { "input_signal": ")" + sig + R"(", "window": 10, "output_signal": ")" + sig + R"(_mean" } })";
+        { "name": "stale_)" +
+                 sig + R"(", "class_name": "Watchdog", "type": "ACTIVE", "target": { "type": "s_F" },
+          "argument": { "input_signal": ")" +
+                 sig + R"(", "timeout": 0.05 } },
+        { "name": "mean_)" +
+                 sig + R"(", "class_name": "MovingAverage", "type": "ACTIVE",
+          "argument": { "input_signal": ")" +
+                 sig + R"(", "window": 10, "output_signal": ")" + sig + R"(_mean" } })";
       first = false;
     }
     s += "]";
@@ -86,11 +91,16 @@ int main(int argc, char** argv) {
   double rate = 1000.0, seconds = 30.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--out") out_path = argv[i + 1];
-    else if (key == "--signals") signals = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
-    else if (key == "--components") components = std::clamp(std::atoi(argv[i + 1]), 1, 100);
-    else if (key == "--rate") rate = std::clamp(std::atof(argv[i + 1]), 1.0, 10000.0);
-    else if (key == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+    if (key == "--out")
+      out_path = argv[i + 1];
+    else if (key == "--signals")
+      signals = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
+    else if (key == "--components")
+      components = std::clamp(std::atoi(argv[i + 1]), 1, 100);
+    else if (key == "--rate")
+      rate = std::clamp(std::atof(argv[i + 1]), 1.0, 10000.0);
+    else if (key == "--seconds")
+      seconds = std::max(1.0, std::atof(argv[i + 1]));
     else {
       std::fprintf(stderr, "peer_detection: unknown option %s\n", key.c_str());
       return 2;
@@ -158,7 +168,8 @@ int main(int argc, char** argv) {
   const std::int64_t t0 = peers::now_ns();
   measuring.store(true);
   const auto start = std::chrono::steady_clock::now();
-  const auto until = start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
+  const auto until =
+      start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
   int crossings = 0;
   for (auto next = start; next < until; next += 10ms) {
     std::this_thread::sleep_until(next);

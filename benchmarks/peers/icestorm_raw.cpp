@@ -178,9 +178,12 @@ int main(int argc, char** argv) {
   int samples = 2000;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--ice") ice_text = argv[i + 1];
-    else if (key == "--out") out_path = argv[i + 1];
-    else if (key == "--samples") samples = std::max(10, std::atoi(argv[i + 1]));
+    if (key == "--ice")
+      ice_text = argv[i + 1];
+    else if (key == "--out")
+      out_path = argv[i + 1];
+    else if (key == "--samples")
+      samples = std::max(10, std::atoi(argv[i + 1]));
     else {
       std::fprintf(stderr, "peer_icestorm_raw: unknown option %s\n", key.c_str());
       return 2;

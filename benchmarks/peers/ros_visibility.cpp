@@ -186,16 +186,26 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const char* v = argv[i + 1];
-    if (key == "--mode") o.mode = v;
-    else if (key == "--out") o.out = v;
-    else if (key == "--dump") o.dump = v;
-    else if (key == "--samples") o.samples = std::max(10, std::atoi(v));
-    else if (key == "--seconds") o.seconds = std::max(1.0, std::atof(v));
-    else if (key == "--items") o.items = std::clamp(std::atoi(v), 1, 10000);
-    else if (key == "--on-ms") o.on_ms = std::max(1.0, std::atof(v));
-    else if (key == "--off-ms") o.off_ms = std::max(1.0, std::atof(v));
-    else if (key == "--period") o.period = std::atof(v);
-    else if (key == "--loop-hz") o.loop_hz = std::clamp(std::atof(v), 1.0, 10000.0);
+    if (key == "--mode")
+      o.mode = v;
+    else if (key == "--out")
+      o.out = v;
+    else if (key == "--dump")
+      o.dump = v;
+    else if (key == "--samples")
+      o.samples = std::max(10, std::atoi(v));
+    else if (key == "--seconds")
+      o.seconds = std::max(1.0, std::atof(v));
+    else if (key == "--items")
+      o.items = std::clamp(std::atoi(v), 1, 10000);
+    else if (key == "--on-ms")
+      o.on_ms = std::max(1.0, std::atof(v));
+    else if (key == "--off-ms")
+      o.off_ms = std::max(1.0, std::atof(v));
+    else if (key == "--period")
+      o.period = std::atof(v);
+    else if (key == "--loop-hz")
+      o.loop_hz = std::clamp(std::atof(v), 1.0, 10000.0);
     else {
       std::fprintf(stderr, "peer_ros_visibility: unknown option %s\n", key.c_str());
       return 2;
@@ -252,9 +262,8 @@ int main(int argc, char** argv) {
     }
   };
   ros::Subscriber sub = o.mode == "raw"
-                            ? nh.subscribe<diagnostic_msgs::DiagnosticArray>("/peer_fault", 100, on_array,
-                                                                             ros::VoidConstPtr(),
-                                                                             ros::TransportHints().tcpNoDelay())
+                            ? nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+                                  "/peer_fault", 100, on_array, ros::VoidConstPtr(), ros::TransportHints().tcpNoDelay())
                             : nh.subscribe<diagnostic_msgs::DiagnosticArray>("/diagnostics_agg", 100, on_array);
   ros::AsyncSpinner spinner(1);
   spinner.start();
@@ -287,9 +296,9 @@ int main(int argc, char** argv) {
                 "{\n  %s,\n  \"onsets\": %lld,\n  \"missed\": %lld,\n  \"mode\": \"%s\",\n  \"items\": %d,\n"
                 "  \"updater_period_s\": %.4f,\n  \"loop_hz\": %.0f,\n"
                 "  \"transport\": \"%s\"\n}\n",
-                peers::latency_members(copy).c_str(), onsets,
-                onsets - static_cast<long long>(copy.size()), o.mode.c_str(), o.mode == "raw" ? 1 : o.items,
-                o.mode == "raw" ? 0.0 : (o.period >= 0 ? o.period : 1.0), o.loop_hz,
+                peers::latency_members(copy).c_str(), onsets, onsets - static_cast<long long>(copy.size()),
+                o.mode.c_str(), o.mode == "raw" ? 1 : o.items, o.mode == "raw" ? 0.0 : (o.period >= 0 ? o.period : 1.0),
+                o.loop_hz,
                 o.mode == "raw" ? "roscpp topic (TCPROS, TCP_NODELAY) on loopback, two processes"
                                 : "diagnostic_updater -> /diagnostics -> diagnostic_aggregator -> /diagnostics_agg");
   std::ofstream(o.out) << json;

@@ -33,11 +33,16 @@ int main(int argc, char** argv) {
   double rate = 10.0, seconds = 30.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--out") out_path = argv[i + 1];
-    else if (key == "--watch-pid") pid = std::atoi(argv[i + 1]);
-    else if (key == "--components") components = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
-    else if (key == "--rate") rate = std::clamp(std::atof(argv[i + 1]), 0.1, 1000.0);
-    else if (key == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+    if (key == "--out")
+      out_path = argv[i + 1];
+    else if (key == "--watch-pid")
+      pid = std::atoi(argv[i + 1]);
+    else if (key == "--components")
+      components = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
+    else if (key == "--rate")
+      rate = std::clamp(std::atof(argv[i + 1]), 0.1, 1000.0);
+    else if (key == "--seconds")
+      seconds = std::max(1.0, std::atof(argv[i + 1]));
     else {
       std::fprintf(stderr, "peer_ros_watch: unknown option %s\n", key.c_str());
       return 2;
@@ -91,7 +96,8 @@ int main(int argc, char** argv) {
   const std::int64_t t0 = peers::now_ns();
   std::uint64_t updates = 0;
   const auto start = std::chrono::steady_clock::now();
-  const auto until = start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
+  const auto until =
+      start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
   for (auto next = start; next < until; next += period) {
     std::this_thread::sleep_until(next);
     cycle();

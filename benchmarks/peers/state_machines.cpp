@@ -46,8 +46,8 @@ struct HealthDef : msm::front::state_machine_def<HealthDef> {
   struct Error : msm::front::state<> {};
   using initial_state = Normal;
 
-  int warnings = 0;                ///< active warning conditions (for Error's completion)
-  std::uint64_t transitions = 0;   ///< counted by every row, so the work cannot be optimised away
+  int warnings = 0;               ///< active warning conditions (for Error's completion)
+  std::uint64_t transitions = 0;  ///< counted by every row, so the work cannot be optimised away
 
   struct Count {
     template <class E, class Fsm, class S, class T>
@@ -85,13 +85,11 @@ struct HealthDef : msm::front::state_machine_def<HealthDef> {
   using none = msm::front::none;
   template <class From, class Event, class To, class Action, class Guard = none>
   using Row = msm::front::Row<From, Event, To, Action, Guard>;
-  using transition_table = mpl::vector<
-      Row<Normal, ErrorOnset, Error, Count>,
-      Row<Normal, WarningOnset, Warning, AddWarning>,
-      Row<Warning, ErrorOnset, Error, Count>,
-      Row<Warning, WarningCompletion, Normal, DropWarning>,
-      Row<Error, ErrorCompletion, Normal, Count, NoWarning>,
-      Row<Error, ErrorCompletion, Warning, Count, SomeWarning>>;
+  using transition_table =
+      mpl::vector<Row<Normal, ErrorOnset, Error, Count>, Row<Normal, WarningOnset, Warning, AddWarning>,
+                  Row<Warning, ErrorOnset, Error, Count>, Row<Warning, WarningCompletion, Normal, DropWarning>,
+                  Row<Error, ErrorCompletion, Normal, Count, NoWarning>,
+                  Row<Error, ErrorCompletion, Warning, Count, SomeWarning>>;
 
   template <class Fsm, class Event>
   void no_transition(const Event&, Fsm&, int) {}
@@ -132,8 +130,8 @@ struct ScError : sc::simple_state<ScError, HealthChart> {
 
 void set_ns_per_event(benchmark::State& state) {
   // Two events per iteration; kAvgIterationsRate | kInvert gives seconds per iteration.
-  state.counters["ns_per_event"] = benchmark::Counter(
-      static_cast<double>(state.iterations()) * 2.0, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["ns_per_event"] = benchmark::Counter(static_cast<double>(state.iterations()) * 2.0,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
 // SAFECASS: an error onset and its completion on a component's s_A, each a transition; the

@@ -93,11 +93,16 @@ int main(int argc, char** argv) {
   double rate = 10.0, seconds = 30.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--ice") ice_text = argv[i + 1];
-    else if (key == "--out") out_path = argv[i + 1];
-    else if (key == "--components") components = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
-    else if (key == "--rate") rate = std::clamp(std::atof(argv[i + 1]), 0.1, 1000.0);
-    else if (key == "--seconds") seconds = std::max(1.0, std::atof(argv[i + 1]));
+    if (key == "--ice")
+      ice_text = argv[i + 1];
+    else if (key == "--out")
+      out_path = argv[i + 1];
+    else if (key == "--components")
+      components = std::clamp(std::atoi(argv[i + 1]), 1, 100000);
+    else if (key == "--rate")
+      rate = std::clamp(std::atof(argv[i + 1]), 0.1, 1000.0);
+    else if (key == "--seconds")
+      seconds = std::max(1.0, std::atof(argv[i + 1]));
     else {
       std::fprintf(stderr, "peer_supervisor_load: unknown option %s\n", key.c_str());
       return 2;
@@ -190,7 +195,8 @@ int main(int argc, char** argv) {
   const std::int64_t t0 = peers::now_ns();
   std::uint64_t changes = 0;
   const auto start = std::chrono::steady_clock::now();
-  const auto until = start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
+  const auto until =
+      start + std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::duration<double>(seconds));
   for (auto next = start; next < until; next += period) {
     std::this_thread::sleep_until(next);
     cycle();
@@ -217,21 +223,21 @@ int main(int argc, char** argv) {
   const double cpu = cpu1 - cpu0;
   const double per_10k = updates > 0 ? cpu / static_cast<double>(updates) * 10000.0 : 0.0;
   char json[1400];
-  std::snprintf(json, sizeof json,
-                "{\n  \"components\": %d,\n  \"rate_hz\": %.1f,\n  \"seconds\": %.2f,\n  \"wall_s\": %.2f,\n"
-                "  \"status_changes\": %llu,\n  \"updates\": %llu,\n  \"state_messages\": %llu,\n"
-                "  \"event_records\": %llu,\n  \"cpu_s\": %.3f,\n  \"cpu_s_per_10k_updates\": %.5f,\n"
-                "  \"cpu_percent_of_one_core\": %.2f,\n  \"rss_bytes\": %.0f,\n  \"rss_before_feed_bytes\": %.0f,\n"
-                "  \"hwm_bytes\": %.0f,\n  \"output_lines\": %llu,\n  \"view_rows\": %llu,\n  \"messages_refused\": %llu,\n"
-                "  \"updates_missed\": %llu,\n  \"events_dropped\": %llu,\n  \"feeder_cpu_s_total\": %.3f,\n"
-                "  \"watcher\": \"SAFECASS supervisor, one process, fed by one coordinator through IceStorm\"\n}\n",
-                components, rate, seconds, wall, static_cast<unsigned long long>(changes),
-                static_cast<unsigned long long>(updates),
-                static_cast<unsigned long long>(after.state_messages_published - before.state_messages_published),
-                static_cast<unsigned long long>(records), cpu, per_10k, wall > 0 ? 100.0 * cpu / wall : 0.0, rss,
-                rss_before, hwm, lines, rows, refused,
-                static_cast<unsigned long long>(after.updates_missed),
-                static_cast<unsigned long long>(after.events_dropped), feeder_cpu);
+  std::snprintf(
+      json, sizeof json,
+      "{\n  \"components\": %d,\n  \"rate_hz\": %.1f,\n  \"seconds\": %.2f,\n  \"wall_s\": %.2f,\n"
+      "  \"status_changes\": %llu,\n  \"updates\": %llu,\n  \"state_messages\": %llu,\n"
+      "  \"event_records\": %llu,\n  \"cpu_s\": %.3f,\n  \"cpu_s_per_10k_updates\": %.5f,\n"
+      "  \"cpu_percent_of_one_core\": %.2f,\n  \"rss_bytes\": %.0f,\n  \"rss_before_feed_bytes\": %.0f,\n"
+      "  \"hwm_bytes\": %.0f,\n  \"output_lines\": %llu,\n  \"view_rows\": %llu,\n  \"messages_refused\": %llu,\n"
+      "  \"updates_missed\": %llu,\n  \"events_dropped\": %llu,\n  \"feeder_cpu_s_total\": %.3f,\n"
+      "  \"watcher\": \"SAFECASS supervisor, one process, fed by one coordinator through IceStorm\"\n}\n",
+      components, rate, seconds, wall, static_cast<unsigned long long>(changes),
+      static_cast<unsigned long long>(updates),
+      static_cast<unsigned long long>(after.state_messages_published - before.state_messages_published),
+      static_cast<unsigned long long>(records), cpu, per_10k, wall > 0 ? 100.0 * cpu / wall : 0.0, rss, rss_before, hwm,
+      lines, rows, refused, static_cast<unsigned long long>(after.updates_missed),
+      static_cast<unsigned long long>(after.events_dropped), feeder_cpu);
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   return updates > 0 && rows >= static_cast<unsigned long long>(components) && refused == 0 ? 0 : 1;

@@ -10,7 +10,6 @@ namespace safecass {
 
 namespace {
 
-
 constexpr std::size_t index(State s) noexcept { return static_cast<std::size_t>(s); }
 
 State state_from_counts(const std::array<std::uint32_t, 3>& counts) noexcept {
@@ -137,7 +136,8 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
     return fail(ErrorCode::Duplicate, "duplicate component '" + std::string(name) + "'");
   }
   if (name == "SYSTEM") {
-    return fail(ErrorCode::InvalidArgument, "component name 'SYSTEM' is reserved: it is the address of the whole system");
+    return fail(ErrorCode::InvalidArgument,
+                "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
   const auto id = static_cast<ComponentId>(components_.size());
   ComponentData& cd = components_.emplace_back();
@@ -151,8 +151,7 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
   return id;
 }
 
-MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std::uint32_t iface,
-                                   std::string address) {
+MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address) {
   MachineData& m = machines_.emplace_back();
   m.kind = kind;
   m.component = component;
@@ -176,7 +175,8 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
 }
 
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
-  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (component >= components_.size())
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -184,7 +184,8 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
   }
   for (MachineId m : c.provided) {
     if (machines_[m].address == c.name + ".s_P." + std::string(name)) {
-      return fail(ErrorCode::Duplicate, "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
+      return fail(ErrorCode::Duplicate,
+                  "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
   const auto iface = static_cast<std::uint32_t>(c.provided.size());
@@ -197,7 +198,8 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 }
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
-  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (component >= components_.size())
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -205,7 +207,8 @@ Expected<MachineId> Coordinator::add_required(ComponentId component, std::string
   }
   for (MachineId m : c.required) {
     if (machines_[m].address == c.name + ".s_R." + std::string(name)) {
-      return fail(ErrorCode::Duplicate, "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
+      return fail(ErrorCode::Duplicate,
+                  "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
   const auto iface = static_cast<std::uint32_t>(c.required.size());
@@ -222,8 +225,7 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
   if (def.name.empty()) return fail(ErrorCode::InvalidArgument, "an event needs a name");
   if (find_event(def.name)) return fail(ErrorCode::Duplicate, "duplicate " + where);
   if (def.severity < kMinSeverity || def.severity > kMaxSeverity) {
-    return fail(ErrorCode::InvalidArgument,
-                where + ": severity " + std::to_string(def.severity) + " is outside 1-255");
+    return fail(ErrorCode::InvalidArgument, where + ": severity " + std::to_string(def.severity) + " is outside 1-255");
   }
   if (def.transitions.empty()) return fail(ErrorCode::InvalidArgument, where + ": state_transition is empty");
   const bool onset = def.transitions.worsening_only();
@@ -274,7 +276,8 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
 
 Expected<void> Coordinator::set_service(ComponentId component, std::string_view provided,
                                         const ServiceDependency& dependency) {
-  if (component >= components_.size()) return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (component >= components_.size())
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
   ComponentData& c = components_[component];
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
@@ -285,8 +288,8 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
                                          "': no provided interface of that name");
   }
   if (dependency.propagate == State::Normal) {
-    return fail(ErrorCode::InvalidArgument, "service '" + c.name + "." + std::string(provided) +
-                                                "': propagate must be Warning or Error");
+    return fail(ErrorCode::InvalidArgument,
+                "service '" + c.name + "." + std::string(provided) + "': propagate must be Warning or Error");
   }
   ServiceData data;
   data.dependency = dependency;
@@ -321,8 +324,8 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
     const auto dot = text.find('.');
     if (dot == std::string_view::npos || dot == 0 || dot + 1 == text.size() ||
         text.find('.', dot + 1) != std::string_view::npos) {
-      return fail(ErrorCode::InvalidArgument, std::string(role) + " '" + std::string(text) +
-                                                  "' must be written Component.Interface");
+      return fail(ErrorCode::InvalidArgument,
+                  std::string(role) + " '" + std::string(text) + "' must be written Component.Interface");
     }
     auto comp = find_component(text.substr(0, dot));
     if (!comp) {
@@ -357,13 +360,15 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   }
   if (client->first == provider->first) {
     return fail(ErrorCode::InvalidArgument, "connection " + std::string(client_required) + " -> " +
-                                                std::string(provider_provided) + ": a component cannot require its own service");
+                                                std::string(provider_provided) +
+                                                ": a component cannot require its own service");
   }
   if (cc.required_connection[r] != kNoConnection) {
     const Connection& old = connections_[cc.required_connection[r]];
-    return fail(ErrorCode::Duplicate, "required interface " + std::string(client_required) +
-                                          " is already connected to " + components_[old.provider].name + "." +
-                                          std::string(interface_name(components_[old.provider].provided[old.provided])));
+    return fail(ErrorCode::Duplicate,
+                "required interface " + std::string(client_required) + " is already connected to " +
+                    components_[old.provider].name + "." +
+                    std::string(interface_name(components_[old.provider].provided[old.provided])));
   }
   Lock lock(*this);
   const auto id = static_cast<ConnectionId>(connections_.size());
@@ -447,8 +452,9 @@ Expected<Address> Coordinator::resolve(std::string_view text) const {
   if (text == "SYSTEM" || (text == name_ && !find_component(text))) return a;
   const auto dot = text.find('.');
   auto comp = find_component(text.substr(0, dot));
-  if (!comp) return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': no component '" +
-                                                  std::string(text.substr(0, dot)) + "'");
+  if (!comp)
+    return fail(ErrorCode::NotFound,
+                "address '" + std::string(text) + "': no component '" + std::string(text.substr(0, dot)) + "'");
   a.component = *comp;
   const ComponentData& c = components_[*comp];
   if (dot == std::string_view::npos) {
@@ -468,8 +474,8 @@ Expected<Address> Coordinator::resolve(std::string_view text) const {
   const auto dot2 = rest.find('.');
   const std::string_view kind = rest.substr(0, dot2);
   if (dot2 == std::string_view::npos || (kind != "s_P" && kind != "s_R" && kind != "s_S")) {
-    return fail(ErrorCode::Parse, "address '" + std::string(text) +
-                                      "': expected C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p or SYSTEM");
+    return fail(ErrorCode::Parse,
+                "address '" + std::string(text) + "': expected C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p or SYSTEM");
   }
   const std::string_view iface = rest.substr(dot2 + 1);
   const auto& list = kind == "s_R" ? c.required : c.provided;
@@ -485,16 +491,16 @@ Expected<Address> Coordinator::resolve(std::string_view text) const {
     }
   }
   return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': component '" + c.name + "' has no " +
-                                       (kind == "s_R" ? "required" : "provided") + " interface '" +
-                                       std::string(iface) + "'");
+                                       (kind == "s_R" ? "required" : "provided") + " interface '" + std::string(iface) +
+                                       "'");
 }
 
 Expected<MachineId> Coordinator::find_machine(std::string_view address) const {
   auto a = resolve(address);
   if (!a) return tl::unexpected(a.error());
   if (a->kind != Address::Kind::Machine) {
-    return fail(ErrorCode::InvalidArgument, "address '" + std::string(address) +
-                                                "' is not a state machine (use C.s_F, C.s_A, C.s_P.p or C.s_R.r)");
+    return fail(ErrorCode::InvalidArgument,
+                "address '" + std::string(address) + "' is not a state machine (use C.s_F, C.s_A, C.s_P.p or C.s_R.r)");
   }
   return a->machine;
 }
@@ -502,8 +508,12 @@ Expected<MachineId> Coordinator::find_machine(std::string_view address) const {
 std::string_view Coordinator::component_name(ComponentId id) const noexcept { return components_[id].name; }
 MachineId Coordinator::framework_machine(ComponentId id) const noexcept { return components_[id].framework; }
 MachineId Coordinator::application_machine(ComponentId id) const noexcept { return components_[id].application; }
-const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept { return components_[id].provided; }
-const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept { return components_[id].required; }
+const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept {
+  return components_[id].provided;
+}
+const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept {
+  return components_[id].required;
+}
 MachineKind Coordinator::machine_kind(MachineId id) const noexcept { return machines_[id].kind; }
 ComponentId Coordinator::machine_component(MachineId id) const noexcept { return machines_[id].component; }
 const std::string& Coordinator::address_of(MachineId id) const noexcept { return machines_[id].address; }
@@ -694,7 +704,8 @@ Expected<void> Coordinator::generate(std::string_view event, std::string_view ta
   if (!e) return tl::unexpected(e.error());
   const Event& ev = events_[*e];
   if (!ev.is_onset && ev.counterpart == kNoEvent) {
-    return fail(ErrorCode::InvalidState, "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
+    return fail(ErrorCode::InvalidState,
+                "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
   }
   if (ev.is_broadcast()) {
     generate(*e, kNoMachine);
@@ -788,7 +799,8 @@ void Coordinator::process(EventId event_id, MachineId target, const SampleCause&
 
 void Coordinator::process_onset(const Event& event, MachineId target, const SampleCause& cause, Time now) noexcept {
   MachineData& m = machines_[target];
-  const ConditionChange change = m.conditions.onset(event, RootCause{event.id, target, now, cause}, now, condition_seq_);
+  const ConditionChange change =
+      m.conditions.onset(event, RootCause{event.id, target, now, cause}, now, condition_seq_);
   if (change.outcome == Outcome::None) return;  // §2.4 onset rule 1: a refresh, not recorded
   const Condition c = m.conditions[static_cast<std::size_t>(change.index)];
   record_added(target, change, now);
@@ -1010,8 +1022,8 @@ void Coordinator::propagate_clear(const RootCause& root, State level, Time now) 
       work_.push_back(e.to);
       const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
       if (i < 0) continue;
-      const EventId completion = framework_event::completion_of(
-          machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
+      const EventId completion =
+          framework_event::completion_of(machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
       remove_condition(e.to, static_cast<std::size_t>(i), completion, now, {});
     }
   }

@@ -61,7 +61,7 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
   const MachineId origin = condition.root.origin;
   constexpr std::size_t kUnseen = static_cast<std::size_t>(-1);
   std::vector<std::size_t> parent_edge(machines_.size(), kUnseen);  // index into `edges`
-  std::vector<std::pair<MachineId, const Edge*>> edges;              // (from, edge)
+  std::vector<std::pair<MachineId, const Edge*>> edges;             // (from, edge)
   std::vector<MachineId> queue{origin};
   std::vector<bool> seen(machines_.size(), false);
   seen[origin] = true;

@@ -14,10 +14,12 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   const auto dot = provider_provided.find('.');
   if (dot == std::string_view::npos || dot == 0 || dot + 1 == provider_provided.size() ||
       provider_provided.find('.', dot + 1) != std::string_view::npos) {
-    return fail(ErrorCode::InvalidArgument, "remote provided interface '" + text + "' must be written Component.Interface");
+    return fail(ErrorCode::InvalidArgument,
+                "remote provided interface '" + text + "' must be written Component.Interface");
   }
   if (propagate == State::Normal) {
-    return fail(ErrorCode::InvalidArgument, "remote provided interface '" + text + "': propagate must be Warning or Error");
+    return fail(ErrorCode::InvalidArgument,
+                "remote provided interface '" + text + "': propagate must be Warning or Error");
   }
   const std::string_view component = provider_provided.substr(0, dot);
   const std::string_view iface = provider_provided.substr(dot + 1);
@@ -42,9 +44,7 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   return *machine;
 }
 
-bool Coordinator::is_remote(ComponentId id) const noexcept {
-  return id < components_.size() && components_[id].remote;
-}
+bool Coordinator::is_remote(ComponentId id) const noexcept { return id < components_.size() && components_[id].remote; }
 
 std::string Coordinator::root_origin(const RootCause& root) const {
   Lock lock(*this);
@@ -65,7 +65,8 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
   ids.reserve(roots.size());
   for (std::size_t i = 0; i < roots.size(); ++i) {
     const RemoteRoot& r = roots[i];
-    const std::string what = "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
+    const std::string what =
+        "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
     auto e = find_event(r.event);
     if (!e) return fail(ErrorCode::InvalidArgument, what + ": no event '" + r.event + "' in this system");
     if (!events_[*e].is_onset) return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
@@ -198,7 +199,8 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
       const bool remote = k->root.remote != kNone && k->root.remote < remote_roots_.size();
       const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin].address;
       std::size_t i = 0;
-      while (i < out.size() && !(ids[i] == k->root.event && out[i].time == k->root.time && out[i].origin == origin)) ++i;
+      while (i < out.size() && !(ids[i] == k->root.event && out[i].time == k->root.time && out[i].origin == origin))
+        ++i;
       if (i < out.size()) {
         std::vector<std::string> path = hop_path(id, *k);
         if (path.size() < out[i].path.size()) out[i].path = std::move(path);

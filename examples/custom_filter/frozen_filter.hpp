@@ -16,12 +16,14 @@ public:
     m.inputs = {"input_signal"};
     return m;
   }
+
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
     same_ = (s.scalar() == last_) ? same_ + 1 : 1;
     last_ = s.scalar();
     report(same_ >= limit_, s.scalar(), s.time);
   }
+
 private:
   double limit_, last_ = 0, same_ = 0;
 };

@@ -14,9 +14,14 @@ int main() {
   (void)co.add_event(EventDef{"EVT_FROZEN", 60, {Transition::N2E}, "", false, "", "encoder stopped updating"});
   (void)co.add_event(EventDef{"/EVT_FROZEN", 60, {Transition::E2N}, "", false, "", ""});
   Signal* angle = *monitor.add_signal("ENCODER.angle");
-  FilterConfig config{"frozen_angle", "Frozen", FilterTarget{MachineKind::Application, "ENCODER", ""},
-                      ExecutionMode::Active, DetectionMode::Edge, true,
-                      Params{{"input_signal", std::string("angle")}, {"samples", 3.0}, {"event_onset", std::string("EVT_FROZEN")}}};
+  FilterConfig config{
+      "frozen_angle",
+      "Frozen",
+      FilterTarget{MachineKind::Application, "ENCODER", ""},
+      ExecutionMode::Active,
+      DetectionMode::Edge,
+      true,
+      Params{{"input_signal", std::string("angle")}, {"samples", 3.0}, {"event_onset", std::string("EVT_FROZEN")}}};
   if (auto f = monitor.add_filter(config); !f) {
     std::fprintf(stderr, "%s\n", f.error().message.c_str());
     return 2;

@@ -41,9 +41,7 @@ private:
     // the next goal, send it to SERVO.
     say(now, "run_normal: cutting along the planned path");
   }
-  void run_warning(Time now, const Event& e) {
-    say(now, "run_warning (" + e.name + "): cutting at reduced feed rate");
-  }
+  void run_warning(Time now, const Event& e) { say(now, "run_warning (" + e.name + "): cutting at reduced feed rate"); }
   void run_error(Time now, const Event& e) {
     // The error handlers for each event of the specification.
     if (e.name == "EVT_CONTROL_FORCE_FREEZE") {
@@ -88,7 +86,8 @@ int main(int argc, char** argv) {
   // The story: every change of a component's extended state, with the reason.
   co.subscribe([&co](const Record& r) {
     if (r.kind == RecordKind::Reset && r.from != State::Normal) {
-      std::printf("%s  %s reset by %s\n", secs(r.time).c_str(), co.address_of(r.machine).c_str(), std::string(r.text).c_str());
+      std::printf("%s  %s reset by %s\n", secs(r.time).c_str(), co.address_of(r.machine).c_str(),
+                  std::string(r.text).c_str());
     }
     if (r.kind != RecordKind::ComponentTransition) return;
     const std::string name(co.component_name(r.component));
@@ -122,17 +121,20 @@ int main(int argc, char** argv) {
   std::printf("\nScenario %s: %d expectations checked, %zu failed.\n", run.scenario().path.c_str(), result.checks,
               result.failures.size());
   for (const std::string& f : result.failures) std::printf("  %s\n", f.c_str());
-  if (!history_path.empty()) std::printf("The whole history (every event, transition, reset) is in %s\n", history_path.c_str());
+  if (!history_path.empty())
+    std::printf("The whole history (every event, transition, reset) is in %s\n", history_path.c_str());
   if (result.inputs) {
     std::printf("What the system was fed is in %s (safecass replay feeds it through a changed spec)\n",
                 result.inputs->path.c_str());
   }
   // Nothing lost silently: a recording with a write error or dropped records is said and fails the run.
   if (result.inputs) {
-    for (const std::string& loss : describe_losses(*result.inputs)) std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
+    for (const std::string& loss : describe_losses(*result.inputs))
+      std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
   }
   if (result.record) {
-    for (const std::string& loss : describe_losses(*result.record)) std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
+    for (const std::string& loss : describe_losses(*result.record))
+      std::fprintf(stderr, "robodoc_demo: %s\n", loss.c_str());
   }
   if (!result.history_complete()) return 2;
   return result.passed() ? 0 : 1;

@@ -89,7 +89,8 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh;
   ControlLoop control(co, (*bridge)->monitor().signals().find("CONTROL.TrackingError"),
                       nh.advertise<sensor_msgs::JointState>("/robodoc/command", 10));
-  if (auto r = (*bridge)->add_loop("CONTROL", std::chrono::milliseconds(10), [&control](Time now) { control(now); }); !r) {
+  if (auto r = (*bridge)->add_loop("CONTROL", std::chrono::milliseconds(10), [&control](Time now) { control(now); });
+      !r) {
     std::fprintf(stderr, "%s\n", r.error().message.c_str());
     return 2;
   }
@@ -97,9 +98,10 @@ int main(int argc, char** argv) {
   co.subscribe([&co](const Record& r) {
     if (r.kind != RecordKind::ComponentTransition) return;
     std::string why;
-    if (r.to > r.from && r.root.event != kNoEvent) why = "  because " + co.address_of(r.root.origin) + ":" + co.event(r.root.event).name;
-    ROS_INFO("%s %s -> %s%s", std::string(co.component_name(r.component)).c_str(), std::string(to_string(r.from)).c_str(),
-             std::string(to_string(r.to)).c_str(), why.c_str());
+    if (r.to > r.from && r.root.event != kNoEvent)
+      why = "  because " + co.address_of(r.root.origin) + ":" + co.event(r.root.event).name;
+    ROS_INFO("%s %s -> %s%s", std::string(co.component_name(r.component)).c_str(),
+             std::string(to_string(r.from)).c_str(), std::string(to_string(r.to)).c_str(), why.c_str());
   });
   if (auto r = (*bridge)->start(); !r) {
     std::fprintf(stderr, "ros_robodoc_control: %s\n", r.error().message.c_str());

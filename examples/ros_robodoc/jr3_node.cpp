@@ -91,11 +91,12 @@ int main(int argc, char** argv) {
   ros::Publisher diagnostics = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 10);
   bool overridden = false;
   double fz = o.fz;
-  ros::Subscriber set = nh.subscribe<std_msgs::Float64>("/jr3_sim/set_fz", 10, [&](const std_msgs::Float64::ConstPtr& m) {
-    overridden = true;
-    fz = m->data;
-    ROS_INFO("jr3_sim: Fz set to %.1f N", fz);
-  });
+  ros::Subscriber set =
+      nh.subscribe<std_msgs::Float64>("/jr3_sim/set_fz", 10, [&](const std_msgs::Float64::ConstPtr& m) {
+        overridden = true;
+        fz = m->data;
+        ROS_INFO("jr3_sim: Fz set to %.1f N", fz);
+      });
 
   const ros::WallTime start = ros::WallTime::now();
   ros::WallTime next_diagnostics = start;
@@ -122,8 +123,10 @@ int main(int argc, char** argv) {
       diagnostic_msgs::DiagnosticStatus s;
       s.name = "jr3_sim: saturation";
       s.hardware_id = "jr3";
-      const double norm = std::sqrt(m.wrench.force.x * m.wrench.force.x + m.wrench.force.y * m.wrench.force.y + fz * fz);
-      s.level = norm > kSaturationWarning ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
+      const double norm =
+          std::sqrt(m.wrench.force.x * m.wrench.force.x + m.wrench.force.y * m.wrench.force.y + fz * fz);
+      s.level =
+          norm > kSaturationWarning ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
       s.message = norm > kSaturationWarning ? "force near the end of the measuring range" : "within range";
       diagnostic_msgs::KeyValue kv;
       kv.key = "force norm";

@@ -15,7 +15,8 @@ Filter::Filter(FilterInit init)
       onset_(init.onset),
       completion_(init.completion),
       name_id_(init.name_id) {
-  detour_.store(static_cast<std::uint8_t>((config_.enabled ? 0 : kDisabled) | (inputs_.size() == 1 ? 0 : kSeveralInputs)));
+  detour_.store(
+      static_cast<std::uint8_t>((config_.enabled ? 0 : kDisabled) | (inputs_.size() == 1 ? 0 : kSeveralInputs)));
   cursors_.reserve(inputs_.size());
   for (Signal* s : inputs_) {
     cursors_.emplace_back(s);
@@ -141,8 +142,8 @@ void Filter::reset() noexcept {
 
 void Filter::report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept {
   const bool was = detected_.load(std::memory_order_relaxed);
-  const SampleCause cause{name_id_, input < inputs_.size() ? inputs_[input]->name_id() : kNoName, value,
-                          sample_time, current_injected_};
+  const SampleCause cause{name_id_, input < inputs_.size() ? inputs_[input]->name_id() : kNoName, value, sample_time,
+                          current_injected_};
   if (detected) {
     if (was && config_.detection == DetectionMode::Edge) return;
     detected_.store(true, std::memory_order_release);
@@ -171,8 +172,8 @@ void Filter::invalid_sample(std::size_t input, const SampleView& sample, bool in
     }
   }
   const SampleCause cause{name_id_, inputs_[input]->name_id(), value, sample.time, current_injected_};
-  const EventId event = invalid ? framework_event::kInvalidSample
-                                : framework_event::completion_of(framework_event::kInvalidSample);
+  const EventId event =
+      invalid ? framework_event::kInvalidSample : framework_event::completion_of(framework_event::kInvalidSample);
   coordinator_->generate(event, coordinator_->framework_machine(component_), cause);
 }
 

@@ -24,8 +24,8 @@ Expected<Signal*> Monitor::add_signal(std::string_view name, std::size_t size) {
   }
   auto component = coordinator_.find_component(name.substr(0, dot));
   if (!component) {
-    return fail(ErrorCode::NotFound, "signal '" + std::string(name) + "': no component '" +
-                                         std::string(name.substr(0, dot)) + "'");
+    return fail(ErrorCode::NotFound,
+                "signal '" + std::string(name) + "': no component '" + std::string(name.substr(0, dot)) + "'");
   }
   auto s = signals_.add(name, *component, size);
   if (s && (*s)->name_id() == kNoName) (*s)->set_name_id(coordinator_.intern((*s)->name()));
@@ -119,15 +119,16 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
       }
       if (s->size() != size) {
         return fail(ErrorCode::InvalidArgument, where + ": parameter '" + manifest.outputs[k] + "': signal '" + full +
-                                                    "' has size " + std::to_string(s->size()) + " but this filter writes " +
-                                                    std::to_string(size));
+                                                    "' has size " + std::to_string(s->size()) +
+                                                    " but this filter writes " + std::to_string(size));
       }
       init.outputs.push_back(s);
       continue;
     }
     const auto dot = full.find('.');
     if (!coordinator_.find_component(std::string_view(full).substr(0, dot))) {
-      return fail(ErrorCode::NotFound, where + ": parameter '" + manifest.outputs[k] + "': no component for '" + full + "'");
+      return fail(ErrorCode::NotFound,
+                  where + ": parameter '" + manifest.outputs[k] + "': no component for '" + full + "'");
     }
     new_outputs.emplace_back(full, size);
     init.outputs.push_back(nullptr);
@@ -142,19 +143,23 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
     if (it == config.params.end()) continue;
     const std::string& name = std::get<std::string>(it->second);
     auto e = coordinator_.find_event(name);
-    if (!e) return fail(ErrorCode::NotFound, where + ": parameter '" + event_params[k]->name + "': no event '" + name + "'");
+    if (!e)
+      return fail(ErrorCode::NotFound, where + ": parameter '" + event_params[k]->name + "': no event '" + name + "'");
     const bool want_onset = k == 0;
     if (coordinator_.event(*e).is_onset != want_onset) {
-      return fail(ErrorCode::InvalidArgument, where + ": parameter '" + event_params[k]->name + "': event '" + name +
-                                                  "' is " + (want_onset ? "a completion; an onset is needed" : "an onset; a completion is needed"));
+      return fail(ErrorCode::InvalidArgument,
+                  where + ": parameter '" + event_params[k]->name + "': event '" + name + "' is " +
+                      (want_onset ? "a completion; an onset is needed" : "an onset; a completion is needed"));
     }
     (want_onset ? init.onset : init.completion) = *e;
   }
-  if (init.onset != kNoEvent && init.completion == kNoEvent) init.completion = coordinator_.event(init.onset).counterpart;
+  if (init.onset != kNoEvent && init.completion == kNoEvent)
+    init.completion = coordinator_.event(init.onset).counterpart;
   if (init.completion != kNoEvent && init.onset != kNoEvent &&
       coordinator_.event(init.completion).counterpart != init.onset) {
     return fail(ErrorCode::InvalidArgument, where + ": completion '" + coordinator_.event(init.completion).name +
-                                                "' does not complete onset '" + coordinator_.event(init.onset).name + "'");
+                                                "' does not complete onset '" + coordinator_.event(init.onset).name +
+                                                "'");
   }
   init.name_id = coordinator_.intern(config.name);
   init.config = std::move(config);
@@ -212,7 +217,8 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
     previous_output.clear();
     if (entry != nullptr && !entry->manifest.outputs.empty()) {
       const auto it = stage.params.find(entry->manifest.outputs.front());
-      if (it != stage.params.end()) previous_output = qualify(std::get<std::string>(it->second), stage.target.component);
+      if (it != stage.params.end())
+        previous_output = qualify(std::get<std::string>(it->second), stage.target.component);
     }
     auto f = add_filter(stage);
     if (!f) {
@@ -224,8 +230,8 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
         filters_.pop_back();
       }
       signals_.truncate(signals_before);
-      return fail(f.error().code, "pipeline '" + std::string(name) + "', stage " + std::to_string(i + 1) + ": " +
-                                      f.error().message);
+      return fail(f.error().code,
+                  "pipeline '" + std::string(name) + "', stage " + std::to_string(i + 1) + ": " + f.error().message);
     }
     created.push_back(*f);
   }
@@ -320,9 +326,9 @@ Expected<void> Monitor::inject_deep(std::string_view signal, const std::vector<s
   if (s == nullptr) return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "'");
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (samples[i].size() != s->size()) {
-      return fail(ErrorCode::InvalidArgument, "deep injection into '" + s->name() + "': sample " + std::to_string(i + 1) +
-                                                  " has " + std::to_string(samples[i].size()) + " values; the signal has size " +
-                                                  std::to_string(s->size()));
+      return fail(ErrorCode::InvalidArgument, "deep injection into '" + s->name() + "': sample " +
+                                                  std::to_string(i + 1) + " has " + std::to_string(samples[i].size()) +
+                                                  " values; the signal has size " + std::to_string(s->size()));
     }
   }
   if (auto finite = check_finite("deep injection into signal " + s->name(), samples); !finite) return finite;

@@ -118,7 +118,8 @@ std::string_view FilterManifest::canonical(std::string_view name) const noexcept
 
 std::string default_output_name(std::string_view filter, std::string_view component) {
   std::string_view bare = filter;
-  if (bare.size() > component.size() && bare.substr(0, component.size()) == component && bare[component.size()] == '.') {
+  if (bare.size() > component.size() && bare.substr(0, component.size()) == component &&
+      bare[component.size()] == '.') {
     bare.remove_prefix(component.size() + 1);
   }
   std::string out(component);
@@ -168,7 +169,8 @@ Expected<Params> check_params(const FilterManifest& manifest, const Params& give
       case ParamType::Number:
       case ParamType::Integer: {
         const double* d = std::get_if<double>(&v);
-        if (d == nullptr) return fail(ErrorCode::InvalidArgument, bad + to_string(spec.type).data() + ", not " + describe(v));
+        if (d == nullptr)
+          return fail(ErrorCode::InvalidArgument, bad + to_string(spec.type).data() + ", not " + describe(v));
         if (!std::isfinite(*d)) return fail(ErrorCode::InvalidArgument, bad + "finite");
         if (spec.type == ParamType::Integer && std::floor(*d) != *d) {
           return fail(ErrorCode::InvalidArgument, bad + "a whole number, not " + number_text(*d));
@@ -180,14 +182,15 @@ Expected<Params> check_params(const FilterManifest& manifest, const Params& give
         break;
       }
       case ParamType::Bool:
-        if (!std::holds_alternative<bool>(v)) return fail(ErrorCode::InvalidArgument, bad + "a boolean, not " + describe(v));
+        if (!std::holds_alternative<bool>(v))
+          return fail(ErrorCode::InvalidArgument, bad + "a boolean, not " + describe(v));
         break;
       case ParamType::String:
       case ParamType::Signal:
       case ParamType::Event:
         if (!std::holds_alternative<std::string>(v) || std::get<std::string>(v).empty()) {
-          return fail(ErrorCode::InvalidArgument, bad + "a non-empty string (" + std::string(to_string(spec.type)) +
-                                                      "), not " + describe(v));
+          return fail(ErrorCode::InvalidArgument,
+                      bad + "a non-empty string (" + std::string(to_string(spec.type)) + "), not " + describe(v));
         }
         break;
       case ParamType::Choice: {

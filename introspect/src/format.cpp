@@ -48,7 +48,8 @@ std::string range_text(const ParamRow& p) {
   const bool low = p.min > -1e299;
   const bool high = p.max < 1e299;
   if (!low && !high) return {};
-  return "[" + (low ? number_text(p.min) : std::string("-inf")) + ", " + (high ? number_text(p.max) : std::string("+inf")) + "]";
+  return "[" + (low ? number_text(p.min) : std::string("-inf")) + ", " +
+         (high ? number_text(p.max) : std::string("+inf")) + "]";
 }
 
 std::string default_text(const ParamRow& p) {
@@ -74,8 +75,9 @@ std::string iso8601_local(std::int64_t unix_ns) {
   localtime_r(&tt, &tm);
   const long offset = tm.tm_gmtoff;
   const long off = offset < 0 ? -offset : offset;
-  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}{}{:02}:{:02}", tm.tm_year + 1900, tm.tm_mon + 1, tm.tm_mday,
-                     tm.tm_hour, tm.tm_min, tm.tm_sec, rest / 1'000'000, offset < 0 ? '-' : '+', off / 3600, (off % 3600) / 60);
+  return fmt::format("{:04}-{:02}-{:02}T{:02}:{:02}:{:02}.{:03}{}{:02}:{:02}", tm.tm_year + 1900, tm.tm_mon + 1,
+                     tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, rest / 1'000'000, offset < 0 ? '-' : '+', off / 3600,
+                     (off % 3600) / 60);
 }
 
 std::string seconds_text(Time t) { return json_seconds(t); }
@@ -201,7 +203,8 @@ std::string history_json(const HistoryEntry& e) {
     JsonObject root;
     root.str("event", r.event).str("origin", r.origin).seconds("t", r.time);
     if (!r.filter.empty()) root.str("filter", r.filter);
-    if (!r.signal.empty()) root.str("signal", r.signal).raw("value", sample_json(r.value)).seconds("sample_t", r.sample_time);
+    if (!r.signal.empty())
+      root.str("signal", r.signal).raw("value", sample_json(r.value)).seconds("sample_t", r.sample_time);
     if (r.injected) root.boolean("injected", true);
     j.raw("root", root.text());
   }
@@ -217,7 +220,8 @@ bool shown_while_watching(const HistoryEntry& e) noexcept {
 // ---- explanations -----------------------------------------------------------------------------
 
 std::string explanation_text(const Explanation& e, const TimeFormat& time) {
-  std::string out = e.machine + ": " + state_text(e.level) + " " + e.event + " (severity " + std::to_string(e.severity) + ")";
+  std::string out =
+      e.machine + ": " + state_text(e.level) + " " + e.event + " (severity " + std::to_string(e.severity) + ")";
   if (e.mirror) out += " <- " + e.root_origin + ":" + e.root_event;
   out += " since " + time.stamp(e.root_time);
   if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
@@ -237,10 +241,19 @@ std::string explanation_text(const Explanation& e, const TimeFormat& time) {
 
 std::string explanation_json(const std::string& address, const Explanation& e) {
   JsonObject j;
-  j.str("address", address).str("machine", e.machine).str("event", e.event).str("level", to_string(e.level))
-      .integer("severity", e.severity).boolean("mirror", e.mirror).boolean("outstanding", e.outstanding)
-      .integer("count", e.count).num("first", to_seconds(e.first)).num("last", to_seconds(e.last))
-      .str("root_event", e.root_event).str("root_origin", e.root_origin).num("root_t", to_seconds(e.root_time))
+  j.str("address", address)
+      .str("machine", e.machine)
+      .str("event", e.event)
+      .str("level", to_string(e.level))
+      .integer("severity", e.severity)
+      .boolean("mirror", e.mirror)
+      .boolean("outstanding", e.outstanding)
+      .integer("count", e.count)
+      .num("first", to_seconds(e.first))
+      .num("last", to_seconds(e.last))
+      .str("root_event", e.root_event)
+      .str("root_origin", e.root_origin)
+      .num("root_t", to_seconds(e.root_time))
       .opt("hazard", e.hazard);
   if (!e.filter.empty()) j.str("filter", e.filter);
   if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
@@ -275,8 +288,13 @@ std::string state_list_text(const std::vector<StateRow>& rows) {
 std::string state_list_json(const std::vector<StateRow>& rows) {
   std::string out;
   for (const StateRow& r : rows) {
-    out += JsonObject().str("address", r.address).str("kind", to_string(r.kind)).str("state", to_string(r.state))
-               .opt("outstanding", r.outstanding).text() + "\n";
+    out += JsonObject()
+               .str("address", r.address)
+               .str("kind", to_string(r.kind))
+               .str("state", to_string(r.state))
+               .opt("outstanding", r.outstanding)
+               .text() +
+           "\n";
   }
   return out;
 }
@@ -287,8 +305,9 @@ std::string filter_list_text(const std::vector<FilterRow>& rows) {
   for (const FilterRow& f : rows) {
     std::string signals = joined(names_of(f.inputs), ",");
     if (!f.outputs.empty()) signals += " -> " + joined(names_of(f.outputs), ",");
-    table.push_back({f.name, f.type, f.target.empty() ? "-" : f.target, f.active ? "ACTIVE" : "PASSIVE", f.edge ? "EDGE" : "LEVEL",
-                     f.enabled ? "enabled" : "disabled", f.detected ? "DETECTED" : "-", signals});
+    table.push_back({f.name, f.type, f.target.empty() ? "-" : f.target, f.active ? "ACTIVE" : "PASSIVE",
+                     f.edge ? "EDGE" : "LEVEL", f.enabled ? "enabled" : "disabled", f.detected ? "DETECTED" : "-",
+                     signals});
   }
   return columns(table);
 }
@@ -296,10 +315,18 @@ std::string filter_list_text(const std::vector<FilterRow>& rows) {
 std::string filter_list_json(const std::vector<FilterRow>& rows) {
   std::string out;
   for (const FilterRow& f : rows) {
-    out += JsonObject().str("filter", f.name).str("type", f.type).str("target", f.target.empty() ? "-" : f.target)
-               .str("execution", f.active ? "ACTIVE" : "PASSIVE").str("detection", f.edge ? "EDGE" : "LEVEL")
-               .boolean("enabled", f.enabled).boolean("detected", f.detected).strings("inputs", names_of(f.inputs))
-               .strings("outputs", names_of(f.outputs)).text() + "\n";
+    out += JsonObject()
+               .str("filter", f.name)
+               .str("type", f.type)
+               .str("target", f.target.empty() ? "-" : f.target)
+               .str("execution", f.active ? "ACTIVE" : "PASSIVE")
+               .str("detection", f.edge ? "EDGE" : "LEVEL")
+               .boolean("enabled", f.enabled)
+               .boolean("detected", f.detected)
+               .strings("inputs", names_of(f.inputs))
+               .strings("outputs", names_of(f.outputs))
+               .text() +
+           "\n";
   }
   return out;
 }
@@ -315,8 +342,8 @@ std::string filter_info_text(const FilterInfo& info) {
   if (info.filter) {
     const FilterRow& f = *info.filter;
     line("filter " + f.name + ": " + info.type + " - " + info.doc);
-    line("  target " + (f.target.empty() ? std::string("-") : f.target) + ", " + (f.active ? "ACTIVE" : "PASSIVE") + ", " +
-         (f.edge ? "EDGE" : "LEVEL"));
+    line("  target " + (f.target.empty() ? std::string("-") : f.target) + ", " + (f.active ? "ACTIVE" : "PASSIVE") +
+         ", " + (f.edge ? "EDGE" : "LEVEL"));
     line(std::string("  ") + (f.enabled ? "enabled" : "disabled") + ", " +
          (f.detected ? "detected (onset sent, no completion yet)" : "not detected") + ", " +
          std::to_string(info.missed_samples) + " missed samples");
@@ -333,7 +360,8 @@ std::string filter_info_text(const FilterInfo& info) {
   for (const ParamRow& p : info.params) {
     const std::string value = info.filter ? (p.value ? param_text(*p.value) : std::string("-")) : std::string();
     const std::string range = range_text(p);
-    rows.push_back({"    " + p.name, std::string(to_string(p.type)), value, default_text(p), range.empty() ? "-" : range, p.doc});
+    rows.push_back(
+        {"    " + p.name, std::string(to_string(p.type)), value, default_text(p), range.empty() ? "-" : range, p.doc});
   }
   if (!info.filter) {
     for (auto& r : rows) r.erase(r.begin() + 2);
@@ -343,22 +371,33 @@ std::string filter_info_text(const FilterInfo& info) {
 
 std::string filter_info_json(const FilterInfo& info) {
   JsonObject head;
-  head.opt("filter", info.filter ? info.filter->name : std::string()).str("type", info.type).str("doc", info.doc)
-      .strings("inputs", info.inputs).strings("outputs", info.outputs).boolean("generates_events", info.generates_events);
+  head.opt("filter", info.filter ? info.filter->name : std::string())
+      .str("type", info.type)
+      .str("doc", info.doc)
+      .strings("inputs", info.inputs)
+      .strings("outputs", info.outputs)
+      .boolean("generates_events", info.generates_events);
   if (info.filter) {
     const FilterRow& f = *info.filter;
-    head.str("target", f.target).str("execution", f.active ? "ACTIVE" : "PASSIVE").str("detection", f.edge ? "EDGE" : "LEVEL")
-        .boolean("enabled", f.enabled).boolean("detected", f.detected)
+    head.str("target", f.target)
+        .str("execution", f.active ? "ACTIVE" : "PASSIVE")
+        .str("detection", f.edge ? "EDGE" : "LEVEL")
+        .boolean("enabled", f.enabled)
+        .boolean("detected", f.detected)
         .integer("missed_samples", static_cast<long long>(info.missed_samples))
-        .strings("input_signals", names_of(f.inputs)).strings("output_signals", names_of(f.outputs));
+        .strings("input_signals", names_of(f.inputs))
+        .strings("output_signals", names_of(f.outputs));
   }
   std::string out = head.text() + "\n";
   for (const ParamRow& p : info.params) {
     JsonObject j;
-    j.str("param", p.name).str("type", to_string(p.type)).raw("default", p.default_value ? param_json(*p.default_value) : "null")
+    j.str("param", p.name)
+        .str("type", to_string(p.type))
+        .raw("default", p.default_value ? param_json(*p.default_value) : "null")
         .boolean("required", !p.default_value && !p.optional);
     if (p.type == ParamType::Number || p.type == ParamType::Integer) {
-      j.raw("min", p.min > -1e299 ? json_number(p.min) : "null").raw("max", p.max < 1e299 ? json_number(p.max) : "null");
+      j.raw("min", p.min > -1e299 ? json_number(p.min) : "null")
+          .raw("max", p.max < 1e299 ? json_number(p.max) : "null");
     }
     if (p.type == ParamType::Choice) j.strings("choices", p.choices);
     if (info.filter) j.raw("value", p.value ? param_json(*p.value) : "null");
@@ -384,10 +423,18 @@ std::string event_list_text(const std::vector<EventRow>& rows) {
 std::string event_list_json(const std::vector<EventRow>& rows) {
   std::string out;
   for (const EventRow& e : rows) {
-    out += JsonObject().str("event", e.name).integer("severity", e.severity).str("kind", event_kind(e))
-               .str("transitions", transitions_text(e.transitions)).opt(e.onset ? "completion" : "completes", e.counterpart)
-               .boolean("latched", e.latched).boolean("framework", e.framework).opt("hazard", e.hazard)
-               .opt("description", e.description).text() + "\n";
+    out += JsonObject()
+               .str("event", e.name)
+               .integer("severity", e.severity)
+               .str("kind", event_kind(e))
+               .str("transitions", transitions_text(e.transitions))
+               .opt(e.onset ? "completion" : "completes", e.counterpart)
+               .boolean("latched", e.latched)
+               .boolean("framework", e.framework)
+               .opt("hazard", e.hazard)
+               .opt("description", e.description)
+               .text() +
+           "\n";
   }
   return out;
 }
@@ -396,9 +443,10 @@ std::string connection_list_text(const std::vector<ConnectionRow>& rows) {
   if (rows.empty()) return "no connections\n";
   std::vector<std::vector<std::string>> table;
   for (const ConnectionRow& k : rows) {
-    table.push_back({k.required, "->", k.provided, "s_R " + (k.required_state ? state_text(*k.required_state) : std::string("?")),
-                     k.service_state ? "s_S " + state_text(*k.service_state) : std::string("s_S ? (in another process)"),
-                     k.propagate ? "propagates " + propagates_text(*k.propagate) : std::string("remote provider")});
+    table.push_back(
+        {k.required, "->", k.provided, "s_R " + (k.required_state ? state_text(*k.required_state) : std::string("?")),
+         k.service_state ? "s_S " + state_text(*k.service_state) : std::string("s_S ? (in another process)"),
+         k.propagate ? "propagates " + propagates_text(*k.propagate) : std::string("remote provider")});
   }
   return columns(table);
 }
@@ -408,9 +456,18 @@ std::string connection_list_json(const std::vector<ConnectionRow>& rows) {
   for (const ConnectionRow& k : rows) {
     JsonObject j;
     j.str("required", k.required).str("provided", k.provided);
-    if (k.required_state) j.str("required_state", to_string(*k.required_state)); else j.null("required_state");
-    if (k.service_state) j.str("service_state", to_string(*k.service_state)); else j.null("service_state");
-    if (k.propagate) j.str("propagates", to_string(*k.propagate)); else j.null("propagates");
+    if (k.required_state)
+      j.str("required_state", to_string(*k.required_state));
+    else
+      j.null("required_state");
+    if (k.service_state)
+      j.str("service_state", to_string(*k.service_state));
+    else
+      j.null("service_state");
+    if (k.propagate)
+      j.str("propagates", to_string(*k.propagate));
+    else
+      j.null("propagates");
     out += j.boolean("remote", k.remote).text() + "\n";
   }
   return out;
@@ -420,7 +477,8 @@ std::string service_list_text(const std::vector<ServiceRow>& rows) {
   if (rows.empty()) return "no provided interfaces\n";
   std::vector<std::vector<std::string>> table;
   for (const ServiceRow& s : rows) {
-    table.push_back({s.address, state_text(s.state), "= " + joined(s.depends_on, " * "), "(propagates " + propagates_text(s.propagate) + ")"});
+    table.push_back({s.address, state_text(s.state), "= " + joined(s.depends_on, " * "),
+                     "(propagates " + propagates_text(s.propagate) + ")"});
   }
   return columns(table);
 }
@@ -428,8 +486,13 @@ std::string service_list_text(const std::vector<ServiceRow>& rows) {
 std::string service_list_json(const std::vector<ServiceRow>& rows) {
   std::string out;
   for (const ServiceRow& s : rows) {
-    out += JsonObject().str("service", s.address).str("state", to_string(s.state)).strings("depends_on", s.depends_on)
-               .str("propagates", to_string(s.propagate)).text() + "\n";
+    out += JsonObject()
+               .str("service", s.address)
+               .str("state", to_string(s.state))
+               .strings("depends_on", s.depends_on)
+               .str("propagates", to_string(s.propagate))
+               .text() +
+           "\n";
   }
   return out;
 }

@@ -89,8 +89,10 @@ std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
   for (const MachineId m : co_.required_machines(id)) machine(m);
   const auto& provided = co_.provided_machines(id);
   for (std::uint32_t p = 0; p < provided.size(); ++p) {
-    out.push_back({name + ".s_S." + std::string(co_.interface_name(provided[p])), RowKind::Service,
-                   co_.service_state(id, p), {}});
+    out.push_back({name + ".s_S." + std::string(co_.interface_name(provided[p])),
+                   RowKind::Service,
+                   co_.service_state(id, p),
+                   {}});
   }
   return out;
 }
@@ -100,7 +102,8 @@ Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view componen
   if (!component.empty()) {
     auto id = co_.find_component(component);
     if (!id || co_.is_remote(*id)) {
-      return fail(ErrorCode::NotFound, "no component '" + std::string(component) + "' in coordinator '" + options_.name + "'");
+      return fail(ErrorCode::NotFound,
+                  "no component '" + std::string(component) + "' in coordinator '" + options_.name + "'");
     }
     return component_rows(*id);
   }
@@ -113,7 +116,8 @@ Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view componen
   return out;
 }
 
-Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, std::size_t last, HistoryFilter filter) {
+Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, std::size_t last,
+                                                        HistoryFilter filter) {
   Address a;  // SYSTEM
   if (!scope.empty() && scope != "SYSTEM") {
     auto r = co_.resolve(scope);
@@ -122,7 +126,8 @@ Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, 
     if (a.kind == Address::Kind::Service) a.kind = Address::Kind::Component;
   }
   std::vector<Record> records = co_.history(a);
-  if (filter == HistoryFilter::Events) std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::Event; });
+  if (filter == HistoryFilter::Events)
+    std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::Event; });
   return tail(co_, records, last);
 }
 
@@ -154,7 +159,8 @@ Expected<std::vector<FilterRow>> LocalQuery::filter_list() {
 Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
   const Filter* f = monitor_.find_filter(name);
   const FilterRegistry::Entry* entry = registry_.find(f != nullptr ? std::string_view(f->type()) : name);
-  if (entry == nullptr) return fail(ErrorCode::NotFound, "no filter or filter type '" + std::string(name) + "' (see filter list)");
+  if (entry == nullptr)
+    return fail(ErrorCode::NotFound, "no filter or filter type '" + std::string(name) + "' (see filter list)");
   const FilterManifest& m = entry->manifest;
   FilterInfo info;
   info.type = m.type;
@@ -197,7 +203,8 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
     r.severity = e.severity;
     r.onset = e.is_onset;
     r.broadcast = e.is_broadcast();
-    for (const Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
+    for (const Transition t :
+         {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (e.transitions.contains(t)) r.transitions.push_back(t);
     }
     r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.event(e.counterpart).name;
@@ -245,7 +252,8 @@ Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
       if (d.framework) r.depends_on.emplace_back("s_F");
       if (d.application) r.depends_on.emplace_back("s_A");
       if (d.all_required) {
-        for (const MachineId m : co_.required_machines(id)) r.depends_on.push_back("s_R." + std::string(co_.interface_name(m)));
+        for (const MachineId m : co_.required_machines(id))
+          r.depends_on.push_back("s_R." + std::string(co_.interface_name(m)));
       } else {
         for (const std::string& name : d.required) r.depends_on.push_back("s_R." + name);
       }
@@ -263,7 +271,8 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
     for (ComponentId id = 0; id < co_.component_count(); ++id) {
       if (co_.is_remote(id)) continue;
       std::vector<Explanation> part = co_.explain(Address{Address::Kind::Component, id});
-      a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
+      a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()),
+                          std::make_move_iterator(part.end()));
     }
     return a;
   }
@@ -303,24 +312,30 @@ Expected<std::unique_ptr<Subscription>> LocalQuery::follow(RecordSink sink) {
   return std::unique_ptr<Subscription>(std::make_unique<LocalSubscription>(co_, id));
 }
 
-Expected<void> LocalQuery::generate(std::string_view event, std::string_view target) { return co_.generate(event, target); }
+Expected<void> LocalQuery::generate(std::string_view event, std::string_view target) {
+  return co_.generate(event, target);
+}
 
 Expected<void> LocalQuery::broadcast(std::string_view event) { return co_.broadcast(event); }
 
 Expected<void> LocalQuery::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
   if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter inject " + std::string(filter) + ": no samples");
-  if (monitor_.find_filter(filter) == nullptr) return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "' (see filter list)");
+  if (monitor_.find_filter(filter) == nullptr)
+    return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "' (see filter list)");
   return monitor_.inject_shallow(filter, samples);
 }
 
 Expected<void> LocalQuery::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
-  if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter dinject " + std::string(signal) + ": no samples");
+  if (samples.empty())
+    return fail(ErrorCode::InvalidArgument, "filter dinject " + std::string(signal) + ": no samples");
   const Signal* s = monitor_.signals().find(signal);
-  if (s == nullptr) return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "' (signals are written Component.signal)");
+  if (s == nullptr)
+    return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "' (signals are written Component.signal)");
   if (samples.size() > s->buffer().capacity()) {
-    return fail(ErrorCode::InvalidArgument, std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples") +
-                                                " would overflow the history of '" + std::string(signal) + "' (" +
-                                                std::to_string(s->buffer().capacity()) + " samples): inject fewer at once");
+    return fail(ErrorCode::InvalidArgument,
+                std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples") +
+                    " would overflow the history of '" + std::string(signal) + "' (" +
+                    std::to_string(s->buffer().capacity()) + " samples): inject fewer at once");
   }
   Time now = co_.clock().now();
   if (options_.base == TimeBase::Simulated && now < Time{0}) now = Time{0};

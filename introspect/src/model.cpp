@@ -38,7 +38,8 @@ HistoryEntry history_entry(const Record& r, const Coordinator& co) {
   e.time = r.time;
   e.kind = r.kind;
   e.outcome = r.outcome;
-  if (r.component != kNoComponent && r.component < co.component_count()) e.component = std::string(co.component_name(r.component));
+  if (r.component != kNoComponent && r.component < co.component_count())
+    e.component = std::string(co.component_name(r.component));
   if (r.machine != kNoMachine && r.machine < co.machine_count()) e.machine = co.address_of(r.machine);
   if (r.event != kNoEvent && r.event < co.event_count()) e.event = co.event(r.event).name;
   e.from = r.from;
@@ -52,7 +53,8 @@ HistoryEntry history_entry(const Record& r, const Coordinator& co) {
     root.event = co.event(r.root.event).name;
     // A root from another process names its origin there (interned when it arrived), not the
     // local stand-in it came through: a live client's history names the same root as in-process.
-    root.origin = r.root.remote_origin != kNoName ? std::string(co.name_of(r.root.remote_origin)) : co.address_of(r.root.origin);
+    root.origin =
+        r.root.remote_origin != kNoName ? std::string(co.name_of(r.root.remote_origin)) : co.address_of(r.root.origin);
     root.time = r.root.time;
     if (r.root.sample.filter != kNoName) root.filter = std::string(co.name_of(r.root.sample.filter));
     if (r.root.sample.signal != kNoName) {

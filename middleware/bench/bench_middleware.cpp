@@ -27,10 +27,10 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
-#include <filesystem>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <mutex>
 #include <string>
@@ -68,14 +68,18 @@ std::string system_text(int k) {
   return R"({
   "safecass": 1, "system": "bench",
   "components": [
-    { "component": "JR3", "interfaces": { "provided": [)" + provided + R"(], "required": [] },
+    { "component": "JR3", "interfaces": { "provided": [)" +
+         provided + R"(], "required": [] },
       "event": [ { "name": "EVT_FORCE_ERROR", "severity": 50, "state_transition": ["N2E", "W2E"] },
                  { "name": "/EVT_FORCE_ERROR", "severity": 50, "state_transition": ["E2N", "E2W"] },
                  { "name": "EVT_JR3_FAULT", "severity": 60, "state_transition": ["N2E", "W2E"] },
                  { "name": "/EVT_JR3_FAULT", "severity": 60, "state_transition": ["E2N", "E2W"] } ],
-      "service": [ )" + services + R"( ] },
-    { "component": "CONTROL", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
-  "connections": [ )" + connections + R"( ],
+      "service": [ )" +
+         services + R"( ] },
+    { "component": "CONTROL", "interfaces": { "provided": [], "required": [)" +
+         required + R"(] } } ],
+  "connections": [ )" +
+         connections + R"( ],
   "coordinators": { "sensor": ["JR3"], "robot": ["CONTROL"] } })";
 }
 
@@ -206,12 +210,18 @@ int main(int argc, char** argv) {
   std::chrono::microseconds pause{50};
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
-    if (key == "--ice") ice_text = argv[i + 1];
-    else if (key == "--out") out_path = argv[i + 1];
-    else if (key == "--samples") samples = std::max(10, std::atoi(argv[i + 1]));
-    else if (key == "--seconds") seconds = std::max(0.2, std::atof(argv[i + 1]));
-    else if (key == "--interfaces") interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
-    else if (key == "--pause-us") pause = std::chrono::microseconds(std::clamp(std::atoi(argv[i + 1]), 0, 1000000));
+    if (key == "--ice")
+      ice_text = argv[i + 1];
+    else if (key == "--out")
+      out_path = argv[i + 1];
+    else if (key == "--samples")
+      samples = std::max(10, std::atoi(argv[i + 1]));
+    else if (key == "--seconds")
+      seconds = std::max(0.2, std::atof(argv[i + 1]));
+    else if (key == "--interfaces")
+      interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
+    else if (key == "--pause-us")
+      pause = std::chrono::microseconds(std::clamp(std::atoi(argv[i + 1]), 0, 1000000));
     else {
       std::fprintf(stderr, "bench_middleware: unknown option %s\n", key.c_str());
       return 2;
@@ -267,15 +277,16 @@ int main(int argc, char** argv) {
   std::mutex mutex;
   std::vector<double> latencies;
   std::atomic<bool> measuring{false};
-  client.co->on_machine(*client.co->find_machine("CONTROL.s_R.ForceData"), StateCallbacks{
-      nullptr,
-      [&](const TransitionInfo& info) {
-        if (!measuring.load() || info.transition != Transition::N2E || info.root == nullptr) return;
-        const double us = static_cast<double>((client.clock.now() - info.root->time).count()) / 1000.0;
-        std::lock_guard lock(mutex);
-        latencies.push_back(us);
-      },
-      nullptr});
+  client.co->on_machine(
+      *client.co->find_machine("CONTROL.s_R.ForceData"),
+      StateCallbacks{nullptr,
+                     [&](const TransitionInfo& info) {
+                       if (!measuring.load() || info.transition != Transition::N2E || info.root == nullptr) return;
+                       const double us = static_cast<double>((client.clock.now() - info.root->time).count()) / 1000.0;
+                       std::lock_guard lock(mutex);
+                       latencies.push_back(us);
+                     },
+                     nullptr});
   if (read_byte(to_parent[0]) != 'r') {
     std::fprintf(stderr, "bench_middleware: the provider did not start\n");
     return 1;
@@ -322,8 +333,8 @@ int main(int argc, char** argv) {
                 "  \"superseded\": %llu,\n  \"state_messages\": %llu,\n  \"updates_missed\": %llu,\n"
                 "  \"final_state_ok\": %s,\n"
                 "  \"transport\": \"IceStorm (icebox) on loopback, two processes\"\n}\n",
-                p50, p99, max, copy.size(), samples, updates_per_s, interfaces, static_cast<long long>(pause.count()), seconds,
-                static_cast<unsigned long long>(changes), static_cast<unsigned long long>(published),
+                p50, p99, max, copy.size(), samples, updates_per_s, interfaces, static_cast<long long>(pause.count()),
+                seconds, static_cast<unsigned long long>(changes), static_cast<unsigned long long>(published),
                 static_cast<unsigned long long>(applied),
                 static_cast<unsigned long long>(changes > published ? changes - published : 0),
                 static_cast<unsigned long long>(messages), static_cast<unsigned long long>(stats.updates_missed),

@@ -91,10 +91,9 @@ Expected<std::string> read_small_file(const std::string& path, struct stat* info
 }
 
 bool valid_signer_name(std::string_view name) {
-  return !name.empty() && name.size() <= 128 &&
-         std::all_of(name.begin(), name.end(), [](char c) {
-           return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
-         });
+  return !name.empty() && name.size() <= 128 && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
 }
 
 /// Writes `text` to a new file `path` with `mode`; an existing file is replaced only when
@@ -107,13 +106,14 @@ Expected<void> write_new_file(const std::string& path, const std::string& text, 
     auto old = read_small_file(path);
     const bool ours = S_ISREG(st.st_mode) && st.st_uid == ::geteuid() && old &&
                       (old->rfind(std::string(kSecretTag), 0) == 0 || old->rfind("# SAFECASS bus keyring", 0) == 0);
-    if (!ours) return fail(ErrorCode::Io, path + ": exists and is not a SAFECASS " + std::string(what) + "; not replaced");
+    if (!ours)
+      return fail(ErrorCode::Io, path + ": exists and is not a SAFECASS " + std::string(what) + "; not replaced");
     if (::unlink(path.c_str()) != 0) return fail(ErrorCode::Io, path + ": " + std::strerror(errno));
   }
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, mode);
   if (fd < 0) return fail(ErrorCode::Io, "cannot create " + path + ": " + std::strerror(errno));
-  const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) && ::fchmod(fd, mode) == 0 &&
-                  ::fsync(fd) == 0;
+  const bool ok = ::write(fd, text.data(), text.size()) == static_cast<ssize_t>(text.size()) &&
+                  ::fchmod(fd, mode) == 0 && ::fsync(fd) == 0;
   ::close(fd);
   if (!ok) return fail(ErrorCode::Io, "cannot write " + path + ": " + std::strerror(errno));
   return {};
@@ -193,8 +193,8 @@ Expected<Keyring> Keyring::load(const std::string& dir) {
   const std::string path = dir + "/keyring";
   auto text = read_small_file(path);
   if (!text) {
-    return fail(text.error().code, "bus keyring: " + text.error().message +
-                                       " (create keys with `safecass keys SYSTEM --out DIR`)");
+    return fail(text.error().code,
+                "bus keyring: " + text.error().message + " (create keys with `safecass keys SYSTEM --out DIR`)");
   }
   Keyring ring;
   std::istringstream lines(*text);

@@ -130,10 +130,10 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     adapter->destroy();
     if (control.empty()) {
       const std::uint64_t refused = finder->refused();
-      return fail(ErrorCode::Io, "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " +
-                                     o.ice.host + ":" + std::to_string(o.ice.port) + " within " +
-                                     std::to_string(o.timeout.count()) + " ms" +
-                                     (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
+      return fail(ErrorCode::Io,
+                  "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " + o.ice.host +
+                      ":" + std::to_string(o.ice.port) + " within " + std::to_string(o.timeout.count()) + " ms" +
+                      (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
     }
     auto prx = impl->ic->stringToProxy(control);
     // Requests and the token go in clear over TCP: only to this host, unless the endpoint is TLS
@@ -141,16 +141,19 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     for (const auto& endpoint : prx->ice_getEndpoints()) {
       auto info = endpoint->getInfo();
       const bool secure = info != nullptr && info->secure();
-      while (info != nullptr && std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info) == nullptr) info = info->underlying;
+      while (info != nullptr && std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info) == nullptr)
+        info = info->underlying;
       const auto ip = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info);
       const bool allowed = ip != nullptr && (is_loopback_host(ip->host) || o.insecure || (secure && o.tls.enabled()));
       if (!allowed) {
-        return fail(ErrorCode::Denied, "coordinator '" + o.coordinator + "' serves its operations at '" +
-                                           printable(control) + "', which is not on this host and not TLS: refused "
-                                           "without --insecure (requests and the token would cross the network unencrypted)");
+        return fail(ErrorCode::Denied,
+                    "coordinator '" + o.coordinator + "' serves its operations at '" + printable(control) +
+                        "', which is not on this host and not TLS: refused "
+                        "without --insecure (requests and the token would cross the network unencrypted)");
       }
     }
-    impl->control = Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
+    impl->control =
+        Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
     const std::string& credential = o.read_token.empty() ? o.token : o.read_token;
     if (!credential.empty()) impl->control = impl->control->ice_context({{kReadCredentialKey, credential}});
     impl->control->ice_ping();
@@ -178,12 +181,15 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
   return out;
 }
 
-Expected<std::vector<introspect::HistoryEntry>> entries_from_wire(const wire::RecordEntrySeq& seq, const std::string& who) {
+Expected<std::vector<introspect::HistoryEntry>> entries_from_wire(const wire::RecordEntrySeq& seq,
+                                                                  const std::string& who) {
   std::vector<introspect::HistoryEntry> out;
   out.reserve(seq.size());
   for (const wire::RecordEntry& w : seq) {
     introspect::HistoryEntry e;
-    if (!from_wire(w, e)) return fail(ErrorCode::Parse, "coordinator '" + who + "' sent a malformed history record (seq " + std::to_string(w.seq) + ")");
+    if (!from_wire(w, e))
+      return fail(ErrorCode::Parse,
+                  "coordinator '" + who + "' sent a malformed history record (seq " + std::to_string(w.seq) + ")");
     out.push_back(std::move(e));
   }
   return out;
@@ -216,7 +222,10 @@ class RemoteSubscription final : public introspect::Subscription {
 public:
   RemoteSubscription(std::shared_ptr<Follower> follower, std::shared_ptr<Ice::ObjectAdapter> adapter,
                      std::shared_ptr<IceStorm::TopicPrx> topic, std::shared_ptr<Ice::ObjectPrx> proxy)
-      : follower_(std::move(follower)), adapter_(std::move(adapter)), topic_(std::move(topic)), proxy_(std::move(proxy)) {}
+      : follower_(std::move(follower)),
+        adapter_(std::move(adapter)),
+        topic_(std::move(topic)),
+        proxy_(std::move(proxy)) {}
   ~RemoteSubscription() override {
     follower_->stop();
     try {
@@ -297,7 +306,8 @@ Expected<std::vector<introspect::StateRow>> RemoteClient::state_list(std::string
   std::vector<introspect::StateRow> out;
   for (const wire::StateEntry& w : *rows) {
     introspect::StateRow r;
-    if (!from_wire(w, r)) return fail(ErrorCode::Parse, "coordinator '" + impl_->options.coordinator + "' sent a malformed state row");
+    if (!from_wire(w, r))
+      return fail(ErrorCode::Parse, "coordinator '" + impl_->options.coordinator + "' sent a malformed state row");
     out.push_back(std::move(r));
   }
   return out;
@@ -316,14 +326,16 @@ Expected<std::vector<introspect::HistoryEntry>> RemoteClient::history(std::strin
 
 Expected<std::vector<introspect::HistoryEntry>> RemoteClient::records_since(std::uint64_t seq, std::size_t max) {
   auto entries = impl_->call("records", [&] {
-    return impl_->control->recordsSince(static_cast<long long>(seq), static_cast<int>(std::min<std::size_t>(max, 1u << 30)));
+    return impl_->control->recordsSince(static_cast<long long>(seq),
+                                        static_cast<int>(std::min<std::size_t>(max, 1u << 30)));
   });
   if (!entries) return tl::unexpected(entries.error());
   return entries_from_wire(*entries, impl_->options.coordinator);
 }
 
 Expected<std::vector<introspect::FilterRow>> RemoteClient::filter_list() {
-  return impl_->call("filter list", [&] { return rows_from_wire<introspect::FilterRow>(impl_->control->filterList()); });
+  return impl_->call("filter list",
+                     [&] { return rows_from_wire<introspect::FilterRow>(impl_->control->filterList()); });
 }
 
 Expected<introspect::FilterInfo> RemoteClient::filter_info(std::string_view name) {
@@ -335,11 +347,13 @@ Expected<std::vector<introspect::EventRow>> RemoteClient::event_list() {
 }
 
 Expected<std::vector<introspect::ConnectionRow>> RemoteClient::connection_list() {
-  return impl_->call("connection list", [&] { return rows_from_wire<introspect::ConnectionRow>(impl_->control->connectionList()); });
+  return impl_->call("connection list",
+                     [&] { return rows_from_wire<introspect::ConnectionRow>(impl_->control->connectionList()); });
 }
 
 Expected<std::vector<introspect::ServiceRow>> RemoteClient::service_list() {
-  return impl_->call("service list", [&] { return rows_from_wire<introspect::ServiceRow>(impl_->control->serviceList()); });
+  return impl_->call("service list",
+                     [&] { return rows_from_wire<introspect::ServiceRow>(impl_->control->serviceList()); });
 }
 
 Expected<introspect::ExplainAnswer> RemoteClient::explain(std::string_view address) {
@@ -358,32 +372,40 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
   const std::uint64_t last = newest->empty() ? 0 : newest->back().seq;
   try {
     const ClientOptions& o = impl_->options;
-    auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(), protocol(o.tls) + " -h 127.0.0.1");
+    auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
+                                                               protocol(o.tls) + " -h 127.0.0.1");
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
     auto proxy = adapter->addWithUUID(follower);
     adapter->activate();
     auto events = topic(topic_manager(impl_->ic, o.ice, o.tls), kEventTopic);
     subscribe(events, proxy, Delivery::Stream);
-    return std::unique_ptr<introspect::Subscription>(std::make_unique<RemoteSubscription>(follower, adapter, events, proxy));
+    return std::unique_ptr<introspect::Subscription>(
+        std::make_unique<RemoteSubscription>(follower, adapter, events, proxy));
   } catch (const Ice::Exception& e) {
-    return fail(ErrorCode::Io, "cannot follow coordinator '" + impl_->options.coordinator + "' on IceStorm: " + e.what());
+    return fail(ErrorCode::Io,
+                "cannot follow coordinator '" + impl_->options.coordinator + "' on IceStorm: " + e.what());
   }
 }
 
 Expected<void> RemoteClient::generate(std::string_view event, std::string_view target) {
-  return impl_->call("event generate", [&] { impl_->control->eventGenerate(impl_->options.token, std::string(event), std::string(target)); });
+  return impl_->call("event generate", [&] {
+    impl_->control->eventGenerate(impl_->options.token, std::string(event), std::string(target));
+  });
 }
 
 Expected<void> RemoteClient::broadcast(std::string_view event) {
-  return impl_->call("event broadcast", [&] { impl_->control->eventBroadcast(impl_->options.token, std::string(event)); });
+  return impl_->call("event broadcast",
+                     [&] { impl_->control->eventBroadcast(impl_->options.token, std::string(event)); });
 }
 
 Expected<void> RemoteClient::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter inject", [&] { impl_->control->filterInject(impl_->options.token, std::string(filter), samples); });
+  return impl_->call("filter inject",
+                     [&] { impl_->control->filterInject(impl_->options.token, std::string(filter), samples); });
 }
 
 Expected<void> RemoteClient::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter dinject", [&] { impl_->control->filterDinject(impl_->options.token, std::string(signal), samples); });
+  return impl_->call("filter dinject",
+                     [&] { impl_->control->filterDinject(impl_->options.token, std::string(signal), samples); });
 }
 
 Expected<void> RemoteClient::filter_dinload(const std::string& signal, const std::string& text) {

@@ -63,8 +63,7 @@ auto rows_to_wire(const std::vector<Row>& rows) {
 class ControlServant final : public wire::Control {
 public:
   explicit ControlServant(ControlContext c)
-      : c_(std::move(c)),
-        query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
+      : c_(std::move(c)), query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
 
   std::string coordinator(const Ice::Current& current) override {
     check_read(current);
@@ -78,14 +77,16 @@ public:
 
   wire::RecordEntrySeq stateHistory(std::string address, int last, const Ice::Current& current) override {
     check_read(current);
-    return rows_to_wire(value_or_raise(
-        locked([&] { return query_.history(address, last <= 0 ? 0 : static_cast<std::size_t>(last), introspect::HistoryFilter::All); })));
+    return rows_to_wire(value_or_raise(locked([&] {
+      return query_.history(address, last <= 0 ? 0 : static_cast<std::size_t>(last), introspect::HistoryFilter::All);
+    })));
   }
 
   wire::RecordEntrySeq recordsSince(long long seq, int max, const Ice::Current& current) override {
     check_read(current);
     return rows_to_wire(value_or_raise(locked([&] {
-      return query_.records_since(seq < 0 ? 0 : static_cast<std::uint64_t>(seq), max <= 0 ? 0 : static_cast<std::size_t>(max));
+      return query_.records_since(seq < 0 ? 0 : static_cast<std::uint64_t>(seq),
+                                  max <= 0 ? 0 : static_cast<std::size_t>(max));
     })));
   }
 
@@ -105,7 +106,8 @@ public:
     check_write(token, "filter inject");
     if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter inject " + filter + ": no samples");
     ok_or_raise(locked([&] { return query_.inject(filter, samples); }));
-    c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(samples.size()) + " samples)");
+    c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(samples.size()) +
+           " samples)");
   }
 
   void filterDinject(std::string token, std::string signal, wire::SampleSeq samples, const Ice::Current&) override {
@@ -131,9 +133,10 @@ public:
         const double v = std::strtod(word.c_str(), &end);
         if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
           // Injected values are finite (Monitor's rule, docs/filters.md), said with the line.
-          raise(ErrorCode::Parse, "filter dinload " + signal + ": line " + std::to_string(number) + ": '" + word +
-                                      (end == word.c_str() || *end != '\0' ? "' is not a number"
-                                                                             : "' is not a finite number: injected values must be finite"));
+          raise(ErrorCode::Parse,
+                "filter dinload " + signal + ": line " + std::to_string(number) + ": '" + word +
+                    (end == word.c_str() || *end != '\0' ? "' is not a number"
+                                                         : "' is not a finite number: injected values must be finite"));
         }
         values.push_back(v);
       }
@@ -151,7 +154,8 @@ public:
   wire::RecordEntrySeq eventHistory(int last, const Ice::Current& current) override {
     check_read(current);
     return rows_to_wire(value_or_raise(locked([&] {
-      return query_.history("SYSTEM", last <= 0 ? 0 : static_cast<std::size_t>(last), introspect::HistoryFilter::Events);
+      return query_.history("SYSTEM", last <= 0 ? 0 : static_cast<std::size_t>(last),
+                            introspect::HistoryFilter::Events);
     })));
   }
 
@@ -210,15 +214,15 @@ private:
       return;
     }
     c_.log("middleware: " + c_.name + ": refused " + current.operation + ": no read credential");
-    raise(ErrorCode::Denied, current.operation + " refused: coordinator '" + c_.name +
-                                 "' needs its read credential (--read-token-file)");
+    raise(ErrorCode::Denied,
+          current.operation + " refused: coordinator '" + c_.name + "' needs its read credential (--read-token-file)");
   }
 
   void check_write(const std::string& token, const char* what) {
     if (!c_.allow_write) {
       c_.log("middleware: " + c_.name + ": refused " + what + ": read-only");
-      raise(ErrorCode::Denied, std::string(what) + " refused: coordinator '" + c_.name +
-                                   "' runs read-only (start it with --allow-write)");
+      raise(ErrorCode::Denied,
+            std::string(what) + " refused: coordinator '" + c_.name + "' runs read-only (start it with --allow-write)");
     }
     if (!token_matches(c_.token, token)) {
       c_.log("middleware: " + c_.name + ": refused " + what + ": wrong or missing token");
@@ -230,7 +234,8 @@ private:
   void deep(const std::string& signal, const wire::SampleSeq& samples) {
     if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter dinject " + signal + ": no samples");
     ok_or_raise(locked([&] { return query_.inject_deep(signal, samples); }));
-    c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(samples.size()) + " samples)");
+    c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(samples.size()) +
+           " samples)");
   }
 
   /// The read model is used by one thread at a time (Ice may dispatch requests on several).
@@ -259,8 +264,8 @@ wire::ExplainEntry to_wire(const Explanation& e) {
   w.severity = e.severity;
   w.mirror = e.mirror;
   w.outstanding = e.outstanding;
-  w.root = wire::Root{e.root_event, e.root_origin, e.root_time.count(), to_wire(e.level), e.filter, e.signal, e.value,
-                      e.sample_time.count(), e.injected, e.path};
+  w.root = wire::Root{e.root_event, e.root_origin, e.root_time.count(),   to_wire(e.level), e.filter,
+                      e.signal,     e.value,       e.sample_time.count(), e.injected,       e.path};
   w.hazard = e.hazard;
   w.line = to_string(e);
   w.count = static_cast<int>(e.count);

@@ -20,7 +20,7 @@ struct ControlContext {
   bool allow_write;
   std::string token;
   std::function<void(const std::string&)> log;
-  std::string read_token;  ///< empty: reads are open to every local client
+  std::string read_token;          ///< empty: reads are open to every local client
   introspect::LocalOptions clock;  ///< how its times read (NodeOptions::clock)
 };
 

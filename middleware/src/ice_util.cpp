@@ -12,7 +12,8 @@ namespace safecass::middleware {
 Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
                                std::initializer_list<std::string_view> hosts) {
   if (tls.enabled()) {
-    for (const std::string& file : {tls.dir + "/ca.pem", tls.dir + "/" + tls.name + ".pem", tls.dir + "/" + tls.name + ".key"}) {
+    for (const std::string& file :
+         {tls.dir + "/ca.pem", tls.dir + "/" + tls.name + ".pem", tls.dir + "/" + tls.name + ".key"}) {
       struct stat st {};
       if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
         return fail(ErrorCode::NotFound, std::string(who) + ": TLS: " + file +
@@ -24,9 +25,11 @@ Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool
   if (insecure) return {};
   for (std::string_view host : hosts) {
     if (!is_loopback_host(host)) {
-      return fail(ErrorCode::InvalidArgument,
-                  std::string(who) + ": '" + std::string(host) + "' is not a loopback address and the bus would cross "
-                  "the network unencrypted: use --tls DIR (mutual TLS, docs/security.md), or --insecure to accept that");
+      return fail(
+          ErrorCode::InvalidArgument,
+          std::string(who) + ": '" + std::string(host) +
+              "' is not a loopback address and the bus would cross "
+              "the network unencrypted: use --tls DIR (mutual TLS, docs/security.md), or --insecure to accept that");
     }
   }
   return {};
@@ -68,8 +71,8 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
 
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls) {
-  const std::string text = std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " + ice.host + " -p " +
-                           std::to_string(ice.port) + " -t 2000";
+  const std::string text = std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " + ice.host +
+                           " -p " + std::to_string(ice.port) + " -t 2000";
   return Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(text));
 }
 
@@ -91,8 +94,8 @@ void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shar
   IceStorm::QoS qos;
   if (delivery == Delivery::Ordered) qos["reliability"] = "ordered";  // needs a twoway subscriber
   try {
-    topic->subscribeAndGetPublisher(qos, delivery == Delivery::Ordered ? subscriber->ice_twoway()
-                                                                       : subscriber->ice_oneway());
+    topic->subscribeAndGetPublisher(
+        qos, delivery == Delivery::Ordered ? subscriber->ice_twoway() : subscriber->ice_oneway());
   } catch (const IceStorm::AlreadySubscribed&) {
     // IceStorm kept the subscription (its database survived a restart): nothing to do.
   }

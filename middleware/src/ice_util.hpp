@@ -18,7 +18,9 @@ namespace safecass::middleware::detail {
 /// State updates go to one topic per coordinator, "safecass.state.<coordinator>": a process
 /// receives only the streams of the providers it holds, never its own.
 inline constexpr const char* kStateTopic = "safecass.state";
-inline std::string state_topic(std::string_view coordinator) { return std::string(kStateTopic) + "." + std::string(coordinator); }
+inline std::string state_topic(std::string_view coordinator) {
+  return std::string(kStateTopic) + "." + std::string(coordinator);
+}
 inline constexpr const char* kEventTopic = "safecass.events";
 inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
 inline constexpr const char* kResyncTopic = "safecass.resync";
@@ -64,7 +66,8 @@ public:
   Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice, TlsOptions tls = {})
       : ic_(std::move(ic)), ice_(std::move(ice)), tls_(std::move(tls)) {}
   /// Registers a subscriber of `topic` (used by every connect()).
-  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber, Delivery delivery = Delivery::Ordered) {
+  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber,
+                    Delivery delivery = Delivery::Ordered) {
     subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery});
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.

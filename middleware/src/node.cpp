@@ -28,14 +28,16 @@ Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
   if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
     e.host = std::string(text.substr(0, colon));
     port = text.substr(colon + 1);
-    if (e.host.empty()) return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': empty host (write HOST:PORT)");
+    if (e.host.empty())
+      return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': empty host (write HOST:PORT)");
   }
   int value = 0;
   if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string_view::npos) {
     return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': the port must be a number (write HOST:PORT)");
   }
   for (char c : port) value = value * 10 + (c - '0');
-  if (value < 1 || value > 65535) return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': port outside 1-65535");
+  if (value < 1 || value > 65535)
+    return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': port outside 1-65535");
   e.port = value;
   return e;
 }
@@ -77,14 +79,16 @@ Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::str
   const auto where = placement(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == coordinator_name; })) {
-    return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + std::string(coordinator_name) + "'");
+    return fail(ErrorCode::NotFound,
+                "system '" + system.name + "' has no coordinator '" + std::string(coordinator_name) + "'");
   }
   for (const spec::ConnectionSpec& k : system.connections) {
     const std::string client = component_of(k.required);
     const std::string provider = component_of(k.provided);
     const auto c = where.find(client);
     const auto p = where.find(provider);
-    if (c == where.end() || p == where.end() || c->second != coordinator_name || p->second == coordinator_name) continue;
+    if (c == where.end() || p == where.end() || c->second != coordinator_name || p->second == coordinator_name)
+      continue;
     State propagate = State::Error;
     if (const spec::ComponentSpec* spec = find_spec(system, provider)) {
       const std::string iface = k.provided.substr(k.provided.find('.') + 1);
@@ -146,16 +150,16 @@ struct CoordinatorNode::Impl {
   /// Another signer on the bus (a coordinator, or the supervisor), as its authenticated
   /// messages describe it (under peer_mutex).
   struct Peer {
-    std::int64_t incarnation = 0;     ///< the newest seen; older ones are replays or a duplicate
-    std::int64_t heartbeat_seq = 0;   ///< last accepted heartbeat of that incarnation
-    std::int64_t resync_seq = 0;      ///< last accepted resync request of that incarnation
-    std::int64_t last_resync = 0;     ///< when we last asked it to republish
-    std::int64_t last_beat = 0;       ///< steady ns of its last accepted heartbeat (0: never)
-    std::int64_t last_honoured = 0;   ///< when we last republished at its request
-    bool resync_pending = false;      ///< a request arrived too soon after the last one
-    bool provider = false;            ///< it runs a provider of an interface held here
-    bool lost = false;                ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
-    std::vector<MachineId> feeds;     ///< required interfaces here that it feeds
+    std::int64_t incarnation = 0;    ///< the newest seen; older ones are replays or a duplicate
+    std::int64_t heartbeat_seq = 0;  ///< last accepted heartbeat of that incarnation
+    std::int64_t resync_seq = 0;     ///< last accepted resync request of that incarnation
+    std::int64_t last_resync = 0;    ///< when we last asked it to republish
+    std::int64_t last_beat = 0;      ///< steady ns of its last accepted heartbeat (0: never)
+    std::int64_t last_honoured = 0;  ///< when we last republished at its request
+    bool resync_pending = false;     ///< a request arrived too soon after the last one
+    bool provider = false;           ///< it runs a provider of an interface held here
+    bool lost = false;               ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
+    std::vector<MachineId> feeds;    ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
   std::mutex peer_mutex;  ///< held, peers; taken before the coordinator's lock, never after
@@ -331,8 +335,8 @@ struct CoordinatorNode::Impl {
     const std::uint64_t quiet = log_of.quiet;
     log_of.logged = now;
     log_of.quiet = 0;
-    log(line + (quiet == 0 ? std::string()
-                           : " (and " + std::to_string(quiet) + " similar case(s) since the last such line)"));
+    log(line +
+        (quiet == 0 ? std::string() : " (and " + std::to_string(quiet) + " similar case(s) since the last such line)"));
   }
 
   /// A state update too large for one message on its own: keeps the roots that fit, the most
@@ -399,8 +403,8 @@ struct CoordinatorNode::Impl {
     const std::size_t base = size_prefix(1) + encode(ic, m).size() + 4 + mark.size();
     if (base > limit) {
       events_dropped.fetch_add(1, std::memory_order_relaxed);
-      log_oversize(record_oversize, what + "dropped: it does not fit even without its " + std::to_string(text.size()) +
-                                        "-byte text");
+      log_oversize(record_oversize,
+                   what + "dropped: it does not fit even without its " + std::to_string(text.size()) + "-byte text");
       return false;
     }
     std::size_t keep = std::min(text.size(), limit - base);
@@ -739,7 +743,7 @@ struct CoordinatorNode::Impl {
     if (u.seq - h.last_seq > kMaxSeqJump) {
       updates_rejected.fetch_add(1);
       refuse(from, what() + ": jumps more than " + std::to_string(kMaxSeqJump) + " ahead of " +
-                         std::to_string(h.last_seq) + "; asking for a republish instead");
+                       std::to_string(h.last_seq) + "; asking for a republish instead");
       h.behind = true;
       return;
     }
@@ -786,7 +790,8 @@ struct CoordinatorNode::Impl {
       return;
     }
     if (hb.coordinator != m.signer) {
-      refuse(m.signer, "a heartbeat naming '" + printable(hb.coordinator) + "' signed by '" + printable(m.signer) + "'");
+      refuse(m.signer,
+             "a heartbeat naming '" + printable(hb.coordinator) + "' signed by '" + printable(m.signer) + "'");
       return;
     }
     const std::int64_t now = steady_ns();
@@ -851,7 +856,8 @@ struct CoordinatorNode::Impl {
       return;
     }
     if (r.requester != m.signer) {
-      refuse(m.signer, "a resync request naming '" + printable(r.requester) + "' signed by '" + printable(m.signer) + "'");
+      refuse(m.signer,
+             "a resync request naming '" + printable(r.requester) + "' signed by '" + printable(m.signer) + "'");
       return;
     }
     if (r.requester == name || (!r.coordinator.empty() && r.coordinator != name)) return;
@@ -886,7 +892,8 @@ struct CoordinatorNode::Impl {
       std::lock_guard lock(peer_mutex);
       const std::int64_t now = steady_ns();
       for (auto& [_, peer] : peers) {
-        if (!peer.resync_pending || now - peer.last_honoured < std::chrono::nanoseconds(options.heartbeat).count()) continue;
+        if (!peer.resync_pending || now - peer.last_honoured < std::chrono::nanoseconds(options.heartbeat).count())
+          continue;
         peer.resync_pending = false;
         peer.last_honoured = now;
         any = true;
@@ -990,8 +997,10 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                                                                    const spec::SystemSpec& system,
                                                                    std::string coordinator_name, NodeOptions options) {
   if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "middleware: no IceStorm port given");
-  if (options.heartbeat.count() <= 0) return fail(ErrorCode::InvalidArgument, "middleware: heartbeat period must be positive");
-  auto impl = std::make_unique<Impl>(coordinator, monitor, registry, system, std::move(coordinator_name), std::move(options));
+  if (options.heartbeat.count() <= 0)
+    return fail(ErrorCode::InvalidArgument, "middleware: heartbeat period must be positive");
+  auto impl =
+      std::make_unique<Impl>(coordinator, monitor, registry, system, std::move(coordinator_name), std::move(options));
   impl->where = placement(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == impl->name; })) {
@@ -1018,8 +1027,8 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   for (ComponentId c = 0; c < coordinator.component_count(); ++c) {
     if (coordinator.is_remote(c)) {
       for (MachineId m : coordinator.provided_machines(c)) {
-        const std::string iface = std::string(coordinator.component_name(c)) + "." +
-                                  std::string(coordinator.interface_name(m));
+        const std::string iface =
+            std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(m));
         const auto w = impl->where.find(coordinator.component_name(c));
         const std::string provider = w == impl->where.end() ? std::string() : w->second;
         impl->held.emplace(iface, Impl::Held{m, provider});
@@ -1032,7 +1041,8 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
       auto s = std::make_unique<Impl::Stream>();
       s->component = c;
       s->provided = p;
-      s->iface = std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(provided[p]));
+      s->iface =
+          std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(provided[p]));
       impl->streams_of[c].push_back(impl->streams.size());
       impl->streams.push_back(std::move(s));
     }
@@ -1063,8 +1073,14 @@ Expected<void> CoordinatorNode::start() {
     auto state = d.adapter->add(std::make_shared<StateServant>(d), Ice::Identity{"state", id});
     auto heartbeat = d.adapter->add(std::make_shared<HeartbeatServant>(d), Ice::Identity{"heartbeat", id});
     auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
-    ControlContext context{d.co, d.monitor, d.registry, d.name, d.options.allow_write, d.options.token,
-                           [&d](const std::string& line) { d.log(line); }, d.options.read_token,
+    ControlContext context{d.co,
+                           d.monitor,
+                           d.registry,
+                           d.name,
+                           d.options.allow_write,
+                           d.options.token,
+                           [&d](const std::string& line) { d.log(line); },
+                           d.options.read_token,
                            d.options.clock};
     auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
@@ -1082,7 +1098,8 @@ Expected<void> CoordinatorNode::start() {
   } catch (const Ice::Exception& e) {
     if (d.ic) d.ic->destroy();
     d.ic = nullptr;
-    return fail(ErrorCode::Io, "middleware: " + d.name + ": cannot listen on " + d.options.listen_host + ": " + e.what());
+    return fail(ErrorCode::Io,
+                "middleware: " + d.name + ": cannot listen on " + d.options.listen_host + ": " + e.what());
   }
   d.subscription = d.co.subscribe([&d](const Record& r) { d.on_record(r); });
   d.started = steady_ns();

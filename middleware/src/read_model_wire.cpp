@@ -16,8 +16,8 @@ State level_of(wire::Level l) {
 }
 
 bool kind_of(std::string_view text, RecordKind& out) {
-  for (const RecordKind k : {RecordKind::Event, RecordKind::Transition, RecordKind::ComponentTransition, RecordKind::Reset,
-                             RecordKind::Injection}) {
+  for (const RecordKind k : {RecordKind::Event, RecordKind::Transition, RecordKind::ComponentTransition,
+                             RecordKind::Reset, RecordKind::Injection}) {
     if (to_string(k) == text) {
       out = k;
       return true;
@@ -31,8 +31,8 @@ bool outcome_of(std::string_view text, Outcome& out) {
     out = Outcome::None;
     return true;
   }
-  for (const Outcome o : {Outcome::Raised, Outcome::Override, Outcome::Joined, Outcome::Masked, Outcome::Cleared,
-                          Outcome::Ignored}) {
+  for (const Outcome o :
+       {Outcome::Raised, Outcome::Override, Outcome::Joined, Outcome::Masked, Outcome::Cleared, Outcome::Ignored}) {
     if (outcome_text(o) == text) {
       out = o;
       return true;
@@ -42,8 +42,9 @@ bool outcome_of(std::string_view text, Outcome& out) {
 }
 
 ParamType param_type_of(std::string_view text) {
-  for (const ParamType t : {ParamType::Number, ParamType::Integer, ParamType::Bool, ParamType::String, ParamType::Choice,
-                            ParamType::Signal, ParamType::SignalList, ParamType::Event, ParamType::NumberList}) {
+  for (const ParamType t :
+       {ParamType::Number, ParamType::Integer, ParamType::Bool, ParamType::String, ParamType::Choice, ParamType::Signal,
+        ParamType::SignalList, ParamType::Event, ParamType::NumberList}) {
     if (to_string(t) == text) return t;
   }
   return ParamType::String;
@@ -84,8 +85,8 @@ ParamValue value_from_wire(const wire::ParamValue& w) {
 }
 
 wire::Root root_to_wire(const in::RootEntry& r) {
-  return wire::Root{r.event, r.origin, r.time.count(), wire::Level::Normal, r.filter, r.signal, r.value,
-                    r.sample_time.count(), r.injected, {}};
+  return wire::Root{r.event,  r.origin, r.time.count(),        wire::Level::Normal, r.filter,
+                    r.signal, r.value,  r.sample_time.count(), r.injected,          {}};
 }
 
 in::RootEntry root_from_wire(const wire::Root& w) {
@@ -293,7 +294,8 @@ in::EventRow from_wire(const wire::EventEntry& w) {
   r.severity = w.severity;
   r.onset = w.onset;
   for (const std::string& t : w.transitions) {
-    for (const Transition x : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
+    for (const Transition x :
+         {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (to_string(x) == t) r.transitions.push_back(x);
     }
   }
@@ -361,7 +363,8 @@ in::ExplainAnswer from_wire(const wire::ExplainReply& w) {
 }
 
 wire::ClockEntry to_wire(const in::ClockInfo& c) {
-  return wire::ClockEntry{c.base == in::TimeBase::Simulated, c.now.count(), c.wall_offset_ns, c.period, c.scenario, c.duration};
+  return wire::ClockEntry{
+      c.base == in::TimeBase::Simulated, c.now.count(), c.wall_offset_ns, c.period, c.scenario, c.duration};
 }
 
 in::ClockInfo from_wire(const wire::ClockEntry& w) {

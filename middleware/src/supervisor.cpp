@@ -13,10 +13,10 @@
 #include "auth.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
-#include "safecass/middleware/keys.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/model.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::middleware {
@@ -72,7 +72,9 @@ struct Supervisor::Impl {
     }
   }
 
-  void refuse(const std::string& source, const std::string& what) { drops->drop(source, "supervisor: refused " + what); }
+  void refuse(const std::string& source, const std::string& what) {
+    drops->drop(source, "supervisor: refused " + what);
+  }
 
   /// Checks a signed message and that every record in it names its signer as its coordinator.
   template <class Seq>
@@ -116,8 +118,8 @@ struct Supervisor::Impl {
     }
     if (pub == nullptr) return;
     try {
-      pub->resync(signer->sign(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner),
-                                                                                  incarnation, ++resync_seq, who})));
+      pub->resync(signer->sign(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner), incarnation,
+                                                                           ++resync_seq, who})));
     } catch (const Ice::Exception&) {
       // The link thread notices and reconnects.
     }
@@ -228,7 +230,8 @@ struct Supervisor::Impl {
     if (h.coordinator == kSupervisorSigner) {
       if (h.incarnation != incarnation) {
         drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
-                                                std::to_string(h.incarnation) + ", ours " + std::to_string(incarnation) + ")");
+                                                std::to_string(h.incarnation) + ", ours " +
+                                                std::to_string(incarnation) + ")");
       }
       return;
     }
@@ -245,9 +248,9 @@ struct Supervisor::Impl {
       if (!fresh(peer, h.coordinator, h.incarnation, "a heartbeat")) {
         // An older incarnation still beating while a newer one runs: two processes, one name.
         if (known != 0 && steady_ns() - peer.last_heartbeat <= std::chrono::nanoseconds(options.lost_after).count()) {
-          drops->drop(h.coordinator + "/duplicate", "supervisor: two processes run coordinator '" +
-                                                        printable(h.coordinator) + "' (incarnations " +
-                                                        std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
+          drops->drop(h.coordinator + "/duplicate",
+                      "supervisor: two processes run coordinator '" + printable(h.coordinator) + "' (incarnations " +
+                          std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
         }
         return;
       }
@@ -309,7 +312,8 @@ struct Supervisor::Impl {
         auto prx = Ice::uncheckedCast<wire::ControlPrx>(ic->stringToProxy(control))->ice_invocationTimeout(1000);
         for (const wire::StateEntry& w : prx->stateList("")) {
           introspect::StateRow r;
-          if (!from_wire(w, r) || r.kind == introspect::RowKind::System || r.kind == introspect::RowKind::Service) continue;
+          if (!from_wire(w, r) || r.kind == introspect::RowKind::System || r.kind == introspect::RowKind::Service)
+            continue;
           if (r.state != State::Normal) {
             const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
             for (const Explanation& e : why.conditions) {
@@ -335,7 +339,8 @@ struct Supervisor::Impl {
           if (it != view.end() && it->second.state == r.state) continue;
           view[r.address] = ViewRow{name, r.address, r.state, cause};
           lines.push_back("[" + who + "] " + printable(r.address) + " " + std::string(to_string(r.state)) +
-                          " (refreshed after missed records" + (cause.empty() ? "" : "; root " + printable(cause)) + ")");
+                          " (refreshed after missed records" + (cause.empty() ? "" : "; root " + printable(cause)) +
+                          ")");
         }
       }
       for (const std::string& l : lines) print(l);
@@ -432,7 +437,8 @@ private:
 Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec& system, SupervisorOptions options) {
   if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "supervisor: no IceStorm port given");
   if (options.tls.enabled() && options.tls.name.empty()) options.tls.name = std::string(kSupervisorSigner);
-  if (auto r = check_transport("supervisor", options.tls, options.insecure, {options.ice.host, options.listen_host}); !r) {
+  if (auto r = check_transport("supervisor", options.tls, options.insecure, {options.ice.host, options.listen_host});
+      !r) {
     return tl::unexpected(r.error());
   }
   auto impl = std::make_unique<Impl>(system, std::move(options));

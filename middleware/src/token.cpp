@@ -73,10 +73,12 @@ std::string not_ours(int fd) {
   if (!S_ISREG(st.st_mode)) return kind_of(st.st_mode);
   if (st.st_uid != ::geteuid()) return "owned by another user (uid " + std::to_string(st.st_uid) + ")";
   if ((st.st_mode & 07777) != 0600) return "mode " + mode_text(st.st_mode) + ", not 0600";
-  if (st.st_size != static_cast<off_t>(kTokenDigits + 1)) return "not a token (" + std::to_string(st.st_size) + " bytes)";
+  if (st.st_size != static_cast<off_t>(kTokenDigits + 1))
+    return "not a token (" + std::to_string(st.st_size) + " bytes)";
   std::string text;
   if (!read_all(fd, text, kTokenDigits + 1)) return "cannot read it: " + reason();
-  if (text.size() != kTokenDigits + 1 || text.back() != '\n' || !is_token_text(std::string_view(text).substr(0, kTokenDigits))) {
+  if (text.size() != kTokenDigits + 1 || text.back() != '\n' ||
+      !is_token_text(std::string_view(text).substr(0, kTokenDigits))) {
     return "not a token";
   }
   return {};
@@ -88,10 +90,11 @@ bool same_file(const struct stat& a, const struct stat& b) { return a.st_dev == 
 Expected<void> check_private_dir(const std::string& dir) {
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0) return fail(ErrorCode::Io, "token directory " + dir + ": " + reason());
-  if (!S_ISDIR(st.st_mode)) return fail(ErrorCode::Io, "token directory " + dir + " is " + kind_of(st.st_mode) + ", not a directory");
+  if (!S_ISDIR(st.st_mode))
+    return fail(ErrorCode::Io, "token directory " + dir + " is " + kind_of(st.st_mode) + ", not a directory");
   if (st.st_uid != ::geteuid()) {
-    return fail(ErrorCode::Io, "token directory " + dir + " is owned by another user (uid " + std::to_string(st.st_uid) +
-                                   "): refusing to keep a token there");
+    return fail(ErrorCode::Io, "token directory " + dir + " is owned by another user (uid " +
+                                   std::to_string(st.st_uid) + "): refusing to keep a token there");
   }
   if ((st.st_mode & 077) != 0) {
     return fail(ErrorCode::Io, "token directory " + dir + " has mode " + mode_text(st.st_mode) +
@@ -130,7 +133,8 @@ Expected<std::string> private_directory(bool& made) {
 std::string file_name_part(std::string_view name) {
   std::string out;
   for (const char c : name) {
-    const bool plain = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+    const bool plain =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
     out += plain ? c : '_';
   }
   return out.empty() || out[0] == '.' ? "_" + out : out;
@@ -168,7 +172,8 @@ void TokenFile::remove() noexcept {
   // Unlink only the file this process created: never one that replaced it at the same path.
   struct stat mine {};
   struct stat there {};
-  if (::fstat(fd_, &mine) == 0 && ::lstat(path_.c_str(), &there) == 0 && same_file(mine, there)) ::unlink(path_.c_str());
+  if (::fstat(fd_, &mine) == 0 && ::lstat(path_.c_str(), &there) == 0 && same_file(mine, there))
+    ::unlink(path_.c_str());
   ::close(fd_);  // releases the lock
   fd_ = -1;
   if (!private_dir_.empty()) ::rmdir(private_dir_.c_str());
@@ -191,8 +196,10 @@ Expected<std::unique_ptr<TokenFile>> TokenFile::create(const std::string& path) 
       }
       return std::unique_ptr<TokenFile>(new TokenFile(fd, path, std::move(*secret), {}));
     }
-    if (errno != EEXIST) return fail(ErrorCode::Io, "cannot create " + refuse.substr(0, refuse.size() - 2) + ": " + reason());
-    if (attempt > 0) return fail(ErrorCode::Io, refuse + "created meanwhile by another process: refusing to overwrite it");
+    if (errno != EEXIST)
+      return fail(ErrorCode::Io, "cannot create " + refuse.substr(0, refuse.size() - 2) + ": " + reason());
+    if (attempt > 0)
+      return fail(ErrorCode::Io, refuse + "created meanwhile by another process: refusing to overwrite it");
 
     // The path exists. Only a token file of ours that no live process holds may be replaced.
     struct stat link {};
@@ -200,7 +207,8 @@ Expected<std::unique_ptr<TokenFile>> TokenFile::create(const std::string& path) 
       return fail(ErrorCode::Io, refuse + "exists and is a symbolic link: refusing to write a token through it");
     }
     const int old = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-    if (old < 0) return fail(ErrorCode::Io, refuse + "exists and cannot be examined (" + reason() + "): refusing to overwrite it");
+    if (old < 0)
+      return fail(ErrorCode::Io, refuse + "exists and cannot be examined (" + reason() + "): refusing to overwrite it");
     if (const std::string why = not_ours(old); !why.empty()) {
       ::close(old);
       return fail(ErrorCode::Io, refuse + "exists and is not a SAFECASS token file of yours (" + why +
@@ -210,8 +218,9 @@ Expected<std::unique_ptr<TokenFile>> TokenFile::create(const std::string& path) 
       const bool held = errno == EWOULDBLOCK;
       ::close(old);
       if (held) {
-        return fail(ErrorCode::Io, refuse + "is the token file of a running process (it holds the file's lock): two "
-                                            "processes cannot share a token file; choose another path");
+        return fail(ErrorCode::Io, refuse +
+                                       "is the token file of a running process (it holds the file's lock): two "
+                                       "processes cannot share a token file; choose another path");
       }
       return fail(ErrorCode::Io, refuse + "cannot lock the existing file: " + reason());
     }

@@ -39,7 +39,8 @@ std::string word(std::string_view s) {
 
 void put_header(std::string& out, const InputLogHeader& h) {
   out += std::string(kMagic) + " " + std::to_string(h.version) + " period_ns=" + std::to_string(h.period.count()) +
-         " start_ns=" + std::to_string(h.start.count()) + " clock=" + word(h.clock) + " system=" + word(h.system) + "\n";
+         " start_ns=" + std::to_string(h.start.count()) + " clock=" + word(h.clock) + " system=" + word(h.system) +
+         "\n";
 }
 
 void put_signal(std::string& out, std::uint16_t id, std::uint16_t width, std::string_view name) {
@@ -149,8 +150,8 @@ Expected<std::unique_ptr<InputLogReader>> InputLogReader::open(const std::string
     std::int64_t n = 0;
     if (key == "period_ns" || key == "start_ns") {
       if (!parse_i64(value, n) || (key == "period_ns" && n < 0)) {
-        return fail(ErrorCode::Parse, path + ":1: header field " + std::string(key) + " is not a number: '" +
-                                          std::string(value) + "'");
+        return fail(ErrorCode::Parse,
+                    path + ":1: header field " + std::string(key) + " is not a number: '" + std::string(value) + "'");
       }
       (key == "period_ns" ? r->header_.period : r->header_.start) = Time{n};
     } else if (key == "clock") {
@@ -218,13 +219,14 @@ InputLogReader::Item InputLogReader::next() {
       case input_log::kSample: {
         if (!whole(3)) return error_.empty() ? Item::Eof : fail_at(error_);
         const auto id = get<std::uint16_t>(buffer_.data() + pos_ + 1);
-        if (id >= widths_.size()) return fail_at("sample of signal id " + std::to_string(id) + ", which was never declared");
+        if (id >= widths_.size())
+          return fail_at("sample of signal id " + std::to_string(id) + ", which was never declared");
         const std::size_t width = widths_[id];
         if (!whole(3 + 8 * width)) return error_.empty() ? Item::Eof : fail_at(error_);
         if (!have_time_) return fail_at("sample before the first time record");
         if (time_ < last_time_[id]) {
-          return fail_at("time goes back for signal " + names_[id] + ": " + std::to_string(to_seconds(time_)) + " s after " +
-                         std::to_string(to_seconds(last_time_[id])) + " s");
+          return fail_at("time goes back for signal " + names_[id] + ": " + std::to_string(to_seconds(time_)) +
+                         " s after " + std::to_string(to_seconds(last_time_[id])) + " s");
         }
         last_time_[id] = time_;
         std::memcpy(aligned_.data(), buffer_.data() + pos_ + 3, 8 * width);
@@ -253,11 +255,13 @@ InputLogReader::Item InputLogReader::next() {
         if (id > input_log::kMaxSignals) return fail_at("signal id " + std::to_string(id) + " is out of range");
         if (id < names_.size()) {
           if (names_[id] != name || widths_[id] != width) {
-            return fail_at("signal id " + std::to_string(id) + " is declared again as " + name + " (it was " + names_[id] + ")");
+            return fail_at("signal id " + std::to_string(id) + " is declared again as " + name + " (it was " +
+                           names_[id] + ")");
           }
         } else {
-          if (id != names_.size()) return fail_at("signal id " + std::to_string(id) + " is declared before id " +
-                                                  std::to_string(names_.size()));
+          if (id != names_.size())
+            return fail_at("signal id " + std::to_string(id) + " is declared before id " +
+                           std::to_string(names_.size()));
           names_.push_back(std::move(name));
           widths_.push_back(width);
           last_time_.push_back(Time::min());

@@ -24,7 +24,9 @@ void append_quoted(std::string& out, std::string_view s) {
   }
   out += '"';
 }
-std::string plural(std::uint64_t n, const char* one, const char* many) { return std::to_string(n) + " " + (n == 1 ? one : many); }
+std::string plural(std::uint64_t n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
 
 constexpr std::size_t kMaxChunk = 256 * 1024;
 constexpr auto kFlushEvery = std::chrono::milliseconds(50);
@@ -39,7 +41,8 @@ std::vector<std::string> describe_losses(const InputRecordStatus& s) {
   }
   if (s.lost != 0) {
     out.push_back(file + plural(s.lost, "sample", "samples") +
-                  " lost: overwritten in their signal's history buffer before the recorder read them (a loss record marks where)");
+                  " lost: overwritten in their signal's history buffer before the recorder read them (a loss record "
+                  "marks where)");
   }
   if (s.dropped != 0) {
     out.push_back(file + plural(s.dropped, "sample", "samples") +
@@ -53,12 +56,14 @@ std::string record_status_json(const InputRecordStatus& s) {
   append_quoted(out, s.path);
   out += ",\"samples\":" + std::to_string(s.samples) + ",\"actions\":" + std::to_string(s.actions) +
          ",\"lost\":" + std::to_string(s.lost) + ",\"dropped\":" + std::to_string(s.dropped) +
-         ",\"unwritten\":" + std::to_string(s.unwritten) + ",\"write_error\":" + (s.write_error.empty() ? "false" : "true");
+         ",\"unwritten\":" + std::to_string(s.unwritten) +
+         ",\"write_error\":" + (s.write_error.empty() ? "false" : "true");
   if (!s.write_error.empty()) {
     out += ",\"error\":";
     append_quoted(out, s.write_error);
   }
-  out += ",\"rotations\":" + std::to_string(s.rotations) + std::string(",\"complete\":") + (s.complete() ? "true" : "false") + "}";
+  out += ",\"rotations\":" + std::to_string(s.rotations) + std::string(",\"complete\":") +
+         (s.complete() ? "true" : "false") + "}";
   return out;
 }
 
@@ -99,10 +104,12 @@ Expected<std::unique_ptr<InputRecorder>> InputRecorder::open(Monitor& monitor, c
   return r;
 }
 
-InputRecorder::InputRecorder(Monitor& monitor, std::unique_ptr<detail::SegmentedFile> file, InputRecorderOptions options)
+InputRecorder::InputRecorder(Monitor& monitor, std::unique_ptr<detail::SegmentedFile> file,
+                             InputRecorderOptions options)
     : monitor_(monitor), file_(std::move(file)), options_(std::move(options)), path_(file_->path()) {
   chunk_limit_ = kMaxChunk;
-  if (options_.limits.max_bytes != 0) chunk_limit_ = std::max<std::size_t>(4096, std::min<std::uint64_t>(kMaxChunk, options_.limits.max_bytes / 4));
+  if (options_.limits.max_bytes != 0)
+    chunk_limit_ = std::max<std::size_t>(4096, std::min<std::uint64_t>(kMaxChunk, options_.limits.max_bytes / 4));
   // Inputs: the signals no filter writes. Filter outputs are computed again by a replay.
   std::set<const Signal*> outputs;
   for (const auto& f : monitor_.filters()) outputs.insert(f->outputs().begin(), f->outputs().end());
@@ -162,7 +169,8 @@ void InputRecorder::drain_locked() {
   }
   if (staged_.empty()) return;
   // Each signal's samples are in order; across signals, order by time (stable: input order).
-  if (!std::is_sorted(staged_.begin(), staged_.end(), [](const Staged& a, const Staged& b) { return a.time < b.time; })) {
+  if (!std::is_sorted(staged_.begin(), staged_.end(),
+                      [](const Staged& a, const Staged& b) { return a.time < b.time; })) {
     std::stable_sort(staged_.begin(), staged_.end(), [](const Staged& a, const Staged& b) { return a.time < b.time; });
   }
   for (const Staged& s : staged_) {
@@ -290,7 +298,8 @@ void InputRecorder::close() { close(monitor_.coordinator().clock().now()); }
 
 InputRecordStatus InputRecorder::status() const {
   std::lock_guard lock(mutex_);
-  return InputRecordStatus{path_, samples_, actions_, lost_, dropped_, unwritten_, write_error_, rotations_, discarded_};
+  return InputRecordStatus{path_,      samples_,     actions_,   lost_,     dropped_,
+                           unwritten_, write_error_, rotations_, discarded_};
 }
 
 }  // namespace safecass

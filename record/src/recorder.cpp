@@ -31,23 +31,27 @@ std::vector<std::string> describe_losses(const RecordStatus& s) {
                   " not written (the system kept running; the history is incomplete)");
   }
   if (s.dropped != 0) {
-    out.push_back(file + std::to_string(s.dropped) + (s.dropped == 1 ? " record" : " records") +
-                  " dropped: the recorder's queue was full (an \"overflow\" line marks where; the history is incomplete)");
+    out.push_back(
+        file + std::to_string(s.dropped) + (s.dropped == 1 ? " record" : " records") +
+        " dropped: the recorder's queue was full (an \"overflow\" line marks where; the history is incomplete)");
   }
   return out;
 }
 
 std::string record_status_json(const RecordStatus& s) {
   introspect::JsonObject j;
-  j.str("kind", "recorder").str("path", s.path).integer("written", static_cast<long long>(s.written))
-      .integer("dropped", static_cast<long long>(s.dropped)).integer("unwritten", static_cast<long long>(s.unwritten))
+  j.str("kind", "recorder")
+      .str("path", s.path)
+      .integer("written", static_cast<long long>(s.written))
+      .integer("dropped", static_cast<long long>(s.dropped))
+      .integer("unwritten", static_cast<long long>(s.unwritten))
       .boolean("write_error", !s.write_error.empty());
   if (!s.write_error.empty()) j.str("error", s.write_error);
   return j.boolean("complete", s.complete()).text();
 }
 
-Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path, std::size_t capacity,
-                                                   FileLimits limits) {
+Expected<std::unique_ptr<Recorder>> Recorder::open(Coordinator& coordinator, const std::string& path,
+                                                   std::size_t capacity, FileLimits limits) {
   auto file = detail::SegmentedFile::open(path, limits);
   if (!file) return fail(ErrorCode::Io, "cannot write history file '" + path + "': " + file.error().message);
   return std::unique_ptr<Recorder>(
@@ -97,7 +101,10 @@ void Recorder::writer() {
       std::string line;
       bool record = false;
       if (dropped_ != dropped_reported_) {
-        line = introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(dropped_ - dropped_reported_)).text();
+        line = introspect::JsonObject()
+                   .str("kind", "overflow")
+                   .integer("dropped", static_cast<long long>(dropped_ - dropped_reported_))
+                   .text();
         dropped_reported_ = dropped_;
       } else {
         const Record r = queue_.front();

@@ -12,7 +12,9 @@ std::string format(const Diagnostic& d) {
   if (d.where.line > 0) {
     out += ':' + std::to_string(d.where.line) + ':' + std::to_string(d.where.column);
   }
-  out += d.severity == Diagnostic::Severity::Error ? ": error: " : d.severity == Diagnostic::Severity::Warning ? ": warning: " : ": note: ";
+  out += d.severity == Diagnostic::Severity::Error     ? ": error: "
+         : d.severity == Diagnostic::Severity::Warning ? ": warning: "
+                                                       : ": note: ";
   out += d.message;
   if (!d.pointer.empty()) out += " [" + d.pointer + "]";
   return out;
@@ -21,10 +23,15 @@ std::string format(const Diagnostic& d) {
 std::string to_json(const Diagnostic& d) {
   const char* severity = d.severity == Diagnostic::Severity::Error     ? "error"
                          : d.severity == Diagnostic::Severity::Warning ? "warning"
-                                                                        : "note";
-  return introspect::JsonObject().str("file", d.where.file).integer("line", d.where.line)
-      .integer("column", d.where.column).str("severity", severity).str("message", d.message)
-      .str("pointer", d.pointer).text();
+                                                                       : "note";
+  return introspect::JsonObject()
+      .str("file", d.where.file)
+      .integer("line", d.where.line)
+      .integer("column", d.where.column)
+      .str("severity", severity)
+      .str("message", d.message)
+      .str("pointer", d.pointer)
+      .text();
 }
 
 std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {

@@ -47,7 +47,8 @@ Expected<std::string> read_regular_file(const std::string& path, std::size_t max
   if (::fstat(file.fd, &st) != 0) return fail(ErrorCode::Io, what + std::strerror(errno));
   if (!S_ISREG(st.st_mode)) return fail(ErrorCode::Io, what + "not a regular file (" + kind_of(st.st_mode) + ")");
   if (st.st_size < 0 || static_cast<std::size_t>(st.st_size) > max_bytes) {
-    return fail(ErrorCode::Io, what + "larger than " + size_text(max_bytes) + " (" + std::to_string(st.st_size) + " bytes)");
+    return fail(ErrorCode::Io,
+                what + "larger than " + size_text(max_bytes) + " (" + std::to_string(st.st_size) + " bytes)");
   }
   std::string text;
   text.reserve(static_cast<std::size_t>(st.st_size));

@@ -107,7 +107,8 @@ private:
     Formula left = unary();
     skip();
     if (!failed() && pos_ < text_.size() && text_[pos_] == 'U' &&
-        (pos_ + 1 == text_.size() || !(std::isalnum(static_cast<unsigned char>(text_[pos_ + 1])) != 0 || text_[pos_ + 1] == '_'))) {
+        (pos_ + 1 == text_.size() ||
+         !(std::isalnum(static_cast<unsigned char>(text_[pos_ + 1])) != 0 || text_[pos_ + 1] == '_'))) {
       const std::size_t at = pos_;
       ++pos_;
       return binary(Formula::Kind::Until, std::move(left), unary(), at);
@@ -136,10 +137,12 @@ private:
     if (take("(")) {
       Formula f = equiv();
       if (failed()) return f;
-      if (!take(")")) return fail("expected ')' to close the '(' at character " + std::to_string(at + 1) + ", found " + describe());
+      if (!take(")"))
+        return fail("expected ')' to close the '(' at character " + std::to_string(at + 1) + ", found " + describe());
       return f;
     }
-    if (pos_ >= text_.size()) return fail("the formula ends where an address, '(' or an operator ([], <>, !) was expected");
+    if (pos_ >= text_.size())
+      return fail("the formula ends where an address, '(' or an operator ([], <>, !) was expected");
     const std::string word = name();
     if (word.empty()) return fail("expected an address, '(' or an operator ([], <>, !), found " + describe());
     if (word == "true" || word == "false") {
@@ -175,8 +178,8 @@ private:
     const auto s = parse_state(level);
     if (!s) {
       pos_ = level_at;
-      return fail("expected a level (Normal, Warning or Error) after '" + word + " " + std::string(to_string(atom.compare)) +
-                  "', found " + describe());
+      return fail("expected a level (Normal, Warning or Error) after '" + word + " " +
+                  std::string(to_string(atom.compare)) + "', found " + describe());
     }
     atom.level = *s;
     return atom;

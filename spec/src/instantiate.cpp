@@ -24,8 +24,9 @@ Expected<void> instantiate(const SystemSpec& system, Coordinator& coordinator, M
     if (it == system.coordinators.end()) {
       std::string known;
       for (const auto& c : system.coordinators) known += (known.empty() ? "" : ", ") + c.first;
-      return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + std::string(only_coordinator) +
-                                           "'" + (known.empty() ? " (it declares none)" : " (known: " + known + ")"));
+      return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" +
+                                           std::string(only_coordinator) + "'" +
+                                           (known.empty() ? " (it declares none)" : " (known: " + known + ")"));
     }
     local.insert(it->second.begin(), it->second.end());
   }

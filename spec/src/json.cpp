@@ -139,7 +139,8 @@ private:
   }
 
   bool literal(std::string_view word, JsonValue& v, JsonValue::Type type, bool b) {
-    if (text_.substr(pos_, word.size()) != word) return fail_here("invalid literal: expected '" + std::string(word) + "'");
+    if (text_.substr(pos_, word.size()) != word)
+      return fail_here("invalid literal: expected '" + std::string(word) + "'");
     for (std::size_t i = 0; i < word.size(); ++i) advance();
     v.type = type;
     v.boolean = b;
@@ -178,8 +179,8 @@ private:
       // Underflow (a negative exponent) is harmlessly zero; overflow is not a usable number.
       const std::size_t e = digits.find_first_of("eE");
       if (e == std::string_view::npos || e + 1 >= digits.size() || digits[e + 1] != '-') {
-        return fail_at(p, "number " + std::string(digits.substr(0, 40)) + (digits.size() > 40 ? "..." : "") +
-                              " is out of range");
+        return fail_at(
+            p, "number " + std::string(digits.substr(0, 40)) + (digits.size() > 40 ? "..." : "") + " is out of range");
       }
       d = 0.0;
     } else if (ec != std::errc() || ptr != digits.data() + digits.size() || !std::isfinite(d)) {
@@ -214,10 +215,14 @@ private:
     for (int i = 0; i < 4; ++i) {
       const char c = peek();
       std::uint32_t d = 0;
-      if (c >= '0' && c <= '9') d = static_cast<std::uint32_t>(c - '0');
-      else if (c >= 'a' && c <= 'f') d = static_cast<std::uint32_t>(c - 'a' + 10);
-      else if (c >= 'A' && c <= 'F') d = static_cast<std::uint32_t>(c - 'A' + 10);
-      else return fail_here("invalid \\u escape: four hex digits expected");
+      if (c >= '0' && c <= '9')
+        d = static_cast<std::uint32_t>(c - '0');
+      else if (c >= 'a' && c <= 'f')
+        d = static_cast<std::uint32_t>(c - 'a' + 10);
+      else if (c >= 'A' && c <= 'F')
+        d = static_cast<std::uint32_t>(c - 'A' + 10);
+      else
+        return fail_here("invalid \\u escape: four hex digits expected");
       out = out * 16 + d;
       advance();
     }
@@ -332,7 +337,8 @@ private:
     }
     for (;;) {
       if (peek() != '"') {
-        return fail_here(at_end() ? "unexpected end of file: expected a member name" : "expected a member name in double quotes");
+        return fail_here(at_end() ? "unexpected end of file: expected a member name"
+                                  : "expected a member name in double quotes");
       }
       JsonMember m;
       m.key_position = here();

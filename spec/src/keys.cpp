@@ -94,7 +94,9 @@ bool same_ignoring_case(std::string_view a, std::string_view b) noexcept {
 }  // namespace
 
 std::string_view canonical_choice(const Key& key, std::string_view value) noexcept {
-  const auto same = [&](std::string_view a, std::string_view b) { return key.any_case ? same_ignoring_case(a, b) : a == b; };
+  const auto same = [&](std::string_view a, std::string_view b) {
+    return key.any_case ? same_ignoring_case(a, b) : a == b;
+  };
   for (const std::string_view c : key.choices) {
     if (same(value, c)) return c;
   }
@@ -109,8 +111,9 @@ const ObjectKind& system_kind() {
       "system",
       "a system file: components (inline or included), connections and coordinators",
       {kSchemaKey, kVersionKey, text("system", "name of the system", true), kDescriptionKey,
-       objects("components", "the components: {\"include\": \"file.json\"} (a component or system file, "
-                             "relative to this file) or a component object",
+       objects("components",
+               "the components: {\"include\": \"file.json\"} (a component or system file, "
+               "relative to this file) or a component object",
                "component_entry", true),
        objects("connections", "connections from a required interface to a provided interface", "connection"),
        object("coordinators", "coordinator (process) name -> the components it runs", "coordinators"),
@@ -120,10 +123,9 @@ const ObjectKind& system_kind() {
 }
 
 const ObjectKind& include_kind() {
-  static const ObjectKind kind{
-      "include",
-      "a component or system file to include",
-      {text("include", "path of the file, relative to the including file", true)}};
+  static const ObjectKind kind{"include",
+                               "a component or system file to include",
+                               {text("include", "path of the file, relative to the including file", true)}};
   return kind;
 }
 
@@ -131,14 +133,16 @@ const ObjectKind& component_kind() {
   static const ObjectKind kind{
       "component",
       "a component: its interfaces, signals, events, filters and services",
-      {kSchemaKey, kVersionKey, text("component", "name of the component (no dots or spaces; \"\" makes the file a framework filter template, "
-                         "applied to every component)", true), kDescriptionKey,
-       object("interfaces", "provided and required interfaces", "interfaces"),
+      {kSchemaKey, kVersionKey,
+       text("component",
+            "name of the component (no dots or spaces; \"\" makes the file a framework filter template, "
+            "applied to every component)",
+            true),
+       kDescriptionKey, object("interfaces", "provided and required interfaces", "interfaces"),
        objects("signals", "signals of the component (Component.signal), scalar or vector", "signal"),
        objects("event", "event definitions (names are unique in the system)", "event"),
        objects("filter", "filters and pipelines", "filter_entry"),
-       objects("service", "what the service state of each provided interface depends on", "service"),
-       [] {
+       objects("service", "what the service state of each provided interface depends on", "service"), [] {
          Key k = text("period", "period of the component's loop in seconds (runs its ACTIVE filters)");
          k.shape = Shape::Number;
          k.min = 0;
@@ -149,28 +153,26 @@ const ObjectKind& component_kind() {
 }
 
 const ObjectKind& interfaces_kind() {
-  static const ObjectKind kind{
-      "interfaces",
-      "the interfaces of a component",
-      {strings("provided", "names of the provided interfaces (machines C.s_P.name)"),
-       strings("required", "names of the required interfaces (machines C.s_R.name)")}};
+  static const ObjectKind kind{"interfaces",
+                               "the interfaces of a component",
+                               {strings("provided", "names of the provided interfaces (machines C.s_P.name)"),
+                                strings("required", "names of the required interfaces (machines C.s_R.name)")}};
   return kind;
 }
 
 const ObjectKind& signal_kind() {
-  static const ObjectKind kind{
-      "signal",
-      "a signal: a scalar or a fixed-size vector of doubles",
-      {text("name", "name of the signal within its component", true),
-       [] {
-         Key k = text("size", "number of doubles per sample (1: a scalar)");
-         k.shape = Shape::Integer;
-         k.min = 1;
-         k.max = kMaxSignalSize;
-         k.default_json = "1";
-         return k;
-       }(),
-       kDescriptionKey}};
+  static const ObjectKind kind{"signal",
+                               "a signal: a scalar or a fixed-size vector of doubles",
+                               {text("name", "name of the signal within its component", true),
+                                [] {
+                                  Key k = text("size", "number of doubles per sample (1: a scalar)");
+                                  k.shape = Shape::Integer;
+                                  k.min = 1;
+                                  k.max = kMaxSignalSize;
+                                  k.default_json = "1";
+                                  return k;
+                                }(),
+                                kDescriptionKey}};
   return kind;
 }
 
@@ -205,15 +207,17 @@ const ObjectKind& filter_kind() {
       {text("name", "unique name in the system (default: Component.Type_index)"),
        text("class_name", "filter type, e.g. Threshold (2016 names such as FilterThreshold are accepted)", true),
        [] {
-         Key k = choice("type", "ACTIVE: runs in the component's loop; PASSIVE: runs in the monitor thread "
-                                "(any letter case; the 2016 INTERNAL and EXTERNAL mean ACTIVE and PASSIVE)",
+         Key k = choice("type",
+                        "ACTIVE: runs in the component's loop; PASSIVE: runs in the monitor thread "
+                        "(any letter case; the 2016 INTERNAL and EXTERNAL mean ACTIVE and PASSIVE)",
                         {"ACTIVE", "PASSIVE"}, "\"ACTIVE\"");
          k.any_case = true;
          k.synonyms = {{"INTERNAL", "ACTIVE"}, {"EXTERNAL", "PASSIVE"}};
          return k;
        }(),
        [] {
-         Key k = choice("event_type", "EDGE: one onset per crossing; LEVEL: an onset every sample while detected (any letter case)",
+         Key k = choice("event_type",
+                        "EDGE: one onset per crossing; LEVEL: an onset every sample while detected (any letter case)",
                         {"EDGE", "LEVEL"}, "\"EDGE\"");
          k.any_case = true;
          return k;
@@ -222,12 +226,16 @@ const ObjectKind& filter_kind() {
        object("target", "the state machine that receives the events (default: s_A of this component)", "target"),
        object("argument", "the parameters of the filter type", ""), kDescriptionKey,
        [] {
-         Key k = boolean("debug", "2016: printed the filter's debug log; accepted and ignored (SAFECASS records every event)", "false");
+         Key k = boolean("debug",
+                         "2016: printed the filter's debug log; accepted and ignored (SAFECASS records every event)",
+                         "false");
          k.ignored = true;
          return k;
        }(),
        [] {
-         Key k = boolean("last_filter", "2016: marked the last filter of a chain; accepted and ignored (a \"pipeline\" says it)", "false");
+         Key k =
+             boolean("last_filter",
+                     "2016: marked the last filter of a chain; accepted and ignored (a \"pipeline\" says it)", "false");
          k.ignored = true;
          return k;
        }()}};
@@ -245,12 +253,11 @@ const ObjectKind& pipeline_kind() {
 }
 
 const ObjectKind& target_kind() {
-  static const ObjectKind kind{
-      "target",
-      "a state machine: C.s_F, C.s_A, C.s_P.interface or C.s_R.interface",
-      {choice("type", "which machine", {"s_F", "s_A", "s_P", "s_R"}, "\"s_A\""),
-       text("component", "the component (default: the component that declares the filter)"),
-       text("interface", "the interface, for s_P and s_R")}};
+  static const ObjectKind kind{"target",
+                               "a state machine: C.s_F, C.s_A, C.s_P.interface or C.s_R.interface",
+                               {choice("type", "which machine", {"s_F", "s_A", "s_P", "s_R"}, "\"s_A\""),
+                                text("component", "the component (default: the component that declares the filter)"),
+                                text("interface", "the interface, for s_P and s_R")}};
   return kind;
 }
 
@@ -268,8 +275,7 @@ const ObjectKind& dependency_kind() {
   static const ObjectKind kind{
       "dependency",
       "s_S.p = s_P.p x [s_F] x [s_A] x the listed required interfaces",
-      {boolean("s_F", "include the framework state", "false"),
-       boolean("s_A", "include the application state", "false"),
+      {boolean("s_F", "include the framework state", "false"), boolean("s_A", "include the application state", "false"),
        strings("s_R", "required interfaces included")}};
   return kind;
 }
@@ -303,9 +309,9 @@ const ObjectKind& invariant_kind() {
 }
 
 std::vector<const ObjectKind*> all_kinds() {
-  return {&system_kind(), &include_kind(), &component_kind(), &interfaces_kind(), &signal_kind(),
-          &event_kind(), &filter_kind(), &pipeline_kind(), &target_kind(), &service_kind(),
-          &dependency_kind(), &connection_kind(), &hazard_kind(), &invariant_kind()};
+  return {&system_kind(),     &include_kind(),    &component_kind(), &interfaces_kind(), &signal_kind(),
+          &event_kind(),      &filter_kind(),     &pipeline_kind(),  &target_kind(),     &service_kind(),
+          &dependency_kind(), &connection_kind(), &hazard_kind(),    &invariant_kind()};
 }
 
 }  // namespace safecass::spec::detail

@@ -10,7 +10,7 @@
 namespace safecass::spec::detail {
 
 enum class Shape : unsigned char {
-  String,      ///< a string
+  String,  ///< a string
   Bool,
   Integer,     ///< a whole number within [min, max]
   Number,      ///< a number within [min, max] (above min when exclusive_min)
@@ -26,12 +26,12 @@ struct Key {
   Shape shape = Shape::String;
   bool required = false;
   std::string_view doc;
-  std::string_view ref;                    ///< $defs name (Object/ObjectList)
-  std::vector<std::string_view> choices;   ///< Choice/ChoiceList
+  std::string_view ref;                   ///< $defs name (Object/ObjectList)
+  std::vector<std::string_view> choices;  ///< Choice/ChoiceList
   double min = -std::numeric_limits<double>::infinity();
   double max = std::numeric_limits<double>::infinity();
   bool exclusive_min = false;
-  std::string_view default_json;           ///< the default as JSON text, for the schema
+  std::string_view default_json;  ///< the default as JSON text, for the schema
   /// Choice: other spellings accepted, as in the 2016 loader: any letter case, and
   /// {synonym, choice} pairs ("INTERNAL" is "ACTIVE").
   bool any_case = false;

@@ -108,8 +108,8 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
     }
     for (const ServiceItem& s : c.services) out.services.push_back(ServiceSpec{s.provided, s.dependency});
     for (const Name& p : c.provided) {
-      const bool written = std::any_of(c.services.begin(), c.services.end(),
-                                       [&](const ServiceItem& s) { return s.provided == p.text; });
+      const bool written =
+          std::any_of(c.services.begin(), c.services.end(), [&](const ServiceItem& s) { return s.provided == p.text; });
       if (!written) out.services.push_back(ServiceSpec{p.text, ServiceDependency{}});
     }
     out.period = c.period;

@@ -40,7 +40,7 @@ class Sink {
 public:
   std::deque<Document> documents;
   std::vector<Diagnostic> diagnostics;
-  std::vector<int> files;  ///< file index of each diagnostic, for sorting
+  std::vector<int> files;         ///< file index of each diagnostic, for sorting
   std::vector<Diagnostic> notes;  ///< what was accepted and ignored (validate --verbose)
   std::vector<int> note_files;
 
@@ -81,7 +81,7 @@ struct EventItem {
   bool has_name = false;
   bool has_severity = false;
   bool has_transitions = false;
-  bool transitions_valid = true;  ///< every listed transition was understood
+  bool transitions_valid = true;        ///< every listed transition was understood
   bool framework_redefinition = false;  ///< repeats a framework event's definition: the built-in is used
 };
 
@@ -110,9 +110,9 @@ struct FilterItem {
   bool has_class = false;
   bool has_target_interface = false;
   bool target_component_given = false;
-  bool argument_misspelled = false;  ///< an unknown key of the filter is a typo of 'argument' (reported)
+  bool argument_misspelled = false;                ///< an unknown key of the filter is a typo of 'argument' (reported)
   const JsonValue* misspelled_argument = nullptr;  ///< its value: the events it names count as generated
-  bool from_template = false;        ///< instantiated from a framework filter template for `owner`
+  bool from_template = false;                      ///< instantiated from a framework filter template for `owner`
   std::vector<ParamItem> params;
 };
 
@@ -195,7 +195,7 @@ struct InvariantItem {
 struct Model {
   std::string name;
   std::string path;
-  bool system_file = false;  ///< the loaded file is a system file (not a single component)
+  bool system_file = false;           ///< the loaded file is a system file (not a single component)
   std::size_t component_entries = 0;  ///< entries of the top-level "components" list
   bool has_components_key = false;    ///< the top-level file has a (well-typed) "components" list
   std::vector<ComponentItem> components;

@@ -4,9 +4,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <map>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <set>
 
 #include "safecass/spec/file.hpp"
@@ -36,9 +36,7 @@ std::string a_type(JsonValue::Type t) {
   return "a value";
 }
 
-std::vector<std::string> to_strings(const std::vector<std::string_view>& views) {
-  return {views.begin(), views.end()};
-}
+std::vector<std::string> to_strings(const std::vector<std::string_view>& views) { return {views.begin(), views.end()}; }
 
 bool whole(double d) noexcept { return std::isfinite(d) && std::floor(d) == d; }
 
@@ -49,7 +47,11 @@ class Fields {
 public:
   Fields(Sink& sink, int file, const JsonValue& object, std::string pointer, const ObjectKind& kind,
          std::string context)
-      : sink_(sink), file_(file), object_(object), pointer_(std::move(pointer)), kind_(kind),
+      : sink_(sink),
+        file_(file),
+        object_(object),
+        pointer_(std::move(pointer)),
+        kind_(kind),
         context_(std::move(context)) {
     std::set<std::string_view> seen;
     for (const JsonMember& m : object.object) {
@@ -64,7 +66,8 @@ public:
       const Key* key = kind_.find(m.key);
       if (const RenamedKey* renamed = key == nullptr ? find_renamed(kind_, m.key) : nullptr) {
         // A key of the original format with a new name or place: say what to write.
-        sink_.error(key_site, context_ + ": unknown key " + quote_name(m.key) + " (" + std::string(renamed->advice) + ")");
+        sink_.error(key_site,
+                    context_ + ": unknown key " + quote_name(m.key) + " (" + std::string(renamed->advice) + ")");
         continue;
       }
       if (key == nullptr) {
@@ -91,8 +94,8 @@ public:
     }
     for (const Key& k : kind_.keys) {
       if (k.required && object.find_member(k.name) == nullptr) {
-        sink_.error(object_site(), context_ + ": missing required key " + quote_name(k.name) + " (" +
-                                       std::string(k.doc) + ")");
+        sink_.error(object_site(),
+                    context_ + ": missing required key " + quote_name(k.name) + " (" + std::string(k.doc) + ")");
       }
     }
   }
@@ -142,10 +145,8 @@ private:
       return false;
     };
     switch (key.shape) {
-      case Shape::String:
-        return v.is_string() || wrong("a string");
-      case Shape::Bool:
-        return v.is_bool() || wrong("true or false");
+      case Shape::String: return v.is_string() || wrong("a string");
+      case Shape::Bool: return v.is_bool() || wrong("true or false");
       case Shape::Integer:
       case Shape::Number: {
         const bool integer = key.shape == Shape::Integer;
@@ -163,7 +164,8 @@ private:
           if (key.min == key.max) {
             range = "must be " + number_text(key.min);
           } else if (std::isinf(key.max)) {
-            range = std::string("must be ") + (key.exclusive_min ? "greater than " : "at least ") + number_text(key.min);
+            range =
+                std::string("must be ") + (key.exclusive_min ? "greater than " : "at least ") + number_text(key.min);
           } else {
             range = "must be within " + number_text(key.min) + "-" + number_text(key.max);
           }
@@ -178,7 +180,9 @@ private:
       }
       case Shape::StringList:
       case Shape::ChoiceList: {
-        if (!v.is_array()) return wrong(key.shape == Shape::StringList ? "an array of strings" : "an array of " + join_or(to_strings(key.choices)));
+        if (!v.is_array())
+          return wrong(key.shape == Shape::StringList ? "an array of strings"
+                                                      : "an array of " + join_or(to_strings(key.choices)));
         for (std::size_t i = 0; i < v.array.size(); ++i) {
           const JsonValue& item = v.array[i];
           const Site item_site{file_, item.position, pointer_join(site.pointer, i)};
@@ -190,10 +194,8 @@ private:
         }
         return true;
       }
-      case Shape::Object:
-        return v.is_object() || wrong("an object");
-      case Shape::ObjectList:
-        return v.is_array() || wrong("an array");
+      case Shape::Object: return v.is_object() || wrong("an object");
+      case Shape::ObjectList: return v.is_array() || wrong("an array");
     }
     return false;
   }
@@ -273,16 +275,20 @@ private:
       return FileKind::Invalid;
     }
     if (root.find_member("steps") != nullptr && !component) {
-      sink_.error(site, "this is a scenario (it has \"steps\"), not a system or component file: run it with "
-                        "`safecass run` or `safecass test`");
+      sink_.error(site,
+                  "this is a scenario (it has \"steps\"), not a system or component file: run it with "
+                  "`safecass run` or `safecass test`");
       return FileKind::Invalid;
     }
     if (system && component) {
-      sink_.error(site, "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both");
+      sink_.error(site,
+                  "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both");
       return FileKind::Invalid;
     }
     if (!system && !component) {
-      sink_.error(site, "not a specification: a system file has \"system\" and \"components\", a component file has \"component\"");
+      sink_.error(
+          site,
+          "not a specification: a system file has \"system\" and \"components\", a component file has \"component\"");
       return FileKind::Invalid;
     }
     return system ? FileKind::System : FileKind::Component;
@@ -294,7 +300,8 @@ private:
   /// names the filter that detects that fault once the limits are written down.
   void refuse_monitor_targets(int doc, const JsonMember& monitor) {
     const std::string base = "/monitor";
-    const std::string intro = "the 2016 monitor-target file is not loaded (a target streams a measurement and sets no limit): ";
+    const std::string intro =
+        "the 2016 monitor-target file is not loaded (a target streams a measurement and sets no limit): ";
     if (!monitor.value.is_array() || monitor.value.array.empty()) {
       sink_.error(Site{doc, monitor.key_position, base},
                   intro + "write a Frequency filter for a thread's period and a DutyCycle filter for its duty cycle");
@@ -315,19 +322,24 @@ private:
       }
       std::string advice;
       if (type == "THREAD_PERIOD") {
-        advice = "for the period of " + component + ", write a Frequency filter (min_rate, max_rate, max_jitter) on the "
+        advice = "for the period of " + component +
+                 ", write a Frequency filter (min_rate, max_rate, max_jitter) on the "
                  "signal its framework extension writes every cycle";
       } else if (type == "THREAD_DUTYCYCLE_TOTAL" || type == "THREAD_DUTYCYCLE_USER") {
-        advice = "for the duty cycle of " + component + ", write a DutyCycle filter (period, max_duty) on its execution "
-                 "time per cycle (" + (type == "THREAD_DUTYCYCLE_USER" ? "the user's code alone" : "the whole cycle") + ")";
+        advice = "for the duty cycle of " + component +
+                 ", write a DutyCycle filter (period, max_duty) on its execution "
+                 "time per cycle (" +
+                 (type == "THREAD_DUTYCYCLE_USER" ? "the user's code alone" : "the whole cycle") + ")";
       } else {
-        advice = "for " + (type.empty() ? std::string("this target") : "target " + quote_name(type)) + " of " + component +
-                 ", write a filter on the signal it measures (Threshold, Range, Frequency, DutyCycle...)";
+        advice = "for " + (type.empty() ? std::string("this target") : "target " + quote_name(type)) + " of " +
+                 component + ", write a filter on the signal it measures (Threshold, Range, Frequency, DutyCycle...)";
       }
       const TextPosition at = target.is_object() && target.find_member("type") != nullptr
-                                  ? target.find_member("type")->key_position : target.position;
-      sink_.error(Site{doc, at, target.is_object() && target.find_member("type") != nullptr ? pointer_join(p, "type") : p},
-                  intro + advice);
+                                  ? target.find_member("type")->key_position
+                                  : target.position;
+      sink_.error(
+          Site{doc, at, target.is_object() && target.find_member("type") != nullptr ? pointer_join(p, "type") : p},
+          intro + advice);
     }
   }
 
@@ -349,8 +361,9 @@ private:
       }
       if (const auto loaded = loaded_.find(canonical); loaded != loaded_.end()) {
         const auto it = included_at_.find(loaded->second);
-        sink_.error(*include_site, "file " + quote_name(path) + " is already included" +
-                                       (it != included_at_.end() ? " (at " + sink_.at(it->second) + ")" : std::string()));
+        sink_.error(*include_site,
+                    "file " + quote_name(path) + " is already included" +
+                        (it != included_at_.end() ? " (at " + sink_.at(it->second) + ")" : std::string()));
         return -1;
       }
       if (stack_.size() >= kMaxIncludeDepth) {
@@ -471,8 +484,9 @@ private:
         const std::string p = pointer_join(f.pointer("components"), i);
         const Site site{doc, entry.position, p};
         if (!entry.is_object()) {
-          sink_.error(site, "a 'components' entry must be an object ({\"include\": \"file.json\"} or a component), not " +
-                                a_type(entry.type));
+          sink_.error(site,
+                      "a 'components' entry must be an object ({\"include\": \"file.json\"} or a component), not " +
+                          a_type(entry.type));
         } else if (entry.find_member("include") != nullptr) {
           include(doc, entry, p);
         } else if (entry.find_member("component") != nullptr) {
@@ -480,7 +494,9 @@ private:
           read_component(doc, entry, p, c);
           model_.components.push_back(std::move(c));
         } else {
-          sink_.error(site, "a 'components' entry must be {\"include\": \"file.json\"} or a component object with \"component\"");
+          sink_.error(
+              site,
+              "a 'components' entry must be {\"include\": \"file.json\"} or a component object with \"component\"");
         }
       }
     }
@@ -489,8 +505,9 @@ private:
         const JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("connections"), i);
         if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p}, "a connection must be an object {\"required\": \"C.r\", \"provided\": \"P.p\"}, not " +
-                                                        a_type(entry.type));
+          sink_.error(Site{doc, entry.position, p},
+                      "a connection must be an object {\"required\": \"C.r\", \"provided\": \"P.p\"}, not " +
+                          a_type(entry.type));
           continue;
         }
         Fields c(sink_, doc, entry, p, connection_kind(), "connection");
@@ -512,8 +529,8 @@ private:
         const JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("hazards"), i);
         if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p}, "a hazard must be an object {\"id\": ..., \"reaction\": {...}}, not " +
-                                                        a_type(entry.type));
+          sink_.error(Site{doc, entry.position, p},
+                      "a hazard must be an object {\"id\": ..., \"reaction\": {...}}, not " + a_type(entry.type));
           continue;
         }
         model_.hazards.push_back(read_hazard(doc, entry, p));
@@ -524,8 +541,8 @@ private:
         const JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("invariants"), i);
         if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p}, "an invariant must be an object {\"name\": ..., \"formula\": ...}, not " +
-                                                        a_type(entry.type));
+          sink_.error(Site{doc, entry.position, p},
+                      "an invariant must be an object {\"name\": ..., \"formula\": ...}, not " + a_type(entry.type));
           continue;
         }
         Fields fi(sink_, doc, entry, p, invariant_kind(), named("invariant", entry, "name"));
@@ -566,7 +583,8 @@ private:
           const JsonValue& c = m.value.array[i];
           const Site item_site{doc, c.position, pointer_join(key_site.pointer, i)};
           if (!c.is_string()) {
-            sink_.error(item_site, "coordinator " + quote_name(m.key) + ": components are named by strings, not " + a_type(c.type));
+            sink_.error(item_site, "coordinator " + quote_name(m.key) + ": components are named by strings, not " +
+                                       a_type(c.type));
             continue;
           }
           item.components.push_back(Name{c.string, item_site});
@@ -598,7 +616,8 @@ private:
         const JsonValue& s = signals->array[i];
         const std::string p = pointer_join(f.pointer("signals"), i);
         if (!s.is_object()) {
-          sink_.error(Site{doc, s.position, p}, ctx + ": a signal must be an object {\"name\": ..., \"size\": ...}, not " + a_type(s.type));
+          sink_.error(Site{doc, s.position, p},
+                      ctx + ": a signal must be an object {\"name\": ..., \"size\": ...}, not " + a_type(s.type));
           continue;
         }
         Fields fs(sink_, doc, s, p, signal_kind(), named("signal", s, "name"));
@@ -635,16 +654,20 @@ private:
         if (e.find_member("pipeline") != nullptr) {
           Fields fp(sink_, doc, e, p, pipeline_kind(), named("pipeline", e, "name"));
           entry.name_site = fp.site("name");
-          if (const JsonValue* n = fp.get("name")) entry.pipeline = n->string;
-          else entry.pipeline = "?";
+          if (const JsonValue* n = fp.get("name"))
+            entry.pipeline = n->string;
+          else
+            entry.pipeline = "?";
           TargetDefault target;
-          if (const JsonValue* t = fp.get("target")) target = read_target(doc, *t, fp.pointer("target"), fp.context(), c.name);
+          if (const JsonValue* t = fp.get("target"))
+            target = read_target(doc, *t, fp.pointer("target"), fp.context(), c.name);
           if (const JsonValue* stages = fp.get("pipeline")) {
             for (std::size_t k = 0; k < stages->array.size(); ++k) {
               const JsonValue& s = stages->array[k];
               const std::string sp = pointer_join(fp.pointer("pipeline"), k);
               if (!s.is_object()) {
-                sink_.error(Site{doc, s.position, sp}, fp.context() + ": a stage must be a filter object, not " + a_type(s.type));
+                sink_.error(Site{doc, s.position, sp},
+                            fp.context() + ": a stage must be a filter object, not " + a_type(s.type));
                 continue;
               }
               FilterItem stage = read_filter(doc, s, sp, c.name, target);
@@ -747,8 +770,10 @@ private:
       item.has_transitions = true;
       for (const JsonValue& x : t->array) {
         const auto tr = x.is_string() ? parse_transition(x.string) : std::nullopt;
-        if (tr) item.def.transitions.insert(*tr);
-        else item.transitions_valid = false;
+        if (tr)
+          item.def.transitions.insert(*tr);
+        else
+          item.transitions_valid = false;
       }
     } else if (f.has("state_transition")) {
       item.transitions_valid = false;
@@ -772,7 +797,7 @@ private:
     out.target.component = owner;
     if (const JsonValue* type = f.get("type")) {
       const std::string& s = type->string;
-      out.target.kind = s == "s_F" ? MachineKind::Framework
+      out.target.kind = s == "s_F"   ? MachineKind::Framework
                         : s == "s_P" ? MachineKind::Provided
                         : s == "s_R" ? MachineKind::Required
                                      : MachineKind::Application;

@@ -135,7 +135,9 @@ std::string_view step_key(ScenarioStep::Kind kind) noexcept {
   return "?";
 }
 
-std::string ScenarioStep::pointer() const { return "/steps/" + std::to_string(index) + "/" + std::string(step_key(kind)); }
+std::string ScenarioStep::pointer() const {
+  return "/steps/" + std::to_string(index) + "/" + std::string(step_key(kind));
+}
 
 // ---- reading a scenario ------------------------------------------------------------------------
 
@@ -146,7 +148,8 @@ public:
   Reader(std::string file, std::vector<Diagnostic>& out) : file_(std::move(file)), out_(out) {}
 
   void error(const TextPosition& p, const std::string& pointer, std::string message) {
-    out_.push_back(Diagnostic{Diagnostic::Severity::Error, Position{file_, p.line, p.column}, std::move(message), pointer});
+    out_.push_back(
+        Diagnostic{Diagnostic::Severity::Error, Position{file_, p.line, p.column}, std::move(message), pointer});
   }
 
   bool number(const JsonValue& v, const std::string& pointer, const char* what, double& out) {
@@ -220,9 +223,12 @@ std::string seconds_text(double s) {
 std::string escape_pointer(const std::string& key) {
   std::string out;
   for (char c : key) {
-    if (c == '~') out += "~0";
-    else if (c == '/') out += "~1";
-    else out += c;
+    if (c == '~')
+      out += "~0";
+    else if (c == '/')
+      out += "~1";
+    else
+      out += c;
   }
   return out;
 }
@@ -233,8 +239,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     r.error(step.position, base, "a step must be an object with \"at\" and one action");
     return;
   }
-  static constexpr std::string_view kActions[] = {"sample", "ramp", "generate", "inject", "reset",
-                                                  "expect", "expect_outstanding", "expect_cause"};
+  static constexpr std::string_view kActions[] = {"sample", "ramp",   "generate",           "inject",
+                                                  "reset",  "expect", "expect_outstanding", "expect_cause"};
   const JsonValue* at = step.find("at");
   double when = 0.0;
   if (at == nullptr) {
@@ -242,7 +248,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     for (const JsonMember& m : step.object) {
       if (std::find(std::begin(kActions), std::end(kActions), m.key) != std::end(kActions)) continue;
       if (detail::nearest(m.key, {"at"})) {
-        r.error(m.key_position, base + "/" + escape_pointer(m.key), "unknown key \"" + m.key + "\"; did you mean 'at'?");
+        r.error(m.key_position, base + "/" + escape_pointer(m.key),
+                "unknown key \"" + m.key + "\"; did you mean 'at'?");
         return;
       }
     }
@@ -260,11 +267,13 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     if (m.key == "at") continue;
     const auto it = std::find(std::begin(kActions), std::end(kActions), m.key);
     if (it == std::end(kActions)) {
-      const std::string suggestion = did_you_mean(m.key, std::vector<std::string>(std::begin(kActions), std::end(kActions)));
+      const std::string suggestion =
+          did_you_mean(m.key, std::vector<std::string>(std::begin(kActions), std::end(kActions)));
       r.error(m.key_position, base + "/" + escape_pointer(m.key),
               "unknown step action \"" + m.key + "\"" +
-                  (suggestion.empty() ? " (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)"
-                                      : suggestion));
+                  (suggestion.empty()
+                       ? " (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)"
+                       : suggestion));
       unknown_action = true;
       continue;
     }
@@ -336,7 +345,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
         const JsonValue* e = v.find("event");
         const JsonValue* t = v.find("target");
         if (e == nullptr) {
-          if (std::find(typos.begin(), typos.end(), "event") == typos.end()) r.error(v.position, p, "\"generate\" needs \"event\"");
+          if (std::find(typos.begin(), typos.end(), "event") == typos.end())
+            r.error(v.position, p, "\"generate\" needs \"event\"");
           ok = false;
           break;
         }
@@ -374,12 +384,14 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           }
         }
         if (sig != nullptr && !a.deep) {
-          r.error(sig->position, p + "/signal", "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
+          r.error(sig->position, p + "/signal",
+                  "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
           ok = false;
         }
         if (vals == nullptr || !vals->is_array() || vals->array.empty()) {
           if (vals != nullptr || !typo("values")) {
-            r.error(vals == nullptr ? v.position : vals->position, p + "/values", "\"values\" must be a non-empty list of samples");
+            r.error(vals == nullptr ? v.position : vals->position, p + "/values",
+                    "\"values\" must be a non-empty list of samples");
           }
           ok = false;
           break;
@@ -401,7 +413,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
         const JsonValue* t = v.find("target");
         const JsonValue* why = v.find("reason");
         if (t == nullptr) {
-          if (std::find(typos.begin(), typos.end(), "target") == typos.end()) r.error(v.position, p, "\"reset\" needs \"target\"");
+          if (std::find(typos.begin(), typos.end(), "target") == typos.end())
+            r.error(v.position, p, "\"reset\" needs \"target\"");
           ok = false;
           break;
         }
@@ -467,9 +480,8 @@ ScenarioLoad load_scenario(const std::string& path) {
   sc.path = path;
   std::vector<Diagnostic> step_diagnostics;
   Reader step_reader(path, step_diagnostics);
-  const JsonParse parsed = parse_json_streaming(text, "steps", [&](std::size_t index, JsonValue&& step) {
-    read_step(step_reader, step, index, sc.steps);
-  });
+  const JsonParse parsed = parse_json_streaming(
+      text, "steps", [&](std::size_t index, JsonValue&& step) { read_step(step_reader, step, index, sc.steps); });
   std::string().swap(text);
   if (parsed.error) {  // the syntax error alone, as for any file that is not JSON
     r.error(parsed.error->position, "", parsed.error->message);
@@ -484,7 +496,8 @@ ScenarioLoad load_scenario(const std::string& path) {
   const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
   const JsonValue* system = root.find("system");
   if (system == nullptr) {
-    if (!typo("system")) r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
+    if (!typo("system"))
+      r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
   } else if (std::string s; r.text(*system, "/system", "\"system\"", s)) {
     const std::filesystem::path base = std::filesystem::path(path).parent_path();
     sc.system = (base / s).lexically_normal().string();
@@ -497,7 +510,8 @@ ScenarioLoad load_scenario(const std::string& path) {
   const JsonValue* duration = root.find("duration");
   if (duration == nullptr) {
     if (!typo("duration")) r.error(root.position, "", "scenario needs \"duration\" (seconds)");
-  } else if (r.number(*duration, "/duration", "\"duration\"", sc.duration) && !(sc.duration >= 0 && sc.duration <= 1e6)) {
+  } else if (r.number(*duration, "/duration", "\"duration\"", sc.duration) &&
+             !(sc.duration >= 0 && sc.duration <= 1e6)) {
     r.error(duration->position, "/duration", "\"duration\" must be in [0, 1e6] seconds");
   }
   if (sc.period > 0 && sc.duration / sc.period > 1e8) {
@@ -523,7 +537,8 @@ ScenarioLoad load_scenario(const std::string& path) {
   // Scenarios are usually written in time order: then nothing moves (a sort would need a buffer
   // of half the steps).
   const auto by_time = [](const ScenarioStep& a, const ScenarioStep& b) { return a.at < b.at; };
-  if (!std::is_sorted(sc.steps.begin(), sc.steps.end(), by_time)) std::stable_sort(sc.steps.begin(), sc.steps.end(), by_time);
+  if (!std::is_sorted(sc.steps.begin(), sc.steps.end(), by_time))
+    std::stable_sort(sc.steps.begin(), sc.steps.end(), by_time);
   if (!out.diagnostics.empty()) {
     out.partial = std::move(sc);
     return out;

@@ -19,7 +19,7 @@ using detail::Shape;
 /// A JSON value under construction: members keep their insertion order, so the text is stable.
 struct Node {
   enum class Kind { Scalar, Object, Array } kind = Kind::Object;
-  std::string scalar;  ///< JSON text
+  std::string scalar;             ///< JSON text
   std::vector<std::string> keys;  ///< object: member names, in order
   std::vector<Node> values;       ///< object: member values
   std::vector<Node> items;        ///< array
@@ -165,8 +165,10 @@ Node key_schema(const Key& k) {
       break;
     }
     case Shape::Object:
-      if (k.ref.empty()) n.set("type", Node::text("object"));
-      else n.set("$ref", Node::text("#/$defs/" + std::string(k.ref)));
+      if (k.ref.empty())
+        n.set("type", Node::text("object"));
+      else
+        n.set("$ref", Node::text("#/$defs/" + std::string(k.ref)));
       break;
     case Shape::ObjectList:
       n.set("type", Node::text("array"));
@@ -253,7 +255,8 @@ Node param_schema(const ParamSpec& p) {
   }
   if (p.default_value) n.set("default", param_value(*p.default_value));
   std::string doc = p.doc;
-  if (p.type == ParamType::Signal || p.type == ParamType::SignalList) doc += " (Component.signal, or a bare name for the target component)";
+  if (p.type == ParamType::Signal || p.type == ParamType::SignalList)
+    doc += " (Component.signal, or a bare name for the target component)";
   if (p.type == ParamType::Event) doc += " (an event of the system)";
   n.set("description", Node::text(doc));
   return n;
@@ -299,8 +302,9 @@ Node argument_schema(const FilterManifest& m) {
 Node filter_schema(const FilterRegistry& registry, const std::vector<const FilterManifest*>& manifests, bool stage) {
   Node schema = object_schema(detail::filter_kind());
   if (stage) {
-    *schema.member("description") = Node::text("a pipeline stage: a filter whose input may come from the previous stage and whose "
-                                  "output may be named by the pipeline");
+    *schema.member("description") = Node::text(
+        "a pipeline stage: a filter whose input may come from the previous stage and whose "
+        "output may be named by the pipeline");
   }
   Node names = Node::array();
   Node all_of = Node::array();
@@ -349,9 +353,10 @@ std::string json_schema(const FilterRegistry& registry) {
   root.set("$schema", Node::text("https://json-schema.org/draft/2020-12/schema"));
   root.set("$id", Node::text("urn:safecass:spec:1"));
   root.set("title", Node::text("SAFECASS specification"));
-  root.set("description", Node::text("A system file (\"system\") or a component file (\"component\"); comments (// and /* */) "
-                                     "are allowed by SAFECASS but not by JSON Schema tools. Generated from the format's key "
-                                     "tables and the filter manifests: see docs/spec-format.md."));
+  root.set("description",
+           Node::text("A system file (\"system\") or a component file (\"component\"); comments (// and /* */) "
+                      "are allowed by SAFECASS but not by JSON Schema tools. Generated from the format's key "
+                      "tables and the filter manifests: see docs/spec-format.md."));
   Node& one_of = root.set("oneOf", Node::array());
   one_of.push(Node::ref("system"));
   one_of.push(Node::ref("component"));
@@ -385,7 +390,8 @@ std::string json_schema(const FilterRegistry& registry) {
   {
     Node c;
     c.set("type", Node::text("object"));
-    c.set("description", Node::text("coordinator (process) name -> the components it runs; each component in one coordinator"));
+    c.set("description",
+          Node::text("coordinator (process) name -> the components it runs; each component in one coordinator"));
     Node& list = c.set("additionalProperties", Node{});
     list.set("type", Node::text("array"));
     Node items;
@@ -397,7 +403,8 @@ std::string json_schema(const FilterRegistry& registry) {
   {
     Node r;
     r.set("type", Node::text("object"));
-    r.set("description", Node::text("address (SYSTEM, C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p) -> the least level it must be at"));
+    r.set("description",
+          Node::text("address (SYSTEM, C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p) -> the least level it must be at"));
     Node& level = r.set("additionalProperties", Node{});
     Node& choices = level.set("enum", Node::array());
     choices.push(Node::text("Warning"));

@@ -50,10 +50,13 @@ std::optional<ParamValue> convert(const JsonValue& v, ParamType type) {
     case JsonValue::Type::Bool: return ParamValue(v.boolean);
     case JsonValue::Type::String: return ParamValue(v.string);
     case JsonValue::Type::Array: {
-      const bool strings = std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_string(); });
-      const bool numbers = std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_number(); });
+      const bool strings =
+          std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_string(); });
+      const bool numbers =
+          std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_number(); });
       if (v.array.empty()) {
-        return type == ParamType::NumberList ? ParamValue(std::vector<double>{}) : ParamValue(std::vector<std::string>{});
+        return type == ParamType::NumberList ? ParamValue(std::vector<double>{})
+                                             : ParamValue(std::vector<std::string>{});
       }
       if (strings) {
         std::vector<std::string> out;
@@ -94,7 +97,7 @@ struct EventInfo {
   bool onset = true;
   bool latched = false;
   int severity = 0;
-  std::string completes;  ///< completion: its onset
+  std::string completes;                 ///< completion: its onset
   std::vector<std::string> completions;  ///< onset: the completions that clear it
   const EventItem* item = nullptr;
   bool generated = false;
@@ -167,7 +170,8 @@ private:
           for (FilterItem& stage : copy.stages) {
             stage.owner = c.name;
             stage.from_template = true;
-            if (!stage.target_component_given || stage.config.target.component.empty()) stage.config.target.component = c.name;
+            if (!stage.target_component_given || stage.config.target.component.empty())
+              stage.config.target.component = c.name;
             if (stage.named) {
               stage.config.name = c.name + "." + stage.config.name;
             } else if (copy.pipeline.empty()) {
@@ -210,8 +214,11 @@ private:
       }
     }
     if (m_.system_file && m_.has_components_key && m_.component_entries == 0) {
-      sink_.warning(Site{0, sink_.documents.empty() || !sink_.documents[0].root ? TextPosition{} : sink_.documents[0].root->position, ""},
-                    "system " + quote_name(m_.name) + " has no components");
+      sink_.warning(
+          Site{0,
+               sink_.documents.empty() || !sink_.documents[0].root ? TextPosition{} : sink_.documents[0].root->position,
+               ""},
+          "system " + quote_name(m_.name) + " has no components");
     }
   }
 
@@ -245,7 +252,8 @@ private:
       std::map<std::string, Site, std::less<>> seen;
       for (const Name& n : *list) {
         if (!simple_name(n.text)) {
-          sink_.error(n.site, who + ": interface name " + quote_name(n.text) + " must be non-empty, without dots or spaces");
+          sink_.error(n.site,
+                      who + ": interface name " + quote_name(n.text) + " must be non-empty, without dots or spaces");
           continue;
         }
         const auto [it, fresh] = seen.emplace(n.text, n.site);
@@ -279,7 +287,7 @@ private:
 
   // ---- signals ---------------------------------------------------------------------------------
   void check_signals(ComponentItem& c) {
-    if (c.is_template()) return;  // reported by expand_templates()
+    if (c.is_template()) return;                        // reported by expand_templates()
     if (invalid_components_.count(c.name) > 0) return;  // reported with the name
     for (const SignalItem& s : c.signals) {
       const auto dot = s.name.find('.');
@@ -311,8 +319,10 @@ private:
       info.kind_known = true;
       info.onset = f.onset;
       info.severity = f.severity;
-      if (f.onset) info.completions.push_back(f.counterpart);
-      else info.completes = f.counterpart;
+      if (f.onset)
+        info.completions.push_back(f.counterpart);
+      else
+        info.completes = f.counterpart;
       events_.emplace(f.name, std::move(info));
     }
     std::vector<EventItem*> completions;
@@ -341,9 +351,10 @@ private:
         if (e.has_transitions && e.transitions_valid) {
           const TransitionSet t = e.def.transitions;
           if (t.empty()) {
-            sink_.error(e.transitions_site, "event " + quote_name(name) +
-                                                ": 'state_transition' is empty: list worsening transitions (an onset) or "
-                                                "improving ones (a completion)");
+            sink_.error(e.transitions_site,
+                        "event " + quote_name(name) +
+                            ": 'state_transition' is empty: list worsening transitions (an onset) or "
+                            "improving ones (a completion)");
           } else if (t.worsening_only() || t.improving_only()) {
             info.kind_known = true;
             info.onset = t.worsening_only();
@@ -354,7 +365,8 @@ private:
           }
         }
         if (info.kind_known && info.onset && !e.def.completes.empty()) {
-          sink_.error(e.completes_site, "event " + quote_name(name) + " is an onset: only a completion may say which onset it 'completes'");
+          sink_.error(e.completes_site, "event " + quote_name(name) +
+                                            " is an onset: only a completion may say which onset it 'completes'");
         }
         if (info.kind_known && !info.onset) {
           if (e.def.latched) {
@@ -401,7 +413,8 @@ private:
         if (info.completions.empty() && !info.latched) {
           sink_.warning(e.name_site, "onset " + quote_name(e.def.name) +
                                          " has no completion: nothing can clear it but a reset (needs reset); define " +
-                                         quote_name("/" + e.def.name) + ", or mark it \"latched\": true if that is intended");
+                                         quote_name("/" + e.def.name) +
+                                         ", or mark it \"latched\": true if that is intended");
         } else if (info.completions.size() > 1) {
           std::vector<std::string> q;
           for (const std::string& n : info.completions) q.push_back(quote_name(n));
@@ -447,8 +460,9 @@ private:
       }
     }
     if (!differs.empty()) {
-      sink_.error(e.name_site, head + " differently: " + differs +
-                                   "; a framework event cannot be changed: remove this definition, or give your event another name");
+      sink_.error(e.name_site,
+                  head + " differently: " + differs +
+                      "; a framework event cannot be changed: remove this definition, or give your event another name");
       return;
     }
     if (!e.def.completes.empty() || e.def.latched) {
@@ -475,8 +489,10 @@ private:
   std::optional<End> connection_end(const std::string& text, bool required, const Site& site) {
     const char* role = required ? "required" : "provided";
     const auto dot = text.find('.');
-    if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() || text.find('.', dot + 1) != std::string::npos) {
-      sink_.error(site, std::string("connection: '") + role + "' must be written Component.interface, not " + quote_name(text));
+    if (dot == std::string::npos || dot == 0 || dot + 1 == text.size() ||
+        text.find('.', dot + 1) != std::string::npos) {
+      sink_.error(
+          site, std::string("connection: '") + role + "' must be written Component.interface, not " + quote_name(text));
       return std::nullopt;
     }
     const std::string comp = text.substr(0, dot);
@@ -491,10 +507,11 @@ private:
     const std::vector<Name>& other = required ? end.component->provided : end.component->required;
     if (contains(same, end.interface)) return end;
     if (contains(other, end.interface)) {
-      sink_.error(site, "connection: " + quote_name(text) + " is a " + (required ? "provided" : "required") +
-                            " interface; '" + role + "' must name a " + role + " interface" +
-                            (same.empty() ? std::string(" (component ") + quote_name(comp) + " has none)"
-                                          : std::string(" of ") + quote_name(comp) + " (" + join_or(names_of(same)) + ")"));
+      sink_.error(
+          site, "connection: " + quote_name(text) + " is a " + (required ? "provided" : "required") + " interface; '" +
+                    role + "' must name a " + role + " interface" +
+                    (same.empty() ? std::string(" (component ") + quote_name(comp) + " has none)"
+                                  : std::string(" of ") + quote_name(comp) + " (" + join_or(names_of(same)) + ")"));
       return std::nullopt;
     }
     sink_.error(site, "connection: component " + quote_name(comp) + " has no " + role + " interface " +
@@ -515,7 +532,8 @@ private:
       const auto provider = connection_end(k.provided, false, k.provided_site);
       if (!client || !provider) continue;
       if (client->component == provider->component) {
-        sink_.error(k.site, "connection " + k.required + " -> " + k.provided + ": a component cannot require its own service");
+        sink_.error(k.site,
+                    "connection " + k.required + " -> " + k.provided + ": a component cannot require its own service");
         continue;
       }
       const auto [it, fresh] = connected_.emplace(k.required, &k);
@@ -534,16 +552,18 @@ private:
     std::map<std::string, Site, std::less<>> names;
     for (const CoordinatorItem& co : m_.coordinators) {
       if (const auto [it, fresh] = names.emplace(co.name.text, co.name.site); !fresh) {
-        sink_.error(co.name.site, "duplicate coordinator " + quote_name(co.name.text) + " (first at " +
-                                      sink_.at(it->second) + ")");
+        sink_.error(co.name.site,
+                    "duplicate coordinator " + quote_name(co.name.text) + " (first at " + sink_.at(it->second) + ")");
       }
       if (!simple_name(co.name.text)) {
-        sink_.error(co.name.site, "coordinator name " + quote_name(co.name.text) + " must be non-empty, without dots or spaces");
+        sink_.error(co.name.site,
+                    "coordinator name " + quote_name(co.name.text) + " must be non-empty, without dots or spaces");
       } else if (co.name.text == "SYSTEM") {
         sink_.error(co.name.site, "coordinator name 'SYSTEM' is reserved: it is the address of the whole system");
       } else if (component(co.name.text) != nullptr) {
-        sink_.error(co.name.site, "coordinator " + quote_name(co.name.text) +
-                                      " has the name of a component: a coordinator's name addresses all its components");
+        sink_.error(co.name.site,
+                    "coordinator " + quote_name(co.name.text) +
+                        " has the name of a component: a coordinator's name addresses all its components");
       }
       for (const Name& n : co.components) {
         if (component(n.text) == nullptr) {
@@ -583,7 +603,8 @@ private:
       bool duplicate_pipeline = false;
       if (is_pipeline_entry) {
         if (entry.pipeline != "?" && !simple_name(entry.pipeline)) {
-          sink_.error(entry.name_site, "pipeline name " + quote_name(entry.pipeline) + " must be non-empty, without dots or spaces");
+          sink_.error(entry.name_site,
+                      "pipeline name " + quote_name(entry.pipeline) + " must be non-empty, without dots or spaces");
         } else if (entry.pipeline != "?") {
           const auto [it, fresh] = pipelines_.emplace(entry.pipeline, entry.name_site);
           if (!fresh) {
@@ -600,7 +621,8 @@ private:
       } else if (!entry.stages.empty() && !entry.stages.front().named) {
         FilterItem& f = entry.stages.front();
         const FilterRegistry::Entry* e = registry_.find(f.config.type);
-        f.config.name = c.name + "." + (e != nullptr ? e->manifest.type : f.config.type) + "_" + std::to_string(index + 1);
+        f.config.name =
+            c.name + "." + (e != nullptr ? e->manifest.type : f.config.type) + "_" + std::to_string(index + 1);
       }
       std::string coordinator;
       for (std::size_t k = 0; k < entry.stages.size(); ++k) {
@@ -608,11 +630,13 @@ private:
         check_filter(f, duplicate_pipeline && !f.named);
         if (is_pipeline_entry && m_.has_coordinators) {
           const std::string here = coordinator_of(f.config.target.component);
-          if (k == 0) coordinator = here;
+          if (k == 0)
+            coordinator = here;
           else if (here != coordinator && !here.empty() && !coordinator.empty()) {
-            sink_.error(f.target_component_site, "pipeline " + quote_name(entry.pipeline) + ": stage " + std::to_string(k + 1) +
-                                                     " targets a component of coordinator " + quote_name(here) +
-                                                     " but the pipeline runs in " + quote_name(coordinator));
+            sink_.error(f.target_component_site, "pipeline " + quote_name(entry.pipeline) + ": stage " +
+                                                     std::to_string(k + 1) + " targets a component of coordinator " +
+                                                     quote_name(here) + " but the pipeline runs in " +
+                                                     quote_name(coordinator));
           }
         }
       }
@@ -629,12 +653,14 @@ private:
       if (!stage.named) stage.config.name = entry.pipeline + "." + std::to_string(i + 1);
       const FilterRegistry::Entry* e = stage.has_class ? registry_.find(stage.config.type) : nullptr;
       const auto has_param = [&](const std::string& name) {
-        return std::any_of(stage.params.begin(), stage.params.end(), [&](const ParamItem& p) { return p.name == name; });
+        return std::any_of(stage.params.begin(), stage.params.end(),
+                           [&](const ParamItem& p) { return p.name == name; });
       };
       if (e != nullptr && i > 0 && !e->manifest.inputs.empty()) {
         const bool has_input = std::any_of(e->manifest.inputs.begin(), e->manifest.inputs.end(), has_param);
         if (!has_input && !previous_output.empty()) {
-          stage.params.push_back(ParamItem{e->manifest.inputs.front(), stage.site, stage.site, nullptr, previous_output});
+          stage.params.push_back(
+              ParamItem{e->manifest.inputs.front(), stage.site, stage.site, nullptr, previous_output});
         }
       }
       if (e != nullptr && !e->manifest.outputs.empty() && i + 1 < entry.stages.size() &&
@@ -646,8 +672,10 @@ private:
       if (e != nullptr && !e->manifest.outputs.empty()) {
         for (const ParamItem& p : stage.params) {
           if (p.name != e->manifest.outputs.front()) continue;
-          if (p.value == nullptr) previous_output = qualify(p.synthetic, stage.config.target.component);
-          else if (p.value->is_string()) previous_output = qualify(p.value->string, stage.config.target.component);
+          if (p.value == nullptr)
+            previous_output = qualify(p.synthetic, stage.config.target.component);
+          else if (p.value->is_string())
+            previous_output = qualify(p.value->string, stage.config.target.component);
         }
       }
     }
@@ -660,8 +688,8 @@ private:
     } else if (!skip_duplicate_name) {
       const auto [it, fresh] = filters_.emplace(f.config.name, f.named ? f.name_site : f.site);
       if (!fresh) {
-        sink_.error(f.named ? f.name_site : f.site, "duplicate filter " + quote_name(f.config.name) + " (first at " +
-                                                         sink_.at(it->second) + ")");
+        sink_.error(f.named ? f.name_site : f.site,
+                    "duplicate filter " + quote_name(f.config.name) + " (first at " + sink_.at(it->second) + ")");
       }
     }
     if (!f.has_class) return;  // reported as a missing key
@@ -697,7 +725,8 @@ private:
     for (ParamItem& p : f.params) {
       const std::string_view canonical = manifest.canonical(p.name);
       if (canonical == p.name) continue;
-      const bool both = std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& q) { return q.name == canonical; });
+      const bool both =
+          std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& q) { return q.name == canonical; });
       if (both) {
         sink_.error(p.key_site, ctx + ": parameters " + quote_name(p.name) + " and " + quote_name(canonical) +
                                     " are the same parameter; give one");
@@ -708,7 +737,8 @@ private:
     }
     // A type that names its own output (the 2016 transforms) writes the signal named after the filter.
     if (manifest.default_output && !manifest.outputs.empty() && !f.argument_misspelled &&
-        std::none_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == manifest.outputs.front(); })) {
+        std::none_of(f.params.begin(), f.params.end(),
+                     [&](const ParamItem& p) { return p.name == manifest.outputs.front(); })) {
       f.params.push_back(ParamItem{manifest.outputs.front(), f.argument_site, f.argument_site, nullptr,
                                    default_output_name(f.config.name, f.config.target.component)});
     }
@@ -767,8 +797,8 @@ private:
         params_ok = false;
         continue;
       }
-      std::optional<ParamValue> value = p.value == nullptr ? std::optional<ParamValue>(ParamValue(p.synthetic))
-                                                            : convert(*p.value, spec->type);
+      std::optional<ParamValue> value =
+          p.value == nullptr ? std::optional<ParamValue>(ParamValue(p.synthetic)) : convert(*p.value, spec->type);
       if (!value) {
         sink_.error(p.value_site, ctx + ": parameter " + quote_name(p.name) + " must be " + param_type_text(*spec) +
                                       ", not " + a_type(p.value->type));
@@ -794,11 +824,13 @@ private:
     }
     if (!has_input_given(f, manifest) && f.argument_misspelled) params_ok = false;
     const std::string pipeline_note =
-        f.stage > 0 ? "; the previous stage of pipeline " + quote_name(f.pipeline) + " writes no output it could read" : "";
+        f.stage > 0 ? "; the previous stage of pipeline " + quote_name(f.pipeline) + " writes no output it could read"
+                    : "";
     bool missing_input = false;
     for (const ParamSpec& spec : manifest.params) {
       if (spec.default_value || spec.optional || given.count(spec.name) > 0) continue;
-      if (std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == spec.name; })) continue;
+      if (std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == spec.name; }))
+        continue;
       const bool input = std::find(manifest.inputs.begin(), manifest.inputs.end(), spec.name) != manifest.inputs.end();
       missing_input = missing_input || input;
       params_ok = false;
@@ -902,8 +934,8 @@ private:
       }
       const std::string comp = full.substr(0, dot);
       if (component(comp) == nullptr) {
-        sink_.error(site, ctx + ": parameter " + quote_name(output) + ": no component " + quote_name(comp) + " for signal " +
-                              quote_name(full) + did_you_mean(comp, component_names()));
+        sink_.error(site, ctx + ": parameter " + quote_name(output) + ": no component " + quote_name(comp) +
+                              " for signal " + quote_name(full) + did_you_mean(comp, component_names()));
         continue;
       }
       check_same_coordinator(ctx, output, full, comp, coordinator, site);
@@ -915,11 +947,13 @@ private:
       }
       if (size != 0 && existing->second.size != 0 && existing->second.size != size) {
         sink_.error(site, ctx + ": parameter " + quote_name(output) + ": signal " + quote_name(full) + " has size " +
-                              std::to_string(existing->second.size) + " but this filter writes " + std::to_string(size));
+                              std::to_string(existing->second.size) + " but this filter writes " +
+                              std::to_string(size));
       }
       if (!existing->second.writer.empty()) {
         sink_.warning(site, ctx + " writes signal " + quote_name(full) + ", which filter " +
-                                quote_name(existing->second.writer) + " also writes (at " + sink_.at(existing->second.site) + ")");
+                                quote_name(existing->second.writer) + " also writes (at " +
+                                sink_.at(existing->second.site) + ")");
       } else {
         existing->second.writer = f.config.name;
       }
@@ -944,7 +978,8 @@ private:
       if (const auto it = given.find(spec.name); it != given.end()) {
         name = std::get_if<std::string>(&it->second);
         site = items.at(spec.name)->value_site;
-      } else if (std::any_of(f.params.begin(), f.params.end(), [&](const ParamItem& p) { return p.name == spec.name; })) {
+      } else if (std::any_of(f.params.begin(), f.params.end(),
+                             [&](const ParamItem& p) { return p.name == spec.name; })) {
         continue;  // given but wrong: reported
       } else if (spec.default_value) {
         name = std::get_if<std::string>(&*spec.default_value);
@@ -974,9 +1009,9 @@ private:
     if (!onset.empty() && !completion.empty()) {
       const EventInfo& c = events_.at(completion);
       if (c.kind_known && c.completes != onset) {
-        sink_.error(completion_site, ctx + ": completion " + quote_name(completion) + " does not complete onset " +
-                                         quote_name(onset) +
-                                         (c.completes.empty() ? "" : " (it completes " + quote_name(c.completes) + ")"));
+        sink_.error(completion_site,
+                    ctx + ": completion " + quote_name(completion) + " does not complete onset " + quote_name(onset) +
+                        (c.completes.empty() ? "" : " (it completes " + quote_name(c.completes) + ")"));
       }
     }
   }
@@ -990,8 +1025,8 @@ private:
   /// Parameters of the original format that have another name now.
   static std::string_view renamed_parameter(std::string_view name) {
     static const std::pair<std::string_view, std::string_view> kRenamed[] = {
-        {"margin", "tolerance"},       {"InputSignalName", "input_signal"}, {"output0", "output_below"},
-        {"output1", "output_above"},   {"input", "input_signal"},          {"output", "output_signal"}};
+        {"margin", "tolerance"},     {"InputSignalName", "input_signal"}, {"output0", "output_below"},
+        {"output1", "output_above"}, {"input", "input_signal"},           {"output", "output_signal"}};
     for (const auto& [old_name, now] : kRenamed) {
       if (old_name == name) return now;
     }
@@ -1020,7 +1055,8 @@ private:
     const bool low = spec.min > -1e300;
     const bool high = spec.max < 1e300;
     if ((low && *d < spec.min) || (high && *d > spec.max)) {
-      if (low && high) return "within " + number_text(spec.min) + "-" + number_text(spec.max) + ", not " + number_text(*d);
+      if (low && high)
+        return "within " + number_text(spec.min) + "-" + number_text(spec.max) + ", not " + number_text(*d);
       if (low) return "at least " + number_text(spec.min) + ", not " + number_text(*d);
       return "at most " + number_text(spec.max) + ", not " + number_text(*d);
     }
@@ -1034,7 +1070,8 @@ private:
     const auto dot = full.find('.');
     const std::string what = ctx + ": parameter " + quote_name(param);
     if (dot == 0 || dot + 1 == full.size()) {
-      sink_.error(site, what + ": " + quote_name(name) + " is not a signal name (Component.signal, or a bare name for the target component)");
+      sink_.error(site, what + ": " + quote_name(name) +
+                            " is not a signal name (Component.signal, or a bare name for the target component)");
       return 0;
     }
     const std::string comp = full.substr(0, dot);
@@ -1075,9 +1112,9 @@ private:
     if (!m_.has_coordinators) return;
     const std::string other = coordinator_of(comp);
     if (!coordinator.empty() && !other.empty() && other != coordinator) {
-      sink_.error(site, ctx + ": parameter " + quote_name(param) + ": signal " + quote_name(signal) + " belongs to coordinator " +
-                            quote_name(other) + ", but the filter runs in " + quote_name(coordinator) +
-                            " (with its target): signals do not cross coordinators");
+      sink_.error(site, ctx + ": parameter " + quote_name(param) + ": signal " + quote_name(signal) +
+                            " belongs to coordinator " + quote_name(other) + ", but the filter runs in " +
+                            quote_name(coordinator) + " (with its target): signals do not cross coordinators");
     }
   }
 
@@ -1106,8 +1143,9 @@ private:
         const EventInfo& info = it->second;
         if (!info.kind_known || !info.onset || info.generated) continue;
         if (info.severity >= kMinBroadcastSeverity) continue;  // broadcasts come from tools
-        sink_.warning(e.name_site, "event " + quote_name(e.def.name) +
-                                       " is not generated by any filter (only the application or a tool can generate it)");
+        sink_.warning(e.name_site,
+                      "event " + quote_name(e.def.name) +
+                          " is not generated by any filter (only the application or a tool can generate it)");
       }
     }
   }
@@ -1167,12 +1205,14 @@ private:
       const std::string ctx = "hazard " + quote_name(h.id);
       for (const HazardItem::Reaction& r : h.reaction) {
         if (const std::string problem = address_problem(r.address); !problem.empty()) {
-          sink_.error(r.key_site, ctx + ": reaction names address " + quote_name(r.address) + ", which does not exist: " + problem);
+          sink_.error(r.key_site,
+                      ctx + ": reaction names address " + quote_name(r.address) + ", which does not exist: " + problem);
         }
         const auto level = parse_state(r.level);
         if (!level) {
-          sink_.error(r.value_site, ctx + ": reaction of " + quote_name(r.address) + " must be \"Warning\" or \"Error\", not " +
-                                        quote_name(r.level) + did_you_mean(r.level, {"Warning", "Error"}));
+          sink_.error(r.value_site, ctx + ": reaction of " + quote_name(r.address) +
+                                        " must be \"Warning\" or \"Error\", not " + quote_name(r.level) +
+                                        did_you_mean(r.level, {"Warning", "Error"}));
         } else if (*level == State::Normal) {
           sink_.error(r.value_site, ctx + ": reaction of " + quote_name(r.address) +
                                         " is Normal, which every state satisfies: say \"Warning\" or \"Error\"");
@@ -1196,12 +1236,13 @@ private:
     }
     for (const HazardItem& h : m_.hazards) {
       if (!h.has_id || linked.count(h.id) > 0) continue;
-      if (const auto it = ids.find(h.id); it == ids.end() || it->second.position.line != h.id_site.position.line ||
-                                          it->second.file != h.id_site.file) {
+      if (const auto it = ids.find(h.id);
+          it == ids.end() || it->second.position.line != h.id_site.position.line || it->second.file != h.id_site.file) {
         continue;  // an invalid or duplicate id: reported
       }
-      sink_.warning(h.id_site, "hazard " + quote_name(h.id) +
-                                   " has no linked event: no onset names it in its \"hazard\" field, so nothing detects it");
+      sink_.warning(h.id_site,
+                    "hazard " + quote_name(h.id) +
+                        " has no linked event: no onset names it in its \"hazard\" field, so nothing detects it");
     }
   }
 
@@ -1212,7 +1253,8 @@ private:
         if (!token_name(inv.name)) {
           sink_.error(inv.name_site, "invariant name " + quote_name(inv.name) + " must be non-empty, without spaces");
         } else if (const auto [it, fresh] = names.emplace(inv.name, inv.name_site); !fresh) {
-          sink_.error(inv.name_site, "duplicate invariant " + quote_name(inv.name) + " (first at " + sink_.at(it->second) + ")");
+          sink_.error(inv.name_site,
+                      "duplicate invariant " + quote_name(inv.name) + " (first at " + sink_.at(it->second) + ")");
         }
       }
       if (!inv.has_formula) continue;

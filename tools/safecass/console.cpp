@@ -22,8 +22,8 @@
 #include <sstream>
 #include <thread>
 
-#include <CLI/CLI.hpp>
 #include <editline/readline.h>
+#include <CLI/CLI.hpp>
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
@@ -169,7 +169,8 @@ public:
       }
       case Id::EventGenerate: {
         if (auto r = q.generate(args[0], args[1]); !r) return r.error().message;
-        done(out, c, Json().str("event", args[0]).str("target", args[1]), "generated " + args[0] + " on " + args[1], true);
+        done(out, c, Json().str("event", args[0]).str("target", args[1]), "generated " + args[0] + " on " + args[1],
+             true);
         return {};
       }
       case Id::EventBroadcast: {
@@ -254,18 +255,19 @@ private:
     out.line(json.text());
   }
 
-  std::string deep_inject(const CommandSpec& c, const std::string& signal, const std::vector<std::vector<double>>& samples,
-                          Out& out) {
+  std::string deep_inject(const CommandSpec& c, const std::string& signal,
+                          const std::vector<std::vector<double>>& samples, Out& out) {
     if (auto r = target_.query->inject_deep(signal, samples); !r) return r.error().message;
     const std::string when = now_text();
     done(out, c, Json().str("signal", signal).integer("samples", static_cast<long long>(samples.size())),
-         "wrote " + count_text(samples.size()) + " into signal " + signal + (when.empty() ? std::string() : " at " + when) +
-             " (seen by every consumer on its next run: use watch)");
+         "wrote " + count_text(samples.size()) + " into signal " + signal +
+             (when.empty() ? std::string() : " at " + when) + " (seen by every consumer on its next run: use watch)");
     return {};
   }
 
   void print_records(const std::vector<in::HistoryEntry>& records, Out& out, std::string_view empty) const {
-    for (const in::HistoryEntry& e : records) out.line(options_.json ? in::history_json(e) : in::history_text(e, time_));
+    for (const in::HistoryEntry& e : records)
+      out.line(options_.json ? in::history_json(e) : in::history_text(e, time_));
     if (records.empty() && !options_.json) out.line(std::string(empty));
   }
 
@@ -297,7 +299,8 @@ private:
     if (!args.empty()) {
       const auto v = parse_number(args[0]);
       if (!v || !std::isfinite(*v) || *v <= 0 || *v > kMaxWatchSeconds) {
-        return "SECONDS must be a number of seconds above 0 and at most " + number_text(kMaxWatchSeconds) + ", not '" + args[0] + "'";
+        return "SECONDS must be a number of seconds above 0 and at most " + number_text(kMaxWatchSeconds) + ", not '" +
+               args[0] + "'";
       }
       seconds = *v;
     }
@@ -311,16 +314,18 @@ private:
       for (Time t = start + tick; t <= until; t += tick) {
         const std::vector<std::string> failures = target_.advance(t);
         for (std::string& l : take_captured()) out.line(std::move(l));
-        for (const std::string& f : failures) out.line(options_.json ? Json().str("kind", "expectation").str("failure", f).text() : f);
+        for (const std::string& f : failures)
+          out.line(options_.json ? Json().str("kind", "expectation").str("failure", f).text() : f);
       }
     } else {
       auto sub = target_.query->follow([this](const in::HistoryEntry& e) { capture(e); });
       if (!sub) return sub.error().message;
-      const auto until = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                                std::chrono::duration<double>(seconds));
+      const auto until =
+          std::chrono::steady_clock::now() +
+          std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
       while (std::chrono::steady_clock::now() < until) {
-        std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(std::chrono::milliseconds(50),
-                                                                                   until - std::chrono::steady_clock::now()));
+        std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(
+            std::chrono::milliseconds(50), until - std::chrono::steady_clock::now()));
       }
       sub->reset();  // no record arrives after this
       for (std::string& l : take_captured()) out.line(std::move(l));
@@ -329,11 +334,16 @@ private:
     auto after = target_.query->clock();
     const Time end = after ? after->now : start;
     if (options_.json) {
-      out.line(Json().str("command", "watch").num("from", to_seconds(start)).num("t", to_seconds(end)).num("seconds", seconds)
-                   .integer("transitions", static_cast<long long>(seen)).text());
+      out.line(Json()
+                   .str("command", "watch")
+                   .num("from", to_seconds(start))
+                   .num("t", to_seconds(end))
+                   .num("seconds", seconds)
+                   .integer("transitions", static_cast<long long>(seen))
+                   .text());
     } else {
-      out.line((simulated_ ? time_.at(end) + "  watched " : "watched " + target_.query->name() + " for ") + number_text(seconds) +
-               " s: " + std::to_string(seen) + (seen == 1 ? " transition" : " transitions"));
+      out.line((simulated_ ? time_.at(end) + "  watched " : "watched " + target_.query->name() + " for ") +
+               number_text(seconds) + " s: " + std::to_string(seen) + (seen == 1 ? " transition" : " transitions"));
     }
     return {};
   }
@@ -342,7 +352,8 @@ private:
     auto clock = target_.query->clock();
     if (!clock) return clock.error().message;
     if (clock->base != in::TimeBase::Simulated) {
-      return "in-process only: coordinator '" + target_.query->name() + "' runs in real time (use watch SECONDS to follow it)";
+      return "in-process only: coordinator '" + target_.query->name() +
+             "' runs in real time (use watch SECONDS to follow it)";
     }
     const Time now = clock->now;
     if (options_.json) {
@@ -413,8 +424,8 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
   InProcessSystem* raw = sys.get();
   target.advance = [raw](Time t) {
     raw->runner->advance_to(t, raw->result);
-    std::vector<std::string> failures(raw->result.failures.begin() + static_cast<std::ptrdiff_t>(raw->failures_reported),
-                                      raw->result.failures.end());
+    std::vector<std::string> failures(
+        raw->result.failures.begin() + static_cast<std::ptrdiff_t>(raw->failures_reported), raw->result.failures.end());
     raw->failures_reported = raw->result.failures.size();
     return failures;
   };
@@ -533,7 +544,8 @@ int run_console(const ConsoleArgs& args) {
 #ifdef SAFECASS_WITH_ICE
     console = connect_console(args);
 #else
-    std::fprintf(stderr, "console: --ice needs the middleware, and this safecass was built without it (SAFECASS_WITH_ICE)\n");
+    std::fprintf(stderr,
+                 "console: --ice needs the middleware, and this safecass was built without it (SAFECASS_WITH_ICE)\n");
     return 2;
 #endif
   } else {
@@ -553,7 +565,8 @@ int run_console(const ConsoleArgs& args) {
 
 void add_console_command(CLI::App& app, int& code) {
   auto args = std::make_shared<ConsoleArgs>();
-  auto* cmd = app.add_subcommand("console", "Read and write the component model of a system, interactively or from commands");
+  auto* cmd =
+      app.add_subcommand("console", "Read and write the component model of a system, interactively or from commands");
   cmd->footer(
       "Runs the system in-process in simulated time (as `safecass run` does); with --scenario its steps are "
       "applied as `watch` advances time. With --ice HOST:PORT --coordinator NAME it works on a live coordinator "
@@ -566,7 +579,8 @@ void add_console_command(CLI::App& app, int& code) {
   cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
   cmd->add_option("--scenario,-s", args->scenario, "scenario file whose steps are applied as simulated time advances");
   auto* commands = cmd->add_option("-c,--command", args->commands, "commands to run, separated by ';'");
-  cmd->add_option("--script", args->script, "file of commands, one per line ('#' starts a comment)")->excludes(commands);
+  cmd->add_option("--script", args->script, "file of commands, one per line ('#' starts a comment)")
+      ->excludes(commands);
   cmd->add_flag("--json", args->json, "print one JSON object per result line");
   cmd->add_flag("--allow-write", args->allow_write, "accept write commands (inject, generate, broadcast, reset)");
   cmd->add_option("--ice", args->ice, "work on a live coordinator: IceStorm at HOST:PORT (with --coordinator)");
@@ -577,9 +591,11 @@ void add_console_command(CLI::App& app, int& code) {
                 "with --ice: accept a coordinator not on this host although requests and the token are not encrypted");
   cmd->add_option("--read-token-file", args->read_token_file,
                   "with --ice: the coordinator's read credential file (when it was started with one)");
-  cmd->add_option("--tls", args->tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
+  cmd->add_option("--tls", args->tls,
+                  "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
   cmd->add_option("--token-file", args->token_file, "with --ice: the coordinator's token file (writes need it)");
-  cmd->add_option("--timeout", args->timeout_ms, "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")
+  cmd->add_option("--timeout", args->timeout_ms,
+                  "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")
       ->check(CLI::Range(100, 600000));
   cmd->callback([args, &code] {
     const bool remote = !args->ice.empty() || !args->coordinator.empty() || !args->token_file.empty();

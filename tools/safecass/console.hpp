@@ -33,20 +33,20 @@ class Backend;
 }
 
 struct ConsoleArgs {
-  std::string system;         ///< system file (default: the scenario's "system")
-  std::string scenario;       ///< optional: its steps are applied as simulated time advances
-  std::string ice;            ///< remote mode: IceStorm at HOST:PORT (instead of system/scenario)
-  std::string coordinator;    ///< remote mode: the coordinator's name
-  std::string token_file;     ///< remote mode: the coordinator's token file (for writes)
+  std::string system;           ///< system file (default: the scenario's "system")
+  std::string scenario;         ///< optional: its steps are applied as simulated time advances
+  std::string ice;              ///< remote mode: IceStorm at HOST:PORT (instead of system/scenario)
+  std::string coordinator;      ///< remote mode: the coordinator's name
+  std::string token_file;       ///< remote mode: the coordinator's token file (for writes)
   std::string read_token_file;  ///< remote mode: the coordinator's read credential file
-  int timeout_ms = 2000;      ///< remote mode: how long to wait for the heartbeat and each answer
-  std::string keys;           ///< remote mode: the system's bus keys (default $SAFECASS_KEYS)
-  bool insecure = false;      ///< remote mode: accept a coordinator not on this host (unencrypted)
-  std::string tls;            ///< remote mode: mutual TLS (DIR with ca.pem, console.pem/.key)
-  std::string commands;       ///< -c: commands separated by ';'
-  std::string script;         ///< --script: one command per line ('#' starts a comment)
-  bool json = false;          ///< one JSON object per output line
-  bool allow_write = false;   ///< accept write operations
+  int timeout_ms = 2000;        ///< remote mode: how long to wait for the heartbeat and each answer
+  std::string keys;             ///< remote mode: the system's bus keys (default $SAFECASS_KEYS)
+  bool insecure = false;        ///< remote mode: accept a coordinator not on this host (unencrypted)
+  std::string tls;              ///< remote mode: mutual TLS (DIR with ca.pem, console.pem/.key)
+  std::string commands;         ///< -c: commands separated by ';'
+  std::string script;           ///< --script: one command per line ('#' starts a comment)
+  bool json = false;            ///< one JSON object per output line
+  bool allow_write = false;     ///< accept write operations
 };
 
 /// What one command line produced.

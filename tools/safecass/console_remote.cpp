@@ -6,9 +6,9 @@
 #include <cstdio>
 
 #include "console_shell.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/token.hpp"
-#include "safecass/introspect/format.hpp"
 #include "timeline.hpp"
 
 namespace safecass::tools {
@@ -21,7 +21,8 @@ namespace {
 Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, const std::string& coordinator,
                                                        const std::string& token, int timeout_ms,
                                                        const std::string& keys, bool insecure,
-                                                       const std::string& tls = {}, const std::string& read_token = {}) {
+                                                       const std::string& tls = {},
+                                                       const std::string& read_token = {}) {
   auto endpoint = middleware::parse_ice_endpoint(ice);
   if (!endpoint) return fail(ErrorCode::Parse, endpoint.error().message);  // names --ice and its text
   middleware::ClientOptions o;
@@ -62,16 +63,18 @@ Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
   if (auto names = (*client)->names(); names) {
     target.subject += " (" + std::to_string(names->components.size()) + " components)";
   }
-  target.write_access = args.token_file.empty() ? "writes allowed, but no --token-file: the coordinator will refuse them"
-                                                : "writes allowed (token from " + args.token_file + ")";
+  target.write_access = args.token_file.empty()
+                            ? "writes allowed, but no --token-file: the coordinator will refuse them"
+                            : "writes allowed (token from " + args.token_file + ")";
   target.query = std::move(*client);
   auto backend = make_backend(std::move(target), options);
   if (!backend) return fail(backend.error().code, "console: " + backend.error().message);
   return std::make_unique<Console>(std::move(*backend), options);
 }
 
-int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out, int timeout_ms,
-                     const std::string& keys, const std::string& tls, const std::string& read_token_file) {
+int run_timeline_ice(const std::string& ice, const std::string& coordinator, const std::string& html_out,
+                     int timeout_ms, const std::string& keys, const std::string& tls,
+                     const std::string& read_token_file) {
   std::string read_token;
   if (!read_token_file.empty()) {
     auto t = middleware::read_token_file(read_token_file);
@@ -96,11 +99,13 @@ int run_timeline_ice(const std::string& ice, const std::string& coordinator, con
   const HistoryParse parsed = parse_history(text);
   if (!parsed.errors.empty()) {  // a record the page cannot draw: say which, write nothing
     for (const HistoryError& e : parsed.errors) {
-      std::fprintf(stderr, "safecass timeline: coordinator '%s', record %d: %s\n", coordinator.c_str(), e.line, e.message.c_str());
+      std::fprintf(stderr, "safecass timeline: coordinator '%s', record %d: %s\n", coordinator.c_str(), e.line,
+                   e.message.c_str());
     }
     return 2;
   }
-  const int written = write_timeline_page(parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
+  const int written =
+      write_timeline_page(parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
   if (written != 0) return written;
   std::fprintf(stderr, "safecass timeline: %zu records of coordinator '%s' drawn in %s\n", parsed.records.size(),
                coordinator.c_str(), html_out.c_str());

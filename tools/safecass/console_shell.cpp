@@ -149,54 +149,147 @@ std::string count_text(std::size_t n) { return std::to_string(n) + (n == 1 ? " s
 
 const std::vector<CommandSpec>& commands() {
   static const std::vector<CommandSpec> table = {
-      {Id::StateList, "state list", "state list [COMPONENT]",
-       "every component and state machine with its state and outstanding event", false, 0, 1, {Arg::Component}},
-      {Id::StateHistory, "state history", "state history [ADDRESS] [N]",
-       "the last N records (default 20) of a machine, a component or the whole system", false, 0, 2,
+      {Id::StateList,
+       "state list",
+       "state list [COMPONENT]",
+       "every component and state machine with its state and outstanding event",
+       false,
+       0,
+       1,
+       {Arg::Component}},
+      {Id::StateHistory,
+       "state history",
+       "state history [ADDRESS] [N]",
+       "the last N records (default 20) of a machine, a component or the whole system",
+       false,
+       0,
+       2,
        {Arg::Address, Arg::None}},
-      {Id::FilterList, "filter list", "filter list",
-       "every filter: type, target, execution, detection, enabled, detected, signals", false, 0, 0, {}},
-      {Id::FilterInfo, "filter info", "filter info NAME",
+      {Id::FilterList,
+       "filter list",
+       "filter list",
+       "every filter: type, target, execution, detection, enabled, detected, signals",
+       false,
+       0,
+       0,
+       {}},
+      {Id::FilterInfo,
+       "filter info",
+       "filter info NAME",
        "a filter's manifest (parameters with type, value, default, range and doc; inputs; outputs) and its "
        "current enabled/detected state; NAME may also be a filter type",
-       false, 1, 1, {Arg::FilterOrType}},
-      {Id::FilterInject, "filter inject", "filter inject NAME SAMPLE...",
+       false,
+       1,
+       1,
+       {Arg::FilterOrType}},
+      {Id::FilterInject,
+       "filter inject",
+       "filter inject NAME SAMPLE...",
        "shallow fault injection: queue samples into one filter's private input, seen by that filter alone on "
        "its next runs (SAMPLE: 1.5, or [1,2,3] for a vector)",
-       true, 2, kMany, {Arg::Filter, Arg::None}},
-      {Id::FilterDinject, "filter dinject", "filter dinject SIGNAL SAMPLE...",
+       true,
+       2,
+       kMany,
+       {Arg::Filter, Arg::None}},
+      {Id::FilterDinject,
+       "filter dinject",
+       "filter dinject SIGNAL SAMPLE...",
        "deep fault injection: write samples into a signal's history buffer at the current time; every "
        "consumer sees them",
-       true, 2, kMany, {Arg::Signal, Arg::None}},
-      {Id::FilterDinload, "filter dinload", "filter dinload SIGNAL FILE",
+       true,
+       2,
+       kMany,
+       {Arg::Signal, Arg::None}},
+      {Id::FilterDinload,
+       "filter dinload",
+       "filter dinload SIGNAL FILE",
        "deep-inject every sample of a text file: one sample per line, numbers separated by spaces or commas "
        "('#' starts a comment)",
-       true, 2, 2, {Arg::Signal, Arg::File}},
-      {Id::EventList, "event list", "event list",
-       "every event with its severity, transitions, counterpart, hazard and description", false, 0, 0, {}},
-      {Id::EventHistory, "event history", "event history [N]",
-       "the last N events processed, ignored or masked by any machine (default 20)", false, 0, 1, {Arg::None}},
-      {Id::EventGenerate, "event generate", "event generate EVENT TARGET",
-       "process EVENT on machine TARGET (C.s_F, C.s_A, C.s_P.p or C.s_R.r) and propagate it", true, 2, 2,
+       true,
+       2,
+       2,
+       {Arg::Signal, Arg::File}},
+      {Id::EventList,
+       "event list",
+       "event list",
+       "every event with its severity, transitions, counterpart, hazard and description",
+       false,
+       0,
+       0,
+       {}},
+      {Id::EventHistory,
+       "event history",
+       "event history [N]",
+       "the last N events processed, ignored or masked by any machine (default 20)",
+       false,
+       0,
+       1,
+       {Arg::None}},
+      {Id::EventGenerate,
+       "event generate",
+       "event generate EVENT TARGET",
+       "process EVENT on machine TARGET (C.s_F, C.s_A, C.s_P.p or C.s_R.r) and propagate it",
+       true,
+       2,
+       2,
        {Arg::Event, Arg::Machine}},
-      {Id::EventBroadcast, "event broadcast", "event broadcast EVENT",
-       "process a broadcast event (severity 251-255) on s_A of every component", true, 1, 1, {Arg::Event}},
-      {Id::ConnectionList, "connection list", "connection list",
-       "every connection: the client's required interface and state, the provider's service and state", false,
-       0, 0, {}},
-      {Id::ServiceList, "service list", "service list",
-       "every provided interface with its service state and dependency formula", false, 0, 0, {}},
-      {Id::Explain, "explain", "explain ADDRESS",
-       "every active condition at ADDRESS with its root cause and the path it took", false, 1, 1, {Arg::Address}},
-      {Id::Watch, "watch", "watch [SECONDS]",
+      {Id::EventBroadcast,
+       "event broadcast",
+       "event broadcast EVENT",
+       "process a broadcast event (severity 251-255) on s_A of every component",
+       true,
+       1,
+       1,
+       {Arg::Event}},
+      {Id::ConnectionList,
+       "connection list",
+       "connection list",
+       "every connection: the client's required interface and state, the provider's service and state",
+       false,
+       0,
+       0,
+       {}},
+      {Id::ServiceList,
+       "service list",
+       "service list",
+       "every provided interface with its service state and dependency formula",
+       false,
+       0,
+       0,
+       {}},
+      {Id::Explain,
+       "explain",
+       "explain ADDRESS",
+       "every active condition at ADDRESS with its root cause and the path it took",
+       false,
+       1,
+       1,
+       {Arg::Address}},
+      {Id::Watch,
+       "watch",
+       "watch [SECONDS]",
        "advance simulated time by SECONDS (default 1), running the scenario and the system and printing each "
        "transition as it happens (against a live coordinator: poll its states for SECONDS, printing each change)",
-       false, 0, 1, {Arg::None}},
-      {Id::Reset, "reset", "reset TARGET [REASON]",
-       "clear every condition (latched ones too) of a machine, a component or SYSTEM, recording the reason", true,
-       1, kMany, {Arg::Address, Arg::None}},
+       false,
+       0,
+       1,
+       {Arg::None}},
+      {Id::Reset,
+       "reset",
+       "reset TARGET [REASON]",
+       "clear every condition (latched ones too) of a machine, a component or SYSTEM, recording the reason",
+       true,
+       1,
+       kMany,
+       {Arg::Address, Arg::None}},
       {Id::Time, "time", "time", "the current simulated time (in-process only)", false, 0, 0, {}},
-      {Id::Help, "help", "help [COMMAND]", "list the commands, or show one command's usage", false, 0, 2,
+      {Id::Help,
+       "help",
+       "help [COMMAND]",
+       "list the commands, or show one command's usage",
+       false,
+       0,
+       2,
        {Arg::Command, Arg::Command}},
       {Id::Quit, "quit", "quit", "leave the console (also: exit, or end of input)", false, 0, 0, {}},
   };
@@ -240,7 +333,8 @@ std::vector<std::string> sub_words(std::string_view group) {
   std::vector<std::string> words;
   for (const CommandSpec& c : commands()) {
     const auto space = c.name.find(' ');
-    if (space != std::string_view::npos && c.name.substr(0, space) == group) words.emplace_back(c.name.substr(space + 1));
+    if (space != std::string_view::npos && c.name.substr(0, space) == group)
+      words.emplace_back(c.name.substr(space + 1));
   }
   return words;
 }
@@ -301,7 +395,8 @@ ConsoleReply Console::failure(std::string_view command, const std::string& messa
   if (options_.json) {
     r.err = Json().boolean("ok", false).opt("command", command).str("error", message).str("usage", usage).text() + "\n";
   } else {
-    r.err = (command.empty() ? std::string() : std::string(command) + ": ") + message + " (usage: " + std::string(usage) + ")\n";
+    r.err = (command.empty() ? std::string() : std::string(command) + ": ") + message +
+            " (usage: " + std::string(usage) + ")\n";
   }
   return r;
 }
@@ -329,9 +424,10 @@ ConsoleReply Console::execute(std::string_view line) {
                    command->usage);
   }
   if (command->writes && !options_.allow_write) {
-    return failure(command->name,
-                   "refused: this console is read-only; start it with --allow-write to inject, generate, broadcast or reset",
-                   command->usage);
+    return failure(
+        command->name,
+        "refused: this console is read-only; start it with --allow-write to inject, generate, broadcast or reset",
+        command->usage);
   }
   ConsoleReply reply;
   if (command->id == Id::Quit) {
@@ -364,7 +460,8 @@ std::string Console::help(const std::vector<std::string>& args, ConsoleReply& re
   for (const CommandSpec* c : selected) {
     const std::string doc = std::string(c->doc) + (c->writes ? " [write: needs --allow-write]" : "");
     if (options_.json) {
-      out.line(Json().str("command", c->name).str("usage", c->usage).str("doc", c->doc).boolean("writes", c->writes).text());
+      out.line(
+          Json().str("command", c->name).str("usage", c->usage).str("doc", c->doc).boolean("writes", c->writes).text());
     } else if (selected.size() == 1) {
       out.line("usage: " + std::string(c->usage));
       out.line("  " + doc);
@@ -393,8 +490,10 @@ std::vector<std::string> Console::complete(std::string_view before, std::string_
   } else if (ctx.words.size() == 1 && is_group(ctx.words[0])) {
     candidates = sub_words(ctx.words[0]);
   } else if (ctx.command != nullptr && ctx.command->id == Id::Help) {
-    if (ctx.arg == 0) candidates = top_words();
-    else if (ctx.arg == 1 && is_group(ctx.words[1])) candidates = sub_words(ctx.words[1]);
+    if (ctx.arg == 0)
+      candidates = top_words();
+    else if (ctx.arg == 1 && is_group(ctx.words[1]))
+      candidates = sub_words(ctx.words[1]);
   } else if (ctx.command != nullptr) {
     const Arg kind = arg_kind(*ctx.command, ctx.arg);
     candidates = kind == Arg::Command ? top_words() : backend_->names(kind);

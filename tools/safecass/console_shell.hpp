@@ -61,20 +61,36 @@ std::string count_text(std::size_t n);
 enum class Arg { None, Component, Address, Machine, Event, Filter, FilterOrType, Signal, File, Command };
 
 enum class Id {
-  StateList, StateHistory, FilterList, FilterInfo, FilterInject, FilterDinject, FilterDinload, EventList,
-  EventHistory, EventGenerate, EventBroadcast, ConnectionList, ServiceList, Explain, Watch, Reset, Time,
-  Help, Quit,
+  StateList,
+  StateHistory,
+  FilterList,
+  FilterInfo,
+  FilterInject,
+  FilterDinject,
+  FilterDinload,
+  EventList,
+  EventHistory,
+  EventGenerate,
+  EventBroadcast,
+  ConnectionList,
+  ServiceList,
+  Explain,
+  Watch,
+  Reset,
+  Time,
+  Help,
+  Quit,
 };
 
 struct CommandSpec {
   Id id;
-  std::string_view name;   ///< one or two words
+  std::string_view name;  ///< one or two words
   std::string_view usage;
   std::string_view doc;
   bool writes;
   std::size_t min_args;
-  std::size_t max_args;    ///< kMany: no limit
-  std::vector<Arg> args;   ///< completion kind of each argument; the last one repeats
+  std::size_t max_args;   ///< kMany: no limit
+  std::vector<Arg> args;  ///< completion kind of each argument; the last one repeats
 };
 
 inline constexpr std::size_t kMany = static_cast<std::size_t>(-1);

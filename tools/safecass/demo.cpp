@@ -40,8 +40,8 @@ int run_demo() {
   must(co.connect("CONTROL.ForceData", "JR3.ForceData"));
   must(co.connect("SERVO.Command", "CONTROL.Command"));
 
-  EventDef force{"EVT_FORCE_ERROR", 50, {Transition::N2E, Transition::W2E}, "", false, "H-3",
-                 "force on the tool above its limit"};
+  EventDef force{
+      "EVT_FORCE_ERROR", 50, {Transition::N2E, Transition::W2E}, "", false, "H-3", "force on the tool above its limit"};
   EventDef force_clear{"/EVT_FORCE_ERROR", 50, {Transition::E2N, Transition::E2W}, "", false, "", ""};
   EventDef high{"EVT_FORCE_HIGH", 30, {Transition::N2W}, "", false, "H-3", "force approaching its limit"};
   EventDef high_clear{"/EVT_FORCE_HIGH", 30, {Transition::W2N}, "", false, "", ""};
@@ -73,10 +73,14 @@ int run_demo() {
     const double f = t < 0.4 ? 100.0 * t : 100.0 * (0.8 - t);  // triangle, peak 40 N at 0.4 s
     SampleCause cause{filter, signal, f, clock.now(), false};
     // The detection half, written by hand here; the filters module does this from a spec.
-    if (f > 30.0) co.generate(force_on, jr3_app, cause);
-    else co.generate(force_off, jr3_app, cause);
-    if (f > 25.0) co.generate(high_on, jr3_app, cause);
-    else co.generate(high_off, jr3_app, cause);
+    if (f > 30.0)
+      co.generate(force_on, jr3_app, cause);
+    else
+      co.generate(force_off, jr3_app, cause);
+    if (f > 25.0)
+      co.generate(high_on, jr3_app, cause);
+    else
+      co.generate(high_off, jr3_app, cause);
 
     // CONTROL's loop, split as in the paper: one handler per extended state.
     std::string mode;

@@ -20,22 +20,31 @@ struct ReplayArgs {
 
 void add_replay_command(CLI::App& app, int& code) {
   auto args = std::make_shared<ReplayArgs>();
-  auto* cmd = app.add_subcommand("replay", "Feed a recorded or field log (SAFECASS recording, CSV, ROS 1 bag) through a system in simulated time");
+  auto* cmd = app.add_subcommand(
+      "replay", "Feed a recorded or field log (SAFECASS recording, CSV, ROS 1 bag) through a system in simulated time");
   cmd->add_option("SYSTEM", args->systems, "the system file; with --diff: SYSTEM_B SYSTEM_A")->required();
-  cmd->add_option("--input,-i", args->options.input, "the log: a SAFECASS input recording, a CSV file or a ROS 1 bag")->required();
-  cmd->add_flag("--diff", args->diff, "replay through SYSTEM_B and SYSTEM_A and print, per address, where their states differ (exit 1 if they do)");
+  cmd->add_option("--input,-i", args->options.input, "the log: a SAFECASS input recording, a CSV file or a ROS 1 bag")
+      ->required();
+  cmd->add_flag(
+      "--diff", args->diff,
+      "replay through SYSTEM_B and SYSTEM_A and print, per address, where their states differ (exit 1 if they do)");
   auto* from = cmd->add_option("--from", args->from, "seconds: start the replay here (inputs before it are not fed)");
   auto* to = cmd->add_option("--to", args->to, "seconds: end the replay here");
-  auto* period = cmd->add_option("--period", args->period, "seconds per tick (default: the recording's, else the smallest component period, else 0.001)")
-                     ->check(CLI::PositiveNumber);
+  auto* period =
+      cmd->add_option("--period", args->period,
+                      "seconds per tick (default: the recording's, else the smallest component period, else 0.001)")
+          ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->options.json, "one JSON object per line");
-  cmd->add_option("--record", args->options.record, "write the replay's history to this file (and its inputs next to it)");
-  cmd->add_option("--record-inputs", args->options.record_inputs, "record the replay's inputs to this file (\"-\": do not)");
+  cmd->add_option("--record", args->options.record,
+                  "write the replay's history to this file (and its inputs next to it)");
+  cmd->add_option("--record-inputs", args->options.record_inputs,
+                  "record the replay's inputs to this file (\"-\": do not)");
   cmd->add_option("--max-bytes", args->max_bytes, "rotate the replay's recordings at this many bytes")
       ->check(CLI::Range(std::uint64_t{4096}, std::uint64_t{1} << 62));
   cmd->add_option("--format", args->options.format, "recording, csv or bag (default: from the file's first bytes)")
       ->check(CLI::IsMember({"recording", "csv", "bag"}));
-  cmd->add_option("--mapping", args->options.mapping, "a ROS bag: the ROS extension's mapping file (topics and field paths to signals)");
+  cmd->add_option("--mapping", args->options.mapping,
+                  "a ROS bag: the ROS extension's mapping file (topics and field paths to signals)");
   cmd->callback([args, from, to, period, &code] {
     replay::ReplayOptions o = args->options;
     if (from->count() != 0) o.from = args->from;

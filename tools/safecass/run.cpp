@@ -34,7 +34,8 @@ int run_run(const RunArgs& args) {
   if (!args.coordinator.empty()) return run_coordinator(args);
 #endif
   if (args.scenario.empty()) {
-    std::fprintf(stderr, "safecass run: --scenario is required (unless --coordinator runs one coordinator in real time)\n");
+    std::fprintf(stderr,
+                 "safecass run: --scenario is required (unless --coordinator runs one coordinator in real time)\n");
     return 2;
   }
   FilterRegistry registry;
@@ -71,7 +72,11 @@ int run_test(const TestArgs& args) {
     options.quiet = true;
     Case c{path, 0, {}};
     c.code = runner::run_scenario_file(path, registry, options, &c.result);
-    std::printf("%-6s %s (%d checks)\n", c.code == 0 ? "PASS" : c.code == 1 ? "FAIL" : "ERROR", path.c_str(), c.result.checks);
+    std::printf("%-6s %s (%d checks)\n",
+                c.code == 0   ? "PASS"
+                : c.code == 1 ? "FAIL"
+                              : "ERROR",
+                path.c_str(), c.result.checks);
     total.events_fired.insert(c.result.coverage.events_fired.begin(), c.result.coverage.events_fired.end());
     total.taken.insert(c.result.coverage.taken.begin(), c.result.coverage.taken.end());
     total.defined.insert(c.result.coverage.defined.begin(), c.result.coverage.defined.end());

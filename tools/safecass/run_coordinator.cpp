@@ -14,12 +14,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <mutex>
 #include <thread>
-#include <unistd.h>
 
 #include "middleware_commands.hpp"
 #include "safecass/filters/monitor.hpp"
@@ -76,7 +76,8 @@ struct Driver {
       if (a.kind != Address::Kind::Component && a.kind != Address::Kind::Machine) return {};
       const StateSnapshot snap = a.kind == Address::Kind::Component ? co.extended(a.component) : co.snapshot(a.machine);
       const std::string got = snap.outstanding == kNoEvent ? "none" : co.event(snap.outstanding).name;
-      return got == expected ? std::string() : "outstanding event of " + address + " is " + got + ", expected " + expected;
+      return got == expected ? std::string()
+                             : "outstanding event of " + address + " is " + got + ", expected " + expected;
     }
     const State level = co.state_of(a);
     for (const Explanation& e : co.explain(a)) {
@@ -94,8 +95,7 @@ struct Driver {
           if (Signal* signal = monitor.signals().find(name)) signal->push(now, values.data());
         }
         break;
-      case spec::ScenarioStep::Kind::Ramp:
-        break;  // handled by the ramp thread
+      case spec::ScenarioStep::Kind::Ramp: break;  // handled by the ramp thread
       case spec::ScenarioStep::Kind::Generate:
         if (local_machine(a->target)) {
           if (inputs != nullptr) inputs->generate(a->event, a->target);
@@ -110,7 +110,8 @@ struct Driver {
           }
         } else {
           std::string signal = a->signal;
-          if (!a->filter.empty() && monitor.find_filter(a->filter) != nullptr) signal = monitor.find_filter(a->filter)->inputs()[0]->name();
+          if (!a->filter.empty() && monitor.find_filter(a->filter) != nullptr)
+            signal = monitor.find_filter(a->filter)->inputs()[0]->name();
           if (monitor.signals().find(signal) != nullptr) {
             if (inputs != nullptr) inputs->inject_deep(signal, a->values);
             (void)monitor.inject_deep(signal, a->values, now);
@@ -180,7 +181,8 @@ void add_middleware_options(CLI::App& run, RunArgs& args) {
   run.add_option("--coordinator", args.coordinator,
                  "run only this coordinator's components, in real time (a process of a multi-process system)");
   run.add_option("--ice", args.ice, "with --coordinator: join the system through IceStorm at HOST:PORT");
-  run.add_option("--duration", args.duration, "with --coordinator: stop after SECONDS (default: the scenario's, else until SIGINT/SIGTERM)");
+  run.add_option("--duration", args.duration,
+                 "with --coordinator: stop after SECONDS (default: the scenario's, else until SIGINT/SIGTERM)");
   run.add_flag("--allow-write", args.allow_write,
                "with --ice: serve write operations (inject, generate, broadcast, reset) to holders of the token");
   run.add_option("--token-file", args.token_file, "with --allow-write: where to write the token (mode 0600)");
@@ -245,9 +247,10 @@ int run_coordinator(const RunArgs& args) {
   }
   co.subscribe([&co](const Record& r) {
     if (r.kind != RecordKind::Transition && r.kind != RecordKind::ComponentTransition) return;
-    std::string line = "[" + std::string(co.name()) + "] " +
-                       (r.machine != kNoMachine ? co.address_of(r.machine) : std::string(co.component_name(r.component))) +
-                       " " + std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
+    std::string line =
+        "[" + std::string(co.name()) + "] " +
+        (r.machine != kNoMachine ? co.address_of(r.machine) : std::string(co.component_name(r.component))) + " " +
+        std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
     if (r.event != kNoEvent) line += " " + co.event(r.event).name;
     if (r.root.event != kNoEvent) {
       // root_origin() takes the coordinator's lock, which this thread holds (it is recursive).
@@ -412,7 +415,8 @@ int run_coordinator(const RunArgs& args) {
   }
   say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
       std::string(to_string(co.coordinator_state())) +
-      (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed" : "") +
+      (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed"
+                : "") +
       (history_complete ? "" : "; the history file is incomplete (see above)"));
   if (!recorder_status.empty()) say(recorder_status);
   return code;

@@ -5,12 +5,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include <unistd.h>
 #include <atomic>
 #include <csignal>
 #include <cstdio>
 #include <mutex>
 #include <thread>
-#include <unistd.h>
 
 #include "middleware_commands.hpp"
 #include "safecass/filters/registry.hpp"
@@ -78,8 +78,8 @@ int run_supervisor(const SupervisorArgs& args) {
   std::signal(SIGINT, on_supervisor_signal);
   std::signal(SIGTERM, on_supervisor_signal);
   const auto start = std::chrono::steady_clock::now();
-  while (!g_supervisor_stop.load() &&
-         (args.duration <= 0 || std::chrono::steady_clock::now() - start < std::chrono::duration<double>(args.duration))) {
+  while (!g_supervisor_stop.load() && (args.duration <= 0 || std::chrono::steady_clock::now() - start <
+                                                                 std::chrono::duration<double>(args.duration))) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   (*supervisor)->stop();
@@ -96,14 +96,17 @@ int run_supervisor(const SupervisorArgs& args) {
 
 void add_supervisor_command(CLI::App& app, int& code) {
   static SupervisorArgs args;
-  auto* cmd = app.add_subcommand("supervisor",
-                                 "Watch a multi-process system through IceStorm: transitions, lost coordinators, system view");
+  auto* cmd = app.add_subcommand(
+      "supervisor", "Watch a multi-process system through IceStorm: transitions, lost coordinators, system view");
   cmd->add_option("SYSTEM", args.system, "the system file its coordinators run")->required();
   cmd->add_option("--ice", args.ice, "IceStorm at HOST:PORT")->required();
-  cmd->add_option("--lost-after", args.lost_after_ms, "milliseconds without a heartbeat before a coordinator is lost (default 600)");
+  cmd->add_option("--lost-after", args.lost_after_ms,
+                  "milliseconds without a heartbeat before a coordinator is lost (default 600)");
   cmd->add_option("--duration", args.duration, "stop after SECONDS (default: until SIGINT/SIGTERM)");
-  cmd->add_option("--keys", args.keys, "the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
-  cmd->add_flag("--insecure", args.insecure, "accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
+  cmd->add_option("--keys", args.keys,
+                  "the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
+  cmd->add_flag("--insecure", args.insecure,
+                "accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
   cmd->add_option("--tls", args.tls, "mutual TLS; DIR holds ca.pem and supervisor.pem/.key (scripts/setup-tls)");
   cmd->add_option("--listen", args.listen, "the address to serve on (default 127.0.0.1)");
   cmd->callback([&code] { code = run_supervisor(args); });

@@ -121,8 +121,7 @@ std::optional<Kind> parse_kind(std::string_view s) {
 bool is_state(std::string_view s) { return s == "Normal" || s == "Warning" || s == "Error"; }
 
 bool is_outcome(std::string_view s) {
-  return s == "raised" || s == "override" || s == "joined" || s == "masked" || s == "cleared" ||
-         s == "ignored";
+  return s == "raised" || s == "override" || s == "joined" || s == "masked" || s == "cleared" || s == "ignored";
 }
 
 /// Reads the fields of one record object; the first problem is returned as a message.
@@ -170,7 +169,8 @@ public:
 
   std::string state(std::string_view key, bool required) {
     std::string s = string(key, required);
-    if (!s.empty() && !is_state(s)) fail("\"" + std::string(key) + "\" must be Normal, Warning or Error, not \"" + s + "\"");
+    if (!s.empty() && !is_state(s))
+      fail("\"" + std::string(key) + "\" must be Normal, Warning or Error, not \"" + s + "\"");
     return s;
   }
 
@@ -185,7 +185,8 @@ private:
 
 /// Checks and types one parsed line. Returns an error message, or nothing when the record is good.
 std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
-  if (!v.is_object()) return "expected a JSON object (one record per line), not " + std::string(spec::type_name(v.type));
+  if (!v.is_object())
+    return "expected a JSON object (one record per line), not " + std::string(spec::type_name(v.type));
   FieldReader f(v);
   const std::string kind_text = f.string("kind", true);
   if (f.error()) return f.error();
@@ -237,9 +238,11 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
       r.root.has_signal = root->find("signal") != nullptr;
       // A non-finite sample (it raised EVT_INVALID_SAMPLE) is written as "nan", "inf" or "-inf".
       const JsonValue* value = root->find("value");
-      if (value != nullptr && value->is_string() && (value->string == "nan" || value->string == "inf" || value->string == "-inf")) {
-        r.root.value = value->string == "nan" ? std::numeric_limits<double>::quiet_NaN()
-                                              : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
+      if (value != nullptr && value->is_string() &&
+          (value->string == "nan" || value->string == "inf" || value->string == "-inf")) {
+        r.root.value = value->string == "nan"
+                           ? std::numeric_limits<double>::quiet_NaN()
+                           : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
       } else {
         r.root.value = rf.number("value", false).value_or(0.0);
       }
@@ -253,7 +256,9 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
   switch (r.kind) {
     case Kind::Event:
     case Kind::Transition:
-      if (r.machine.empty()) return std::string("missing \"machine\" (a ") + (r.kind == Kind::Event ? "event" : "transition") + " record names its state machine)";
+      if (r.machine.empty())
+        return std::string("missing \"machine\" (a ") + (r.kind == Kind::Event ? "event" : "transition") +
+               " record names its state machine)";
       break;
     case Kind::ComponentTransition:
       if (r.component.empty()) return std::string("missing \"component\" (a component-transition names its component)");
@@ -291,7 +296,7 @@ int machine_rank(std::string_view address) {
 struct Bar {
   std::string state;
   double from = 0.0;
-  std::optional<double> to;  ///< nothing: still in this state at the end of the history
+  std::optional<double> to;                ///< nothing: still in this state at the end of the history
   const HistoryRecord* entered = nullptr;  ///< the transition that began it; null for the initial state
   std::string reset_text;                  ///< a reset at the same time, when no event caused it
 };
@@ -325,8 +330,8 @@ int severity_rank(std::string_view state) { return state == "Error" ? 2 : state 
 /// The root cause of a record; `clears` when the record ends that condition (an improving transition).
 std::string root_lines(const HistoryRecord& r, bool clears = false) {
   if (!r.has_root) return {};
-  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" + r.root.event +
-                    (r.root.has_t ? " at " + secs(r.root.t) + " s" : std::string());
+  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" +
+                    r.root.event + (r.root.has_t ? " at " + secs(r.root.t) + " s" : std::string());
   if (!r.root.filter.empty() || r.root.has_signal || r.root.injected) {
     out += "\n";
     std::string detail;
@@ -343,7 +348,8 @@ std::string root_lines(const HistoryRecord& r, bool clears = false) {
 
 std::string bar_tip(const Lane& lane, const Bar& b) {
   std::string tip = lane.address + (lane.component ? " (extended state): " : ": ") + b.state + "\n";
-  tip += secs(b.from) + " s to " + (b.to ? secs(*b.to) + " s (" + secs(*b.to - b.from) + " s)" : std::string("the end of the history"));
+  tip += secs(b.from) + " s to " +
+         (b.to ? secs(*b.to) + " s (" + secs(*b.to - b.from) + " s)" : std::string("the end of the history"));
   if (b.entered == nullptr) return tip + "\nstate at the start of the history";
   const HistoryRecord& r = *b.entered;
   if (!r.event.empty()) {
@@ -359,14 +365,22 @@ std::string bar_tip(const Lane& lane, const Bar& b) {
 std::string marker_tip(const Lane& lane, const Marker& m) {
   const HistoryRecord& r = *m.record;
   std::string head;
-  if (m.kind == "ignored") head = "Ignored completion " + r.event;
-  else if (m.kind == "masked") head = "Masked onset " + r.event + " (below the current state)";
-  else if (m.kind == "override") head = "Override: onset " + r.event + " at the current level, now outstanding";
-  else if (m.kind == "joined") head = "Joined: onset " + r.event + " at the current level";
-  else if (m.kind == "cleared") head = "Cleared " + (r.event.empty() ? "condition " + r.root.event : r.event) + " (no state change)";
-  else if (m.kind == "reset") head = "Reset (state before: " + r.from + ")";
-  else head = "Fault injection";
-  std::string tip = head + "\n" + lane.address + ", t = " + secs(r.t) + " s (history line " + std::to_string(r.line) + ")";
+  if (m.kind == "ignored")
+    head = "Ignored completion " + r.event;
+  else if (m.kind == "masked")
+    head = "Masked onset " + r.event + " (below the current state)";
+  else if (m.kind == "override")
+    head = "Override: onset " + r.event + " at the current level, now outstanding";
+  else if (m.kind == "joined")
+    head = "Joined: onset " + r.event + " at the current level";
+  else if (m.kind == "cleared")
+    head = "Cleared " + (r.event.empty() ? "condition " + r.root.event : r.event) + " (no state change)";
+  else if (m.kind == "reset")
+    head = "Reset (state before: " + r.from + ")";
+  else
+    head = "Fault injection";
+  std::string tip =
+      head + "\n" + lane.address + ", t = " + secs(r.t) + " s (history line " + std::to_string(r.line) + ")";
   if (r.kind == Kind::Event) {
     tip += "\n";
     if (!r.level.empty()) tip += "level " + r.level + ", ";
@@ -386,7 +400,8 @@ public:
   void lane(const Lane& l) {
     // Each bar and marker is one object of the JSON writer, one a line so that golden diffs read
     // well; strings go through quote() (JSON, safe inside <script>).
-    out += "{\"address\":" + quote(l.address) + ",\"kind\":" + (l.component ? "\"component\"" : "\"machine\"") + ",\"bars\":[";
+    out += "{\"address\":" + quote(l.address) + ",\"kind\":" + (l.component ? "\"component\"" : "\"machine\"") +
+           ",\"bars\":[";
     for (std::size_t i = 0; i < l.bars.size(); ++i) {
       const Bar& b = l.bars[i];
       out += i == 0 ? "\n" : ",\n";
@@ -452,8 +467,8 @@ HistoryParse parse_history(std::string_view text) {
     }
     if (r.kind != Kind::Overflow) {
       if (last_t && r.t < *last_t) {
-        out.errors.push_back({line_no, "time " + secs(r.t) + " s is earlier than the previous record's (" + secs(*last_t) +
-                                           " s): records must be in time order"});
+        out.errors.push_back({line_no, "time " + secs(r.t) + " s is earlier than the previous record's (" +
+                                           secs(*last_t) + " s): records must be in time order"});
         continue;
       }
       last_t = r.t;
@@ -580,24 +595,29 @@ Model build_model(const std::vector<HistoryRecord>& records) {
 std::vector<const Lane*> ordered_machines(const Group& g) {
   std::vector<const Lane*> lanes;
   for (const auto& [address, l] : g.machines) lanes.push_back(&l);
-  std::stable_sort(lanes.begin(), lanes.end(), [](const Lane* a, const Lane* b) {
-    return machine_rank(a->address) < machine_rank(b->address);
-  });
+  std::stable_sort(lanes.begin(), lanes.end(),
+                   [](const Lane* a, const Lane* b) { return machine_rank(a->address) < machine_rank(b->address); });
   return lanes;
 }
 
 std::string model_json(const Model& m, std::size_t record_count) {
   ModelWriter w;
   w.out = "{\"start\":" + num(m.start) + ",\"end\":" + num(m.end) + ",\"records\":" + std::to_string(record_count) +
-          ",\"transitions\":" + std::to_string(m.transitions) + ",\"lanes\":" + std::to_string(m.lanes) + ",\n\"overflows\":[";
+          ",\"transitions\":" + std::to_string(m.transitions) + ",\"lanes\":" + std::to_string(m.lanes) +
+          ",\n\"overflows\":[";
   for (std::size_t i = 0; i < m.overflows.size(); ++i) {
     const auto& band = m.overflows[i];
     w.out += i == 0 ? "\n" : ",\n";
     const std::string tip = "The recorder dropped " + std::to_string(band.record->dropped) +
                             " records here (history line " + std::to_string(band.record->line) +
                             "): states in this interval may be incomplete.";
-    w.out += introspect::JsonObject().integer("line", band.record->line).integer("dropped", static_cast<long long>(band.record->dropped))
-                 .raw("from", num(band.from)).raw("to", band.to ? num(*band.to) : "null").raw("tip", quote(tip)).text();
+    w.out += introspect::JsonObject()
+                 .integer("line", band.record->line)
+                 .integer("dropped", static_cast<long long>(band.record->dropped))
+                 .raw("from", num(band.from))
+                 .raw("to", band.to ? num(*band.to) : "null")
+                 .raw("tip", quote(tip))
+                 .text();
   }
   w.out += "],\n\"groups\":[";
   for (std::size_t gi = 0; gi < m.groups.size(); ++gi) {
@@ -639,9 +659,9 @@ std::string summary_text(const Model& m, std::size_t record_count) {
 std::string warnings_html(const Model& m, const std::optional<HistoryError>& torn) {
   std::string out;
   for (const auto& band : m.overflows) {
-    out += "<p class=\"warning\">&#9888; History line " + std::to_string(band.record->line) + ": the recorder dropped " +
-           std::to_string(band.record->dropped) + " records between " + secs(band.from) + " s and " +
-           (band.to ? secs(*band.to) + " s" : std::string("the end")) +
+    out += "<p class=\"warning\">&#9888; History line " + std::to_string(band.record->line) +
+           ": the recorder dropped " + std::to_string(band.record->dropped) + " records between " + secs(band.from) +
+           " s and " + (band.to ? secs(*band.to) + " s" : std::string("the end")) +
            "; states in that interval may be incomplete (hatched band).</p>\n";
   }
   if (torn) {
@@ -685,12 +705,9 @@ std::string render_timeline_page(const std::vector<HistoryRecord>& records, cons
                                  const std::optional<HistoryError>& torn) {
   const Model m = build_model(records);
   const std::map<std::string, std::string, std::less<>> values{
-      {"TITLE", html_escape(title)},
-      {"SUMMARY", html_escape(summary_text(m, records.size()))},
-      {"WARNINGS", warnings_html(m, torn)},
-      {"CSS", std::string(web::kTimelineCss)},
-      {"JS", std::string(web::kTimelineJs)},
-      {"MODEL", model_json(m, records.size())},
+      {"TITLE", html_escape(title)},         {"SUMMARY", html_escape(summary_text(m, records.size()))},
+      {"WARNINGS", warnings_html(m, torn)},  {"CSS", std::string(web::kTimelineCss)},
+      {"JS", std::string(web::kTimelineJs)}, {"MODEL", model_json(m, records.size())},
       {"HISTORY", history_json(records)},
   };
   return fill(web::kTimelineHtml, values);
@@ -722,8 +739,8 @@ int run_timeline(const std::string& history, const std::string& html_out) {
   return write_timeline_page(parsed.records, title, html_out, parsed.torn);
 }
 
-int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out,
-                        const std::optional<HistoryError>& torn) {
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title,
+                        const std::string& html_out, const std::optional<HistoryError>& torn) {
   const std::string page = render_timeline_page(records, title, torn);
   std::ofstream out(html_out, std::ios::binary | std::ios::trunc);
   if (out) out.write(page.data(), static_cast<std::streamsize>(page.size()));

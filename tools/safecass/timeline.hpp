@@ -30,8 +30,8 @@ struct HistoryRecord {
   std::string component;  ///< component name
   std::string machine;    ///< machine address (JR3.s_A, CONTROL.s_R.ForceData)
   std::string event;
-  std::string from, to;   ///< Normal, Warning, Error
-  std::string level;      ///< Event: level of the condition added or removed
+  std::string from, to;  ///< Normal, Warning, Error
+  std::string level;     ///< Event: level of the condition added or removed
   int severity = 0;
   bool mirror = false;    ///< a condition mirrored along a connection
   bool has_root = false;  ///< root cause present
@@ -39,7 +39,7 @@ struct HistoryRecord {
     std::string event, origin, filter, signal;
     double t = 0.0, value = 0.0, sample_t = 0.0;
     bool has_signal = false;
-    bool has_t = false;   ///< the root's time is known (a live history fetched remotely has none)
+    bool has_t = false;  ///< the root's time is known (a live history fetched remotely has none)
     bool injected = false;
   } root;
   std::string text;           ///< reason (ignored, reset "who: why") or injection description
@@ -89,7 +89,7 @@ int run_timeline(const std::string& history, const std::string& html_out);
 
 /// Renders `records` and writes the page to `html_out`. Returns 0, or 2 after printing
 /// "safecass timeline: cannot write ..." to stderr.
-int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title, const std::string& html_out,
-                        const std::optional<HistoryError>& torn = std::nullopt);
+int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title,
+                        const std::string& html_out, const std::optional<HistoryError>& torn = std::nullopt);
 
 }  // namespace safecass::tools

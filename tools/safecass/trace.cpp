@@ -53,7 +53,8 @@ int run_trace(const TraceArgs& args) {
   auto built = trace::build_trace(options, registry);
   if (!built) {
     for (const spec::Diagnostic& d : built.error()) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-    std::fprintf(stderr, "safecass trace: nothing traced (%zu error%s)\n", built.error().size(), built.error().size() == 1 ? "" : "s");
+    std::fprintf(stderr, "safecass trace: nothing traced (%zu error%s)\n", built.error().size(),
+                 built.error().size() == 1 ? "" : "s");
     return 2;
   }
   const trace::Trace& t = *built;

@@ -51,11 +51,12 @@ int run_validate(const std::vector<std::string>& files, bool json_output, bool v
         diagnostics.insert(diagnostics.end(), loaded.notes.begin(), loaded.notes.end());
         std::map<std::string, std::size_t> rank;  // files in the order they first appear (load order)
         for (const spec::Diagnostic& d : diagnostics) rank.emplace(d.where.file, rank.size());
-        std::stable_sort(diagnostics.begin(), diagnostics.end(), [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
-          if (a.where.file != b.where.file) return rank[a.where.file] < rank[b.where.file];
-          if (a.where.line != b.where.line) return a.where.line < b.where.line;
-          return a.where.column < b.where.column;
-        });
+        std::stable_sort(diagnostics.begin(), diagnostics.end(),
+                         [&](const spec::Diagnostic& a, const spec::Diagnostic& b) {
+                           if (a.where.file != b.where.file) return rank[a.where.file] < rank[b.where.file];
+                           if (a.where.line != b.where.line) return a.where.line < b.where.line;
+                           return a.where.column < b.where.column;
+                         });
       }
     }
     for (const spec::Diagnostic& d : diagnostics) {
@@ -65,8 +66,11 @@ int run_validate(const std::vector<std::string>& files, bool json_output, bool v
     }
   }
   if (json_output) {
-    const std::string summary = introspect::JsonObject().strings("files", files).integer("errors", static_cast<long long>(errors))
-                                    .integer("warnings", static_cast<long long>(warnings)).text();
+    const std::string summary = introspect::JsonObject()
+                                    .strings("files", files)
+                                    .integer("errors", static_cast<long long>(errors))
+                                    .integer("warnings", static_cast<long long>(warnings))
+                                    .text();
     std::printf("%s\n", summary.c_str());
   } else {
     std::printf("%zu error%s, %zu warning%s\n", errors, errors == 1 ? "" : "s", warnings, warnings == 1 ? "" : "s");

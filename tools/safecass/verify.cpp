@@ -43,16 +43,20 @@ void add_verify_command(CLI::App& app, int& code) {
     bool json = false;
   };
   auto args = std::make_shared<Args>();
-  auto* cmd = app.add_subcommand("verify", "Model-check hazard reactions and invariants with SPIN; counterexamples as scenarios");
+  auto* cmd = app.add_subcommand("verify",
+                                 "Model-check hazard reactions and invariants with SPIN; counterexamples as scenarios");
   cmd->add_option("SYSTEM", args->system, "system file")->required();
   cmd->add_option("--property", args->options.property, "check only this property (a hazard id or an invariant name)");
-  cmd->add_option("--out", args->options.out_dir, "write each violated property's counterexample as DIR/<property>.scenario.json");
+  cmd->add_option("--out", args->options.out_dir,
+                  "write each violated property's counterexample as DIR/<property>.scenario.json");
   cmd->add_flag("--json", args->json, "one JSON object per property, then a summary object");
   cmd->add_option("--memory", args->options.memory_mb, "SPIN's memory bound per property, in MB (default 4096)");
-  cmd->add_flag("--no-slice", [args](std::int64_t) { args->options.slice = false; },
-                "keep every onset in every property's model (no cone of influence)");
-  cmd->add_flag("--no-merge", [args](std::int64_t) { args->options.merge = false; },
-                "track every onset on its own (no counting of interchangeable onsets)");
+  cmd->add_flag(
+      "--no-slice", [args](std::int64_t) { args->options.slice = false; },
+      "keep every onset in every property's model (no cone of influence)");
+  cmd->add_flag(
+      "--no-merge", [args](std::int64_t) { args->options.merge = false; },
+      "track every onset on its own (no counting of interchangeable onsets)");
   cmd->callback([args, &code] { code = run_verify(args->system, args->options, args->json); });
 }
 
@@ -94,7 +98,8 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
       }
       if (!p.structural) {
         char buf[200];
-        std::snprintf(buf, sizeof buf, ",\"states\":%llu,\"memory_mb\":%.3f,\"seconds\":%.3f,\"onsets\":%zu,\"onsets_total\":%zu",
+        std::snprintf(buf, sizeof buf,
+                      ",\"states\":%llu,\"memory_mb\":%.3f,\"seconds\":%.3f,\"onsets\":%zu,\"onsets_total\":%zu",
                       static_cast<unsigned long long>(p.states), p.memory_mb, p.seconds, p.onsets, p.onsets_total);
         line += buf;
       }
@@ -112,27 +117,32 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
     }
     const std::string label = std::string(verify::to_string(p.kind)) + " " + p.name;
     if (p.structural) {
-      std::printf("%-32s %-9s (%s)\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(), p.message.c_str());
+      std::printf("%-32s %-9s (%s)\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(),
+                  p.message.c_str());
       continue;
     }
-    std::printf("%-32s %-9s %s\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(), figures(p).c_str());
+    std::printf("%-32s %-9s %s\n", label.c_str(), std::string(verify::to_string(p.verdict)).c_str(),
+                figures(p).c_str());
     if (p.verdict != verify::PropertyResult::Verdict::Holds) {
       const std::string at = where_text(p.where);
       std::printf("  %s%s%s\n", at.c_str(), at.empty() ? "" : ": ", p.text.c_str());
       std::printf("  %s\n", p.message.c_str());
-      if (!p.scenario.empty()) std::printf("  counterexample: %s (safecass run --scenario %s)\n", p.scenario.c_str(), p.scenario.c_str());
+      if (!p.scenario.empty())
+        std::printf("  counterexample: %s (safecass run --scenario %s)\n", p.scenario.c_str(), p.scenario.c_str());
       if (!p.advice.empty()) std::printf("  %s\n", p.advice.c_str());
     }
   }
   const int exit = report->exit_code();
   if (json) {
-    std::printf("{\"kind\":\"summary\",\"system\":%s,\"holds\":%zu,\"violated\":%zu,\"undecided\":%zu,\"warnings\":%zu,"
-                "\"seconds\":%.3f,\"exit\":%d}\n",
-                json_string(report->system).c_str(), holds, violated, undecided, findings, report->seconds, exit);
+    std::printf(
+        "{\"kind\":\"summary\",\"system\":%s,\"holds\":%zu,\"violated\":%zu,\"undecided\":%zu,\"warnings\":%zu,"
+        "\"seconds\":%.3f,\"exit\":%d}\n",
+        json_string(report->system).c_str(), holds, violated, undecided, findings, report->seconds, exit);
   } else {
-    std::printf("%s: %zu propert%s hold%s, %zu violated, %zu undecided, %zu warning%s about the specification (%.2f s)\n",
-                report->system.c_str(), holds, holds == 1 ? "y" : "ies", holds == 1 ? "s" : "", violated, undecided,
-                findings, findings == 1 ? "" : "s", report->seconds);
+    std::printf(
+        "%s: %zu propert%s hold%s, %zu violated, %zu undecided, %zu warning%s about the specification (%.2f s)\n",
+        report->system.c_str(), holds, holds == 1 ? "y" : "ies", holds == 1 ? "s" : "", violated, undecided, findings,
+        findings == 1 ? "" : "s", report->seconds);
   }
   return exit;
 }

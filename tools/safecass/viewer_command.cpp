@@ -35,11 +35,11 @@ struct ViewerArgs {
   double speed = 1.0;
   bool allow_write = false;
   bool open = false;
-  std::string ice;                      ///< --ice HOST:PORT: a live system
-  std::string keys;                     ///< --keys DIR: the system's bus keys
-  std::string tls;                      ///< --tls DIR: mutual TLS
+  std::string ice;                            ///< --ice HOST:PORT: a live system
+  std::string keys;                           ///< --keys DIR: the system's bus keys
+  std::string tls;                            ///< --tls DIR: mutual TLS
   std::vector<std::string> read_token_files;  ///< --read-token-file COORD=FILE
-  std::vector<std::string> token_files; ///< --token-file COORD=FILE
+  std::vector<std::string> token_files;       ///< --token-file COORD=FILE
   bool speed_given = false;
 };
 
@@ -59,9 +59,11 @@ Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args
   }
 #ifdef SAFECASS_WITH_ICE
   if (!args.scenario.empty() || args.speed_given) {
-    return fail(ErrorCode::InvalidArgument, "safecass viewer: --scenario and --speed drive an in-process system, not a live one (--ice)");
+    return fail(ErrorCode::InvalidArgument,
+                "safecass viewer: --scenario and --speed drive an in-process system, not a live one (--ice)");
   }
-  if (args.system.empty()) return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice needs --system SYSTEM (its coordinators)");
+  if (args.system.empty())
+    return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice needs --system SYSTEM (its coordinators)");
   viewer::MiddlewareOptions options;
   options.ice = args.ice;
   options.keys_dir = args.keys;
@@ -70,7 +72,8 @@ Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args
   for (const std::string& t : args.read_token_files) {
     const auto eq = t.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == t.size()) {
-      return fail(ErrorCode::InvalidArgument, "safecass viewer: --read-token-file '" + t + "': write it COORDINATOR=FILE");
+      return fail(ErrorCode::InvalidArgument,
+                  "safecass viewer: --read-token-file '" + t + "': write it COORDINATOR=FILE");
     }
     options.read_token_files[t.substr(0, eq)] = t.substr(eq + 1);
   }
@@ -81,14 +84,16 @@ Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args
       return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file '" + t + "': write it COORDINATOR=FILE");
     }
     if (!options.token_files.emplace(t.substr(0, eq), t.substr(eq + 1)).second) {
-      return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file: coordinator '" + t.substr(0, eq) + "' given twice");
+      return fail(ErrorCode::InvalidArgument,
+                  "safecass viewer: --token-file: coordinator '" + t.substr(0, eq) + "' given twice");
     }
   }
   auto source = viewer::MiddlewareSource::open(options);
   if (!source) return fail(source.error().code, "safecass viewer: " + source.error().message);
   return std::unique_ptr<viewer::ViewSource>(std::move(*source));
 #else
-  return fail(ErrorCode::InvalidArgument, "safecass viewer: --ice: this safecass was built without the middleware (ZeroC Ice)");
+  return fail(ErrorCode::InvalidArgument,
+              "safecass viewer: --ice: this safecass was built without the middleware (ZeroC Ice)");
 #endif
 }
 
@@ -144,12 +149,14 @@ int run_viewer(const ViewerArgs& args) {
   const viewer::SystemView v = (*source)->view();
   std::printf("safecass viewer: %s (%s)\n", v.system.c_str(), v.description.c_str());
   for (const viewer::CoordinatorView& co : v.coordinators) {
-    if (!co.status.empty()) std::printf("  coordinator %s: %s (tried again until it answers)\n", co.name.c_str(), co.status.c_str());
+    if (!co.status.empty())
+      std::printf("  coordinator %s: %s (tried again until it answers)\n", co.name.c_str(), co.status.c_str());
   }
   std::printf("  open %s\n", url.c_str());
   if (args.allow_write) {
-    std::printf("  write access: the token is in %s (mode 0600): paste it into the page, or open %s#token=<the token>\n",
-                token_file->path().c_str(), url.c_str());
+    std::printf(
+        "  write access: the token is in %s (mode 0600): paste it into the page, or open %s#token=<the token>\n",
+        token_file->path().c_str(), url.c_str());
   } else {
     std::printf("  read-only (start with --allow-write to generate, inject and reset)\n");
   }
@@ -172,7 +179,8 @@ int run_viewer(const ViewerArgs& args) {
 
 void add_viewer_command(CLI::App& app, int& code) {
   auto args = std::make_shared<ViewerArgs>();
-  auto* cmd = app.add_subcommand("viewer", "Serve a live web view of a system: states, causes and the last transitions");
+  auto* cmd =
+      app.add_subcommand("viewer", "Serve a live web view of a system: states, causes and the last transitions");
   cmd->footer(
       "The system runs in this process in real time (its simulated clock follows the wall clock times --speed), "
       "driven by the scenario if one is given; when the scenario ends the system stays up. The page shows every "
@@ -188,8 +196,10 @@ void add_viewer_command(CLI::App& app, int& code) {
   cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")
       ->capture_default_str()
       ->each([args](const std::string&) { args->speed_given = true; });
-  cmd->add_option("--keys", args->keys, "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
-  cmd->add_option("--tls", args->tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
+  cmd->add_option("--keys", args->keys,
+                  "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
+  cmd->add_option("--tls", args->tls,
+                  "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
   cmd->add_option("--read-token-file", args->read_token_files,
                   "with --ice: COORDINATOR=FILE, a coordinator's read credential (repeatable)");
   cmd->add_option("--ice", args->ice,

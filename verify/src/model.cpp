@@ -150,7 +150,8 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
   }
   for (std::size_t i = 0; i < roots_.size(); ++i) {
     Root& r = roots_[i];
-    for (State s : {State::Normal, State::Warning, State::Error}) r.level[static_cast<std::size_t>(s)] = onset_level(r.transitions, s);
+    for (State s : {State::Normal, State::Warning, State::Error})
+      r.level[static_cast<std::size_t>(s)] = onset_level(r.transitions, s);
     at_machine_[r.machine].push_back(i);
   }
 
@@ -229,7 +230,8 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       if (d.application) deps.push_back(co.application_machine(c));
       for (MachineId r : co.required_machines(c)) {
         const std::string iface(co.interface_name(r));
-        if (d.all_required || std::find(d.required.begin(), d.required.end(), iface) != d.required.end()) deps.push_back(r);
+        if (d.all_required || std::find(d.required.begin(), d.required.end(), iface) != d.required.end())
+          deps.push_back(r);
       }
       make(name + ".s_S." + std::string(co.interface_name(co.provided_machines(c)[p])), deps, where);
     }
@@ -301,11 +303,15 @@ std::vector<RootClass> Model::classes(const std::vector<std::size_t>& roots, boo
     // Interchangeable: same machine (resets), same level rule, same latching and clearability,
     // same hazard (reactions tell roots apart by hazard only).
     std::uint8_t bits = 0;
-    for (std::size_t s = 0; s < 3; ++s) bits = static_cast<std::uint8_t>(bits * 3 + static_cast<std::uint8_t>(r.level[s]));
-    const auto key = std::make_tuple(r.machine, bits, r.latched, r.clearable() ? std::string("c") : std::string(), r.hazard);
+    for (std::size_t s = 0; s < 3; ++s)
+      bits = static_cast<std::uint8_t>(bits * 3 + static_cast<std::uint8_t>(r.level[s]));
+    const auto key =
+        std::make_tuple(r.machine, bits, r.latched, r.clearable() ? std::string("c") : std::string(), r.hazard);
     const auto [it, fresh] = index.emplace(key, out.size());
-    if (fresh) out.push_back(RootClass{{i}});
-    else out[it->second].members.push_back(i);
+    if (fresh)
+      out.push_back(RootClass{{i}});
+    else
+      out[it->second].members.push_back(i);
   }
   return out;
 }

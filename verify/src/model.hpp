@@ -33,9 +33,9 @@ struct Root {
   TransitionSet transitions;
   bool latched = false;
   std::string hazard;
-  int broadcast = -1;      ///< index of the broadcast event it belongs to, or -1
-  std::string source;      ///< who generates it, for people
-  spec::Position where;    ///< the event's definition (empty for framework events)
+  int broadcast = -1;    ///< index of the broadcast event it belongs to, or -1
+  std::string source;    ///< who generates it, for people
+  spec::Position where;  ///< the event's definition (empty for framework events)
   /// The level it takes when it arrives in a machine at Normal, Warning, Error (DESIGN §2.3).
   std::array<State, 3> level{};
   bool clearable() const { return !completion.empty() && !latched; }

@@ -179,7 +179,8 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
     for (std::size_t c : cs) {
       const std::string id = std::to_string(c);
       guard += (guard.empty() ? "" : " || ") + std::string("!ACTIVE_") + id;
-      body += "       if\n       :: !ACTIVE_" + id + " ->\n" + raise(c, "          ") + "       :: else -> skip\n       fi;\n";
+      body += "       if\n       :: !ACTIVE_" + id + " ->\n" + raise(c, "          ") +
+              "       :: else -> skip\n       fi;\n";
       clear_guard += (clear_guard.empty() ? "" : " || ") + std::string("ACTIVE_") + id;
       clear_body += "       w" + id + " = 0; e" + id + " = 0;\n";
     }

@@ -11,9 +11,9 @@ namespace safecass::verify::detail {
 
 /// What the Promela text is for.
 struct PromelaSpec {
-  std::string title;                     ///< first comment line
-  std::vector<RootClass> classes;        ///< the variables
-  std::vector<std::size_t> addresses;    ///< addresses the property (or the printing) reads
+  std::string title;                   ///< first comment line
+  std::vector<RootClass> classes;      ///< the variables
+  std::vector<std::size_t> addresses;  ///< addresses the property (or the printing) reads
   /// The properties, as named LTL claims (SPIN syntax) over the macros ST_<a> (a in
   /// `addresses`) and ACTIVE_<c> (classes); the verifier checks one at a time (pan -N name).
   std::vector<std::pair<std::string, std::string>> claims;

@@ -1,10 +1,10 @@
 #include "spin.hpp"
 
+#include <sys/wait.h>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sys/wait.h>
 
 namespace safecass::verify::detail {
 
@@ -13,8 +13,10 @@ namespace fs = std::filesystem;
 std::string shell_quote(const std::string& word) {
   std::string out = "'";
   for (char c : word) {
-    if (c == '\'') out += "'\\''";
-    else out += c;
+    if (c == '\'')
+      out += "'\\''";
+    else
+      out += c;
   }
   return out + "'";
 }
@@ -45,7 +47,9 @@ Expected<WorkDir> WorkDir::create(const std::string& given) {
   return WorkDir(pattern, true);
 }
 
-WorkDir::WorkDir(WorkDir&& other) noexcept : path_(std::move(other.path_)), owned_(other.owned_) { other.owned_ = false; }
+WorkDir::WorkDir(WorkDir&& other) noexcept : path_(std::move(other.path_)), owned_(other.owned_) {
+  other.owned_ = false;
+}
 
 WorkDir::~WorkDir() {
   if (!owned_) return;
@@ -56,7 +60,8 @@ WorkDir::~WorkDir() {
 Expected<std::string> spin_version(const std::string& spin) {
   auto r = run_command("/", shell_quote(spin) + " -V");
   if (!r || r->status != 0 || r->output.find("Spin Version") == std::string::npos) {
-    return fail(ErrorCode::Io, "cannot run SPIN ('" + spin + " -V'): install the Debian package 'spin' (scripts/install-deps.sh)");
+    return fail(ErrorCode::Io,
+                "cannot run SPIN ('" + spin + " -V'): install the Debian package 'spin' (scripts/install-deps.sh)");
   }
   std::string v = r->output;
   while (!v.empty() && (v.back() == '\n' || v.back() == '\r')) v.pop_back();
@@ -66,7 +71,8 @@ Expected<std::string> spin_version(const std::string& spin) {
 Expected<void> compiler_check(const std::string& cc) {
   auto r = run_command("/", shell_quote(cc) + " --version");
   if (!r || r->status != 0) {
-    return fail(ErrorCode::Io, "cannot run the C compiler '" + cc + "' that builds SPIN's verifiers: install build-essential");
+    return fail(ErrorCode::Io,
+                "cannot run the C compiler '" + cc + "' that builds SPIN's verifiers: install build-essential");
   }
   return {};
 }
@@ -135,7 +141,8 @@ Expected<std::string> compile(const std::string& dir, const std::string& name, c
   const std::string binary = "pan_" + name;
   auto cc = run_command(dir, shell_quote(options.cc) + " " + flags + " -o " + shell_quote(binary) + " pan.c");
   if (!cc) return tl::unexpected(cc.error());
-  if (cc->status != 0) return fail(ErrorCode::Io, "the C compiler failed on SPIN's verifier for " + pml + ":\n" + cc->output);
+  if (cc->status != 0)
+    return fail(ErrorCode::Io, "the C compiler failed on SPIN's verifier for " + pml + ":\n" + cc->output);
   return binary;
 }
 
@@ -144,7 +151,8 @@ Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
   std::error_code ec;
   const std::string trail = dir + "/" + name + ".pml.trail";
   fs::remove(trail, ec);
-  std::string run = "./" + shell_quote(binary) + " -n -N " + shell_quote(claim) + " -w" + std::to_string(options.hash_bits);
+  std::string run =
+      "./" + shell_quote(binary) + " -n -N " + shell_quote(claim) + " -w" + std::to_string(options.hash_bits);
   if (options.ltl) run += " -a -m1000000";
   auto pan = run_command(dir, run);
   if (!pan) return tl::unexpected(pan.error());
@@ -152,7 +160,8 @@ Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
   r.output = pan->output;
   r.states = number_before(r.output, "states, stored");
   r.memory_mb = double_before(r.output, "total actual memory usage");
-  const bool limit = r.output.find("MEMLIM") != std::string::npos || r.output.find("out of memory") != std::string::npos;
+  const bool limit =
+      r.output.find("MEMLIM") != std::string::npos || r.output.find("out of memory") != std::string::npos;
   const bool errors = r.output.find("errors: 0") == std::string::npos && r.output.find("errors:") != std::string::npos;
   if (limit) {
     r.outcome = PanResult::Outcome::MemoryLimit;
@@ -176,8 +185,8 @@ Expected<std::vector<std::string>> simulate_model(const std::string& dir, const 
                                                   std::size_t steps, const std::string& spin) {
   const std::string pml = "simulation.pml";
   if (!write_file(dir + "/" + pml, model)) return fail(ErrorCode::Io, "cannot write '" + dir + "/" + pml + "'");
-  auto r = run_command(dir, shell_quote(spin) + " -n" + std::to_string(seed) + " -u" + std::to_string(steps) + " " +
-                                shell_quote(pml));
+  auto r = run_command(
+      dir, shell_quote(spin) + " -n" + std::to_string(seed) + " -u" + std::to_string(steps) + " " + shell_quote(pml));
   if (!r) return tl::unexpected(r.error());
   if (r->output.find("error") != std::string::npos && r->output.find("@ ") == std::string::npos) {
     return fail(ErrorCode::Io, "SPIN's simulation failed:\n" + r->output);

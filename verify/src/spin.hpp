@@ -40,9 +40,9 @@ private:
 };
 
 struct PanOptions {
-  bool ltl = false;            ///< search for acceptance cycles (-a), depth-first; else safety, breadth-first
+  bool ltl = false;  ///< search for acceptance cycles (-a), depth-first; else safety, breadth-first
   std::size_t memory_mb = 4096;
-  int hash_bits = 20;          ///< -w
+  int hash_bits = 20;  ///< -w
   std::string spin = "spin";
   std::string cc = "cc";
 };
@@ -51,9 +51,9 @@ struct PanResult {
   enum class Outcome { Holds, Violated, MemoryLimit, Failed } outcome = Outcome::Failed;
   std::uint64_t states = 0;
   double memory_mb = 0.0;
-  std::string output;          ///< pan's report, for diagnosis
+  std::string output;              ///< pan's report, for diagnosis
   std::vector<std::string> trail;  ///< the "@ ..." lines of the counterexample, in order
-  bool cycle = false;          ///< LTL: the trail ends in a cycle (starting at `cycle_start`)
+  bool cycle = false;              ///< LTL: the trail ends in a cycle (starting at `cycle_start`)
   std::size_t cycle_start = 0;
 };
 

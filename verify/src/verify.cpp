@@ -15,8 +15,8 @@
 
 #include "model.hpp"
 #include "promela.hpp"
-#include "spin.hpp"
 #include "safecass/spec/json.hpp"
+#include "spin.hpp"
 
 namespace safecass::verify {
 
@@ -66,7 +66,8 @@ std::string level_name(State s) { return std::string(safecass::to_string(s)); }
 /// A file name for a property: letters, digits, '-', '_' and '.'; anything else becomes '_'.
 std::string file_name(const std::string& name) {
   std::string out;
-  for (char c : name) out += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' || c == '.') ? c : '_';
+  for (char c : name)
+    out += (std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_' || c == '.') ? c : '_';
   if (out.empty() || out[0] == '.') out = "_" + out;
   return out;
 }
@@ -87,9 +88,9 @@ struct Check {
   PropertyResult result;
   std::vector<std::size_t> seed_roots;
   std::vector<std::pair<std::size_t, bool>> seed_addresses;
-  std::vector<std::size_t> linked;                          ///< reactions: the hazard's roots
-  std::vector<std::pair<std::size_t, State>> reaction;      ///< reactions: address, level
-  std::optional<spec::Formula> formula;                     ///< invariants
+  std::vector<std::size_t> linked;                      ///< reactions: the hazard's roots
+  std::vector<std::pair<std::size_t, State>> reaction;  ///< reactions: address, level
+  std::optional<spec::Formula> formula;                 ///< invariants
 };
 
 class Verifier {
@@ -150,7 +151,8 @@ public:
       std::set<std::size_t> addresses;
       for (std::size_t i : groups[g]) {
         Check& check = *items[i].check;
-        spec.title += (i == groups[g].front() ? "" : ", ") + std::string(to_string(check.result.kind)) + " " + check.result.name;
+        spec.title +=
+            (i == groups[g].front() ? "" : ", ") + std::string(to_string(check.result.kind)) + " " + check.result.name;
         for (const auto& [a, warning] : check.seed_addresses) addresses.insert(a);
         spec.claims.emplace_back("p" + std::to_string(i), claim(check, class_of));
       }
@@ -161,7 +163,8 @@ public:
       pan.memory_mb = options_.memory_mb;
       // Slots for the states the classes allow; the table (8 bytes a slot) takes at most a
       // quarter of the memory bound.
-      const int most = std::max(10, static_cast<int>(std::floor(std::log2(static_cast<double>(options_.memory_mb) * 1024 * 1024 / 32))));
+      const int most = std::max(
+          10, static_cast<int>(std::floor(std::log2(static_cast<double>(options_.memory_mb) * 1024 * 1024 / 32))));
       pan.hash_bits = std::clamp(static_cast<int>(std::ceil(state_bits(roots))) + 2, 10, std::min(26, most));
       pan.spin = options_.spin;
       pan.cc = options_.cc;
@@ -260,7 +263,8 @@ private:
       most += (i ? ", " : "") + m_.machine_address(sorted[i].second) + " (" + std::to_string(sorted[i].first) + ")";
     }
     std::string off;
-    if (!options_.slice) off += " without --no-slice only the onsets that can influence the property stay in its model;";
+    if (!options_.slice)
+      off += " without --no-slice only the onsets that can influence the property stay in its model;";
     if (!options_.merge) off += " without --no-merge interchangeable onsets are counted, not tracked;";
     if (!off.empty()) off = " First:" + off;
     return "the property depends on " + std::to_string(classes.size()) +
@@ -270,7 +274,8 @@ private:
            "mean the same thing the same definition; (2) a property reads fewer onsets when it names fewer "
            "addresses: split an invariant over SYSTEM or many components into one per component; (3) narrower "
            "service dependencies (\"dependency\") and \"propagate\": \"error\" shrink what reaches an address; "
-           "(4) --memory MB raises the bound." + off;
+           "(4) --memory MB raises the bound." +
+           off;
   }
 
   /// Replays the trail on the coordinator, writes the scenario, and says what failed.
@@ -335,17 +340,19 @@ private:
         const detail::Root& root = m_.roots()[x];
         const auto id = co.find_event(root.event);
         for (const Condition& c : co.conditions(root.machine)) {
-          if (!c.mirror && id && c.event == *id) active += (active.empty() ? "" : ", ") + root.event + " on " + co.address_of(root.machine);
+          if (!c.mirror && id && c.event == *id)
+            active += (active.empty() ? "" : ", ") + root.event + " on " + co.address_of(root.machine);
         }
       }
       std::string below;
       for (const auto& [address, level] : expect) {
         const auto resolved = co.resolve(address);
-        below += (below.empty() ? "" : ", ") + address + " is " + level_name(co.state_of(*resolved)) + ", not at least " +
-                 level_name(level);
+        below += (below.empty() ? "" : ", ") + address + " is " + level_name(co.state_of(*resolved)) +
+                 ", not at least " + level_name(level);
       }
       const bool several = active.find(", ") != std::string::npos;
-      r.message = "while " + (active.empty() ? std::string("an onset of the hazard") : active) + (several ? " are" : " is") + " active, " +
+      r.message = "while " + (active.empty() ? std::string("an onset of the hazard") : active) +
+                  (several ? " are" : " is") + " active, " +
                   (below.empty() ? std::string("the reaction fails") : below);
     } else if (check.formula->is_state_invariant()) {
       expect = repair(check.formula->operands[0]);
@@ -356,11 +363,13 @@ private:
       for (const spec::Formula* atom : atoms) {
         if (!seen.insert(atom->address).second) continue;
         const auto resolved = co.resolve(atom->address);
-        if (resolved) actual += (actual.empty() ? "" : ", ") + atom->address + " is " + level_name(co.state_of(*resolved));
+        if (resolved)
+          actual += (actual.empty() ? "" : ", ") + atom->address + " is " + level_name(co.state_of(*resolved));
       }
       r.message = "reachable state where " + actual;
     } else {
-      r.message = std::string("a run that violates the formula") + (pan.cycle ? " (it ends in a cycle that repeats for ever)" : "");
+      r.message = std::string("a run that violates the formula") +
+                  (pan.cycle ? " (it ends in a cycle that repeats for ever)" : "");
     }
     if (problem.empty() && r.kind != PropertyResult::Kind::Invariant && expect.empty()) {
       problem = "the coordinator does not reproduce the violation the model found";
@@ -380,10 +389,13 @@ private:
     std::string system_path = m_.system().path;
     const fs::path rel = fs::absolute(system_path, ec).lexically_relative(fs::absolute(options_.out_dir, ec));
     if (!rel.empty()) system_path = rel.generic_string();
-    std::string text = "// Counterexample of " + std::string(to_string(r.kind)) + " " + r.name + " found by `safecass verify`\n";
+    std::string text =
+        "// Counterexample of " + std::string(to_string(r.kind)) + " " + r.name + " found by `safecass verify`\n";
     text += "// (SPIN's shortest trail). `safecass run` replays it and fails at the last step.\n";
     text += "{\n  \"system\": " + json_string(system_path) + ",\n";
-    text += "  \"description\": " + json_string(std::string(to_string(r.kind)) + " " + r.name + " violated: " + r.message) + ",\n";
+    text +=
+        "  \"description\": " + json_string(std::string(to_string(r.kind)) + " " + r.name + " violated: " + r.message) +
+        ",\n";
     text += "  \"period\": 0.001,\n  \"duration\": 0.0,\n  \"steps\": [\n";
     std::vector<std::string> lines;
     for (const Step& s : steps) {
@@ -451,8 +463,9 @@ private:
       }
       int distance = 0;
       for (std::size_t i = 0; i < n; ++i) distance += std::abs(static_cast<int>(v[i]) - static_cast<int>(actual[i]));
-      const bool better = changes < best_changes ||
-                          (changes == best_changes && (last > best_last || (last == best_last && distance < best_distance)));
+      const bool better =
+          changes < best_changes ||
+          (changes == best_changes && (last > best_last || (last == best_last && distance < best_distance)));
       if (changes == 0 || !better) continue;
       if (eval(p, addresses, v)) {
         best = v;
@@ -474,7 +487,8 @@ private:
       case K::True: return true;
       case K::False: return false;
       case K::Atom: {
-        const auto i = static_cast<std::size_t>(std::find(addresses.begin(), addresses.end(), f.address) - addresses.begin());
+        const auto i =
+            static_cast<std::size_t>(std::find(addresses.begin(), addresses.end(), f.address) - addresses.begin());
         return spec::holds(f.compare, v[i], f.level);
       }
       case K::Not: return !eval(f.operands[0], addresses, v);
@@ -512,7 +526,8 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
     for (const auto& [address, level] : h.reaction) {
       text += (text.empty() ? "" : ", ") + address + " >= " + level_name(level);
       const int a = model.address_index(address);
-      if (a < 0) return fail(ErrorCode::InvalidArgument, "hazard '" + h.id + "': no address '" + address + "' in the model");
+      if (a < 0)
+        return fail(ErrorCode::InvalidArgument, "hazard '" + h.id + "': no address '" + address + "' in the model");
       c.reaction.emplace_back(static_cast<std::size_t>(a), level);
       c.seed_addresses.emplace_back(static_cast<std::size_t>(a), level == State::Warning);
     }
@@ -533,12 +548,16 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
     f->atoms(atoms);
     for (const spec::Formula* atom : atoms) {
       const int a = model.address_index(atom->address);
-      if (a < 0) return fail(ErrorCode::InvalidArgument, "invariant '" + inv.name + "': no address '" + atom->address + "' in the model");
+      if (a < 0)
+        return fail(ErrorCode::InvalidArgument,
+                    "invariant '" + inv.name + "': no address '" + atom->address + "' in the model");
       const bool warning = needs_warning(atom->compare, atom->level);
       const auto it = std::find_if(c.seed_addresses.begin(), c.seed_addresses.end(),
                                    [&](const auto& s) { return s.first == static_cast<std::size_t>(a); });
-      if (it == c.seed_addresses.end()) c.seed_addresses.emplace_back(static_cast<std::size_t>(a), warning);
-      else it->second = it->second || warning;
+      if (it == c.seed_addresses.end())
+        c.seed_addresses.emplace_back(static_cast<std::size_t>(a), warning);
+      else
+        it->second = it->second || warning;
     }
     c.formula = std::move(*f);
     checks.push_back(std::move(c));
@@ -565,8 +584,8 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
   for (Check& c : checks) {
     if (c.result.kind == PropertyResult::Kind::Reaction && (c.reaction.empty() || c.linked.empty())) {
       c.result.structural = true;
-      c.result.message = c.reaction.empty() ? "no reaction to check"
-                                            : "vacuously: no onset of the model is linked to the hazard";
+      c.result.message =
+          c.reaction.empty() ? "no reaction to check" : "vacuously: no onset of the model is linked to the hazard";
       report.properties.push_back(c.result);
       continue;
     }
@@ -589,8 +608,9 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
       p.name = subject;
       p.where = r.where;
       p.text = "every onset can be cleared";
-      p.message = "onset '" + r.event + "' on " + (r.broadcast >= 0 ? std::string("every s_A") : co.address_of(r.machine)) +
-                  " (from " + r.source + ") has no completion and is not latched: nothing but a reset can clear it";
+      p.message = "onset '" + r.event + "' on " +
+                  (r.broadcast >= 0 ? std::string("every s_A") : co.address_of(r.machine)) + " (from " + r.source +
+                  ") has no completion and is not latched: nothing but a reset can clear it";
       report.properties.push_back(std::move(p));
     }
     for (const spec::HazardSpec& h : system.hazards) {
@@ -602,7 +622,8 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
       p.name = h.id;
       p.where = h.where;
       p.text = "some onset of the model detects the hazard";
-      p.message = "hazard '" + h.id + "' is undetectable: no onset in the model is linked to it, so its reaction holds "
+      p.message = "hazard '" + h.id +
+                  "' is undetectable: no onset in the model is linked to it, so its reaction holds "
                   "vacuously and nothing will ever raise it";
       report.properties.push_back(std::move(p));
     }
@@ -633,7 +654,8 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
       p.name = address;
       p.where = where;
       p.text = "the address can leave Normal";
-      p.message = "address '" + address + "' can never leave Normal: no onset of the model reaches it, so a reaction "
+      p.message = "address '" + address +
+                  "' can never leave Normal: no onset of the model reaches it, so a reaction "
                   "that requires it at Warning or Error cannot be met";
       report.properties.push_back(std::move(p));
     }

@@ -16,7 +16,8 @@ Expected<void> Runtime::add_task(ComponentId component, Time period, Body body) 
   const std::string name(coordinator_.component_name(component));
   if (period <= Time{0}) return fail(ErrorCode::InvalidArgument, "task of '" + name + "': period must be positive");
   for (const Task& t : tasks_) {
-    if (t.component == component) return fail(ErrorCode::InvalidArgument, "component '" + name + "' already has a task");
+    if (t.component == component)
+      return fail(ErrorCode::InvalidArgument, "component '" + name + "' already has a task");
   }
   tasks_.push_back(Task{component, period, std::move(body)});
   return {};

@@ -55,15 +55,15 @@ struct Bridge::Impl {
   struct Topic {
     const TopicMapping* map = nullptr;
     std::vector<Bound> bound;
-    std::vector<double> scratch;  ///< all bound values of one message, so a bad message pushes nothing
+    std::vector<double> scratch;   ///< all bound values of one message, so a bad message pushes nothing
     std::vector<ComponentId> run;  ///< components whose ACTIVE filters each message runs
     Signal* rate = nullptr;
     Signal* age = nullptr;
     std::array<Time, 10> arrivals{};
     std::size_t arrival_count = 0;
     std::atomic<Time::rep> last_arrival{-1};
-    MachineId provided = kNoMachine;             ///< kNoMachine when the provider is not local
-    std::vector<MachineId> required;             ///< per mapping.required; kNoMachine when not local
+    MachineId provided = kNoMachine;  ///< kNoMachine when the provider is not local
+    std::vector<MachineId> required;  ///< per mapping.required; kNoMachine when not local
     ros::Subscriber subscriber;
   };
   struct Loop {
@@ -77,7 +77,7 @@ struct Bridge::Impl {
   struct Ingest {
     const IngestRule* rule = nullptr;
     MachineId target = kNoMachine;
-    std::array<EventId, 3> onset{};  ///< WARN, ERROR, STALE
+    std::array<EventId, 3> onset{};                              ///< WARN, ERROR, STALE
     std::map<std::string, DiagnosticLevel, std::less<>> levels;  ///< per status name
     std::array<bool, 3> active{};
   };
@@ -108,8 +108,8 @@ struct Bridge::Impl {
   bool graph_stop = false;
   std::map<MachineId, std::set<std::string>> graph_problems;  ///< graph thread only
 
-  std::atomic<std::uint64_t> messages{0}, bad_messages{0}, published{0}, ingested{0}, bad_statuses{0},
-      graph_checks{0}, graph_problem_count{0};
+  std::atomic<std::uint64_t> messages{0}, bad_messages{0}, published{0}, ingested{0}, bad_statuses{0}, graph_checks{0},
+      graph_problem_count{0};
 
   Expected<void> bind();
   template <class M>
@@ -145,11 +145,13 @@ Expected<std::unique_ptr<Bridge>> Bridge::create(const std::string& mapping_path
   Coordinator& co = *impl->coordinator;
   const std::string where = impl->mapping.path + ": ";
   for (const EventDef& e : impl->mapping.events) {
-    if (auto r = co.add_event(e); !r) return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
+    if (auto r = co.add_event(e); !r)
+      return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
   }
   for (const EventDef& e : default_ros_events()) {
     if (co.find_event(e.name)) continue;
-    if (auto r = co.add_event(e); !r) return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
+    if (auto r = co.add_event(e); !r)
+      return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
   }
   // Which connections the system declares, to check the topics against.
   std::set<std::pair<std::string, std::string>> connections;
@@ -158,7 +160,8 @@ Expected<std::unique_ptr<Bridge>> Bridge::create(const std::string& mapping_path
   for (const spec::ComponentSpec& c : sys.system->components) components.insert(c.name);
   for (const auto& n : impl->mapping.nodes) {
     if (components.count(n.first) == 0) {
-      return fail(ErrorCode::NotFound, where + "nodes: system '" + sys.system->name + "' has no component '" + n.first + "'");
+      return fail(ErrorCode::NotFound,
+                  where + "nodes: system '" + sys.system->name + "' has no component '" + n.first + "'");
     }
   }
   for (const TopicMapping& t : impl->mapping.topics) {
@@ -187,13 +190,15 @@ Expected<void> Bridge::Impl::bind() {
     FilterTarget t;
     t.kind = co.machine_kind(*m);
     t.component = std::string(co.component_name(co.machine_component(*m)));
-    if (t.kind == MachineKind::Provided || t.kind == MachineKind::Required) t.interface = std::string(co.interface_name(*m));
+    if (t.kind == MachineKind::Provided || t.kind == MachineKind::Required)
+      t.interface = std::string(co.interface_name(*m));
     return t;
   };
   auto need_onset = [&](const std::string& event, const std::string& what) -> Expected<EventId> {
     auto e = co.find_event(event);
     if (!e) return fail(ErrorCode::NotFound, what + ": no event '" + event + "'");
-    if (!co.event(*e).is_onset) return fail(ErrorCode::InvalidArgument, what + ": '" + event + "' is a completion, not an onset");
+    if (!co.event(*e).is_onset)
+      return fail(ErrorCode::InvalidArgument, what + ": '" + event + "' is a completion, not an onset");
     if (co.event(*e).counterpart == kNoEvent) {
       return fail(ErrorCode::InvalidArgument, what + ": '" + event + "' has no completion, so it could never clear");
     }
@@ -220,8 +225,9 @@ Expected<void> Bridge::Impl::bind() {
       std::size_t width = b.path.width();
       if (width == 0) width = b.size != 0 ? b.size : (s != nullptr ? s->size() : 0);
       if (width == 0) {
-        return fail(ErrorCode::InvalidArgument, what + ": signal '" + b.signal + "' reads the whole array '" + b.path.text +
-                                                    "': declare the signal in the spec or give {\"field\": ..., \"size\": N}");
+        return fail(ErrorCode::InvalidArgument,
+                    what + ": signal '" + b.signal + "' reads the whole array '" + b.path.text +
+                        "': declare the signal in the spec or give {\"field\": ..., \"size\": N}");
       }
       if (s == nullptr) {
         auto created = monitor->add_signal(b.signal, width);
@@ -229,13 +235,15 @@ Expected<void> Bridge::Impl::bind() {
         s = *created;
       } else if (s->size() != width) {
         return fail(ErrorCode::InvalidArgument, what + ": field '" + b.path.text + "' gives " + std::to_string(width) +
-                                                    " doubles but signal '" + b.signal + "' has " + std::to_string(s->size()));
+                                                    " doubles but signal '" + b.signal + "' has " +
+                                                    std::to_string(s->size()));
       }
       t->bound.push_back(Bound{s, b.path, width});
       total += width;
     }
     t->scratch.resize(total);
-    for (auto [name, out] : {std::pair<const std::string*, Signal**>{&tm.rate_signal, &t->rate}, {&tm.age_signal, &t->age}}) {
+    for (auto [name, out] :
+         {std::pair<const std::string*, Signal**>{&tm.rate_signal, &t->rate}, {&tm.age_signal, &t->age}}) {
       if (name->empty()) continue;
       auto s = monitor->add_signal(*name, 1);
       if (!s) return fail(s.error().code, what + ": " + s.error().message);
@@ -316,9 +324,11 @@ Expected<void> Bridge::add_loop(std::string_view component, Time period, Body bo
   if (impl_->started) return fail(ErrorCode::InvalidState, "add_loop() after start()");
   auto c = impl_->coordinator->find_component(component);
   if (!c) return tl::unexpected(c.error());
-  if (period <= Time{0}) return fail(ErrorCode::InvalidArgument, "loop of '" + std::string(component) + "': period must be positive");
+  if (period <= Time{0})
+    return fail(ErrorCode::InvalidArgument, "loop of '" + std::string(component) + "': period must be positive");
   for (const auto& l : impl_->loops) {
-    if (l->component == *c) return fail(ErrorCode::InvalidArgument, "component '" + std::string(component) + "' already has a loop");
+    if (l->component == *c)
+      return fail(ErrorCode::InvalidArgument, "component '" + std::string(component) + "' already has a loop");
   }
   auto loop = std::make_unique<Impl::Loop>();
   loop->component = *c;
@@ -355,7 +365,8 @@ Expected<void> Bridge::start() {
         break;
       case MessageType::WrenchStamped:
         t->subscriber = nh.subscribe<geometry_msgs::WrenchStamped>(
-            t->map->topic, 100, [&d, topic](const geometry_msgs::WrenchStamped::ConstPtr& m) { d.on_message(*topic, *m); },
+            t->map->topic, 100,
+            [&d, topic](const geometry_msgs::WrenchStamped::ConstPtr& m) { d.on_message(*topic, *m); },
             ros::VoidConstPtr(), hints);
         break;
       case MessageType::JointState:
@@ -373,7 +384,8 @@ Expected<void> Bridge::start() {
   }
   for (auto& l : d.loops) {
     Impl::Loop* loop = l.get();
-    l->timer = nh.createTimer(ros::Duration(to_seconds(l->period)), [&d, loop](const ros::TimerEvent&) { d.run_loop(*loop); });
+    l->timer =
+        nh.createTimer(ros::Duration(to_seconds(l->period)), [&d, loop](const ros::TimerEvent&) { d.run_loop(*loop); });
   }
   d.observer = d.coordinator->subscribe([&d](const Record& r) {
     if (r.kind != RecordKind::Event && r.kind != RecordKind::Injection) d.dirty.store(true, std::memory_order_release);
@@ -459,7 +471,8 @@ void Bridge::Impl::run_loop(Loop& loop) {
       coordinator->generate(framework_event::completion_of(framework_event::kThreadException), framework);
     }
   } catch (const std::exception& e) {
-    ROS_ERROR_THROTTLE(5.0, "safecass: the loop of %s threw: %s", std::string(coordinator->component_name(loop.component)).c_str(), e.what());
+    ROS_ERROR_THROTTLE(5.0, "safecass: the loop of %s threw: %s",
+                       std::string(coordinator->component_name(loop.component)).c_str(), e.what());
     if (!loop.threw) coordinator->generate(framework_event::kThreadException, framework);
     loop.threw = true;
   } catch (...) {
@@ -469,8 +482,9 @@ void Bridge::Impl::run_loop(Loop& loop) {
   const bool overran = std::chrono::steady_clock::now() - begin > loop.period;
   if (overran != loop.overran) {
     loop.overran = overran;
-    coordinator->generate(overran ? framework_event::kPeriodOverrun : framework_event::completion_of(framework_event::kPeriodOverrun),
-                          framework);
+    coordinator->generate(
+        overran ? framework_event::kPeriodOverrun : framework_event::completion_of(framework_event::kPeriodOverrun),
+        framework);
   }
 }
 
@@ -509,13 +523,15 @@ void Bridge::Impl::fill_status(diagnostic_msgs::DiagnosticStatus& s, const std::
     const std::string cause = co.address_of(root.origin) + ":" + co.event(root.event).name;
     s.message += " (cause " + cause;
     if (root.sample.present()) {
-      s.message += ", " + std::string(co.name_of(root.sample.filter)) + " judged " + std::string(co.name_of(root.sample.signal));
+      s.message +=
+          ", " + std::string(co.name_of(root.sample.filter)) + " judged " + std::string(co.name_of(root.sample.signal));
       if (root.sample.filter != graph_name) s.message += " = " + fmt_double(root.sample.value);
     }
     s.message += ")";
     s.values.push_back(kv("root_cause", cause));
     if (!co.event(root.event).hazard.empty()) s.values.push_back(kv("hazard", co.event(root.event).hazard));
-    if (!co.event(root.event).description.empty()) s.values.push_back(kv("description", co.event(root.event).description));
+    if (!co.event(root.event).description.empty())
+      s.values.push_back(kv("description", co.event(root.event).description));
     if (root.sample.present()) {
       if (root.sample.filter != kNoName) s.values.push_back(kv("filter", std::string(co.name_of(root.sample.filter))));
       if (root.sample.signal != kNoName) s.values.push_back(kv("signal", std::string(co.name_of(root.sample.signal))));
@@ -562,8 +578,10 @@ void Bridge::Impl::publish_diagnostics() {
   const std::uint64_t bad = bad_messages.load() + bad_statuses.load();
   self.level = bad == 0 ? diagnostic_msgs::DiagnosticStatus::OK : diagnostic_msgs::DiagnosticStatus::WARN;
   self.message = std::to_string(messages.load()) + " messages, " + std::to_string(bad) + " rejected";
-  self.values = {kv("messages", std::to_string(messages.load())), kv("bad_messages", std::to_string(bad_messages.load())),
-                 kv("statuses_ingested", std::to_string(ingested.load())), kv("bad_statuses", std::to_string(bad_statuses.load())),
+  self.values = {kv("messages", std::to_string(messages.load())),
+                 kv("bad_messages", std::to_string(bad_messages.load())),
+                 kv("statuses_ingested", std::to_string(ingested.load())),
+                 kv("bad_statuses", std::to_string(bad_statuses.load())),
                  kv("graph_checks", std::to_string(graph_checks.load())),
                  kv("graph_problems", std::to_string(graph_problem_count.load()))};
   array.status.push_back(std::move(self));
@@ -617,12 +635,14 @@ void Bridge::Impl::on_diagnostics(const ros::MessageEvent<diagnostic_msgs::Diagn
 
 void Bridge::Impl::graph_loop() {
   std::unique_lock<std::mutex> lock(graph_mutex);
-  if (graph_wake.wait_for(lock, std::chrono::duration<double>(mapping.graph_grace), [this] { return graph_stop; })) return;
+  if (graph_wake.wait_for(lock, std::chrono::duration<double>(mapping.graph_grace), [this] { return graph_stop; }))
+    return;
   while (!graph_stop) {
     lock.unlock();
     check_graph();
     lock.lock();
-    if (graph_wake.wait_for(lock, std::chrono::duration<double>(mapping.graph_period), [this] { return graph_stop; })) return;
+    if (graph_wake.wait_for(lock, std::chrono::duration<double>(mapping.graph_period), [this] { return graph_stop; }))
+      return;
   }
 }
 
@@ -648,7 +668,8 @@ void Bridge::Impl::check_graph() {
       }
     }
   } catch (const XmlRpc::XmlRpcException& e) {
-    ROS_WARN_THROTTLE(10.0, "safecass: malformed getSystemState answer (%s); graph not checked", e.getMessage().c_str());
+    ROS_WARN_THROTTLE(10.0, "safecass: malformed getSystemState answer (%s); graph not checked",
+                      e.getMessage().c_str());
     return;
   }
   graph_checks.fetch_add(1, std::memory_order_relaxed);
@@ -657,8 +678,10 @@ void Bridge::Impl::check_graph() {
   std::size_t problems = 0;
   auto report = [&](MachineId machine, std::string text) {
     ++problems;
-    if (machine != kNoMachine) now[machine].insert(std::move(text));
-    else ROS_WARN_THROTTLE(10.0, "safecass: %s", text.c_str());
+    if (machine != kNoMachine)
+      now[machine].insert(std::move(text));
+    else
+      ROS_WARN_THROTTLE(10.0, "safecass: %s", text.c_str());
   };
   auto component_of = [](const std::string& iface) { return iface.substr(0, iface.find('.')); };
   for (const auto& n : mapping.nodes) {

@@ -41,9 +41,7 @@ inline bool extract(const FieldPath& path, const geometry_msgs::WrenchStamped& m
     case FieldPath::Field::Wrench: first = 0; break;
     case FieldPath::Field::Force: first = 0; break;
     case FieldPath::Field::Torque: first = 3; break;
-    default:
-      error = "path '" + path.text + "' does not read a WrenchStamped";
-      return false;
+    default: error = "path '" + path.text + "' does not read a WrenchStamped"; return false;
   }
   if (path.index >= 0) first += static_cast<std::size_t>(path.index);
   for (std::size_t i = 0; i < width; ++i) out[i] = all[first + i];
@@ -55,9 +53,18 @@ inline bool extract(const FieldPath& path, const sensor_msgs::JointState& msg, d
   const std::vector<double>* array = nullptr;
   const char* name = "";
   switch (path.field) {
-    case FieldPath::Field::Position: array = &msg.position; name = "position"; break;
-    case FieldPath::Field::Velocity: array = &msg.velocity; name = "velocity"; break;
-    case FieldPath::Field::Effort: array = &msg.effort; name = "effort"; break;
+    case FieldPath::Field::Position:
+      array = &msg.position;
+      name = "position";
+      break;
+    case FieldPath::Field::Velocity:
+      array = &msg.velocity;
+      name = "velocity";
+      break;
+    case FieldPath::Field::Effort:
+      array = &msg.effort;
+      name = "effort";
+      break;
     default: break;
   }
   if (path.type != MessageType::JointState || array == nullptr) {

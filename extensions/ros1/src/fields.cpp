@@ -98,7 +98,8 @@ Expected<FieldPath> parse_field_path(MessageType type, std::string_view path) {
       std::string_view name;
       int index = -1;
       if (parts[0] != "wrench") {
-        return bad("unknown field '" + std::string(parts[0]) + "' (expected wrench, wrench.force, wrench.torque, "
+        return bad("unknown field '" + std::string(parts[0]) +
+                   "' (expected wrench, wrench.force, wrench.torque, "
                    "wrench.force.x ...)");
       }
       if (parts.size() == 1) {

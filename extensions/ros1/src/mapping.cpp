@@ -58,8 +58,9 @@ public:
   }
   bool expect(const JsonValue& v, JsonValue::Type type, const std::string& pointer, const char* what) {
     if (v.type == type) return true;
-    error(v, pointer, std::string(what) + " must be a " + std::string(spec::type_name(type)) + ", not a " +
-                          std::string(spec::type_name(v.type)));
+    error(v, pointer,
+          std::string(what) + " must be a " + std::string(spec::type_name(type)) + ", not a " +
+              std::string(spec::type_name(v.type)));
     return false;
   }
   /// Reports every key of `object` that is not in `known`.
@@ -70,7 +71,8 @@ public:
       if (!ok) {
         std::string list;
         for (const char* k : known) list += (list.empty() ? "" : ", ") + std::string(k);
-        out_.push_back(Diagnostic{Diagnostic::Severity::Error, spec::Position{file_, m.key_position.line, m.key_position.column},
+        out_.push_back(Diagnostic{Diagnostic::Severity::Error,
+                                  spec::Position{file_, m.key_position.line, m.key_position.column},
                                   "unknown key '" + m.key + "' (known: " + list + ")", pointer + "/" + m.key});
       }
     }
@@ -89,13 +91,15 @@ public:
     out = v->string;
     return true;
   }
-  bool number(const JsonValue& object, const char* key, const std::string& pointer, double& out, double min, double max) {
+  bool number(const JsonValue& object, const char* key, const std::string& pointer, double& out, double min,
+              double max) {
     const JsonValue* v = object.find(key);
     if (v == nullptr) return false;
     if (!expect(*v, JsonValue::Type::Number, pointer + "/" + key, key)) return false;
     if (!(v->number >= min && v->number <= max)) {
-      error(*v, pointer + "/" + key, std::string("'") + key + "' = " + std::to_string(v->number) + " is outside [" +
-                                         std::to_string(min) + ", " + std::to_string(max) + "]");
+      error(*v, pointer + "/" + key,
+            std::string("'") + key + "' = " + std::to_string(v->number) + " is outside [" + std::to_string(min) + ", " +
+                std::to_string(max) + "]");
       return false;
     }
     out = v->number;
@@ -121,7 +125,8 @@ std::string directory_of(const std::string& path) {
   return slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
 }
 
-void read_check(Reader& r, const JsonValue& v, const std::string& pointer, bool watchdog, std::optional<TopicCheck>& out) {
+void read_check(Reader& r, const JsonValue& v, const std::string& pointer, bool watchdog,
+                std::optional<TopicCheck>& out) {
   if (!r.expect(v, JsonValue::Type::Object, pointer, watchdog ? "watchdog" : "frequency")) return;
   if (watchdog) {
     r.known_keys(v, pointer, {"timeout", "target", "event"});
@@ -152,8 +157,9 @@ void read_check(Reader& r, const JsonValue& v, const std::string& pointer, bool 
 
 void read_topic(Reader& r, const JsonValue& v, const std::string& pointer, Mapping& m) {
   if (!r.expect(v, JsonValue::Type::Object, pointer, "a topic")) return;
-  r.known_keys(v, pointer, {"topic", "type", "provided", "required", "signals", "rate_signal", "age_signal",
-                            "watchdog", "frequency"});
+  r.known_keys(
+      v, pointer,
+      {"topic", "type", "provided", "required", "signals", "rate_signal", "age_signal", "watchdog", "frequency"});
   TopicMapping t;
   t.where = r.at(v);
   bool ok = r.string(v, "topic", pointer, t.topic, true);
@@ -173,7 +179,8 @@ void read_topic(Reader& r, const JsonValue& v, const std::string& pointer, Mappi
     }
   }
   ok = ok && typed;
-  if (r.string(v, "provided", pointer, t.provided, false)) ok = r.dotted(*v.find("provided"), pointer + "/provided", t.provided, "interface") && ok;
+  if (r.string(v, "provided", pointer, t.provided, false))
+    ok = r.dotted(*v.find("provided"), pointer + "/provided", t.provided, "interface") && ok;
   if (const JsonValue* req = v.find("required")) {
     if (r.expect(*req, JsonValue::Type::Array, pointer + "/required", "'required'")) {
       for (std::size_t i = 0; i < req->array.size(); ++i) {
@@ -232,8 +239,10 @@ void read_topic(Reader& r, const JsonValue& v, const std::string& pointer, Mappi
       ok = false;
     }
   }
-  if (r.string(v, "rate_signal", pointer, t.rate_signal, false)) ok = r.dotted(*v.find("rate_signal"), pointer + "/rate_signal", t.rate_signal, "signal") && ok;
-  if (r.string(v, "age_signal", pointer, t.age_signal, false)) ok = r.dotted(*v.find("age_signal"), pointer + "/age_signal", t.age_signal, "signal") && ok;
+  if (r.string(v, "rate_signal", pointer, t.rate_signal, false))
+    ok = r.dotted(*v.find("rate_signal"), pointer + "/rate_signal", t.rate_signal, "signal") && ok;
+  if (r.string(v, "age_signal", pointer, t.age_signal, false))
+    ok = r.dotted(*v.find("age_signal"), pointer + "/age_signal", t.age_signal, "signal") && ok;
   if (const JsonValue* w = v.find("watchdog")) read_check(r, *w, pointer + "/watchdog", true, t.watchdog);
   if (const JsonValue* f = v.find("frequency")) read_check(r, *f, pointer + "/frequency", false, t.frequency);
   if ((t.watchdog || t.frequency) && t.rate_signal.empty()) {
@@ -263,7 +272,8 @@ void read_event(Reader& r, const JsonValue& v, const std::string& pointer, Mappi
       const JsonValue& x = ts->array[i];
       auto t = x.is_string() ? parse_transition(x.string) : std::nullopt;
       if (!t) {
-        r.error(x, pointer + "/state_transition/" + std::to_string(i), "not a transition (N2W, N2E, W2E, W2N, E2N, E2W)");
+        r.error(x, pointer + "/state_transition/" + std::to_string(i),
+                "not a transition (N2W, N2E, W2E, W2N, E2N, E2W)");
         ok = false;
       } else {
         e.transitions.insert(*t);
@@ -325,19 +335,21 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
   spec::JsonParse parsed = spec::parse_json(text);
   if (!parsed.value) {
     const spec::JsonError& e = *parsed.error;
-    out.diagnostics.push_back(
-        Diagnostic{Diagnostic::Severity::Error, spec::Position{name, e.position.line, e.position.column}, e.message, ""});
+    out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error,
+                                         spec::Position{name, e.position.line, e.position.column}, e.message, ""});
     return out;
   }
   const JsonValue& root = *parsed.value;
   Reader r(name, out.diagnostics);
   if (!r.expect(root, JsonValue::Type::Object, "", "a ROS mapping")) return out;
-  r.known_keys(root, "", {"safecass_ros1", "system", "coordinator", "nodes", "events", "topics", "diagnostics", "graph"});
+  r.known_keys(root, "",
+               {"safecass_ros1", "system", "coordinator", "nodes", "events", "topics", "diagnostics", "graph"});
   Mapping m;
   m.path = name;
   const JsonValue* version = root.find("safecass_ros1");
   if (version == nullptr || !version->is_number() || version->number != 1) {
-    r.error(version ? *version : root, version ? "/safecass_ros1" : "", "a ROS mapping starts with \"safecass_ros1\": 1");
+    r.error(version ? *version : root, version ? "/safecass_ros1" : "",
+            "a ROS mapping starts with \"safecass_ros1\": 1");
   }
   if (r.string(root, "system", "", m.system, true) && m.system.front() != '/') m.system = directory_of(name) + m.system;
   r.string(root, "coordinator", "", m.coordinator, false);
@@ -359,7 +371,8 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
   }
   if (const JsonValue* events = root.find("events")) {
     if (r.expect(*events, JsonValue::Type::Array, "/events", "'events'")) {
-      for (std::size_t i = 0; i < events->array.size(); ++i) read_event(r, events->array[i], "/events/" + std::to_string(i), m);
+      for (std::size_t i = 0; i < events->array.size(); ++i)
+        read_event(r, events->array[i], "/events/" + std::to_string(i), m);
     }
   }
   if (const JsonValue* topics = root.find("topics")) {
@@ -369,7 +382,8 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
         const std::size_t before = m.topics.size();
         read_topic(r, topics->array[i], "/topics/" + std::to_string(i), m);
         if (m.topics.size() > before && !seen.insert(m.topics.back().topic).second) {
-          r.error(topics->array[i], "/topics/" + std::to_string(i), "topic '" + m.topics.back().topic + "' is mapped twice");
+          r.error(topics->array[i], "/topics/" + std::to_string(i),
+                  "topic '" + m.topics.back().topic + "' is mapped twice");
         }
       }
     }

@@ -86,12 +86,14 @@ int main(int argc, char** argv) {
   int code = 0;
   if (inputs) {
     inputs->close();
-    for (const std::string& loss : safecass::describe_losses(inputs->status())) std::fprintf(stderr, "%s\n", loss.c_str());
+    for (const std::string& loss : safecass::describe_losses(inputs->status()))
+      std::fprintf(stderr, "%s\n", loss.c_str());
     if (!inputs->status().complete()) code = 2;
   }
   if (history) {
     history->close();
-    for (const std::string& loss : safecass::describe_losses(history->status())) std::fprintf(stderr, "%s\n", loss.c_str());
+    for (const std::string& loss : safecass::describe_losses(history->status()))
+      std::fprintf(stderr, "%s\n", loss.c_str());
     if (!history->status().complete()) code = 2;
   }
   return code;

@@ -11,9 +11,10 @@ namespace safecass::builtin {
 
 /// `event_onset` / `event_completion` (the onset is optional for filters that can be pure transforms).
 inline void add_event_params(FilterManifest& m, bool required = false) {
-  m.params.push_back(ParamSpec::event("event_onset", "event generated when the condition is detected",
-                                      std::nullopt, !required));
-  m.params.push_back(ParamSpec::event("event_completion", "event generated when the condition clears (default: the onset's completion)",
+  m.params.push_back(
+      ParamSpec::event("event_onset", "event generated when the condition is detected", std::nullopt, !required));
+  m.params.push_back(ParamSpec::event("event_completion",
+                                      "event generated when the condition clears (default: the onset's completion)",
                                       std::nullopt, true));
 }
 

@@ -24,15 +24,18 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "event when a scalar crosses a threshold (with tolerance, hysteresis and persistence)";
-    m.params = {ParamSpec::signal("input_signal", "scalar signal to check"),
-                ParamSpec::number("threshold", "the limit"),
-                ParamSpec::number("tolerance", "margin added to the limit before an onset", 0.0, 0, 1e300),
-                ParamSpec::number("hysteresis", "how far back past the limit the value must return to clear", 0.0, 0, 1e300),
-                ParamSpec::choice("direction", "which side of the limit is the fault", {"above", "below"}, "above"),
-                persistence_param(), persistence_unit_param(),
-                ParamSpec::signal("output_signal", "written every sample: output_above while detected, else output_below", true),
-                ParamSpec::number("output_above", "output value while detected", 1.0),
-                ParamSpec::number("output_below", "output value otherwise", 0.0)};
+    m.params = {
+        ParamSpec::signal("input_signal", "scalar signal to check"),
+        ParamSpec::number("threshold", "the limit"),
+        ParamSpec::number("tolerance", "margin added to the limit before an onset", 0.0, 0, 1e300),
+        ParamSpec::number("hysteresis", "how far back past the limit the value must return to clear", 0.0, 0, 1e300),
+        ParamSpec::choice("direction", "which side of the limit is the fault", {"above", "below"}, "above"),
+        persistence_param(),
+        persistence_unit_param(),
+        ParamSpec::signal("output_signal", "written every sample: output_above while detected, else output_below",
+                          true),
+        ParamSpec::number("output_above", "output value while detected", 1.0),
+        ParamSpec::number("output_below", "output value otherwise", 0.0)};
     add_event_params(m);
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
@@ -70,18 +73,23 @@ private:
 class Range final : public Filter {
 public:
   explicit Range(FilterInit init)
-      : Filter(std::move(init)), min_(number("min")), max_(number("max")), hysteresis_(number("hysteresis")),
+      : Filter(std::move(init)),
+        min_(number("min")),
+        max_(number("max")),
+        hysteresis_(number("hysteresis")),
         persistence_(number("persistence"), text("persistence_unit") == "seconds") {}
 
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "event when a scalar leaves the range [min, max]";
-    m.params = {ParamSpec::signal("input_signal", "scalar signal to check"),
-                ParamSpec::number("min", "lowest allowed value"),
-                ParamSpec::number("max", "highest allowed value"),
-                ParamSpec::number("hysteresis", "how far inside the range the value must return to clear", 0.0, 0, 1e300),
-                persistence_param(), persistence_unit_param(),
-                ParamSpec::signal("output_signal", "1 while out of range, else 0", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "scalar signal to check"),
+        ParamSpec::number("min", "lowest allowed value"),
+        ParamSpec::number("max", "highest allowed value"),
+        ParamSpec::number("hysteresis", "how far inside the range the value must return to clear", 0.0, 0, 1e300),
+        persistence_param(),
+        persistence_unit_param(),
+        ParamSpec::signal("output_signal", "1 while out of range, else 0", true)};
     add_event_params(m);
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
@@ -92,9 +100,14 @@ public:
     const double hi = std::get<double>(s.params.at("max"));
     const double h = std::get<double>(s.params.at("hysteresis"));
     if (!(lo + 2 * h <= hi)) {
-      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Range): 'min' + 2 x 'hysteresis' must not exceed 'max'");
+      return fail(ErrorCode::InvalidArgument,
+                  "filter '" + s.filter + "' (Range): 'min' + 2 x 'hysteresis' must not exceed 'max'");
     }
-    static const FilterManifest m = [] { auto x = manifest(); x.type = "Range"; return x; }();
+    static const FilterManifest m = [] {
+      auto x = manifest();
+      x.type = "Range";
+      return x;
+    }();
     return scalar_shape(m, s);
   }
 
@@ -195,8 +208,8 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "debounces an on/off input: on must persist before the onset, off must persist before the completion";
-    m.params = {ParamSpec::signal("input_signal", "scalar signal, 0 = off"),
-                persistence_param(3), persistence_unit_param(),
+    m.params = {ParamSpec::signal("input_signal", "scalar signal, 0 = off"), persistence_param(3),
+                persistence_unit_param(),
                 ParamSpec::integer("release", "consecutive off samples before the completion", 1.0, 1, 1e9),
                 ParamSpec::signal("output_signal", "the debounced value, 1 or 0", true)};
     add_event_params(m, true);

@@ -76,11 +76,12 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "event when the input has no new sample for timeout seconds (heartbeat, staleness)";
-    m.params = {ParamSpec::signal("input_signal", "any signal (a heartbeat)"),
-                ParamSpec::number("timeout", "seconds without a new sample that make it stale", std::nullopt, 1e-9, 1e9),
-                ParamSpec::signal("output_signal", "age of the newest sample in seconds, every run", true),
-                ParamSpec::event("event_onset", "event when stale", std::string("EVT_STALE")),
-                ParamSpec::event("event_completion", "event when fresh again", std::string("/EVT_STALE"))};
+    m.params = {
+        ParamSpec::signal("input_signal", "any signal (a heartbeat)"),
+        ParamSpec::number("timeout", "seconds without a new sample that make it stale", std::nullopt, 1e-9, 1e9),
+        ParamSpec::signal("output_signal", "age of the newest sample in seconds, every run", true),
+        ParamSpec::event("event_onset", "event when stale", std::string("EVT_STALE")),
+        ParamSpec::event("event_completion", "event when fresh again", std::string("/EVT_STALE"))};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     return m;
@@ -121,11 +122,14 @@ public:
         intervals_(window_, 0.0) {}
   static FilterManifest manifest() {
     FilterManifest m;
-    m.doc = "event when the sample rate leaves [min_rate, max_rate] or an interval deviates from the mean by more than max_jitter";
+    m.doc =
+        "event when the sample rate leaves [min_rate, max_rate] or an interval deviates from the mean by more than "
+        "max_jitter";
     m.params = {ParamSpec::signal("input_signal", "any signal whose sample times are judged"),
                 ParamSpec::number("min_rate", "lowest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
                 ParamSpec::number("max_rate", "highest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
-                ParamSpec::number("max_jitter", "largest allowed |interval - mean interval| in seconds (0: no bound)", 0.0, 0, 1e9),
+                ParamSpec::number("max_jitter", "largest allowed |interval - mean interval| in seconds (0: no bound)",
+                                  0.0, 0, 1e9),
                 ParamSpec::integer("window", "intervals averaged; judged once the window is full", 10.0, 1, 1e6),
                 ParamSpec::signal("output_signal", "the mean rate in Hz", true)};
     add_event_params(m, true);
@@ -177,7 +181,8 @@ private:
 /// Execution time / period above `max_duty` → onset.
 class DutyCycle final : public Filter {
 public:
-  explicit DutyCycle(FilterInit init) : Filter(std::move(init)), period_(number("period")), max_duty_(number("max_duty")) {}
+  explicit DutyCycle(FilterInit init)
+      : Filter(std::move(init)), period_(number("period")), max_duty_(number("max_duty")) {}
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "event when a task's execution time exceeds max_duty of its period";
@@ -212,9 +217,10 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "event when the time from a start checkpoint to an end checkpoint exceeds deadline seconds";
-    m.params = {ParamSpec::signals("input_signals", "two signals: [start checkpoint, end checkpoint]"),
-                ParamSpec::number("deadline", "longest allowed time from start to end, in seconds", std::nullopt, 1e-9, 1e9),
-                ParamSpec::signal("output_signal", "elapsed time of each completed pair", true)};
+    m.params = {
+        ParamSpec::signals("input_signals", "two signals: [start checkpoint, end checkpoint]"),
+        ParamSpec::number("deadline", "longest allowed time from start to end, in seconds", std::nullopt, 1e-9, 1e9),
+        ParamSpec::signal("output_signal", "elapsed time of each completed pair", true)};
     add_event_params(m, true);
     m.inputs = {"input_signals"};
     m.outputs = {"output_signal"};
@@ -222,8 +228,10 @@ public:
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     if (s.inputs.size() != 2) {
-      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Deadline): 'input_signals' must list exactly two signals (start, end), not " +
-                                                  std::to_string(s.inputs.size()));
+      return fail(ErrorCode::InvalidArgument,
+                  "filter '" + s.filter +
+                      "' (Deadline): 'input_signals' must list exactly two signals (start, end), not " +
+                      std::to_string(s.inputs.size()));
     }
     return std::vector<std::size_t>{1};
   }

@@ -44,9 +44,13 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "rate of change of the input per second (element-wise)";
-    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
-                ParamSpec::boolean("time_scaling", "divide the difference of two samples by their time difference (false: the difference alone)", true),
-                ParamSpec::signal("output_signal", "the derivative, same size as the input (default: the signal named after the filter)", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "scalar or vector signal"),
+        ParamSpec::boolean(
+            "time_scaling",
+            "divide the difference of two samples by their time difference (false: the difference alone)", true),
+        ParamSpec::signal("output_signal",
+                          "the derivative, same size as the input (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
@@ -91,9 +95,11 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "moving average over the last window samples (element-wise)";
-    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
-                ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
-                ParamSpec::signal("output_signal", "the average, same size as the input (default: the signal named after the filter)", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "scalar or vector signal"),
+        ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
+        ParamSpec::signal("output_signal",
+                          "the average, same size as the input (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
@@ -159,13 +165,18 @@ private:
 /// L2 (default), L1 or L∞ norm of a vector.
 class Norm final : public Filter {
 public:
-  explicit Norm(FilterInit init) : Filter(std::move(init)), kind_(text("norm") == "L1" ? 1 : text("norm") == "Linf" ? 2 : 0) {}
+  explicit Norm(FilterInit init)
+      : Filter(std::move(init)),
+        kind_(text("norm") == "L1"     ? 1
+              : text("norm") == "Linf" ? 2
+                                       : 0) {}
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "norm of a vector signal";
-    m.params = {ParamSpec::signal("input_signal", "vector (or scalar) signal"),
-                ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
-                ParamSpec::signal("output_signal", "the norm (scalar; default: the signal named after the filter)", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "vector (or scalar) signal"),
+        ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
+        ParamSpec::signal("output_signal", "the norm (scalar; default: the signal named after the filter)", true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
@@ -197,15 +208,20 @@ class Arithmetic final : public Filter {
 public:
   static constexpr const char* kType = "Arithmetic";
   explicit Arithmetic(FilterInit init)
-      : Filter(std::move(init)), op_(op_of(text("operation"))), operand_(number("operand")), out_(inputs()[0]->size(), 0.0) {}
+      : Filter(std::move(init)),
+        op_(op_of(text("operation"))),
+        operand_(number("operand")),
+        out_(inputs()[0]->size(), 0.0) {}
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "element-wise add, subtract, multiply, divide, min or max of two signals, or of a signal and a constant";
-    m.params = {ParamSpec::signal("input_signal", "first operand (with 'operand' as the second)", true),
-                ParamSpec::signals("input_signals", "two signals of the same size", true),
-                ParamSpec::choice("operation", "the operation", {"add", "subtract", "multiply", "divide", "min", "max"}, "add"),
-                ParamSpec::number("operand", "constant second operand when there is one input", 0.0),
-                ParamSpec::signal("output_signal", "the result, same size as the inputs (default: the signal named after the filter)", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "first operand (with 'operand' as the second)", true),
+        ParamSpec::signals("input_signals", "two signals of the same size", true),
+        ParamSpec::choice("operation", "the operation", {"add", "subtract", "multiply", "divide", "min", "max"}, "add"),
+        ParamSpec::number("operand", "constant second operand when there is one input", 0.0),
+        ParamSpec::signal("output_signal",
+                          "the result, same size as the inputs (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal", "input_signals"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
@@ -216,10 +232,14 @@ public:
     const bool one = s.params.count("input_signal") > 0;
     const bool two = s.params.count("input_signals") > 0;
     if (one == two) {
-      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Arithmetic): give either 'input_signal' (with 'operand') or 'input_signals' (two signals)");
+      return fail(ErrorCode::InvalidArgument,
+                  "filter '" + s.filter +
+                      "' (Arithmetic): give either 'input_signal' (with 'operand') or 'input_signals' (two signals)");
     }
     if (two && s.inputs.size() != 2) {
-      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Arithmetic): 'input_signals' must list exactly two signals, not " + std::to_string(s.inputs.size()));
+      return fail(ErrorCode::InvalidArgument,
+                  "filter '" + s.filter + "' (Arithmetic): 'input_signals' must list exactly two signals, not " +
+                      std::to_string(s.inputs.size()));
     }
     return same_size<Arithmetic>(s);
   }
@@ -267,9 +287,11 @@ public:
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "combines scalar signals into one vector signal";
-    m.params = {ParamSpec::signal("input_signal", "one scalar signal (a vector of one)", true),
-                ParamSpec::signals("input_signals", "scalar signals, in vector order", true),
-                ParamSpec::signal("output_signal", "vector of the inputs' latest values (default: the signal named after the filter)", true)};
+    m.params = {
+        ParamSpec::signal("input_signal", "one scalar signal (a vector of one)", true),
+        ParamSpec::signals("input_signals", "scalar signals, in vector order", true),
+        ParamSpec::signal("output_signal",
+                          "vector of the inputs' latest values (default: the signal named after the filter)", true)};
     m.inputs = {"input_signal", "input_signals"};
     m.outputs = {"output_signal"};
     m.generates_events = false;
@@ -278,12 +300,14 @@ public:
   }
   static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     if ((s.params.count("input_signal") > 0) == (s.params.count("input_signals") > 0)) {
-      return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Vectorize): give either 'input_signals' or 'input_signal'");
+      return fail(ErrorCode::InvalidArgument,
+                  "filter '" + s.filter + "' (Vectorize): give either 'input_signals' or 'input_signal'");
     }
     for (const Signal* in : s.inputs) {
       if (in->size() != 1) {
         return fail(ErrorCode::InvalidArgument, "filter '" + s.filter + "' (Vectorize): input '" + in->name() +
-                                                    "' has size " + std::to_string(in->size()) + "; Vectorize takes scalars");
+                                                    "' has size " + std::to_string(in->size()) +
+                                                    "; Vectorize takes scalars");
       }
     }
     return std::vector<std::size_t>{s.inputs.size()};
@@ -311,12 +335,15 @@ public:
   explicit Bypass(FilterInit init) : Filter(std::move(init)) {}
   static FilterManifest manifest() {
     FilterManifest m;
-    m.doc = "copies the input to the output (a tap for injection and observation); with event_on, a non-zero input is an onset";
-    m.params = {ParamSpec::signal("input_signal", "scalar or vector signal"),
-                ParamSpec::signal("output_signal", "the same samples (default: the signal named after the filter)", true),
-                ParamSpec::event("event_on", "event generated when the input turns non-zero (any element)", std::nullopt, true),
-                ParamSpec::event("event_off", "event generated when it is zero again (default: the onset's completion)",
-                                 std::nullopt, true)};
+    m.doc =
+        "copies the input to the output (a tap for injection and observation); with event_on, a non-zero input is an "
+        "onset";
+    m.params = {
+        ParamSpec::signal("input_signal", "scalar or vector signal"),
+        ParamSpec::signal("output_signal", "the same samples (default: the signal named after the filter)", true),
+        ParamSpec::event("event_on", "event generated when the input turns non-zero (any element)", std::nullopt, true),
+        ParamSpec::event("event_off", "event generated when it is zero again (default: the onset's completion)",
+                         std::nullopt, true)};
     m.inputs = {"input_signal"};
     m.outputs = {"output_signal"};
     m.default_output = true;

@@ -206,7 +206,8 @@ private:
 class IceStorm {
 public:
   IceStorm(std::string source, const std::string& scratch)
-      : script_(std::move(source) + "/scripts/start-icestorm"), dir_(scratch + "/chaos-icestorm"),
+      : script_(std::move(source) + "/scripts/start-icestorm"),
+        dir_(scratch + "/chaos-icestorm"),
         env_file_(scratch + "/chaos-icestorm.env") {
     std::remove(env_file_.c_str());
     const pid_t parent = ::getpid();
@@ -241,8 +242,8 @@ public:
   /// The script gives IceBox 5 s to be ready, which a heavily loaded machine can exceed: up to
   /// three attempts.
   bool start() {
-    const std::string command = script_ + " --port " + (port_.empty() ? "0" : port_) + " --dir " + dir_ + " --env " +
-                                env_file_ + " >/dev/null";
+    const std::string command =
+        script_ + " --port " + (port_.empty() ? "0" : port_) + " --dir " + dir_ + " --env " + env_file_ + " >/dev/null";
     bool started = false;
     for (int attempt = 0; attempt < 3 && !started; ++attempt) started = std::system(command.c_str()) == 0;
     if (!started) return false;
@@ -319,7 +320,8 @@ std::vector<std::string> rows_of(const std::vector<introspect::StateRow>& rows) 
   std::vector<std::string> out;
   for (const auto& r : rows) {
     if (r.kind == introspect::RowKind::System) continue;  // the reference lists the components alone
-    out.push_back(r.address + " " + std::string(to_string(r.state)) + (r.outstanding.empty() ? "" : " " + r.outstanding));
+    out.push_back(r.address + " " + std::string(to_string(r.state)) +
+                  (r.outstanding.empty() ? "" : " " + r.outstanding));
   }
   std::sort(out.begin(), out.end());
   return out;
@@ -330,8 +332,8 @@ std::vector<std::string> rows_of(const std::vector<introspect::StateRow>& rows) 
 std::vector<std::string> causes_of(const std::vector<Explanation>& why) {
   std::vector<std::string> out;
   for (const Explanation& e : why) {
-    std::string line = e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin + ":" +
-                       e.root_event + " path";
+    std::string line = e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin +
+                       ":" + e.root_event + " path";
     for (const std::string& hop : e.path) line += " " + hop;
     out.push_back(std::move(line));
   }
@@ -340,7 +342,8 @@ std::vector<std::string> causes_of(const std::vector<Explanation>& why) {
 }
 
 bool has_root(const Expected<introspect::ExplainAnswer>& why, const std::string& event) {
-  return why && std::any_of(why->conditions.begin(), why->conditions.end(), [&](const Explanation& e) { return e.root_event == event; });
+  return why && std::any_of(why->conditions.begin(), why->conditions.end(),
+                            [&](const Explanation& e) { return e.root_event == event; });
 }
 
 /// "- wanted" / "+ got" lines of two sorted lists, empty when they are equal.
@@ -381,7 +384,7 @@ struct SupervisorLog {
   std::map<std::string, bool> lost;
   std::map<std::string, std::vector<std::string>> received;
   std::map<std::string, std::uint64_t> missed;
-  std::uint64_t missed_total = 0;   ///< over every incarnation
+  std::uint64_t missed_total = 0;  ///< over every incarnation
   std::uint64_t refused = 0;
 
   explicit SupervisorLog(const std::string& path) {
@@ -442,12 +445,13 @@ struct Delivery {
     return who + ": " + std::to_string(printed) + " transitions printed, " + std::to_string(expected) +
            " since the supervisor subscribed, " + std::to_string(received) + " received by it, " +
            std::to_string(unmatched) + " of those not received, " + std::to_string(reported_missed) +
-           " record(s) reported missed" + (foreign ? "; the supervisor printed a transition the process did not make: " + foreign_line : "");
+           " record(s) reported missed" +
+           (foreign ? "; the supervisor printed a transition the process did not make: " + foreign_line : "");
   }
 };
 
-Delivery delivered(const std::vector<std::string>& printed, std::size_t anchor, const std::vector<std::string>& received,
-                   std::uint64_t missed) {
+Delivery delivered(const std::vector<std::string>& printed, std::size_t anchor,
+                   const std::vector<std::string>& received, std::uint64_t missed) {
   Delivery d;
   d.printed = printed.size();
   d.received = received.size();
@@ -498,12 +502,15 @@ struct Operation {
 const std::vector<Operation>& operations() {
   static const std::vector<Operation> ops = [] {
     std::vector<Operation> v;
-    const std::vector<std::pair<std::string, std::string>> faults{
-        {"EVT_FORCE_ERROR", "JR3.s_A"},          {"EVT_FORCE_HIGH", "JR3.s_A"},
-        {"EVT_BONE_MOTION", "BMM.s_A"},          {"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
-        {"EVT_TRACKING_ERROR", "CONTROL.s_A"},   {"EVT_TRACKING_ERROR", "CONTROL.s_P.Status"},
-        {"EVT_FORCE_ERROR", "CONTROL.s_P.Command"}, {"EVT_SERVO_OVERLOAD", "SERVO.s_A"},
-        {"EVT_PERIOD_OVERRUN", "CONTROL.s_F"}};
+    const std::vector<std::pair<std::string, std::string>> faults{{"EVT_FORCE_ERROR", "JR3.s_A"},
+                                                                  {"EVT_FORCE_HIGH", "JR3.s_A"},
+                                                                  {"EVT_BONE_MOTION", "BMM.s_A"},
+                                                                  {"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
+                                                                  {"EVT_TRACKING_ERROR", "CONTROL.s_A"},
+                                                                  {"EVT_TRACKING_ERROR", "CONTROL.s_P.Status"},
+                                                                  {"EVT_FORCE_ERROR", "CONTROL.s_P.Command"},
+                                                                  {"EVT_SERVO_OVERLOAD", "SERVO.s_A"},
+                                                                  {"EVT_PERIOD_OVERRUN", "CONTROL.s_F"}};
     for (const auto& [event, target] : faults) {
       v.push_back({false, event, target});
       v.push_back({false, "/" + event, target});
@@ -519,9 +526,12 @@ const std::vector<Operation>& operations() {
 class Chaos {
 public:
   Chaos()
-      : bin_(env("SAFECASS_BIN")), source_(env("SAFECASS_SOURCE_DIR")), scratch_(env("SAFECASS_SCRATCH", "/tmp")),
+      : bin_(env("SAFECASS_BIN")),
+        source_(env("SAFECASS_SOURCE_DIR")),
+        scratch_(env("SAFECASS_SCRATCH", "/tmp")),
         system_(source_ + "/examples/robodoc/robodoc.json"),
-        feed_(source_ + "/tests/integration/middleware/chaos_robot_feed.json"), icestorm_(source_, scratch_),
+        feed_(source_ + "/tests/integration/middleware/chaos_robot_feed.json"),
+        icestorm_(source_, scratch_),
         reference_(system_) {
     if (reference_.load.ok()) {
       for (const auto& [coordinator, components] : reference_.load.system->coordinators) {
@@ -581,11 +591,13 @@ public:
         log_path("robot", robot_n_));
     anchor_["robot"] = 0;  // the supervisor runs: it receives this process's records from its start
     std::string token;
-    if (!eventually([&] {
-          auto t = middleware::read_token_file(token_file);
-          if (t) token = *t;
-          return t.has_value();
-        }, 15000ms)) {
+    if (!eventually(
+            [&] {
+              auto t = middleware::read_token_file(token_file);
+              if (t) token = *t;
+              return t.has_value();
+            },
+            15000ms)) {
       ADD_FAILURE() << "the robot wrote no token\n" << tail(robot_->log());
       return false;
     }
@@ -597,9 +609,9 @@ public:
 
   bool start_ui() {
     ++ui_n_;
-    ui_ = std::make_unique<Process>(
-        std::vector<std::string>{bin_, "run", system_, "--coordinator", "ui", "--ice", icestorm_.endpoint(), "--duration", "300"},
-        log_path("ui", ui_n_));
+    ui_ = std::make_unique<Process>(std::vector<std::string>{bin_, "run", system_, "--coordinator", "ui", "--ice",
+                                                             icestorm_.endpoint(), "--duration", "300"},
+                                    log_path("ui", ui_n_));
     anchor_["ui"] = 0;
     ui_client_ = connect("ui", "");
     ui_up_ = Steady::now();
@@ -627,10 +639,10 @@ public:
   /// Applies `op` to the robot and to the reference; both must accept or refuse it alike.
   std::string apply(const Operation& op) {
     reference_.clock.advance(1ms);  // distinct onset times, as in the real run
-    Expected<void> local = op.reset ? reference_.co->reset(op.target, "chaos", "burst")
-                                    : reference_.co->generate(op.event, op.target);
-    Expected<void> remote = op.reset ? robot_client_->reset(op.target, "chaos", "burst")
-                                     : robot_client_->generate(op.event, op.target);
+    Expected<void> local =
+        op.reset ? reference_.co->reset(op.target, "chaos", "burst") : reference_.co->generate(op.event, op.target);
+    Expected<void> remote =
+        op.reset ? robot_client_->reset(op.target, "chaos", "burst") : robot_client_->generate(op.event, op.target);
     if (local.has_value() != remote.has_value()) {
       return op.text() + ": in-process " + (local ? "accepted" : "refused (" + local.error().message + ")") +
              ", robot " + (remote ? "accepted" : "refused (" + remote.error().message + ")");
@@ -652,8 +664,8 @@ public:
   /// Everything that differs from the reference now; empty when every process has converged.
   std::string divergence() {
     std::string out;
-    for (const auto& [who, client] : {std::pair{std::string("robot"), robot_client_.get()},
-                                      std::pair{std::string("ui"), ui_client_.get()}}) {
+    for (const auto& [who, client] :
+         {std::pair{std::string("robot"), robot_client_.get()}, std::pair{std::string("ui"), ui_client_.get()}}) {
       const std::vector<std::string> components(components_[who].begin(), components_[who].end());
       auto rows = client->state_list();
       if (!rows) {
@@ -715,8 +727,10 @@ public:
   std::string totals() const {
     std::size_t printed = 0;
     std::uint64_t missed = 0, refused = 0;
-    for (int n = 1; n <= robot_n_; ++n) printed += transitions_printed(log_path("robot", n), "robot", components_.at("robot")).size();
-    for (int n = 1; n <= ui_n_; ++n) printed += transitions_printed(log_path("ui", n), "ui", components_.at("ui")).size();
+    for (int n = 1; n <= robot_n_; ++n)
+      printed += transitions_printed(log_path("robot", n), "robot", components_.at("robot")).size();
+    for (int n = 1; n <= ui_n_; ++n)
+      printed += transitions_printed(log_path("ui", n), "ui", components_.at("ui")).size();
     for (int n = 1; n <= supervisor_n_; ++n) {
       const SupervisorLog s(log_path("supervisor", n));
       missed += s.missed_total;
@@ -783,11 +797,13 @@ private:
     o.token = token;
     o.timeout = 3000ms;
     std::unique_ptr<middleware::RemoteClient> c;
-    eventually([&] {
-      auto r = middleware::RemoteClient::connect(o);
-      if (r) c = std::move(*r);
-      return c != nullptr;
-    }, 15000ms);
+    eventually(
+        [&] {
+          auto r = middleware::RemoteClient::connect(o);
+          if (r) c = std::move(*r);
+          return c != nullptr;
+        },
+        15000ms);
     return c;
   }
 
@@ -828,7 +844,7 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
   ASSERT_TRUE(chaos.reference().co != nullptr);
   ASSERT_TRUE(chaos.start()) << chaos.logs();
 
-  std::vector<Action> plan{Action::KillRobot, Action::StopRobot, Action::KillUi,
+  std::vector<Action> plan{Action::KillRobot,    Action::StopRobot,      Action::KillUi,
                            Action::KillIceStorm, Action::KillSupervisor, Action::Burst};
   std::shuffle(plan.begin(), plan.end(), random);
   while (static_cast<int>(plan.size()) < rounds) {
@@ -854,7 +870,8 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
     std::string failure;
     auto burst = [&](int n) {
       for (int i = 0; i < n && failure.empty(); ++i) {
-        const Operation& op = operations()[static_cast<std::size_t>(uniform(0, static_cast<int>(operations().size()) - 1))];
+        const Operation& op =
+            operations()[static_cast<std::size_t>(uniform(0, static_cast<int>(operations().size()) - 1))];
         what += "\n    " + op.text();
         failure = chaos.apply(op);
       }
@@ -864,7 +881,8 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
       case Action::KillRobot: {
         chaos.kill_robot();
         // Fail toward safe: the ui does not keep showing the dead robot's last state.
-        if (!eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_COORDINATOR_LOST"); }, 3000ms)) {
+        if (!eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_COORDINATOR_LOST"); },
+                        3000ms)) {
           failure = "the ui does not show EVT_COORDINATOR_LOST on PENDANT.s_R.Status while the robot is dead";
         }
         std::this_thread::sleep_for(Millis(uniform(0, 500)));
@@ -881,7 +899,8 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
         // While it is stopped the ui must have declared it lost (bound: 3 heartbeats, 300 ms).
         const int lost_after = count_lines_containing(chaos.log_of("ui"), "coordinator 'robot' lost");
         chaos.stop_robot(false);
-        if (lost_after <= lost_before) failure = "the ui did not declare the stopped robot lost within " + std::to_string(pause) + " ms";
+        if (lost_after <= lost_before)
+          failure = "the ui did not declare the stopped robot lost within " + std::to_string(pause) + " ms";
         break;
       }
       case Action::KillUi: {
@@ -896,7 +915,8 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
         // bus is down, and the ui, which cannot hear the robot, shows it lost.
         burst(uniform(0, 5));
         if (failure.empty() &&
-            !eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_COORDINATOR_LOST"); }, 3000ms)) {
+            !eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_COORDINATOR_LOST"); },
+                        3000ms)) {
           failure = "the ui does not show EVT_COORDINATOR_LOST on PENDANT.s_R.Status while IceStorm is down";
         }
         std::this_thread::sleep_for(Millis(uniform(0, 700)));
@@ -906,19 +926,19 @@ TEST(Chaos, EveryProcessConvergesToTheInProcessStatesAfterEachOfTwentyRandomFaul
       case Action::KillSupervisor: {
         chaos.kill_supervisor();
         // The monitor is itself monitored: both coordinators raise EVT_SUPERVISOR_LOST.
-        if (!eventually([&] {
-              return has_root(chaos.robot()->explain("JR3.s_F"), "EVT_SUPERVISOR_LOST") &&
-                     has_root(chaos.ui()->explain("PENDANT.s_F"), "EVT_SUPERVISOR_LOST");
-            }, 3000ms)) {
+        if (!eventually(
+                [&] {
+                  return has_root(chaos.robot()->explain("JR3.s_F"), "EVT_SUPERVISOR_LOST") &&
+                         has_root(chaos.ui()->explain("PENDANT.s_F"), "EVT_SUPERVISOR_LOST");
+                },
+                3000ms)) {
           failure = "the coordinators do not show EVT_SUPERVISOR_LOST while the supervisor is dead";
         }
         std::this_thread::sleep_for(Millis(uniform(0, 500)));
         if (failure.empty() && !chaos.start_supervisor()) failure = "the supervisor did not restart";
         break;
       }
-      case Action::Burst:
-        burst(uniform(5, 30));
-        break;
+      case Action::Burst: burst(uniform(5, 30)); break;
     }
     if (!failure.empty()) {
       ADD_FAILURE() << "round " << round << " (" << what << "): " << failure << "\n" << chaos.logs();
@@ -1022,7 +1042,8 @@ TEST(Chaos, TheSupervisorsViewShowsTheTrueStatesAgainAfterItReportsRecordsLostIn
   // A later record of the robot reveals the gap.
   ASSERT_EQ(chaos.apply({false, "EVT_TRACKING_ERROR", "CONTROL.s_A"}), "");
   ASSERT_TRUE(eventually([&] { return SupervisorLog(chaos.log_of("supervisor")).missed["robot"] > 0; }, 10000ms))
-      << "the supervisor does not report the robot's records lost in the crash\n" << chaos.logs();
+      << "the supervisor does not report the robot's records lost in the crash\n"
+      << chaos.logs();
   EXPECT_TRUE(chaos.converges(bound, problem))
       << "after reporting the missed records the supervisor still shows states the robot no longer has\n"
       << problem << chaos.logs();

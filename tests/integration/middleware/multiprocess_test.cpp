@@ -132,7 +132,8 @@ struct TwoProcesses {
   std::string tag;
   std::unique_ptr<Process> robot, ui;
 
-  TwoProcesses(std::string ice_endpoint, std::string test_tag) : ice(std::move(ice_endpoint)), tag(std::move(test_tag)) {}
+  TwoProcesses(std::string ice_endpoint, std::string test_tag)
+      : ice(std::move(ice_endpoint)), tag(std::move(test_tag)) {}
 
   std::string token_file() const { return p.scratch + "/" + tag + "-robot.token"; }
   void start_robot() {
@@ -153,11 +154,13 @@ struct TwoProcesses {
     o.token = token;
     o.timeout = 3000ms;
     std::unique_ptr<middleware::RemoteClient> c;
-    eventually([&] {
-      auto r = middleware::RemoteClient::connect(o);
-      if (r) c = std::move(*r);
-      return c != nullptr;
-    }, 10000ms);
+    eventually(
+        [&] {
+          auto r = middleware::RemoteClient::connect(o);
+          if (r) c = std::move(*r);
+          return c != nullptr;
+        },
+        10000ms);
     return c;
   }
   std::string logs() const {
@@ -178,7 +181,8 @@ State state_of(middleware::RemoteClient& c, const std::string& address) {
 std::string causes(const std::vector<Explanation>& why) {
   std::string out;
   for (const Explanation& e : why) {
-    out += e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin + ":" + e.root_event + " path";
+    out += e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin + ":" +
+           e.root_event + " path";
     for (const std::string& hop : e.path) out += " " + hop;
     out += "\n";
   }
@@ -214,15 +218,17 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
   auto robot = sys.client("robot", *token);
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
-  ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal && state_of(*robot, "CONTROL") == State::Normal; }))
-      << sys.logs();
+  ASSERT_TRUE(eventually([&] {
+    return state_of(*ui, "PENDANT") == State::Normal && state_of(*robot, "CONTROL") == State::Normal;
+  })) << sys.logs();
 
   ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A")) << sys.logs();
   ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Error; })) << sys.logs();
   EXPECT_EQ(state_of(*ui, "PENDANT.s_R.Status"), State::Error);
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error);
 
-  const std::string expected = in_process([](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
+  const std::string expected =
+      in_process([](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
   auto remote = ui->explain("PENDANT");
   ASSERT_TRUE(remote) << remote.error().message;
   EXPECT_EQ(causes(remote->conditions), expected);
@@ -251,8 +257,9 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   TwoProcesses sys(ice_of_fixture(), "audit");
   sys.start_robot();
   sys.start_ui({"--lost-after", "3000"});  // this test is about causes: no loss under CI load
-  Process supervisor({sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "3000", "--duration", "40"},
-                     sys.p.scratch + "/audit-supervisor.log");
+  Process supervisor(
+      {sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "3000", "--duration", "40"},
+      sys.p.scratch + "/audit-supervisor.log");
   auto token = middleware::read_token_file(sys.token_file());
   ASSERT_TRUE(eventually([&] { return (token = middleware::read_token_file(sys.token_file())).has_value(); }))
       << sys.logs();
@@ -278,9 +285,12 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     const char* event;
     const char* target;
   };
-  const std::vector<Op> ops{{"EVT_FORCE_ERROR", "JR3.s_A"},          {"/EVT_FORCE_ERROR", "JR3.s_A"},
-                            {"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}, {"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
-                            {"EVT_BONE_MOTION", "BMM.s_A"},          {"reset", "BMM"}};
+  const std::vector<Op> ops{{"EVT_FORCE_ERROR", "JR3.s_A"},
+                            {"/EVT_FORCE_ERROR", "JR3.s_A"},
+                            {"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
+                            {"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"},
+                            {"EVT_BONE_MOTION", "BMM.s_A"},
+                            {"reset", "BMM"}};
   auto roots = [](const std::vector<Explanation>& why) {
     std::vector<std::string> out;
     for (const Explanation& e : why) out.push_back(e.root_origin + ":" + e.root_event);
@@ -302,7 +312,9 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     ASSERT_TRUE(eventually([&] {
       auto got = ui->explain("PENDANT.s_R.Status");
       return got && roots(got->conditions) == want;
-    })) << "step " << step << " " << op.event << " " << op.target << "\n" << sys.logs();
+    })) << "step "
+        << step << " " << op.event << " " << op.target << "\n"
+        << sys.logs();
   }
 
   std::vector<std::string> expected, expected_transitions;
@@ -313,7 +325,8 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     const std::string root_origin = r.root.event == kNoEvent ? "" : reference.root_origin(r.root);
     const std::string outcome = r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome));
     const std::string event = r.event == kNoEvent ? "" : reference.event(r.event).name;
-    expected.push_back(history_line(std::string(to_string(r.kind)), outcome, event, r.from, r.to, root_origin, root_event));
+    expected.push_back(
+        history_line(std::string(to_string(r.kind)), outcome, event, r.from, r.to, root_origin, root_event));
     if (r.kind == RecordKind::Transition) {
       expected_transitions.push_back("[ui] PENDANT.s_R.Status " + std::string(to_string(r.from)) + " -> " +
                                      std::string(to_string(r.to)) + " " + event + " (root " + root_origin + ":" +
@@ -325,8 +338,9 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   ASSERT_TRUE(rows) << rows.error().message;
   std::vector<std::string> got;
   for (const auto& r : *rows) {
-    got.push_back(history_line(std::string(to_string(r.kind)), r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome)),
-                               r.event, r.from, r.to, r.root ? r.root->origin : "", r.root ? r.root->event : ""));
+    got.push_back(history_line(std::string(to_string(r.kind)),
+                               r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome)), r.event, r.from,
+                               r.to, r.root ? r.root->origin : "", r.root ? r.root->event : ""));
   }
   ASSERT_GE(got.size(), expected.size());
   got.erase(got.begin(), got.end() - static_cast<std::ptrdiff_t>(expected.size()));  // the start-up records
@@ -354,9 +368,9 @@ TEST(MultiProcess, ReadsAreRefusedWithoutTheReadCredentialWhenTheCoordinatorHasO
   ::unlink(credential_file.c_str());
   sys.start_ui({"--read-token-file", credential_file});
   std::optional<std::string> credential;
-  ASSERT_TRUE(eventually([&] { return (credential = middleware::read_token_file(credential_file).value_or("")) &&
-                                      !credential->empty(); }))
-      << sys.logs();
+  ASSERT_TRUE(eventually([&] {
+    return (credential = middleware::read_token_file(credential_file).value_or("")) && !credential->empty();
+  })) << sys.logs();
   struct stat st {};
   ASSERT_EQ(::stat(credential_file.c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u);
@@ -366,13 +380,17 @@ TEST(MultiProcess, ReadsAreRefusedWithoutTheReadCredentialWhenTheCoordinatorHasO
   o.coordinator = "ui";
   o.timeout = 3000ms;
   std::unique_ptr<middleware::RemoteClient> anonymous;
-  ASSERT_TRUE(eventually([&] {
-    auto r = middleware::RemoteClient::connect(o);
-    if (r) anonymous = std::move(*r);
-    return anonymous != nullptr;
-  }, 10000ms)) << sys.logs();
+  ASSERT_TRUE(eventually(
+      [&] {
+        auto r = middleware::RemoteClient::connect(o);
+        if (r) anonymous = std::move(*r);
+        return anonymous != nullptr;
+      },
+      10000ms))
+      << sys.logs();
   for (auto refused : {anonymous->state_list("PENDANT").has_value(), anonymous->explain("PENDANT").has_value(),
-                       anonymous->history("SYSTEM", 5, introspect::HistoryFilter::Events).has_value(), anonymous->history("PENDANT", 5).has_value()}) {
+                       anonymous->history("SYSTEM", 5, introspect::HistoryFilter::Events).has_value(),
+                       anonymous->history("PENDANT", 5).has_value()}) {
     EXPECT_FALSE(refused);
   }
   auto why = anonymous->state_list("PENDANT");
@@ -443,14 +461,16 @@ TEST(MultiProcess, TheSupervisorDetectsAKilledCoordinatorAndItsRecovery) {
   TwoProcesses sys(ice_of_fixture(), "supervisor");
   sys.start_robot();
   sys.start_ui();
-  Process supervisor({sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "500", "--duration", "40"},
-                     sys.p.scratch + "/supervisor-supervisor.log");
+  Process supervisor(
+      {sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "500", "--duration", "40"},
+      sys.p.scratch + "/supervisor-supervisor.log");
   auto robot = sys.client("robot");
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
   ASSERT_TRUE(eventually([&] {
     const std::string out = supervisor.output();
-    return out.find("coordinator 'robot' is up") != std::string::npos && out.find("coordinator 'ui' is up") != std::string::npos;
+    return out.find("coordinator 'robot' is up") != std::string::npos &&
+           out.find("coordinator 'ui' is up") != std::string::npos;
   })) << supervisor.output();
 
   sys.robot->stop(SIGKILL);
@@ -465,7 +485,8 @@ TEST(MultiProcess, TheSupervisorDetectsAKilledCoordinatorAndItsRecovery) {
   EXPECT_EQ(supervisor.output().find("coordinator 'ui' lost"), std::string::npos) << supervisor.output();
 
   sys.start_robot();
-  EXPECT_TRUE(eventually([&] { return supervisor.output().find("coordinator 'robot' recovered") != std::string::npos; }, 10000ms))
+  EXPECT_TRUE(eventually([&] { return supervisor.output().find("coordinator 'robot' recovered") != std::string::npos; },
+                         10000ms))
       << supervisor.output();
   EXPECT_TRUE(eventually([&] {
     return supervisor.output().find("supervisor: PENDANT.s_R.Status Error -> Normal") != std::string::npos;
@@ -537,21 +558,25 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error) << "local propagation does not wait for the network";
   std::this_thread::sleep_for(300ms);
 
-  ASSERT_EQ(std::system((start + " --port " + port + " --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
+  ASSERT_EQ(std::system((start + " --port " + port + " --dir " + dir + " --env " + env_file + " >/dev/null").c_str()),
+            0);
   icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
   const std::string expected = in_process(
       [](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A")); }, "PENDANT");
-  EXPECT_TRUE(eventually([&] {
-    auto why = ui->explain("PENDANT");
-    return why && causes(why->conditions) == expected;
-  }, 10000ms)) << "after resync the ui holds exactly the robot's current roots\n" << causes(ui->explain("PENDANT")->conditions) << sys.logs();
+  EXPECT_TRUE(eventually(
+      [&] {
+        auto why = ui->explain("PENDANT");
+        return why && causes(why->conditions) == expected;
+      },
+      10000ms))
+      << "after resync the ui holds exactly the robot's current roots\n"
+      << causes(ui->explain("PENDANT")->conditions) << sys.logs();
   EXPECT_NE(sys.ui->output().find("connected to IceStorm"), std::string::npos);
 
   ASSERT_TRUE(robot->generate("/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << "propagation works again\n"
-                                                                                   << sys.logs();
+                                                                                     << sys.logs();
 }
-
 
 /// One coordinator of a system on the fixture's IceStorm, in this process.
 struct Node {
@@ -599,13 +624,16 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   }
   const std::string text = R"({ "safecass": 1, "system": "burst",
     "components": [
-      { "component": "S", "interfaces": { "provided": [)" + provided + R"(], "required": [] },
+      { "component": "S", "interfaces": { "provided": [)" +
+                           provided + R"(], "required": [] },
         "event": [ { "name": "EVT_E", "severity": 50, "state_transition": ["N2E", "W2E"] },
                    { "name": "/EVT_E", "severity": 50, "state_transition": ["E2N", "E2W"] },
                    { "name": "EVT_F", "severity": 60, "state_transition": ["N2E", "W2E"] },
                    { "name": "/EVT_F", "severity": 60, "state_transition": ["E2N", "E2W"] } ] },
-      { "component": "A", "interfaces": { "provided": [], "required": [)" + required + R"(] } } ],
-    "connections": [ )" + connections + R"( ],
+      { "component": "A", "interfaces": { "provided": [], "required": [)" +
+                           required + R"(] } } ],
+    "connections": [ )" + connections +
+                           R"( ],
     "coordinators": { "burst-s": ["S"], "burst-a": ["A"] } })";
   const std::string keys = Paths{}.scratch + "/burst-keys";
   {
@@ -628,7 +656,8 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   const auto applied_before = client.node->stats().updates_applied;
   std::mt19937 random(7);
   for (int round = 0; round < 400; ++round) {
-    for (int k = 0; k < kInterfaces; ++k) provider.co->generate(events[random() % 4], targets[random() % targets.size()]);
+    for (int k = 0; k < kInterfaces; ++k)
+      provider.co->generate(events[random() % 4], targets[random() % targets.size()]);
     if (round % 20 == 0) std::this_thread::sleep_for(1ms);
   }
   // Every interface ends in the provider's exact final state: the same roots (origin, event, onset
@@ -643,7 +672,8 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
       }
       auto why = client.co->explain("S.s_P.D" + std::to_string(i));
       if (!why) return false;
-      for (const Explanation& e : *why) got.push_back(e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()));
+      for (const Explanation& e : *why)
+        got.push_back(e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()));
       std::sort(want.begin(), want.end());
       std::sort(got.begin(), got.end());
       const State client_state = client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i)));
@@ -663,9 +693,8 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   const std::uint64_t messages = after.state_messages_published - before.state_messages_published;
   EXPECT_GT(updates, static_cast<std::uint64_t>(kInterfaces));
   EXPECT_LT(messages, updates) << "several interfaces' updates share one message";
-  EXPECT_TRUE(eventually([&] {
-    return client.node->stats().updates_applied - applied_before == updates;
-  })) << "every update sent was applied, in order";
+  EXPECT_TRUE(eventually([&] { return client.node->stats().updates_applied - applied_before == updates; }))
+      << "every update sent was applied, in order";
   const auto received = client.node->stats();
   EXPECT_EQ(received.updates_rejected, 0u);
   EXPECT_EQ(received.updates_missed, 0u) << "batched updates keep consecutive sequence numbers";

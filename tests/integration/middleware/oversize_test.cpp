@@ -39,8 +39,8 @@ namespace safecass {
 namespace {
 
 using namespace std::chrono_literals;
-using ::testing::HasSubstr;
 using ::testing::ContainsRegex;
+using ::testing::HasSubstr;
 using ::testing::MatchesRegex;
 
 constexpr std::size_t kLimit = 4096;
@@ -77,8 +77,8 @@ std::string system_text(int warnings, int errors, std::size_t length) {
   std::string events;
   auto add = [&](const std::string& name, int severity, const char* on, const char* off) {
     if (!events.empty()) events += ",\n";
-    events += R"({ "name": ")" + name + R"(", "severity": )" + std::to_string(severity) + R"(, "state_transition": )" + on +
-              R"( }, { "name": "/)" + name + R"(", "severity": )" + std::to_string(severity) +
+    events += R"({ "name": ")" + name + R"(", "severity": )" + std::to_string(severity) + R"(, "state_transition": )" +
+              on + R"( }, { "name": "/)" + name + R"(", "severity": )" + std::to_string(severity) +
               R"(, "state_transition": )" + off + " }";
   };
   for (int i = 0; i < warnings; ++i) add(long_event("WARNING", i, length), 30, R"(["N2W"])", R"(["W2N"])");
@@ -94,11 +94,16 @@ std::string system_text(int warnings, int errors, std::size_t length) {
   }
   return R"({ "safecass": 1, "system": "over",
   "components": [
-    { "component": "P", "interfaces": { "provided": [)" + provided + R"(], "required": [] },
-      "event": [ )" + events + R"( ],
-      "service": [ )" + services + R"( ] },
-    { "component": "C", "interfaces": { "provided": [], "required": [)" + provided + R"(] } } ],
-  "connections": [ )" + connections + R"( ],
+    { "component": "P", "interfaces": { "provided": [)" +
+         provided + R"(], "required": [] },
+      "event": [ )" +
+         events + R"( ],
+      "service": [ )" +
+         services + R"( ] },
+    { "component": "C", "interfaces": { "provided": [], "required": [)" +
+         provided + R"(] } } ],
+  "connections": [ )" +
+         connections + R"( ],
   "coordinators": { "over-p": ["P"], "over-c": ["C"] } })";
 }
 
@@ -175,8 +180,9 @@ struct Node {
 /// as large as a SAFECASS process does (Ice.MessageSizeMax 4096 KiB).
 struct Bus {
   std::string port = fixture_port();
-  std::string keys = std::string(std::getenv("SAFECASS_SCRATCH") != nullptr ? std::getenv("SAFECASS_SCRATCH") : "/tmp") +
-                     "/oversize-keys";
+  std::string keys =
+      std::string(std::getenv("SAFECASS_SCRATCH") != nullptr ? std::getenv("SAFECASS_SCRATCH") : "/tmp") +
+      "/oversize-keys";
   FilterRegistry registry;
   spec::LoadResult load;
   Node provider, client;
@@ -314,8 +320,8 @@ TEST(Oversize, AStateUpdateTooLargeForOneMessageGoesOutWithItsMostSevereRootsAnd
   EXPECT_GE(stats.roots_truncated, kWarnings + kErrors - last.roots.size());
   const std::string log = bus.provider.all_log();
   EXPECT_THAT(log, ContainsRegex("middleware: over-p: state update of P\\.D \\(seq [0-9]+\\) is [0-9]+ bytes, over "
-                                "the 4096-byte message limit: sent with [0-9]+ of its [0-9]+ roots, the most severe "
-                                "first; [0-9]+ left out"))
+                                 "the 4096-byte message limit: sent with [0-9]+ of its [0-9]+ roots, the most severe "
+                                 "first; [0-9]+ left out"))
       << log;
   EXPECT_THAT(log, HasSubstr("sent with " + std::to_string(last.roots.size()) + " of its " +
                              std::to_string(kWarnings + kErrors) + " roots, the most severe first; " +
@@ -348,8 +354,11 @@ TEST(Oversize, ABatchTooLargeForOneMessageIsSplitAndEveryUpdateArrivesWhole) {
 
   for (int e = 0; e < 8; ++e) {
     const std::string iface = "E" + std::to_string(e);
-    EXPECT_TRUE(eventually([&] { return bus.client_state("C.s_R." + iface) == State::Error && bus.held(iface).size() == 5; }))
-        << iface << "\n" << bus.provider.all_log() << bus.client.all_log();
+    EXPECT_TRUE(eventually([&] {
+      return bus.client_state("C.s_R." + iface) == State::Error && bus.held(iface).size() == 5;
+    })) << iface
+        << "\n"
+        << bus.provider.all_log() << bus.client.all_log();
   }
   const auto batches = bus.states->batches();
   std::size_t most = 0;
@@ -389,7 +398,8 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
     }
     return !seen.empty() && seen.back().kind == "reset";
   })) << bus.provider.all_log();
-  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i].seq, static_cast<std::int64_t>(i + 1)) << "in order, none lost";
+  for (std::size_t i = 0; i < seen.size(); ++i)
+    EXPECT_EQ(seen[i].seq, static_cast<std::int64_t>(i + 1)) << "in order, none lost";
   for (std::size_t size : bus.events->sizes_of("over-p")) EXPECT_LE(size, kLimit);
   const middleware::NodeStats stats = bus.provider.node->stats();
   EXPECT_EQ(stats.events_published, seen.size());
@@ -400,9 +410,10 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
   const wire::EventMessage& reset = seen.back();
   EXPECT_THAT(reset.text, MatchesRegex("operator: r+ \\[cut: 10010 bytes\\]"));
   EXPECT_LT(reset.text.size(), kLimit);
-  EXPECT_THAT(bus.provider.all_log(),
-              ContainsRegex("middleware: over-p: event record seq [0-9]+ \\(reset of P\\.s_A\\) is [0-9]+ bytes, over the "
-                           "4096-byte message limit: sent with its text cut from 10010 to [0-9]+ bytes"))
+  EXPECT_THAT(
+      bus.provider.all_log(),
+      ContainsRegex("middleware: over-p: event record seq [0-9]+ \\(reset of P\\.s_A\\) is [0-9]+ bytes, over the "
+                    "4096-byte message limit: sent with its text cut from 10010 to [0-9]+ bytes"))
       << bus.provider.all_log();
 }
 
@@ -417,15 +428,16 @@ TEST(Oversize, AStateOfMegabytesIsCutToTheDefaultLimitAndCrossesIceStormWhole) {
   for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(p.generate(long_event("ERROR", i, kName), "P.s_A"));
   bus.start_provider();
   ASSERT_TRUE(bus.provider.node && bus.client.node);
-  ASSERT_TRUE(eventually([&] { return bus.client_state("C.s_R.D") == State::Error && !bus.held("D").empty(); }, 20000ms))
+  ASSERT_TRUE(
+      eventually([&] { return bus.client_state("C.s_R.D") == State::Error && !bus.held("D").empty(); }, 20000ms))
       << bus.provider.all_log() << bus.client.all_log();
   const std::size_t held = bus.held("D").size();
   EXPECT_LT(held, std::size_t{kErrors});
   EXPECT_GE(held, std::size_t{kErrors} * 3 / 4) << "about 4 MB of 4.8 MB";
   for (std::size_t size : bus.states->sizes()) EXPECT_LE(size, middleware::kDefaultMaxMessageBytes);
-  EXPECT_THAT(bus.provider.all_log(),
-              HasSubstr("-byte message limit: sent with " + std::to_string(held) + " of its " + std::to_string(kErrors) +
-                        " roots, the most severe first; " + std::to_string(kErrors - static_cast<int>(held)) + " left out"));
+  EXPECT_THAT(bus.provider.all_log(), HasSubstr("-byte message limit: sent with " + std::to_string(held) + " of its " +
+                                                std::to_string(kErrors) + " roots, the most severe first; " +
+                                                std::to_string(kErrors - static_cast<int>(held)) + " left out"));
   EXPECT_EQ(bus.provider.node->stats().roots_truncated % (kErrors - held), 0u);
 }
 

@@ -85,7 +85,8 @@ public:
   /// Starts the node; false (with a message) when it cannot.
   bool serve(std::string& why) {
     middleware::NodeOptions o;
-    auto ice = middleware::parse_ice_endpoint("127.0.0.1:" + env_file_value(env("SAFECASS_ICESTORM_ENV"), "ICESTORM_PORT"));
+    auto ice =
+        middleware::parse_ice_endpoint("127.0.0.1:" + env_file_value(env("SAFECASS_ICESTORM_ENV"), "ICESTORM_PORT"));
     if (!ice) {
       why = ice.error().message;
       return false;
@@ -96,7 +97,8 @@ public:
     o.clock.duration = duration_;
     o.lost_after = std::chrono::milliseconds(60000);
     o.log = [](const std::string&) {};
-    auto node = middleware::CoordinatorNode::create(runner_->coordinator(), runner_->monitor(), registry_, system_, "robot", o);
+    auto node =
+        middleware::CoordinatorNode::create(runner_->coordinator(), runner_->monitor(), registry_, system_, "robot", o);
     if (!node) {
       why = node.error().message;
       return false;
@@ -124,7 +126,8 @@ public:
 
   std::unique_ptr<tools::Console> remote_console(bool json, std::string& why) {
     middleware::ClientOptions o;
-    o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + env_file_value(env("SAFECASS_ICESTORM_ENV"), "ICESTORM_PORT"));
+    o.ice =
+        *middleware::parse_ice_endpoint("127.0.0.1:" + env_file_value(env("SAFECASS_ICESTORM_ENV"), "ICESTORM_PORT"));
     o.coordinator = "robot";
     o.timeout = std::chrono::milliseconds(5000);
     auto client = middleware::RemoteClient::connect(o);
@@ -176,26 +179,28 @@ TEST_P(ConsoleReadCommand, AnswersTheSameInProcessAndRemote) {
     const tools::ConsoleReply got = remote->execute(GetParam().line);
     if (!json) EXPECT_FALSE(want.out.empty() && want.err.empty()) << "the command answers something";
     EXPECT_EQ(got.ok, want.ok) << GetParam().line;
-    EXPECT_EQ(normalised(got.out, "robot"), normalised(want.out, "robot")) << GetParam().line << (json ? " (--json)" : "");
-    EXPECT_EQ(normalised(got.err, "robot"), normalised(want.err, "robot")) << GetParam().line << (json ? " (--json)" : "");
+    EXPECT_EQ(normalised(got.out, "robot"), normalised(want.out, "robot"))
+        << GetParam().line << (json ? " (--json)" : "");
+    EXPECT_EQ(normalised(got.err, "robot"), normalised(want.err, "robot"))
+        << GetParam().line << (json ? " (--json)" : "");
   }
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Robodoc, ConsoleReadCommand,
-    ::testing::Values(ReadCommand{"state_list", "state list"}, ReadCommand{"state_list_component", "state list CONTROL"},
-                      ReadCommand{"state_history", "state history 200"},
-                      ReadCommand{"state_history_component", "state history CONTROL 100"},
-                      ReadCommand{"state_history_machine", "state history JR3.s_A 100"},
-                      ReadCommand{"state_history_service", "state history CONTROL.s_S.Command 100"},
-                      ReadCommand{"event_history", "event history 200"}, ReadCommand{"filter_list", "filter list"},
-                      ReadCommand{"filter_info", "filter info force_limit"},
-                      ReadCommand{"filter_info_type", "filter info Threshold"}, ReadCommand{"event_list", "event list"},
-                      ReadCommand{"connection_list", "connection list"}, ReadCommand{"service_list", "service list"},
-                      ReadCommand{"explain_component", "explain SERVO"}, ReadCommand{"explain_system", "explain SYSTEM"},
-                      ReadCommand{"explain_machine", "explain JR3.s_A"},
-                      ReadCommand{"explain_service", "explain CONTROL.s_S.Command"},
-                      ReadCommand{"time", "time"}, ReadCommand{"unknown_name", "explain NOPE"}),
+    ::testing::Values(
+        ReadCommand{"state_list", "state list"}, ReadCommand{"state_list_component", "state list CONTROL"},
+        ReadCommand{"state_history", "state history 200"},
+        ReadCommand{"state_history_component", "state history CONTROL 100"},
+        ReadCommand{"state_history_machine", "state history JR3.s_A 100"},
+        ReadCommand{"state_history_service", "state history CONTROL.s_S.Command 100"},
+        ReadCommand{"event_history", "event history 200"}, ReadCommand{"filter_list", "filter list"},
+        ReadCommand{"filter_info", "filter info force_limit"}, ReadCommand{"filter_info_type", "filter info Threshold"},
+        ReadCommand{"event_list", "event list"}, ReadCommand{"connection_list", "connection list"},
+        ReadCommand{"service_list", "service list"}, ReadCommand{"explain_component", "explain SERVO"},
+        ReadCommand{"explain_system", "explain SYSTEM"}, ReadCommand{"explain_machine", "explain JR3.s_A"},
+        ReadCommand{"explain_service", "explain CONTROL.s_S.Command"}, ReadCommand{"time", "time"},
+        ReadCommand{"unknown_name", "explain NOPE"}),
     [](const ::testing::TestParamInfo<ReadCommand>& info) { return std::string(info.param.name); });
 
 }  // namespace

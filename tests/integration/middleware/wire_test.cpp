@@ -21,13 +21,13 @@
 
 #include <atomic>
 #include <chrono>
-#include <map>
-#include <optional>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -78,10 +78,9 @@ constexpr const char* kSystem = R"({ "safecass": 1, "system": "wire",
                    { "required": "C.D2", "provided": "P.D2" }, { "required": "C.D3", "provided": "P.D3" } ],
   "coordinators": { "wire-p": ["P"], "wire-c": ["C"] } })";
 
-
+using middleware::detail::encode;
 using middleware::detail::Keyring;
 using middleware::detail::Signer;
-using middleware::detail::encode;
 
 constexpr std::int64_t kIncarnation = 42;
 
@@ -94,7 +93,8 @@ wire::StateUpdate update(const std::string& iface, std::int64_t seq, const std::
   u.iface = iface;
   u.state = level;
   if (!event.empty()) {
-    u.roots.push_back(wire::Root{event, "P.s_A", 1000, level, "", "", 0.0, 0, false, {"P.s_A", "P.s_S." + iface.substr(2)}});
+    u.roots.push_back(
+        wire::Root{event, "P.s_A", 1000, level, "", "", 0.0, 0, false, {"P.s_A", "P.s_S." + iface.substr(2)}});
   }
   return u;
 }
@@ -190,7 +190,8 @@ struct Bus {
     wire::Heartbeat h;
     h.coordinator = name;
     h.incarnation = incarnation;
-    h.time = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    h.time = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+                 .count();
     h.control = std::move(control);
     {
       std::lock_guard lock(mutex);
@@ -242,11 +243,13 @@ TEST(Wire, ABadUpdateInABatchIsRefusedAloneAndTheOthersApply) {
   EXPECT_EQ(bus.node->stats().updates_rejected, 2u);
   // Refusals are logged at most once per second per source (and always counted).
   EXPECT_NE(bus.all_log().find("refused state update P.D1 seq 1 from coordinator 'wire-p': nothing changed"),
-            std::string::npos) << bus.all_log();
+            std::string::npos)
+      << bus.all_log();
   EXPECT_NE(bus.all_log().find("no event 'EVT_UNKNOWN'"), std::string::npos) << bus.all_log();
 
   // The refused streams are not stuck: their next update applies; a repeated number is ignored.
-  bus.send(*bus.provider, {update("P.D1", 2, "EVT_E", wire::Level::Error), update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  bus.send(*bus.provider,
+           {update("P.D1", 2, "EVT_E", wire::Level::Error), update("P.D0", 1, "EVT_E", wire::Level::Error)});
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }));
   EXPECT_TRUE(eventually([&] { return bus.node->stats().updates_rejected == 3u; })) << "P.D0 seq 1 again: stale";
 }
@@ -270,7 +273,8 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   // 3. Signed by another coordinator of the system (a real key) but naming wire-p.
   bus.send(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
   // 4. Claiming wire-p as signer with another key's signature, and with no signature at all.
-  wire::Signed relabelled = bus.other->sign(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
+  wire::Signed relabelled = bus.other->sign(
+      middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
   relabelled.signer = "wire-p";
   bus.state_pub->updates(relabelled);
   wire::Signed unsigned_message = relabelled;
@@ -315,7 +319,8 @@ TEST(Wire, AClientRaisesCoordinatorLostWhenItsProviderFallsSilentAndClearsOnceIt
     bus.beat(*bus.attacker, "wire-p", kIncarnation);
     std::this_thread::sleep_for(50ms);
   }
-  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << "lost within the bound (3 heartbeats) + one check\n" << bus.all_log();
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << "lost within the bound (3 heartbeats) + one check\n"
+                                                 << bus.all_log();
   for (const char* r : {"C.s_R.D0", "C.s_R.D1", "C.s_R.D2", "C.s_R.D3"}) {
     EXPECT_TRUE(bus.explains(r, "EVT_COORDINATOR_LOST")) << r;
   }
@@ -364,7 +369,8 @@ TEST(Wire, AClientSendsItsTokenOnlyToACoordinatorFoundThroughAnAuthenticatedHear
       // Forged: "wire-p" with an attacker's Control proxy on this host.
       bus.beat(*bus.attacker, "wire-p", kIncarnation, "control-wire-p -t:tcp -h 127.0.0.1 -p 1");
       // Genuine, but its Control endpoint is on another host.
-      if (remote_control.load()) bus.beat(*bus.provider, "wire-p", kIncarnation, "control-wire-p -t:tcp -h 10.1.2.3 -p 9");
+      if (remote_control.load())
+        bus.beat(*bus.provider, "wire-p", kIncarnation, "control-wire-p -t:tcp -h 10.1.2.3 -p 9");
       std::this_thread::sleep_for(50ms);
     }
   });
@@ -455,10 +461,12 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
     return m;
   };
   auto ic = bus.ice.communicator();
-  events->records(bus.attacker->sign(middleware::detail::kKindEvents,
-                                     encode(ic, wire::EventMessageSeq{record(1, "transition", "P.s_A\n[wire-p] FORGED", "")})));
-  events->records(bus.provider->sign(middleware::detail::kKindEvents,
-                                     encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "operator\n[wire-p] FAKE LINE")})));
+  events->records(
+      bus.attacker->sign(middleware::detail::kKindEvents,
+                         encode(ic, wire::EventMessageSeq{record(1, "transition", "P.s_A\n[wire-p] FORGED", "")})));
+  events->records(
+      bus.provider->sign(middleware::detail::kKindEvents,
+                         encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "operator\n[wire-p] FAKE LINE")})));
   ASSERT_TRUE(eventually([&] { return output().find("[wire-p] reset P (") != std::string::npos; })) << output();
   EXPECT_NE(output().find("[wire-p] reset P (operator\\x0a[wire-p] FAKE LINE)"), std::string::npos) << output();
   EXPECT_EQ(output().find("\n[wire-p] FAKE LINE"), std::string::npos) << output();
@@ -473,9 +481,11 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
     bus.beat(*bus.provider, "wire-p", kIncarnation + 1);
     std::this_thread::sleep_for(50ms);
   }
-  EXPECT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' restarted; its view is refreshed") != std::string::npos; }))
+  EXPECT_TRUE(eventually([&] {
+    return output().find("coordinator 'wire-p' restarted; its view is refreshed") != std::string::npos;
+  })) << output();
+  EXPECT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' recovered") != std::string::npos; }))
       << output();
-  EXPECT_TRUE(eventually([&] { return output().find("coordinator 'wire-p' recovered") != std::string::npos; })) << output();
   bus.beat(*bus.provider, "wire-p", kIncarnation);
   EXPECT_TRUE(eventually([&] { return output().find("two processes run coordinator 'wire-p'") != std::string::npos; }))
       << output();
@@ -524,8 +534,9 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
   const auto before = (*node)->stats().updates_published;
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t i = 1; i <= 300; ++i) {
-    resync->resync(bus.supervisor->sign(middleware::detail::kKindResync,
-                                        encode(bus.ice.communicator(), wire::ResyncRequest{"supervisor", kIncarnation, i, "wire-p"})));
+    resync->resync(bus.supervisor->sign(
+        middleware::detail::kKindResync,
+        encode(bus.ice.communicator(), wire::ResyncRequest{"supervisor", kIncarnation, i, "wire-p"})));
   }
   const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
   std::this_thread::sleep_for(400ms);  // the last request kept inside a period is honoured

@@ -56,14 +56,15 @@ int main(int argc, char** argv) {
     diagnostic_msgs::DiagnosticStatus last;
     bool seen = false;
     ros::NodeHandle nh;
-    ros::Subscriber s = nh.subscribe<diagnostic_msgs::DiagnosticArray>(argv[2], 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
-      for (const auto& st : a->status) {
-        if (!ends_with(st.name, name)) continue;
-        last = st;
-        seen = true;
-        if (st.level == level && st.message.find(text) != std::string::npos) found = true;
-      }
-    });
+    ros::Subscriber s = nh.subscribe<diagnostic_msgs::DiagnosticArray>(
+        argv[2], 10, [&](const diagnostic_msgs::DiagnosticArray::ConstPtr& a) {
+          for (const auto& st : a->status) {
+            if (!ends_with(st.name, name)) continue;
+            last = st;
+            seen = true;
+            if (st.level == level && st.message.find(text) != std::string::npos) found = true;
+          }
+        });
     const ros::WallTime until = ros::WallTime::now() + ros::WallDuration(timeout);
     while (!found && ros::ok() && ros::WallTime::now() < until) {
       ros::spinOnce();
@@ -73,7 +74,8 @@ int main(int argc, char** argv) {
       print(last);
       return 0;
     }
-    std::printf("timeout: no status '%s' with level %d and '%s' on %s within %.1f s\n", name.c_str(), level, text.c_str(), argv[2], timeout);
+    std::printf("timeout: no status '%s' with level %d and '%s' on %s within %.1f s\n", name.c_str(), level,
+                text.c_str(), argv[2], timeout);
     if (seen) {
       std::printf("last seen: ");
       print(last);
@@ -100,6 +102,8 @@ int main(int argc, char** argv) {
     a.status.push_back(st);
     return publish_one(argv[2], a);
   }
-  std::fprintf(stderr, "usage: ros1_probe wait TOPIC NAME LEVEL TEXT TIMEOUT | float TOPIC VALUE | joints TOPIC N | status TOPIC NAME LEVEL\n");
+  std::fprintf(stderr,
+               "usage: ros1_probe wait TOPIC NAME LEVEL TEXT TIMEOUT | float TOPIC VALUE | joints TOPIC N | status "
+               "TOPIC NAME LEVEL\n");
   return 2;
 }

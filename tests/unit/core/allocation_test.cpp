@@ -60,8 +60,12 @@ void* operator new(std::size_t n, std::align_val_t al) { return allocate_aligned
 void* operator new[](std::size_t n, std::align_val_t al) { return allocate_aligned_or_throw(n, al); }
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept { return allocate(n); }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return allocate(n); }
-void* operator new(std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept { return allocate_aligned(n, al); }
-void* operator new[](std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept { return allocate_aligned(n, al); }
+void* operator new(std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
+  return allocate_aligned(n, al);
+}
+void* operator new[](std::size_t n, std::align_val_t al, const std::nothrow_t&) noexcept {
+  return allocate_aligned(n, al);
+}
 
 void operator delete(void* p) noexcept { deallocate(p); }
 void operator delete[](void* p) noexcept { deallocate(p); }
@@ -222,14 +226,14 @@ TEST(CoreAllocation, WithAnObserverAndCallbacksOnEveryMachineTheHotPathsStillAll
   long callbacks = 0;
   rig.co.subscribe([&records](const Record&) { ++records; });
   for (MachineId m = 0; m < rig.co.machine_count(); ++m) {
-    rig.co.on_machine(m, StateCallbacks{[&callbacks](State) { ++callbacks; },
-                                        [&callbacks](const TransitionInfo&) { ++callbacks; },
-                                        [&callbacks](State) { ++callbacks; }});
+    rig.co.on_machine(
+        m, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
+                          [&callbacks](State) { ++callbacks; }});
   }
   for (ComponentId c = 0; c < rig.co.component_count(); ++c) {
-    rig.co.on_component(c, StateCallbacks{[&callbacks](State) { ++callbacks; },
-                                          [&callbacks](const TransitionInfo&) { ++callbacks; },
-                                          [&callbacks](State) { ++callbacks; }});
+    rig.co.on_component(
+        c, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
+                          [&callbacks](State) { ++callbacks; }});
   }
   auto rounds = [&] {
     bool ok = true;
@@ -262,11 +266,11 @@ TEST(CoreAllocation, RefreshesIgnoredCompletionsMaskedOnsetsAndWarningPropagatio
   }
   auto mixed = [&] {
     bool ok = true;
-    rig.co.generate(rig.onset, rig.head_app);            // N2E, propagates to the tail
-    rig.co.generate(rig.warning, rig.head_app);          // masked below Error; its mirrors too
-    rig.co.generate(rig.warning, rig.head_app);          // refresh
-    rig.co.generate(rig.completion, rig.single_app);     // ignored: not active
-    rig.co.generate(rig.completion, rig.head_app);       // E2W everywhere: the warning is still present
+    rig.co.generate(rig.onset, rig.head_app);         // N2E, propagates to the tail
+    rig.co.generate(rig.warning, rig.head_app);       // masked below Error; its mirrors too
+    rig.co.generate(rig.warning, rig.head_app);       // refresh
+    rig.co.generate(rig.completion, rig.single_app);  // ignored: not active
+    rig.co.generate(rig.completion, rig.head_app);    // E2W everywhere: the warning is still present
     ok = ok && rig.co.extended_state(rig.chain.back()) == State::Warning;
     rig.co.generate(rig.warning_completion, rig.head_app);
     ok = ok && rig.co.coordinator_state() == State::Normal;

@@ -251,10 +251,11 @@ TEST(ExtendedState, SystemAndCoordinatorStatesAreTheProductOverComponents) {
 struct Log {
   std::vector<std::string> lines;
   StateCallbacks callbacks(const std::string& who) {
-    return StateCallbacks{
-        [this, who](State s) { lines.push_back(who + " exit " + std::string(to_string(s))); },
-        [this, who](const TransitionInfo& i) { lines.push_back(who + " transition " + std::string(to_string(i.transition))); },
-        [this, who](State s) { lines.push_back(who + " entry " + std::string(to_string(s))); }};
+    return StateCallbacks{[this, who](State s) { lines.push_back(who + " exit " + std::string(to_string(s))); },
+                          [this, who](const TransitionInfo& i) {
+                            lines.push_back(who + " transition " + std::string(to_string(i.transition)));
+                          },
+                          [this, who](State s) { lines.push_back(who + " entry " + std::string(to_string(s))); }};
   }
 };
 
@@ -266,11 +267,10 @@ TEST(Callbacks, MachineCallbacksFireExitThenTransitionThenEntry) {
   c.gen("EF", "C.s_A");
   c.gen("/EF", "C.s_A");
   c.gen("/WF", "C.s_A");
-  EXPECT_EQ(log.lines, (std::vector<std::string>{
-                           "s_A exit Normal", "s_A transition N2W", "s_A entry Warning",  //
-                           "s_A exit Warning", "s_A transition W2E", "s_A entry Error",   //
-                           "s_A exit Error", "s_A transition E2W", "s_A entry Warning",   //
-                           "s_A exit Warning", "s_A transition W2N", "s_A entry Normal"}));
+  EXPECT_EQ(log.lines, (std::vector<std::string>{"s_A exit Normal", "s_A transition N2W", "s_A entry Warning",  //
+                                                 "s_A exit Warning", "s_A transition W2E", "s_A entry Error",   //
+                                                 "s_A exit Error", "s_A transition E2W", "s_A entry Warning",   //
+                                                 "s_A exit Warning", "s_A transition W2N", "s_A entry Normal"}));
 }
 
 TEST(Callbacks, ExtendedStateCallbacksFireExitThenTransitionThenEntryAfterTheMachines) {
@@ -281,11 +281,10 @@ TEST(Callbacks, ExtendedStateCallbacksFireExitThenTransitionThenEntryAfterTheMac
   c.gen("EF", "C.s_F");
   c.gen("WF", "C.s_A");  // no transition of C: Error already
   c.gen("/EF", "C.s_F");
-  EXPECT_EQ(log.lines, (std::vector<std::string>{
-                           "s_F exit Normal", "s_F transition N2E", "s_F entry Error",  //
-                           "C exit Normal", "C transition N2E", "C entry Error",        //
-                           "s_F exit Error", "s_F transition E2N", "s_F entry Normal",  //
-                           "C exit Error", "C transition E2W", "C entry Warning"}));
+  EXPECT_EQ(log.lines, (std::vector<std::string>{"s_F exit Normal", "s_F transition N2E", "s_F entry Error",  //
+                                                 "C exit Normal", "C transition N2E", "C entry Error",        //
+                                                 "s_F exit Error", "s_F transition E2N", "s_F entry Normal",  //
+                                                 "C exit Error", "C transition E2W", "C entry Warning"}));
 }
 
 TEST(Callbacks, NoCallbackFiresWhenTheStateDoesNotChange) {
@@ -393,11 +392,11 @@ TEST(Callbacks, EventsGeneratedFromACallbackAreProcessedBeforeTheOuterGenerateRe
   Comp c;
   // C.s_A entering Error makes D degrade; D's extended state entering Warning raises D.s_F.
   c.co.on_machine(c.machine("C.s_A"), StateCallbacks{{}, {}, [&](State s) {
-                                                         if (s == E) c.co.generate(c.id("WF"), c.machine("D.s_A"));
-                                                       }});
+                                                       if (s == E) c.co.generate(c.id("WF"), c.machine("D.s_A"));
+                                                     }});
   c.co.on_component(c.comp("D"), StateCallbacks{{}, {}, [&](State s) {
-                                                   if (s == W) test::must(c.co.generate("EF", "D.s_F"), "generate");
-                                                 }});
+                                                  if (s == W) test::must(c.co.generate("EF", "D.s_F"), "generate");
+                                                }});
   c.gen("EF", "C.s_A");
   EXPECT_EQ(c.at("D.s_A"), W);
   EXPECT_EQ(c.at("D.s_F"), E);
@@ -407,8 +406,9 @@ TEST(Callbacks, EventsGeneratedFromACallbackAreProcessedBeforeTheOuterGenerateRe
 TEST(Callbacks, AResetRequestedFromACallbackIsAppliedBeforeTheOuterCallReturns) {
   Comp c;
   c.co.on_machine(c.machine("C.s_A"), StateCallbacks{{}, {}, [&](State s) {
-                                                         if (s == E) test::must(c.co.reset("D", "C", "interlock"), "reset");
-                                                       }});
+                                                       if (s == E)
+                                                         test::must(c.co.reset("D", "C", "interlock"), "reset");
+                                                     }});
   c.pair("LATCHED", 40, E, true);
   c.gen("LATCHED", "D.s_A");
   c.gen("EF", "C.s_A");
@@ -422,8 +422,8 @@ TEST(Callbacks, ACallbackLoopIsBoundedAndTheDroppedRequestsAreCounted) {
   // A callback that undoes every transition it sees would keep the monitored thread busy forever.
   Comp c;
   c.co.on_machine(c.machine("C.s_A"), StateCallbacks{{}, {}, [&](State s) {
-                                                         c.co.generate(c.id(s == E ? "/EF" : "EF"), c.machine("C.s_A"));
-                                                       }});
+                                                       c.co.generate(c.id(s == E ? "/EF" : "EF"), c.machine("C.s_A"));
+                                                     }});
   EXPECT_EQ(c.co.dropped_requests(), 0u);
   c.gen("EF", "C.s_A");  // returns
   EXPECT_GT(c.co.dropped_requests(), 0u);
@@ -436,10 +436,10 @@ TEST(Callbacks, ACallbackSeesTheNewStateWhenItsEntryFires) {
   Comp c;
   State seen_machine = N;
   State seen_component = N;
-  c.co.on_machine(c.machine("C.s_A"), StateCallbacks{{}, {}, [&](State) {
-                                                         seen_machine = c.co.state(c.machine("C.s_A"));
-                                                       }});
-  c.co.on_component(c.comp("C"), StateCallbacks{{}, {}, [&](State) { seen_component = c.co.extended_state(c.comp("C")); }});
+  c.co.on_machine(c.machine("C.s_A"),
+                  StateCallbacks{{}, {}, [&](State) { seen_machine = c.co.state(c.machine("C.s_A")); }});
+  c.co.on_component(c.comp("C"),
+                    StateCallbacks{{}, {}, [&](State) { seen_component = c.co.extended_state(c.comp("C")); }});
   c.gen("WF", "C.s_A");
   EXPECT_EQ(seen_machine, W);
   EXPECT_EQ(seen_component, W);

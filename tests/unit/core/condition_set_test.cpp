@@ -37,20 +37,26 @@ constexpr Time kNow{std::chrono::seconds(7)};
 
 /// The event of a row (DESIGN §2.3 for the levels: onset_level()).
 enum class Op {
-  WarningOnset,              ///< X {N2W}, severity 60
-  ErrorOnset,                ///< X {N2E, W2E}, severity 60
-  EscalatingOnset,           ///< X {N2W, W2E}, severity 60: Warning from Normal, Error from Warning
-  LowerSeverityWarningOnset, ///< X {N2W}, severity 20
-  LowerSeverityErrorOnset,   ///< X {N2E, W2E}, severity 20
-  EqualSeverityErrorOnset,   ///< X {N2E, W2E}, severity 40 (= the background's)
-  WarningCompletion,         ///< completion of X {N2W}, severity 60
-  ErrorCompletion,           ///< completion of X {N2E, W2E}, severity 60
-  UndefinedCompletion,       ///< a completion whose onset is not defined
-  Reset,                     ///< reset of the machine
+  WarningOnset,               ///< X {N2W}, severity 60
+  ErrorOnset,                 ///< X {N2E, W2E}, severity 60
+  EscalatingOnset,            ///< X {N2W, W2E}, severity 60: Warning from Normal, Error from Warning
+  LowerSeverityWarningOnset,  ///< X {N2W}, severity 20
+  LowerSeverityErrorOnset,    ///< X {N2E, W2E}, severity 20
+  EqualSeverityErrorOnset,    ///< X {N2E, W2E}, severity 40 (= the background's)
+  WarningCompletion,          ///< completion of X {N2W}, severity 60
+  ErrorCompletion,            ///< completion of X {N2E, W2E}, severity 60
+  UndefinedCompletion,        ///< a completion whose onset is not defined
+  Reset,                      ///< reset of the machine
 };
-constexpr Op kAllOps[] = {Op::WarningOnset,           Op::ErrorOnset,          Op::EscalatingOnset,
-                          Op::LowerSeverityWarningOnset, Op::LowerSeverityErrorOnset, Op::EqualSeverityErrorOnset,
-                          Op::WarningCompletion,      Op::ErrorCompletion,     Op::UndefinedCompletion,
+constexpr Op kAllOps[] = {Op::WarningOnset,
+                          Op::ErrorOnset,
+                          Op::EscalatingOnset,
+                          Op::LowerSeverityWarningOnset,
+                          Op::LowerSeverityErrorOnset,
+                          Op::EqualSeverityErrorOnset,
+                          Op::WarningCompletion,
+                          Op::ErrorCompletion,
+                          Op::UndefinedCompletion,
                           Op::Reset};
 
 /// The subject condition X before the event.
@@ -58,11 +64,11 @@ enum class Subject { Absent, Active, Latched, Mirrored };
 constexpr Subject kAllSubjects[] = {Subject::Absent, Subject::Active, Subject::Latched, Subject::Mirrored};
 
 struct Row {
-  const char* rule;      ///< the test's name: state, event, subject, what happens
+  const char* rule;  ///< the test's name: state, event, subject, what happens
   Subject subject;
   Op op;
-  const char* before;    ///< the set before (tokens)
-  Outcome outcome;       ///< None: a refresh (onset) or a reset that removed nothing
+  const char* before;  ///< the set before (tokens)
+  Outcome outcome;     ///< None: a refresh (onset) or a reset that removed nothing
   State after;
   const char* set_after;
   const char* outstanding;  ///< B, X, M or "-" (none)
@@ -321,8 +327,9 @@ TEST_P(ConditionSetTable, FollowsTheSeverityPolicy) {
   EXPECT_EQ(out == nullptr ? std::string("-") : name_of(*out), row.outstanding);
   EXPECT_EQ(set.outstanding_event(), out == nullptr ? kNoEvent : out->event);
   for (State level : {W, E}) {
-    EXPECT_EQ(set.count_at(level), static_cast<std::uint32_t>(std::count_if(
-                                       set.begin(), set.end(), [level](const Condition& c) { return c.level == level; })));
+    EXPECT_EQ(set.count_at(level),
+              static_cast<std::uint32_t>(
+                  std::count_if(set.begin(), set.end(), [level](const Condition& c) { return c.level == level; })));
   }
 
   if (row.op == Op::Reset) {
@@ -373,7 +380,9 @@ TEST_P(ConditionSetTable, FollowsTheSeverityPolicy) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rule, ConditionSetTable, ::testing::ValuesIn(kRows),
-                         [](const ::testing::TestParamInfo<Row>& row_info) { return std::string(row_info.param.rule); });
+                         [](const ::testing::TestParamInfo<Row>& row_info) {
+                           return std::string(row_info.param.rule);
+                         });
 
 // The table is exhaustive: every machine state × every event kind × every subject condition that
 // can exist has at least one row (X active implies a state at or above X's level; a mirror implies
@@ -390,8 +399,8 @@ TEST(ConditionSetTableCoverage, EveryStateEventAndSubjectCombinationHasARow) {
         const bool error_level_subject = op == Op::ErrorOnset || op == Op::LowerSeverityErrorOnset ||
                                          op == Op::EqualSeverityErrorOnset || op == Op::ErrorCompletion;
         // An active (or latched) X needs a state at or above its level; a mirror, any state but Normal.
-        const bool possible = subject == Subject::Absent || s == E ||
-                              (s == W && (subject == Subject::Mirrored || !error_level_subject));
+        const bool possible =
+            subject == Subject::Absent || s == E || (s == W && (subject == Subject::Mirrored || !error_level_subject));
         EXPECT_EQ(seen.count({s, op, subject}) > 0, possible)
             << "state " << to_string(s) << ", op " << static_cast<int>(op) << ", subject " << static_cast<int>(subject);
       }
@@ -523,7 +532,8 @@ TEST(ConditionSet, SeededRandomChangesKeepStateAndOutstandingConsistentWhateverT
     const Condition* best = nullptr;
     for (const Condition& c : set) {
       if (c.level != set.state()) continue;
-      if (best == nullptr || c.severity > best->severity || (c.severity == best->severity && c.seq > best->seq)) best = &c;
+      if (best == nullptr || c.severity > best->severity || (c.severity == best->severity && c.seq > best->seq))
+        best = &c;
     }
     ASSERT_EQ(set.outstanding(), best);
     std::set<EventId> roots;

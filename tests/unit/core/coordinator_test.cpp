@@ -55,22 +55,24 @@ void expect_rejected(Model& m, const std::function<Expected<T>()>& call, ErrorCo
 
 TEST(BadInput, DuplicateComponentIsRejectedAndChangesNothing) {
   Model m;
-  expect_rejected<ComponentId>(m, [&] { return m.co.add_component("JR3"); }, ErrorCode::Duplicate, "JR3");
+  expect_rejected<ComponentId>(
+      m, [&] { return m.co.add_component("JR3"); }, ErrorCode::Duplicate, "JR3");
   EXPECT_EQ(m.co.provided_machines(m.comp("JR3")).size(), 1u);
 }
 
 TEST(BadInput, InvalidComponentNamesAreRejected) {
   Model m;
   for (const char* bad : {"", "A.B", "has space", "tab\there"}) {
-    expect_rejected<ComponentId>(m, [&] { return m.co.add_component(bad); }, ErrorCode::InvalidArgument,
-                                 std::string("'") + bad + "'");
+    expect_rejected<ComponentId>(
+        m, [&] { return m.co.add_component(bad); }, ErrorCode::InvalidArgument, std::string("'") + bad + "'");
   }
 }
 
 TEST(BadInput, AComponentCannotTakeANameThatAddressesTheWholeSystem) {
   // "SYSTEM" resolves to the system: a component so named could never be addressed.
   Model m;
-  expect_rejected<ComponentId>(m, [&] { return m.co.add_component("SYSTEM"); }, ErrorCode::InvalidArgument, "SYSTEM");
+  expect_rejected<ComponentId>(
+      m, [&] { return m.co.add_component("SYSTEM"); }, ErrorCode::InvalidArgument, "SYSTEM");
 }
 
 TEST(Addresses, TheCoordinatorsNameAddressesTheSystemUnlessAComponentHasThatName) {
@@ -89,9 +91,10 @@ TEST(BadInput, DuplicateInterfaceIsRejectedAndChangesNothing) {
   Model m;
   const ComponentId jr3 = m.comp("JR3");
   const ComponentId control = m.comp("CONTROL");
-  expect_rejected<MachineId>(m, [&] { return m.co.add_provided(jr3, "ForceData"); }, ErrorCode::Duplicate, "ForceData");
-  expect_rejected<MachineId>(m, [&] { return m.co.add_required(control, "ForceData"); }, ErrorCode::Duplicate,
-                             "ForceData");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_provided(jr3, "ForceData"); }, ErrorCode::Duplicate, "ForceData");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_required(control, "ForceData"); }, ErrorCode::Duplicate, "ForceData");
   // The message also names the component.
   const auto r = m.co.add_provided(jr3, "ForceData");
   ASSERT_FALSE(r);
@@ -109,24 +112,31 @@ TEST(BadInput, AProvidedAndARequiredInterfaceMayShareAName) {
 
 TEST(BadInput, InterfacesOfAnUnknownComponentOrWithInvalidNamesAreRejected) {
   Model m;
-  expect_rejected<MachineId>(m, [&] { return m.co.add_provided(77, "X"); }, ErrorCode::NotFound, "77");
-  expect_rejected<MachineId>(m, [&] { return m.co.add_required(77, "X"); }, ErrorCode::NotFound, "77");
-  expect_rejected<MachineId>(m, [&] { return m.co.add_provided(m.comp("JR3"), "a.b"); }, ErrorCode::InvalidArgument,
-                             "a.b");
-  expect_rejected<MachineId>(m, [&] { return m.co.add_required(m.comp("JR3"), ""); }, ErrorCode::InvalidArgument, "JR3");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_provided(77, "X"); }, ErrorCode::NotFound, "77");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_required(77, "X"); }, ErrorCode::NotFound, "77");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_provided(m.comp("JR3"), "a.b"); }, ErrorCode::InvalidArgument, "a.b");
+  expect_rejected<MachineId>(
+      m, [&] { return m.co.add_required(m.comp("JR3"), ""); }, ErrorCode::InvalidArgument, "JR3");
 }
 
 TEST(BadInput, DuplicateEventNameIsRejectedAndChangesNothing) {
   Model m;
-  expect_rejected<EventId>(m, [&] { return m.co.add_event(onset("EVT_FORCE_ERROR", 60, kToError)); },
-                           ErrorCode::Duplicate, "EVT_FORCE_ERROR");
+  expect_rejected<EventId>(
+      m, [&] { return m.co.add_event(onset("EVT_FORCE_ERROR", 60, kToError)); }, ErrorCode::Duplicate,
+      "EVT_FORCE_ERROR");
   EXPECT_EQ(m.co.event(m.id("EVT_FORCE_ERROR")).severity, 50);
 }
 
 TEST(BadInput, EventMixingWorseningAndImprovingTransitionsIsRejectedAndChangesNothing) {
   Model m;
   expect_rejected<EventId>(
-      m, [&] { return m.co.add_event(onset("EVT_BAD", 10, {Transition::N2E, Transition::E2N})); },
+      m,
+      [&] {
+        return m.co.add_event(onset("EVT_BAD", 10, {Transition::N2E, Transition::E2N}));
+      },
       ErrorCode::InvalidArgument, "EVT_BAD");
   EXPECT_FALSE(m.co.find_event("EVT_BAD"));
 }
@@ -134,8 +144,8 @@ TEST(BadInput, EventMixingWorseningAndImprovingTransitionsIsRejectedAndChangesNo
 TEST(BadInput, SeverityOutside1To255IsRejectedAndChangesNothing) {
   Model m;
   for (int severity : {0, 256, -1}) {
-    expect_rejected<EventId>(m, [&] { return m.co.add_event(onset("EVT_SEV", severity, kToError)); },
-                             ErrorCode::InvalidArgument, "EVT_SEV");
+    expect_rejected<EventId>(
+        m, [&] { return m.co.add_event(onset("EVT_SEV", severity, kToError)); }, ErrorCode::InvalidArgument, "EVT_SEV");
   }
   EXPECT_FALSE(m.co.find_event("EVT_SEV"));
 }
@@ -145,49 +155,52 @@ TEST(BadInput, ACompletionThatFailsDoesNotLinkItselfToItsOnset) {
   m.event(onset("EVT_ON", 10, kToError));
   EventDef bad = completion("/EVT_ON", 10, kFromError);
   bad.latched = true;
-  expect_rejected<EventId>(m, [&] { return m.co.add_event(bad); }, ErrorCode::InvalidArgument, "/EVT_ON");
+  expect_rejected<EventId>(
+      m, [&] { return m.co.add_event(bad); }, ErrorCode::InvalidArgument, "/EVT_ON");
   EXPECT_EQ(m.co.event(m.id("EVT_ON")).counterpart, kNoEvent);
 }
 
 TEST(BadInput, ConnectionToAnUnknownComponentIsRejectedAndChangesNothing) {
   Model m;
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("ARM.Cmd", "GHOST.Out"); }, ErrorCode::NotFound, "GHOST");
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("GHOST.In", "JR3.ForceData"); }, ErrorCode::NotFound,
-                                "GHOST");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("ARM.Cmd", "GHOST.Out"); }, ErrorCode::NotFound, "GHOST");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("GHOST.In", "JR3.ForceData"); }, ErrorCode::NotFound, "GHOST");
 }
 
 TEST(BadInput, ConnectionToAnUnknownInterfaceIsRejectedAndChangesNothing) {
   Model m;
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("ARM.Nope", "CONTROL.Motion"); }, ErrorCode::NotFound,
-                                "Nope");
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("ARM.Cmd", "CONTROL.Nope"); }, ErrorCode::NotFound,
-                                "Nope");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("ARM.Nope", "CONTROL.Motion"); }, ErrorCode::NotFound, "Nope");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("ARM.Cmd", "CONTROL.Nope"); }, ErrorCode::NotFound, "Nope");
   // Direction matters: a provided interface is not a required one.
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("JR3.ForceData", "CONTROL.Motion"); },
-                                ErrorCode::NotFound, "ForceData");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("JR3.ForceData", "CONTROL.Motion"); }, ErrorCode::NotFound, "ForceData");
 }
 
 TEST(BadInput, MalformedConnectionTextIsRejectedAndChangesNothing) {
   Model m;
   for (const char* bad : {"ARM", "ARM.", ".Cmd", "ARM.Cmd.x", "", "."}) {
-    expect_rejected<ConnectionId>(m, [&] { return m.co.connect(bad, "CONTROL.Motion"); }, ErrorCode::InvalidArgument,
-                                  std::string("'") + bad + "'");
-    expect_rejected<ConnectionId>(m, [&] { return m.co.connect("ARM.Cmd", bad); }, ErrorCode::InvalidArgument,
-                                  std::string("'") + bad + "'");
+    expect_rejected<ConnectionId>(
+        m, [&] { return m.co.connect(bad, "CONTROL.Motion"); }, ErrorCode::InvalidArgument,
+        std::string("'") + bad + "'");
+    expect_rejected<ConnectionId>(
+        m, [&] { return m.co.connect("ARM.Cmd", bad); }, ErrorCode::InvalidArgument, std::string("'") + bad + "'");
   }
 }
 
 TEST(BadInput, ConnectingARequiredInterfaceTwiceIsRejectedAndChangesNothing) {
   Model m;
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("CONTROL.ForceData", "JR3.ForceData"); },
-                                ErrorCode::Duplicate, "CONTROL.ForceData");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("CONTROL.ForceData", "JR3.ForceData"); }, ErrorCode::Duplicate, "CONTROL.ForceData");
 }
 
 TEST(BadInput, ConnectingAComponentToItselfIsRejectedAndChangesNothing) {
   Model m;
   test::must(m.co.add_provided(m.comp("ARM"), "State"), "add_provided");
-  expect_rejected<ConnectionId>(m, [&] { return m.co.connect("ARM.Cmd", "ARM.State"); }, ErrorCode::InvalidArgument,
-                                "ARM");
+  expect_rejected<ConnectionId>(
+      m, [&] { return m.co.connect("ARM.Cmd", "ARM.State"); }, ErrorCode::InvalidArgument, "ARM");
 }
 
 TEST(BadInput, ARejectedConnectionDoesNotPropagateAnything) {
@@ -280,8 +293,8 @@ TEST(Address, AServiceAddressResolvesToTheProvidedInterfacesServiceState) {
 TEST(Address, StateOfFollowsEveryKindOfAddress) {
   Model m;
   m.gen("EVT_FORCE_ERROR", "JR3.s_A");
-  for (const char* a : {"SYSTEM", "JR3", "JR3.s_A", "JR3.s_S.ForceData", "CONTROL", "CONTROL.s_R.ForceData",
-                        "CONTROL.s_S.Motion"}) {
+  for (const char* a :
+       {"SYSTEM", "JR3", "JR3.s_A", "JR3.s_S.ForceData", "CONTROL", "CONTROL.s_R.ForceData", "CONTROL.s_S.Motion"}) {
     EXPECT_EQ(m.at(a), State::Error) << a;
   }
   for (const char* a : {"ARM", "JR3.s_F", "JR3.s_P.ForceData", "CONTROL.s_A", "CONTROL.s_P.Motion"}) {

@@ -7,9 +7,9 @@
 #include <initializer_list>
 #include <ostream>
 #include <stdexcept>
-#include <type_traits>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 

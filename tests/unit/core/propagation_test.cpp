@@ -258,8 +258,8 @@ TEST(Propagation, AChainCarriesTheRootToTheEndAndClearingTheRootClearsAll) {
     EXPECT_EQ(cs[0].event, framework_event::kServiceFailure);
     EXPECT_EQ(cs[0].root.origin, g.machine("A.s_A")) << m;
   }
-  EXPECT_EQ(path_of(g, "D.s_R.in"), (std::vector<std::string>{"A.s_A", "A.s_S.out", "B.s_R.in", "B.s_S.out",
-                                                              "C.s_R.in", "C.s_S.out", "D.s_R.in"}));
+  EXPECT_EQ(path_of(g, "D.s_R.in"), (std::vector<std::string>{"A.s_A", "A.s_S.out", "B.s_R.in", "B.s_S.out", "C.s_R.in",
+                                                              "C.s_S.out", "D.s_R.in"}));
   g.gen("/EVT_ROOT", "A.s_A");
   for (const char* c : {"A", "B", "C", "D"}) EXPECT_EQ(g.at(c), N) << c;
 }
@@ -307,8 +307,8 @@ TEST(Propagation, ACycleOfConnectionsClearsWholeWhenTheRootClears) {
     EXPECT_EQ(g.at(m), E) << m;
     EXPECT_EQ(g.mirrors(m), 1u) << m;
   }
-  EXPECT_EQ(path_of(g, "A.s_R.in"), (std::vector<std::string>{"A.s_A", "A.s_S.out", "B.s_R.in", "B.s_S.out",
-                                                              "C.s_R.in", "C.s_S.out", "A.s_R.in"}));
+  EXPECT_EQ(path_of(g, "A.s_R.in"), (std::vector<std::string>{"A.s_A", "A.s_S.out", "B.s_R.in", "B.s_S.out", "C.s_R.in",
+                                                              "C.s_S.out", "A.s_R.in"}));
   g.gen("/EVT_ROOT", "A.s_A");
   for (const char* c : {"A", "B", "C"}) {
     EXPECT_EQ(g.at(c), N) << c << ": the original latched forever in a cycle";

@@ -45,7 +45,9 @@ public:
   int between(int lo, int hi) { return lo + static_cast<int>(below(static_cast<std::size_t>(hi - lo + 1))); }
   bool chance(double p) { return static_cast<double>(next() >> 11) * 0x1.0p-53 < p; }
   template <class T>
-  const T& pick(const std::vector<T>& v) { return v[below(v.size())]; }
+  const T& pick(const std::vector<T>& v) {
+    return v[below(v.size())];
+  }
   template <class T>
   void shuffle(std::vector<T>& v) {
     for (std::size_t i = v.size(); i > 1; --i) std::swap(v[i - 1], v[below(i)]);
@@ -71,9 +73,9 @@ State expected_onset_level(TransitionSet t, State current) {
 }
 
 Transition expected_transition(State from, State to) {
-  static const std::map<std::pair<int, int>, Transition> table = {
-      {{0, 1}, Transition::N2W}, {{0, 2}, Transition::N2E}, {{1, 2}, Transition::W2E},
-      {{1, 0}, Transition::W2N}, {{2, 0}, Transition::E2N}, {{2, 1}, Transition::E2W}};
+  static const std::map<std::pair<int, int>, Transition> table = {{{0, 1}, Transition::N2W}, {{0, 2}, Transition::N2E},
+                                                                  {{1, 2}, Transition::W2E}, {{1, 0}, Transition::W2N},
+                                                                  {{2, 0}, Transition::E2N}, {{2, 1}, Transition::E2W}};
   return table.at({rank(from), rank(to)});
 }
 
@@ -485,9 +487,9 @@ enum class Phase { Exit, Transition, Entry };
 
 struct CallbackCall {
   Phase phase;
-  bool component;        ///< extended-state callback (else machine callback)
-  std::uint32_t id;      ///< machine or component
-  State state = State::Normal;  ///< on_exit: old; on_entry: new
+  bool component;                   ///< extended-state callback (else machine callback)
+  std::uint32_t id;                 ///< machine or component
+  State state = State::Normal;      ///< on_exit: old; on_entry: new
   State read_back = State::Normal;  ///< on_entry: the lock-free state read inside the callback
   TransitionInfo info;
 };
@@ -496,10 +498,10 @@ struct CallbackCall {
 struct Coverage {
   std::map<Outcome, int> outcomes;  ///< of Event records, roots and mirrors
   int machine_transitions = 0;
-  int warning_mirrors = 0;          ///< mirrors at Warning level seen in checks
+  int warning_mirrors = 0;  ///< mirrors at Warning level seen in checks
   int error_mirrors = 0;
-  std::size_t max_conditions = 0;   ///< most conditions active at once, all machines
-  int explained_mirrors = 0;        ///< mirrors whose hop path was checked
+  std::size_t max_conditions = 0;  ///< most conditions active at once, all machines
+  int explained_mirrors = 0;       ///< mirrors whose hop path was checked
   int late_connections = 0;
 };
 
@@ -739,7 +741,9 @@ private:
 
   StateCallbacks callbacks(bool component, std::uint32_t id) {
     StateCallbacks cb;
-    cb.on_exit = [this, component, id](State s) { calls_.push_back(CallbackCall{Phase::Exit, component, id, s, s, {}}); };
+    cb.on_exit = [this, component, id](State s) {
+      calls_.push_back(CallbackCall{Phase::Exit, component, id, s, s, {}});
+    };
     cb.on_transition = [this, component, id](const TransitionInfo& info) {
       calls_.push_back(CallbackCall{Phase::Transition, component, id, State::Normal, State::Normal, info});
     };
@@ -794,12 +798,14 @@ private:
           return at + ": root " + co_.event(c.event).name + " has level " + std::string(to_string(c.level)) +
                  ", oracle says " + std::string(to_string(it->level));
         }
-        if (c.count != it->count) return at + ": root " + co_.event(c.event).name + " count " + std::to_string(c.count) +
-                                         ", oracle says " + std::to_string(it->count);
+        if (c.count != it->count)
+          return at + ": root " + co_.event(c.event).name + " count " + std::to_string(c.count) + ", oracle says " +
+                 std::to_string(it->count);
         if (c.first != it->first || c.last != it->last) return at + ": root " + co_.event(c.event).name + " times";
         if (c.severity != o.info(c.event).severity) return at + ": root severity";
         if (c.via != kNoConnection) return at + ": a root condition names a connection";
-        if (c.root.event != c.event || c.root.origin != m || c.root.time != it->first) return at + ": root cause of a root";
+        if (c.root.event != c.event || c.root.origin != m || c.root.time != it->first)
+          return at + ": root cause of a root";
         if (!same_cause(c.root.sample, it->cause)) return at + ": sample cause of root " + co_.event(c.event).name;
       }
       if (roots != o.roots(m).size()) {
@@ -826,7 +832,8 @@ private:
         if (!same_cause(c.root.sample, it->cause)) return at + ": " + what + " lost the sample cause";
         if (c.via >= co_.connections().size()) return at + ": " + what + " names no connection";
         const Connection& via = co_.connections()[c.via];
-        if (co_.required_machines(via.client)[via.required] != m) return at + ": " + what + " arrived via another machine's connection";
+        if (co_.required_machines(via.client)[via.required] != m)
+          return at + ": " + what + " arrived via another machine's connection";
       }
       total_conditions += conds.size();
       for (const Condition& c : conds) {
@@ -835,7 +842,8 @@ private:
       if (mirrors != o.mirrors(m).size()) {
         std::string missing;
         for (const MirrorModel& x : o.mirrors(m)) {
-          missing += " " + co_.address_of(x.origin) + ":" + co_.event(x.root_event).name + "/" + std::string(to_string(x.level));
+          missing += " " + co_.address_of(x.origin) + ":" + co_.event(x.root_event).name + "/" +
+                     std::string(to_string(x.level));
         }
         return at + ": " + std::to_string(mirrors) + " mirrors, oracle expects " + std::to_string(o.mirrors(m).size()) +
                ":" + missing;
@@ -852,12 +860,15 @@ private:
       const Condition* best = nullptr;
       for (const Condition& c : conds) {
         if (c.level != max_level) continue;
-        if (best == nullptr || c.severity > best->severity || (c.severity == best->severity && c.seq > best->seq)) best = &c;
+        if (best == nullptr || c.severity > best->severity || (c.severity == best->severity && c.seq > best->seq))
+          best = &c;
       }
       const EventId want_outstanding = best == nullptr ? kNoEvent : best->event;
-      if (snap.outstanding != want_outstanding) return at + ": snapshot outstanding event is not the highest severity at the current level";
+      if (snap.outstanding != want_outstanding)
+        return at + ": snapshot outstanding event is not the highest severity at the current level";
       const auto out = co_.outstanding(m);
-      if (out.has_value() != (best != nullptr) || (best != nullptr && (out->seq != best->seq || out->event != best->event))) {
+      if (out.has_value() != (best != nullptr) ||
+          (best != nullptr && (out->seq != best->seq || out->event != best->event))) {
         return at + ": outstanding() is not the highest severity, most recent condition at the current level";
       }
       states[m] = max_level;
@@ -875,18 +886,19 @@ private:
       for (const auto& conds : held) {
         for (const Condition& x : conds) {
           if (x.level != ext) continue;
-          if (best == nullptr || x.severity > best->severity || (x.severity == best->severity && x.seq > best->seq)) best = &x;
+          if (best == nullptr || x.severity > best->severity || (x.severity == best->severity && x.seq > best->seq))
+            best = &x;
         }
       }
       const StateSnapshot snap = co_.extended(c);
-      if (snap.state != ext || co_.extended_state(c) != ext) return name + ": extended state is not the product of its machines";
+      if (snap.state != ext || co_.extended_state(c) != ext)
+        return name + ": extended state is not the product of its machines";
       if (snap.outstanding != (best == nullptr ? kNoEvent : best->event)) return name + ": extended outstanding event";
       int calls = 0;
       State dispatched = State::Normal;
       EventId passed = kNoEvent;
       co_.dispatch(
-          c, [&] { ++calls; },
-          [&](const Event& e) { ++calls, dispatched = State::Warning, passed = e.id; },
+          c, [&] { ++calls; }, [&](const Event& e) { ++calls, dispatched = State::Warning, passed = e.id; },
           [&](const Event& e) { ++calls, dispatched = State::Error, passed = e.id; });
       if (calls != 1 || dispatched != ext || passed != snap.outstanding) return name + ": dispatch";
       const auto addr = co_.resolve(name);
@@ -952,10 +964,12 @@ private:
         return who + ": a transition's callbacks are interleaved with another's";
       }
       State& tracked = x.component ? component_state_[x.id] : machine_state_[x.id];
-      if (x.state != tracked) return who + ": on_exit(" + std::string(to_string(x.state)) + ") but the state was " +
-                                     std::string(to_string(tracked));
+      if (x.state != tracked)
+        return who + ": on_exit(" + std::string(to_string(x.state)) + ") but the state was " +
+               std::string(to_string(tracked));
       if (x.state == n.state) return who + ": a transition to the same state";
-      if (t.info.transition != expected_transition(x.state, n.state)) return who + ": on_transition names the wrong transition";
+      if (t.info.transition != expected_transition(x.state, n.state))
+        return who + ": on_transition names the wrong transition";
       if (x.component ? (t.info.component != x.id || t.info.machine != kNoMachine)
                       : (t.info.machine != x.id || t.info.component != co_.machine_component(x.id))) {
         return who + ": on_transition names the wrong machine or component";
@@ -969,7 +983,8 @@ private:
       if (machine_state_[m] != co_.state(m)) return co_.address_of(m) + ": a state change fired no callbacks";
     }
     for (ComponentId c = 0; c < co_.component_count(); ++c) {
-      if (component_state_[c] != co_.extended_state(c)) return std::string(co_.component_name(c)) + ": a change fired no callbacks";
+      if (component_state_[c] != co_.extended_state(c))
+        return std::string(co_.component_name(c)) + ": a change fired no callbacks";
     }
     // The observer stream has one Transition record per machine transition, in seq order.
     std::map<std::pair<bool, std::uint32_t>, int> recorded;
@@ -1004,7 +1019,8 @@ private:
         case Outcome::Ignored: consistent = r.to == r.from; break;
         case Outcome::None: consistent = false; break;
       }
-      if (!consistent) return at + ": Event record " + std::string(to_string(r.outcome)) + " inconsistent with its states";
+      if (!consistent)
+        return at + ": Event record " + std::string(to_string(r.outcome)) + " inconsistent with its states";
       if (r.mirror) continue;
       if (r.event == kNoEvent) {  // a root cleared by reset
         if (r.outcome != Outcome::Cleared || r.text != reset_text_) return at + ": reset clear record";
@@ -1062,13 +1078,18 @@ private:
         const auto svc = co_.resolve(x.path[i]);
         const auto to = co_.find_machine(x.path[i + 1]);
         if (!from || !svc || svc->kind != Address::Kind::Service || !to) return what + ": malformed hop path";
-        if (!depends_on(co_, svc->component, svc->service, *from)) return what + ": hop path leaves through a service that does not depend on " + x.path[i - 1];
+        if (!depends_on(co_, svc->component, svc->service, *from))
+          return what + ": hop path leaves through a service that does not depend on " + x.path[i - 1];
         bool ok = false;
         for (const Hop& h : hops[*from]) {
           const Connection& k = co_.connections()[h.via];
-          if (h.to == *to && k.provider == svc->component && k.provided == svc->service && rank(level) >= rank(h.min_level)) ok = true;
+          if (h.to == *to && k.provider == svc->component && k.provided == svc->service &&
+              rank(level) >= rank(h.min_level))
+            ok = true;
         }
-        if (!ok) return what + ": hop path takes a connection the condition cannot pass: " + x.path[i] + " -> " + x.path[i + 1];
+        if (!ok)
+          return what + ": hop path takes a connection the condition cannot pass: " + x.path[i] + " -> " +
+                 x.path[i + 1];
       }
     }
     return {};

@@ -67,7 +67,8 @@ struct Split {
 std::vector<std::string> lines(const Coordinator& co, std::string_view address) {
   std::vector<std::string> out;
   for (const Explanation& e : must(co.explain(address), "explain")) {
-    out.push_back(e.machine + " " + e.event + " " + std::string(to_string(e.level)) + " <- " + e.root_origin + ":" + e.root_event);
+    out.push_back(e.machine + " " + e.event + " " + std::string(to_string(e.level)) + " <- " + e.root_origin + ":" +
+                  e.root_event);
     for (const std::string& hop : e.path) out.back() += " / " + hop;
   }
   return out;
@@ -269,7 +270,15 @@ TEST(RemoteProvider, ARootThatClearsClearsEverywhereAroundACycleOfProcesses) {
 
 TEST(RemoteProvider, ARootWhosePathContainsTheReceivingMachineIsDropped) {
   Split two;
-  RemoteRoot looped{"EVT_FORCE_ERROR", "X.s_A", Time{1}, E, {}, {}, 0.0, {}, false,
+  RemoteRoot looped{"EVT_FORCE_ERROR",
+                    "X.s_A",
+                    Time{1},
+                    E,
+                    {},
+                    {},
+                    0.0,
+                    {},
+                    false,
                     {"X.s_A", "X.s_S.out", "CONTROL.s_R.ForceData", "CONTROL.s_S.Command", "JR3.s_R.in"}};
   const auto r = must(two.robot.co.apply_remote(two.proxy, {looped}), "apply_remote");
   EXPECT_EQ(r.dropped, 1u);

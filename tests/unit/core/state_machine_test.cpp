@@ -253,7 +253,8 @@ TEST(ConditionSet, CompletionOfLatchedOnsetIsIgnoredUntilReset) {
 TEST(ConditionSet, CompletionOfErrorReestablishesStillPresentWarning) {
   Machine m;
   std::vector<Transition> seen;
-  m.co.on_machine(m.machine("C.s_A"), StateCallbacks{{}, [&](const TransitionInfo& i) { seen.push_back(i.transition); }, {}});
+  m.co.on_machine(m.machine("C.s_A"),
+                  StateCallbacks{{}, [&](const TransitionInfo& i) { seen.push_back(i.transition); }, {}});
   m.gen("W20", "C.s_A");
   m.gen("E50", "C.s_A");
   m.gen("/E50", "C.s_A");
@@ -301,7 +302,7 @@ TEST(ConditionSet, CompletionOfOneOfTwoErrorsKeepsErrorAndPassesOutstandingOn) {
 TEST(ConditionSet, StateEqualsMaxLevelOfActiveConditions) {
   Machine m;
   const MachineId a = m.machine("C.s_A");
-  const char* events[] = {"W10",  "W20",  "W200",  "E50",  "E80",   "E80B",  "LATCH",  "LATCHW",
+  const char* events[] = {"W10",  "W20",  "W200",  "E50",  "E80",  "E80B",  "LATCH",  "LATCHW",
                           "/W10", "/W20", "/W200", "/E50", "/E80", "/E80B", "/LATCH", "/LATCHW"};
   std::uint32_t seed = 12345;  // fixed: the sequence is the same on every run
   for (int step = 0; step < 2000; ++step) {
@@ -363,10 +364,10 @@ struct OnsetRow {
   const char* transitions_text;
   TransitionSet transitions;
   State start;
-  State level;             // level the onset takes (DESIGN §2.3)
-  State result;            // machine state after the onset
-  Outcome outcome_ge;      // outcome when the onset's severity >= the outstanding's
-  Outcome outcome_lt;      // outcome when it is lower
+  State level;         // level the onset takes (DESIGN §2.3)
+  State result;        // machine state after the onset
+  Outcome outcome_ge;  // outcome when the onset's severity >= the outstanding's
+  Outcome outcome_lt;  // outcome when it is lower
 };
 
 // Written out by hand: 7 subsets of worsening transitions × 3 starting states.
@@ -456,8 +457,8 @@ struct CompletionRow {
   State before;
   State after;
   Outcome outcome;
-  const char* reason;      // text of an ignored record
-  std::string outstanding; // after
+  const char* reason;       // text of an ignored record
+  std::string outstanding;  // after
 };
 
 TEST(ConditionSetTable, EveryCompletionCaseGivesTheTabledStateAndOutcome) {
@@ -473,7 +474,14 @@ TEST(ConditionSetTable, EveryCompletionCaseGivesTheTabledStateAndOutcome) {
       {"inactive onset in Error", {"E80"}, "/E50", E, E, Outcome::Ignored, "not active", "E80"},
       {"latched error", {"LATCH"}, "/LATCH", E, E, Outcome::Ignored, "latched: needs reset", "LATCH"},
       {"latched warning", {"LATCHW"}, "/LATCHW", W, W, Outcome::Ignored, "latched: needs reset", "LATCHW"},
-      {"latched error over a warning", {"W20", "LATCH"}, "/LATCH", E, E, Outcome::Ignored, "latched: needs reset", "LATCH"},
+      {"latched error over a warning",
+       {"W20", "LATCH"},
+       "/LATCH",
+       E,
+       E,
+       Outcome::Ignored,
+       "latched: needs reset",
+       "LATCH"},
       {"unlatched error next to a latched one", {"LATCH", "E50"}, "/E50", E, E, Outcome::Cleared, "", "LATCH"},
       {"warning next to a latched warning", {"LATCHW", "W20"}, "/W20", W, W, Outcome::Cleared, "", "LATCHW"},
   };
@@ -492,8 +500,7 @@ TEST(ConditionSetTable, EveryCompletionCaseGivesTheTabledStateAndOutcome) {
     EXPECT_EQ(r.to, row.after) << row.name;
     EXPECT_EQ(std::string(r.text), row.reason) << row.name;
     EXPECT_EQ(m.outstanding("C.s_A"), row.outstanding) << row.name;
-    EXPECT_EQ(m.co.conditions(m.machine("C.s_A")).size(),
-              conditions_before - (row.outcome == Outcome::Cleared ? 1 : 0))
+    EXPECT_EQ(m.co.conditions(m.machine("C.s_A")).size(), conditions_before - (row.outcome == Outcome::Cleared ? 1 : 0))
         << row.name;
     EXPECT_EQ(m.transitions(), transitions_before + (row.before != row.after ? 1 : 0)) << row.name;
   }
@@ -597,10 +604,12 @@ TEST(Reset, AResetGoesStraightToNormalWithoutPassingThroughAWarning) {
     ASSERT_EQ(m.at("C.s_A"), E);
     std::vector<Transition> machine_transitions;
     std::vector<Transition> component_transitions;
-    m.co.on_machine(m.machine("C.s_A"),
-                    StateCallbacks{{}, [&](const TransitionInfo& i) { machine_transitions.push_back(i.transition); }, {}});
-    m.co.on_component(m.comp("C"),
-                      StateCallbacks{{}, [&](const TransitionInfo& i) { component_transitions.push_back(i.transition); }, {}});
+    m.co.on_machine(
+        m.machine("C.s_A"),
+        StateCallbacks{{}, [&](const TransitionInfo& i) { machine_transitions.push_back(i.transition); }, {}});
+    m.co.on_component(
+        m.comp("C"),
+        StateCallbacks{{}, [&](const TransitionInfo& i) { component_transitions.push_back(i.transition); }, {}});
     m.reset("C.s_A");
     EXPECT_EQ(machine_transitions, std::vector<Transition>{Transition::E2N}) << order.front();
     EXPECT_EQ(component_transitions, std::vector<Transition>{Transition::E2N}) << order.front();
@@ -616,8 +625,9 @@ TEST(Reset, AComponentResetGoesStraightToNormalEvenWhenItsMachinesHoldDifferentL
   m.gen("W20", "C.s_A");
   ASSERT_EQ(m.co.extended_state(m.comp("C")), E);
   std::vector<Transition> component_transitions;
-  m.co.on_component(m.comp("C"),
-                    StateCallbacks{{}, [&](const TransitionInfo& i) { component_transitions.push_back(i.transition); }, {}});
+  m.co.on_component(
+      m.comp("C"),
+      StateCallbacks{{}, [&](const TransitionInfo& i) { component_transitions.push_back(i.transition); }, {}});
   m.reset("C");
   EXPECT_EQ(component_transitions, std::vector<Transition>{Transition::E2N});
   EXPECT_EQ(m.co.extended_state(m.comp("C")), N);
@@ -686,8 +696,11 @@ TEST(History, EveryProcessedIgnoredMaskedOverrideAndResetRecordIsInHistoryAndOnT
   EXPECT_EQ(count(Outcome::Ignored), 2);
   // /E80 plus the four conditions the reset removed (E50, E80B, LATCH, W20).
   EXPECT_EQ(count(Outcome::Cleared), 5);
-  EXPECT_EQ(std::count_if(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Reset; }), 1);
-  EXPECT_EQ(std::count_if(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Transition; }), 2);
+  EXPECT_EQ(std::count_if(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Reset; }),
+            1);
+  EXPECT_EQ(
+      std::count_if(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Transition; }),
+      2);
   // Component transitions are on the stream too.
   EXPECT_EQ(std::count_if(m.stream.begin(), m.stream.end(),
                           [](const Record& r) { return r.kind == RecordKind::ComponentTransition; }),

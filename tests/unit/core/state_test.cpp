@@ -40,8 +40,7 @@ TEST(StateProduct, IsAssociativeOverAllTwentySevenTriples) {
   for (State a : kStates) {
     for (State b : kStates) {
       for (State c : kStates) {
-        EXPECT_EQ((a * b) * c, a * (b * c))
-            << to_string(a) << ", " << to_string(b) << ", " << to_string(c);
+        EXPECT_EQ((a * b) * c, a * (b * c)) << to_string(a) << ", " << to_string(b) << ", " << to_string(c);
         // And the triple product is the maximum of the three, whatever the grouping.
         State max = a;
         if (b > max) max = b;

@@ -24,10 +24,18 @@ void* counted(std::size_t n) {
 void* operator new(std::size_t n) { return counted(n); }
 void* operator new[](std::size_t n) { return counted(n); }
 void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted(n); } catch (...) { return nullptr; }
+  try {
+    return counted(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void* operator new[](std::size_t n, const std::nothrow_t&) noexcept {
-  try { return counted(n); } catch (...) { return nullptr; }
+  try {
+    return counted(n);
+  } catch (...) {
+    return nullptr;
+  }
 }
 void operator delete(void* p) noexcept { std::free(p); }
 void operator delete[](void* p) noexcept { std::free(p); }
@@ -81,7 +89,8 @@ TEST(FilterAllocation, CounterDetectsAnAllocationSoTheseTestsCannotPassVacuously
 TEST(FilterAllocation, ThresholdSampleWithoutEventAllocatesNothing) {
   Rig s;
   Signal* x = *s.monitor.add_signal("C.x");
-  Filter* f = s.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = s.add("Threshold",
+                    {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   for (int i = 0; i < 10; ++i) {
     x->push(Time{i}, 1.0);
     f->run(Time{i});
@@ -99,8 +108,10 @@ TEST(FilterAllocation, ThreeStagePipelineAllocatesNothingInSteadyState) {
   Rig s;
   Signal* force = *s.monitor.add_signal("C.force", 3);
   s.add("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}});
-  s.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
-  s.add("Threshold", {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  s.add("MovingAverage",
+        {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}, {"window", 10.0}});
+  s.add("Threshold",
+        {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
   const double sample[] = {1, 2, 3};
   for (int i = 0; i < 20; ++i) {
     force->push(Time{i}, sample);
@@ -139,7 +150,8 @@ TEST(FilterAllocation, MonitorTickOverPassiveFiltersAllocatesNothing) {
 TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
   Rig s;
   Signal* x = *s.monitor.add_signal("C.x");
-  Filter* f = s.add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = s.add("Threshold",
+                    {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   for (int i = 0; i < 10; ++i) {
     x->push(Time{i}, i % 2 ? 20.0 : 1.0);
     f->run(Time{i});

@@ -41,7 +41,7 @@ TEST_F(ThresholdFilter, CompletionOnlyAtOrBelowThresholdPlusToleranceMinusHyster
   feed(x, f, 1.0, 13);    // onset (> 12)
   feed(x, f, 1.1, 9.25);  // > 9: still detected
   EXPECT_EQ(events_, Events{"EVT_X"});
-  feed(x, f, 1.2, 9.0);   // ≤ 12 − 3: completion
+  feed(x, f, 1.2, 9.0);  // ≤ 12 − 3: completion
   EXPECT_EQ(events_, (Events{"EVT_X", "/EVT_X"}));
   EXPECT_EQ(times_, at({1.0, 1.2}));
   EXPECT_EQ(app_state(), State::Normal);
@@ -76,15 +76,16 @@ TEST_F(ThresholdFilter, WithoutHysteresisClearsAtTheOnsetLevel) {
 
 TEST_F(ThresholdFilter, DirectionBelowMirrorsOnsetAndCompletion) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", threshold_params(10, {{"tolerance", 1.0}, {"hysteresis", 2.0},
+  Filter* f = make("Threshold", threshold_params(10, {{"tolerance", 1.0},
+                                                      {"hysteresis", 2.0},
                                                       {"direction", std::string("below")},
                                                       {"output_signal", std::string("out")}}));
   feed(x, f, 1.0, 50);   // far above: fine for "below"
   feed(x, f, 1.1, 9.0);  // equal to threshold − tolerance: not beyond
   EXPECT_TRUE(events_.empty());
-  feed(x, f, 1.2, 8.75);  // onset (< 9)
-  feed(x, f, 1.3, 10.75); // band [9, 11): kept
-  feed(x, f, 1.4, 8.0);   // beyond again: no second onset (EDGE)
+  feed(x, f, 1.2, 8.75);   // onset (< 9)
+  feed(x, f, 1.3, 10.75);  // band [9, 11): kept
+  feed(x, f, 1.4, 8.0);    // beyond again: no second onset (EDGE)
   EXPECT_EQ(events_, Events{"EVT_X"});
   EXPECT_EQ(values_, Values{8.75});
   feed(x, f, 1.5, 11.0);  // ≥ 9 + 2: completion
@@ -97,7 +98,7 @@ TEST_F(ThresholdFilter, PersistenceInSamplesNeedsConsecutiveSamplesAndADipResets
   Filter* f = make("Threshold", threshold_params(10, {{"persistence", 3.0}}));
   feed(x, f, 1.0, 11);
   feed(x, f, 1.1, 12);
-  feed(x, f, 1.2, 5);   // dip: the count starts again
+  feed(x, f, 1.2, 5);  // dip: the count starts again
   feed(x, f, 1.3, 13);
   feed(x, f, 1.4, 14);
   EXPECT_TRUE(events_.empty());
@@ -111,9 +112,10 @@ TEST_F(ThresholdFilter, PersistenceInSamplesNeedsConsecutiveSamplesAndADipResets
 
 TEST_F(ThresholdFilter, PersistenceInSecondsCountsTimeSinceTheFirstSampleBeyond) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", threshold_params(10, {{"persistence", 0.5}, {"persistence_unit", std::string("seconds")}}));
+  Filter* f =
+      make("Threshold", threshold_params(10, {{"persistence", 0.5}, {"persistence_unit", std::string("seconds")}}));
   feed(x, f, 1.0, 11);
-  feed(x, f, 1.3, 5);   // dip: the clock starts again at the next sample beyond
+  feed(x, f, 1.3, 5);  // dip: the clock starts again at the next sample beyond
   feed(x, f, 1.6, 12);
   feed(x, f, 1.9, 13);
   feed(x, f, 2.05, 14);  // 0.45 s since 1.6
@@ -139,7 +141,7 @@ TEST_F(ThresholdFilter, LevelModeRepeatsTheOnsetEverySampleAndTheMachineOnlyRefr
   Filter* f = make("Threshold", threshold_params(10, {{"hysteresis", 2.0}}), DetectionMode::Level);
   feed(x, f, 1.0, 11);
   feed(x, f, 1.1, 12);
-  feed(x, f, 1.2, 9);   // in the band: still detected, so still an onset
+  feed(x, f, 1.2, 9);  // in the band: still detected, so still an onset
   feed(x, f, 1.3, 13);
   std::vector<Condition> conditions = co_.conditions(app());
   ASSERT_EQ(conditions.size(), 1u);
@@ -170,9 +172,9 @@ TEST_F(ThresholdFilter, LevelModeSecondCrossingStartsANewConditionCount) {
 
 TEST_F(ThresholdFilter, OutputSignalCarriesOutputAboveAndOutputBelowEverySample) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", threshold_params(10, {{"output_signal", std::string("over")},
-                                                      {"output_above", 7.5},
-                                                      {"output_below", -3.0}}));
+  Filter* f = make(
+      "Threshold",
+      threshold_params(10, {{"output_signal", std::string("over")}, {"output_above", 7.5}, {"output_below", -3.0}}));
   const double ts[] = {1.0, 1.1, 1.2, 1.3};
   const double xs[] = {5, 11, 12, 2};
   for (int i = 0; i < 4; ++i) feed(x, f, ts[i], xs[i]);
@@ -184,8 +186,8 @@ TEST_F(ThresholdFilter, OutputSignalCarriesOutputAboveAndOutputBelowEverySample)
 
 TEST_F(ThresholdFilter, WithoutEventsItOnlyWritesItsOutput) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0},
-                                 {"output_signal", std::string("out")}});
+  Filter* f = make("Threshold",
+                   {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"output_signal", std::string("out")}});
   for (double v : {0.0, 2.0, 0.0}) feed(x, f, 1.0, v);
   EXPECT_TRUE(events_.empty());
   EXPECT_EQ(values_of("out"), (Values{0, 1, 0}));
@@ -203,8 +205,12 @@ TEST_F(ThresholdFilter, The2016NameFilterThresholdBehavesTheSame) {
 // ---- Range ------------------------------------------------------------------------------------
 
 Params range_params(double lo, double hi, double h = 0) {
-  return {{"input_signal", std::string("x")}, {"min", lo}, {"max", hi}, {"hysteresis", h},
-          {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("out")}};
+  return {{"input_signal", std::string("x")},
+          {"min", lo},
+          {"max", hi},
+          {"hysteresis", h},
+          {"event_onset", std::string("EVT_X")},
+          {"output_signal", std::string("out")}};
 }
 
 TEST_F(RangeFilter, RaisesBelowMinAndAboveMaxAndClearsInside) {
@@ -232,14 +238,14 @@ TEST_F(RangeFilter, JumpingFromBelowMinToAboveMaxIsOneDetection) {
 TEST_F(RangeFilter, HysteresisKeepsDetectionNearEitherEdge) {
   Signal* x = signal("x");
   Filter* f = make("Range", range_params(0, 10, 2));
-  feed(x, f, 1.0, 11);   // onset above
-  feed(x, f, 1.1, 9);    // inside but within 2 of max: kept
+  feed(x, f, 1.0, 11);  // onset above
+  feed(x, f, 1.1, 9);   // inside but within 2 of max: kept
   EXPECT_EQ(events_, Events{"EVT_X"});
-  feed(x, f, 1.2, 8);    // ≤ max − h: completion
-  feed(x, f, 1.3, -0.5); // onset below
-  feed(x, f, 1.4, 1.5);  // kept
+  feed(x, f, 1.2, 8);     // ≤ max − h: completion
+  feed(x, f, 1.3, -0.5);  // onset below
+  feed(x, f, 1.4, 1.5);   // kept
   EXPECT_EQ(events_, (Events{"EVT_X", "/EVT_X", "EVT_X"}));
-  feed(x, f, 1.5, 2);    // ≥ min + h: completion
+  feed(x, f, 1.5, 2);  // ≥ min + h: completion
   EXPECT_EQ(events_, (Events{"EVT_X", "/EVT_X", "EVT_X", "/EVT_X"}));
   EXPECT_EQ(values_of("out"), (Values{1, 1, 0, 1, 1, 0}));
 }
@@ -285,8 +291,10 @@ TEST_F(RangeFilter, PersistenceDelaysTheOnset) {
 
 TEST_F(OnOffFilter, NonZeroSendsEventOnAndZeroSendsEventOff) {
   Signal* x = signal("x");
-  Filter* f = make("OnOff", {{"input_signal", std::string("x")}, {"event_on", std::string("EVT_X")},
-                             {"event_off", std::string("/EVT_X")}, {"output_signal", std::string("out")}});
+  Filter* f = make("OnOff", {{"input_signal", std::string("x")},
+                             {"event_on", std::string("EVT_X")},
+                             {"event_off", std::string("/EVT_X")},
+                             {"output_signal", std::string("out")}});
   for (double v : {0.0, 1.0, -2.0, 0.0, 0.0, 0.5}) feed(x, f, 1.0, v);
   EXPECT_EQ(events_, (Events{"EVT_X", "/EVT_X", "EVT_X"}));
   EXPECT_EQ(values_.at(0), 1.0);
@@ -313,7 +321,8 @@ TEST_F(OnOffFilter, UsesEventOnNotEventOnset) {
 
 TEST_F(ChangeDetectionFilter, FirstSampleIsNeverAChange) {
   Signal* x = signal("x");
-  Filter* f = make("ChangeDetection", {{"input_signal", std::string("x")}, {"event_onset", std::string("EVT_X")},
+  Filter* f = make("ChangeDetection", {{"input_signal", std::string("x")},
+                                       {"event_onset", std::string("EVT_X")},
                                        {"output_signal", std::string("out")}});
   feed(x, f, 1.0, 1000);
   EXPECT_TRUE(events_.empty());
@@ -327,8 +336,10 @@ TEST_F(ChangeDetectionFilter, FirstSampleIsNeverAChange) {
 
 TEST_F(ChangeDetectionFilter, OnlyChangesLargerThanToleranceCount) {
   Signal* x = signal("x");
-  Filter* f = make("ChangeDetection", {{"input_signal", std::string("x")}, {"tolerance", 0.5},
-                                       {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("out")}});
+  Filter* f = make("ChangeDetection", {{"input_signal", std::string("x")},
+                                       {"tolerance", 0.5},
+                                       {"event_onset", std::string("EVT_X")},
+                                       {"output_signal", std::string("out")}});
   feed(x, f, 1.0, 1.0);
   feed(x, f, 1.1, 1.5);   // change 0.5: not larger than the tolerance
   feed(x, f, 1.2, 2.25);  // change 0.75: onset
@@ -342,8 +353,10 @@ TEST_F(ChangeDetectionFilter, OnlyChangesLargerThanToleranceCount) {
 
 TEST_F(ChangeDetectionFilter, VectorInputChangesWhenAnyElementChanges) {
   Signal* v = signal("v", 3);
-  Filter* f = make("ChangeDetection", {{"input_signal", std::string("v")}, {"tolerance", 0.5},
-                                       {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("changed")}});
+  Filter* f = make("ChangeDetection", {{"input_signal", std::string("v")},
+                                       {"tolerance", 0.5},
+                                       {"event_onset", std::string("EVT_X")},
+                                       {"output_signal", std::string("changed")}});
   ASSERT_EQ(monitor_.signals().find("C.changed")->size(), 1u);
   feed(v, f, 1.0, {0, 0, 0});
   feed(v, f, 1.1, {0, 0, 0.25});
@@ -358,17 +371,20 @@ TEST_F(ChangeDetectionFilter, VectorInputChangesWhenAnyElementChanges) {
 
 TEST_F(DebounceFilter, OnsetAfterPersistenceAndCompletionAfterRelease) {
   Signal* x = signal("x");
-  Filter* f = make("Debounce", {{"input_signal", std::string("x")}, {"persistence", 3.0}, {"release", 2.0},
-                                {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("out")}});
+  Filter* f = make("Debounce", {{"input_signal", std::string("x")},
+                                {"persistence", 3.0},
+                                {"release", 2.0},
+                                {"event_onset", std::string("EVT_X")},
+                                {"output_signal", std::string("out")}});
   for (double v : {1.0, 1.0, 0.0, 1.0, 1.0}) feed(x, f, 1.0, v);  // the bounce resets the count
   EXPECT_TRUE(events_.empty());
-  feed(x, f, 1.1, 1);   // third consecutive: onset
+  feed(x, f, 1.1, 1);  // third consecutive: onset
   EXPECT_EQ(events_, Events{"EVT_X"});
-  feed(x, f, 1.2, 0);   // one off sample: not released
-  feed(x, f, 1.3, 1);   // on again resets the release count
+  feed(x, f, 1.2, 0);  // one off sample: not released
+  feed(x, f, 1.3, 1);  // on again resets the release count
   feed(x, f, 1.4, 0);
   EXPECT_EQ(events_, Events{"EVT_X"});
-  feed(x, f, 1.5, 0);   // second consecutive off: completion
+  feed(x, f, 1.5, 0);  // second consecutive off: completion
   EXPECT_EQ(events_, (Events{"EVT_X", "/EVT_X"}));
   EXPECT_EQ(times_, at({1.1, 1.5}));
   EXPECT_EQ(values_of("out"), (Values{0, 0, 0, 0, 0, 1, 1, 1, 1, 0}));
@@ -376,8 +392,10 @@ TEST_F(DebounceFilter, OnsetAfterPersistenceAndCompletionAfterRelease) {
 
 TEST_F(DebounceFilter, PersistenceAliasAndPersistenceInSeconds) {
   Signal* x = signal("x");
-  Filter* f = make("Persistence", {{"input_signal", std::string("x")}, {"persistence", 0.25},
-                                   {"persistence_unit", std::string("seconds")}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = make("Persistence", {{"input_signal", std::string("x")},
+                                   {"persistence", 0.25},
+                                   {"persistence_unit", std::string("seconds")},
+                                   {"event_onset", std::string("EVT_X")}});
   feed(x, f, 1.0, 1);
   feed(x, f, 1.2, 1);
   EXPECT_TRUE(events_.empty());

@@ -20,9 +20,11 @@ FilterConfig named(std::string name, const std::string& type, Params p) {
 
 TEST_F(ShallowInjectionEnd, TheEndOfAShallowInjectionRestoresTheUnchangedRealScalarValue) {
   Signal* x = signal("x");
-  ASSERT_TRUE(monitor_.add_filter(named("limit", "Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
-                                                               {"output_signal", std::string("above")},
-                                                               {"event_onset", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(named("limit", "Threshold",
+                                        {{"input_signal", std::string("x")},
+                                         {"threshold", 10.0},
+                                         {"output_signal", std::string("above")},
+                                         {"event_onset", std::string("EVT_X")}})));
   x->push(seconds_to_time(0.0), 1.0);
   monitor_.run_active(component_, seconds_to_time(0.0));
   ASSERT_EQ(app_state(), State::Normal);
@@ -43,10 +45,11 @@ TEST_F(ShallowInjectionEnd, TheEndOfAShallowInjectionRestoresTheUnchangedRealSca
 
 TEST_F(ShallowInjectionEnd, TheEndOfAShallowInjectionRestoresTheUnchangedRealVectorValue) {
   Signal* force = signal("force", 3);
-  ASSERT_TRUE(monitor_.add_filter(named("norm", "Norm", {{"input_signal", std::string("force")},
-                                                         {"output_signal", std::string("norm")}})));
-  ASSERT_TRUE(monitor_.add_filter(named("limit", "Threshold", {{"input_signal", std::string("norm")}, {"threshold", 10.0},
-                                                               {"event_onset", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      named("norm", "Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      named("limit", "Threshold",
+            {{"input_signal", std::string("norm")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}})));
   const double real[3] = {3, 4, 0};
   force->push(seconds_to_time(0.0), real);
   monitor_.run_active(component_, seconds_to_time(0.0));
@@ -63,8 +66,8 @@ TEST_F(ShallowInjectionEnd, TheEndOfAShallowInjectionRestoresTheUnchangedRealVec
 TEST_F(ShallowInjectionEnd, ASensorThatPublishesOnlyOnChangeDoesNotStayInErrorAfterATestInjection) {
   // An on/off sensor that publishes once, at start-up, and then only when its value changes.
   Signal* door = signal("door_open");
-  ASSERT_TRUE(monitor_.add_filter(named("door", "OnOff", {{"input_signal", std::string("door_open")},
-                                                          {"event_on", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      named("door", "OnOff", {{"input_signal", std::string("door_open")}, {"event_on", std::string("EVT_X")}})));
   door->push(seconds_to_time(0.0), 0.0);
   monitor_.run_active(component_, seconds_to_time(0.0));
   ASSERT_TRUE(monitor_.inject_shallow("door", {{1}}));  // a test: "the door opens"
@@ -77,8 +80,9 @@ TEST_F(ShallowInjectionEnd, ASensorThatPublishesOnlyOnChangeDoesNotStayInErrorAf
 
 TEST_F(ShallowInjectionEnd, ARealSampleWrittenDuringTheInjectionIsTheValueRestored) {
   Signal* x = signal("x");
-  ASSERT_TRUE(monitor_.add_filter(named("limit", "Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
-                                                               {"event_onset", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      named("limit", "Threshold",
+            {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}})));
   x->push(seconds_to_time(0.0), 1.0);
   monitor_.run_active(component_, seconds_to_time(0.0));
   ASSERT_TRUE(monitor_.inject_shallow("limit", {{50}}));
@@ -93,8 +97,9 @@ TEST_F(ShallowInjectionEnd, ARealSampleWrittenDuringTheInjectionIsTheValueRestor
 
 TEST_F(ShallowInjectionEnd, ASignalWithoutAnyRealSampleHasNothingToRestore) {
   signal("x");
-  ASSERT_TRUE(monitor_.add_filter(named("limit", "Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
-                                                               {"event_onset", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      named("limit", "Threshold",
+            {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}})));
   ASSERT_TRUE(monitor_.inject_shallow("limit", {{50}}));
   monitor_.run_active(component_, seconds_to_time(0.1));
   monitor_.run_active(component_, seconds_to_time(0.2));

@@ -15,9 +15,11 @@ FilterConfig stage(const std::string& type, Params p) {
 
 TEST_F(PipelineTest, OutputOfOneFilterFeedsTheNextInTheSameRun) {
   Signal* force = signal("force", 3);
-  ASSERT_TRUE(monitor_.add_filter(stage("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}})));
-  ASSERT_TRUE(monitor_.add_filter(stage("Threshold", {{"input_signal", std::string("norm")}, {"threshold", 30.0},
-                                                      {"event_onset", std::string("EVT_X")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      stage("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}})));
+  ASSERT_TRUE(monitor_.add_filter(
+      stage("Threshold",
+            {{"input_signal", std::string("norm")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}})));
   const double f[] = {0, 30, 40};
   force->push(Time{1}, f);
   monitor_.run_active(component_, Time{1});
@@ -28,9 +30,9 @@ TEST_F(PipelineTest, OutputOfOneFilterFeedsTheNextInTheSameRun) {
 TEST_F(PipelineTest, PipelineSugarChainsStagesThroughGeneratedSignals) {
   Signal* force = signal("force", 3);
   auto p = monitor_.add_pipeline(
-      "force_check", {stage("Norm", {{"input_signal", std::string("force")}}),
-                      stage("MovingAverage", {{"window", 2.0}}),
-                      stage("Threshold", {{"threshold", 30.0}, {"event_onset", std::string("EVT_X")}})});
+      "force_check",
+      {stage("Norm", {{"input_signal", std::string("force")}}), stage("MovingAverage", {{"window", 2.0}}),
+       stage("Threshold", {{"threshold", 30.0}, {"event_onset", std::string("EVT_X")}})});
   ASSERT_TRUE(p) << p.error().message;
   ASSERT_EQ(p->size(), 3u);
   EXPECT_EQ((*p)[1]->inputs()[0]->name(), "C.force_check_1");
@@ -49,8 +51,7 @@ TEST_F(PipelineTest, FailingStageLeavesNothingBehind) {
   signal("force", 3);
   const std::size_t signals = monitor_.signals().all().size();
   auto p = monitor_.add_pipeline(
-      "broken", {stage("Norm", {{"input_signal", std::string("force")}}),
-                 stage("MovingAverage", {{"window", 0.0}}),
+      "broken", {stage("Norm", {{"input_signal", std::string("force")}}), stage("MovingAverage", {{"window", 0.0}}),
                  stage("Threshold", {{"threshold", 30.0}, {"event_onset", std::string("EVT_X")}})});
   ASSERT_FALSE(p);
   EXPECT_NE(p.error().message.find("stage 2"), std::string::npos) << p.error().message;
@@ -63,7 +64,8 @@ using InjectionTest = FilterFixture;
 
 TEST_F(InjectionTest, ShallowInjectionIsSeenByThatFilterAloneAndMarked) {
   Signal* x = signal("x");
-  FilterConfig a = stage("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  FilterConfig a = stage(
+      "Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   a.name = "target";
   FilterConfig b = stage("Bypass", {{"input_signal", std::string("x")}, {"output_signal", std::string("copy")}});
   b.name = "bystander";
@@ -93,7 +95,8 @@ TEST_F(InjectionTest, AShallowInjectedSampleIsHeldForItsRunAndTheEndOfTheInjecti
   Signal* a = signal("a");
   Signal* b = signal("b");
   FilterConfig c = stage("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
-                                        {"output_signal", std::string("d")}, {"operation", std::string("subtract")}});
+                                        {"output_signal", std::string("d")},
+                                        {"operation", std::string("subtract")}});
   c.name = "diff";
   ASSERT_TRUE(monitor_.add_filter(c));
   a->push(Time{1}, 10.0);
@@ -113,7 +116,8 @@ TEST_F(InjectionTest, AShallowInjectedSampleIsHeldForItsRunAndTheEndOfTheInjecti
 
 TEST_F(InjectionTest, DeepInjectionWritesTheSignalSoEveryConsumerSeesIt) {
   Signal* x = signal("x");
-  FilterConfig a = stage("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+  FilterConfig a = stage(
+      "Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   FilterConfig b = stage("Bypass", {{"input_signal", std::string("x")}, {"output_signal", std::string("copy")}});
   ASSERT_TRUE(monitor_.add_filter(a));
   ASSERT_TRUE(monitor_.add_filter(b));
@@ -128,7 +132,8 @@ TEST_F(InjectionTest, DeepInjectionWritesTheSignalSoEveryConsumerSeesIt) {
   EXPECT_DOUBLE_EQ(v, 42);
   EXPECT_TRUE(injected) << "the signal's history marks injected samples";
   const auto history = co_.history(co_.application_machine(component_));
-  const bool has_injection = std::any_of(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Injection; });
+  const bool has_injection =
+      std::any_of(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Injection; });
   EXPECT_TRUE(has_injection) << "the injection is in the target machine's history";
 }
 

@@ -179,41 +179,114 @@ Params with_events(Params p, const char* onset_param = "event_onset") {
 
 const std::vector<Case>& cases() {
   static const std::vector<Case> all = {
-      {"Threshold", with_events({{"input_signal", std::string("x")}, {"threshold", 10.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {5, 11, 12}, 3},
-      {"Range", with_events({{"input_signal", std::string("x")}, {"min", 0.0}, {"max", 10.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {5, 11, 12}, 5},
-      {"OnOff", with_events({{"input_signal", std::string("x")}, {"output_signal", std::string("out")}}, "event_on"),
-       {{"x", 1}}, "out", {0, 1, 0}, 1},
-      {"ChangeDetection", with_events({{"input_signal", std::string("v")}, {"tolerance", 0.5}, {"output_signal", std::string("out")}}),
-       {{"v", 3}}, "out", {1, 2, 2}, 5},
-      {"Debounce", with_events({{"input_signal", std::string("x")}, {"persistence", 2.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {1, 1, 1}, 0},
-      {"Derivative", {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
-       {{"v", 3}}, "out", {1, 2, 4}, 0},
-      {"MovingAverage", {{"input_signal", std::string("v")}, {"window", 3.0}, {"output_signal", std::string("out")}},
-       {{"v", 3}}, "out", {1, 2, 4}, 8},
-      {"Norm", {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
-       {{"v", 3}}, "out", {1, 2, 3}, 4},
-      {"Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}}, {"operation", std::string("multiply")},
-                      {"output_signal", std::string("out")}},
-       {{"a", 2}, {"b", 2}}, "out", {1, 2, 3}, 4},
-      {"Vectorize", {{"input_signals", std::vector<std::string>{"x", "y", "z"}}, {"output_signal", std::string("out")}},
-       {{"x", 1}, {"y", 1}, {"z", 1}}, "out", {1, 2, 3}, 4},
-      {"Bypass", {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
-       {{"v", 3}}, "out", {1, 2, 3}, 4},
+      {"Threshold",
+       with_events({{"input_signal", std::string("x")}, {"threshold", 10.0}, {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {5, 11, 12},
+       3},
+      {"Range",
+       with_events(
+           {{"input_signal", std::string("x")}, {"min", 0.0}, {"max", 10.0}, {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {5, 11, 12},
+       5},
+      {"OnOff",
+       with_events({{"input_signal", std::string("x")}, {"output_signal", std::string("out")}}, "event_on"),
+       {{"x", 1}},
+       "out",
+       {0, 1, 0},
+       1},
+      {"ChangeDetection",
+       with_events({{"input_signal", std::string("v")}, {"tolerance", 0.5}, {"output_signal", std::string("out")}}),
+       {{"v", 3}},
+       "out",
+       {1, 2, 2},
+       5},
+      {"Debounce",
+       with_events({{"input_signal", std::string("x")}, {"persistence", 2.0}, {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {1, 1, 1},
+       0},
+      {"Derivative",
+       {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
+       {{"v", 3}},
+       "out",
+       {1, 2, 4},
+       0},
+      {"MovingAverage",
+       {{"input_signal", std::string("v")}, {"window", 3.0}, {"output_signal", std::string("out")}},
+       {{"v", 3}},
+       "out",
+       {1, 2, 4},
+       8},
+      {"Norm",
+       {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
+       {{"v", 3}},
+       "out",
+       {1, 2, 3},
+       4},
+      {"Arithmetic",
+       {{"input_signals", std::vector<std::string>{"a", "b"}},
+        {"operation", std::string("multiply")},
+        {"output_signal", std::string("out")}},
+       {{"a", 2}, {"b", 2}},
+       "out",
+       {1, 2, 3},
+       4},
+      {"Vectorize",
+       {{"input_signals", std::vector<std::string>{"x", "y", "z"}}, {"output_signal", std::string("out")}},
+       {{"x", 1}, {"y", 1}, {"z", 1}},
+       "out",
+       {1, 2, 3},
+       4},
+      {"Bypass",
+       {{"input_signal", std::string("v")}, {"output_signal", std::string("out")}},
+       {{"v", 3}},
+       "out",
+       {1, 2, 3},
+       4},
       {"NOP", {{"input_signal", std::string("v")}}, {{"v", 3}}, "", {1, 2, 3}, 4},
-      {"Occurrence", with_events({{"input_signal", std::string("x")}, {"count", 2.0}, {"window", 10.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {1, 0, 0}, 1},
-      {"Watchdog", {{"input_signal", std::string("x")}, {"timeout", 0.35}, {"output_signal", std::string("out")}},
-       {{"x", 1}}, "out", {1, 1, 1}, 1},
-      {"Frequency", with_events({{"input_signal", std::string("x")}, {"max_rate", 5.0}, {"window", 2.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {1, 1, 1}, 1},
-      {"DutyCycle", with_events({{"input_signal", std::string("x")}, {"period", 1.0}, {"output_signal", std::string("out")}}),
-       {{"x", 1}}, "out", {0.5, 0.9, 0.95}, 0.1},
-      {"Deadline", with_events({{"input_signals", std::vector<std::string>{"start", "end"}}, {"deadline", 0.05},
-                                {"output_signal", std::string("out")}}),
-       {{"start", 1}, {"end", 1}}, "out", {1, 1, 1}, 1},
+      {"Occurrence",
+       with_events({{"input_signal", std::string("x")},
+                    {"count", 2.0},
+                    {"window", 10.0},
+                    {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {1, 0, 0},
+       1},
+      {"Watchdog",
+       {{"input_signal", std::string("x")}, {"timeout", 0.35}, {"output_signal", std::string("out")}},
+       {{"x", 1}},
+       "out",
+       {1, 1, 1},
+       1},
+      {"Frequency",
+       with_events({{"input_signal", std::string("x")},
+                    {"max_rate", 5.0},
+                    {"window", 2.0},
+                    {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {1, 1, 1},
+       1},
+      {"DutyCycle",
+       with_events({{"input_signal", std::string("x")}, {"period", 1.0}, {"output_signal", std::string("out")}}),
+       {{"x", 1}},
+       "out",
+       {0.5, 0.9, 0.95},
+       0.1},
+      {"Deadline",
+       with_events({{"input_signals", std::vector<std::string>{"start", "end"}},
+                    {"deadline", 0.05},
+                    {"output_signal", std::string("out")}}),
+       {{"start", 1}, {"end", 1}},
+       "out",
+       {1, 1, 1},
+       1},
   };
   return all;
 }
@@ -254,8 +327,9 @@ TEST_F(NonFiniteSample, RaisesOnTheFrameworkMachineOfTheTargetComponentNotTheSig
 
 TEST_F(NonFiniteSample, LevelModeStillRaisesInvalidSampleOnlyOnce) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0},
-                                 {"event_onset", std::string("EVT_X")}}, DetectionMode::Level);
+  Filter* f =
+      make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}},
+           DetectionMode::Level);
   feed(x, f, 1.0, 5);
   for (double v : {kNaN, kInf, kNaN, -kInf}) feed(x, f, 1.1, v);
   feed(x, f, 1.2, 6);
@@ -281,7 +355,7 @@ TEST_F(NonFiniteSample, StuckNonFiniteInputStaysRaisedWhileAnotherInputIsFine) {
   EXPECT_EQ(events_, Events{"EVT_INVALID_SAMPLE"});
   push(b, 5.0, kInf);  // a second bad input joins the same condition
   run_all(5.0);
-  push(a, 6.0, 10);    // a recovers, b is still bad
+  push(a, 6.0, 10);  // a recovers, b is still bad
   run_all(6.0);
   EXPECT_EQ(events_, Events{"EVT_INVALID_SAMPLE"});
   push(b, 7.0, 20);
@@ -295,7 +369,8 @@ TEST_F(NonFiniteSample, StuckNonFiniteInputStaysRaisedWhileAnotherInputIsFine) {
 TEST_F(NonFiniteSample, VectorsWithANonFiniteElementLeaveTheLastFiniteVectorHeld) {
   Signal* a = signal("a", 2);
   Signal* b = signal("b", 2);
-  make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}}, {"output_signal", std::string("r")},
+  make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
+                      {"output_signal", std::string("r")},
                       {"operation", std::string("subtract")}});
   push(a, 1.0, Values{10, 20});
   push(b, 1.0, Values{1, 2});
@@ -316,7 +391,8 @@ TEST_F(NonFiniteSample, VectorsWithANonFiniteElementLeaveTheLastFiniteVectorHeld
 TEST_F(NonFiniteSample, AnInfiniteSampleIsReportedAsInfiniteNotAsNaN) {
   Signal* x = signal("x");
   Signal* v = signal("v", 3);
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = make("Threshold",
+                   {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
   Filter* n = make("Norm", {{"input_signal", std::string("v")}, {"output_signal", std::string("vn")}});
   feed(x, f, 1.0, kInf);
   std::vector<Condition> conditions = co_.conditions(framework());
@@ -340,7 +416,8 @@ TEST_F(NonFiniteSample, AnInfiniteSampleIsReportedAsInfiniteNotAsNaN) {
 TEST_F(NonFiniteSample, TheMonitorRefusesToInjectANonFiniteValueAndChangesNothing) {
   Signal* x = signal("x");
   signal("v", 2);
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = make("Threshold",
+                   {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")}});
   std::size_t injections = 0;
   co_.subscribe([&injections](const Record& r) { injections += r.kind == RecordKind::Injection ? 1 : 0; });
   const struct {
@@ -368,7 +445,9 @@ TEST_F(NonFiniteSample, ShallowInjectedNaNIsMarkedAsInjected) {
   // Below the monitor's rule (injected values are finite), the filter's own mechanism still marks
   // an invalid sample that came from an injection.
   Signal* x = signal("x");
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_X")},
+  Filter* f = make("Threshold", {{"input_signal", std::string("x")},
+                                 {"threshold", 1.0},
+                                 {"event_onset", std::string("EVT_X")},
                                  {"output_signal", std::string("out")}});
   feed(x, f, 1.0, 0);
   ASSERT_TRUE(f->inject({{kNaN}}));
@@ -414,7 +493,9 @@ protected:
     EXPECT_EQ(monitor_.find_filter("bad"), nullptr);
   }
   static Params threshold(Params extra = {}) {
-    Params p{{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")},
+    Params p{{"input_signal", std::string("x")},
+             {"threshold", 10.0},
+             {"event_onset", std::string("EVT_X")},
              {"output_signal", std::string("new_out")}};
     for (auto& [k, v] : extra) p[k] = v;
     return p;
@@ -443,13 +524,16 @@ TEST_F(CreationError, UnknownParameter) {
 }
 
 TEST_F(CreationError, OutOfRangeValues) {
-  expect_rejected("MovingAverage", {{"input_signal", std::string("x")}, {"window", 0.0}, {"output_signal", std::string("new_out")}},
+  expect_rejected("MovingAverage",
+                  {{"input_signal", std::string("x")}, {"window", 0.0}, {"output_signal", std::string("new_out")}},
                   {"'window'"});
-  expect_rejected("MovingAverage", {{"input_signal", std::string("x")}, {"window", 2.5}, {"output_signal", std::string("new_out")}},
+  expect_rejected("MovingAverage",
+                  {{"input_signal", std::string("x")}, {"window", 2.5}, {"output_signal", std::string("new_out")}},
                   {"'window'", "whole number"});
   expect_rejected("Threshold", threshold({{"hysteresis", -1.0}}), {"'hysteresis'"});
   expect_rejected("Threshold", threshold({{"persistence_unit", std::string("minutes")}}), {"'persistence_unit'"});
-  expect_rejected("Watchdog", {{"input_signal", std::string("x")}, {"timeout", 0.0}, {"output_signal", std::string("new_out")}},
+  expect_rejected("Watchdog",
+                  {{"input_signal", std::string("x")}, {"timeout", 0.0}, {"output_signal", std::string("new_out")}},
                   {"'timeout'"});
 }
 
@@ -464,38 +548,48 @@ TEST_F(CreationError, UnknownFilterType) {
 
 TEST_F(CreationError, UnknownEvent) {
   expect_rejected("Threshold", threshold({{"event_onset", std::string("EVT_NOPE")}}), {"'event_onset'", "'EVT_NOPE'"});
-  expect_rejected("Threshold", threshold({{"event_completion", std::string("/EVT_NOPE")}}), {"'event_completion'", "'/EVT_NOPE'"});
-  expect_rejected("OnOff", {{"input_signal", std::string("x")}, {"event_on", std::string("EVT_NOPE")}}, {"'event_on'", "'EVT_NOPE'"});
+  expect_rejected("Threshold", threshold({{"event_completion", std::string("/EVT_NOPE")}}),
+                  {"'event_completion'", "'/EVT_NOPE'"});
+  expect_rejected("OnOff", {{"input_signal", std::string("x")}, {"event_on", std::string("EVT_NOPE")}},
+                  {"'event_on'", "'EVT_NOPE'"});
 }
 
 TEST_F(CreationError, CompletionGivenAsOnsetOrOnsetAsCompletion) {
   expect_rejected("Threshold", threshold({{"event_onset", std::string("/EVT_X")}}), {"'event_onset'", "'/EVT_X'"});
-  expect_rejected("Threshold", threshold({{"event_completion", std::string("EVT_X")}}), {"'event_completion'", "'EVT_X'"});
+  expect_rejected("Threshold", threshold({{"event_completion", std::string("EVT_X")}}),
+                  {"'event_completion'", "'EVT_X'"});
 }
 
 TEST_F(CreationError, InputSignalThatDoesNotExist) {
   expect_rejected("Threshold", threshold({{"input_signal", std::string("nope")}}), {"'input_signal'", "'C.nope'"});
-  expect_rejected("Vectorize", {{"input_signals", std::vector<std::string>{"x", "nope"}}, {"output_signal", std::string("new_out")}},
+  expect_rejected("Vectorize",
+                  {{"input_signals", std::vector<std::string>{"x", "nope"}}, {"output_signal", std::string("new_out")}},
                   {"'input_signals'", "'C.nope'"});
 }
 
 TEST_F(CreationError, VectorWhereAScalarIsNeeded) {
   expect_rejected("Threshold", threshold({{"input_signal", std::string("v")}}), {"'C.v'", "size 3"});
-  expect_rejected("FilterRange", {{"input_signal", std::string("v")}, {"min", 0.0}, {"max", 1.0}, {"event_onset", std::string("EVT_X")}},
-                  {"'C.v'", "size 3"});
+  expect_rejected(
+      "FilterRange",
+      {{"input_signal", std::string("v")}, {"min", 0.0}, {"max", 1.0}, {"event_onset", std::string("EVT_X")}},
+      {"'C.v'", "size 3"});
 }
 
 TEST_F(CreationError, MismatchedSizes) {
-  expect_rejected("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}}, {"output_signal", std::string("new_out")}},
+  expect_rejected("Arithmetic",
+                  {{"input_signals", std::vector<std::string>{"a", "b"}}, {"output_signal", std::string("new_out")}},
                   {"'C.a'", "'C.b'"});
-  expect_rejected("Bypass", {{"input_signal", std::string("v")}, {"output_signal", std::string("s")}}, {"'output_signal'", "'C.s'"});
+  expect_rejected("Bypass", {{"input_signal", std::string("v")}, {"output_signal", std::string("s")}},
+                  {"'output_signal'", "'C.s'"});
 }
 
 TEST_F(CreationError, OutputThatIsAlsoAnInput) {
   // Writing into its own input would give the filter a new sample for every sample it writes.
-  expect_rejected("Bypass", {{"input_signal", std::string("v")}, {"output_signal", std::string("v")}}, {"'output_signal'", "'C.v'"});
+  expect_rejected("Bypass", {{"input_signal", std::string("v")}, {"output_signal", std::string("v")}},
+                  {"'output_signal'", "'C.v'"});
   expect_rejected("Threshold", threshold({{"output_signal", std::string("C.x")}}), {"'output_signal'", "'C.x'"});
-  expect_rejected("Arithmetic", {{"input_signals", std::vector<std::string>{"x", "s"}}, {"output_signal", std::string("s")}},
+  expect_rejected("Arithmetic",
+                  {{"input_signals", std::vector<std::string>{"x", "s"}}, {"output_signal", std::string("s")}},
                   {"'output_signal'", "'C.s'"});
 }
 

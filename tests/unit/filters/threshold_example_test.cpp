@@ -7,8 +7,8 @@ using ThresholdExample = FilterFixture;
 
 TEST_F(ThresholdExample, EdgeThresholdRaisesOnceAndClearsOnReturn) {
   Signal* x = signal("x");
-  Filter* f = make("Threshold", {{"input_signal", std::string("x")}, {"threshold", 10.0},
-                                 {"event_onset", std::string("EVT_X")}});
+  Filter* f = make("Threshold",
+                   {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
   feed(x, f, 0.001, 5);
   feed(x, f, 0.002, 11);
   feed(x, f, 0.003, 12);

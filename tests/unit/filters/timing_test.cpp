@@ -15,8 +15,11 @@ using DeadlineFilter = BuiltinFixture;
 // ---- Occurrence -------------------------------------------------------------------------------
 
 Params occurrence_params(double count, double window) {
-  return {{"input_signal", std::string("x")}, {"count", count}, {"window", window},
-          {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("n")}};
+  return {{"input_signal", std::string("x")},
+          {"count", count},
+          {"window", window},
+          {"event_onset", std::string("EVT_X")},
+          {"output_signal", std::string("n")}};
 }
 
 TEST_F(OccurrenceFilter, CountsRisingEdgesWithinTheWindow) {
@@ -44,7 +47,7 @@ TEST_F(OccurrenceFilter, ClearsAsOldOccurrencesAgeOutOnTick) {
     feed(x, f, t + 0.05, 0);
   }
   ASSERT_EQ(events_, Events{"EVT_X"});
-  tick(f, 1.1);   // 0.1 is exactly one window old: still counted
+  tick(f, 1.1);  // 0.1 is exactly one window old: still counted
   EXPECT_EQ(events_, Events{"EVT_X"});
   EXPECT_EQ(latest("C.n"), 3);
   tick(f, 1.15);  // 0.1 has left the window
@@ -74,7 +77,8 @@ TEST_F(OccurrenceFilter, EdgesFartherApartThanTheWindowNeverAccumulate) {
 
 TEST_F(WatchdogFilter, TimeoutIsCountedFromTheFirstRunAndANewSampleClears) {
   Signal* hb = signal("hb");
-  Filter* f = make("Watchdog", {{"input_signal", std::string("hb")}, {"timeout", 0.5}, {"output_signal", std::string("age")}});
+  Filter* f =
+      make("Watchdog", {{"input_signal", std::string("hb")}, {"timeout", 0.5}, {"output_signal", std::string("age")}});
   tick(f, 10.0);  // start-up
   tick(f, 10.4);
   EXPECT_TRUE(events_.empty());
@@ -117,7 +121,8 @@ TEST_F(WatchdogFilter, HoldingAValueWithoutANewSampleIsNotANewSample) {
 
 TEST_F(WatchdogFilter, AnOlderSampleArrivingLateDoesNotMoveTheLastSignOfLifeBack) {
   Signal* hb = signal("hb");
-  Filter* f = make("Watchdog", {{"input_signal", std::string("hb")}, {"timeout", 0.5}, {"output_signal", std::string("age")}});
+  Filter* f =
+      make("Watchdog", {{"input_signal", std::string("hb")}, {"timeout", 0.5}, {"output_signal", std::string("age")}});
   feed(hb, f, 10.1, 1);
   push(hb, 9.9, 1);  // stamped before the newest sample
   tick(f, 10.5);
@@ -141,8 +146,10 @@ TEST_F(WatchdogFilter, RegularSamplesKeepItQuiet) {
 
 TEST_F(WatchdogFilter, HeartbeatAliasWatchesAVectorSignalWithChosenEvents) {
   Signal* v = signal("v", 3);
-  Filter* f = make("Heartbeat", {{"input_signal", std::string("v")}, {"timeout", 1.0},
-                                 {"event_onset", std::string("EVT_X")}, {"event_completion", std::string("/EVT_X")}});
+  Filter* f = make("Heartbeat", {{"input_signal", std::string("v")},
+                                 {"timeout", 1.0},
+                                 {"event_onset", std::string("EVT_X")},
+                                 {"event_completion", std::string("/EVT_X")}});
   feed(v, f, 0.0, {1, 2, 3});
   tick(f, 1.5);
   feed(v, f, 2.0, {1, 2, 3});
@@ -154,8 +161,11 @@ TEST_F(WatchdogFilter, HeartbeatAliasWatchesAVectorSignalWithChosenEvents) {
 
 TEST_F(FrequencyFilter, MeanRateBelowMinRateRaisesAndRecovers) {
   Signal* x = signal("x");
-  Filter* f = make("Frequency", {{"input_signal", std::string("x")}, {"min_rate", 9.0}, {"window", 4.0},
-                                 {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("rate")}});
+  Filter* f = make("Frequency", {{"input_signal", std::string("x")},
+                                 {"min_rate", 9.0},
+                                 {"window", 4.0},
+                                 {"event_onset", std::string("EVT_X")},
+                                 {"output_signal", std::string("rate")}});
   for (double t : {1.0, 1.1, 1.2, 1.3, 1.4}) feed(x, f, t, 0);
   EXPECT_TRUE(events_.empty());
   feed(x, f, 1.6, 0);  // intervals 0.1 0.1 0.1 0.2: 8 Hz
@@ -175,8 +185,9 @@ TEST_F(FrequencyFilter, MeanRateBelowMinRateRaisesAndRecovers) {
 
 TEST_F(FrequencyFilter, MeanRateAboveMaxRateRaises) {
   Signal* x = signal("x");
-  Filter* f = make("Frequency", {{"input_signal", std::string("x")}, {"max_rate", 20.0}, {"window", 3.0},
-                                 {"event_onset", std::string("EVT_X")}});
+  Filter* f = make(
+      "Frequency",
+      {{"input_signal", std::string("x")}, {"max_rate", 20.0}, {"window", 3.0}, {"event_onset", std::string("EVT_X")}});
   for (double t : {0.0, 0.1, 0.2, 0.3, 0.32}) feed(x, f, t, 0);  // 10 Hz, then 0.1 0.1 0.02: 13.6 Hz
   EXPECT_TRUE(events_.empty());
   feed(x, f, 0.34, 0);  // 0.1 0.02 0.02: 21.4 Hz
@@ -190,7 +201,9 @@ TEST_F(FrequencyFilter, MeanRateAboveMaxRateRaises) {
 
 TEST_F(FrequencyFilter, IntervalFarFromTheMeanIsJitter) {
   Signal* x = signal("x");
-  Filter* f = make("Frequency", {{"input_signal", std::string("x")}, {"max_jitter", 0.02}, {"window", 4.0},
+  Filter* f = make("Frequency", {{"input_signal", std::string("x")},
+                                 {"max_jitter", 0.02},
+                                 {"window", 4.0},
                                  {"event_onset", std::string("EVT_X")}});
   for (double t : {1.0, 1.1, 1.2, 1.3, 1.4}) feed(x, f, t, 0);
   feed(x, f, 1.515, 0);  // 0.115 vs mean 0.10375: 0.01125, within
@@ -205,8 +218,11 @@ TEST_F(FrequencyFilter, IntervalFarFromTheMeanIsJitter) {
 
 TEST_F(FrequencyFilter, JudgedOnlyOnceTheWindowIsFull) {
   Signal* x = signal("x");
-  Filter* f = make("Period", {{"input_signal", std::string("x")}, {"min_rate", 100.0}, {"window", 5.0},
-                              {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("rate")}});
+  Filter* f = make("Period", {{"input_signal", std::string("x")},
+                              {"min_rate", 100.0},
+                              {"window", 5.0},
+                              {"event_onset", std::string("EVT_X")},
+                              {"output_signal", std::string("rate")}});
   for (double t : {1.0, 2.0, 3.0, 4.0, 5.0}) feed(x, f, t, 0);  // four intervals at 1 Hz
   EXPECT_TRUE(events_.empty());
   EXPECT_EQ(count_of("rate"), 0u);
@@ -221,8 +237,11 @@ TEST_F(FrequencyFilter, JudgedOnlyOnceTheWindowIsFull) {
 
 TEST_F(DutyCycleFilter, ExecutionTimeAboveMaxDutyOfThePeriodRaises) {
   Signal* x = signal("exec");
-  Filter* f = make("DutyCycle", {{"input_signal", std::string("exec")}, {"period", 0.01}, {"max_duty", 0.8},
-                                 {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("duty")}});
+  Filter* f = make("DutyCycle", {{"input_signal", std::string("exec")},
+                                 {"period", 0.01},
+                                 {"max_duty", 0.8},
+                                 {"event_onset", std::string("EVT_X")},
+                                 {"output_signal", std::string("duty")}});
   feed(x, f, 1.00, 0.005);
   feed(x, f, 1.01, 0.009);
   feed(x, f, 1.02, 0.0085);
@@ -238,7 +257,8 @@ TEST_F(DutyCycleFilter, ExecutionTimeAboveMaxDutyOfThePeriodRaises) {
 
 TEST_F(DutyCycleFilter, DefaultMaxDutyIsEightyPercent) {
   Signal* x = signal("exec");
-  Filter* f = make("DutyCycle", {{"input_signal", std::string("exec")}, {"period", 2.0}, {"event_onset", std::string("EVT_X")}});
+  Filter* f = make("DutyCycle",
+                   {{"input_signal", std::string("exec")}, {"period", 2.0}, {"event_onset", std::string("EVT_X")}});
   feed(x, f, 1.0, 1.5);  // 0.75
   EXPECT_TRUE(events_.empty());
   feed(x, f, 2.0, 1.75);  // 0.875
@@ -248,8 +268,10 @@ TEST_F(DutyCycleFilter, DefaultMaxDutyIsEightyPercent) {
 // ---- Deadline ---------------------------------------------------------------------------------
 
 Params deadline_params(double deadline) {
-  return {{"input_signals", std::vector<std::string>{"start", "end"}}, {"deadline", deadline},
-          {"event_onset", std::string("EVT_X")}, {"output_signal", std::string("elapsed")}};
+  return {{"input_signals", std::vector<std::string>{"start", "end"}},
+          {"deadline", deadline},
+          {"event_onset", std::string("EVT_X")},
+          {"output_signal", std::string("elapsed")}};
 }
 
 TEST_F(DeadlineFilter, LateEndRaisesAndAPairWithinTheDeadlineClears) {

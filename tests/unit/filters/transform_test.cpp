@@ -215,7 +215,8 @@ TEST_F(ArithmeticFilter, EachOperationOnTwoVectorSignalsElementWise) {
   Signal* b = signal("b", 2);
   for (const char* op : kOperations) {
     make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
-                        {"output_signal", std::string("r_") + op}, {"operation", std::string(op)}});
+                        {"output_signal", std::string("r_") + op},
+                        {"operation", std::string(op)}});
   }
   push(a, 1.0, {6, 1});
   push(b, 1.0, {4, -2});
@@ -232,7 +233,8 @@ TEST_F(ArithmeticFilter, EachOperationOnTwoVectorSignalsElementWise) {
 TEST_F(ArithmeticFilter, TwoSignalsWaitForBothThenUseTheNewestOfEach) {
   Signal* a = signal("a");
   Signal* b = signal("b");
-  make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}}, {"output_signal", std::string("d")},
+  make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b"}},
+                      {"output_signal", std::string("d")},
                       {"operation", std::string("subtract")}});
   push(a, 1.0, 10);
   run_all(1.0);
@@ -262,8 +264,8 @@ TEST_F(ArithmeticFilter, NeedsExactlyOneOfInputSignalAndInputSignals) {
   auto neither = try_make("Arithmetic", {{"output_signal", std::string("r")}, {"operand", 1.0}});
   ASSERT_FALSE(neither);
   EXPECT_NE(neither.error().message.find("'input_signal"), std::string::npos) << neither.error().message;
-  auto three = try_make("Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b", "a"}},
-                                       {"output_signal", std::string("r")}});
+  auto three = try_make(
+      "Arithmetic", {{"input_signals", std::vector<std::string>{"a", "b", "a"}}, {"output_signal", std::string("r")}});
   ASSERT_FALSE(three);
   EXPECT_NE(three.error().message.find("'input_signals'"), std::string::npos) << three.error().message;
   EXPECT_EQ(monitor_.filters().size(), 0u);
@@ -276,7 +278,8 @@ TEST_F(VectorizeFilter, ScalarsBecomeOneVectorOnceEveryInputHasASample) {
   Signal* x = signal("x");
   Signal* y = signal("y");
   Signal* z = signal("z");
-  make("Vectorize", {{"input_signals", std::vector<std::string>{"x", "y", "z"}}, {"output_signal", std::string("xyz")}});
+  make("Vectorize",
+       {{"input_signals", std::vector<std::string>{"x", "y", "z"}}, {"output_signal", std::string("xyz")}});
   ASSERT_EQ(monitor_.signals().find("C.xyz")->size(), 3u);
   push(x, 1.0, 1);
   run_all(1.0);
@@ -297,7 +300,8 @@ TEST_F(VectorizeFilter, ScalarsBecomeOneVectorOnceEveryInputHasASample) {
 TEST_F(VectorizeFilter, VectorInputsAreRejected) {
   signal("x");
   signal("v", 2);
-  auto f = try_make("Vectorize", {{"input_signals", std::vector<std::string>{"x", "v"}}, {"output_signal", std::string("o")}});
+  auto f = try_make("Vectorize",
+                    {{"input_signals", std::vector<std::string>{"x", "v"}}, {"output_signal", std::string("o")}});
   ASSERT_FALSE(f);
   EXPECT_NE(f.error().message.find("'C.v'"), std::string::npos) << f.error().message;
   EXPECT_EQ(monitor_.signals().find("C.o"), nullptr);

@@ -31,11 +31,13 @@ struct Robot {
 
   Robot() {
     register_builtin_filters(registry);
-    const spec::LoadResult load = spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json", registry);
+    const spec::LoadResult load =
+        spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json", registry);
     EXPECT_TRUE(load.ok());
     EXPECT_TRUE(spec::instantiate(*load.system, co, monitor, "robot"));
     co.subscribe([this](const Record& r) { injections += r.kind == RecordKind::Injection ? 1 : 0; });
-    control = detail::make_control(detail::ControlContext{co, monitor, registry, "robot", true, kToken, [](const std::string&) {}});
+    control = detail::make_control(
+        detail::ControlContext{co, monitor, registry, "robot", true, kToken, [](const std::string&) {}});
   }
 
   /// The message of the OperationError `call` throws, or "(accepted)".
@@ -53,12 +55,19 @@ struct Robot {
 TEST(ControlServant, RefusesToInjectANonFiniteValueOnEveryWritePathAndChangesNothing) {
   Robot r;
   const Ice::Current current{};
-  EXPECT_EQ(r.refusal([&] { r.control->filterInject(kToken, "force_limit", {{10.0}, {kInf}}, current); }),
-            "shallow injection into filter force_limit: sample 2 is inf, not a finite number: injected values must be finite");
+  EXPECT_EQ(r.refusal([&] {
+    r.control->filterInject(kToken, "force_limit", {{10.0}, {kInf}}, current);
+  }),
+            "shallow injection into filter force_limit: sample 2 is inf, not a finite number: injected values must be "
+            "finite");
   EXPECT_EQ(r.refusal([&] { r.control->filterInject(kToken, "force_limit", {{-kInf}}, current); }),
-            "shallow injection into filter force_limit: sample 1 is -inf, not a finite number: injected values must be finite");
-  EXPECT_EQ(r.refusal([&] { r.control->filterDinject(kToken, "JR3.Force", {{0.0, kNaN, 0.0}}, current); }),
-            "deep injection into signal JR3.Force: sample 1 value 2 is nan, not a finite number: injected values must be finite");
+            "shallow injection into filter force_limit: sample 1 is -inf, not a finite number: injected values must be "
+            "finite");
+  EXPECT_EQ(r.refusal([&] {
+    r.control->filterDinject(kToken, "JR3.Force", {{0.0, kNaN, 0.0}}, current);
+  }),
+            "deep injection into signal JR3.Force: sample 1 value 2 is nan, not a finite number: injected values must "
+            "be finite");
   EXPECT_EQ(r.refusal([&] { r.control->filterDinload(kToken, "JR3.Force", "0 0 10\n0, 0, inf\n", current); }),
             "filter dinload JR3.Force: line 2: 'inf' is not a finite number: injected values must be finite");
   EXPECT_EQ(r.refusal([&] { r.control->filterDinload(kToken, "JR3.Force", "nan 0 0\n", current); }),

@@ -153,7 +153,6 @@ TEST(BusKeys, LoopbackHostsAreRecognised) {
   EXPECT_FALSE(is_loopback_host("robot.example"));
 }
 
-
 // ---- the publisher's snapshot: service_roots() built from the conditions ----------------------
 
 /// The full state of a service as the publisher used to build it: from explain() of the service
@@ -265,8 +264,10 @@ TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
         ASSERT_EQ(text_of(got), text_of(roots_from_explain(co, c, p)))
             << "step " << step << ", service " << name << " #" << p;
         if (std::string(name) == "A" && p == 0) {
-          const bool any_remote = std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] == 'S'; });
-          const bool any_local = std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] != 'S'; });
+          const bool any_remote =
+              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] == 'S'; });
+          const bool any_local =
+              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] != 'S'; });
           mixed += any_remote && any_local ? 1 : 0;
         }
       }

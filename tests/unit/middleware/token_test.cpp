@@ -65,8 +65,10 @@ public:
     if (const char* v = std::getenv(name)) value_ = v;
   }
   ~EnvGuard() {
-    if (value_) ::setenv(name_, value_->c_str(), 1);
-    else ::unsetenv(name_);
+    if (value_)
+      ::setenv(name_, value_->c_str(), 1);
+    else
+      ::unsetenv(name_);
   }
 
 private:
@@ -132,8 +134,8 @@ TEST_F(TokenFileTest, AnExistingFileThatIsNotATokenFileOfOursIsNeitherOverwritte
     auto file = TokenFile::create(path);
     ASSERT_FALSE(file) << c.name;
     EXPECT_EQ(file.error().code, ErrorCode::Io);
-    EXPECT_EQ(file.error().message, "token file " + path + ": exists and is not a SAFECASS token file of yours (" + c.why +
-                                        "): refusing to overwrite it; remove it or choose another path");
+    EXPECT_EQ(file.error().message, "token file " + path + ": exists and is not a SAFECASS token file of yours (" +
+                                        c.why + "): refusing to overwrite it; remove it or choose another path");
     EXPECT_EQ(read_text(path), c.text) << c.name << " is unchanged";
     EXPECT_EQ(mode_of(path), c.mode) << c.name;
   }
@@ -191,9 +193,10 @@ TEST_F(TokenFileTest, TwoProcessesGivenOnePathDoNotOverwriteEachOther) {
   const std::string first = read_text(path);
   auto second = TokenFile::create(path);
   ASSERT_FALSE(second);
-  EXPECT_EQ(second.error().message, "token file " + path +
-                                        ": is the token file of a running process (it holds the file's lock): two processes "
-                                        "cannot share a token file; choose another path");
+  EXPECT_EQ(second.error().message,
+            "token file " + path +
+                ": is the token file of a running process (it holds the file's lock): two processes "
+                "cannot share a token file; choose another path");
   EXPECT_EQ(read_text(path), first) << "the running process's token is intact";
   (void)!::write(stop[1], "x", 1);
   int status = 0;

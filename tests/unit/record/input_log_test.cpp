@@ -71,7 +71,8 @@ std::string read_all(const std::string& path, std::string* error = nullptr, bool
     char buf[256];
     switch (item) {
       case InputLogReader::Item::Sample: {
-        std::snprintf(buf, sizeof buf, "S %s %g [", (*r)->signal_name((*r)->signal()).c_str(), to_seconds((*r)->time()));
+        std::snprintf(buf, sizeof buf, "S %s %g [", (*r)->signal_name((*r)->signal()).c_str(),
+                      to_seconds((*r)->time()));
         out += buf;
         for (std::size_t i = 0; i < (*r)->width(); ++i) out += (i ? " " : "") + std::to_string((*r)->values()[i]);
         out += "]\n";
@@ -79,8 +80,8 @@ std::string read_all(const std::string& path, std::string* error = nullptr, bool
       }
       case InputLogReader::Item::Action: {
         const InputAction& a = (*r)->action();
-        std::snprintf(buf, sizeof buf, "A %d %g %s|%s|%s|%zu\n", static_cast<int>(a.kind), to_seconds(a.time), a.a.c_str(),
-                      a.b.c_str(), a.c.c_str(), a.values.size());
+        std::snprintf(buf, sizeof buf, "A %d %g %s|%s|%s|%zu\n", static_cast<int>(a.kind), to_seconds(a.time),
+                      a.a.c_str(), a.b.c_str(), a.c.c_str(), a.values.size());
         out += buf;
         break;
       }
@@ -182,11 +183,13 @@ TEST(InputLogReader, AFileThatIsNotARecordingIsRefusedAtItsFirstLine) {
   spit(path, "time,JR3.Fz\n0,1\n");
   auto r = InputLogReader::open(path);
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().message, path + ":1: not a SAFECASS input recording (the first line must start with \"SAFECASS-INPUTS 1\")");
+  EXPECT_EQ(r.error().message,
+            path + ":1: not a SAFECASS input recording (the first line must start with \"SAFECASS-INPUTS 1\")");
   spit(path, "SAFECASS-INPUTS 7 period_ns=1\n");
   r = InputLogReader::open(path);
   ASSERT_FALSE(r);
-  EXPECT_EQ(r.error().message, path + ":1: recording format version 7 is not supported (this safecass reads version 1)");
+  EXPECT_EQ(r.error().message,
+            path + ":1: recording format version 7 is not supported (this safecass reads version 1)");
 }
 
 TEST(InputLogReader, AnUnknownRecordIsAnErrorWithItsIndexAndByteOffset) {
@@ -248,7 +251,8 @@ TEST_F(InputRecording, SamplesOverwrittenBeforeTheRecorderReadThemAreCountedMark
   const auto losses = describe_losses(s);
   ASSERT_EQ(losses.size(), 1u);
   EXPECT_EQ(losses[0], "input recording '" + path +
-                           "': 1977 samples lost: overwritten in their signal's history buffer before the recorder read them (a loss record marks where)");
+                           "': 1977 samples lost: overwritten in their signal's history buffer before the recorder "
+                           "read them (a loss record marks where)");
   EXPECT_THAT(record_status_json(s), HasSubstr("\"lost\":1977,"));
 }
 
@@ -292,7 +296,8 @@ TEST_F(InputRecording, SamplesThatFindTheQueueToTheDiskFullAreDroppedCountedAndM
     reader = std::thread([&] {
       std::this_thread::sleep_for(std::chrono::milliseconds(300));
       char buffer[65536];
-      for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;) text.append(buffer, static_cast<std::size_t>(n));
+      for (ssize_t n; (n = ::read(fds[0], buffer, sizeof buffer)) > 0;)
+        text.append(buffer, static_cast<std::size_t>(n));
     });
     auto rec = InputRecorder::open(monitor_, "/proc/self/fd/" + std::to_string(fds[1]), o);
     ASSERT_TRUE(rec) << rec.error().message;

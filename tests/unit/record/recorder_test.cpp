@@ -19,8 +19,8 @@
 namespace safecass {
 namespace {
 
-using ::testing::HasSubstr;
 using test::Gcm;
+using ::testing::HasSubstr;
 
 /// A component with one error onset and its completion; `rounds` faults raised and cleared make
 /// four records each (event, transition, event, transition) and a component transition each way.
@@ -55,7 +55,8 @@ TEST(Recorder, AWriteErrorIsKeptWithItsReasonAndTheSystemKeepsRunning) {
   ASSERT_EQ(losses.size(), 1u);
   EXPECT_THAT(losses[0], HasSubstr("history file '/dev/full': write error after 0 records: No space left on device"));
   EXPECT_THAT(losses[0], HasSubstr(std::to_string(s.unwritten) + " records were not written"));
-  EXPECT_THAT(record_status_json(s), HasSubstr("\"write_error\":true,\"error\":\"No space left on device\",\"complete\":false"));
+  EXPECT_THAT(record_status_json(s),
+              HasSubstr("\"write_error\":true,\"error\":\"No space left on device\",\"complete\":false"));
 }
 
 TEST(Recorder, AFileThatCannotBeCreatedIsAnIoErrorWithPathAndReason) {
@@ -63,7 +64,8 @@ TEST(Recorder, AFileThatCannotBeCreatedIsAnIoErrorWithPathAndReason) {
   auto recorder = Recorder::open(m.co, "/nonexistent-dir/h.jsonl");
   ASSERT_FALSE(recorder);
   EXPECT_EQ(recorder.error().code, ErrorCode::Io);
-  EXPECT_EQ(recorder.error().message, "cannot write history file '/nonexistent-dir/h.jsonl': No such file or directory");
+  EXPECT_EQ(recorder.error().message,
+            "cannot write history file '/nonexistent-dir/h.jsonl': No such file or directory");
 }
 
 TEST(Recorder, AHistoryWithNothingLostIsCompleteAndSaysNothing) {
@@ -77,7 +79,8 @@ TEST(Recorder, AHistoryWithNothingLostIsCompleteAndSaysNothing) {
   EXPECT_TRUE(s.complete());
   EXPECT_GT(s.written, 0u);
   EXPECT_TRUE(describe_losses(s).empty());
-  EXPECT_THAT(record_status_json(s), HasSubstr("\"dropped\":0,\"unwritten\":0,\"write_error\":false,\"complete\":true}"));
+  EXPECT_THAT(record_status_json(s),
+              HasSubstr("\"dropped\":0,\"unwritten\":0,\"write_error\":false,\"complete\":true}"));
   ::unlink(path.c_str());
 }
 

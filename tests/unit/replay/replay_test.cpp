@@ -181,10 +181,11 @@ TEST(ReplayDiff, ALowerForceLimitDiffersFromTheOriginalExactlyWhereTheForceIsBet
   EXPECT_EQ(r.code, 1) << r.err;
   // The force ramps 5 → 40 N over 0.2..0.6 s and back over 0.6..1.0 s: above 27 N from 0.452 s,
   // above 30 N from 0.486 s; down to 28 N at 0.738 s (A clears), to 25 N at 0.772 s (B clears).
-  EXPECT_THAT(r.out, HasSubstr("JR3.s_A\n"
-                               "  0.452000 .. 0.486000 s  B Error, A Warning  first cause (B): JR3.s_A:EVT_FORCE_ERROR "
-                               "[filter force_limit, JR3.ForceNorm = 27.05]\n"
-                               "  0.738000 .. 0.772000 s  B Error, A Warning  first cause (B): JR3.s_A:EVT_FORCE_ERROR "));
+  EXPECT_THAT(r.out,
+              HasSubstr("JR3.s_A\n"
+                        "  0.452000 .. 0.486000 s  B Error, A Warning  first cause (B): JR3.s_A:EVT_FORCE_ERROR "
+                        "[filter force_limit, JR3.ForceNorm = 27.05]\n"
+                        "  0.738000 .. 0.772000 s  B Error, A Warning  first cause (B): JR3.s_A:EVT_FORCE_ERROR "));
   EXPECT_THAT(r.out, HasSubstr("CONTROL\n  0.452000 .. 0.486000 s  B Error, A Normal"));
   EXPECT_THAT(r.out, Not(HasSubstr("BMM")));
   EXPECT_THAT(r.out, HasSubstr("differ at "));

@@ -93,7 +93,8 @@ TEST(Ros1Bridge, TheExampleBuildsTheRobotCoordinatorWithTopicSignalsAndTimingFil
   ASSERT_NE(mon.find_filter("ros/jr3/wrench:watchdog"), nullptr);
   EXPECT_EQ(mon.find_filter("ros/jr3/wrench:watchdog")->type(), "Watchdog");
   ASSERT_NE(mon.find_filter("ros/jr3/wrench:frequency"), nullptr);
-  for (const char* e : {"EVT_ROS_DIAG_WARN", "/EVT_ROS_DIAG_ERROR", "EVT_ROS_GRAPH_MISSING", "EVT_WRENCH_TOPIC_STALE"}) {
+  for (const char* e :
+       {"EVT_ROS_DIAG_WARN", "/EVT_ROS_DIAG_ERROR", "EVT_ROS_GRAPH_MISSING", "EVT_WRENCH_TOPIC_STALE"}) {
     EXPECT_TRUE(co.find_event(e)) << e;
   }
   EXPECT_EQ((*bridge)->status_name("JR3.s_A"), "safecass: JR3.s_A");
@@ -105,7 +106,8 @@ TEST(Ros1Bridge, AddLoopChecksTheComponentAndPeriod) {
   auto bridge = Bridge::create("examples/ros_robodoc/mapping.json", registry);
   ASSERT_TRUE(bridge) << bridge.error().message;
   EXPECT_TRUE((*bridge)->add_loop("CONTROL", std::chrono::milliseconds(10), [](Time) {}));
-  EXPECT_EQ((*bridge)->add_loop("CONTROL", std::chrono::milliseconds(10), [](Time) {}).error().code, ErrorCode::InvalidArgument);
+  EXPECT_EQ((*bridge)->add_loop("CONTROL", std::chrono::milliseconds(10), [](Time) {}).error().code,
+            ErrorCode::InvalidArgument);
   EXPECT_EQ((*bridge)->add_loop("NOPE", std::chrono::milliseconds(10), [](Time) {}).error().code, ErrorCode::NotFound);
   EXPECT_EQ((*bridge)->add_loop("JR3", Time{0}, [](Time) {}).error().code, ErrorCode::InvalidArgument);
   // start() without ros::init() is refused, not a crash.

@@ -60,7 +60,8 @@ TEST_F(ReadRegularFile, ReadsARegularFileWhole) {
 
 TEST_F(ReadRegularFile, RefusesDevicesFifosDirectoriesAndMissingFilesSayingWhatAndWhere) {
   const auto started = std::chrono::steady_clock::now();
-  EXPECT_EQ(error_of(read_regular_file("/dev/zero")), "cannot read file '/dev/zero': not a regular file (a character device)");
+  EXPECT_EQ(error_of(read_regular_file("/dev/zero")),
+            "cannot read file '/dev/zero': not a regular file (a character device)");
   const std::string f = fifo("samples.fifo");
   EXPECT_EQ(error_of(read_regular_file(f)), "cannot read file '" + f + "': not a regular file (a FIFO)");
   EXPECT_EQ(error_of(read_regular_file(dir_)), "cannot read file '" + dir_ + "': not a regular file (a directory)");
@@ -73,24 +74,27 @@ TEST_F(ReadRegularFile, RefusesDevicesFifosDirectoriesAndMissingFilesSayingWhatA
 
 TEST_F(ReadRegularFile, RefusesAFileLargerThanTheLimitFromItsSize) {
   const std::string big = sparse("big.txt", static_cast<off_t>(kMaxInputFileBytes) + 1);
-  EXPECT_EQ(error_of(read_regular_file(big)),
-            "cannot read file '" + big + "': larger than 64 MiB (" + std::to_string(kMaxInputFileBytes + 1) + " bytes)");
+  EXPECT_EQ(error_of(read_regular_file(big)), "cannot read file '" + big + "': larger than 64 MiB (" +
+                                                  std::to_string(kMaxInputFileBytes + 1) + " bytes)");
   const std::string exact = sparse("exact.txt", 1000);
   EXPECT_TRUE(read_regular_file(exact, 1000));
-  EXPECT_EQ(error_of(read_regular_file(exact, 999)), "cannot read file '" + exact + "': larger than 999 bytes (1000 bytes)");
+  EXPECT_EQ(error_of(read_regular_file(exact, 999)),
+            "cannot read file '" + exact + "': larger than 999 bytes (1000 bytes)");
 }
 
 TEST_F(ReadRegularFile, ScenarioLoaderRefusesDevicesFifosDirectoriesAndHugeFilesWithTheirPosition) {
   const std::string f = fifo("scenario.fifo");
   const std::string big = sparse("scenario.json", static_cast<off_t>(kMaxInputFileBytes) + 1);
-  for (const auto& [path, why] : {std::pair<std::string, std::string>{"/dev/zero", "not a regular file (a character device)"},
-                                  {f, "not a regular file (a FIFO)"},
-                                  {dir_, "not a regular file (a directory)"},
-                                  {big, "larger than 64 MiB"}}) {
+  for (const auto& [path, why] :
+       {std::pair<std::string, std::string>{"/dev/zero", "not a regular file (a character device)"},
+        {f, "not a regular file (a FIFO)"},
+        {dir_, "not a regular file (a directory)"},
+        {big, "larger than 64 MiB"}}) {
     const ScenarioLoad load = load_scenario(path);
     EXPECT_FALSE(load.scenario) << path;
     ASSERT_EQ(load.diagnostics.size(), 1u) << path;
-    EXPECT_THAT(format(load.diagnostics[0]), ::testing::StartsWith(path + ":1:1: error: cannot read file '" + path + "': " + why));
+    EXPECT_THAT(format(load.diagnostics[0]),
+                ::testing::StartsWith(path + ":1:1: error: cannot read file '" + path + "': " + why));
   }
 }
 
@@ -107,7 +111,8 @@ TEST_F(ReadRegularFile, SystemLoaderRefusesAFifoOrADeviceWithoutHanging) {
   const std::string big = sparse("huge.json", (std::size_t{16} << 20) + 1);
   const LoadResult r = load_system(big, registry);
   ASSERT_FALSE(r.diagnostics.empty());
-  EXPECT_THAT(r.diagnostics[0].message, ::testing::HasSubstr("larger than 16 MiB")) << "a system file keeps its 16 MiB limit";
+  EXPECT_THAT(r.diagnostics[0].message, ::testing::HasSubstr("larger than 16 MiB"))
+      << "a system file keeps its 16 MiB limit";
 }
 
 }  // namespace

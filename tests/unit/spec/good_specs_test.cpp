@@ -99,8 +99,8 @@ TEST(GoodSpecs, RobodocInstantiatesEveryComponentMachineAndFilter) {
   EXPECT_EQ(co.event_count(), framework_event::kCount + 9);
   EXPECT_EQ(co.connections().size(), 2u);
   EXPECT_EQ(monitor.filters().size(), 10u);
-  for (const char* name : {"force_norm", "force_limit", "force_warn", "force_spike.1", "force_spike.2",
-                           "force_spike.3", "heartbeat", "tracking.1", "tracking.2", "servo_duty"}) {
+  for (const char* name : {"force_norm", "force_limit", "force_warn", "force_spike.1", "force_spike.2", "force_spike.3",
+                           "heartbeat", "tracking.1", "tracking.2", "servo_duty"}) {
     EXPECT_NE(monitor.find_filter(name), nullptr) << name;
   }
   EXPECT_NE(monitor.signals().find("JR3.ForceNorm"), nullptr);

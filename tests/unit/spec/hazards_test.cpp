@@ -18,7 +18,8 @@ const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 std::string arm_system(const std::string& sections, const std::string& hazard = "H-3") {
   return R"({"safecass": 1, "system": "arm", )" + sections + R"(
   "components": [{"component": "ARM", "interfaces": {"provided": ["Motion"]}, "signals": [{"name": "Force"}],
-    "event": [{"name": "EVT_F", "severity": 50, "state_transition": ["N2E"], "hazard": ")" + hazard + R"("},
+    "event": [{"name": "EVT_F", "severity": 50, "state_transition": ["N2E"], "hazard": ")" +
+         hazard + R"("},
               {"name": "/EVT_F", "severity": 50, "state_transition": ["E2N"]}],
     "filter": [{"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 1,
                 "event_onset": "EVT_F", "event_completion": "/EVT_F"}}]}]})";
@@ -40,7 +41,8 @@ TEST(SpecHazards, RobodocDeclaresItsHazardsWithReactionsOnControlAndServo) {
   ASSERT_EQ(s.invariants.size(), 1u);
   EXPECT_EQ(s.invariants[0].name, "servo_follows_control");
   // Every hazard has a linked onset: no "no linked event" warning.
-  for (const Diagnostic& d : r.diagnostics) EXPECT_EQ(d.message.find("no linked event"), std::string::npos) << format(d);
+  for (const Diagnostic& d : r.diagnostics)
+    EXPECT_EQ(d.message.find("no linked event"), std::string::npos) << format(d);
 }
 
 TEST(SpecHazards, EventPositionsAreKeptForEveryEvent) {
@@ -59,7 +61,8 @@ TEST(SpecHazards, WithoutAHazardsSectionHazardIdsAreFreeText) {
 }
 
 TEST(SpecHazards, UnknownHazardIdIsAnErrorAtTheEventsHazardField) {
-  const LoadResult r = load_system_from_text(arm_system(R"("hazards": [{"id": "H-3"}],)", "H-4"), "arm.json", builtin_registry());
+  const LoadResult r =
+      load_system_from_text(arm_system(R"("hazards": [{"id": "H-3"}],)", "H-4"), "arm.json", builtin_registry());
   ASSERT_EQ(r.errors(), 1u);
   const auto error = std::find_if(r.diagnostics.begin(), r.diagnostics.end(),
                                   [](const Diagnostic& d) { return d.severity == Diagnostic::Severity::Error; });
@@ -69,8 +72,8 @@ TEST(SpecHazards, UnknownHazardIdIsAnErrorAtTheEventsHazardField) {
 
 TEST(SpecHazards, ReactionOnAnAddressThatDoesNotExistIsAnError) {
   const LoadResult r = load_system_from_text(
-      arm_system(R"("hazards": [{"id": "H-3", "reaction": {"ARM.s_S.Motion": "Error", "ARM.s_P.Nope": "Error"}}],)"), "arm.json",
-      builtin_registry());
+      arm_system(R"("hazards": [{"id": "H-3", "reaction": {"ARM.s_S.Motion": "Error", "ARM.s_P.Nope": "Error"}}],)"),
+      "arm.json", builtin_registry());
   ASSERT_EQ(r.errors(), 1u);
   EXPECT_THAT(r.diagnostics[0].message, ::testing::HasSubstr("'ARM.s_P.Nope', which does not exist"));
 }
@@ -145,9 +148,9 @@ TEST(InvariantGrammar, ErrorsSayWhatAndWhere) {
     const char* message;
     std::size_t offset;
   };
-  for (const Case& c : {Case{"", "ends where", 0}, Case{"A == Error)", "after the end", 10}, Case{"A = Error", "comparison", 2},
-                        Case{"(A == Error", "to close", 11}, Case{"A == Fine", "expected a level", 5},
-                        Case{"[] && A == Error", "expected an address", 3}}) {
+  for (const Case& c : {Case{"", "ends where", 0}, Case{"A == Error)", "after the end", 10},
+                        Case{"A = Error", "comparison", 2}, Case{"(A == Error", "to close", 11},
+                        Case{"A == Fine", "expected a level", 5}, Case{"[] && A == Error", "expected an address", 3}}) {
     const auto f = parse_formula(c.text);
     ASSERT_FALSE(f) << c.text;
     EXPECT_THAT(f.error().message, ::testing::HasSubstr(c.message)) << c.text;

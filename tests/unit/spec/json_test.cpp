@@ -25,7 +25,8 @@ JsonError parse_error(std::string_view text, int max_depth = 64) {
 }
 
 TEST(JsonReader, ReadsEveryKindOfValue) {
-  const JsonValue v = parse_ok(R"({"s": "x", "n": -1.5e2, "i": 42, "t": true, "f": false, "z": null, "a": [1, "2"], "o": {}})");
+  const JsonValue v =
+      parse_ok(R"({"s": "x", "n": -1.5e2, "i": 42, "t": true, "f": false, "z": null, "a": [1, "2"], "o": {}})");
   ASSERT_TRUE(v.is_object());
   EXPECT_EQ(v.find("s")->string, "x");
   EXPECT_DOUBLE_EQ(v.find("n")->number, -150.0);
@@ -169,13 +170,16 @@ TEST(JsonReader, StreamsTheElementsOfOneListOfTheRootObjectAndKeepsTheRestAsATre
 
   // Errors are as parse_json's, with their positions; the elements before them were handed.
   seen.clear();
-  const JsonParse bad = parse_json_streaming("{\"steps\": [1, 2,]}", "steps",
-                                             [&](std::size_t index, JsonValue&& e) { seen.emplace_back(index, std::move(e)); });
+  const JsonParse bad = parse_json_streaming("{\"steps\": [1, 2,]}", "steps", [&](std::size_t index, JsonValue&& e) {
+    seen.emplace_back(index, std::move(e));
+  });
   ASSERT_TRUE(bad.error);
   EXPECT_EQ(bad.error->message, "trailing comma before ']'");
   EXPECT_EQ(bad.error->position.column, 17);
   EXPECT_EQ(seen.size(), 2u);
-  EXPECT_EQ(parse_json_streaming("{\"steps\": [[[1]]]}", "steps", [](std::size_t, JsonValue&&) {}, 2).error->message,
+  EXPECT_EQ(parse_json_streaming(
+                "{\"steps\": [[[1]]]}", "steps", [](std::size_t, JsonValue&&) {}, 2)
+                .error->message,
             "nesting deeper than 2 levels");
 }
 

@@ -43,7 +43,8 @@ TEST(SpecDiagnostics, FormatLikeACompiler) {
 
 TEST(SpecDiagnostics, ConvertToOneLineJson) {
   const Diagnostic d{Diagnostic::Severity::Error, {"a.json", 3, 7}, "say \"x\"", "/a~1b"};
-  EXPECT_EQ(to_json(d), R"({"file":"a.json","line":3,"column":7,"severity":"error","message":"say \"x\"","pointer":"/a~1b"})");
+  EXPECT_EQ(to_json(d),
+            R"({"file":"a.json","line":3,"column":7,"severity":"error","message":"say \"x\"","pointer":"/a~1b"})");
 }
 
 TEST(SpecLoad, TheBaseComponentHasNoDiagnostic) {
@@ -62,32 +63,34 @@ TEST(SpecLoad, ReportsEveryProblemAtOnceSortedByPosition) {
   "filter": [{"class_name": "Nope"}, {"name": 3}],
   "period": -1
 })");
-  EXPECT_EQ(formatted(r),
-            "tests/data/inline.json:3:3: error: component 'ARM': unknown key 'evnt'; did you mean 'event'? [/evnt]\n"
-            "tests/data/inline.json:4:41: error: signal 'Force': 'size' must be within 1-4096, not 0 [/signals/0/size]\n"
-            "tests/data/inline.json:5:29: error: filter 'ARM.Nope_1': unknown filter class 'Nope'; did you mean 'NOP'? "
-            "[/filter/0/class_name]\n"
-            "tests/data/inline.json:5:38: error: filter: missing required key 'class_name' (filter type, e.g. Threshold "
-            "(2016 names such as FilterThreshold are accepted)) [/filter/1]\n"
-            "tests/data/inline.json:5:47: error: filter: 'name' must be a string, not a number [/filter/1/name]\n"
-            "tests/data/inline.json:6:13: error: component 'ARM': 'period' must be greater than 0, not -1 [/period]\n");
+  EXPECT_EQ(
+      formatted(r),
+      "tests/data/inline.json:3:3: error: component 'ARM': unknown key 'evnt'; did you mean 'event'? [/evnt]\n"
+      "tests/data/inline.json:4:41: error: signal 'Force': 'size' must be within 1-4096, not 0 [/signals/0/size]\n"
+      "tests/data/inline.json:5:29: error: filter 'ARM.Nope_1': unknown filter class 'Nope'; did you mean 'NOP'? "
+      "[/filter/0/class_name]\n"
+      "tests/data/inline.json:5:38: error: filter: missing required key 'class_name' (filter type, e.g. Threshold "
+      "(2016 names such as FilterThreshold are accepted)) [/filter/1]\n"
+      "tests/data/inline.json:5:47: error: filter: 'name' must be a string, not a number [/filter/1/name]\n"
+      "tests/data/inline.json:6:13: error: component 'ARM': 'period' must be greater than 0, not -1 [/period]\n");
   EXPECT_EQ(r.errors(), 6u);
   EXPECT_FALSE(r.system);
 }
 
 TEST(SpecLoad, UnknownFilterClassFarFromAnyKnownOneListsThem) {
   const LoadResult r = load_text(component("", R"(, {"class_name": "Kalman"})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "filter 'ARM.Kalman_2': unknown filter class 'Kalman' (known: Threshold, Range, OnOff, "
-                               "ChangeDetection, Debounce, Derivative, MovingAverage, Norm, Arithmetic, Vectorize, Bypass, "
-                               "NOP, Occurrence, Watchdog, Frequency, DutyCycle, Deadline)"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre(
+                  "filter 'ARM.Kalman_2': unknown filter class 'Kalman' (known: Threshold, Range, OnOff, "
+                  "ChangeDetection, Debounce, Derivative, MovingAverage, Norm, Arithmetic, Vectorize, Bypass, "
+                  "NOP, Occurrence, Watchdog, Frequency, DutyCycle, Deadline)"));
 }
 
 TEST(SpecLoad, UnknownKeyFarFromAnyKnownKeyListsTheKnownKeys) {
   const LoadResult r = load_text(R"({"component": "ARM", "colour": "red"})");
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "component 'ARM': unknown key 'colour' (known keys: $schema, safecass, component, "
-                               "description, interfaces, signals, event, filter, service, period)"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("component 'ARM': unknown key 'colour' (known keys: $schema, safecass, component, "
+                                     "description, interfaces, signals, event, filter, service, period)"));
 }
 
 TEST(SpecLoad, JsonPointersEscapeSlashAndTilde) {
@@ -98,12 +101,14 @@ TEST(SpecLoad, JsonPointersEscapeSlashAndTilde) {
 
 TEST(SpecLoad, AMissingFileIsAnErrorOnTheFileAsAWhole) {
   const LoadResult r = load_system("tests/data/no_such_file.json", builtin_registry());
-  EXPECT_EQ(formatted(r), "tests/data/no_such_file.json: error: cannot read file 'tests/data/no_such_file.json': no such file\n");
+  EXPECT_EQ(formatted(r),
+            "tests/data/no_such_file.json: error: cannot read file 'tests/data/no_such_file.json': no such file\n");
   EXPECT_FALSE(r.ok());
 }
 
 TEST(SpecLoad, AnIncludeThatCannotBeExaminedGivesTheSystemsReason) {
-  const LoadResult r = load_text(R"({"system": "s", "components": [{"include": ")" + std::string(5000, 'a') + R"("}]})");
+  const LoadResult r =
+      load_text(R"({"system": "s", "components": [{"include": ")" + std::string(5000, 'a') + R"("}]})");
   ASSERT_EQ(r.diagnostics.size(), 1u);
   EXPECT_THAT(r.diagnostics[0].message, HasSubstr("File name too long"));
 }
@@ -134,115 +139,156 @@ TEST(SpecLoad, AnEmptyIncludePathIsAnError) {
 }
 
 TEST(SpecLoad, UnnamedFiltersAreNamedAfterComponentTypeAndPosition) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "FilterNorm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
+  const LoadResult r = load_text(
+      component("", R"(, {"class_name": "FilterNorm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
   ASSERT_TRUE(r.system) << formatted(r);
   EXPECT_EQ(r.system->components[0].filters[1].stages[0].name, "ARM.Norm_2");
   EXPECT_EQ(r.system->components[0].filters[1].stages[0].type, "Norm");
 }
 
 TEST(SpecLoad, OnsetMustNotSayWhatItCompletes) {
-  const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"], "completes": "EVT_F"})"));
-  EXPECT_THAT(messages(r), ::testing::Contains("event 'EVT_G' is an onset: only a completion may say which onset it 'completes'"));
+  const LoadResult r = load_text(
+      component("", "", R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"], "completes": "EVT_F"})"));
+  EXPECT_THAT(messages(r),
+              ::testing::Contains("event 'EVT_G' is an onset: only a completion may say which onset it 'completes'"));
 }
 
 TEST(SpecLoad, CompletionMustBeNamedSlashOnsetOrSayWhatItCompletes) {
-  const LoadResult r = load_text(component("", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"]})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("completion 'F_CLEARED' must be named '/ONSET' or say which onset it 'completes'"));
+  const LoadResult r =
+      load_text(component("", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"]})"));
+  EXPECT_THAT(messages(r), ::testing::ElementsAre(
+                               "completion 'F_CLEARED' must be named '/ONSET' or say which onset it 'completes'"));
 }
 
 TEST(SpecLoad, CompletionMayNameItsOnsetExplicitly) {
-  const LoadResult r = load_text(component("", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"], "completes": "EVT_F"})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "onset 'EVT_F' has 2 completions ('/EVT_F' and 'F_CLEARED'): name the one each filter sends "
-                               "with its completion parameter"));
+  const LoadResult r = load_text(component(
+      "", "", R"(, {"name": "F_CLEARED", "severity": 5, "state_transition": ["E2N"], "completes": "EVT_F"})"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre(
+                  "onset 'EVT_F' has 2 completions ('/EVT_F' and 'F_CLEARED'): name the one each filter sends "
+                  "with its completion parameter"));
   EXPECT_TRUE(r.ok());
 }
 
 TEST(SpecLoad, CompletionOfACompletionIsAnError) {
-  const LoadResult r = load_text(component("", "", R"(, {"name": "X", "severity": 5, "state_transition": ["E2N"], "completes": "/EVT_F"})"));
+  const LoadResult r = load_text(
+      component("", "", R"(, {"name": "X", "severity": 5, "state_transition": ["E2N"], "completes": "/EVT_F"})"));
   EXPECT_THAT(messages(r), ::testing::Contains("completion 'X' completes '/EVT_F', which is not an onset"));
 }
 
 TEST(SpecLoad, LatchedOnsetsAreExpectedToNeedAReset) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 9, "event_onset": "EVT_L"}})",
-                                           R"(, {"name": "EVT_L", "severity": 70, "state_transition": ["N2E"], "latched": true})"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 9, "event_onset": "EVT_L"}})",
+      R"(, {"name": "EVT_L", "severity": 70, "state_transition": ["N2E"], "latched": true})"));
   EXPECT_EQ(formatted(r), "");
 }
 
 TEST(SpecLoad, BroadcastEventsNeedNoFilter) {
-  const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_ESTOP", "severity": 255, "state_transition": ["N2E"], "latched": true})"));
+  const LoadResult r = load_text(
+      component("", "", R"(, {"name": "EVT_ESTOP", "severity": 255, "state_transition": ["N2E"], "latched": true})"));
   EXPECT_EQ(formatted(r), "");
 }
 
 TEST(SpecLoad, AnEmptyTransitionListIsAnError) {
   const LoadResult r = load_text(component("", "", R"(, {"name": "EVT_G", "severity": 5, "state_transition": []})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("event 'EVT_G': 'state_transition' is empty: list worsening transitions "
-                                                  "(an onset) or improving ones (a completion)"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("event 'EVT_G': 'state_transition' is empty: list worsening transitions "
+                                     "(an onset) or improving ones (a completion)"));
 }
 
 TEST(SpecLoad, FilterCompletionMustCompleteItsOnset) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_onset": "EVT_G", "event_completion": "/EVT_F"}})",
-                                           R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"]}, {"name": "/EVT_G", "severity": 5, "state_transition": ["W2N"]})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): completion '/EVT_F' does not complete "
-                                                  "onset 'EVT_G' (it completes 'EVT_F')"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_onset": "EVT_G", "event_completion": "/EVT_F"}})",
+      R"(, {"name": "EVT_G", "severity": 5, "state_transition": ["N2W"]}, {"name": "/EVT_G", "severity": 5, "state_transition": ["W2N"]})"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): completion '/EVT_F' does not complete "
+                                     "onset 'EVT_G' (it completes 'EVT_F')"));
 }
 
 TEST(SpecLoad, FilterCompletionWithoutOnsetIsAnError) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_completion": "/EVT_F"}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): parameter 'event_completion' gives a "
-                                                  "completion but no onset ('event_onset')"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 2, "event_completion": "/EVT_F"}})"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("filter 'ARM.Threshold_2' (Threshold): parameter 'event_completion' gives a "
+                                     "completion but no onset ('event_onset')"));
 }
 
 TEST(SpecLoad, ProvidedOrRequiredTargetNeedsAnInterface) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_R"}, "argument": {"input_signal": "Force"}})"));
+  const LoadResult r = load_text(
+      component("", R"(, {"class_name": "NOP", "target": {"type": "s_R"}, "argument": {"input_signal": "Force"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.NOP_2' (NOP): target type s_R needs an 'interface'"));
-  const LoadResult ok = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_R", "interface": "Command"}, "argument": {"input_signal": "Force"}})"));
+  const LoadResult ok = load_text(component(
+      "",
+      R"(, {"class_name": "NOP", "target": {"type": "s_R", "interface": "Command"}, "argument": {"input_signal": "Force"}})"));
   EXPECT_EQ(formatted(ok), "");
 }
 
 TEST(SpecLoad, AnInterfaceOnAnApplicationTargetIsIgnoredWithAWarning) {
-  const LoadResult r = load_text(component("", R"(, {"class_name": "NOP", "target": {"type": "s_A", "interface": "Motion"}, "argument": {"input_signal": "Force"}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'ARM.NOP_2' (NOP): 'interface' is ignored for target type s_A"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"class_name": "NOP", "target": {"type": "s_A", "interface": "Motion"}, "argument": {"input_signal": "Force"}})"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("filter 'ARM.NOP_2' (NOP): 'interface' is ignored for target type s_A"));
   EXPECT_TRUE(r.ok());
 }
 
 TEST(SpecLoad, TwoFiltersWritingOneSignalGetAWarning) {
-  const LoadResult r = load_text(component("", R"(, {"name": "a", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}},
+  const LoadResult r = load_text(component(
+      "", R"(, {"name": "a", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}},
                                                    {"name": "b", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
   ASSERT_EQ(r.diagnostics.size(), 1u);
-  EXPECT_THAT(r.diagnostics[0].message, HasSubstr("filter 'b' (Norm) writes signal 'ARM.N', which filter 'a' also writes"));
+  EXPECT_THAT(r.diagnostics[0].message,
+              HasSubstr("filter 'b' (Norm) writes signal 'ARM.N', which filter 'a' also writes"));
 }
 
 TEST(SpecLoad, AFilterCanReadOnlyWhatAnEarlierFilterWrites) {
-  const LoadResult r = load_text(component("", R"(, {"name": "late", "class_name": "Threshold", "argument": {"input_signal": "N", "threshold": 1}},
+  const LoadResult r = load_text(
+      component("", R"(, {"name": "late", "class_name": "Threshold", "argument": {"input_signal": "N", "threshold": 1}},
                                                    {"name": "norm", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N"}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'late' (Threshold): parameter 'input_signal': signal 'ARM.N' is not "
-                                                  "declared and no earlier filter writes it"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("filter 'late' (Threshold): parameter 'input_signal': signal 'ARM.N' is not "
+                                     "declared and no earlier filter writes it"));
 }
 
 TEST(SpecLoad, VectorSizesFlowThroughOutputs) {
   // MovingAverage of a 6-vector writes a 6-vector; Threshold needs a scalar.
-  const LoadResult r = load_text(component("", R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Wrench", "output_signal": "W"}},
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Wrench", "output_signal": "W"}},
                                                    {"name": "lim", "class_name": "Threshold", "argument": {"input_signal": "W", "threshold": 1}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'lim' (Threshold): input 'ARM.W' has size 6; Threshold needs a scalar (use Norm for vectors)"));
+  EXPECT_THAT(
+      messages(r),
+      ::testing::ElementsAre(
+          "filter 'lim' (Threshold): input 'ARM.W' has size 6; Threshold needs a scalar (use Norm for vectors)"));
 }
 
 TEST(SpecLoad, ParameterListsAreCheckedItemByItem) {
-  const LoadResult r = load_text(component("", R"(, {"name": "v", "class_name": "Vectorize", "argument": {"input_signals": ["Force", "Forse"], "output_signal": "V"}},
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "v", "class_name": "Vectorize", "argument": {"input_signals": ["Force", "Forse"], "output_signal": "V"}},
                                                    {"name": "w", "class_name": "Vectorize", "argument": {"input_signals": ["Force", 3], "output_signal": "V2"}})"));
   ASSERT_EQ(r.diagnostics.size(), 2u) << formatted(r);
   EXPECT_EQ(r.diagnostics[0].pointer, "/filter/1/argument/input_signals/1");
   EXPECT_THAT(r.diagnostics[0].message, HasSubstr("signal 'ARM.Forse' is not declared"));
-  EXPECT_EQ(r.diagnostics[1].message, "filter 'w' (Vectorize): parameter 'input_signals' must be a list of signal names, not an array");
+  EXPECT_EQ(r.diagnostics[1].message,
+            "filter 'w' (Vectorize): parameter 'input_signals' must be a list of signal names, not an array");
 }
 
 TEST(SpecLoad, IntegerParametersMustBeWhole) {
-  const LoadResult r = load_text(component("", R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Force", "output_signal": "A", "window": 2.5}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'avg' (MovingAverage): parameter 'window' must be a whole number, not 2.5"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "avg", "class_name": "MovingAverage", "argument": {"input_signal": "Force", "output_signal": "A", "window": 2.5}})"));
+  EXPECT_THAT(messages(r), ::testing::ElementsAre(
+                               "filter 'avg' (MovingAverage): parameter 'window' must be a whole number, not 2.5"));
 }
 
 TEST(SpecLoad, ChoiceParametersUseTheFiltersModuleCheck) {
-  const LoadResult r = load_text(component("", R"(, {"name": "n", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N", "norm": "L3"}})"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "n", "class_name": "Norm", "argument": {"input_signal": "Wrench", "output_signal": "N", "norm": "L3"}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 'n' (Norm): parameter 'norm' must be one of L2, L1, Linf"));
 }
 
@@ -250,7 +296,8 @@ TEST(SpecLoad, EmptyPipelineAndDuplicatePipelineAreErrors) {
   const LoadResult r = load_text(component("", R"(, {"name": "p", "pipeline": []},
       {"name": "q", "pipeline": [{"class_name": "NOP", "argument": {"input_signal": "Force"}}]},
       {"name": "q", "pipeline": [{"class_name": "NOP", "argument": {"input_signal": "Force"}}]})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("pipeline 'p' has no stages", ::testing::StartsWith("duplicate pipeline 'q'")));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("pipeline 'p' has no stages", ::testing::StartsWith("duplicate pipeline 'q'")));
 }
 
 TEST(SpecLoad, PipelineTargetIsTheDefaultOfItsStages) {
@@ -270,9 +317,11 @@ TEST(SpecLoad, PipelineTargetIsTheDefaultOfItsStages) {
 }
 
 TEST(SpecLoad, CoordinatorNamesMustNotBeComponentNames) {
-  const LoadResult r = load_text(R"({"system": "s", "components": [{"component": "A"}], "coordinators": {"A": ["A"]}})");
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "coordinator 'A' has the name of a component: a coordinator's name addresses all its components"));
+  const LoadResult r =
+      load_text(R"({"system": "s", "components": [{"component": "A"}], "coordinators": {"A": ["A"]}})");
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre(
+                  "coordinator 'A' has the name of a component: a coordinator's name addresses all its components"));
 }
 
 TEST(SpecLoad, PipelineStagesRunInOneCoordinator) {
@@ -282,17 +331,22 @@ TEST(SpecLoad, PipelineStagesRunInOneCoordinator) {
        {"class_name": "Bypass", "target": {"component": "A"}, "argument": {"input_signal": "x"}},
        {"class_name": "NOP", "target": {"component": "B"}}]}]}],
     "coordinators": {"one": ["A", "C"], "two": ["B"]}})");
-  EXPECT_THAT(messages(r), ::testing::Contains(
-                               "pipeline 'p': stage 2 targets a component of coordinator 'two' but the pipeline runs in 'one'"));
+  EXPECT_THAT(messages(r),
+              ::testing::Contains(
+                  "pipeline 'p': stage 2 targets a component of coordinator 'two' but the pipeline runs in 'one'"));
 }
 
 TEST(SpecLoad, SeverityBoundsAreInclusive) {
   for (const char* ok : {"1", "255"}) {
-    const LoadResult r = load_text(component("", "", std::string(R"(, {"name": "EVT_B", "severity": )") + ok + R"(, "state_transition": ["N2W"], "latched": true})"));
+    const LoadResult r = load_text(component("", "",
+                                             std::string(R"(, {"name": "EVT_B", "severity": )") + ok +
+                                                 R"(, "state_transition": ["N2W"], "latched": true})"));
     EXPECT_TRUE(r.ok()) << formatted(r);
   }
   for (const char* bad : {"0", "256", "-3", "1e300", "50.5"}) {
-    const LoadResult r = load_text(component("", "", std::string(R"(, {"name": "EVT_B", "severity": )") + bad + R"(, "state_transition": ["N2W"], "latched": true})"));
+    const LoadResult r = load_text(component("", "",
+                                             std::string(R"(, {"name": "EVT_B", "severity": )") + bad +
+                                                 R"(, "state_transition": ["N2W"], "latched": true})"));
     EXPECT_EQ(r.errors(), 1u) << bad << "\n" << formatted(r);
   }
 }
@@ -302,8 +356,9 @@ TEST(SpecLoad, IncompatibleConnectionOnTheProvidedSide) {
     {"component": "A", "interfaces": {"provided": ["P"], "required": ["R"]}},
     {"component": "B", "interfaces": {"provided": ["Q"], "required": ["S"]}}],
     "connections": [{"required": "A.R", "provided": "B.S"}, {"required": "B.S", "provided": "A.P"}]})");
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "connection: 'B.S' is a required interface; 'provided' must name a provided interface of 'B' (Q)"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre(
+                  "connection: 'B.S' is a required interface; 'provided' must name a provided interface of 'B' (Q)"));
 }
 
 TEST(SpecLoad, A2016ComponentImpliesItsInterfacesFromItsServices) {
@@ -321,8 +376,9 @@ TEST(SpecLoad, ComponentFileCanDeclareItsSchemaAndVersion) {
 
 TEST(SpecLoad, NeitherFileKindNorBothAreAccepted) {
   const LoadResult r = load_text(R"({"system": "s", "component": "A", "components": []})");
-  EXPECT_THAT(messages(r), ::testing::ElementsAre(
-                               "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre(
+                  "a file is either a system (\"system\", \"components\") or a component (\"component\"), not both"));
 }
 
 TEST(SpecLoad, AComponentWithoutAValidNameReportsOnlyThat) {
@@ -338,18 +394,25 @@ TEST(SpecLoad, NoComponentsIsAWarning) {
 }
 
 TEST(SpecLoad, NullAndObjectParametersAreRejected) {
-  const LoadResult r = load_text(component("", R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": null, "tolerance": {}}})"));
-  EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 't' (Threshold): parameter 'threshold' must be a number, not null",
-                                                  "filter 't' (Threshold): parameter 'tolerance' must be a number, not an object"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": null, "tolerance": {}}})"));
+  EXPECT_THAT(messages(r),
+              ::testing::ElementsAre("filter 't' (Threshold): parameter 'threshold' must be a number, not null",
+                                     "filter 't' (Threshold): parameter 'tolerance' must be a number, not an object"));
 }
 
 TEST(SpecLoad, DuplicateParametersAreErrors) {
-  const LoadResult r = load_text(component("", R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 1, "threshold": 2}})"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "t", "class_name": "Threshold", "argument": {"input_signal": "Force", "threshold": 1, "threshold": 2}})"));
   EXPECT_THAT(messages(r), ::testing::ElementsAre("filter 't': duplicate parameter 'threshold'"));
 }
 
 TEST(SpecLoad, WatchdogDefaultsToTheFrameworkStaleEvents) {
-  const LoadResult r = load_text(component("", R"(, {"name": "w", "class_name": "Heartbeat", "target": {"type": "s_F"}, "argument": {"input_signal": "Force", "timeout": 0.1}})"));
+  const LoadResult r = load_text(component(
+      "",
+      R"(, {"name": "w", "class_name": "Heartbeat", "target": {"type": "s_F"}, "argument": {"input_signal": "Force", "timeout": 0.1}})"));
   EXPECT_EQ(formatted(r), "");
   ASSERT_TRUE(r.system);
   EXPECT_EQ(r.system->components[0].filters[1].stages[0].type, "Watchdog");

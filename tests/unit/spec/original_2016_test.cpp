@@ -94,8 +94,11 @@ TEST(Original2016, TheKeysAndValuesTheOriginalAcceptedLoad) {
   EXPECT_EQ(filter(arm, "arm_too_fast").execution, ExecutionMode::Passive) << "\"passive\"";
   EXPECT_EQ(filter(arm, "arm_too_fast").detection, DetectionMode::Level) << "\"level\"";
   EXPECT_EQ(filter(arm, "arm_mode").detection, DetectionMode::Edge) << "\"edge\"";
-  EXPECT_THAT(notes(r), HasSubstr("arm.json:19:13: note: filter 'arm_speed': 'debug' is accepted for the 2016 files and ignored"));
-  EXPECT_THAT(notes(r), HasSubstr("note: filter 'arm_too_fast': 'last_filter' is accepted for the 2016 files and ignored"));
+  EXPECT_THAT(
+      notes(r),
+      HasSubstr("arm.json:19:13: note: filter 'arm_speed': 'debug' is accepted for the 2016 files and ignored"));
+  EXPECT_THAT(notes(r),
+              HasSubstr("note: filter 'arm_too_fast': 'last_filter' is accepted for the 2016 files and ignored"));
   for (const Diagnostic& d : r.diagnostics) {
     EXPECT_THAT(d.message, HasSubstr("is not declared; assumed to be a scalar")) << format(d);
   }
@@ -158,7 +161,8 @@ TEST(Original2016, ValidateVerbosePrintsTheNotesAndCountsThemAsNothing) {
   EXPECT_THAT(out, HasSubstr("0 errors, 0 warnings\n"));
   ::testing::internal::CaptureStdout();
   run_validate({std::string(kDir) + "framework_filters.json"}, false, false);
-  EXPECT_THAT(::testing::internal::GetCapturedStdout(), ::testing::Not(HasSubstr("note:"))) << "notes only with --verbose";
+  EXPECT_THAT(::testing::internal::GetCapturedStdout(), ::testing::Not(HasSubstr("note:")))
+      << "notes only with --verbose";
 }
 
 TEST(Original2016, ARedefinitionOfAFrameworkEventThatChangesItIsRefused) {

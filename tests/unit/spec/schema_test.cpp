@@ -21,8 +21,8 @@ TEST(SpecSchema, CheckedInFileEqualsTheGeneratedSchema) {
     std::ofstream("docs/schema.json", std::ios::binary) << schema;
     GTEST_SKIP() << "rewrote docs/schema.json";
   }
-  EXPECT_EQ(read_text("docs/schema.json"), schema)
-      << "docs/schema.json is stale: run `safecass schema > docs/schema.json` (or this test with SAFECASS_UPDATE_GOLDEN=1)";
+  EXPECT_EQ(read_text("docs/schema.json"), schema) << "docs/schema.json is stale: run `safecass schema > "
+                                                      "docs/schema.json` (or this test with SAFECASS_UPDATE_GOLDEN=1)";
 }
 
 TEST(SpecSchema, IsDeterministicJsonOfDraft2020_12) {
@@ -33,8 +33,9 @@ TEST(SpecSchema, IsDeterministicJsonOfDraft2020_12) {
   EXPECT_EQ(p.value->find("$schema")->string, "https://json-schema.org/draft/2020-12/schema");
   const JsonValue* defs = p.value->find("$defs");
   ASSERT_NE(defs, nullptr);
-  for (const char* def : {"system", "component", "include", "interfaces", "signal", "event", "filter", "pipeline", "target",
-                          "service", "dependency", "connection", "coordinators", "component_entry", "filter_entry"}) {
+  for (const char* def :
+       {"system", "component", "include", "interfaces", "signal", "event", "filter", "pipeline", "target", "service",
+        "dependency", "connection", "coordinators", "component_entry", "filter_entry"}) {
     EXPECT_NE(defs->find(def), nullptr) << def;
   }
 }
@@ -49,7 +50,8 @@ TEST(SpecSchema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
     EXPECT_EQ(argument->find("additionalProperties")->boolean, false);
     // Every parameter, and every other name of one (ChangeDetection's 2016 `event`).
     EXPECT_EQ(argument->find("properties")->object.size(), m->params.size() + m->aliases.size()) << m->type;
-    for (const auto& [alias, param] : m->aliases) EXPECT_NE(argument->find("properties")->find(alias), nullptr) << alias;
+    for (const auto& [alias, param] : m->aliases)
+      EXPECT_NE(argument->find("properties")->find(alias), nullptr) << alias;
   }
   const JsonValue* names = defs->find("filter")->find("properties")->find("class_name")->find("enum");
   ASSERT_NE(names, nullptr);

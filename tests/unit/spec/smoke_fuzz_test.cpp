@@ -21,11 +21,41 @@ const std::vector<std::string> kSeeds = {
     "tests/data/good_specs/robodoc.json", "tests/data/good_specs/jr3.json", "tests/data/good_specs/parts/control.json",
     "tests/data/good_specs/legacy_2016/jr3.json", "tests/data/good_specs/legacy_2016/system.json"};
 
-const std::vector<std::string> kTokens = {
-    "{", "}", "[", "]", "\"", ",", ":", "null", "true", "0", "-1", "1e999", "1e-999", "256", "\"\"", "[]", "{}",
-    "//", "/*", "*/", "\\u", "\\ud800", "\xff", "\xc3", "\xed\xa0\x80", std::string(1, '\0'), "\"include\": \"robodoc.json\"",
-    "\"pipeline\": []", "\"class_name\": \"Range\"", "\"event_onset\": \"EVT_STALE\"", "\"s_P\"", "\"JR3.Force\"",
-    "\"N2E\", \"E2N\"", "\"size\": 4097", "\"size\": 3"};
+const std::vector<std::string> kTokens = {"{",
+                                          "}",
+                                          "[",
+                                          "]",
+                                          "\"",
+                                          ",",
+                                          ":",
+                                          "null",
+                                          "true",
+                                          "0",
+                                          "-1",
+                                          "1e999",
+                                          "1e-999",
+                                          "256",
+                                          "\"\"",
+                                          "[]",
+                                          "{}",
+                                          "//",
+                                          "/*",
+                                          "*/",
+                                          "\\u",
+                                          "\\ud800",
+                                          "\xff",
+                                          "\xc3",
+                                          "\xed\xa0\x80",
+                                          std::string(1, '\0'),
+                                          "\"include\": \"robodoc.json\"",
+                                          "\"pipeline\": []",
+                                          "\"class_name\": \"Range\"",
+                                          "\"event_onset\": \"EVT_STALE\"",
+                                          "\"s_P\"",
+                                          "\"JR3.Force\"",
+                                          "\"N2E\", \"E2N\"",
+                                          "\"size\": 4097",
+                                          "\"size\": 3"};
 
 std::string mutate(const std::string& text, std::mt19937& rng) {
   std::string s = text;
@@ -63,8 +93,10 @@ std::string mutate(const std::string& text, std::mt19937& rng) {
 std::vector<std::size_t> line_lengths(const std::string& text) {
   std::vector<std::size_t> out{0};
   for (const char c : text) {
-    if (c == '\n') out.push_back(0);
-    else ++out.back();
+    if (c == '\n')
+      out.push_back(0);
+    else
+      ++out.back();
   }
   return out;
 }
@@ -81,9 +113,9 @@ public:
       EXPECT_FALSE(d.message.empty());
       EXPECT_TRUE(d.pointer.empty() || d.pointer[0] == '/') << d.pointer;
       const std::vector<std::size_t>& lines = d.where.file == name ? line_lengths(text) : file_lines(d.where.file);
-      const bool inside = d.where.line >= 1 && static_cast<std::size_t>(d.where.line) <= lines.size() &&
-                          d.where.column >= 1 &&
-                          static_cast<std::size_t>(d.where.column) <= lines[static_cast<std::size_t>(d.where.line) - 1] + 1;
+      const bool inside =
+          d.where.line >= 1 && static_cast<std::size_t>(d.where.line) <= lines.size() && d.where.column >= 1 &&
+          static_cast<std::size_t>(d.where.column) <= lines[static_cast<std::size_t>(d.where.line) - 1] + 1;
       EXPECT_TRUE(inside) << format(d);
       if (!inside) return false;
     }
@@ -156,10 +188,11 @@ void collect(JsonValue& v, std::vector<JsonValue*>& out) {
 }
 
 TEST(SpecSmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
-  const std::vector<std::string> replacements = {"null", "0", "-1", "1e300", "2.5", "\"\"", "\"x.y\"", "[]", "[1]", "{}",
-                                                 "true"};
+  const std::vector<std::string> replacements = {"null",    "0",  "-1",  "1e300", "2.5", "\"\"",
+                                                 "\"x.y\"", "[]", "[1]", "{}",    "true"};
   Checker checker;
-  for (const std::string& seed : {std::string("tests/data/good_specs/jr3.json"), std::string("tests/data/good_specs/robodoc.json")}) {
+  for (const std::string& seed :
+       {std::string("tests/data/good_specs/jr3.json"), std::string("tests/data/good_specs/robodoc.json")}) {
     const JsonParse parsed = parse_json(read_text(seed));
     ASSERT_TRUE(parsed.value);
     std::vector<JsonValue*> nodes;

@@ -24,7 +24,8 @@ TEST(SpecValidateCommand, GoodSystemExitsZero) {
 
 TEST(SpecValidateCommand, ErrorsExitOneAndPrintEveryDiagnostic) {
   ::testing::internal::CaptureStdout();
-  const int code = run_validate({"tests/data/bad_specs/unknown_key.json", "tests/data/bad_specs/needs_reset.json"}, false);
+  const int code =
+      run_validate({"tests/data/bad_specs/unknown_key.json", "tests/data/bad_specs/needs_reset.json"}, false);
   const std::string out = ::testing::internal::GetCapturedStdout();
   EXPECT_EQ(code, 1);
   EXPECT_EQ(out, read_text("tests/data/bad_specs/unknown_key.json.expected") +
@@ -53,7 +54,8 @@ TEST(SpecValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
   EXPECT_EQ(code, 1);
   std::vector<std::string> lines;
   std::size_t start = 0;
-  for (std::size_t nl; (nl = out.find('\n', start)) != std::string::npos; start = nl + 1) lines.push_back(out.substr(start, nl - start));
+  for (std::size_t nl; (nl = out.find('\n', start)) != std::string::npos; start = nl + 1)
+    lines.push_back(out.substr(start, nl - start));
   ASSERT_EQ(lines.size(), 2u);
   const JsonParse first = parse_json(lines[0]);
   ASSERT_TRUE(first.value);

@@ -19,8 +19,8 @@ using console::Out;
 
 /// Records every command it is asked to run; fails with `error` when set.
 struct Calls {
-  std::vector<std::string> commands;             ///< "name|arg|arg..."
-  std::vector<std::string> frames;               ///< "begin", "end ok", "end failed"
+  std::vector<std::string> commands;  ///< "name|arg|arg..."
+  std::vector<std::string> frames;    ///< "begin", "end ok", "end failed"
   std::string error;
 };
 
@@ -117,8 +117,9 @@ TEST(ConsoleShell, ABackendErrorIsPrintedWithTheCommandAndItsUsageInTextAndJson)
   auto json = fake_console(calls, true, true);
   r = json->execute("event generate EVT_A ARM.s_A");
   EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.err, "{\"ok\":false,\"command\":\"event generate\",\"error\":\"event generate refused: the request does "
-                   "not carry coordinator 'robot''s token\",\"usage\":\"event generate EVENT TARGET\"}\n");
+  EXPECT_EQ(r.err,
+            "{\"ok\":false,\"command\":\"event generate\",\"error\":\"event generate refused: the request does "
+            "not carry coordinator 'robot''s token\",\"usage\":\"event generate EVENT TARGET\"}\n");
 }
 
 TEST(ConsoleShell, HelpAndQuitAreAnsweredWithoutTheBackend) {

@@ -31,7 +31,9 @@ std::unique_ptr<Console> open_console(bool allow_write, bool json = false, const
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-std::size_t count_lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+std::size_t count_lines(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));
+}
 
 /// Everything a command could change, as the console shows it.
 std::string observable(Console& console) {
@@ -153,7 +155,8 @@ TEST(ConsoleInjection, TheEndOfAShallowInjectionFromTheConsoleRestoresTheRealVal
   ASSERT_TRUE(console->execute("filter inject door 1").ok);
   const std::string watched = console->execute("watch 0.01").out;
   EXPECT_TRUE(contains(watched, "CELL.s_A  Normal -> Error  EVT_DOOR")) << watched;
-  EXPECT_TRUE(contains(watched, "CELL.s_A  Error -> Normal  /EVT_DOOR")) << "the real value, closed, is judged again: " << watched;
+  EXPECT_TRUE(contains(watched, "CELL.s_A  Error -> Normal  /EVT_DOOR"))
+      << "the real value, closed, is judged again: " << watched;
   EXPECT_TRUE(contains(console->execute("state list CELL").out, "Normal"));
 }
 
@@ -183,8 +186,8 @@ TEST_F(ConsoleTest, EventListShowsEveryEventWithItsDefinition) {
   EXPECT_TRUE(contains(out, "EVT_FORCE_ERROR")) << out;
   EXPECT_TRUE(contains(out, "50   onset       N2E,W2E  cleared by /EVT_FORCE_ERROR, hazard H-3")) << out;
   EXPECT_TRUE(contains(out, "/EVT_FORCE_ERROR")) << out;
-  EXPECT_TRUE(contains(out, "latched")) << out;                 // EVT_BONE_MOTION
-  EXPECT_TRUE(contains(out, "EVT_SERVICE_FAILURE")) << out;     // framework events too
+  EXPECT_TRUE(contains(out, "latched")) << out;              // EVT_BONE_MOTION
+  EXPECT_TRUE(contains(out, "EVT_SERVICE_FAILURE")) << out;  // framework events too
 }
 
 TEST_F(ConsoleTest, EventHistoryShowsTheEventsProcessedIgnoredOrMasked) {
@@ -202,7 +205,8 @@ TEST_F(ConsoleTest, EventGenerateProcessesTheEventAndPrintsWhatItChanged) {
   const std::string out = run("event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A").out;
   EXPECT_TRUE(contains(out, "generated EVT_CONTROL_FORCE_FREEZE on CONTROL.s_A at t=0.000000")) << out;
   EXPECT_TRUE(contains(out, "CONTROL.s_A  Normal -> Error  EVT_CONTROL_FORCE_FREEZE")) << out;
-  EXPECT_TRUE(contains(out, "SERVO.s_R.Command  Normal -> Error  EVT_SERVICE_FAILURE  <- CONTROL.s_A:EVT_CONTROL_FORCE_FREEZE"))
+  EXPECT_TRUE(
+      contains(out, "SERVO.s_R.Command  Normal -> Error  EVT_SERVICE_FAILURE  <- CONTROL.s_A:EVT_CONTROL_FORCE_FREEZE"))
       << out;
   const std::string states = run("state list").out;
   EXPECT_TRUE(contains(states, "SYSTEM                    Error   -")) << states;
@@ -230,15 +234,18 @@ TEST(ConsoleBroadcast, EventBroadcastReachesTheApplicationMachineOfEveryComponen
 
 TEST_F(ConsoleTest, ConnectionListShowsEveryConnectionWithBothEndsStates) {
   const std::string out = run("connection list").out;
-  EXPECT_TRUE(contains(out, "CONTROL.ForceData   ->  JR3.ForceData    s_R Normal  s_S Normal  propagates Error")) << out;
-  EXPECT_TRUE(contains(out, "PENDANT.Status      ->  CONTROL.Status   s_R Normal  s_S Normal  propagates Warning and Error"))
+  EXPECT_TRUE(contains(out, "CONTROL.ForceData   ->  JR3.ForceData    s_R Normal  s_S Normal  propagates Error"))
+      << out;
+  EXPECT_TRUE(
+      contains(out, "PENDANT.Status      ->  CONTROL.Status   s_R Normal  s_S Normal  propagates Warning and Error"))
       << out;
   EXPECT_EQ(count_lines(out), 4u);
 }
 
 TEST_F(ConsoleTest, ServiceListShowsEveryServiceStateAndItsDependencyFormula) {
   const std::string out = run("service list").out;
-  EXPECT_TRUE(contains(out, "CONTROL.s_S.Command  Normal  = s_P.Command * s_F * s_A * s_R.ForceData * s_R.BoneMotion")) << out;
+  EXPECT_TRUE(contains(out, "CONTROL.s_S.Command  Normal  = s_P.Command * s_F * s_A * s_R.ForceData * s_R.BoneMotion"))
+      << out;
   EXPECT_TRUE(contains(out, "JR3.s_S.ForceData    Normal  = s_P.ForceData * s_F * s_A")) << out;
   EXPECT_TRUE(contains(out, "(propagates Warning and Error)")) << out;
   run("event generate EVT_FORCE_ERROR JR3.s_A");
@@ -249,7 +256,8 @@ TEST_F(ConsoleTest, ExplainGivesEachConditionWithItsRootCauseAndPath) {
   EXPECT_TRUE(contains(run("explain SERVO").out, "SERVO is Normal: no active condition"));
   run("event generate EVT_FORCE_ERROR JR3.s_A");
   const std::string out = run("explain SERVO").out;
-  EXPECT_TRUE(contains(out, "SERVO.s_R.Command: Error EVT_SERVICE_FAILURE (severity 220) <- JR3.s_A:EVT_FORCE_ERROR")) << out;
+  EXPECT_TRUE(contains(out, "SERVO.s_R.Command: Error EVT_SERVICE_FAILURE (severity 220) <- JR3.s_A:EVT_FORCE_ERROR"))
+      << out;
   EXPECT_TRUE(contains(out, "[hazard H-3]")) << out;
   EXPECT_TRUE(contains(out, "path JR3.s_A -> ")) << out;
 }
@@ -293,11 +301,11 @@ TEST_F(ConsoleTest, ResetClearsEveryConditionOfTheTargetAndRecordsTheReason) {
 
 TEST_F(ConsoleTest, HelpListsEveryCommandAndShowsOneCommandsUsage) {
   const std::string all = run("help").out;
-  for (const char* usage : {"state list", "state history [ADDRESS] [N]", "filter list", "filter info NAME",
-                            "filter inject NAME SAMPLE...", "filter dinject SIGNAL SAMPLE...", "filter dinload SIGNAL FILE",
-                            "event list", "event history [N]", "event generate EVENT TARGET", "event broadcast EVENT",
-                            "connection list", "service list", "explain ADDRESS", "watch [SECONDS]",
-                            "reset TARGET [REASON]", "time", "help [COMMAND]", "quit"}) {
+  for (const char* usage :
+       {"state list", "state history [ADDRESS] [N]", "filter list", "filter info NAME", "filter inject NAME SAMPLE...",
+        "filter dinject SIGNAL SAMPLE...", "filter dinload SIGNAL FILE", "event list", "event history [N]",
+        "event generate EVENT TARGET", "event broadcast EVENT", "connection list", "service list", "explain ADDRESS",
+        "watch [SECONDS]", "reset TARGET [REASON]", "time", "help [COMMAND]", "quit"}) {
     EXPECT_TRUE(contains(all, usage)) << usage;
   }
   const std::string one = run("help filter dinload").out;
@@ -326,9 +334,10 @@ TEST(ConsoleReadOnly, EveryWriteIsRefusedAndChangesNothing) {
   ASSERT_NE(console, nullptr);
   const std::string file = write_file("console_refused.txt", "0 0 50\n");
   const std::string before = observable(*console);
-  for (const std::string& line : std::vector<std::string>{"filter inject force_limit 50", "filter dinject JR3.Force [0,0,50]",
-                                 "filter dinload JR3.Force " + file, "event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A",
-                                 "event broadcast EVT_CONTROL_FORCE_FREEZE", "reset SYSTEM"}) {
+  for (const std::string& line : std::vector<std::string>{
+           "filter inject force_limit 50", "filter dinject JR3.Force [0,0,50]", "filter dinload JR3.Force " + file,
+           "event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A", "event broadcast EVT_CONTROL_FORCE_FREEZE",
+           "reset SYSTEM"}) {
     const ConsoleReply r = console->execute(line);
     EXPECT_FALSE(r.ok) << line;
     EXPECT_TRUE(r.out.empty()) << line;
@@ -348,19 +357,56 @@ TEST(ConsoleReadOnly, EveryWriteIsRefusedAndChangesNothing) {
 
 TEST_F(ConsoleTest, BadCommandsGiveOneUsageLineAndChangeNothing) {
   const std::string before = observable(*console);
-  const std::vector<std::string> bad = {
-      "frobnicate", "state", "state frob", "state list NOPE", "state list JR3 BMM", "state history JR3 0",
-      "state history NOPE.s_A", "state history JR3 5 6", "filter", "filter info", "filter info nope",
-      "filter info force_limit extra", "filter inject force_limit", "filter inject force_limit abc",
-      "filter inject force_limit [1,2", "filter inject nope 1", "filter inject force_limit [1,2,3]",
-      "filter inject force_limit 1 x", "filter dinject JR3.Force 1", "filter dinject JR3.Nope 1",
-      "filter dinject JR3.Force []", "filter dinload JR3.Force /nonexistent/samples.txt", "filter dinload JR3.Force",
-      "event", "event generate EVT_NOPE CONTROL.s_A", "event generate EVT_CONTROL_FORCE_FREEZE NOPE.s_A",
-      "event generate EVT_CONTROL_FORCE_FREEZE CONTROL", "event generate EVT_CONTROL_FORCE_FREEZE",
-      "event broadcast EVT_FORCE_ERROR", "event broadcast", "event history x", "connection", "connection list x",
-      "service list x", "explain", "explain NOPE", "explain JR3.s_X", "watch -1", "watch 0", "watch abc",
-      "watch 1 2", "watch 100000", "watch nan", "reset", "reset NOPE", "time now", "help nope", "quit now",
-      "state list 'unterminated", "reset [1,2"};
+  const std::vector<std::string> bad = {"frobnicate",
+                                        "state",
+                                        "state frob",
+                                        "state list NOPE",
+                                        "state list JR3 BMM",
+                                        "state history JR3 0",
+                                        "state history NOPE.s_A",
+                                        "state history JR3 5 6",
+                                        "filter",
+                                        "filter info",
+                                        "filter info nope",
+                                        "filter info force_limit extra",
+                                        "filter inject force_limit",
+                                        "filter inject force_limit abc",
+                                        "filter inject force_limit [1,2",
+                                        "filter inject nope 1",
+                                        "filter inject force_limit [1,2,3]",
+                                        "filter inject force_limit 1 x",
+                                        "filter dinject JR3.Force 1",
+                                        "filter dinject JR3.Nope 1",
+                                        "filter dinject JR3.Force []",
+                                        "filter dinload JR3.Force /nonexistent/samples.txt",
+                                        "filter dinload JR3.Force",
+                                        "event",
+                                        "event generate EVT_NOPE CONTROL.s_A",
+                                        "event generate EVT_CONTROL_FORCE_FREEZE NOPE.s_A",
+                                        "event generate EVT_CONTROL_FORCE_FREEZE CONTROL",
+                                        "event generate EVT_CONTROL_FORCE_FREEZE",
+                                        "event broadcast EVT_FORCE_ERROR",
+                                        "event broadcast",
+                                        "event history x",
+                                        "connection",
+                                        "connection list x",
+                                        "service list x",
+                                        "explain",
+                                        "explain NOPE",
+                                        "explain JR3.s_X",
+                                        "watch -1",
+                                        "watch 0",
+                                        "watch abc",
+                                        "watch 1 2",
+                                        "watch 100000",
+                                        "watch nan",
+                                        "reset",
+                                        "reset NOPE",
+                                        "time now",
+                                        "help nope",
+                                        "quit now",
+                                        "state list 'unterminated",
+                                        "reset [1,2"};
   for (const std::string& line : bad) {
     const ConsoleReply r = console->execute(line);
     EXPECT_FALSE(r.ok) << line;
@@ -432,7 +478,8 @@ TEST_F(ConsoleTest, InjectingANonFiniteValueIsRefusedOnEveryPathAndChangesNothin
   const std::string file = write_file("console_infinite_dinload.txt", "0 0 10\n0, 0, -inf\n");
   const ConsoleReply r = console->execute("filter dinload JR3.Force " + file);
   EXPECT_FALSE(r.ok);
-  EXPECT_TRUE(contains(r.err, "console_infinite_dinload.txt:2: '-inf' is not a finite number: injected values must be finite"))
+  EXPECT_TRUE(
+      contains(r.err, "console_infinite_dinload.txt:2: '-inf' is not a finite number: injected values must be finite"))
       << r.err;
   EXPECT_EQ(observable(*console), before);
   EXPECT_FALSE(contains(console->execute("watch 0.05").out, "EVT_INVALID_SAMPLE"));
@@ -448,7 +495,8 @@ TEST_F(ConsoleTest, UsageNamesTheCommandThatWasMistyped) {
 TEST(ConsoleOpen, ABadSystemOrScenarioIsAnErrorWithItsDiagnostics) {
   EXPECT_FALSE(Console::open(kSource + "/no/such/system.json", {}, {}).has_value());
   EXPECT_FALSE(Console::open({}, {}, {}).has_value());
-  const std::string bad = write_file("console_bad_system.json", "{ \"safecass\": 1, \"components\": [ { \"component\": 5 } ] }");
+  const std::string bad =
+      write_file("console_bad_system.json", "{ \"safecass\": 1, \"components\": [ { \"component\": 5 } ] }");
   auto r = Console::open(bad, {}, {});
   ASSERT_FALSE(r.has_value());
   EXPECT_TRUE(contains(r.error().message, "console_bad_system.json:1:")) << r.error().message;
@@ -459,10 +507,11 @@ TEST(ConsoleOpen, ABadSystemOrScenarioIsAnErrorWithItsDiagnostics) {
 TEST(ConsoleJson, EveryResultLineIsOneJsonObject) {
   auto console = open_console(true, true);
   ASSERT_NE(console, nullptr);
-  for (const char* line : {"state list", "filter list", "filter info force_limit", "filter info Threshold", "event list",
-                           "event generate EVT_FORCE_ERROR JR3.s_A", "state history", "event history", "connection list",
-                           "service list", "explain CONTROL", "watch 0.06", "time", "help", "reset SYSTEM operator",
-                           "filter inject force_limit 1", "filter dinject JR3.Force [1,2,3]"}) {
+  for (const char* line :
+       {"state list", "filter list", "filter info force_limit", "filter info Threshold", "event list",
+        "event generate EVT_FORCE_ERROR JR3.s_A", "state history", "event history", "connection list", "service list",
+        "explain CONTROL", "watch 0.06", "time", "help", "reset SYSTEM operator", "filter inject force_limit 1",
+        "filter dinject JR3.Force [1,2,3]"}) {
     const ConsoleReply r = console->execute(line);
     ASSERT_TRUE(r.ok) << line << ": " << r.err;
     ASSERT_FALSE(r.out.empty()) << line;

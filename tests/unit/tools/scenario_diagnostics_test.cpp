@@ -92,15 +92,17 @@ TEST(ScenarioDiagnostics, FormatAndNameProblemsAreReportedInOnePass) {
   std::string all;
   for (const auto& d : found) all += spec::format(d) + "\n";
   EXPECT_THAT(all, ::testing::HasSubstr("\"at\" must be a number")) << "a format problem";
-  EXPECT_THAT(all, ::testing::HasSubstr("no signal 'ARM.Forse'; did you mean 'ARM.Force'?")) << "and a name problem, together";
+  EXPECT_THAT(all, ::testing::HasSubstr("no signal 'ARM.Forse'; did you mean 'ARM.Force'?"))
+      << "and a name problem, together";
 }
 
 TEST(ScenarioDiagnostics, AnExpectationAfterTheDurationIsAnInputErrorThatSaysSo) {
   const std::string path = std::string(kCorpus) + "/expectation_after_duration.json";
   const auto found = check_scenario(path, registry());
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_EQ(spec::format(found[0]), path + ":7:28: error: expectation at t=0.5 is after the duration (0.1 s): it would "
-                                            "never be checked; move it or lengthen \"duration\" [/steps/2/expect]");
+  EXPECT_EQ(spec::format(found[0]), path +
+                                        ":7:28: error: expectation at t=0.5 is after the duration (0.1 s): it would "
+                                        "never be checked; move it or lengthen \"duration\" [/steps/2/expect]");
   std::FILE* err = std::tmpfile();
   RunResult result;
   RunOptions options;

@@ -95,8 +95,9 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
   ASSERT_FALSE(opened) << "a scenario with a bad step is not opened";
   const Diagnostics& problems = opened.error();
   ASSERT_EQ(problems.size(), 1u);
-  EXPECT_EQ(spec::format(problems[0]), path + ":3:7: error: an injected value is not a finite number: injected values "
-                                              "must be finite [/steps/9/inject]");
+  EXPECT_EQ(spec::format(problems[0]), path +
+                                           ":3:7: error: an injected value is not a finite number: injected values "
+                                           "must be finite [/steps/9/inject]");
 }
 
 }  // namespace
@@ -112,10 +113,12 @@ TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingR
   {
     std::FILE* f = std::fopen(path.c_str(), "w");
     ASSERT_NE(f, nullptr);
-    std::fprintf(f, "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
-                    "  \"steps\": [\n"
-                    "    { \"at\": 0.0, \"reset\": { \"target\": \"JR3.s_S.ForceData\", \"reason\": \"operator\" } } ] }\n",
-                 SAFECASS_SOURCE_DIR);
+    std::fprintf(
+        f,
+        "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
+        "  \"steps\": [\n"
+        "    { \"at\": 0.0, \"reset\": { \"target\": \"JR3.s_S.ForceData\", \"reason\": \"operator\" } } ] }\n",
+        SAFECASS_SOURCE_DIR);
     std::fclose(f);
   }
   FilterRegistry registry;
@@ -126,7 +129,8 @@ TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingR
   Captured err;
   const int code = run_scenario_file(path, registry, options, &result, err.file);
   EXPECT_EQ(code, 2) << err.str();
-  EXPECT_THAT(err.str(), HasSubstr(path + ":3:27: error: cannot reset service state 'JR3.s_S.ForceData': it is derived; reset its component or a machine [/steps/0/reset]"));
+  EXPECT_THAT(err.str(), HasSubstr(path + ":3:27: error: cannot reset service state 'JR3.s_S.ForceData': it is "
+                                          "derived; reset its component or a machine [/steps/0/reset]"));
   EXPECT_EQ(result.checks, 0) << "nothing ran";
   std::remove(path.c_str());
 }

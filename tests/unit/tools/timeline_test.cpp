@@ -155,17 +155,19 @@ TEST(Timeline, TextFromTheHistoryCannotBreakOutOfThePage) {
 TEST(Timeline, MalformedLinesAreErrorsNamingTheirLineNumbers) {
   const std::string text =
       "{\"t\":0.1,\"kind\":\"transition\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Error\"}\n"  // 1 good
-      "{\"t\":0.2,\"kind\":\"transition\"\n"                                                          // 2 truncated
-      "[1,2]\n"                                                                                       // 3 not an object
-      "{\"t\":0.3,\"kind\":\"heartbeat\"}\n"                                                          // 4 unknown kind
-      "{\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\"}\n"              // 5 no time
+      "{\"t\":0.2,\"kind\":\"transition\"\n"                                                              // 2 truncated
+      "[1,2]\n"                                                                           // 3 not an object
+      "{\"t\":0.3,\"kind\":\"heartbeat\"}\n"                                              // 4 unknown kind
+      "{\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\"}\n"  // 5 no time
       "{\"t\":0.4,\"kind\":\"transition\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Red\"}\n"  // 6 bad state
-      "\n"                                                                                            // 7 empty
-      "{\"t\":0.05,\"kind\":\"injection\",\"machine\":\"A.s_A\"}\n"                                   // 8 time goes back
-      "{\"kind\":\"overflow\",\"dropped\":-2}\n"                                                      // 9 bad count
-      "{\"t\":0.5,\"kind\":\"event\",\"outcome\":\"vanished\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\"}\n"
-      "{\"t\":0.6,\"kind\":\"transition\",\"from\":\"Error\",\"to\":\"Normal\"}\n"                    // 11 no machine
-      "{\"t\":0.7,\"kind\":\"event\",\"outcome\":\"masked\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\",\"root\":3}";
+      "\n"                                                                                             // 7 empty
+      "{\"t\":0.05,\"kind\":\"injection\",\"machine\":\"A.s_A\"}\n"  // 8 time goes back
+      "{\"kind\":\"overflow\",\"dropped\":-2}\n"                     // 9 bad count
+      "{\"t\":0.5,\"kind\":\"event\",\"outcome\":\"vanished\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":"
+      "\"Error\"}\n"
+      "{\"t\":0.6,\"kind\":\"transition\",\"from\":\"Error\",\"to\":\"Normal\"}\n"  // 11 no machine
+      "{\"t\":0.7,\"kind\":\"event\",\"outcome\":\"masked\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\","
+      "\"root\":3}";
   const HistoryParse p = parse_history(text);
   ASSERT_EQ(p.errors.size(), 11u);
   const std::vector<std::pair<int, std::string>> expected{
@@ -215,7 +217,8 @@ TEST(Timeline, AMalformedLineThatIsNotTheLastIsStillAnErrorWhenTheLastIsTorn) {
 }
 
 TEST(Timeline, ALastLineWithoutNewlineThatIsCompleteIsARecordAndABadOneAnError) {
-  const HistoryParse good = parse_history("{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}");
+  const HistoryParse good =
+      parse_history("{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}");
   EXPECT_TRUE(good.errors.empty());
   EXPECT_FALSE(good.torn.has_value());
   EXPECT_EQ(good.records.size(), 1u);
@@ -240,7 +243,8 @@ TEST(Timeline, CommandDrawsAHistoryWithATornLastLineAndWarnsOnceNamingFileAndLin
   const std::string html = read_text(page.string());
   EXPECT_THAT(html, HasSubstr("History line 28 is torn"));
   const HistoryParse complete = parse_history(good);
-  EXPECT_EQ(script_data(html, "timeline-model"), script_data(render_timeline_page(complete.records, "killed.jsonl"), "timeline-model"))
+  EXPECT_EQ(script_data(html, "timeline-model"),
+            script_data(render_timeline_page(complete.records, "killed.jsonl"), "timeline-model"))
       << "every complete record is drawn";
   std::filesystem::remove_all(dir);
 }
@@ -248,8 +252,9 @@ TEST(Timeline, CommandDrawsAHistoryWithATornLastLineAndWarnsOnceNamingFileAndLin
 TEST(Timeline, CommandExitsTwoWithFileAndLineForABadHistoryAndWritesNoPage) {
   const auto dir = temp_dir();
   const auto history = dir / "bad.jsonl";
-  std::ofstream(history) << "{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
-                            "not json\n";
+  std::ofstream(history)
+      << "{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
+         "not json\n";
   const auto page = dir / "bad.html";
   ::testing::internal::CaptureStderr();
   const int code = run_timeline(history.string(), page.string());

@@ -113,7 +113,7 @@ TEST(ViewerLiveDiff, PictureFromRowsHasTheShapeOfTheInProcessPicture) {
 TEST(ViewerLiveDiff, PictureTakesTheWorstComponentStateAndSkipsRowsItCannotPlace) {
   using introspect::RowKind;
   const std::vector<introspect::StateRow> rows = {
-      {"SYSTEM", RowKind::System, State::Error, ""},       // not a component
+      {"SYSTEM", RowKind::System, State::Error, ""},  // not a component
       {"JR3", RowKind::Component, State::Error, "EVT_FORCE_ERROR"},
       {"JR3.s_A", RowKind::Application, State::Error, "EVT_FORCE_ERROR"},
       {"BMM.s_F", RowKind::Framework, State::Warning, "E"},  // no BMM component row before it
@@ -167,7 +167,8 @@ public:
 TEST(ViewerLiveDiff, ProtocolShowsALiveCoordinatorsStatusInTheViewAndPushesItsChanges) {
   FakeSource source;
   source.v.system = "robodoc";
-  source.v.coordinators.push_back(coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Normal, ""}}));
+  source.v.coordinators.push_back(
+      coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Normal, ""}}));
   source.v.coordinators.back().status = "unreachable";
   Protocol protocol(source, {});
   const spec::JsonValue view = parse(protocol.view_json());

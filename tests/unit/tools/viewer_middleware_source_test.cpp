@@ -7,8 +7,8 @@
 
 #ifdef SAFECASS_VIEWER_WITH_ICE
 
-#include <sys/socket.h>
 #include <netinet/in.h>
+#include <sys/socket.h>
 #include <unistd.h>
 
 #include <cerrno>

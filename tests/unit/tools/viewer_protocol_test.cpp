@@ -93,9 +93,9 @@ TEST(ViewerProtocol, ViewListsCoordinatorsComponentsAndEveryMachineWithItsState)
     addresses.push_back(str(m, "address"));
     kinds.push_back(str(m, "kind"));
   }
-  EXPECT_THAT(addresses, ::testing::ElementsAre("CONTROL.s_F", "CONTROL.s_A", "CONTROL.s_P.Command", "CONTROL.s_P.Status",
-                                                "CONTROL.s_R.ForceData", "CONTROL.s_R.BoneMotion", "CONTROL.s_S.Command",
-                                                "CONTROL.s_S.Status"));
+  EXPECT_THAT(addresses, ::testing::ElementsAre("CONTROL.s_F", "CONTROL.s_A", "CONTROL.s_P.Command",
+                                                "CONTROL.s_P.Status", "CONTROL.s_R.ForceData", "CONTROL.s_R.BoneMotion",
+                                                "CONTROL.s_S.Command", "CONTROL.s_S.Status"));
   EXPECT_THAT(kinds, ::testing::ElementsAre("framework", "application", "provided", "provided", "required", "required",
                                             "service", "service"));
 
@@ -214,13 +214,17 @@ TEST(ViewerProtocol, MalformedMessagesGetAnErrorThatSaysWhatIsWrongAndChangeNoth
       {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","token":"s3cret"})", "missing key 'target'"},
       {R"({"op":"generate","event":"EVT_NOPE","target":"CONTROL.s_A","token":"s3cret"})", "EVT_NOPE"},
       {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL","token":"s3cret"})", "CONTROL"},
-      {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL.s_A","token":7})", "'token' must be a string"},
+      {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL.s_A","token":7})",
+       "'token' must be a string"},
       {R"({"op":"inject","samples":[[1]],"token":"s3cret"})", "give either 'filter'"},
-      {R"({"op":"inject","filter":"force_limit","signal":"JR3.Fz","samples":[[1]],"token":"s3cret"})", "give either 'filter'"},
+      {R"({"op":"inject","filter":"force_limit","signal":"JR3.Fz","samples":[[1]],"token":"s3cret"})",
+       "give either 'filter'"},
       {R"({"op":"inject","filter":"force_limit","token":"s3cret"})", "missing key 'samples'"},
       {R"({"op":"inject","filter":"force_limit","samples":[],"token":"s3cret"})", "non-empty array"},
-      {R"({"op":"inject","filter":"force_limit","samples":[["x"]],"token":"s3cret"})", "samples[0] must hold numbers only"},
-      {R"({"op":"inject","filter":"force_limit","samples":[1,{}],"token":"s3cret"})", "samples[1] must be a number or an array"},
+      {R"({"op":"inject","filter":"force_limit","samples":[["x"]],"token":"s3cret"})",
+       "samples[0] must hold numbers only"},
+      {R"({"op":"inject","filter":"force_limit","samples":[1,{}],"token":"s3cret"})",
+       "samples[1] must be a number or an array"},
       {R"({"op":"inject","filter":"nope","samples":[1],"token":"s3cret"})", "no filter 'nope'"},
       {R"({"op":"inject","signal":"JR3.nope","samples":[1],"token":"s3cret"})", "no signal 'JR3.nope'"},
       {R"({"op":"reset","token":"s3cret"})", "missing key 'target'"},
@@ -244,7 +248,8 @@ TEST(ViewerProtocol, TooLongMessageIsRefused) {
   o.max_message = 100;
   Protocol protocol(*source, o);
   const std::string message = R"({"op":"explain","address":")" + std::string(200, 'A') + "\"}";
-  EXPECT_THAT(str(parse(protocol.handle(message)), "error"), HasSubstr("message too long (" + std::to_string(message.size()) + " bytes; at most 100)"));
+  EXPECT_THAT(str(parse(protocol.handle(message)), "error"),
+              HasSubstr("message too long (" + std::to_string(message.size()) + " bytes; at most 100)"));
   // Names longer than 256 characters are refused too.
   Protocol wide(*source, {});
   EXPECT_THAT(str(parse(wide.handle(R"({"op":"explain","address":")" + std::string(300, 'A') + "\"}")), "error"),
@@ -265,10 +270,11 @@ TEST(ViewerProtocol, WritesAreRefusedWhenTheViewerIsReadOnly) {
   ASSERT_NE(source, nullptr);
   Protocol protocol(*source, {});  // read-only, no token at all
   source->take_records();
-  for (const std::string message : {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL.s_A","token":"x"})",
-                                    R"({"op":"broadcast","event":"EVT_CONTROL_FORCE_FREEZE","token":"x"})",
-                                    R"({"op":"inject","filter":"force_limit","samples":[50],"token":"x"})",
-                                    R"({"op":"reset","target":"SYSTEM"})"}) {
+  for (const std::string message :
+       {R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL.s_A","token":"x"})",
+        R"({"op":"broadcast","event":"EVT_CONTROL_FORCE_FREEZE","token":"x"})",
+        R"({"op":"inject","filter":"force_limit","samples":[50],"token":"x"})",
+        R"({"op":"reset","target":"SYSTEM"})"}) {
     const spec::JsonValue reply = parse(protocol.handle(message));
     EXPECT_EQ(str(reply, "type"), "error") << message;
     EXPECT_THAT(str(reply, "error"), HasSubstr("refused: this viewer is read-only")) << message;
@@ -284,8 +290,10 @@ TEST(ViewerProtocol, WritesWithoutTheRightTokenAreRefusedAndWithItApplied) {
   source->take_records();
   const std::string generate = R"({"op":"generate","event":"EVT_CONTROL_FORCE_FREEZE","target":"CONTROL.s_A")";
   EXPECT_THAT(str(parse(protocol.handle(generate + "}")), "error"), HasSubstr("refused: a write needs the token"));
-  EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":"s3cre"})")), "error"), HasSubstr("refused: wrong token"));
-  EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":"s3cret!"})")), "error"), HasSubstr("refused: wrong token"));
+  EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":"s3cre"})")), "error"),
+              HasSubstr("refused: wrong token"));
+  EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":"s3cret!"})")), "error"),
+              HasSubstr("refused: wrong token"));
   EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":""})")), "error"), HasSubstr("refused"));
   const Coordinator& co = source->coordinator();
   EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Normal);
@@ -298,7 +306,8 @@ TEST(ViewerProtocol, WritesWithoutTheRightTokenAreRefusedAndWithItApplied) {
   EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Error);
   EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Error);
 
-  const spec::JsonValue reset = parse(protocol.handle(R"({"op":"reset","target":"CONTROL","reason":"test","token":"s3cret"})"));
+  const spec::JsonValue reset =
+      parse(protocol.handle(R"({"op":"reset","target":"CONTROL","reason":"test","token":"s3cret"})"));
   EXPECT_THAT(str(reset, "text"), HasSubstr("reset CONTROL"));
   EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Normal);
 }
@@ -309,7 +318,8 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   Protocol protocol(*source, writable("k"));
   source->advance_to(0.1);
   // Deep: a 1.5 mm bone displacement written into BMM.Displacement is seen on the next run.
-  const spec::JsonValue deep = parse(protocol.handle(R"({"op":"inject","signal":"BMM.Displacement","samples":[1.5],"token":"k"})"));
+  const spec::JsonValue deep =
+      parse(protocol.handle(R"({"op":"inject","signal":"BMM.Displacement","samples":[1.5],"token":"k"})"));
   EXPECT_THAT(str(deep, "text"), HasSubstr("wrote 1 sample into signal BMM.Displacement"));
   source->advance_to(0.102);
   const std::vector<Explanation> why = *source->explain("BMM.s_A");
@@ -317,7 +327,8 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   EXPECT_EQ(why[0].root_event, "EVT_BONE_MOTION");
   EXPECT_TRUE(why[0].injected);
   // Shallow: queued into one filter.
-  const spec::JsonValue shallow = parse(protocol.handle(R"({"op":"inject","filter":"force_limit","samples":[[50],[50]],"token":"k"})"));
+  const spec::JsonValue shallow =
+      parse(protocol.handle(R"({"op":"inject","filter":"force_limit","samples":[[50],[50]],"token":"k"})"));
   EXPECT_THAT(str(shallow, "text"), HasSubstr("queued 2 samples into filter force_limit"));
 }
 

@@ -96,9 +96,8 @@ public:
     beast::get_lowest_layer(ws_).expires_after(std::chrono::seconds(10));
     beast::get_lowest_layer(ws_).connect(tcp::endpoint(asio::ip::make_address("127.0.0.1"), port));
     if (!origin.empty()) {
-      ws_.set_option(websocket::stream_base::decorator([origin](websocket::request_type& r) {
-        r.set(http::field::origin, origin);
-      }));
+      ws_.set_option(websocket::stream_base::decorator(
+          [origin](websocket::request_type& r) { r.set(http::field::origin, origin); }));
     }
     ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws");
   }
@@ -114,7 +113,8 @@ public:
     ws_.write(asio::buffer(message));
     for (;;) {
       std::string m = read();
-      if (m.find(R"("type":"update")") == std::string::npos && m.find(R"("type":"time")") == std::string::npos) return m;
+      if (m.find(R"("type":"update")") == std::string::npos && m.find(R"("type":"time")") == std::string::npos)
+        return m;
     }
   }
   void send_binary(const std::string& message) {
@@ -164,12 +164,14 @@ TEST(ViewerServer, WebSocketSaysHelloAnswersRequestsAndRefusesBadOnes) {
   Client client(viewer.port());
   const std::string hello = client.read();
   EXPECT_THAT(hello, HasSubstr(R"("type":"hello","write":false)"));
-  EXPECT_THAT(client.ask(R"({"id":1,"op":"explain","address":"SYSTEM"})"), HasSubstr(R"("type":"reply","id":1,"op":"explain")"));
+  EXPECT_THAT(client.ask(R"({"id":1,"op":"explain","address":"SYSTEM"})"),
+              HasSubstr(R"("type":"reply","id":1,"op":"explain")"));
   EXPECT_THAT(client.ask("{oops"), HasSubstr(R"("type":"error")"));
   EXPECT_THAT(client.ask(R"({"op":"reset","target":"SYSTEM"})"), HasSubstr("refused: this viewer is read-only"));
   client.send_binary("\x01\x02");
   std::string reply;
-  do reply = client.read(); while (reply.find(R"("type":"error")") == std::string::npos);
+  do reply = client.read();
+  while (reply.find(R"("type":"error")") == std::string::npos);
   EXPECT_THAT(reply, HasSubstr("binary messages are not accepted"));
   // The connection is still usable after every refusal.
   EXPECT_THAT(client.ask(R"({"op":"view"})"), HasSubstr(R"("system":"robodoc")"));
@@ -194,7 +196,8 @@ TEST(ViewerServer, PushesTheTransitionsOfTheScenarioAsTheyHappen) {
     double transition_t = -1;
     for (const spec::JsonValue& r : p.value->find("records")->array) {
       const spec::JsonValue* c = r.find("component");
-      if (r.find("kind")->string == "component-transition" && c != nullptr && c->string == "CONTROL") transition_t = r.find("t")->number;
+      if (r.find("kind")->string == "component-transition" && c != nullptr && c->string == "CONTROL")
+        transition_t = r.find("t")->number;
     }
     ASSERT_GE(transition_t, 0.0) << m;
     EXPECT_LT(p.value->find("t")->number - transition_t, 0.1);

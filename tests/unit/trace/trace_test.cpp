@@ -36,7 +36,8 @@ protected:
     return std::move(*t);
   }
 
-  std::vector<spec::Diagnostic> fail(const std::string& system, std::vector<std::string> scenarios, const std::string& verify = {}) {
+  std::vector<spec::Diagnostic> fail(const std::string& system, std::vector<std::string> scenarios,
+                                     const std::string& verify = {}) {
     TraceOptions o;
     o.system = system;
     o.scenarios = std::move(scenarios);
@@ -160,7 +161,8 @@ TEST_F(TraceTest, HazardThatNothingDetectsIsAnErrorGapNamingIt) {
   // H-1 has its filter: not undetected.
   EXPECT_EQ(find_gap(t, "hazard-undetected", "H-1"), nullptr);
   // The validation warning (a hazard with no linked event) is kept as a note.
-  EXPECT_TRUE(std::any_of(t.notes.begin(), t.notes.end(), [](const spec::Diagnostic& d) { return d.message.find("H-8") != std::string::npos; }));
+  EXPECT_TRUE(std::any_of(t.notes.begin(), t.notes.end(),
+                          [](const spec::Diagnostic& d) { return d.message.find("H-8") != std::string::npos; }));
   // Errors come first.
   EXPECT_EQ(t.gaps.front().severity, Severity::Error);
 }
@@ -214,12 +216,13 @@ TEST_F(TraceTest, FailingScenarioIsAnErrorGapAndItsEvidenceIsStillListed) {
 }
 
 TEST_F(TraceTest, VerifyResultGivesEachHazardItsVerdictAndAViolationIsAnErrorGap) {
-  const Trace holds = build("tests/data/trace/arm.json", {"tests/data/trace/covered.scenario.json"}, "tests/data/trace/verify_holds.jsonl");
+  const Trace holds = build("tests/data/trace/arm.json", {"tests/data/trace/covered.scenario.json"},
+                            "tests/data/trace/verify_holds.jsonl");
   ASSERT_NE(hazard(holds, "H-1"), nullptr);
   EXPECT_EQ(hazard(holds, "H-1")->verified, Verdict::Holds);
   EXPECT_FALSE(holds.has_error_gap());
-  const Trace violated =
-      build("tests/data/trace/arm.json", {"tests/data/trace/covered.scenario.json"}, "tests/data/trace/verify_violated.jsonl");
+  const Trace violated = build("tests/data/trace/arm.json", {"tests/data/trace/covered.scenario.json"},
+                               "tests/data/trace/verify_violated.jsonl");
   EXPECT_EQ(hazard(violated, "H-1")->verified, Verdict::Violated);
   const Gap* g = find_gap(violated, "reaction-violated", "H-1");
   ASSERT_NE(g, nullptr);

@@ -42,12 +42,16 @@ std::string tree(int n) {
   std::string s = R"({"safecass": 1, "system": "tree", "components": [)";
   for (int k = 0; k < n; ++k) {
     const std::string c = "C" + std::to_string(k);
-    s += std::string(k ? ",\n" : "\n") + R"({"component": ")" + c + R"(", "interfaces": {"provided": ["Out", "Back"], "required": [)" +
-         (k ? R"("In")" : R"("Loop")") + R"(]}, "event": [)";
+    s += std::string(k ? ",\n" : "\n") + R"({"component": ")" + c +
+         R"(", "interfaces": {"provided": ["Out", "Back"], "required": [)" + (k ? R"("In")" : R"("Loop")") +
+         R"(]}, "event": [)";
     s += R"({"name": "EVT_)" + c + R"(_FAULT", "severity": 50, "state_transition": ["N2E", "W2E"]},
-            {"name": "/EVT_)" + c + R"(_FAULT", "severity": 50, "state_transition": ["E2N", "E2W"]},
-            {"name": "EVT_)" + c + R"(_SLOW", "severity": 30, "state_transition": ["N2W", "W2E"]},
-            {"name": "/EVT_)" + c + R"(_SLOW", "severity": 30, "state_transition": ["W2N", "E2N", "E2W"]})";
+            {"name": "/EVT_)" +
+         c + R"(_FAULT", "severity": 50, "state_transition": ["E2N", "E2W"]},
+            {"name": "EVT_)" +
+         c + R"(_SLOW", "severity": 30, "state_transition": ["N2W", "W2E"]},
+            {"name": "/EVT_)" +
+         c + R"(_SLOW", "severity": 30, "state_transition": ["W2N", "E2N", "E2W"]})";
     if (k % 3 == 0) {
       s += R"(, {"name": "EVT_)" + c + R"(_LOST", "severity": 90, "state_transition": ["N2E"], "latched": true})";
     }
@@ -92,8 +96,8 @@ void compare(const spec::SystemSpec& system, unsigned seeds, std::size_t steps, 
       }
       for (std::size_t a = 0; a < addresses.size(); ++a) {
         ASSERT_EQ(co.state_of(addresses[a]), sim->states[k][a])
-            << system.name << ", seed " << seed << ", step " << k << " (" << (s.kind == Step::Kind::Reset ? "reset " : s.event + " on ")
-            << s.target << "): " << sim->addresses[a];
+            << system.name << ", seed " << seed << ", step " << k << " ("
+            << (s.kind == Step::Kind::Reset ? "reset " : s.event + " on ") << s.target << "): " << sim->addresses[a];
       }
       ++total;
     }

@@ -207,12 +207,14 @@ TEST(Verify, LatchedConditionsClearOnlyByReset) {
   // CTRL's EVT_FREEZE is latched and has no completion: once raised, CTRL.s_A leaves Error only
   // by a reset of CTRL.s_A.
   spec::SystemSpec system = load("tests/data/verify/missing_dependency.fixed.json");
-  system.invariants.push_back(spec::InvariantSpec{"freeze_stays", "[] (CTRL.s_A == Error -> [] (CTRL.s_A == Error))", "", {}});
+  system.invariants.push_back(
+      spec::InvariantSpec{"freeze_stays", "[] (CTRL.s_A == Error -> [] (CTRL.s_A == Error))", "", {}});
   Options options;
   options.property = "freeze_stays";
   auto report = verify(system, registry(), options);
   ASSERT_TRUE(report) << report.error().message;
-  EXPECT_EQ(report->properties.at(0).verdict, PropertyResult::Verdict::Violated) << "a reset clears a latched condition";
+  EXPECT_EQ(report->properties.at(0).verdict, PropertyResult::Verdict::Violated)
+      << "a reset clears a latched condition";
   EXPECT_THAT(report->properties.at(0).message, HasSubstr("violates the formula"));
 }
 
@@ -248,15 +250,17 @@ TEST(Verify, AnUnknownPropertyIsBadInput) {
 std::string wide_system(int n) {
   std::string s = R"({"safecass": 1, "system": "wide", "hazards": [)";
   for (int k = 0; k < n; ++k) {
-    for (int j = 0; j < 3; ++j) s += std::string(k + j ? "," : "") + R"({"id": "H-)" + std::to_string(k) + "-" + std::to_string(j) + R"("})";
+    for (int j = 0; j < 3; ++j)
+      s += std::string(k + j ? "," : "") + R"({"id": "H-)" + std::to_string(k) + "-" + std::to_string(j) + R"("})";
   }
   s += R"x(], "invariants": [{"name": "everything", "formula": "[] (SYSTEM <= Error)"}], "components": [)x";
   for (int k = 0; k < n; ++k) {
     s += std::string(k ? "," : "") + R"({"component": "C)" + std::to_string(k) + R"(", "event": [)";
     for (int j = 0; j < 3; ++j) {
       const std::string e = "EVT_" + std::to_string(k) + "_" + std::to_string(j);
-      s += std::string(j ? "," : "") + R"({"name": ")" + e + R"(", "severity": 10, "state_transition": ["N2W", "W2E"], "hazard": "H-)" +
-           std::to_string(k) + "-" + std::to_string(j) + R"("}, {"name": "/)" + e + R"(", "severity": 10, "state_transition": ["W2N", "E2N"]})";
+      s += std::string(j ? "," : "") + R"({"name": ")" + e +
+           R"(", "severity": 10, "state_transition": ["N2W", "W2E"], "hazard": "H-)" + std::to_string(k) + "-" +
+           std::to_string(j) + R"("}, {"name": "/)" + e + R"(", "severity": 10, "state_transition": ["W2N", "E2N"]})";
     }
     s += "]}";
   }
@@ -282,8 +286,10 @@ TEST(Verify, InterchangeableOnsetsAreCountedNotTracked) {
   std::string s = R"({"safecass": 1, "system": "s", "hazards": [{"id": "H-1", "reaction": {"A": "Error"}}],
     "components": [{"component": "A", "event": [)";
   for (int j = 0; j < 3; ++j) {
-    s += std::string(j ? "," : "") + R"({"name": "EVT_)" + std::to_string(j) + R"(", "severity": 50, "state_transition": ["N2E"], "hazard": "H-1"},
-         {"name": "/EVT_)" + std::to_string(j) + R"(", "severity": 50, "state_transition": ["E2N"]})";
+    s += std::string(j ? "," : "") + R"({"name": "EVT_)" + std::to_string(j) +
+         R"(", "severity": 50, "state_transition": ["N2E"], "hazard": "H-1"},
+         {"name": "/EVT_)" +
+         std::to_string(j) + R"(", "severity": 50, "state_transition": ["E2N"]})";
   }
   s += "]}]}";
   const spec::SystemSpec system = load_text(s);

@@ -99,7 +99,8 @@ public:
         ++it_;
       } catch (const std::exception& e) {
         failed_ = true;
-        error_ = path_ + ": message " + std::to_string(index_) + ": the bag is truncated or damaged (rosbag: " + e.what() + ")";
+        error_ = path_ + ": message " + std::to_string(index_) +
+                 ": the bag is truncated or damaged (rosbag: " + e.what() + ")";
         item.kind = Item::Kind::Error;
         return item;
       }
@@ -122,7 +123,8 @@ public:
   std::string where() const override { return path_ + ": message " + std::to_string(index_); }
   std::vector<std::string> notes() const override {
     std::vector<std::string> out;
-    for (const std::string& s : skipped_) out.push_back(path_ + ": mapped signal " + s + " is not in the system: not fed");
+    for (const std::string& s : skipped_)
+      out.push_back(path_ + ": mapped signal " + s + " is not in the system: not fed");
     return out;
   }
 
@@ -145,7 +147,8 @@ private:
       const std::size_t at = values_.size();
       values_.resize(at + b.width);
       std::string why;
-      if (!ros1::detail::extract(b.path, msg, values_.data() + at, b.width, why)) return fail_message(t.mapping.topic, why);
+      if (!ros1::detail::extract(b.path, msg, values_.data() + at, b.width, why))
+        return fail_message(t.mapping.topic, why);
       pending_.push_back(Pending{time, b.signal, at});
     }
     return true;
@@ -166,7 +169,8 @@ private:
     try {
       switch (t->mapping.type) {
         case ros1::MessageType::Float64: return extract_all(*t, *m.instantiate<std_msgs::Float64>(), time);
-        case ros1::MessageType::WrenchStamped: return extract_all(*t, *m.instantiate<geometry_msgs::WrenchStamped>(), time);
+        case ros1::MessageType::WrenchStamped:
+          return extract_all(*t, *m.instantiate<geometry_msgs::WrenchStamped>(), time);
         case ros1::MessageType::JointState: return extract_all(*t, *m.instantiate<sensor_msgs::JointState>(), time);
       }
     } catch (const std::exception& e) {

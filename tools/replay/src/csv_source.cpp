@@ -40,7 +40,8 @@ public:
     std::string_view line;
     if (!read_line(line)) {
       if (!error_.empty()) return fail(ErrorCode::Io, error_);
-      return fail(ErrorCode::Parse, path_ + ":1: the file is empty: it needs a header naming a time column and signals");
+      return fail(ErrorCode::Parse,
+                  path_ + ":1: the file is empty: it needs a header naming a time column and signals");
     }
     // Header cells, with their columns (1-based characters).
     struct Cell {
@@ -50,13 +51,19 @@ public:
     std::vector<Cell> cells;
     for (std::size_t at = 0;;) {
       const std::size_t comma = line.find(',', at);
-      const std::string_view raw = line.substr(at, comma == std::string_view::npos ? std::string_view::npos : comma - at);
-      const std::size_t lead = raw.size() - raw.substr(raw.find_first_not_of(" \t") == std::string_view::npos ? raw.size() : raw.find_first_not_of(" \t")).size();
+      const std::string_view raw =
+          line.substr(at, comma == std::string_view::npos ? std::string_view::npos : comma - at);
+      const std::size_t lead =
+          raw.size() -
+          raw.substr(raw.find_first_not_of(" \t") == std::string_view::npos ? raw.size() : raw.find_first_not_of(" \t"))
+              .size();
       cells.push_back(Cell{std::string(trim(raw)), static_cast<int>(at + lead + 1)});
       if (comma == std::string_view::npos) break;
       at = comma + 1;
     }
-    const auto where = [this](int column) { return path_ + ":" + std::to_string(line_no_) + ":" + std::to_string(column) + ": "; };
+    const auto where = [this](int column) {
+      return path_ + ":" + std::to_string(line_no_) + ":" + std::to_string(column) + ": ";
+    };
     columns_ = cells.size();
     time_column_ = -1;
     std::map<std::string, int> seen;
@@ -69,7 +76,8 @@ public:
     std::vector<std::string> order;
     for (std::size_t i = 0; i < cells.size(); ++i) {
       const Cell& c = cells[i];
-      if (c.text.empty()) return fail(ErrorCode::Parse, where(c.column) + "column " + std::to_string(i + 1) + " has no name");
+      if (c.text.empty())
+        return fail(ErrorCode::Parse, where(c.column) + "column " + std::to_string(i + 1) + " has no name");
       if (auto [it, fresh] = seen.emplace(c.text, c.column); !fresh) {
         return fail(ErrorCode::Parse, where(c.column) + "column '" + c.text + "' appears twice (first at column " +
                                           std::to_string(it->second) + ")");
@@ -86,23 +94,28 @@ public:
         const std::string_view digits = std::string_view(name).substr(open + 1, name.size() - open - 2);
         const auto r = std::from_chars(digits.data(), digits.data() + digits.size(), index);
         if (name.back() != ']' || digits.empty() || r.ec != std::errc() || r.ptr != digits.data() + digits.size()) {
-          return fail(ErrorCode::Parse, where(c.column) + "column '" + c.text +
-                                            "' is not Component.signal or Component.signal[i]");
+          return fail(ErrorCode::Parse,
+                      where(c.column) + "column '" + c.text + "' is not Component.signal or Component.signal[i]");
         }
         name.resize(open);
         indexed = true;
       }
       if (name.find('.') == std::string::npos) {
-        return fail(ErrorCode::Parse, where(c.column) + "column '" + c.text +
-                                          "' is not a signal (Component.signal or Component.signal[i]) nor the time column ('time' or 't')");
+        return fail(
+            ErrorCode::Parse,
+            where(c.column) + "column '" + c.text +
+                "' is not a signal (Component.signal or Component.signal[i]) nor the time column ('time' or 't')");
       }
       if (by_signal.count(name) == 0) order.push_back(name);
       auto& elements = by_signal[name];
-      if (!indexed && !elements.empty()) return fail(ErrorCode::Parse, where(c.column) + "column '" + c.text + "' mixes a scalar and indexed columns");
+      if (!indexed && !elements.empty())
+        return fail(ErrorCode::Parse, where(c.column) + "column '" + c.text + "' mixes a scalar and indexed columns");
       elements.push_back(Element{index, i, c.column});
     }
     if (time_column_ < 0) {
-      return fail(ErrorCode::Parse, path_ + ":" + std::to_string(line_no_) + ": missing column 'time' (the time of each row in seconds; also accepted: 't')");
+      return fail(ErrorCode::Parse,
+                  path_ + ":" + std::to_string(line_no_) +
+                      ": missing column 'time' (the time of each row in seconds; also accepted: 't')");
     }
     cell_group_.assign(columns_, -1);
     cell_element_.assign(columns_, 0);
@@ -114,8 +127,9 @@ public:
       std::vector<bool> have(size, false);
       for (const Element& e : elements) {
         if (e.index >= size) {
-          return fail(ErrorCode::Parse, where(e.at) + "column '" + cells[e.column].text + "': signal '" + name + "' has size " +
-                                            std::to_string(size) + " (indices 0.." + std::to_string(size - 1) + ")");
+          return fail(ErrorCode::Parse, where(e.at) + "column '" + cells[e.column].text + "': signal '" + name +
+                                            "' has size " + std::to_string(size) + " (indices 0.." +
+                                            std::to_string(size - 1) + ")");
         }
         have[e.index] = true;
         cell_group_[e.column] = static_cast<int>(groups_.size());
@@ -123,8 +137,9 @@ public:
       }
       for (std::size_t k = 0; k < size; ++k) {
         if (!have[k]) {
-          return fail(ErrorCode::Parse, path_ + ":" + std::to_string(line_no_) + ": missing column '" + name + "[" + std::to_string(k) + "]': signal '" + name +
-                                            "' has size " + std::to_string(size) + ", each element needs a column");
+          return fail(ErrorCode::Parse, path_ + ":" + std::to_string(line_no_) + ": missing column '" + name + "[" +
+                                            std::to_string(k) + "]': signal '" + name + "' has size " +
+                                            std::to_string(size) + ", each element needs a column");
         }
       }
       groups_.push_back(Group{*s, name, size, values_.size(), 0});
@@ -247,7 +262,8 @@ private:
       if (!cell.empty()) {
         double v = 0;
         if (!parse_number(cell, v)) {
-          const std::string what = static_cast<int>(column) == time_column_ ? "time" : "column " + std::to_string(column + 1);
+          const std::string what =
+              static_cast<int>(column) == time_column_ ? "time" : "column " + std::to_string(column + 1);
           return fail_line(static_cast<int>(at + 1), "malformed number '" + std::string(cell) + "' in " + what +
                                                          " (a finite decimal number is expected)");
         }
@@ -264,7 +280,8 @@ private:
       at = comma + 1;
     }
     if (column + 1 != columns_) {
-      return fail_line(0, "the row has " + std::to_string(column + 1) + " cells, the header " + std::to_string(columns_) + " columns");
+      return fail_line(0, "the row has " + std::to_string(column + 1) + " cells, the header " +
+                              std::to_string(columns_) + " columns");
     }
     if (!have_time) return fail_line(0, "the row has no time");
     const Time time = seconds_to_time(t);

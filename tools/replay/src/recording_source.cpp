@@ -26,8 +26,8 @@ Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name) {
   for (const auto& f : monitor.filters()) {
     for (const Signal* o : f->outputs()) {
       if (o == s) {
-        return fail(ErrorCode::InvalidArgument, "signal '" + name + "' is computed by filter " + f->name() +
-                                                    ": a log feeds input signals only");
+        return fail(ErrorCode::InvalidArgument,
+                    "signal '" + name + "' is computed by filter " + f->name() + ": a log feeds input signals only");
       }
     }
   }
@@ -64,18 +64,10 @@ public:
           item.time = reader_->action().time;
           item.action = &reader_->action();
           return item;
-        case InputLogReader::Item::Loss:
-          lost_ += reader_->lost();
-          continue;
-        case InputLogReader::Item::End:
-          end_ = reader_->mark_time();
-          continue;
-        case InputLogReader::Item::Eof:
-          item.kind = Item::Kind::End;
-          return item;
-        case InputLogReader::Item::Error:
-          error_ = reader_->error();
-          return error_item();
+        case InputLogReader::Item::Loss: lost_ += reader_->lost(); continue;
+        case InputLogReader::Item::End: end_ = reader_->mark_time(); continue;
+        case InputLogReader::Item::Eof: item.kind = Item::Kind::End; return item;
+        case InputLogReader::Item::Error: error_ = reader_->error(); return error_item();
       }
     }
   }
@@ -91,7 +83,9 @@ public:
   std::vector<std::string> notes() const override {
     std::vector<std::string> out;
     if (reader_->truncated()) {
-      out.push_back(reader_->path() + ": the recording ends inside a record (its recorder was stopped by force): replayed up to its last whole record");
+      out.push_back(reader_->path() +
+                    ": the recording ends inside a record (its recorder was stopped by force): replayed up to its last "
+                    "whole record");
     } else if (!end_) {
       out.push_back(reader_->path() + ": the recording has no end record (its recorder did not close it)");
     }

@@ -61,19 +61,22 @@ Expected<std::unique_ptr<InputSource>> open_input(const ReplayOptions& o, const 
   if (format == "bag") {
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG
     if (o.mapping.empty()) {
-      return fail(ErrorCode::InvalidArgument, o.input + ": a ROS bag needs the ROS extension's mapping file (--mapping FILE)");
+      return fail(ErrorCode::InvalidArgument,
+                  o.input + ": a ROS bag needs the ROS extension's mapping file (--mapping FILE)");
     }
     return open_bag(o.input, o.mapping);
 #else
-    return fail(ErrorCode::InvalidArgument, o.input + ": a ROS bag needs the ROS 1 extension, and this safecass was built without it (SAFECASS_WITH_ROS1)");
+    return fail(
+        ErrorCode::InvalidArgument,
+        o.input + ": a ROS bag needs the ROS 1 extension, and this safecass was built without it (SAFECASS_WITH_ROS1)");
 #endif
   }
   return fail(ErrorCode::InvalidArgument, "unknown log format '" + format + "' (recording, csv or bag)");
 }
 
 /// The system, composed as `safecass run` composes it, with no scenario steps.
-std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::optional<Time> period, const std::string& input,
-                                            const FilterRegistry& registry, std::FILE* err) {
+std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::optional<Time> period,
+                                            const std::string& input, const FilterRegistry& registry, std::FILE* err) {
   spec::LoadResult sys = spec::load_system(path, registry);
   for (const auto& d : sys.diagnostics) {
     if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(err, "%s\n", spec::format(d).c_str());
@@ -186,9 +189,7 @@ bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, std::option
     const Item item = src.next();
     switch (item.kind) {
       case Item::Kind::End: return true;
-      case Item::Kind::Error:
-        std::fprintf(err, "%s\n", src.error().c_str());
-        return false;
+      case Item::Kind::Error: std::fprintf(err, "%s\n", src.error().c_str()); return false;
       case Item::Kind::Action:
         if (const std::string why = check_action(r, *item.action); !why.empty()) {
           std::fprintf(err, "%s: action at t=%s: %s\n", src.where().c_str(), secs(item.time).c_str(), why.c_str());
@@ -480,8 +481,10 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   for (const std::string& name : addresses_of(b->coordinator())) {
     auto ab = b->coordinator().resolve(name);
     auto aa = a->coordinator().resolve(name);
-    if (ab && aa) tracked.push_back(Tracked{name, *ab, *aa, {}});
-    else only.push_back(name + " (only in " + system_b + ")");
+    if (ab && aa)
+      tracked.push_back(Tracked{name, *ab, *aa, {}});
+    else
+      only.push_back(name + " (only in " + system_b + ")");
   }
   for (const std::string& name : addresses_of(a->coordinator())) {
     if (!b->coordinator().resolve(name)) only.push_back(name + " (only in " + o.system + ")");
@@ -560,11 +563,13 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
         if (!c.signal.empty()) {
           char v[40];
           std::snprintf(v, sizeof v, "%.9g", c.value);
-          cause += ",\"signal\":" + quoted(c.signal) + ",\"value\":" + (std::isfinite(c.value) ? std::string(v) : quoted(v));
+          cause +=
+              ",\"signal\":" + quoted(c.signal) + ",\"value\":" + (std::isfinite(c.value) ? std::string(v) : quoted(v));
         }
         cause += "}";
         std::fprintf(o.out,
-                     "{\"kind\":\"difference\",\"address\":%s,\"from\":%s,\"to\":%s,\"until_end\":%s,\"b\":\"%s\",\"a\":\"%s\",\"cause\":%s}\n",
+                     "{\"kind\":\"difference\",\"address\":%s,\"from\":%s,\"to\":%s,\"until_end\":%s,\"b\":\"%s\","
+                     "\"a\":\"%s\",\"cause\":%s}\n",
                      quoted(t.name).c_str(), secs(i.from).c_str(), until.c_str(), i.open ? "true" : "false",
                      std::string(to_string(i.b)).c_str(), std::string(to_string(i.a)).c_str(), cause.c_str());
       } else {
@@ -577,7 +582,8 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
   if (o.json) {
     std::fprintf(o.out, "{\"kind\":\"diff\",\"b\":%s,\"a\":%s,\"addresses\":%zu,\"intervals\":%zu,\"differ\":%s}\n",
-                 quoted(system_b).c_str(), quoted(o.system).c_str(), addresses, intervals, addresses ? "true" : "false");
+                 quoted(system_b).c_str(), quoted(o.system).c_str(), addresses, intervals,
+                 addresses ? "true" : "false");
   } else if (addresses == 0) {
     std::fprintf(o.out, "B (%s) and A (%s) never differ on %s\n", system_b.c_str(), o.system.c_str(), o.input.c_str());
   } else {

@@ -73,8 +73,8 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(spec::Scenario scen
   return runner;
 }
 
-Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSource& source, const FilterRegistry& registry,
-                                                             Diagnostics* notes) {
+Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSource& source,
+                                                             const FilterRegistry& registry, Diagnostics* notes) {
   // Every problem at once: the scenario's format problems and the names its readable steps use
   // that the system does not have, in file order, then the system file's errors.
   Diagnostics problems;
@@ -91,7 +91,8 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
       if (a.where.line != b.where.line) return a.where.line < b.where.line;
       return a.where.column < b.where.column;
     });
-    problems.insert(problems.end(), std::make_move_iterator(system_errors.begin()), std::make_move_iterator(system_errors.end()));
+    problems.insert(problems.end(), std::make_move_iterator(system_errors.begin()),
+                    std::make_move_iterator(system_errors.end()));
   };
 
   std::optional<spec::Scenario> scenario;
@@ -133,7 +134,8 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
         problems.insert(problems.end(), std::make_move_iterator(names.begin()), std::make_move_iterator(names.end()));
       }
     } else if (loaded_ok) {
-      system_errors.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error, spec::Position{scenario->system, 0, 0},
+      system_errors.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error,
+                                               spec::Position{scenario->system, 0, 0},
                                                "cannot load system '" + scenario->system + "'", ""});
     }
   }
@@ -165,18 +167,22 @@ Diagnostics ScenarioRunner::check_names() {
           Signal* sig = monitor_->signals().find(name);
           if (sig == nullptr) {
             const std::string suggestion = spec::did_you_mean(name, signal_names);
-            out.push_back(error_at(s, "no signal '" + std::string(name) + "'" +
-                                          (suggestion.empty() ? " (signals are written Component.signal)" : suggestion)));
+            out.push_back(
+                error_at(s, "no signal '" + std::string(name) + "'" +
+                                (suggestion.empty() ? " (signals are written Component.signal)" : suggestion)));
           } else if (sig->size() != values.size()) {
             out.push_back(error_at(s, "signal '" + std::string(name) + "' has size " + std::to_string(sig->size()) +
-                                                     ", the sample has " + std::to_string(values.size()) + " values"));
+                                          ", the sample has " + std::to_string(values.size()) + " values"));
           }
         }
         break;
       case spec::ScenarioStep::Kind::Ramp: {
         Signal* sig = monitor_->signals().find(action->signal);
-        if (sig == nullptr) out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
-        else if (sig->size() != 1) out.push_back(error_at(s, "a ramp needs a scalar signal; '" + action->signal + "' has size " + std::to_string(sig->size())));
+        if (sig == nullptr)
+          out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
+        else if (sig->size() != 1)
+          out.push_back(error_at(
+              s, "a ramp needs a scalar signal; '" + action->signal + "' has size " + std::to_string(sig->size())));
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
@@ -184,7 +190,8 @@ Diagnostics ScenarioRunner::check_names() {
         if (!e) {
           out.push_back(error_at(s, unknown("event", action->event, event_names)));
         } else if (!coordinator_.event(*e).is_broadcast()) {
-          if (action->target.empty()) out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
+          if (action->target.empty())
+            out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
           else if (auto m = coordinator_.find_machine(action->target); !m) {
             out.push_back(error_at(s, no_address(action->target, m.error().message)));
           }
@@ -208,9 +215,9 @@ Diagnostics ScenarioRunner::check_names() {
           } else {
             for (const auto& v : action->values) {
               if (v.size() != f->inputs()[0]->size()) {
-                out.push_back(error_at(s, "filter '" + action->filter + "' reads '" + f->inputs()[0]->name() + "' of size " +
-                                              std::to_string(f->inputs()[0]->size()) + "; an injected sample has " +
-                                              std::to_string(v.size()) + " values"));
+                out.push_back(error_at(s, "filter '" + action->filter + "' reads '" + f->inputs()[0]->name() +
+                                              "' of size " + std::to_string(f->inputs()[0]->size()) +
+                                              "; an injected sample has " + std::to_string(v.size()) + " values"));
                 break;
               }
             }
@@ -266,13 +273,14 @@ Diagnostics ScenarioRunner::check_names() {
 
 void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
   const spec::StepAction* action = s.action.get();  // null for a sample step
-  InputRecorder* inputs = inputs_.get();  // records each action as it is applied (samples: drained)
+  InputRecorder* inputs = inputs_.get();            // records each action as it is applied (samples: drained)
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Sample:
       for (const auto& [name, values] : s.samples) monitor_->signals().find(name)->push(now, values.data());
       break;
     case spec::ScenarioStep::Kind::Ramp:
-      ramps_.push_back(Ramp{monitor_->signals().find(action->signal), now, seconds_to_time(action->until), action->from, action->to});
+      ramps_.push_back(Ramp{monitor_->signals().find(action->signal), now, seconds_to_time(action->until), action->from,
+                            action->to});
       break;
     case spec::ScenarioStep::Kind::Generate:
       if (inputs != nullptr) inputs->generate(action->event, action->target);
@@ -283,7 +291,8 @@ void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
         if (inputs != nullptr) inputs->inject_shallow(action->filter, action->values);
         (void)monitor_->inject_shallow(action->filter, action->values);
       } else {
-        const std::string signal = action->filter.empty() ? action->signal : monitor_->find_filter(action->filter)->inputs()[0]->name();
+        const std::string signal =
+            action->filter.empty() ? action->signal : monitor_->find_filter(action->filter)->inputs()[0]->name();
         if (inputs != nullptr) inputs->inject_deep(signal, action->values);
         (void)monitor_->inject_deep(signal, action->values, now);
       }
@@ -301,8 +310,10 @@ void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
   }
 }
 
-std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::string& address, const std::string& expected) {
-  if (const auto* components = coordinator_components(address); components != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) {
+std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::string& address,
+                                      const std::string& expected) {
+  if (const auto* components = coordinator_components(address);
+      components != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) {
     // The state of a coordinator of the system: the product of its components' (DESIGN §2.2).
     State got = State::Normal;
     for (const std::string& c : *components) got = std::max(got, coordinator_.state_of(*coordinator_.resolve(c)));
@@ -319,8 +330,8 @@ std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::st
       return address + " is " + std::string(to_string(got)) + ", expected " + std::string(to_string(want));
     }
     case spec::ScenarioStep::Kind::ExpectOutstanding: {
-      const StateSnapshot snap = a.kind == Address::Kind::Component ? coordinator_.extended(a.component)
-                                                                    : coordinator_.snapshot(a.machine);
+      const StateSnapshot snap =
+          a.kind == Address::Kind::Component ? coordinator_.extended(a.component) : coordinator_.snapshot(a.machine);
       const std::string got = snap.outstanding == kNoEvent ? "none" : coordinator_.event(snap.outstanding).name;
       if (got == expected) return {};
       return "outstanding event of " + address + " is " + got + ", expected " + expected;
@@ -365,7 +376,8 @@ bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
     recorder_ = std::move(*r);
   }
   std::string inputs_path = options.inputs_path;
-  if (inputs_path.empty() && !options.record_path.empty()) inputs_path = InputRecorder::path_for_history(options.record_path);
+  if (inputs_path.empty() && !options.record_path.empty())
+    inputs_path = InputRecorder::path_for_history(options.record_path);
   if (!inputs_path.empty() && inputs_path != "-") {
     InputRecorderOptions o;
     o.limits = options.limits;
@@ -377,15 +389,18 @@ bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
     }
     inputs_ = std::move(*r);
   }
-  printer_ = coordinator_.subscribe([this, &result, json = options.json, quiet = options.quiet, out = options.out](const Record& r) {
+  printer_ = coordinator_.subscribe([this, &result, json = options.json, quiet = options.quiet,
+                                     out = options.out](const Record& r) {
     if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent) {
       result.coverage.events_fired.insert(coordinator_.event(r.event).name);
       if (r.root.event != kNoEvent) result.coverage.events_fired.insert(coordinator_.event(r.root.event).name);
     }
     if (r.kind == RecordKind::Transition && r.event != kNoEvent) {
-      result.coverage.taken.emplace(coordinator_.event(r.event).name, std::string(to_string(transition_between(r.from, r.to))));
+      result.coverage.taken.emplace(coordinator_.event(r.event).name,
+                                    std::string(to_string(transition_between(r.from, r.to))));
     }
-    const bool shown = r.kind == RecordKind::Transition || r.kind == RecordKind::Reset || r.kind == RecordKind::Injection ||
+    const bool shown = r.kind == RecordKind::Transition || r.kind == RecordKind::Reset ||
+                       r.kind == RecordKind::Injection ||
                        (r.kind == RecordKind::Event && (r.outcome == Outcome::Masked || r.outcome == Outcome::Ignored));
     if (quiet || !shown) return;
     const std::string line = json ? record_to_json(r, coordinator_) : record_to_text(r, coordinator_);
@@ -398,7 +413,8 @@ void ScenarioRunner::finish(RunResult& result) {
   for (; next_check_ < checks_.size(); ++next_check_) {
     const spec::ScenarioStep& s = *checks_[next_check_];
     result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
-                              ": expectation at t=" + secs(seconds_to_time(s.at)) + " is after the scenario's duration");
+                              ": expectation at t=" + secs(seconds_to_time(s.at)) +
+                              " is after the scenario's duration");
   }
   if (printer_ != 0) {
     coordinator_.unsubscribe(printer_);
@@ -414,7 +430,8 @@ void ScenarioRunner::finish(RunResult& result) {
   }
   for (EventId e = framework_event::kCount; e < coordinator_.event_count(); ++e) {
     const Event& ev = coordinator_.event(e);
-    for (Transition t : {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
+    for (Transition t :
+         {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (ev.transitions.contains(t)) result.coverage.defined.emplace(ev.name, std::string(to_string(t)));
     }
   }
@@ -433,15 +450,14 @@ void ScenarioRunner::split_steps() {
   if (split_) return;
   split_ = true;
   for (const spec::ScenarioStep& s : scenario_.steps) {
-    const bool is_check = s.kind == spec::ScenarioStep::Kind::Expect || s.kind == spec::ScenarioStep::Kind::ExpectOutstanding ||
+    const bool is_check = s.kind == spec::ScenarioStep::Kind::Expect ||
+                          s.kind == spec::ScenarioStep::Kind::ExpectOutstanding ||
                           s.kind == spec::ScenarioStep::Kind::ExpectCause;
     (is_check ? checks_ : actions_).push_back(&s);
   }
 }
 
-Time ScenarioRunner::now() const noexcept {
-  return Time{(next_tick_ - 1) * seconds_to_time(scenario_.period).count()};
-}
+Time ScenarioRunner::now() const noexcept { return Time{(next_tick_ - 1) * seconds_to_time(scenario_.period).count()}; }
 
 void ScenarioRunner::advance_to(Time until, RunResult& result) {
   split_steps();
@@ -451,7 +467,8 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
     clock_.set(now);
     if (feed_) feed_(now);
     // (1) steps due at this tick, in file order (first tick at or after their time).
-    while (next_step_ < actions_.size() && seconds_to_time(actions_[next_step_]->at) <= now) apply(*actions_[next_step_++], now);
+    while (next_step_ < actions_.size() && seconds_to_time(actions_[next_step_]->at) <= now)
+      apply(*actions_[next_step_++], now);
     for (auto it = ramps_.begin(); it != ramps_.end();) {
       const double span = to_seconds(it->until - it->from_time);
       const double f = span <= 0 ? 1.0 : std::min(1.0, to_seconds(now - it->from_time) / span);
@@ -462,7 +479,8 @@ void ScenarioRunner::advance_to(Time until, RunResult& result) {
     runtime_->step(now);
     if (inputs_) inputs_->drain();
     // (3) expectations due at this tick.
-    while (next_check_ < checks_.size() && seconds_to_time(checks_[next_check_]->at) <= now) check(*checks_[next_check_++], now, result);
+    while (next_check_ < checks_.size() && seconds_to_time(checks_[next_check_]->at) <= now)
+      check(*checks_[next_check_++], now, result);
   }
 }
 

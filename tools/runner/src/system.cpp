@@ -63,8 +63,10 @@ Opened<std::unique_ptr<System>> open_system(const std::string& path, const Filte
 Diagnostics keep_errors(Diagnostics diagnostics, Diagnostics* notes) {
   Diagnostics errors;
   for (spec::Diagnostic& d : diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) errors.push_back(std::move(d));
-    else if (notes != nullptr) notes->push_back(std::move(d));
+    if (d.severity == spec::Diagnostic::Severity::Error)
+      errors.push_back(std::move(d));
+    else if (notes != nullptr)
+      notes->push_back(std::move(d));
   }
   return errors;
 }

@@ -23,7 +23,8 @@ std::string where_text(const spec::Position& p) {
 
 std::string uses_text(const std::vector<ScenarioUse>& uses) {
   std::vector<std::string> out;
-  for (const ScenarioUse& u : uses) out.push_back(u.scenario + (u.transitions.empty() ? "" : " (" + join(u.transitions, " ") + ")"));
+  for (const ScenarioUse& u : uses)
+    out.push_back(u.scenario + (u.transitions.empty() ? "" : " (" + join(u.transitions, " ") + ")"));
   return join(out, "; ");
 }
 
@@ -45,22 +46,23 @@ std::string json_strings(const std::vector<std::string>& items) {
 }
 
 std::string json_where(const spec::Position& p) {
-  return "{\"file\":" + q(p.file) + ",\"line\":" + std::to_string(p.line) + ",\"column\":" + std::to_string(p.column) + "}";
+  return "{\"file\":" + q(p.file) + ",\"line\":" + std::to_string(p.line) + ",\"column\":" + std::to_string(p.column) +
+         "}";
 }
 
 std::string json_filter(const FilterLink& f) {
   return "{\"name\":" + q(f.name) + ",\"pipeline\":" + q(f.pipeline) + ",\"chain\":" + json_strings(f.chain) +
          ",\"class\":" + q(f.type) + ",\"component\":" + q(f.component) + ",\"target\":" + q(f.target) +
-         ",\"signals\":" + q(f.signals) + ",\"threshold\":" + q(f.threshold) + ",\"parameters\":" + json_strings(f.parameters) +
-         ",\"execution\":" + q(f.execution) + ",\"period\":" + q(f.period) + ",\"role\":" + q(f.role) +
-         ",\"where\":" + json_where(f.where) + "}";
+         ",\"signals\":" + q(f.signals) + ",\"threshold\":" + q(f.threshold) +
+         ",\"parameters\":" + json_strings(f.parameters) + ",\"execution\":" + q(f.execution) +
+         ",\"period\":" + q(f.period) + ",\"role\":" + q(f.role) + ",\"where\":" + json_where(f.where) + "}";
 }
 
 std::string json_event(const EventLink& e) {
-  std::string out = "{\"name\":" + q(e.name) + ",\"component\":" + q(e.component) + ",\"role\":" +
-                    q(e.onset ? "onset" : "completion") + ",\"severity\":" + std::to_string(e.severity) +
-                    ",\"level\":" + q(e.level) + ",\"transitions\":" + q(e.transitions) + ",\"targets\":" +
-                    json_strings(e.targets) + ",\"latched\":" + (e.latched ? "true" : "false") +
+  std::string out = "{\"name\":" + q(e.name) + ",\"component\":" + q(e.component) +
+                    ",\"role\":" + q(e.onset ? "onset" : "completion") + ",\"severity\":" + std::to_string(e.severity) +
+                    ",\"level\":" + q(e.level) + ",\"transitions\":" + q(e.transitions) +
+                    ",\"targets\":" + json_strings(e.targets) + ",\"latched\":" + (e.latched ? "true" : "false") +
                     ",\"completion\":" + q(e.completion) + ",\"filters\":[";
   for (std::size_t k = 0; k < e.filters.size(); ++k) out += (k == 0 ? "" : ",") + json_filter(e.filters[k]);
   out += "],\"fired_by\":[";
@@ -86,9 +88,10 @@ std::string csv_field(const std::string& s) {
 std::string gaps_of(const Trace& t, const std::string& hazard, const std::string& event, const std::string& filter) {
   std::vector<std::string> out;
   for (const Gap& g : t.gaps) {
-    const bool mine = (!hazard.empty() && g.hazard == hazard && (g.subject == hazard || g.subject == event ||
-                                                                 (event.empty() && g.kind == "reaction-unchecked"))) ||
-                      (hazard.empty() && !filter.empty() && g.subject == filter);
+    const bool mine =
+        (!hazard.empty() && g.hazard == hazard &&
+         (g.subject == hazard || g.subject == event || (event.empty() && g.kind == "reaction-unchecked"))) ||
+        (hazard.empty() && !filter.empty() && g.subject == filter);
     if (mine) out.push_back(std::string(to_string(g.severity)) + " " + g.kind + ": " + g.subject);
   }
   return join(out, "; ");
@@ -102,10 +105,13 @@ std::string trace_text(const Trace& t) {
     out += "\n" + h.id + ": " + h.description + "\n";
     std::vector<std::string> reaction;
     for (const ReactionLink& r : h.reaction) {
-      reaction.push_back(r.address + " >= " + r.level + (r.checked_by.empty() ? " (checked by no scenario)" : " (checked by " + join(r.checked_by, ", ") + ")"));
+      reaction.push_back(
+          r.address + " >= " + r.level +
+          (r.checked_by.empty() ? " (checked by no scenario)" : " (checked by " + join(r.checked_by, ", ") + ")"));
     }
     out += "  reaction: " + (reaction.empty() ? std::string("none") : join(reaction, "; ")) + "\n";
-    out += "  verify: " + std::string(to_string(h.verified)) + (h.verify_detail.empty() ? "" : " (" + h.verify_detail + ")") + "\n";
+    out += "  verify: " + std::string(to_string(h.verified)) +
+           (h.verify_detail.empty() ? "" : " (" + h.verify_detail + ")") + "\n";
     if (h.events.empty()) out += "  no linked event\n";
     for (const EventLink& e : h.events) {
       out += "  " + std::string(e.onset ? "onset " : "completion ") + e.name + " (" + e.component + ", severity " +
@@ -114,7 +120,9 @@ std::string trace_text(const Trace& t) {
       for (const FilterLink& f : e.filters) out += "    filter " + filter_text(f) + "\n";
       if (e.filters.empty()) out += "    no filter generates it\n";
       out += "    fired by: " + (e.fired_by.empty() ? std::string("no scenario") : uses_text(e.fired_by)) + "\n";
-      if (e.onset) out += "    cleared by: " + (e.cleared_by.empty() ? std::string("no scenario") : join(e.cleared_by, ", ")) + "\n";
+      if (e.onset)
+        out +=
+            "    cleared by: " + (e.cleared_by.empty() ? std::string("no scenario") : join(e.cleared_by, ", ")) + "\n";
     }
   }
   if (!t.unlinked.empty()) {
@@ -131,7 +139,8 @@ std::string trace_text(const Trace& t) {
   out += "\nGaps (" + std::to_string(t.gaps.size()) + ")\n";
   for (const Gap& g : t.gaps) {
     const std::string at = where_text(g.where);
-    out += "  " + (at.empty() ? std::string() : at + ": ") + std::string(to_string(g.severity)) + ": " + g.message + " [" + g.kind + "]\n";
+    out += "  " + (at.empty() ? std::string() : at + ": ") + std::string(to_string(g.severity)) + ": " + g.message +
+           " [" + g.kind + "]\n";
   }
   const Coverage& c = t.coverage;
   out += "\nCoverage: hazards " + std::to_string(c.hazards_detected) + "/" + std::to_string(c.hazards) + " detected, " +
@@ -143,24 +152,27 @@ std::string trace_text(const Trace& t) {
 }
 
 std::string trace_json(const Trace& t) {
-  std::string out = "{\"system\":" + q(t.system) + ",\"path\":" + q(t.system_path) + ",\"version\":" + q(tool_version()) +
-                    ",\"files\":[";
+  std::string out = "{\"system\":" + q(t.system) + ",\"path\":" + q(t.system_path) +
+                    ",\"version\":" + q(tool_version()) + ",\"files\":[";
   for (std::size_t k = 0; k < t.files.size(); ++k) {
-    out += std::string(k == 0 ? "" : ",") + "{\"path\":" + q(t.files[k].path) + ",\"sha256\":" + q(t.files[k].sha256) + "}";
+    out += std::string(k == 0 ? "" : ",") + "{\"path\":" + q(t.files[k].path) + ",\"sha256\":" + q(t.files[k].sha256) +
+           "}";
   }
   out += "],\"hazards\":[";
   for (std::size_t k = 0; k < t.hazards.size(); ++k) {
     const HazardTrace& h = t.hazards[k];
-    out += std::string(k == 0 ? "" : ",") + "{\"id\":" + q(h.id) + ",\"description\":" + q(h.description) + ",\"events\":[";
+    out += std::string(k == 0 ? "" : ",") + "{\"id\":" + q(h.id) + ",\"description\":" + q(h.description) +
+           ",\"events\":[";
     for (std::size_t e = 0; e < h.events.size(); ++e) out += (e == 0 ? "" : ",") + json_event(h.events[e]);
     out += "],\"reaction\":[";
     for (std::size_t r = 0; r < h.reaction.size(); ++r) {
-      out += std::string(r == 0 ? "" : ",") + "{\"address\":" + q(h.reaction[r].address) + ",\"level\":" + q(h.reaction[r].level) +
-             ",\"checked_by\":" + json_strings(h.reaction[r].checked_by) + ",\"where\":" + json_where(h.reaction[r].where) + "}";
+      out += std::string(r == 0 ? "" : ",") + "{\"address\":" + q(h.reaction[r].address) +
+             ",\"level\":" + q(h.reaction[r].level) + ",\"checked_by\":" + json_strings(h.reaction[r].checked_by) +
+             ",\"where\":" + json_where(h.reaction[r].where) + "}";
     }
     out += "],\"verify\":" + q(to_string(h.verified)) + ",\"verify_detail\":" + q(h.verify_detail) +
-           ",\"excerpt\":{\"scenario\":" + q(h.excerpt_scenario) + ",\"components\":" + json_strings(h.excerpt_components) + "}" +
-           ",\"where\":" + json_where(h.where) + "}";
+           ",\"excerpt\":{\"scenario\":" + q(h.excerpt_scenario) +
+           ",\"components\":" + json_strings(h.excerpt_components) + "}" + ",\"where\":" + json_where(h.where) + "}";
   }
   out += "],\"unlinked\":[";
   for (std::size_t k = 0; k < t.unlinked.size(); ++k) out += (k == 0 ? "" : ",") + json_event(t.unlinked[k]);
@@ -178,20 +190,32 @@ std::string trace_json(const Trace& t) {
            ",\"where\":" + json_where(g.where) + "}";
   }
   const Coverage& c = t.coverage;
-  out += "],\"coverage\":{\"hazards\":" + std::to_string(c.hazards) + ",\"hazards_detected\":" + std::to_string(c.hazards_detected) +
-         ",\"hazards_exercised\":" + std::to_string(c.hazards_exercised) + ",\"reactions\":" + std::to_string(c.reactions) +
-         ",\"reactions_checked\":" + std::to_string(c.reactions_checked) + ",\"events_defined\":" + std::to_string(c.events_defined) +
-         ",\"events_fired\":" + std::to_string(c.events_fired) + ",\"transitions_defined\":" + std::to_string(c.transitions_defined) +
+  out += "],\"coverage\":{\"hazards\":" + std::to_string(c.hazards) +
+         ",\"hazards_detected\":" + std::to_string(c.hazards_detected) +
+         ",\"hazards_exercised\":" + std::to_string(c.hazards_exercised) +
+         ",\"reactions\":" + std::to_string(c.reactions) +
+         ",\"reactions_checked\":" + std::to_string(c.reactions_checked) +
+         ",\"events_defined\":" + std::to_string(c.events_defined) +
+         ",\"events_fired\":" + std::to_string(c.events_fired) +
+         ",\"transitions_defined\":" + std::to_string(c.transitions_defined) +
          ",\"transitions_taken\":" + std::to_string(c.transitions_taken) + "},\"verify_source\":" + q(t.verify_source) +
          ",\"error_gaps\":" + (t.has_error_gap() ? "true" : "false") + "}\n";
   return out;
 }
 
 std::string trace_csv(const Trace& t) {
-  static const char* const kHeader[] = {"hazard", "hazard_description", "reaction", "reaction_checked_by", "verify",
-                                        "event", "role", "component", "severity", "level", "transitions", "targets",
-                                        "latched", "filter", "pipeline", "class", "signals", "threshold", "parameters",
-                                        "execution", "period", "fired_by", "cleared_by", "gaps"};
+  static const char* const kHeader[] = {"hazard",      "hazard_description",
+                                        "reaction",    "reaction_checked_by",
+                                        "verify",      "event",
+                                        "role",        "component",
+                                        "severity",    "level",
+                                        "transitions", "targets",
+                                        "latched",     "filter",
+                                        "pipeline",    "class",
+                                        "signals",     "threshold",
+                                        "parameters",  "execution",
+                                        "period",      "fired_by",
+                                        "cleared_by",  "gaps"};
   std::string out;
   for (std::size_t k = 0; k < std::size(kHeader); ++k) out += std::string(k == 0 ? "" : ",") + kHeader[k];
   out += "\r\n";
@@ -218,14 +242,21 @@ std::string trace_csv(const Trace& t) {
       row(fields);
       return;
     }
-    const std::vector<std::string> event = {e->name, e->onset ? "onset" : "completion", e->component, std::to_string(e->severity),
-                                            e->level, e->transitions, join(e->targets, "; "), e->latched ? "yes" : "no"};
+    const std::vector<std::string> event = {e->name,
+                                            e->onset ? "onset" : "completion",
+                                            e->component,
+                                            std::to_string(e->severity),
+                                            e->level,
+                                            e->transitions,
+                                            join(e->targets, "; "),
+                                            e->latched ? "yes" : "no"};
     const auto emit = [&](const FilterLink* f) {
       std::vector<std::string> fields = head;
       fields.insert(fields.end(), event.begin(), event.end());
       if (f != nullptr) {
-        fields.insert(fields.end(), {f->name, f->pipeline.empty() ? "" : f->pipeline + ": " + join(f->chain, " -> "), f->type,
-                                     f->signals, f->threshold, join(f->parameters, " "), f->execution, f->period});
+        fields.insert(fields.end(),
+                      {f->name, f->pipeline.empty() ? "" : f->pipeline + ": " + join(f->chain, " -> "), f->type,
+                       f->signals, f->threshold, join(f->parameters, " "), f->execution, f->period});
       } else {
         fields.insert(fields.end(), 8, "");
       }

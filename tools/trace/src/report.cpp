@@ -51,7 +51,8 @@ std::string marker(Severity s, const std::string& kind, const std::string& text)
   const std::string sev(to_string(s));
   std::string label = sev;
   for (char& c : label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return "<span class=\"marker-gap " + sev + "\" data-gap=\"" + esc(kind) + "\">" + label + ": " + esc(text) + "</span>";
+  return "<span class=\"marker-gap " + sev + "\" data-gap=\"" + esc(kind) + "\">" + label + ": " + esc(text) +
+         "</span>";
 }
 
 /// The gaps about one subject of one hazard ("" hazard: gaps of no hazard).
@@ -67,12 +68,18 @@ std::string markers(const std::vector<const Gap*>& gaps) {
   std::string out;
   for (const Gap* g : gaps) {
     std::string short_text = g->kind;
-    if (g->kind == "hazard-undetected") short_text = "no detecting filter";
-    else if (g->kind == "event-not-fired") short_text = "no scenario fires it";
-    else if (g->kind == "onset-not-cleared") short_text = "no scenario clears it";
-    else if (g->kind == "reaction-unchecked") short_text = "no scenario checks it";
-    else if (g->kind == "filter-without-hazard") short_text = "linked to no hazard";
-    else if (g->kind == "reaction-violated") short_text = "violated";
+    if (g->kind == "hazard-undetected")
+      short_text = "no detecting filter";
+    else if (g->kind == "event-not-fired")
+      short_text = "no scenario fires it";
+    else if (g->kind == "onset-not-cleared")
+      short_text = "no scenario clears it";
+    else if (g->kind == "reaction-unchecked")
+      short_text = "no scenario checks it";
+    else if (g->kind == "filter-without-hazard")
+      short_text = "linked to no hazard";
+    else if (g->kind == "reaction-violated")
+      short_text = "violated";
     out += "<br>" + marker(g->severity, g->kind, short_text);
   }
   return out;
@@ -85,18 +92,20 @@ Severity worst(const std::vector<const Gap*>& gaps, Severity none) {
 }
 
 std::string filter_cell(const FilterLink& f) {
-  std::string out = "<b>" + esc(f.name) + "</b> <span class=\"small\">(" + esc(f.role) + ")</span><br>" + esc(f.type) + ", " +
-                    esc(f.execution) + ", every " + esc(f.period) + "<br>on " + esc(f.target);
+  std::string out = "<b>" + esc(f.name) + "</b> <span class=\"small\">(" + esc(f.role) + ")</span><br>" + esc(f.type) +
+                    ", " + esc(f.execution) + ", every " + esc(f.period) + "<br>on " + esc(f.target);
   if (!f.signals.empty()) out += "<br>reads " + esc(f.signals);
   if (!f.threshold.empty()) out += "<br>threshold <b>" + esc(f.threshold) + "</b>";
   if (!f.parameters.empty()) out += "<br><span class=\"small\">" + esc(join(f.parameters, ", ")) + "</span>";
-  if (!f.pipeline.empty()) out += "<br><span class=\"small\">pipeline " + esc(f.pipeline) + ": " + esc(join(f.chain, " → ")) + "</span>";
+  if (!f.pipeline.empty())
+    out += "<br><span class=\"small\">pipeline " + esc(f.pipeline) + ": " + esc(join(f.chain, " → ")) + "</span>";
   return out;
 }
 
 std::string event_cell(const EventLink& e) {
-  std::string out = "<b>" + esc(e.name) + "</b> <span class=\"small\">(" + (e.onset ? "onset" : "completion") + ")</span><br>" +
-                    esc(e.component) + ", severity " + std::to_string(e.severity) + "<br>" + esc(e.transitions);
+  std::string out = "<b>" + esc(e.name) + "</b> <span class=\"small\">(" + (e.onset ? "onset" : "completion") +
+                    ")</span><br>" + esc(e.component) + ", severity " + std::to_string(e.severity) + "<br>" +
+                    esc(e.transitions);
   if (e.onset) out += " → " + esc(e.level);
   if (e.latched) out += "<br><b>latched</b> (cleared by reset)";
   out += "<br>to " + esc(join(e.targets, ", "));
@@ -107,11 +116,14 @@ std::string scenarios_cell(const EventLink& e) {
   if (e.fired_by.empty()) return "<span class=\"bad\">none</span>";
   std::string out = "<ul class=\"plain\">";
   for (const ScenarioUse& u : e.fired_by) {
-    out += "<li>" + esc(u.scenario) + (u.transitions.empty() ? "" : " <span class=\"small\">(" + esc(join(u.transitions, " ")) + ")</span>") + "</li>";
+    out += "<li>" + esc(u.scenario) +
+           (u.transitions.empty() ? "" : " <span class=\"small\">(" + esc(join(u.transitions, " ")) + ")</span>") +
+           "</li>";
   }
   out += "</ul>";
   if (e.onset) {
-    out += "<span class=\"small\">cleared by: " + (e.cleared_by.empty() ? std::string("none") : esc(join(e.cleared_by, ", "))) + "</span>";
+    out += "<span class=\"small\">cleared by: " +
+           (e.cleared_by.empty() ? std::string("none") : esc(join(e.cleared_by, ", "))) + "</span>";
   }
   return out;
 }
@@ -120,9 +132,10 @@ std::string reaction_cell(const Trace& t, const HazardTrace& h) {
   if (h.reaction.empty()) return "<span class=\"small\">none declared</span>";
   std::string out = "<ul class=\"plain\">";
   for (const ReactionLink& r : h.reaction) {
-    out += "<li data-address=\"" + esc(r.address) + "\"><b>" + esc(r.address) + "</b> ≥ " + esc(r.level) + "<br><span class=\"small\">" +
-           (r.checked_by.empty() ? std::string("checked by no expect") : "expect in " + esc(join(r.checked_by, ", "))) + "</span>" +
-           markers(gaps_about(t, h.id, r.address)) + "</li>";
+    out += "<li data-address=\"" + esc(r.address) + "\"><b>" + esc(r.address) + "</b> ≥ " + esc(r.level) +
+           "<br><span class=\"small\">" +
+           (r.checked_by.empty() ? std::string("checked by no expect") : "expect in " + esc(join(r.checked_by, ", "))) +
+           "</span>" + markers(gaps_about(t, h.id, r.address)) + "</li>";
   }
   return out + "</ul>";
 }
@@ -130,8 +143,8 @@ std::string reaction_cell(const Trace& t, const HazardTrace& h) {
 std::string verify_cell(const HazardTrace& h) {
   const std::string v(to_string(h.verified));
   const char* cls = h.verified == Verdict::Holds ? "ok" : h.verified == Verdict::Violated ? "bad" : "small";
-  return "<span class=\"" + std::string(cls) + "\" data-verify=\"" + v + "\">" + esc(v) + "</span><br><span class=\"small\">" +
-         esc(h.verify_detail) + "</span>";
+  return "<span class=\"" + std::string(cls) + "\" data-verify=\"" + v + "\">" + esc(v) +
+         "</span><br><span class=\"small\">" + esc(h.verify_detail) + "</span>";
 }
 
 std::string row_class(Severity s) {
@@ -175,15 +188,19 @@ std::string matrix(const Trace& t) {
              esc(r.filter != nullptr ? r.filter->name : "") + "\"" + row_class_or_none(worst(row_gaps, kNoGap)) + ">";
       if (k == 0) {
         const std::string span = " rowspan=\"" + std::to_string(rows.size()) + "\"";
-        out += "<td class=\"hazard-id\"" + span + ">" + esc(h.id) + "<br><span class=\"desc\">" + esc(h.description) + "</span>" +
-               markers(hazard_gaps) + "</td>";
+        out += "<td class=\"hazard-id\"" + span + ">" + esc(h.id) + "<br><span class=\"desc\">" + esc(h.description) +
+               "</span>" + markers(hazard_gaps) + "</td>";
         out += "<td" + span + ">" + reaction_cell(t, h) + "</td>";
       }
       if (r.event == nullptr) {
         out += "<td colspan=\"3\"><span class=\"bad\">no linked event</span></td>";
       } else {
         out += "<td>" + event_cell(*r.event) + (first_of_event ? markers(event_gaps) : std::string()) + "</td>";
-        out += "<td>" + (r.filter != nullptr ? filter_cell(*r.filter) : std::string("<span class=\"small\">no filter: generated by the component's code</span>")) + "</td>";
+        out += "<td>" +
+               (r.filter != nullptr
+                    ? filter_cell(*r.filter)
+                    : std::string("<span class=\"small\">no filter: generated by the component's code</span>")) +
+               "</td>";
         out += "<td>" + scenarios_cell(*r.event) + "</td>";
       }
       if (k == 0) out += "<td rowspan=\"" + std::to_string(rows.size()) + "\">" + verify_cell(h) + "</td>";
@@ -199,9 +216,15 @@ std::string matrix(const Trace& t) {
     for (const EventLink& e : t.unlinked) {
       for (const FilterLink& f : e.filters) {
         const auto g = gaps_about(t, "", f.name);
-        out += "<tr data-event=\"" + esc(e.name) + "\" data-filter=\"" + esc(f.name) + "\"" + row_class_or_none(worst(g, kNoGap)) + ">";
-        if (first) out += "<td class=\"hazard-id\" rowspan=\"" + std::to_string(rows) + "\">no hazard<br><span class=\"desc\">onsets generated by filters and linked to no declared hazard</span></td><td rowspan=\"" + std::to_string(rows) + "\"></td>";
-        out += "<td>" + event_cell(e) + "</td><td>" + filter_cell(f) + markers(g) + "</td><td>" + scenarios_cell(e) + "</td>";
+        out += "<tr data-event=\"" + esc(e.name) + "\" data-filter=\"" + esc(f.name) + "\"" +
+               row_class_or_none(worst(g, kNoGap)) + ">";
+        if (first)
+          out += "<td class=\"hazard-id\" rowspan=\"" + std::to_string(rows) +
+                 "\">no hazard<br><span class=\"desc\">onsets generated by filters and linked to no declared "
+                 "hazard</span></td><td rowspan=\"" +
+                 std::to_string(rows) + "\"></td>";
+        out += "<td>" + event_cell(e) + "</td><td>" + filter_cell(f) + markers(g) + "</td><td>" + scenarios_cell(e) +
+               "</td>";
         if (first) out += "<td rowspan=\"" + std::to_string(rows) + "\"></td>";
         out += "</tr>\n";
         first = false;
@@ -214,14 +237,16 @@ std::string matrix(const Trace& t) {
 
 std::string gap_table(const Trace& t) {
   if (t.gaps.empty()) return "<p id=\"no-gaps\">No gaps.</p>\n";
-  std::string out = "<table id=\"gap-table\"><thead><tr><th>Severity</th><th>Gap</th><th>Hazard</th><th>About</th><th>What is missing</th><th>Where</th></tr></thead><tbody>\n";
+  std::string out =
+      "<table id=\"gap-table\"><thead><tr><th>Severity</th><th>Gap</th><th>Hazard</th><th>About</th><th>What is "
+      "missing</th><th>Where</th></tr></thead><tbody>\n";
   for (const Gap& g : t.gaps) {
     std::string where = g.where.file;
     if (g.where.line > 0) where += ":" + std::to_string(g.where.line) + ":" + std::to_string(g.where.column);
-    out += "<tr class=\"gap gap-" + std::string(to_string(g.severity)) + "\" data-kind=\"" + esc(g.kind) + "\" data-severity=\"" +
-           std::string(to_string(g.severity)) + "\"><td>" + marker(g.severity, g.kind, g.kind) + "</td><td>" + esc(g.kind) +
-           "</td><td>" + esc(g.hazard) + "</td><td>" + esc(g.subject) + "</td><td>" + esc(g.message) + "</td><td>" + esc(where) +
-           "</td></tr>\n";
+    out += "<tr class=\"gap gap-" + std::string(to_string(g.severity)) + "\" data-kind=\"" + esc(g.kind) +
+           "\" data-severity=\"" + std::string(to_string(g.severity)) + "\"><td>" + marker(g.severity, g.kind, g.kind) +
+           "</td><td>" + esc(g.kind) + "</td><td>" + esc(g.hazard) + "</td><td>" + esc(g.subject) + "</td><td>" +
+           esc(g.message) + "</td><td>" + esc(where) + "</td></tr>\n";
   }
   return out + "</tbody></table>\n";
 }
@@ -232,7 +257,8 @@ std::string excerpts(const Trace& t) {
   for (const HazardTrace& h : t.hazards) {
     out += "<h3>" + esc(h.id) + " <span class=\"desc\">" + esc(h.description) + "</span></h3>\n";
     if (h.excerpt_scenario.empty()) {
-      out += "<p class=\"bad\" data-excerpt-missing=\"" + esc(h.id) + "\">No scenario exercises " + esc(h.id) + ".</p>\n";
+      out +=
+          "<p class=\"bad\" data-excerpt-missing=\"" + esc(h.id) + "\">No scenario exercises " + esc(h.id) + ".</p>\n";
       continue;
     }
     const ScenarioResult* run = nullptr;
@@ -240,7 +266,8 @@ std::string excerpts(const Trace& t) {
       if (s.path == h.excerpt_scenario) run = &s;
     }
     if (run == nullptr || run->history.empty()) {
-      out += "<p class=\"small\">" + esc(h.id) + " is exercised by " + esc(h.excerpt_scenario) + " (no history kept).</p>\n";
+      out += "<p class=\"small\">" + esc(h.id) + " is exercised by " + esc(h.excerpt_scenario) +
+             " (no history kept).</p>\n";
       continue;
     }
     auto it = parsed.find(run->path);
@@ -251,12 +278,17 @@ std::string excerpts(const Trace& t) {
       const std::string component = !r.component.empty() ? r.component : r.machine.substr(0, r.machine.find('.'));
       if (r.kind == tools::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
     }
-    out += "<figure class=\"excerpt\" data-hazard=\"" + esc(h.id) + "\" data-scenario=\"" + esc(run->path) + "\" data-from=\"" +
-           number(h.excerpt_from) + "\" data-to=\"" + number(h.excerpt_to) + "\">\n<figcaption>" + esc(h.id) + " in " + esc(run->path) +
-           ", t = " + number(h.excerpt_from) + " s to " + number(h.excerpt_to) + " s; " + esc(join(h.excerpt_components, ", ")) +
-           "</figcaption>\n<div class=\"excerpt-box\"><svg class=\"timeline-axis\" role=\"img\" aria-label=\"Time axis in seconds\"></svg>"
-           "<svg class=\"timeline-lanes\" role=\"img\" aria-label=\"States during " + esc(h.id) + "\"></svg></div>\n"
-           "<script type=\"application/json\" class=\"excerpt-model\">" + tools::timeline_model_json(records) + "</script>\n</figure>\n";
+    out += "<figure class=\"excerpt\" data-hazard=\"" + esc(h.id) + "\" data-scenario=\"" + esc(run->path) +
+           "\" data-from=\"" + number(h.excerpt_from) + "\" data-to=\"" + number(h.excerpt_to) + "\">\n<figcaption>" +
+           esc(h.id) + " in " + esc(run->path) + ", t = " + number(h.excerpt_from) + " s to " + number(h.excerpt_to) +
+           " s; " + esc(join(h.excerpt_components, ", ")) +
+           "</figcaption>\n<div class=\"excerpt-box\"><svg class=\"timeline-axis\" role=\"img\" aria-label=\"Time axis "
+           "in seconds\"></svg>"
+           "<svg class=\"timeline-lanes\" role=\"img\" aria-label=\"States during " +
+           esc(h.id) +
+           "\"></svg></div>\n"
+           "<script type=\"application/json\" class=\"excerpt-model\">" +
+           tools::timeline_model_json(records) + "</script>\n</figure>\n";
   }
   return out;
 }
@@ -272,10 +304,12 @@ std::string coverage_table(const Trace& t) {
   out += row("reaction addresses checked by an expect", c.reactions_checked, c.reactions);
   out += row("events fired", c.events_fired, c.events_defined);
   out += row("defined transitions taken", c.transitions_taken, c.transitions_defined);
-  out += "</tbody></table>\n<table id=\"scenario-table\"><thead><tr><th>Scenario</th><th>Result</th><th>Checks</th></tr></thead><tbody>\n";
+  out +=
+      "</tbody></table>\n<table "
+      "id=\"scenario-table\"><thead><tr><th>Scenario</th><th>Result</th><th>Checks</th></tr></thead><tbody>\n";
   for (const ScenarioResult& s : t.scenarios) {
-    out += "<tr><td>" + esc(s.path) + "</td><td class=\"" + (s.passed ? "ok" : "bad") + "\">" + (s.passed ? "passed" : "FAILED") +
-           "</td><td>" + std::to_string(s.checks) + "</td></tr>\n";
+    out += "<tr><td>" + esc(s.path) + "</td><td class=\"" + (s.passed ? "ok" : "bad") + "\">" +
+           (s.passed ? "passed" : "FAILED") + "</td><td>" + std::to_string(s.checks) + "</td></tr>\n";
   }
   return out + "</tbody></table>\n";
 }
@@ -290,8 +324,10 @@ std::string fill(std::string_view tmpl, const std::map<std::string, std::string,
     if (close == std::string_view::npos) break;
     out.append(tmpl.substr(pos, open - pos));
     const auto it = values.find(tmpl.substr(open + 2, close - open - 2));
-    if (it != values.end()) out += it->second;
-    else out.append(tmpl.substr(open, close + 2 - open));
+    if (it != values.end())
+      out += it->second;
+    else
+      out.append(tmpl.substr(open, close + 2 - open));
     pos = close + 2;
   }
   out.append(tmpl.substr(pos));
@@ -319,29 +355,36 @@ std::string render_trace_page(const Trace& t, const std::string& date) {
   for (const Gap& g : t.gaps) {
     (g.severity == Severity::Error ? errors : g.severity == Severity::Warning ? warnings : infos) += 1;
   }
-  std::string body = "<header class=\"report\">\n<h1>Hazard trace: <span id=\"system-name\">" + esc(t.system) + "</span></h1>\n<dl class=\"meta\">";
+  std::string body = "<header class=\"report\">\n<h1>Hazard trace: <span id=\"system-name\">" + esc(t.system) +
+                     "</span></h1>\n<dl class=\"meta\">";
   body += "<dt>System file</dt><dd>" + esc(t.system_path) + "</dd>";
   body += "<dt>Tool</dt><dd id=\"tool-version\">safecass " + esc(tool_version()) + " (safecass trace)</dd>";
   body += "<dt>Date</dt><dd id=\"report-date\">" + esc(date) + "</dd>";
   body += "<dt>Scenarios</dt><dd>" + std::to_string(t.scenarios.size()) + "</dd>";
-  body += "<dt>Verification</dt><dd>" + (t.verify_source.empty() ? std::string("not run (no `safecass verify --json` result given)") : esc(t.verify_source)) + "</dd>";
-  body += "</dl>\n<table class=\"files\" id=\"file-table\"><thead><tr><th>Specification file</th><th>SHA-256</th></tr></thead><tbody>\n";
-  for (const SpecFile& f : t.files) body += "<tr><td>" + esc(f.path) + "</td><td class=\"hash\">" + f.sha256 + "</td></tr>\n";
+  body += "<dt>Verification</dt><dd>" +
+          (t.verify_source.empty() ? std::string("not run (no `safecass verify --json` result given)")
+                                   : esc(t.verify_source)) +
+          "</dd>";
+  body +=
+      "</dl>\n<table class=\"files\" id=\"file-table\"><thead><tr><th>Specification "
+      "file</th><th>SHA-256</th></tr></thead><tbody>\n";
+  for (const SpecFile& f : t.files)
+    body += "<tr><td>" + esc(f.path) + "</td><td class=\"hash\">" + f.sha256 + "</td></tr>\n";
   body += "</tbody></table>\n<p id=\"verdict\" class=\"verdict " + std::string(errors == 0 ? "pass" : "fail") + "\">" +
-          (errors == 0 ? "No gap of error severity." : std::to_string(errors) + " gap" + (errors == 1 ? "" : "s") + " of error severity.") +
-          " " + std::to_string(warnings) + " warning" + (warnings == 1 ? "" : "s") + ", " + std::to_string(infos) + " info.</p>\n</header>\n";
+          (errors == 0 ? "No gap of error severity."
+                       : std::to_string(errors) + " gap" + (errors == 1 ? "" : "s") + " of error severity.") +
+          " " + std::to_string(warnings) + " warning" + (warnings == 1 ? "" : "s") + ", " + std::to_string(infos) +
+          " info.</p>\n</header>\n";
   body += "<section id=\"matrix\"><h2>Traceability matrix</h2>\n" + matrix(t) + "</section>\n";
   body += "<section id=\"gaps\"><h2>Gaps</h2>\n" + gap_table(t) + "</section>\n";
-  body += "<section id=\"excerpts\"><h2>Timeline excerpts</h2>\n<p class=\"small\">Per hazard, the scenario that exercises it, from its first linked onset to its clearing.</p>\n" +
-          excerpts(t) + "</section>\n";
+  body +=
+      "<section id=\"excerpts\"><h2>Timeline excerpts</h2>\n<p class=\"small\">Per hazard, the scenario that exercises "
+      "it, from its first linked onset to its clearing.</p>\n" +
+      excerpts(t) + "</section>\n";
   body += "<section id=\"coverage\"><h2>Coverage</h2>\n" + coverage_table(t) + "</section>\n";
   const std::map<std::string, std::string, std::less<>> values{
-      {"TITLE", esc(t.system)},
-      {"TIMELINE_CSS", std::string(web::kTimelineCss)},
-      {"CSS", std::string(web::kTraceCss)},
-      {"BODY", body},
-      {"TIMELINE_JS", std::string(web::kTimelineJs)},
-      {"JS", std::string(web::kTraceJs)},
+      {"TITLE", esc(t.system)}, {"TIMELINE_CSS", std::string(web::kTimelineCss)}, {"CSS", std::string(web::kTraceCss)},
+      {"BODY", body},           {"TIMELINE_JS", std::string(web::kTimelineJs)},   {"JS", std::string(web::kTraceJs)},
   };
   return fill(web::kTraceHtml, values);
 }

@@ -62,7 +62,7 @@ struct InProcessSource::Impl {
   // Real-time driving: simulated time = base_sim + (wall - base_wall) * speed.
   std::chrono::steady_clock::time_point base_wall;
   Time base_sim{};
-  std::unique_ptr<introspect::LocalQuery> query;  // what the source reads and writes through
+  std::unique_ptr<introspect::LocalQuery> query;        // what the source reads and writes through
   std::unique_ptr<introspect::Subscription> following;  // the records, for take_records()
   std::vector<std::string> pending;
   std::uint64_t dropped = 0;
@@ -201,7 +201,10 @@ std::vector<std::string> InProcessSource::take_records() {
   std::vector<std::string> out;
   out.swap(impl_->pending);
   if (impl_->dropped != 0) {
-    out.push_back(introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(impl_->dropped)).text());
+    out.push_back(introspect::JsonObject()
+                      .str("kind", "overflow")
+                      .integer("dropped", static_cast<long long>(impl_->dropped))
+                      .text());
     impl_->dropped = 0;
   }
   return out;

@@ -47,7 +47,8 @@ CoordinatorView coordinator_view(std::string name, const std::vector<introspect:
       continue;
     }
     NodeKind kind{};
-    if (!node_kind(r.kind, kind) || cv.components.empty() || component_of(r.address) != cv.components.back().name) continue;
+    if (!node_kind(r.kind, kind) || cv.components.empty() || component_of(r.address) != cv.components.back().name)
+      continue;
     MachineView m;
     m.address = r.address;
     m.kind = kind;
@@ -60,8 +61,12 @@ CoordinatorView coordinator_view(std::string name, const std::vector<introspect:
 }
 
 std::string coordinator_record(std::string_view coordinator, std::string_view text, double t) {
-  return introspect::JsonObject().raw("t", introspect::json_seconds(seconds_to_time(t))).str("kind", "coordinator")
-      .str("coordinator", coordinator).str("text", text).text();
+  return introspect::JsonObject()
+      .raw("t", introspect::json_seconds(seconds_to_time(t)))
+      .str("kind", "coordinator")
+      .str("coordinator", coordinator)
+      .str("text", text)
+      .text();
 }
 
 }  // namespace safecass::viewer

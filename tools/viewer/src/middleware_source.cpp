@@ -12,13 +12,13 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/spec/load.hpp"
-#include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
-#include "safecass/introspect/local_query.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer {
@@ -52,7 +52,7 @@ std::string component_of(std::string_view address) { return std::string(address.
 /// the connection the server thread uses for explain and writes.
 struct MiddlewareLink {
   std::string name;
-  std::string token;  ///< empty without --token-file for it
+  std::string token;       ///< empty without --token-file for it
   std::string read_token;  ///< its read credential, when it has one
   std::unique_ptr<Coordinator> local;
   std::unique_ptr<Monitor> monitor;  ///< the local model's filters and signals (for routing)
@@ -111,7 +111,10 @@ struct MiddlewareSource::Impl {
     if (l.status == status) return;
     l.status = status;
     ++version;
-    push(coordinator_record(l.name, status.empty() ? "answering" : detail.empty() ? status : status + ": " + detail,
+    push(coordinator_record(l.name,
+                            status.empty()   ? "answering"
+                            : detail.empty() ? status
+                                             : status + ": " + detail,
                             host_seconds()));
   }
 
@@ -236,15 +239,18 @@ struct MiddlewareSource::Impl {
   Expected<std::shared_ptr<RemoteClient>> requests(const MiddlewareLink& l) const {
     std::lock_guard lock(mutex);
     if (!l.requests) {
-      return fail(ErrorCode::Io, "coordinator '" + l.name + "' is " + (l.status.empty() ? std::string("not connected") : l.status) +
-                                     " (IceStorm " + options.ice + ")");
+      return fail(ErrorCode::Io, "coordinator '" + l.name + "' is " +
+                                     (l.status.empty() ? std::string("not connected") : l.status) + " (IceStorm " +
+                                     options.ice + ")");
     }
     return l.requests;
   }
 
   /// The request connection of the coordinator owning `target` for a write.
-  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer(std::string_view target, std::string_view what) const {
-    if (!options.allow_write) return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
+  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer(std::string_view target,
+                                                                             std::string_view what) const {
+    if (!options.allow_write)
+      return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
     MiddlewareLink* l = owner(target);
     if (l == nullptr) {
       return fail(ErrorCode::NotFound, std::string(what) + ": no component '" + component_of(target) + "' in system '" +
@@ -254,10 +260,12 @@ struct MiddlewareSource::Impl {
   }
 
   Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer_of(MiddlewareLink& l) const {
-    if (!options.allow_write) return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
+    if (!options.allow_write)
+      return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
     if (l.token.empty()) {
-      return fail(ErrorCode::Denied, "refused: no token for coordinator '" + l.name + "' (start the viewer with --token-file " +
-                                         l.name + "=FILE, the file its `safecass run --allow-write --token-file` wrote)");
+      return fail(ErrorCode::Denied, "refused: no token for coordinator '" + l.name +
+                                         "' (start the viewer with --token-file " + l.name +
+                                         "=FILE, the file its `safecass run --allow-write --token-file` wrote)");
     }
     auto c = requests(l);
     if (!c) return tl::unexpected(c.error());
@@ -286,8 +294,9 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
   }
   const spec::SystemSpec& system = *loaded.system;
   if (system.coordinators.empty()) {
-    return fail(ErrorCode::InvalidArgument, "system '" + system.name + "' (" + options.system +
-                                                ") has no \"coordinators\": it runs as one process; view it in-process (--system without --ice)");
+    return fail(ErrorCode::InvalidArgument,
+                "system '" + system.name + "' (" + options.system +
+                    ") has no \"coordinators\": it runs as one process; view it in-process (--system without --ice)");
   }
   impl->system_name = system.name;
   std::string names;
@@ -323,7 +332,8 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
                                                   "' has no coordinator '" + name + "' (it has " + names + ")");
     }
     auto token = middleware::read_token_file(path);
-    if (!token) return fail(token.error().code, "--read-token-file " + name + "=" + path + ": " + token.error().message);
+    if (!token)
+      return fail(token.error().code, "--read-token-file " + name + "=" + path + ": " + token.error().message);
     l->read_token = *token;
   }
   impl->description = "live: " + file_name(options.system) + " through IceStorm " + impl->ice.host + ":" +
@@ -355,7 +365,8 @@ void MiddlewareSource::poll() {
     m.pending.clear();
   }
   if (m.dropped != 0) {
-    m.taken.push_back(introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(m.dropped)).text());
+    m.taken.push_back(
+        introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(m.dropped)).text());
     m.dropped = 0;
   }
   if (m.version == m.shown_version) return;
@@ -429,8 +440,8 @@ Expected<std::vector<Explanation>> MiddlewareSource::explain(std::string_view ad
   }
   const MiddlewareLink* l = m.owner(address);
   if (l == nullptr) {
-    return fail(ErrorCode::NotFound, "no component '" + component_of(address) + "' in system '" + m.system_name + "' (address '" +
-                                         std::string(address) + "')");
+    return fail(ErrorCode::NotFound, "no component '" + component_of(address) + "' in system '" + m.system_name +
+                                         "' (address '" + std::string(address) + "')");
   }
   if (auto r = add(*l, std::string(address)); !r) return tl::unexpected(r.error());
   return all;
@@ -491,15 +502,19 @@ Expected<std::string> MiddlewareSource::reset(std::string_view target, std::stri
     std::string done;
     for (auto& l : impl_->links) {
       auto w = impl_->writer_of(*l);
-      auto r = w ? w->second->reset("SYSTEM", "viewer", std::string(reason)) : Expected<void>(tl::unexpected(w.error()));
-      if (!r) return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message + (done.empty() ? "" : " (reset done on " + done + ")"));
+      auto r =
+          w ? w->second->reset("SYSTEM", "viewer", std::string(reason)) : Expected<void>(tl::unexpected(w.error()));
+      if (!r)
+        return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message +
+                                        (done.empty() ? "" : " (reset done on " + done + ")"));
       done += (done.empty() ? "" : ", ") + l->name;
     }
     return "reset SYSTEM (coordinators " + done + ") at t=" + seconds_text(now()) + " (" + std::string(reason) + ")";
   }
   auto w = impl_->writer(target, "reset");
   if (!w) return tl::unexpected(w.error());
-  if (auto r = w->second->reset(std::string(target), "viewer", std::string(reason)); !r) return tl::unexpected(r.error());
+  if (auto r = w->second->reset(std::string(target), "viewer", std::string(reason)); !r)
+    return tl::unexpected(r.error());
   return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at t=" + seconds_text(now()) + " (" +
          std::string(reason) + ")";
 }

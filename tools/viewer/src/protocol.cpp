@@ -14,10 +14,10 @@ namespace safecass::viewer {
 
 namespace {
 
-constexpr std::size_t kMaxString = 256;       ///< longest name, address or reason accepted
-constexpr std::size_t kMaxSamples = 1000;     ///< samples in one injection
-constexpr std::size_t kMaxSampleSize = 64;    ///< doubles in one sample
-constexpr long long kTimeIntervalMs = 250;    ///< clock-only messages at most this often
+constexpr std::size_t kMaxString = 256;     ///< longest name, address or reason accepted
+constexpr std::size_t kMaxSamples = 1000;   ///< samples in one injection
+constexpr std::size_t kMaxSampleSize = 64;  ///< doubles in one sample
+constexpr long long kTimeIntervalMs = 250;  ///< clock-only messages at most this often
 
 std::string quote(std::string_view s) { return introspect::json_string(s); }
 
@@ -60,28 +60,58 @@ std::string view_to_json(const SystemView& v) {
   const std::string coordinators = array(v.coordinators, [](const CoordinatorView& co) {
     const std::string components = array(co.components, [](const ComponentView& c) {
       const std::string machines = array(c.machines, [](const MachineView& m) {
-        return Object().str("address", m.address).str("kind", to_string(m.kind)).str("name", m.name)
-            .raw("state", state_text(m.state)).str("outstanding", m.outstanding).text();
+        return Object()
+            .str("address", m.address)
+            .str("kind", to_string(m.kind))
+            .str("name", m.name)
+            .raw("state", state_text(m.state))
+            .str("outstanding", m.outstanding)
+            .text();
       });
-      return Object().str("name", c.name).str("address", c.name).raw("state", state_text(c.state))
-          .str("outstanding", c.outstanding).raw("machines", machines).text();
+      return Object()
+          .str("name", c.name)
+          .str("address", c.name)
+          .raw("state", state_text(c.state))
+          .str("outstanding", c.outstanding)
+          .raw("machines", machines)
+          .text();
     });
-    return Object().str("name", co.name).str("address", "coordinator:" + co.name).raw("state", state_text(co.state))
-        .str("status", co.status).raw("components", components).text();
+    return Object()
+        .str("name", co.name)
+        .str("address", "coordinator:" + co.name)
+        .raw("state", state_text(co.state))
+        .str("status", co.status)
+        .raw("components", components)
+        .text();
   });
-  return Object().str("system", v.system).str("description", v.description).raw("t", seconds(v.t))
-      .boolean("running", v.running).raw("state", state_text(v.state)).raw("coordinators", coordinators).text();
+  return Object()
+      .str("system", v.system)
+      .str("description", v.description)
+      .raw("t", seconds(v.t))
+      .boolean("running", v.running)
+      .raw("state", state_text(v.state))
+      .raw("coordinators", coordinators)
+      .text();
 }
 
 std::string explanation_to_json(const Explanation& e) {
   Object o;
-  o.str("machine", e.machine).str("event", e.event).raw("level", state_text(e.level)).integer("severity", e.severity)
-      .boolean("mirror", e.mirror).boolean("outstanding", e.outstanding).integer("count", e.count)
-      .raw("first", seconds(to_seconds(e.first))).raw("last", seconds(to_seconds(e.last)))
-      .str("root_event", e.root_event).str("root_origin", e.root_origin).raw("root_t", seconds(to_seconds(e.root_time)));
+  o.str("machine", e.machine)
+      .str("event", e.event)
+      .raw("level", state_text(e.level))
+      .integer("severity", e.severity)
+      .boolean("mirror", e.mirror)
+      .boolean("outstanding", e.outstanding)
+      .integer("count", e.count)
+      .raw("first", seconds(to_seconds(e.first)))
+      .raw("last", seconds(to_seconds(e.last)))
+      .str("root_event", e.root_event)
+      .str("root_origin", e.root_origin)
+      .raw("root_t", seconds(to_seconds(e.root_time)));
   if (!e.hazard.empty()) o.str("hazard", e.hazard);
   if (!e.filter.empty()) o.str("filter", e.filter);
-  if (!e.signal.empty()) o.str("signal", e.signal).num("value", e.value).raw("sample_t", seconds(to_seconds(e.sample_time)));
+  if (!e.signal.empty())
+    o.str("signal", e.signal).num("value", e.value).raw("sample_t", seconds(to_seconds(e.sample_time)));
   if (e.injected) o.boolean("injected", true);
   o.raw("path", array(e.path, [](const std::string& hop) { return quote(hop); }));
   return o.text();
@@ -130,9 +160,11 @@ std::string check_keys(const spec::JsonValue& object, std::initializer_list<std:
 std::string get_string(const spec::JsonValue& object, std::string_view key, std::string& out, bool required = true) {
   const spec::JsonValue* v = object.find(key);
   if (v == nullptr) return required ? "missing key '" + std::string(key) + "'" : std::string();
-  if (!v->is_string()) return "'" + std::string(key) + "' must be a string, not " + std::string(spec::type_name(v->type));
+  if (!v->is_string())
+    return "'" + std::string(key) + "' must be a string, not " + std::string(spec::type_name(v->type));
   if (v->string.empty()) return "'" + std::string(key) + "' must not be empty";
-  if (v->string.size() > kMaxString) return "'" + std::string(key) + "' is longer than " + std::to_string(kMaxString) + " characters";
+  if (v->string.size() > kMaxString)
+    return "'" + std::string(key) + "' is longer than " + std::to_string(kMaxString) + " characters";
   out = v->string;
   return {};
 }
@@ -185,9 +217,13 @@ Protocol::Protocol(ViewSource& source, ProtocolOptions options) : source_(source
 std::string Protocol::view_json() const { return view_to_json(source_.view()); }
 
 std::string Protocol::hello() const {
-  return Object().str("type", "hello").boolean("write", options_.allow_write)
-      .integer("max_message", static_cast<long long>(options_.max_message)).raw("view", view_json())
-      .raw("recent", array(recent_, [](const std::string& r) { return r; })).text();
+  return Object()
+      .str("type", "hello")
+      .boolean("write", options_.allow_write)
+      .integer("max_message", static_cast<long long>(options_.max_message))
+      .raw("view", view_json())
+      .raw("recent", array(recent_, [](const std::string& r) { return r; }))
+      .text();
 }
 
 std::string Protocol::update(long long now_ms) {
@@ -216,8 +252,13 @@ std::string Protocol::update(long long now_ms) {
   changed += '}';
   if (changed.size() > 2 || listed.size() > 2) {
     last_time_ms_ = now_ms;
-    return Object().str("type", "update").raw("t", seconds(source_.now())).boolean("running", source_.running()).raw("states", changed)
-        .raw("records", listed).text();
+    return Object()
+        .str("type", "update")
+        .raw("t", seconds(source_.now()))
+        .boolean("running", source_.running())
+        .raw("states", changed)
+        .raw("records", listed)
+        .text();
   }
   if (now_ms - last_time_ms_ >= kTimeIntervalMs) {
     last_time_ms_ = now_ms;
@@ -228,28 +269,35 @@ std::string Protocol::update(long long now_ms) {
 
 std::string Protocol::refuse_write(std::string_view id, std::string_view op, std::string_view token) const {
   if (!options_.allow_write) {
-    return error_reply(std::string(id), op, "refused: this viewer is read-only (start it with --allow-write to " + std::string(op) + ")");
+    return error_reply(std::string(id), op,
+                       "refused: this viewer is read-only (start it with --allow-write to " + std::string(op) + ")");
   }
   if (token.empty()) {
-    return error_reply(std::string(id), op, "refused: a write needs the token (key 'token'), in the token file named when the viewer started");
+    return error_reply(
+        std::string(id), op,
+        "refused: a write needs the token (key 'token'), in the token file named when the viewer started");
   }
-  if (!middleware::token_matches(options_.token, token)) return error_reply(std::string(id), op, "refused: wrong token");
+  if (!middleware::token_matches(options_.token, token))
+    return error_reply(std::string(id), op, "refused: wrong token");
   return {};
 }
 
 std::string Protocol::handle(std::string_view message) {
   if (message.size() > options_.max_message) {
-    return error_reply({}, {}, "message too long (" + std::to_string(message.size()) + " bytes; at most " +
-                                   std::to_string(options_.max_message) + ")");
+    return error_reply({}, {},
+                       "message too long (" + std::to_string(message.size()) + " bytes; at most " +
+                           std::to_string(options_.max_message) + ")");
   }
   const spec::JsonParse parsed = spec::parse_json(message, 8);
   if (!parsed.value) {
     const spec::JsonError& e = *parsed.error;
-    return error_reply({}, {}, "not JSON: " + std::to_string(e.position.line) + ":" + std::to_string(e.position.column) +
-                                   ": " + e.message);
+    return error_reply(
+        {}, {},
+        "not JSON: " + std::to_string(e.position.line) + ":" + std::to_string(e.position.column) + ": " + e.message);
   }
   const spec::JsonValue& object = *parsed.value;
-  if (!object.is_object()) return error_reply({}, {}, "a message must be a JSON object, not " + std::string(spec::type_name(object.type)));
+  if (!object.is_object())
+    return error_reply({}, {}, "a message must be a JSON object, not " + std::string(spec::type_name(object.type)));
   Request r;
   r.object = &object;
   if (const spec::JsonValue* id = object.find("id")) {
@@ -262,7 +310,8 @@ std::string Protocol::handle(std::string_view message) {
     }
   }
   const spec::JsonValue* op = object.find("op");
-  if (op == nullptr) return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset)");
+  if (op == nullptr)
+    return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset)");
   if (!op->is_string()) return error_reply(r.id, {}, "'op' must be a string");
   r.op = op->string;
   std::string problem;
@@ -283,7 +332,8 @@ std::string Protocol::handle(std::string_view message) {
   }
   if (r.op == "explain") {
     std::string address;
-    if (problem = check_keys(object, {"id", "op", "address"}); !problem.empty()) return error_reply(r.id, r.op, problem);
+    if (problem = check_keys(object, {"id", "op", "address"}); !problem.empty())
+      return error_reply(r.id, r.op, problem);
     if (problem = get_string(object, "address", address); !problem.empty()) return error_reply(r.id, r.op, problem);
     auto conditions = source_.explain(address);
     if (!conditions) return error_reply(r.id, r.op, conditions.error().message);
@@ -315,7 +365,9 @@ std::string Protocol::handle(std::string_view message) {
     const bool has_filter = object.find("filter") != nullptr;
     const bool has_signal = object.find("signal") != nullptr;
     if (problem.empty() && has_filter == has_signal) {
-      problem = "give either 'filter' (shallow injection into one filter) or 'signal' (deep injection into a signal's history)";
+      problem =
+          "give either 'filter' (shallow injection into one filter) or 'signal' (deep injection into a signal's "
+          "history)";
     }
     if (problem.empty()) {
       request.deep = has_signal;

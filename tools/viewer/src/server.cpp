@@ -36,12 +36,14 @@ constexpr auto kHttpTimeout = std::chrono::seconds(30);
 
 std::string lower(std::string_view s) {
   std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(out.begin(), out.end(), out.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return out;
 }
 
 long long monotonic_ms() {
-  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 void log_line(const std::string& text) {
@@ -92,9 +94,8 @@ public:
 
   void start(http::request<http::string_body> request) {
     ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
-    ws_.set_option(websocket::stream_base::decorator([](websocket::response_type& res) {
-      res.set(http::field::server, "safecass-viewer");
-    }));
+    ws_.set_option(websocket::stream_base::decorator(
+        [](websocket::response_type& res) { res.set(http::field::server, "safecass-viewer"); }));
     ws_.read_message_max(kMaxWebSocketFrame);
     ws_.async_accept(request, [self = shared_from_this()](beast::error_code ec) {
       if (ec) return;
@@ -197,9 +198,11 @@ private:
       return respond(req, http::status::misdirected_request, "text/plain", "unknown host '" + host + "'\n");
     }
     if (websocket::is_upgrade(req)) {
-      if (req.target() != "/ws") return respond(req, http::status::not_found, "text/plain", "the WebSocket is at /ws\n");
+      if (req.target() != "/ws")
+        return respond(req, http::status::not_found, "text/plain", "the WebSocket is at /ws\n");
       const auto origin = req.find(http::field::origin);
-      if (origin != req.end() && lower(std::string_view(origin->value().data(), origin->value().size())) != "http://" + lower(host)) {
+      if (origin != req.end() &&
+          lower(std::string_view(origin->value().data(), origin->value().size())) != "http://" + lower(host)) {
         return respond(req, http::status::forbidden, "text/plain", "WebSocket from another origin refused\n");
       }
       stream_.expires_never();
@@ -213,14 +216,18 @@ private:
     }
     std::string_view target(req.target().data(), req.target().size());
     target = target.substr(0, target.find('?'));
-    if (target == "/" || target == "/index.html") return respond(req, http::status::ok, "text/html; charset=utf-8", std::string(web::kViewerHtml));
-    if (target == "/viewer.js") return respond(req, http::status::ok, "text/javascript; charset=utf-8", std::string(web::kViewerJs));
-    if (target == "/viewer.css") return respond(req, http::status::ok, "text/css; charset=utf-8", std::string(web::kViewerCss));
+    if (target == "/" || target == "/index.html")
+      return respond(req, http::status::ok, "text/html; charset=utf-8", std::string(web::kViewerHtml));
+    if (target == "/viewer.js")
+      return respond(req, http::status::ok, "text/javascript; charset=utf-8", std::string(web::kViewerJs));
+    if (target == "/viewer.css")
+      return respond(req, http::status::ok, "text/css; charset=utf-8", std::string(web::kViewerCss));
     if (target == "/api/view") return respond(req, http::status::ok, "application/json", server_.protocol.view_json());
     return respond(req, http::status::not_found, "text/plain", "not found: " + std::string(target) + "\n");
   }
 
-  void respond(const http::request<http::string_body>& req, http::status status, std::string_view type, std::string body) {
+  void respond(const http::request<http::string_body>& req, http::status status, std::string_view type,
+               std::string body) {
     auto res = std::make_shared<http::response<http::string_body>>(status, req.version());
     res->set(http::field::server, "safecass-viewer");
     res->set(http::field::content_type, std::string(type));
@@ -279,10 +286,11 @@ void ServerCore::accept() {
       // backlog, so accepting again at once fails again at once. Wait, and say so rarely.
       const AcceptBackoff::Step step = backoff.failed(AcceptBackoff::Clock::now());
       if (step.log) {
-        log_line("accept: " + ec.message() + "; trying again in " + std::to_string(step.delay.count()) + " ms, up to every " +
-                 std::to_string(AcceptBackoff::kMaxDelay.count()) + " ms" +
-                 (step.not_logged == 0 ? std::string()
-                                       : " (" + std::to_string(step.not_logged) + " failed accepts not logged since the last line)"));
+        log_line("accept: " + ec.message() + "; trying again in " + std::to_string(step.delay.count()) +
+                 " ms, up to every " + std::to_string(AcceptBackoff::kMaxDelay.count()) + " ms" +
+                 (step.not_logged == 0
+                      ? std::string()
+                      : " (" + std::to_string(step.not_logged) + " failed accepts not logged since the last line)"));
       }
       accept_timer.expires_after(step.delay);
       accept_timer.async_wait([this](beast::error_code e) {
@@ -352,8 +360,10 @@ Server::~Server() = default;
 
 Expected<std::unique_ptr<Server>> Server::open(ViewSource& source, const ProtocolOptions& protocol,
                                                const ServerOptions& options) {
-  if (protocol.allow_write && protocol.token.empty()) return fail(ErrorCode::InvalidArgument, "write access needs a token");
-  if (options.poll_ms <= 0 || options.poll_ms > 1000) return fail(ErrorCode::InvalidArgument, "poll period must be 1 to 1000 ms");
+  if (protocol.allow_write && protocol.token.empty())
+    return fail(ErrorCode::InvalidArgument, "write access needs a token");
+  if (options.poll_ms <= 0 || options.poll_ms > 1000)
+    return fail(ErrorCode::InvalidArgument, "poll period must be 1 to 1000 ms");
   beast::error_code ec;
   const asio::ip::address address = asio::ip::make_address(options.bind, ec);
   if (ec) return fail(ErrorCode::InvalidArgument, "--bind: '" + options.bind + "' is not an IPv4 or IPv6 address");
@@ -364,7 +374,8 @@ Expected<std::unique_ptr<Server>> Server::open(ViewSource& source, const Protoco
   if (!ec) impl->acceptor.bind(endpoint, ec);
   if (!ec) impl->acceptor.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) {
-    return fail(ErrorCode::Io, "cannot listen on " + options.bind + ":" + std::to_string(options.port) + ": " + ec.message());
+    return fail(ErrorCode::Io,
+                "cannot listen on " + options.bind + ":" + std::to_string(options.port) + ": " + ec.message());
   }
   impl->port = impl->acceptor.local_endpoint().port();
   const std::string p = ":" + std::to_string(impl->port);

@@ -44,13 +44,13 @@ struct Condition {
   EventId event = kNoEvent;  ///< the event; for mirrors EVT_SERVICE_FAILURE/DEGRADED
   State level = State::Normal;
   std::uint8_t severity = 0;
-  bool mirror = false;                 ///< propagated from a provider (DESIGN §2.6)
-  ConnectionId via = kNoConnection;    ///< mirrors: the connection it arrived through
-  Time first{};                        ///< activation time
-  Time last{};                         ///< last onset (refresh) time
-  std::uint32_t count = 1;             ///< onsets seen while active (1 + refreshes)
-  std::uint64_t seq = 0;               ///< activation order, for "most recent" ties
-  RootCause root;                      ///< for a root condition, root.event == event
+  bool mirror = false;               ///< propagated from a provider (DESIGN §2.6)
+  ConnectionId via = kNoConnection;  ///< mirrors: the connection it arrived through
+  Time first{};                      ///< activation time
+  Time last{};                       ///< last onset (refresh) time
+  std::uint32_t count = 1;           ///< onsets seen while active (1 + refreshes)
+  std::uint64_t seq = 0;             ///< activation order, for "most recent" ties
+  RootCause root;                    ///< for a root condition, root.event == event
 };
 
 }  // namespace safecass

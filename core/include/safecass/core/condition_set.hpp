@@ -39,8 +39,8 @@ struct ConditionChange {
   /// Added or refreshed: the condition's index (valid until the set changes again). Ignored
   /// because latched: the index of the condition that stays. Otherwise -1.
   std::int32_t index = -1;
-  Condition removed;         ///< Cleared: the condition that was removed
-  std::string_view reason;   ///< Ignored: why (one of the ConditionSet::kIgnored* texts)
+  Condition removed;        ///< Cleared: the condition that was removed
+  std::string_view reason;  ///< Ignored: why (one of the ConditionSet::kIgnored* texts)
 
   bool transition() const noexcept { return from != to; }
 };
@@ -67,13 +67,9 @@ public:
   /// Index of the outstanding condition; -1 in Normal.
   std::int32_t outstanding_index() const noexcept { return outstanding_; }
   /// The outstanding condition; nullptr in Normal.
-  const Condition* outstanding() const noexcept {
-    return outstanding_ < 0 ? nullptr : &data()[outstanding_];
-  }
+  const Condition* outstanding() const noexcept { return outstanding_ < 0 ? nullptr : &data()[outstanding_]; }
   /// The outstanding condition's event; kNoEvent in Normal.
-  EventId outstanding_event() const noexcept {
-    return outstanding_ < 0 ? kNoEvent : data()[outstanding_].event;
-  }
+  EventId outstanding_event() const noexcept { return outstanding_ < 0 ? kNoEvent : data()[outstanding_].event; }
 
   /// Index of the root condition (not a mirror) of `onset`, or -1.
   std::int32_t find_root(EventId onset) const noexcept;

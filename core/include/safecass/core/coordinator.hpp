@@ -58,9 +58,9 @@ enum class MachineKind : std::uint8_t { Framework, Application, Provided, Requir
 /// The default-constructed value is the conservative default used when a provided interface has
 /// no `service` entry: s_F, s_A and every required interface.
 struct ServiceDependency {
-  bool framework = true;      ///< include s_F
-  bool application = true;    ///< include s_A
-  bool all_required = true;   ///< include every required interface (ignores `required`)
+  bool framework = true;              ///< include s_F
+  bool application = true;            ///< include s_A
+  bool all_required = true;           ///< include every required interface (ignores `required`)
   std::vector<std::string> required;  ///< used when all_required is false
   State propagate = State::Error;     ///< lowest level that crosses connections (Error or Warning)
 
@@ -100,8 +100,8 @@ struct TransitionInfo {
   ComponentId component = kNoComponent;
   MachineId machine = kNoMachine;  ///< kNoMachine for the extended component state
   Transition transition = Transition::N2W;
-  EventId event = kNoEvent;        ///< the event processed (kNoEvent for a reset)
-  const RootCause* root = nullptr; ///< the root cause of the condition added/removed, if any
+  EventId event = kNoEvent;         ///< the event processed (kNoEvent for a reset)
+  const RootCause* root = nullptr;  ///< the root cause of the condition added/removed, if any
   Time time{};
 };
 
@@ -115,7 +115,7 @@ struct StateCallbacks {
 
 /// One active condition, with its root cause and the path it took (DESIGN §2.6 `explain`).
 struct Explanation {
-  std::string machine;   ///< address of the machine holding the condition
+  std::string machine;  ///< address of the machine holding the condition
   std::string event;
   State level = State::Normal;
   int severity = 0;
@@ -125,10 +125,10 @@ struct Explanation {
   Time first{};
   Time last{};
   std::string root_event;
-  std::string root_origin;   ///< address of the origin machine
+  std::string root_origin;  ///< address of the origin machine
   Time root_time{};
-  std::string hazard;        ///< of the root event
-  std::string filter;        ///< empty unless a filter fired the root
+  std::string hazard;  ///< of the root event
+  std::string filter;  ///< empty unless a filter fired the root
   std::string signal;
   double value = 0.0;
   Time sample_time{};
@@ -143,11 +143,11 @@ std::string to_string(const Explanation& e);
 /// of the full state that replaces the set held by a remote provided interface (apply_remote()).
 /// Identity across processes is (origin, event, time).
 struct RemoteRoot {
-  std::string event;              ///< the root onset's name (events are system-wide names)
-  std::string origin;             ///< address of the origin machine in the provider's process
-  Time time{};                    ///< onset time at the origin (the provider's clock)
-  State level = State::Error;     ///< the root's level (Warning or Error)
-  std::string filter;             ///< empty unless a filter fired the root
+  std::string event;           ///< the root onset's name (events are system-wide names)
+  std::string origin;          ///< address of the origin machine in the provider's process
+  Time time{};                 ///< onset time at the origin (the provider's clock)
+  State level = State::Error;  ///< the root's level (Warning or Error)
+  std::string filter;          ///< empty unless a filter fired the root
   std::string signal;
   double value = 0.0;
   Time sample_time{};
@@ -174,11 +174,11 @@ struct RemoteApplyResult {
 /// still in the ring. A quiet address keeps its records as long as the whole coordinator has not
 /// produced a ring's worth of newer ones (docs/semantics.md §8).
 struct CoordinatorOptions {
-  std::size_t history_capacity = 256;      ///< at most this many records returned per address
-  std::size_t history_records = 8192;      ///< the ring holds at least this many records
-  std::size_t history_per_address = 8;     ///< ... and this many per machine and component
+  std::size_t history_capacity = 256;                      ///< at most this many records returned per address
+  std::size_t history_records = 8192;                      ///< the ring holds at least this many records
+  std::size_t history_per_address = 8;                     ///< ... and this many per machine and component
   std::size_t history_records_max = std::size_t{1} << 20;  ///< ... and at most this many
-  std::size_t pending_capacity = 256;      ///< events generated from callbacks, reserved up front
+  std::size_t pending_capacity = 256;                      ///< events generated from callbacks, reserved up front
 };
 
 namespace detail {
@@ -211,8 +211,7 @@ private:
 class Coordinator {
 public:
   /// `clock` must outlive the coordinator; null means an owned SteadyClock.
-  explicit Coordinator(std::string name = "local", const Clock* clock = nullptr,
-                       CoordinatorOptions options = {});
+  explicit Coordinator(std::string name = "local", const Clock* clock = nullptr, CoordinatorOptions options = {});
   ~Coordinator();
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
@@ -234,8 +233,7 @@ public:
   /// Errors: NotFound (component, provided or required interface), InvalidArgument (propagate
   /// Normal), InvalidState (a machine of the component holds a condition: the mirrors it feeds
   /// would no longer match the entry).
-  Expected<void> set_service(ComponentId component, std::string_view provided,
-                             const ServiceDependency& dependency);
+  Expected<void> set_service(ComponentId component, std::string_view provided, const ServiceDependency& dependency);
   /// Connects `client_required` ("C.r") to `provider_provided` ("P.p").
   /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected).
   Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
@@ -316,10 +314,16 @@ public:
   void reset(const Address& target, std::string_view who, std::string_view why);
 
   // ---- lock-free reads -----------------------------------------------------------------------
-  State state(MachineId id) const noexcept { return unpack(machines_[id].snapshot.load(std::memory_order_acquire)).state; }
-  StateSnapshot snapshot(MachineId id) const noexcept { return unpack(machines_[id].snapshot.load(std::memory_order_acquire)); }
+  State state(MachineId id) const noexcept {
+    return unpack(machines_[id].snapshot.load(std::memory_order_acquire)).state;
+  }
+  StateSnapshot snapshot(MachineId id) const noexcept {
+    return unpack(machines_[id].snapshot.load(std::memory_order_acquire));
+  }
   /// The extended component state ŝ_ext(C) and its outstanding event.
-  StateSnapshot extended(ComponentId id) const noexcept { return unpack(components_[id].snapshot.load(std::memory_order_acquire)); }
+  StateSnapshot extended(ComponentId id) const noexcept {
+    return unpack(components_[id].snapshot.load(std::memory_order_acquire));
+  }
   State extended_state(ComponentId id) const noexcept { return extended(id).state; }
   /// Service state s_S.p of provided interface `provided` (index) of `component`.
   State service_state(ComponentId component, std::uint32_t provided) const noexcept;
@@ -403,7 +407,7 @@ private:
     std::uint32_t iface = kNone;  ///< index of the interface for Provided/Required
     std::atomic<std::uint64_t> snapshot{0};
     std::vector<Edge> fanout;
-    ConditionSet conditions;      ///< §2.4: the machine's state and outstanding condition
+    ConditionSet conditions;  ///< §2.4: the machine's state and outstanding condition
     std::vector<StateCallbacks> callbacks;
     std::string address;
   };
@@ -429,19 +433,19 @@ private:
     MachineId application = kNoMachine;
     std::vector<MachineId> provided;
     std::vector<MachineId> required;
-    std::vector<ServiceData> services;            ///< one per provided interface
-    std::vector<ConnectionId> required_connection;///< one per required interface
-    std::vector<ConnectionId> provider_connections;///< connections to its provided interfaces
+    std::vector<ServiceData> services;               ///< one per provided interface
+    std::vector<ConnectionId> required_connection;   ///< one per required interface
+    std::vector<ConnectionId> provider_connections;  ///< connections to its provided interfaces
     std::string name;
   };
   /// What update_component() reads of each machine, in one dense array by machine id: the
   /// machines of a component are created together, so their summaries share a cache line and a
   /// component's outstanding event is found without visiting its machines.
   struct MachineSummary {
-    std::uint64_t seq = 0;       ///< the outstanding condition's activation order
-    EventId event = kNoEvent;    ///< the outstanding condition's event; kNoEvent in Normal
+    std::uint64_t seq = 0;     ///< the outstanding condition's activation order
+    EventId event = kNoEvent;  ///< the outstanding condition's event; kNoEvent in Normal
     State state = State::Normal;
-    std::uint8_t severity = 0;   ///< the outstanding condition's severity
+    std::uint8_t severity = 0;  ///< the outstanding condition's severity
   };
   enum class PendingKind : std::uint8_t { Generate, Reset };
   struct Pending {
@@ -478,8 +482,7 @@ private:
   /// Adds a condition (root or mirror) to a machine and applies §2.4 step 2.
   void add_condition(MachineId id, const Condition& c, Time now) noexcept;
   /// Removes condition `index` of a machine; `completion` is the event recorded.
-  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now,
-                        std::string_view text) noexcept;
+  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::string_view text) noexcept;
   void propagate_onset(const Condition& root) noexcept;
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
   /// Writes the event record of a condition just added (change.index) and publishes the machine.
@@ -489,8 +492,8 @@ private:
                       std::string_view text) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
-  void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
-            State from, State to) noexcept;
+  void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info, State from,
+            State to) noexcept;
   void emit(const Record& r) noexcept;
   void record_machine(MachineId id, Record& r) noexcept;
   std::vector<Explanation> explain_machine(MachineId id) const;
@@ -556,9 +559,9 @@ private:
   std::uint64_t record_seq_ = 0;
   std::uint64_t dropped_requests_ = 0;
   std::vector<Pending> pending_;
-  std::vector<MachineSummary> summaries_;    ///< by machine id, kept by update_machine()
-  std::vector<MachineId> work_;              ///< BFS queue for propagation, reserved up front
-  std::vector<std::uint64_t> visit_marks_;   ///< per machine: last BFS that visited it
+  std::vector<MachineSummary> summaries_;   ///< by machine id, kept by update_machine()
+  std::vector<MachineId> work_;             ///< BFS queue for propagation, reserved up front
+  std::vector<std::uint64_t> visit_marks_;  ///< per machine: last BFS that visited it
   std::uint64_t visit_epoch_ = 0;
   std::vector<std::pair<SubscriptionId, std::function<void(const Record&)>>> observers_;
   SubscriptionId next_subscription_ = 1;

@@ -19,11 +19,11 @@ inline constexpr int kMaxSeverity = 255;
 /// An event as written in a specification, before the coordinator checks it.
 struct EventDef {
   std::string name;
-  int severity = 0;             ///< 1–255; int so that out-of-range values can be reported
-  TransitionSet transitions;    ///< onset: worsening only; completion: improving only
-  std::string completes;        ///< completion only: the onset it clears (default "/X" → "X")
-  bool latched = false;         ///< onset only: a completion is ignored, only reset clears it
-  std::string hazard;           ///< an id from the user's hazard analysis
+  int severity = 0;           ///< 1–255; int so that out-of-range values can be reported
+  TransitionSet transitions;  ///< onset: worsening only; completion: improving only
+  std::string completes;      ///< completion only: the onset it clears (default "/X" → "X")
+  bool latched = false;       ///< onset only: a completion is ignored, only reset clears it
+  std::string hazard;         ///< an id from the user's hazard analysis
   std::string description;
 };
 
@@ -51,7 +51,7 @@ constexpr State onset_level(TransitionSet transitions, State current) noexcept {
   if (current == State::Normal) return transitions.contains(Transition::N2E) ? State::Error : State::Warning;
   if (current == State::Warning && transitions.contains(Transition::W2E)) return State::Error;
   return (transitions.contains(Transition::N2E) || transitions.contains(Transition::W2E)) ? State::Error
-                                                                                           : State::Warning;
+                                                                                          : State::Warning;
 }
 
 /// The framework events every coordinator defines (DESIGN §2.7), with fixed ids.

@@ -11,13 +11,13 @@ namespace safecass {
 
 /// What kind of recoverable error happened; the message says which thing and why.
 enum class ErrorCode {
-  Duplicate,      ///< a name that must be unique is used twice
-  NotFound,       ///< a name or address that does not exist
-  InvalidArgument,///< a value outside its range or of the wrong shape
-  InvalidState,   ///< the operation is not allowed in the current state
-  Io,             ///< a file could not be read or written
-  Parse,          ///< malformed input text
-  Denied,         ///< refused for lack of write access
+  Duplicate,        ///< a name that must be unique is used twice
+  NotFound,         ///< a name or address that does not exist
+  InvalidArgument,  ///< a value outside its range or of the wrong shape
+  InvalidState,     ///< the operation is not allowed in the current state
+  Io,               ///< a file could not be read or written
+  Parse,            ///< malformed input text
+  Denied,           ///< refused for lack of write access
 };
 
 struct Error {

@@ -13,11 +13,11 @@
 namespace safecass {
 
 enum class RecordKind : std::uint8_t {
-  Event,        ///< an onset or completion processed (or ignored) by a machine
-  Transition,   ///< a machine changed state
+  Event,                ///< an onset or completion processed (or ignored) by a machine
+  Transition,           ///< a machine changed state
   ComponentTransition,  ///< a component's extended state changed
-  Reset,        ///< a machine was reset (text: "who: why")
-  Injection,    ///< a fault was injected (published by the filters module)
+  Reset,                ///< a machine was reset (text: "who: why")
+  Injection,            ///< a fault was injected (published by the filters module)
 };
 
 enum class Outcome : std::uint8_t {

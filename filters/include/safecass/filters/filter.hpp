@@ -49,8 +49,8 @@ struct FilterTarget {
 
 /// A filter instance as written in a specification.
 struct FilterConfig {
-  std::string name;   ///< unique within the monitor (default: the type and an index)
-  std::string type;   ///< registry name
+  std::string name;  ///< unique within the monitor (default: the type and an index)
+  std::string type;  ///< registry name
   FilterTarget target;
   ExecutionMode execution = ExecutionMode::Active;
   DetectionMode detection = DetectionMode::Edge;
@@ -60,12 +60,12 @@ struct FilterConfig {
 
 /// Everything a filter needs at construction, prepared by the monitor.
 struct FilterInit {
-  FilterConfig config;              ///< params checked and completed with defaults
+  FilterConfig config;  ///< params checked and completed with defaults
   Coordinator* coordinator = nullptr;
   MachineId target = kNoMachine;
   ComponentId component = kNoComponent;
-  std::vector<Signal*> inputs;      ///< resolved, in manifest order (lists expanded)
-  std::vector<Signal*> outputs;     ///< resolved or created, in manifest order
+  std::vector<Signal*> inputs;   ///< resolved, in manifest order (lists expanded)
+  std::vector<Signal*> outputs;  ///< resolved or created, in manifest order
   EventId onset = kNoEvent;
   EventId completion = kNoEvent;
   NameId name_id = kNoName;
@@ -196,7 +196,7 @@ private:
   std::vector<Signal*> inputs_;
   std::vector<Signal*> outputs_;
   std::vector<SignalCursor> cursors_;  ///< per input; each keeps the input's newest finite sample
-  std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
+  std::vector<SampleView> pending_;    ///< merge of several inputs: next sample of each
   std::vector<char> has_pending_;
   EventId onset_;
   EventId completion_;
@@ -210,8 +210,8 @@ private:
   static constexpr std::uint8_t kRestore = 16;       ///< a shallow injection ended: judge reality once
   std::atomic<std::uint8_t> detour_{0};
   std::atomic<bool> detected_{false};
-  std::vector<char> invalid_;       ///< per input: its last sample was not finite
-  std::size_t invalid_count_ = 0;   ///< inputs marked in invalid_
+  std::vector<char> invalid_;      ///< per input: its last sample was not finite
+  std::size_t invalid_count_ = 0;  ///< inputs marked in invalid_
   bool current_injected_ = false;
   bool ticks_ = true;  ///< on_tick is overridden (cleared by the default on its first call)
 

@@ -23,8 +23,8 @@ using ParamValue = std::variant<double, bool, std::string, std::vector<std::stri
 using Params = std::map<std::string, ParamValue, std::less<>>;
 
 enum class ParamType {
-  Number,      ///< double, within [min, max]
-  Integer,     ///< whole number, within [min, max]
+  Number,   ///< double, within [min, max]
+  Integer,  ///< whole number, within [min, max]
   Bool,
   String,
   Choice,      ///< one of `choices`
@@ -39,20 +39,19 @@ std::string_view to_string(ParamType t) noexcept;
 struct ParamSpec {
   std::string name;
   ParamType type = ParamType::Number;
-  std::string doc;                       ///< one line
+  std::string doc;                          ///< one line
   std::optional<ParamValue> default_value;  ///< none: the parameter is required (unless `optional`)
-  bool optional = false;                 ///< may be absent, with no default
+  bool optional = false;                    ///< may be absent, with no default
   double min = -1e300;
   double max = 1e300;
-  std::vector<std::string> choices;      ///< for Choice
+  std::vector<std::string> choices;  ///< for Choice
 
   static ParamSpec number(std::string name, std::string doc, std::optional<double> def = std::nullopt,
                           double min = -1e300, double max = 1e300);
   static ParamSpec integer(std::string name, std::string doc, std::optional<double> def = std::nullopt,
                            double min = -1e300, double max = 1e300);
   static ParamSpec boolean(std::string name, std::string doc, bool def);
-  static ParamSpec choice(std::string name, std::string doc, std::vector<std::string> choices,
-                          std::string def);
+  static ParamSpec choice(std::string name, std::string doc, std::vector<std::string> choices, std::string def);
   static ParamSpec signal(std::string name, std::string doc, bool optional = false);
   static ParamSpec signals(std::string name, std::string doc, bool optional = false);
   static ParamSpec event(std::string name, std::string doc, std::optional<std::string> def = std::nullopt,
@@ -61,11 +60,11 @@ struct ParamSpec {
 
 /// What a filter type reads, writes and accepts.
 struct FilterManifest {
-  std::string type;                   ///< registry name, e.g. "Threshold"
-  std::string doc;                    ///< one line
+  std::string type;  ///< registry name, e.g. "Threshold"
+  std::string doc;   ///< one line
   std::vector<ParamSpec> params;
-  std::vector<std::string> inputs;    ///< names of the Signal/SignalList parameters read
-  std::vector<std::string> outputs;   ///< names of the Signal parameters written
+  std::vector<std::string> inputs;   ///< names of the Signal/SignalList parameters read
+  std::vector<std::string> outputs;  ///< names of the Signal parameters written
   bool generates_events = true;
   /// Without its first output parameter, the filter writes the signal named after the filter
   /// (default_output_name()), as the 2016 filters named their outputs themselves.

@@ -27,9 +27,9 @@ namespace safecass {
 
 /// What the sizing check of a filter type sees: its checked parameters and resolved inputs.
 struct FilterShape {
-  const std::string& filter;            ///< instance name, for messages
+  const std::string& filter;  ///< instance name, for messages
   const Params& params;
-  const std::vector<Signal*>& inputs;   ///< manifest order, lists expanded
+  const std::vector<Signal*>& inputs;  ///< manifest order, lists expanded
 };
 
 /// Checks input sizes and returns the size of each output (manifest order).
@@ -43,8 +43,8 @@ namespace detail {
 template <class T, class = void>
 struct HasOutputSizes : std::false_type {};
 template <class T>
-struct HasOutputSizes<T, std::void_t<decltype(T::output_sizes(std::declval<const FilterShape&>()))>>
-    : std::true_type {};
+struct HasOutputSizes<T, std::void_t<decltype(T::output_sizes(std::declval<const FilterShape&>()))>> : std::true_type {
+};
 }  // namespace detail
 
 class FilterRegistry {
@@ -64,9 +64,10 @@ public:
     if constexpr (detail::HasOutputSizes<T>::value) {
       shape = [](const FilterShape& s) { return T::output_sizes(s); };
     }
-    return add(std::move(type), std::move(m),
-               [](FilterInit init) -> std::unique_ptr<Filter> { return std::make_unique<T>(std::move(init)); },
-               std::move(shape));
+    return add(
+        std::move(type), std::move(m),
+        [](FilterInit init) -> std::unique_ptr<Filter> { return std::make_unique<T>(std::move(init)); },
+        std::move(shape));
   }
   /// Registers a type from its parts. An empty `shape` means scalar_shape. Errors: Duplicate.
   Expected<void> add(std::string type, FilterManifest manifest, FilterFactory factory, ShapeCheck shape = {});

@@ -276,9 +276,9 @@ private:
   std::uint64_t next_ = 0;           ///< next sample of the history buffer
   std::uint64_t injected_next_ = 0;  ///< next sample of the injection ring
   std::uint64_t missed_ = 0;
-  std::vector<double> scratch_;     ///< two samples: the kept one and the one being read
-  double* reading_ = nullptr;       ///< the half of scratch_ the next sample is read into
-  const double* kept_ = nullptr;    ///< the other half once keep() was called
+  std::vector<double> scratch_;   ///< two samples: the kept one and the one being read
+  double* reading_ = nullptr;     ///< the half of scratch_ the next sample is read into
+  const double* kept_ = nullptr;  ///< the other half once keep() was called
 };
 
 /// The signals of one coordinator, by name. Signals are created during configuration; their

@@ -44,7 +44,9 @@ public:
   JsonObject& null(std::string_view key) { return raw(key, "null"); }
   /// A string, or null when empty.
   JsonObject& opt(std::string_view key, std::string_view value) { return value.empty() ? null(key) : str(key, value); }
-  JsonObject& strings(std::string_view key, const std::vector<std::string>& items) { return raw(key, json_string_array(items)); }
+  JsonObject& strings(std::string_view key, const std::vector<std::string>& items) {
+    return raw(key, json_string_array(items));
+  }
   /// The object's text.
   std::string text() const { return text_ + "}"; }
 

@@ -21,9 +21,9 @@ struct LocalOptions {
   std::string name;  ///< what name() answers (default: the coordinator's name)
   /// Simulated (in-process runs) or Host (a live coordinator process on HostClock).
   TimeBase base = TimeBase::Simulated;
-  double period = 0.0;        ///< Simulated: the tick, seconds
-  std::string scenario;       ///< Simulated: the scenario file, if any
-  double duration = 0.0;      ///< Simulated: the scenario's duration, seconds
+  double period = 0.0;    ///< Simulated: the tick, seconds
+  std::string scenario;   ///< Simulated: the scenario file, if any
+  double duration = 0.0;  ///< Simulated: the scenario's duration, seconds
 };
 
 class LocalQuery final : public SystemQuery {

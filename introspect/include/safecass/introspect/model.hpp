@@ -48,7 +48,7 @@ bool parse_row_kind(std::string_view text, RowKind& out) noexcept;
 /// One row of `state list`: SYSTEM, a component's extended state, one of its machines or its
 /// service states.
 struct StateRow {
-  std::string address;      ///< "SYSTEM", "JR3", "JR3.s_A", "JR3.s_S.ForceData"
+  std::string address;  ///< "SYSTEM", "JR3", "JR3.s_A", "JR3.s_S.ForceData"
   RowKind kind = RowKind::Component;
   State state = State::Normal;
   std::string outstanding;  ///< the outstanding event; empty when Normal and for SYSTEM and services
@@ -73,20 +73,20 @@ struct RootEntry {
 /// One record of the observer stream: an event processed (or ignored, masked), a machine or
 /// component transition, a reset, an injection.
 struct HistoryEntry {
-  std::uint64_t seq = 0;     ///< coordinator-wide order
+  std::uint64_t seq = 0;  ///< coordinator-wide order
   Time time{};
   RecordKind kind = RecordKind::Event;
   Outcome outcome = Outcome::None;
-  std::string component;     ///< the component (empty when the record names none)
-  std::string machine;       ///< the machine's address (empty for component records)
-  std::string event;         ///< the event processed (empty for none)
+  std::string component;  ///< the component (empty when the record names none)
+  std::string machine;    ///< the machine's address (empty for component records)
+  std::string event;      ///< the event processed (empty for none)
   State from = State::Normal;
   State to = State::Normal;
   State level = State::Normal;
   int severity = 0;
   bool mirror = false;
   std::optional<RootEntry> root;
-  std::string text;          ///< reason of an ignored event, "who: why" of a reset
+  std::string text;  ///< reason of an ignored event, "who: why" of a reset
 
   /// The machine, else the component, else "-".
   std::string_view where() const noexcept;
@@ -122,9 +122,9 @@ struct SignalRef {
 struct FilterRow {
   std::string name;
   std::string type;
-  std::string target;     ///< machine address, empty when none
-  bool active = true;     ///< ACTIVE (false: PASSIVE)
-  bool edge = true;       ///< EDGE (false: LEVEL)
+  std::string target;  ///< machine address, empty when none
+  bool active = true;  ///< ACTIVE (false: PASSIVE)
+  bool edge = true;    ///< EDGE (false: LEVEL)
   bool enabled = true;
   bool detected = false;
   std::vector<SignalRef> inputs;
@@ -177,12 +177,12 @@ struct ConnectionRow {
   std::optional<State> required_state;
   std::optional<State> service_state;
   std::optional<State> propagate;
-  bool remote = false;   ///< the provider runs in another process
+  bool remote = false;  ///< the provider runs in another process
 };
 
 /// One row of `service list`.
 struct ServiceRow {
-  std::string address;                  ///< "C.s_S.p"
+  std::string address;  ///< "C.s_S.p"
   State state = State::Normal;
   std::vector<std::string> depends_on;  ///< "s_P.p", "s_F", "s_A", "s_R.r" in that order
   State propagate = State::Error;

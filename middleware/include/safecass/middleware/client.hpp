@@ -35,9 +35,9 @@
 namespace safecass::middleware {
 
 struct ClientOptions {
-  IceEndpoint ice;           ///< IceStorm, to find the coordinator by its heartbeat
-  std::string coordinator;   ///< the coordinator's name
-  std::string token;         ///< the write token (from its token file); empty: read-only
+  IceEndpoint ice;          ///< IceStorm, to find the coordinator by its heartbeat
+  std::string coordinator;  ///< the coordinator's name
+  std::string token;        ///< the write token (from its token file); empty: read-only
   /// The read credential (from its read token file), sent with every request; the write token
   /// is sent as the read credential when this is empty.
   std::string read_token;
@@ -71,8 +71,9 @@ public:
   std::string name() const override;
   Expected<introspect::ClockInfo> clock() override;
   Expected<std::vector<introspect::StateRow>> state_list(std::string_view component = {}) override;
-  Expected<std::vector<introspect::HistoryEntry>> history(std::string_view scope, std::size_t last,
-                                                          introspect::HistoryFilter filter = introspect::HistoryFilter::All) override;
+  Expected<std::vector<introspect::HistoryEntry>> history(
+      std::string_view scope, std::size_t last,
+      introspect::HistoryFilter filter = introspect::HistoryFilter::All) override;
   Expected<std::vector<introspect::HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
   Expected<std::vector<introspect::FilterRow>> filter_list() override;
   Expected<introspect::FilterInfo> filter_info(std::string_view name) override;

@@ -89,12 +89,12 @@ Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::str
                                         Coordinator& coordinator);
 
 struct NodeOptions {
-  IceEndpoint ice;                       ///< IceStorm
-  std::string listen_host = "127.0.0.1"; ///< the node's own endpoint (subscribers, Control)
-  int control_port = 0;                  ///< 0: any free port (advertised in the heartbeat)
+  IceEndpoint ice;                        ///< IceStorm
+  std::string listen_host = "127.0.0.1";  ///< the node's own endpoint (subscribers, Control)
+  int control_port = 0;                   ///< 0: any free port (advertised in the heartbeat)
   std::chrono::milliseconds heartbeat{100};
-  bool allow_write = false;              ///< accept write operations
-  std::string token;                     ///< the secret write requests must carry
+  bool allow_write = false;  ///< accept write operations
+  std::string token;         ///< the secret write requests must carry
   /// When not empty, reads (state, history, filters, events, connections, services, explain)
   /// must carry this credential (or the write token); empty: reads are open to local clients.
   std::string read_token;
@@ -127,24 +127,24 @@ struct NodeOptions {
 
 /// Counters, readable at any time (thread-safe).
 struct NodeStats {
-  std::uint64_t updates_published = 0;   ///< interface full states sent (each differs from the last one sent)
+  std::uint64_t updates_published = 0;         ///< interface full states sent (each differs from the last one sent)
   std::uint64_t state_messages_published = 0;  ///< Ice messages carrying them (one per publishing cycle)
   std::uint64_t updates_applied = 0;
-  std::uint64_t updates_rejected = 0;   ///< malformed, unknown interface or stale sequence number
-  std::uint64_t updates_missed = 0;     ///< gaps seen in sequence numbers
+  std::uint64_t updates_rejected = 0;  ///< malformed, unknown interface or stale sequence number
+  std::uint64_t updates_missed = 0;    ///< gaps seen in sequence numbers
   std::uint64_t events_published = 0;
   std::uint64_t event_messages_published = 0;  ///< Ice messages carrying the event records
-  std::uint64_t events_dropped = 0;     ///< observer queue overflow (never silent: counted here)
+  std::uint64_t events_dropped = 0;            ///< observer queue overflow (never silent: counted here)
   std::uint64_t resyncs_requested = 0;
-  std::uint64_t connects = 0;           ///< successful (re)connections to IceStorm
-  std::uint64_t messages_refused = 0;   ///< unauthenticated, forged, replayed or malformed bus messages
-  std::uint64_t providers_lost = 0;     ///< times a provider coordinator was declared lost
-  std::uint64_t duplicates_seen = 0;    ///< heartbeats of another process using this node's name
+  std::uint64_t connects = 0;          ///< successful (re)connections to IceStorm
+  std::uint64_t messages_refused = 0;  ///< unauthenticated, forged, replayed or malformed bus messages
+  std::uint64_t providers_lost = 0;    ///< times a provider coordinator was declared lost
+  std::uint64_t duplicates_seen = 0;   ///< heartbeats of another process using this node's name
   /// State updates and event records too large for one message on their own
   /// (NodeOptions::max_message_bytes): sent cut down (roots left out, text cut), each logged. A
   /// record too large even without its text is dropped and also counted in events_dropped.
   std::uint64_t oversized_messages = 0;
-  std::uint64_t roots_truncated = 0;    ///< roots left out of those state updates (the least severe)
+  std::uint64_t roots_truncated = 0;  ///< roots left out of those state updates (the least severe)
   bool connected = false;
 };
 
@@ -156,8 +156,8 @@ public:
   /// a non-loopback endpoint without `insecure`), Denied/Parse/Io (the keys, as keys.hpp says).
   static Expected<std::unique_ptr<CoordinatorNode>> create(Coordinator& coordinator, Monitor& monitor,
                                                            const FilterRegistry& registry,
-                                                           const spec::SystemSpec& system,
-                                                           std::string coordinator_name, NodeOptions options);
+                                                           const spec::SystemSpec& system, std::string coordinator_name,
+                                                           NodeOptions options);
   ~CoordinatorNode();
   CoordinatorNode(const CoordinatorNode&) = delete;
   CoordinatorNode& operator=(const CoordinatorNode&) = delete;

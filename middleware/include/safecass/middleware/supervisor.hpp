@@ -43,7 +43,7 @@ struct ViewRow {
   std::string coordinator;
   std::string address;
   State state = State::Normal;
-  std::string cause;   ///< "origin:event" of the last transition, empty when Normal
+  std::string cause;  ///< "origin:event" of the last transition, empty when Normal
 };
 
 class Supervisor {

@@ -26,8 +26,8 @@ namespace safecass {
 /// The first line of a recording: "SAFECASS-INPUTS 1 period_ns=N start_ns=N clock=C system=S\n".
 struct InputLogHeader {
   int version = 1;
-  Time period{};  ///< the tick period of the run that recorded it (0: unknown)
-  Time start{};   ///< the recording clock's time when recording started
+  Time period{};                    ///< the tick period of the run that recorded it (0: unknown)
+  Time start{};                     ///< the recording clock's time when recording started
   std::string clock = "simulated";  ///< "simulated" or "steady"/"ros": where the times come from
   std::string system;               ///< the recorded system's name (informative)
 };

@@ -69,10 +69,10 @@ std::vector<std::string> describe_losses(const InputRecordStatus& status);
 std::string record_status_json(const InputRecordStatus& status);
 
 struct InputRecorderOptions {
-  FileLimits limits;                        ///< rotation (--max-bytes)
-  std::size_t queue_bytes = 64u << 20;      ///< bytes waiting for the disk before samples are dropped
-  Time period{};                            ///< the run's tick period, for the header (0: unknown)
-  std::string clock = "simulated";          ///< where the times come from, for the header
+  FileLimits limits;                    ///< rotation (--max-bytes)
+  std::size_t queue_bytes = 64u << 20;  ///< bytes waiting for the disk before samples are dropped
+  Time period{};                        ///< the run's tick period, for the header (0: unknown)
+  std::string clock = "simulated";      ///< where the times come from, for the header
   /// Record only these input signals ("Component.signal"); empty: every input signal. A framework
   /// bridge that adds signals of its own (the ROS bridge's topic rates) records those of the spec.
   std::vector<std::string> signals;

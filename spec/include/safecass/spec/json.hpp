@@ -28,7 +28,7 @@ struct JsonValue {
   Type type = Type::Null;
   bool boolean = false;
   double number = 0.0;
-  bool integral = false;        ///< written without fraction or exponent
+  bool integral = false;  ///< written without fraction or exponent
   std::string string;
   std::vector<JsonValue> array;
   std::vector<JsonMember> object;  ///< in file order; duplicates kept (validation reports them)

@@ -119,7 +119,7 @@ struct StepAction {
 
 struct ScenarioStep {
   enum class Kind : std::uint8_t { Sample, Ramp, Generate, Inject, Reset, Expect, ExpectOutstanding, ExpectCause };
-  double at = 0.0;          ///< seconds
+  double at = 0.0;  ///< seconds
   /// Sample: signal → values, in file order.
   SampleList samples;
   /// Every other kind: what it does (never null for those; null for a `sample` step).
@@ -137,10 +137,10 @@ struct ScenarioStep {
 std::string_view step_key(ScenarioStep::Kind kind) noexcept;
 
 struct Scenario {
-  std::string path;        ///< the scenario file as given
-  std::string system;      ///< the system file, resolved relative to the scenario file
-  double period = 0.001;   ///< seconds per tick
-  double duration = 0.0;   ///< seconds
+  std::string path;       ///< the scenario file as given
+  std::string system;     ///< the system file, resolved relative to the scenario file
+  double period = 0.001;  ///< seconds per tick
+  double duration = 0.0;  ///< seconds
   /// Sorted by time, file order within a time. A deque: a scenario of millions of steps grows
   /// without reallocating (and copying) them all.
   std::deque<ScenarioStep> steps;

@@ -21,8 +21,8 @@ namespace safecass::spec {
 /// One `filter` entry: a single filter (`pipeline` empty, one stage) or a pipeline (sugar for a
 /// chain: a stage without an input reads the previous stage's output).
 struct FilterSpec {
-  std::string pipeline;             ///< empty for a single filter
-  std::vector<FilterConfig> stages; ///< type is the registry's canonical name; unnamed filters get a name
+  std::string pipeline;              ///< empty for a single filter
+  std::vector<FilterConfig> stages;  ///< type is the registry's canonical name; unnamed filters get a name
   Position where;
 };
 
@@ -85,7 +85,7 @@ struct SystemSpec {
   std::vector<ConnectionSpec> connections;
   /// Coordinator name -> its components, in file order. Empty: one coordinator runs everything.
   std::vector<std::pair<std::string, std::vector<std::string>>> coordinators;
-  std::vector<HazardSpec> hazards;        ///< empty when the system declares none
+  std::vector<HazardSpec> hazards;  ///< empty when the system declares none
   std::vector<InvariantSpec> invariants;
 
   /// The hazard of that id, or null.

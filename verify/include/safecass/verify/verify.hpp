@@ -29,14 +29,14 @@
 namespace safecass::verify {
 
 struct Options {
-  std::string property;      ///< only this property (a hazard id or an invariant name); empty: all
-  std::string out_dir;       ///< write counterexample scenarios (and the Promela of violated properties) here
+  std::string property;          ///< only this property (a hazard id or an invariant name); empty: all
+  std::string out_dir;           ///< write counterexample scenarios (and the Promela of violated properties) here
   std::size_t memory_mb = 4096;  ///< SPIN's memory bound per property (pan -DMEMLIM)
-  bool slice = true;         ///< keep only the onsets that can influence a property (cone of influence)
-  bool merge = true;         ///< count interchangeable onsets instead of tracking each one
-  std::string spin = "spin"; ///< the SPIN executable
-  std::string cc = "cc";     ///< the C compiler for SPIN's verifier
-  std::string work_dir;      ///< where SPIN's files go (default: a fresh temporary directory, removed)
+  bool slice = true;             ///< keep only the onsets that can influence a property (cone of influence)
+  bool merge = true;             ///< count interchangeable onsets instead of tracking each one
+  std::string spin = "spin";     ///< the SPIN executable
+  std::string cc = "cc";         ///< the C compiler for SPIN's verifier
+  std::string work_dir;          ///< where SPIN's files go (default: a fresh temporary directory, removed)
 };
 
 /// One property and its verdict.
@@ -45,18 +45,18 @@ struct PropertyResult {
   enum class Verdict { Holds, Violated, Undecided };
   Kind kind = Kind::Reaction;
   Verdict verdict = Verdict::Holds;
-  std::string name;           ///< hazard id, invariant name, or the finding's subject
-  std::string text;           ///< what is checked, for people
-  std::string message;        ///< for a violation or a finding: what and why
-  spec::Position where;       ///< what it concerns, in the specification
-  bool structural = false;    ///< decided on the model's structure (no state search)
-  std::uint64_t states = 0;   ///< states SPIN stored
-  double memory_mb = 0.0;     ///< SPIN's total memory
-  double seconds = 0.0;       ///< translation, compilation and search
-  std::size_t onsets = 0;     ///< onset classes in this property's model (after slicing and merging)
+  std::string name;              ///< hazard id, invariant name, or the finding's subject
+  std::string text;              ///< what is checked, for people
+  std::string message;           ///< for a violation or a finding: what and why
+  spec::Position where;          ///< what it concerns, in the specification
+  bool structural = false;       ///< decided on the model's structure (no state search)
+  std::uint64_t states = 0;      ///< states SPIN stored
+  double memory_mb = 0.0;        ///< SPIN's total memory
+  double seconds = 0.0;          ///< translation, compilation and search
+  std::size_t onsets = 0;        ///< onset classes in this property's model (after slicing and merging)
   std::size_t onsets_total = 0;  ///< onsets the system has
-  std::string scenario;       ///< the counterexample scenario written (violations with out_dir)
-  std::string advice;         ///< Undecided: which abstraction would help
+  std::string scenario;          ///< the counterexample scenario written (violations with out_dir)
+  std::string advice;            ///< Undecided: which abstraction would help
 };
 
 struct Report {
@@ -85,9 +85,9 @@ struct Step {
 /// A random run of the Promela model (SPIN's random simulation, seeded): the steps it took and,
 /// after each one, the state of every address in `addresses`, as the model computed them.
 struct Simulation {
-  std::vector<std::string> addresses;        ///< SYSTEM, components, machines, services
+  std::vector<std::string> addresses;  ///< SYSTEM, components, machines, services
   std::vector<Step> steps;
-  std::vector<std::vector<State>> states;    ///< states[k][a]: after step k, address a
+  std::vector<std::vector<State>> states;  ///< states[k][a]: after step k, address a
 };
 
 /// Runs the whole model (no slicing, no merging) for `steps` steps with SPIN's random simulation

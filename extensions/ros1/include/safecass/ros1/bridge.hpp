@@ -37,13 +37,13 @@ namespace safecass::ros1 {
 
 /// Counters, readable at any time (approximate while running).
 struct BridgeStats {
-  std::uint64_t messages = 0;          ///< topic messages that fed signals
-  std::uint64_t bad_messages = 0;      ///< topic messages rejected (shape did not match the path)
+  std::uint64_t messages = 0;      ///< topic messages that fed signals
+  std::uint64_t bad_messages = 0;  ///< topic messages rejected (shape did not match the path)
   std::uint64_t diagnostics_published = 0;
-  std::uint64_t statuses_ingested = 0; ///< statuses of other nodes that matched a rule
-  std::uint64_t bad_statuses = 0;      ///< statuses with a level that is not one
+  std::uint64_t statuses_ingested = 0;  ///< statuses of other nodes that matched a rule
+  std::uint64_t bad_statuses = 0;       ///< statuses with a level that is not one
   std::uint64_t graph_checks = 0;
-  std::uint64_t graph_problems = 0;    ///< missing items found by the last check
+  std::uint64_t graph_problems = 0;  ///< missing items found by the last check
 };
 
 class Bridge {

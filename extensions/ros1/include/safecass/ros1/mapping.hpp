@@ -27,12 +27,12 @@ struct FieldBinding {
 
 /// Timing supervision of one topic, built as a filter on the topic's arrival signal.
 struct TopicCheck {
-  std::string target;  ///< machine address, e.g. "JR3.s_F"
+  std::string target;     ///< machine address, e.g. "JR3.s_F"
   double timeout = 0.0;   ///< watchdog: seconds without a message
   double min_rate = 0.0;  ///< frequency: Hz (0: no bound)
   double max_rate = 0.0;
   int window = 10;
-  std::string event;   ///< onset (default: EVT_STALE for a watchdog, EVT_ROS_TOPIC_RATE for a frequency)
+  std::string event;  ///< onset (default: EVT_STALE for a watchdog, EVT_ROS_TOPIC_RATE for a frequency)
 };
 
 /// A topic: the connection it carries (a provided interface and the required interfaces that use
@@ -52,8 +52,8 @@ struct TopicMapping {
 
 /// Existing `/diagnostics` statuses turned into events (OK/WARN/ERROR/STALE → events on a machine).
 struct IngestRule {
-  std::string name;      ///< status name, exactly, or a prefix when it ends with '*'
-  std::string target;    ///< machine address
+  std::string name;    ///< status name, exactly, or a prefix when it ends with '*'
+  std::string target;  ///< machine address
   std::string warn = "EVT_ROS_DIAG_WARN";
   std::string error = "EVT_ROS_DIAG_ERROR";
   std::string stale = "EVT_STALE";
@@ -63,17 +63,17 @@ struct IngestRule {
 };
 
 struct Mapping {
-  std::string path;         ///< the mapping file as given
-  std::string system;       ///< the system file, resolved relative to the mapping file
-  std::string coordinator;  ///< only this coordinator's components (empty: all)
+  std::string path;                                        ///< the mapping file as given
+  std::string system;                                      ///< the system file, resolved relative to the mapping file
+  std::string coordinator;                                 ///< only this coordinator's components (empty: all)
   std::vector<std::pair<std::string, std::string>> nodes;  ///< component → ROS node name
-  std::vector<EventDef> events;                             ///< extra events of the ROS side
+  std::vector<EventDef> events;                            ///< extra events of the ROS side
   std::vector<TopicMapping> topics;
   // diagnostics
   std::string publish_topic = "/diagnostics";
   double publish_period = 1.0;  ///< seconds; a change is published at once in addition
   std::string prefix = "safecass";
-  std::string hardware_id;      ///< default: the coordinator's name
+  std::string hardware_id;  ///< default: the coordinator's name
   std::string ingest_topic = "/diagnostics";
   std::vector<IngestRule> ingest;
   // graph check

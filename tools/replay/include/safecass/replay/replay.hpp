@@ -21,13 +21,14 @@
 namespace safecass::replay {
 
 struct ReplayOptions {
-  std::string system;         ///< the system file replayed (with --diff: SYSTEM_A, the reference)
-  std::string input;          ///< the log
-  std::string format;         ///< "recording", "csv", "bag"; empty: from the file's first bytes
-  std::string mapping;        ///< a bag: the ROS extension's mapping file
-  std::optional<double> from; ///< seconds: inputs before are not fed; the replay starts there
-  std::optional<double> to;   ///< seconds: inputs after are not fed; the replay ends there
-  std::optional<double> period;  ///< seconds per tick (default: the recording's, else the smallest component period, else 1 ms)
+  std::string system;          ///< the system file replayed (with --diff: SYSTEM_A, the reference)
+  std::string input;           ///< the log
+  std::string format;          ///< "recording", "csv", "bag"; empty: from the file's first bytes
+  std::string mapping;         ///< a bag: the ROS extension's mapping file
+  std::optional<double> from;  ///< seconds: inputs before are not fed; the replay starts there
+  std::optional<double> to;    ///< seconds: inputs after are not fed; the replay ends there
+  std::optional<double>
+      period;  ///< seconds per tick (default: the recording's, else the smallest component period, else 1 ms)
   bool json = false;
   std::string record;         ///< the replay's own history (and inputs next to it)
   std::string record_inputs;  ///< the replay's own inputs recording ("-": none)

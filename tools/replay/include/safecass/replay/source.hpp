@@ -26,8 +26,8 @@ struct Item {
   enum class Kind : std::uint8_t { Sample, Action, End, Error };
   Kind kind = Kind::End;
   Time time{};
-  Signal* signal = nullptr;        ///< Sample: the bound signal
-  const double* values = nullptr;  ///< Sample: signal->size() values, valid until the next next()
+  Signal* signal = nullptr;             ///< Sample: the bound signal
+  const double* values = nullptr;       ///< Sample: signal->size() values, valid until the next next()
   const InputAction* action = nullptr;  ///< Action
 };
 

@@ -25,17 +25,17 @@
 #include "safecass/native/runtime.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
+#include "safecass/runner/system.hpp"
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
 #include "safecass/spec/system.hpp"
-#include "safecass/runner/system.hpp"
 
 namespace safecass::runner {
 
 struct RunOptions {
-  bool json = false;            ///< one JSON object per line instead of text
-  bool quiet = false;           ///< print nothing but failures
-  std::string record_path;      ///< write the whole history as JSON lines
+  bool json = false;        ///< one JSON object per line instead of text
+  bool quiet = false;       ///< print nothing but failures
+  std::string record_path;  ///< write the whole history as JSON lines
   /// Record the inputs (samples and actions, record/input_log.hpp) to this file; with record_path
   /// and no inputs_path, next to the history (InputRecorder::path_for_history). "-": none.
   std::string inputs_path;
@@ -54,15 +54,15 @@ struct StateCheck {
 
 /// What a run did, for `safecass test`'s coverage summary and `safecass trace`'s matrix.
 struct Coverage {
-  std::set<std::string> events_fired;                       ///< events processed (not ignored)
-  std::set<std::pair<std::string, std::string>> taken;      ///< (event, transition) that caused a transition
-  std::set<std::pair<std::string, std::string>> defined;    ///< (event, transition) listed by the system's events
-  std::vector<StateCheck> states_checked;                   ///< every `expect` step's checks, in run order
+  std::set<std::string> events_fired;                     ///< events processed (not ignored)
+  std::set<std::pair<std::string, std::string>> taken;    ///< (event, transition) that caused a transition
+  std::set<std::pair<std::string, std::string>> defined;  ///< (event, transition) listed by the system's events
+  std::vector<StateCheck> states_checked;                 ///< every `expect` step's checks, in run order
 };
 
 struct RunResult {
-  int checks = 0;                       ///< expectations checked
-  std::vector<std::string> failures;    ///< "file:line:col: expectation failed at t=...: ..."
+  int checks = 0;                     ///< expectations checked
+  std::vector<std::string> failures;  ///< "file:line:col: expectation failed at t=...: ..."
   Coverage coverage;
   /// With RunOptions::record_path: what the recorder wrote and lost (after the run).
   std::optional<RecordStatus> record;

@@ -36,14 +36,15 @@ struct MiddlewareOptions {
   std::string system;  ///< the system file: its coordinators and their components
   /// Coordinator name → its token file (written by `safecass run ... --allow-write --token-file`).
   std::map<std::string, std::string> token_files;
-  bool allow_write = false;                     ///< without it every write is refused here too
-  std::string keys_dir;                         ///< the system's bus keys (empty: $SAFECASS_KEYS)
-  std::string tls_dir;                          ///< mutual TLS (ca.pem, console.pem/.key); empty: TCP
+  bool allow_write = false;  ///< without it every write is refused here too
+  std::string keys_dir;      ///< the system's bus keys (empty: $SAFECASS_KEYS)
+  std::string tls_dir;       ///< mutual TLS (ca.pem, console.pem/.key); empty: TCP
   /// Coordinator name → its read credential file (`safecass run ... --read-token-file`).
   std::map<std::string, std::string> read_token_files;
-  std::chrono::milliseconds timeout{1500};      ///< one request; also the wait for a heartbeat
-  std::chrono::milliseconds retry{500};         ///< pause before trying an unreachable coordinator again; liveness check period
-  std::chrono::milliseconds first_wait{3000};   ///< open() waits at most this for every first answer
+  std::chrono::milliseconds timeout{1500};  ///< one request; also the wait for a heartbeat
+  std::chrono::milliseconds retry{
+      500};  ///< pause before trying an unreachable coordinator again; liveness check period
+  std::chrono::milliseconds first_wait{3000};  ///< open() waits at most this for every first answer
 };
 
 class MiddlewareSource final : public ViewSource {

@@ -40,9 +40,9 @@ namespace safecass::viewer {
 
 struct ProtocolOptions {
   bool allow_write = false;
-  std::string token;                  ///< required in every write request when allow_write
-  std::size_t max_message = 64 * 1024;///< longer messages are refused
-  std::size_t recent = 100;           ///< records kept for the "recent" list of new pages
+  std::string token;                    ///< required in every write request when allow_write
+  std::size_t max_message = 64 * 1024;  ///< longer messages are refused
+  std::size_t recent = 100;             ///< records kept for the "recent" list of new pages
 };
 
 /// The records shown in the page's side list (transitions, resets, injections); events without

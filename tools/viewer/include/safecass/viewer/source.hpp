@@ -28,9 +28,9 @@ std::string_view to_string(NodeKind kind) noexcept;
 
 /// One state machine (s_F, s_A, s_P.p, s_R.r) or service state (s_S.p) of a component.
 struct MachineView {
-  std::string address;      ///< "CONTROL.s_R.ForceData"
+  std::string address;  ///< "CONTROL.s_R.ForceData"
   NodeKind kind = NodeKind::Framework;
-  std::string name;         ///< "s_F", "s_A" or the interface name
+  std::string name;  ///< "s_F", "s_A" or the interface name
   State state = State::Normal;
   std::string outstanding;  ///< the outstanding event; empty when Normal or derived
 };
