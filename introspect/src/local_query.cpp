@@ -313,16 +313,24 @@ Expected<std::unique_ptr<Subscription>> LocalQuery::follow(RecordSink sink) {
 }
 
 Expected<void> LocalQuery::generate(std::string_view event, std::string_view target) {
-  return co_.generate(event, target);
+  auto done = co_.generate(event, target);
+  if (done && options_.actions != nullptr) options_.actions->generated(event, target);
+  return done;
 }
 
-Expected<void> LocalQuery::broadcast(std::string_view event) { return co_.broadcast(event); }
+Expected<void> LocalQuery::broadcast(std::string_view event) {
+  auto done = co_.broadcast(event);
+  if (done && options_.actions != nullptr) options_.actions->broadcast(event);
+  return done;
+}
 
 Expected<void> LocalQuery::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
   if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter inject " + std::string(filter) + ": no samples");
   if (monitor_.find_filter(filter) == nullptr)
     return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "' (see filter list)");
-  return monitor_.inject_shallow(filter, samples);
+  auto done = monitor_.inject_shallow(filter, samples);
+  if (done && options_.actions != nullptr) options_.actions->injected(filter, samples);
+  return done;
 }
 
 Expected<void> LocalQuery::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
@@ -339,11 +347,15 @@ Expected<void> LocalQuery::inject_deep(std::string_view signal, const std::vecto
   }
   Time now = co_.clock().now();
   if (options_.base == TimeBase::Simulated && now < Time{0}) now = Time{0};
-  return monitor_.inject_deep(signal, samples, now);
+  auto done = monitor_.inject_deep(signal, samples, now);
+  if (done && options_.actions != nullptr) options_.actions->injected_deep(signal, samples);
+  return done;
 }
 
 Expected<void> LocalQuery::reset(std::string_view target, std::string_view who, std::string_view why) {
-  return co_.reset(target, who, why);
+  auto done = co_.reset(target, who, why);
+  if (done && options_.actions != nullptr) options_.actions->reset(target, who, why);
+  return done;
 }
 
 }  // namespace safecass::introspect

@@ -262,12 +262,12 @@ int run_coordinator(const RunArgs& args) {
   // The durable history: opened before anything runs, so it holds every record of the process.
   std::unique_ptr<Recorder> recorder;
   if (!args.record.empty()) {
-    auto opened = Recorder::open(co, args.record, 65536, FileLimits{args.max_bytes});
-    if (!opened) {
-      std::fprintf(stderr, "safecass run: %s\n", opened.error().message.c_str());
+    auto history_file = Recorder::open(co, args.record, 65536, FileLimits{args.max_bytes});
+    if (!history_file) {
+      std::fprintf(stderr, "safecass run: %s\n", history_file.error().message.c_str());
       return 2;
     }
-    recorder = std::move(*opened);
+    recorder = std::move(*history_file);
   }
 
   // The inputs (samples of the local input signals, and the scenario's actions) next to the
@@ -294,6 +294,7 @@ int run_coordinator(const RunArgs& args) {
   std::string token_path;
   std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
   std::unique_ptr<middleware::TokenFile> read_token_file;
+  std::unique_ptr<RecordedActions> recorded_writes;  // outlives the node that calls it
   std::unique_ptr<middleware::CoordinatorNode> node;
   if (!args.ice.empty()) {
     auto endpoint = middleware::parse_ice_endpoint(args.ice);
@@ -332,6 +333,10 @@ int run_coordinator(const RunArgs& args) {
     if (!args.listen.empty()) options.listen_host = args.listen;
     options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
     options.log = [](const std::string& line) { say(line); };
+    if (inputs) {
+      recorded_writes = std::make_unique<RecordedActions>(*inputs);  // console/viewer writes
+      options.clock.actions = recorded_writes.get();
+    }
     auto created = middleware::CoordinatorNode::create(co, monitor, registry, system, args.coordinator, options);
     if (!created) {
       std::fprintf(stderr, "safecass run: %s\n", created.error().message.c_str());

@@ -7,6 +7,7 @@ Usage: live_record_test.py CASE SAFECASS SOURCE_DIR ICESTORM_ENV KEYS_DIR SCRATC
 CASE is one of
   history_holds_the_printed_transitions_and_draws_as_a_timeline
   a_write_error_is_said_and_fails_the_run
+  an_operators_write_over_the_bus_is_recorded_and_replays
 
 The IceStorm is the ctest fixture's (middleware.icestorm_start writes ICESTORM_PORT into
 ICESTORM_ENV); KEYS_DIR holds the robodoc system's bus keys (middleware.keys). Standard library
@@ -18,6 +19,7 @@ import os
 import re
 import subprocess
 import sys
+import time
 
 TRANSITION = re.compile(r"^\[robot\] (\S+) (Normal|Warning|Error) -> (Normal|Warning|Error)(?: (\S+))?(?: \(root (\S+)\))?$")
 
@@ -168,6 +170,61 @@ def a_write_error_is_said_and_fails_the_run(live):
     print("ok: a write error and an uncreatable file are said and fail the run")
 
 
+def an_operators_write_over_the_bus_is_recorded_and_replays(live):
+    # A write from `safecass console --ice --allow-write` is an input of the run: the live
+    # coordinator records it as an action next to its samples, and the replay applies it.
+    history = os.path.join(live.scratch, "operator-history.jsonl")
+    token = os.path.join(live.scratch, "operator.token")
+    for f in (history, token):
+        if os.path.exists(f):
+            os.unlink(f)
+    quiet = os.path.join(live.source, "tests/integration/console_ice/robot_quiet.json")
+    command = [live.binary, "run", os.path.join(live.source, "examples/robodoc/robodoc.json"),
+               "--coordinator", "robot", "--ice", live.ice, "--scenario", quiet, "--duration", "6",
+               "--record", history, "--allow-write", "--token-file", token, "--lost-after", "2000"]
+    robot = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=live.env,
+                             cwd=live.source)
+    try:
+        console = [live.binary, "console", "--ice", live.ice, "--coordinator", "robot", "--allow-write",
+                   "--token-file", token, "-c"]
+        deadline = time.monotonic() + 20
+        while True:
+            done = subprocess.run(console + ["event generate EVT_SERVO_OVERLOAD SERVO.s_A"] if os.path.exists(token)
+                                  else ["false"], capture_output=True, text=True, timeout=30, env=live.env)
+            if done.returncode == 0:
+                break
+            if time.monotonic() > deadline or robot.poll() is not None:
+                fail(f"the console's write never reached the robot: {done.stderr}")
+            time.sleep(0.2)
+        refused = subprocess.run(console + ["event generate EVT_NO_SUCH_EVENT SERVO.s_A"], capture_output=True,
+                                 text=True, timeout=30, env=live.env)
+        if refused.returncode == 0:
+            fail("an unknown event was accepted")
+        done = subprocess.run(console + ["event generate /EVT_SERVO_OVERLOAD SERVO.s_A"], capture_output=True,
+                              text=True, timeout=30, env=live.env)
+        if done.returncode != 0:
+            fail(f"the completion was refused: {done.stderr}")
+        out, err = robot.communicate(timeout=60)
+    finally:
+        if robot.poll() is None:
+            robot.kill()
+            robot.wait()
+    if robot.returncode != 0:
+        fail(f"the robot exited with {robot.returncode}:\n{out}\n{err}")
+    inputs = os.path.join(live.scratch, "operator-history.inputs")
+    done = subprocess.run([live.binary, "replay", os.path.join(live.source, "examples/robodoc/robodoc.json"),
+                           "--input", inputs], capture_output=True, text=True, timeout=60)
+    if done.returncode != 0:
+        fail(f"replay: exit code {done.returncode}: {done.stderr}")
+    if "2 actions" not in done.stderr:
+        fail("the replay did not apply exactly the two accepted writes: " + done.stderr)
+    onset = re.search(r"^t=(\S+)  SERVO\.s_A  Normal -> Warning  EVT_SERVO_OVERLOAD", done.stdout, re.M)
+    completion = re.search(r"^t=(\S+)  SERVO\.s_A  Warning -> Normal  /EVT_SERVO_OVERLOAD", done.stdout, re.M)
+    if not onset or not completion or float(completion.group(1)) < float(onset.group(1)):
+        fail("the replay does not raise and clear the operator's event:\n" + done.stdout)
+    print(f"ok: the operator's two writes were recorded and replay at t={onset.group(1)} and t={completion.group(1)}")
+
+
 def main():
     if len(sys.argv) != 7:
         print(__doc__)
@@ -176,7 +233,9 @@ def main():
     live = Live(os.path.abspath(binary), os.path.abspath(source), env_file, keys, os.path.abspath(scratch))
     {"history_holds_the_printed_transitions_and_draws_as_a_timeline":
          history_holds_the_printed_transitions_and_draws_as_a_timeline,
-     "a_write_error_is_said_and_fails_the_run": a_write_error_is_said_and_fails_the_run}[case](live)
+     "a_write_error_is_said_and_fails_the_run": a_write_error_is_said_and_fails_the_run,
+     "an_operators_write_over_the_bus_is_recorded_and_replays":
+         an_operators_write_over_the_bus_is_recorded_and_replays}[case](live)
     return 0
 
 

@@ -13,9 +13,12 @@
 #include <string>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/record/input_log.hpp"
+#include "safecass/record/input_recorder.hpp"
 #include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
+#include "safecass/runner/system.hpp"
 
 namespace safecass::replay {
 namespace {
@@ -146,6 +149,71 @@ TEST(ReplayRecording, TheRecordingOfARunReplaysToTheSameTransitionsAndTheSameHis
   EXPECT_EQ(r.out, printed);
   EXPECT_EQ(read_text(o.record), read_text(scratch("story.jsonl"))) << "the histories differ";
   EXPECT_EQ(read_text(o.record_inputs), read_text(inputs)) << "the replay's own recording differs";
+}
+
+/// Counts what a LocalQuery tells its observer.
+struct CountedWrites final : introspect::ActionObserver {
+  std::vector<std::string> told;
+  void generated(std::string_view e, std::string_view t) override {
+    told.push_back("generate " + std::string(e) + " " + std::string(t));
+  }
+  void broadcast(std::string_view e) override { told.push_back("broadcast " + std::string(e)); }
+  void injected(std::string_view f, const std::vector<std::vector<double>>&) override {
+    told.push_back("inject " + std::string(f));
+  }
+  void injected_deep(std::string_view s, const std::vector<std::vector<double>>&) override {
+    told.push_back("dinject " + std::string(s));
+  }
+  void reset(std::string_view t, std::string_view, std::string_view) override {
+    told.push_back("reset " + std::string(t));
+  }
+};
+
+TEST(ReadModelWrites, OnlyAWriteThatWasAppliedIsToldToTheActionObserver) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  auto system = runner::open_system(kRobodoc + "robodoc.json", registry);
+  ASSERT_TRUE(system.has_value());
+  CountedWrites observer;
+  introspect::LocalOptions lo;
+  lo.actions = &observer;
+  introspect::LocalQuery query((*system)->coordinator(), (*system)->monitor(), registry, lo);
+  EXPECT_FALSE(query.generate("EVT_NO_SUCH_EVENT", "JR3.s_A").has_value());
+  EXPECT_FALSE(query.inject("no_such_filter", {{1.0}}).has_value());
+  EXPECT_FALSE(query.inject_deep("JR3.NoSuchSignal", {{1.0}}).has_value());
+  EXPECT_TRUE(observer.told.empty()) << "refused writes were told: " << observer.told.size();
+  ASSERT_TRUE(query.generate("EVT_FORCE_ERROR", "JR3.s_A").has_value());
+  ASSERT_TRUE(query.reset("JR3.s_A", "operator", "cleared").has_value());
+  EXPECT_THAT(observer.told, ::testing::ElementsAre("generate EVT_FORCE_ERROR JR3.s_A", "reset JR3.s_A"));
+}
+
+TEST(ReplayRecording, AnOperatorsWritesThroughTheReadModelAreRecordedAsActionsAndReplayAtTheirTimes) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  const std::string path = scratch("operator.inputs");
+  {
+    auto system = runner::open_system(kRobodoc + "robodoc.json", registry);
+    ASSERT_TRUE(system.has_value());
+    SimulatedClock& clock = *(*system)->simulated_clock();
+    auto inputs = InputRecorder::open((*system)->monitor(), path);
+    ASSERT_TRUE(inputs.has_value()) << inputs.error().message;
+    RecordedActions recorded(**inputs);
+    introspect::LocalOptions lo;
+    lo.actions = &recorded;
+    introspect::LocalQuery query((*system)->coordinator(), (*system)->monitor(), registry, lo);
+    clock.set(std::chrono::milliseconds(250));
+    ASSERT_TRUE(query.generate("EVT_FORCE_ERROR", "JR3.s_A").has_value());
+    EXPECT_FALSE(query.generate("EVT_NO_SUCH_EVENT", "JR3.s_A").has_value());  // refused: not recorded
+    clock.set(std::chrono::milliseconds(500));
+    ASSERT_TRUE(query.generate("/EVT_FORCE_ERROR", "JR3.s_A").has_value());
+    (*inputs)->close(std::chrono::milliseconds(600));
+    EXPECT_EQ((*inputs)->status().actions, 2u);
+  }
+  const Ran r = replay(options(kRobodoc + "robodoc.json", path));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("t=0.250000  JR3.s_A  Normal -> Error  EVT_FORCE_ERROR"));
+  EXPECT_THAT(r.out, HasSubstr("t=0.500000  JR3.s_A  Error -> Normal  /EVT_FORCE_ERROR"));
+  EXPECT_THAT(r.err, HasSubstr("2 actions"));
 }
 
 TEST(ReplayCsv, ALogThatCannotBeReadIsAnIoErrorWithThePathAndReason) {

@@ -13,6 +13,7 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/action_observer.hpp"
 #include "safecass/introspect/query.hpp"
 
 namespace safecass::introspect {
@@ -21,9 +22,10 @@ struct LocalOptions {
   std::string name;  ///< what name() answers (default: the coordinator's name)
   /// Simulated (in-process runs) or Host (a live coordinator process on HostClock).
   TimeBase base = TimeBase::Simulated;
-  double period = 0.0;    ///< Simulated: the tick, seconds
-  std::string scenario;   ///< Simulated: the scenario file, if any
-  double duration = 0.0;  ///< Simulated: the scenario's duration, seconds
+  double period = 0.0;                ///< Simulated: the tick, seconds
+  std::string scenario;               ///< Simulated: the scenario file, if any
+  double duration = 0.0;              ///< Simulated: the scenario's duration, seconds
+  ActionObserver* actions = nullptr;  ///< told of every applied write; must outlive the query
 };
 
 class LocalQuery final : public SystemQuery {

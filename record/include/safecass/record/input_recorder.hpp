@@ -38,6 +38,7 @@
 #include <vector>
 
 #include "safecass/filters/monitor.hpp"
+#include "safecass/introspect/action_observer.hpp"
 #include "safecass/record/file_limits.hpp"
 #include "safecass/record/input_log.hpp"
 
@@ -163,6 +164,28 @@ private:
   std::thread poller_;
   bool polling_stop_ = false;
   std::condition_variable poll_wake_;
+};
+
+/// The writes a LocalQuery applies (an operator's console or viewer, over the bus) recorded as
+/// actions next to the inputs, so that a replay applies them at the same times:
+/// `LocalOptions::actions = &recorded` (a live `safecass run --coordinator ... --record`).
+class RecordedActions final : public introspect::ActionObserver {
+public:
+  explicit RecordedActions(InputRecorder& inputs) : inputs_(inputs) {}
+  void generated(std::string_view event, std::string_view target) override { inputs_.generate(event, target); }
+  void broadcast(std::string_view event) override { inputs_.broadcast(event); }
+  void injected(std::string_view filter, const std::vector<std::vector<double>>& samples) override {
+    inputs_.inject_shallow(filter, samples);
+  }
+  void injected_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override {
+    inputs_.inject_deep(signal, samples);
+  }
+  void reset(std::string_view target, std::string_view who, std::string_view why) override {
+    inputs_.reset(target, who, why);
+  }
+
+private:
+  InputRecorder& inputs_;
 };
 
 }  // namespace safecass
