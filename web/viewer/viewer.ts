@@ -328,6 +328,8 @@ class Viewer {
     this.replay = null;
     this.render(m.view);
     byId('replay-bar').hidden = m.view.replay === undefined;
+    // Connected to a replay: what is shown is the recording, not a system running now.
+    if (m.view.replay !== undefined) byId('connection').textContent = 'replay';
     if (m.view.replay !== undefined) this.setReplay(m.view.replay, m.view.t);
     byId('write-panel').hidden = !m.write;
     const list = byId('transitions');

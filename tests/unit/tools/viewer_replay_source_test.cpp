@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/record/input_recorder.hpp"
+#include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/json.hpp"
 #include "safecass/viewer/protocol.hpp"
@@ -231,6 +233,54 @@ TEST_F(RecordedStory, PlayAdvancesWithTheWallClockTimesTheSpeedAndStopsAtTheEnd)
   }
   EXPECT_FALSE(source->replay()->playing);
   EXPECT_NEAR(source->now(), 2.0, 1e-9);
+}
+
+TEST(ViewerReplaySource, ACsvLogShowsAtEveryTickTheStatesSafecassReplayPrintsForIt) {
+  const std::string system = kSource + "/tests/data/replay/arm.json";
+  const std::string log = kSource + "/tests/data/replay/arm_ok.csv";
+  // What `safecass replay --json` prints for the same log: the transitions.
+  replay::ReplayOptions o;
+  o.system = system;
+  o.input = log;
+  o.json = true;
+  std::FILE* out = std::tmpfile();
+  std::FILE* err = std::tmpfile();
+  ASSERT_NE(out, nullptr);
+  o.out = out;
+  o.err = err;
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  ASSERT_EQ(replay::run_replay(o, registry), 0);
+  std::rewind(out);
+  std::vector<std::pair<double, std::string>> transitions;  // ARM.s_A's
+  char line[4096];
+  while (std::fgets(line, sizeof line, out) != nullptr) {
+    const spec::JsonParse p = spec::parse_json(line, 16);
+    if (!p.value || !p.value->is_object()) continue;
+    const spec::JsonValue* kind = p.value->find("kind");
+    const spec::JsonValue* machine = p.value->find("machine");
+    if (kind != nullptr && kind->string == "transition" && machine != nullptr && machine->string == "ARM.s_A")
+      transitions.emplace_back(p.value->find("t")->number, p.value->find("to")->string);
+  }
+  std::fclose(out);
+  std::fclose(err);
+  ASSERT_EQ(transitions.size(), 2u);  // the spike: Error at 0.003 s, Normal at 0.005 s
+
+  ReplaySourceOptions ro;
+  ro.system = system;
+  ro.input = log;
+  auto source = ReplaySource::open(ro);
+  ASSERT_TRUE(source.has_value()) << source.error().message;
+  const ReplayView r = *(*source)->replay();
+  EXPECT_NEAR(r.end, 0.006, 1e-9);
+  for (double t = r.end; t >= r.start - 1e-9; t -= r.period) {  // backwards: each seek starts over
+    seek(**source, t);
+    std::string expected = "Normal";
+    for (const auto& [when, to] : transitions) {
+      if (when <= t + 1e-9) expected = to;
+    }
+    EXPECT_EQ(shown_states(**source)["ARM.s_A"], expected) << "t=" << t;
+  }
 }
 
 TEST(ViewerReplaySource, ABadLogIsRefusedWithFileLineAndTheReason) {
