@@ -316,7 +316,7 @@ TEST_F(RecordedStory, ProtocolCarriesTheReplayAndItsControlsAndGreetsPagesAgainW
   EXPECT_THAT(protocol.handle(R"({"op":"replay","action":"seek","t":1.2})"), HasSubstr("seeking to t=1.200"));
   long long ms = 0;
   std::string pushed;
-  for (int i = 0; i < 100 && source->replay()->busy != ""; ++i) pushed += protocol.update(ms += 10);
+  for (int i = 0; i < 100 && !source->replay()->busy.empty(); ++i) pushed += protocol.update(ms += 10);
   pushed += protocol.update(ms += 10);
   EXPECT_THAT(pushed, HasSubstr(R"("type":"update")"));
   EXPECT_THAT(pushed, HasSubstr(R"("kind":"component-transition")"));
