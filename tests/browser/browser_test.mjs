@@ -124,6 +124,17 @@ async function testViewer() {
   check(/root cause: EVT_FORCE_ERROR at JR3\.s_A/.test(cause), 'the cause names the root: JR3.s_A EVT_FORCE_ERROR');
   check(/filter force_limit/.test(cause) && /JR3\.ForceNorm = /.test(cause), 'the cause names the filter, signal and value');
   check(/JR3\.s_A → .*CONTROL\.s_R\.ForceData/.test(cause), 'the cause shows the hop path');
+  // The graph: every component coloured by its state, and the path of CONTROL's cause lit.
+  check(await page.getAttribute('#graph .gnode[data-component="CONTROL"]', 'data-state') === 'Error',
+    'the graph shows CONTROL in Error');
+  check(await page.getAttribute('#graph .gnode[data-component="BMM"]', 'data-state') === 'Normal',
+    'the graph shows BMM Normal');
+  await page.waitForSelector('#graph-path[data-hops]', { timeout: 5000 });
+  const lit = await page.evaluate(() => [...document.querySelectorAll('#graph .gedge.on-path')].map((e) => `${e.dataset.provided}->${e.dataset.required}`));
+  check(lit.join(' ') === 'JR3.ForceData->CONTROL.ForceData', `the graph lights the path of CONTROL's cause (${lit.join(' ')})`);
+  // A scenario run in-process: scenario seconds, and no replay controls.
+  check(/^t = \d+\.\d{3} s/.test((await page.textContent('#clock')).trim()), 'the clock shows scenario seconds');
+  check(await page.isHidden('#replay-bar'), 'no replay controls on a running system');
   fs.mkdirSync(out, { recursive: true });
   await page.screenshot({ path: path.join(out, 'viewer.png'), fullPage: true });
 

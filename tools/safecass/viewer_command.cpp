@@ -16,6 +16,7 @@
 
 #include "safecass/middleware/token.hpp"
 #include "safecass/viewer/in_process_source.hpp"
+#include "safecass/viewer/replay_source.hpp"
 #include "safecass/viewer/server.hpp"
 #ifdef SAFECASS_WITH_ICE
 #include "safecass/viewer/middleware_source.hpp"
@@ -41,10 +42,39 @@ struct ViewerArgs {
   std::vector<std::string> read_token_files;  ///< --read-token-file COORD=FILE
   std::vector<std::string> token_files;       ///< --token-file COORD=FILE
   bool speed_given = false;
+  std::string replay;   ///< --replay LOG: a recorded input log fed through --system
+  std::string format;   ///< --format of the log
+  std::string mapping;  ///< --mapping: a bag's mapping file
 };
 
 /// The source: the system in this process, or (--ice) the live system through the middleware.
 Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
+  if (!args.replay.empty()) {
+    if (!args.ice.empty() || !args.scenario.empty()) {
+      return fail(ErrorCode::InvalidArgument,
+                  "safecass viewer: --replay shows a recorded log; --scenario and --ice drive a running system");
+    }
+    if (args.allow_write || !args.token_files.empty()) {
+      return fail(ErrorCode::InvalidArgument,
+                  "safecass viewer: a replay is read-only (--allow-write and --token-file are for a running system)");
+    }
+    if (args.system.empty()) {
+      return fail(ErrorCode::InvalidArgument,
+                  "safecass viewer: --replay needs --system SYSTEM, the system file the log is fed through");
+    }
+    viewer::ReplaySourceOptions options;
+    options.system = args.system;
+    options.input = args.replay;
+    options.format = args.format;
+    options.mapping = args.mapping;
+    options.speed = args.speed;
+    auto source = viewer::ReplaySource::open(options);
+    if (!source) return tl::unexpected(source.error());
+    return std::unique_ptr<viewer::ViewSource>(std::move(*source));
+  }
+  if (!args.format.empty() || !args.mapping.empty()) {
+    return fail(ErrorCode::InvalidArgument, "safecass viewer: --format and --mapping describe a --replay log");
+  }
   if (args.ice.empty()) {
     if (!args.token_files.empty()) {
       return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file is for a live system (--ice)");
@@ -157,6 +187,8 @@ int run_viewer(const ViewerArgs& args) {
     std::printf(
         "  write access: the token is in %s (mode 0600): paste it into the page, or open %s#token=<the token>\n",
         token_file->path().c_str(), url.c_str());
+  } else if (!args.replay.empty()) {
+    std::printf("  read-only: a replay; the page's slider plays, pauses and moves it in time\n");
   } else {
     std::printf("  read-only (start with --allow-write to generate, inject and reset)\n");
   }
@@ -188,12 +220,15 @@ void add_viewer_command(CLI::App& app, int& code) {
       "Read-only unless --allow-write: then every write request must carry the token written to a private file "
       "whose path is printed at start. With --ice the system is not run here: the viewer follows the live "
       "coordinators of the --system file through IceStorm (one that does not answer is shown unreachable and "
-      "tried again), and each write goes to the coordinator owning its target with that coordinator's token.");
+      "tried again), and each write goes to the coordinator owning its target with that coordinator's token. With "
+      "--replay LOG the system is fed the recorded inputs in simulated time, as `safecass replay` feeds them, and "
+      "the page moves through the recording with a time slider (--speed: its playing speed).");
   cmd->add_option("--system", args->system, "system file (default: the scenario's \"system\")");
   cmd->add_option("--scenario,-s", args->scenario, "scenario file: timed samples, events, injections and resets");
   cmd->add_option("--port,-p", args->port, "TCP port (0: pick a free one)")->capture_default_str();
   cmd->add_option("--bind", args->bind, "address to listen on")->capture_default_str();
-  cmd->add_option("--speed", args->speed, "simulated seconds per wall-clock second (0 < X <= 1000)")
+  cmd->add_option("--speed", args->speed,
+                  "simulated seconds per wall-clock second (0 < X <= 1000); with --replay, the playing speed")
       ->capture_default_str()
       ->each([args](const std::string&) { args->speed_given = true; });
   cmd->add_option("--keys", args->keys,
@@ -208,6 +243,13 @@ void add_viewer_command(CLI::App& app, int& code) {
   cmd->add_option("--token-file", args->token_files,
                   "COORDINATOR=FILE (repeatable, with --ice): the token file of a coordinator started with "
                   "--allow-write; writes to it carry its token");
+  cmd->add_option("--replay", args->replay,
+                  "a recorded input log (SAFECASS recording, CSV or ROS 1 bag) fed through --system in simulated "
+                  "time; the page gets a time slider (play, pause, speed, seek, next transition); read-only");
+  cmd->add_option("--format", args->format,
+                  "with --replay: recording, csv or bag (default: from the file's first bytes)")
+      ->check(CLI::IsMember({"recording", "csv", "bag"}));
+  cmd->add_option("--mapping", args->mapping, "with --replay of a ROS bag: the ROS extension's mapping file");
   cmd->add_flag("--allow-write", args->allow_write, "accept generate, inject and reset requests that carry the token");
   cmd->add_flag("--open", args->open, "open the page in the desktop's browser (xdg-open)");
   cmd->callback([args, &code] { code = run_viewer(*args); });

@@ -1,8 +1,12 @@
 // The SAFECASS live viewer page: draws coordinators → components → machines from the server's
-// "hello", keeps them current from its "update" pushes, shows the cause of a clicked state
-// ("explain") and, when the viewer was started with --allow-write, sends generate / inject /
-// reset requests carrying the token. The protocol is documented in
-// tools/viewer/include/safecass/viewer/protocol.hpp.
+// "hello", and a graph of the components and their connections (laid out by @dagrejs/dagre);
+// keeps both current from its "update" pushes, shows the cause of a clicked state ("explain")
+// with its hop path highlighted in the graph and, when the viewer was started with
+// --allow-write, sends generate / inject / reset requests carrying the token. A replay
+// (`safecass viewer --replay`) gets a time slider: play, pause, speed, seek, next transition.
+// The protocol is documented in tools/viewer/include/safecass/viewer/protocol.hpp.
+
+import { graphlib, layout } from './dagre.js';
 
 type StateName = 'Normal' | 'Warning' | 'Error';
 
@@ -31,6 +35,23 @@ interface CoordinatorView {
   components: ComponentView[];
 }
 
+interface ConnectionView {
+  required: string;  // "CONTROL.ForceData"
+  provided: string;  // "JR3.ForceData"
+}
+
+/** Scenario seconds, or a live system's host clock shown as wall-clock time. */
+type ClockView = { base: 'simulated' } | { base: 'host'; wall_offset_ms: number };
+
+interface ReplayView {
+  start: number;
+  end: number;
+  period: number;
+  playing: boolean;
+  speed: number;
+  busy: '' | 'seek' | 'next';
+}
+
 interface SystemView {
   system: string;
   description: string;
@@ -38,6 +59,9 @@ interface SystemView {
   running: boolean;
   state: StateName;
   coordinators: CoordinatorView[];
+  connections?: ConnectionView[];
+  clock?: ClockView;
+  replay?: ReplayView;
 }
 
 /** One record of the observer stream (record_to_json's format). */
@@ -80,8 +104,8 @@ interface Condition {
 }
 
 interface Hello { type: 'hello'; write: boolean; max_message: number; view: SystemView; recent: HistoryRecord[] }
-interface Update { type: 'update'; t: number; running: boolean; states: Record<string, [StateName, string]>; records: HistoryRecord[] }
-interface TimeMessage { type: 'time'; t: number; running: boolean }
+interface Update { type: 'update'; t: number; running: boolean; states: Record<string, [StateName, string]>; records: HistoryRecord[]; replay?: ReplayView }
+interface TimeMessage { type: 'time'; t: number; running: boolean; replay?: ReplayView }
 interface Reply {
   type: 'reply';
   id?: number;
@@ -116,9 +140,57 @@ function seconds(t: number | undefined): string {
   return t === undefined ? '–' : t.toFixed(3);
 }
 
+function pad(n: number, width = 2): string {
+  return String(Math.trunc(n)).padStart(width, '0');
+}
+
+/** ISO 8601 in the local zone with milliseconds, as the read model writes a live system's times:
+ *  "2026-03-01T14:02:11.532+01:00". */
+export function iso8601Local(unixMs: number): string {
+  const d = new Date(Math.floor(unixMs));
+  const offset = -d.getTimezoneOffset();  // minutes east of UTC
+  const off = Math.abs(offset);
+  return `${pad(d.getFullYear(), 4)}-${pad(d.getMonth() + 1)}-${pad(d.getDate())}T${pad(d.getHours())}:` +
+    `${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}${offset < 0 ? '-' : '+'}` +
+    `${pad(off / 60)}:${pad(off % 60)}`;
+}
+
+/** The component of an address: "CONTROL.s_R.ForceData" → "CONTROL". */
+function componentOf(address: string): string {
+  const dot = address.indexOf('.');
+  return dot < 0 ? address : address.slice(0, dot);
+}
+
+const kSvg = 'http://www.w3.org/2000/svg';
+
+function svg(tag: string, className: string, attributes: Record<string, string | number> = {}): SVGElement {
+  const el = document.createElementNS(kSvg, tag) as SVGElement;
+  if (className !== '') el.setAttribute('class', className);
+  for (const [k, v] of Object.entries(attributes)) el.setAttribute(k, String(v));
+  return el;
+}
+
+/** The graph edges of a hop path: consecutive hops "P.s_S.p" → "C.s_R.r" cross the connection
+ *  from P's provided interface p to C's required interface r. */
+function pathEdges(path: string[]): { provided: string; required: string }[] {
+  const edges: { provided: string; required: string }[] = [];
+  for (let i = 0; i + 1 < path.length; i += 1) {
+    const from = /^([^.]+)\.s_S\.(.+)$/.exec(path[i]);
+    const to = /^([^.]+)\.s_R\.(.+)$/.exec(path[i + 1]);
+    if (from !== null && to !== null) edges.push({ provided: `${from[1]}.${from[2]}`, required: `${to[1]}.${to[2]}` });
+  }
+  return edges;
+}
+
+type Node = HTMLElement | SVGElement;
+
 class Viewer {
   private socket: WebSocket | null = null;
-  private nodes = new Map<string, HTMLElement[]>();
+  private nodes = new Map<string, Node[]>();
+  private clock: ClockView = { base: 'simulated' };
+  private replay: ReplayView | null = null;
+  private scrubbing = false;
+  private conditions: Condition[] = [];
   private selected = '';
   private nextId = 1;
   private pending = new Map<number, string>();
@@ -153,6 +225,22 @@ class Viewer {
       }
       const kind = byId<HTMLSelectElement>('inject-kind').value === 'signal' ? 'signal' : 'filter';
       this.write({ op: 'inject', [kind]: this.field('inject-target'), samples });
+    });
+    byId('replay-play').addEventListener('click', () => {
+      this.send({ op: 'replay', action: this.replay !== null && this.replay.playing ? 'pause' : 'play' });
+    });
+    byId('replay-next').addEventListener('click', () => this.send({ op: 'replay', action: 'next' }));
+    byId<HTMLSelectElement>('replay-speed').addEventListener('change', (e) => {
+      this.send({ op: 'replay', action: 'speed', speed: Number((e.target as HTMLSelectElement).value) });
+    });
+    const slider = byId<HTMLInputElement>('replay-slider');
+    slider.addEventListener('input', () => {
+      this.scrubbing = true;
+      byId('replay-time').textContent = `${seconds(Number(slider.value))} s`;
+    });
+    slider.addEventListener('change', () => {
+      this.scrubbing = false;
+      this.send({ op: 'replay', action: 'seek', t: Number(slider.value) });
     });
     byId<HTMLFormElement>('reset-form').addEventListener('submit', (e) => {
       e.preventDefault();
@@ -226,14 +314,23 @@ class Viewer {
     switch (m.type) {
       case 'hello': return this.onHello(m);
       case 'update': return this.onUpdate(m);
-      case 'time': return this.setClock(m.t, m.running);
+      case 'time':
+        this.setClock(m.t, m.running);
+        if (m.replay !== undefined) this.setReplay(m.replay, m.t);
+        return;
       case 'reply': return this.onReply(m);
       case 'error': return this.onError(m);
     }
   }
 
   private onHello(m: Hello): void {
+    this.clock = m.view.clock ?? { base: 'simulated' };
+    this.replay = null;
     this.render(m.view);
+    byId('replay-bar').hidden = m.view.replay === undefined;
+    // Connected to a replay: what is shown is the recording, not a system running now.
+    if (m.view.replay !== undefined) byId('connection').textContent = 'replay';
+    if (m.view.replay !== undefined) this.setReplay(m.view.replay, m.view.t);
     byId('write-panel').hidden = !m.write;
     const list = byId('transitions');
     list.replaceChildren();
@@ -243,6 +340,7 @@ class Viewer {
 
   private onUpdate(m: Update): void {
     this.setClock(m.t, m.running);
+    if (m.replay !== undefined) this.setReplay(m.replay, m.t);
     let selectedChanged = false;
     // A state the page has not drawn (a live coordinator now answers with another shape): redraw.
     if (Object.keys(m.states).some((address) => !this.nodes.has(address))) this.send({ op: 'view' });
@@ -263,6 +361,8 @@ class Viewer {
       this.render(m.view);
     } else if (kWriteOps.has(op)) {
       this.showResult(true, m.text ?? 'done');
+    } else if (op === 'replay') {
+      this.showReplayResult(true, m.text ?? 'done');
     }
   }
 
@@ -271,6 +371,8 @@ class Viewer {
     if (m.id !== undefined) this.pending.delete(m.id);
     if (op === 'explain') {
       byId('cause').replaceChildren(element('p', 'result error', m.error));
+    } else if (op === 'replay') {
+      this.showReplayResult(false, m.error);
     } else {
       this.showResult(false, m.error);
     }
@@ -282,8 +384,53 @@ class Viewer {
     result.className = ok ? 'result ok' : 'result error';
   }
 
+  private showReplayResult(ok: boolean, text: string): void {
+    const result = byId('replay-result');
+    result.textContent = text;
+    result.className = ok ? 'result ok' : 'result error';
+  }
+
+  /** A time of the system: scenario seconds, or (a live system) wall-clock time. */
+  private time(t: number | undefined): string {
+    if (t === undefined) return '–';
+    return this.clock.base === 'host' ? iso8601Local(t * 1000 + this.clock.wall_offset_ms) : seconds(t);
+  }
+
   private setClock(t: number, running: boolean): void {
-    byId('clock').textContent = `t = ${seconds(t)} s${running ? '' : ' (no scenario steps left: the system stays up)'}`;
+    const clock = byId('clock');
+    clock.dataset.t = String(t);
+    if (this.clock.base === 'host') {
+      clock.textContent = this.time(t);
+    } else if (this.replay !== null) {
+      clock.textContent = `t = ${seconds(t)} s`;
+    } else {
+      clock.textContent = `t = ${seconds(t)} s${running ? '' : ' (no scenario steps left: the system stays up)'}`;
+    }
+  }
+
+  private setReplay(r: ReplayView, t: number): void {
+    this.replay = r;
+    const slider = byId<HTMLInputElement>('replay-slider');
+    slider.min = String(r.start);
+    slider.max = String(r.end);
+    slider.step = String(r.period > 0 ? r.period : 0.001);
+    if (!this.scrubbing) {
+      slider.value = String(t);
+      byId('replay-time').textContent = `${seconds(t)} s`;
+    }
+    byId('replay-end').textContent = `of ${seconds(r.start)}–${seconds(r.end)} s`;
+    byId('replay-play').textContent = r.playing ? 'Pause' : 'Play';
+    const speed = byId<HTMLSelectElement>('replay-speed');
+    if (document.activeElement !== speed) speed.value = String(r.speed);
+    const bar = byId('replay-bar');
+    bar.dataset.busy = r.busy;
+    bar.dataset.playing = String(r.playing);
+    bar.dataset.t = String(t);
+  }
+
+  private register(address: string, el: Node): void {
+    const list = this.nodes.get(address);
+    if (list === undefined) this.nodes.set(address, [el]); else list.push(el);
   }
 
   private stateNode(address: string, state: StateName, outstanding: string, kind: string, label: string): HTMLElement {
@@ -296,9 +443,90 @@ class Viewer {
     el.append(element('span', 'label', label));
     el.append(element('span', 'event', outstanding));
     el.title = `${address}: ${state}${outstanding !== '' ? ' (' + outstanding + ')' : ''}`;
-    const list = this.nodes.get(address);
-    if (list === undefined) this.nodes.set(address, [el]); else list.push(el);
+    this.register(address, el);
     return el;
+  }
+
+  /** The components as a graph, laid out left to right along their connections (provider →
+   *  client, the way errors propagate), each node coloured by the component's state. */
+  private renderGraph(v: SystemView): void {
+    const root = byId('graph');
+    const g = new graphlib.Graph({ multigraph: true });
+    g.setGraph({ rankdir: 'LR', nodesep: 18, ranksep: 70, marginx: 6, marginy: 6 });
+    g.setDefaultEdgeLabel(() => ({}));
+    const components = new Map<string, ComponentView>();
+    for (const co of v.coordinators) for (const c of co.components) components.set(c.name, c);
+    // Wide enough for the name and for an outstanding event such as EVT_SERVICE_FAILURE.
+    for (const c of components.values()) g.setNode(c.name, { width: Math.max(136, c.name.length * 9 + 28), height: 42 });
+    const connections = (v.connections ?? []).filter((c) =>
+      components.has(componentOf(c.provided)) && components.has(componentOf(c.required)));
+    for (const c of connections) g.setEdge(componentOf(c.provided), componentOf(c.required), { provided: c.provided, required: c.required }, c.required);
+    layout(g);
+    const size = g.graph();
+    const width = Math.ceil(size.width ?? 0);
+    const height = Math.ceil(size.height ?? 0);
+    const drawing = svg('svg', 'graph-drawing', { width, height, viewBox: `0 0 ${width} ${height}`, role: 'img' });
+    const caption = svg('title', '');
+    caption.textContent = `components of ${v.system} and their connections`;
+    drawing.append(caption);
+    const defs = svg('defs', '');
+    const marker = svg('marker', '', { id: 'arrow', viewBox: '0 0 10 10', refX: 9, refY: 5, markerWidth: 9, markerHeight: 9, markerUnits: 'userSpaceOnUse', orient: 'auto-start-reverse' });
+    marker.append(svg('path', 'arrow-head', { d: 'M 0 0 L 10 5 L 0 10 z' }));
+    defs.append(marker);
+    drawing.append(defs);
+    for (const e of g.edges()) {
+      const label = g.edge(e) as { points?: { x: number; y: number }[]; provided?: string; required?: string };
+      const points = label.points ?? [];
+      if (points.length === 0) continue;
+      const d = points.map((p, i) => `${i === 0 ? 'M' : 'L'} ${p.x.toFixed(1)} ${p.y.toFixed(1)}`).join(' ');
+      const edge = svg('path', 'gedge', { d, 'marker-end': 'url(#arrow)' });
+      edge.dataset.provided = label.provided ?? '';
+      edge.dataset.required = label.required ?? '';
+      const title = svg('title', '');
+      title.textContent = `${label.provided ?? ''} → ${label.required ?? ''}`;
+      edge.append(title);
+      drawing.append(edge);
+    }
+    for (const name of g.nodes()) {
+      const n = g.node(name) as { x: number; y: number; width: number; height: number };
+      const c = components.get(name);
+      if (c === undefined) continue;
+      const node = svg('g', `gnode state-${c.state}`, { transform: `translate(${(n.x - n.width / 2).toFixed(1)} ${(n.y - n.height / 2).toFixed(1)})`, tabindex: 0, role: 'button' });
+      node.dataset.address = c.name;
+      node.dataset.component = c.name;
+      node.dataset.state = c.state;
+      node.append(svg('rect', 'gbox', { width: n.width, height: n.height, rx: 5, ry: 5 }));
+      const label = svg('text', 'glabel', { x: n.width / 2, y: 17, 'text-anchor': 'middle' });
+      label.textContent = c.name;
+      const event = svg('text', 'event', { x: n.width / 2, y: 33, 'text-anchor': 'middle' });
+      event.textContent = c.outstanding;
+      node.append(label, event);
+      this.register(c.name, node);
+      drawing.append(node);
+    }
+    root.replaceChildren(drawing);
+    byId('graph-panel').hidden = components.size === 0;
+  }
+
+  /** Highlights the hop path of `c` (from its root to the selected address) in the graph. */
+  private highlight(c: Condition | null): void {
+    for (const el of document.querySelectorAll('#graph .on-path')) el.classList.remove('on-path');
+    const info = byId('graph-path');
+    info.replaceChildren();
+    delete info.dataset.hops;
+    if (c === null) return;
+    const components = new Set(c.path.map(componentOf));
+    for (const el of document.querySelectorAll<SVGElement>('#graph .gnode')) {
+      if (components.has(el.dataset.component ?? '')) el.classList.add('on-path');
+    }
+    for (const e of pathEdges(c.path)) {
+      for (const el of document.querySelectorAll<SVGElement>('#graph .gedge')) {
+        if (el.dataset.provided === e.provided && el.dataset.required === e.required) el.classList.add('on-path');
+      }
+    }
+    info.dataset.hops = JSON.stringify(c.path);
+    info.append(element('span', 'hint', `path of ${c.machine} (${c.root_origin}:${c.root_event}): `),
+      element('span', 'address', c.path.join(' → ')));
   }
 
   private render(v: SystemView): void {
@@ -333,6 +561,7 @@ class Viewer {
       }
       model.append(box);
     }
+    this.renderGraph(v);
     if (this.selected !== '') this.markSelected();
   }
 
@@ -344,9 +573,9 @@ class Viewer {
       el.dataset.state = state;
       const event = el.querySelector('.event');
       if (event !== null) event.textContent = outstanding;
-      el.title = `${address}: ${state}${outstanding !== '' ? ' (' + outstanding + ')' : ''}`;
+      if (el instanceof HTMLElement) el.title = `${address}: ${state}${outstanding !== '' ? ' (' + outstanding + ')' : ''}`;
       if (address === 'SYSTEM') el.textContent = `SYSTEM ${state}`;
-      if (!before) {
+      if (!before && el instanceof HTMLElement) {
         el.classList.remove('flash');
         void el.offsetWidth;  // restart the animation
         el.classList.add('flash');
@@ -357,7 +586,7 @@ class Viewer {
   private addTransition(r: HistoryRecord): void {
     const list = byId('transitions');
     const item = element('li', `kind-${r.kind}`);
-    item.append(element('span', 't', seconds(r.t)));
+    item.append(element('span', 't', this.time(r.t)));
     const where = r.machine ?? r.component ?? r.coordinator ?? '';
     let text: string;
     switch (r.kind) {
@@ -383,6 +612,11 @@ class Viewer {
   }
 
   private onClick(e: MouseEvent): void {
+    const condition = e.target instanceof Element ? e.target.closest<HTMLElement>('[data-condition]') : null;
+    if (condition !== null) {
+      this.highlight(this.conditions[Number(condition.dataset.condition)] ?? null);
+      return;
+    }
     const target = e.target instanceof Element ? e.target.closest<HTMLElement>('[data-address]') : null;
     if (target === null || target.dataset.address === undefined) return;
     this.select(target.dataset.address);
@@ -396,13 +630,16 @@ class Viewer {
   }
 
   private markSelected(): void {
-    for (const el of document.querySelectorAll('.state.selected')) el.classList.remove('selected');
+    for (const el of document.querySelectorAll('.state.selected, .gnode.selected')) el.classList.remove('selected');
     for (const el of this.nodes.get(this.selected) ?? []) el.classList.add('selected');
   }
 
   private showCause(address: string, state: StateName, conditions: Condition[]): void {
     const box = byId('cause');
     box.replaceChildren();
+    this.conditions = conditions;
+    // The path shown in the graph: the outstanding condition's (what the state is because of).
+    this.highlight(conditions.find((c) => c.outstanding) ?? conditions[0] ?? null);
     if (conditions.length === 0) {
       box.append(element('p', 'hint', `${address} is ${state}: no active condition.`));
       return;
@@ -410,17 +647,21 @@ class Viewer {
     box.append(element('p', 'hint', `${address} is ${state}: ${conditions.length} active condition${conditions.length === 1 ? '' : 's'}.`));
     for (const c of conditions) {
       const item = element('div', `condition level-${c.level}`);
+      item.dataset.condition = String(this.conditions.indexOf(c));
+      item.title = 'show its path in the graph';
       const flags = [c.outstanding ? 'outstanding' : '', c.mirror ? 'mirrored' : ''].filter((f) => f !== '').join(', ');
       item.append(element('div', 'head', `${c.machine}: ${c.event} (${c.level}, severity ${c.severity}${flags !== '' ? ', ' + flags : ''})`));
-      let root = `root cause: ${c.root_event} at ${c.root_origin}, t=${seconds(c.root_t)}`;
+      const at = this.clock.base === 'host' ? ' at ' : ', t=';
+      let root = `root cause: ${c.root_event} at ${c.root_origin}${at}${this.time(c.root_t)}`;
       if (c.filter !== undefined) root += `; filter ${c.filter}`;
-      if (c.signal !== undefined) root += `, ${c.signal} = ${c.value ?? ''} at t=${seconds(c.sample_t)}`;
+      if (c.signal !== undefined) root += `, ${c.signal} = ${c.value ?? ''}${this.clock.base === 'host' ? ' at ' : ' at t='}${this.time(c.sample_t)}`;
       if (c.injected === true) root += ' (injected)';
       if (c.hazard !== undefined) root += `; hazard ${c.hazard}`;
       item.append(element('div', 'root', root));
       item.append(element('div', 'path', c.path.join(' → ')));
       // A live coordinator's explain does not carry the counts (count 0): no line then.
-      if (c.count > 0) item.append(element('div', 'meta hint', `since t=${seconds(c.first)}, seen ${c.count}×, last t=${seconds(c.last)}`));
+      const t = this.clock.base === 'host' ? '' : 't=';
+      if (c.count > 0) item.append(element('div', 'meta hint', `since ${t}${this.time(c.first)}, seen ${c.count}×, last ${t}${this.time(c.last)}`));
       box.append(item);
     }
   }

@@ -239,6 +239,28 @@ async function test() {
   await page.waitForFunction(() => /root cause/.test(document.getElementById('cause').textContent), null, { timeout: 5000 }).catch(() => {});
   const cause = await page.textContent('#cause');
   check(/root cause: EVT_FORCE_ERROR at JR3\.s_A/.test(cause), `the cause of PENDANT names JR3.s_A EVT_FORCE_ERROR (${cause.slice(0, 200)})`);
+
+  // A live system's times are wall-clock time, ISO 8601 in the local zone with milliseconds, as
+  // the read model's formatter writes them (not seconds since the host booted): the clock, the
+  // transition list and the cause.
+  const iso = /\d{4}-\d{2}-\d{2}T\d{2}:\d{2}:\d{2}\.\d{3}[+-]\d{2}:\d{2}/;
+  const near = (text) => {
+    const m = iso.exec(text);
+    return m !== null && Math.abs(Date.parse(m[0]) - Date.now()) < 120000;
+  };
+  const clockText = (await page.textContent('#clock')).trim();
+  check(near(clockText), `the page's clock is wall-clock time (${clockText})`);
+  const firstTime = (await page.textContent('#transitions li .t')).trim();
+  check(iso.test(firstTime) && near(firstTime), `a transition's time is wall-clock time (${firstTime})`);
+  check(/root cause: EVT_FORCE_ERROR at JR3\.s_A at \d{4}-/.test(cause), "the cause's root time is wall-clock time");
+  // The page's text is the formatter's, in the zone of the host: "+01:00", never "Z".
+  const offset = -new Date().getTimezoneOffset();
+  const zone = `${offset < 0 ? '-' : '+'}${String(Math.trunc(Math.abs(offset) / 60)).padStart(2, '0')}:${String(Math.abs(offset) % 60).padStart(2, '0')}`;
+  check(clockText.endsWith(zone), `the clock is in the local zone (${zone})`);
+  // The graph: a node per component of both processes, coloured by state.
+  check(await page.getAttribute('#graph .gnode[data-component="PENDANT"]', 'data-state') === 'Error',
+    'the graph shows PENDANT (ui process) in Error');
+  check(await page.locator('#graph .gedge').count() === 4, 'the graph has the four connections of robodoc.json');
   fs.mkdirSync(out, { recursive: true });
   await page.screenshot({ path: path.join(out, 'viewer_ice.png'), fullPage: true });
 
@@ -275,6 +297,7 @@ async function test() {
   await page.waitForSelector('#write-result.ok, #write-result.error', { timeout: 5000 });
   const result = await page.textContent('#write-result');
   check(/generated \/EVT_FORCE_ERROR on JR3\.s_A \(coordinator robot\)/.test(result), `the page's write goes to robot (${result})`);
+  check(near(result), `the write says when in wall-clock time (${result})`);
   // Each coordinator is polled by its own thread: PENDANT (ui) can reach the page before CONTROL
   // and JR3 (robot) do, so wait for all of them, not for PENDANT alone.
   const cleared = ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM'];

@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -129,6 +130,26 @@ TEST(ViewerMiddlewareSource, CoordinatorsThatDoNotAnswerAreShownUnreachableWithT
   auto done = s.generate("EVT_FORCE_ERROR", "JR3.s_A");
   ASSERT_FALSE(done.has_value());
   EXPECT_THAT(done.error().message, HasSubstr("read-only"));
+}
+
+TEST(ViewerMiddlewareSource, ALiveSystemsTimesAreTheHostClockShownAsWallClockTimeWithItsConnections) {
+  auto source = MiddlewareSource::open(options_for(closed_port()));
+  ASSERT_TRUE(source.has_value()) << source.error().message;
+  const SystemView v = (*source)->view();
+  EXPECT_TRUE(v.host_clock);
+  // Wall-clock time of the host clock's now = now + offset: the system clock's now, give or take.
+  const auto wall =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+  const auto shown = static_cast<std::int64_t>((*source)->now() * 1e9) + v.wall_offset_ns;
+  EXPECT_LT(std::abs(wall - shown), 1'000'000'000LL)
+      << "the page would show a time " << (wall - shown) / 1000000 << " ms away from the wall clock";
+  // The page says so: a "host" clock with the offset in milliseconds (ISO 8601 on the page).
+  Protocol protocol(**source, ProtocolOptions{});
+  EXPECT_THAT(protocol.view_json(), HasSubstr(R"("clock":{"base":"host","wall_offset_ms":)"));
+  // The graph's edges: every connection of the system file.
+  ASSERT_FALSE(v.connections.empty());
+  EXPECT_EQ(v.connections[0].required, "CONTROL.ForceData");
+  EXPECT_EQ(v.connections[0].provided, "JR3.ForceData");
 }
 
 TEST(ViewerMiddlewareSource, WritesNeedTheTokenOfTheCoordinatorThatOwnsTheTarget) {

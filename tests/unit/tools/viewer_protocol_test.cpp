@@ -332,6 +332,23 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   EXPECT_THAT(str(shallow, "text"), HasSubstr("queued 2 samples into filter force_limit"));
 }
 
+TEST(ViewerProtocol, ViewCarriesTheConnectionsForTheGraphAndScenarioSecondsAsItsClock) {
+  auto source = open_story();
+  ASSERT_NE(source, nullptr);
+  Protocol protocol(*source, ProtocolOptions{});
+  const spec::JsonValue view = parse(protocol.view_json());
+  const spec::JsonValue* connections = view.find("connections");
+  ASSERT_NE(connections, nullptr);
+  ASSERT_EQ(connections->array.size(), 4u);  // as robodoc.json lists them
+  EXPECT_EQ(str(connections->array[2], "required"), "SERVO.Command");
+  EXPECT_EQ(str(connections->array[2], "provided"), "CONTROL.Command");
+  EXPECT_EQ(str(*view.find("clock"), "base"), "simulated");  // a simulated run keeps scenario seconds
+  EXPECT_EQ(view.find("replay"), nullptr);                   // not a replay
+  const std::string refused = protocol.handle(R"({"op":"replay","action":"play"})");
+  EXPECT_THAT(refused, HasSubstr(R"("type":"error")"));
+  EXPECT_THAT(refused, HasSubstr("not a replay"));
+}
+
 TEST(ViewerInProcessSource, OpenReportsWhatIsMissingOrWrong) {
   InProcessOptions none;
   none.log = nullptr;

@@ -138,6 +138,16 @@ TEST(ViewerServer, ServesTheEmbeddedPageAndTheViewOnLoopback) {
   EXPECT_THAT(js.type, HasSubstr("text/javascript"));
   EXPECT_THAT(js.body, HasSubstr("new WebSocket"));
   EXPECT_EQ(get(viewer.port(), "/viewer.css").status, 200u);
+  // The graph's layout library, beside the page (the page imports ./dagre.js), and its licence.
+  EXPECT_THAT(page.body, HasSubstr(R"(id="graph")"));
+  EXPECT_THAT(js.body, HasSubstr("from './dagre.js'"));
+  const Response dagre = get(viewer.port(), "/dagre.js");
+  EXPECT_EQ(dagre.status, 200u);
+  EXPECT_THAT(dagre.type, HasSubstr("text/javascript"));
+  EXPECT_THAT(dagre.body, HasSubstr("export{"));
+  const Response licence = get(viewer.port(), "/dagre.esm.js.LEGAL.txt");
+  EXPECT_EQ(licence.status, 200u);
+  EXPECT_THAT(licence.body, HasSubstr("Permission is hereby granted"));
   const Response view = get(viewer.port(), "/api/view", "localhost:" + std::to_string(viewer.port()));
   EXPECT_EQ(view.status, 200u);
   EXPECT_THAT(view.type, HasSubstr("application/json"));

@@ -182,13 +182,21 @@ struct Window {
   Time to = Time::max();
 };
 
+/// What the first pass learns of the inputs in the window: the first and the last one's time
+/// (nullopt for none) and the recorded run's last tick, when the log says.
+struct LogSpan {
+  std::optional<Time> first;
+  std::optional<Time> last;
+  std::optional<Time> end;
+};
+
 /// The first pass: reads the whole log, checking what the source checks and every action.
-/// Returns the time of the first input fed (or nullopt for an empty log); false on error.
-bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, std::optional<Time>& first, std::FILE* err) {
+/// Fills `span`; false on error.
+bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, LogSpan& span, std::FILE* err) {
   for (;;) {
     const Item item = src.next();
     switch (item.kind) {
-      case Item::Kind::End: return true;
+      case Item::Kind::End: span.end = src.end(); return true;
       case Item::Kind::Error: std::fprintf(err, "%s\n", src.error().c_str()); return false;
       case Item::Kind::Action:
         if (const std::string why = check_action(r, *item.action); !why.empty()) {
@@ -197,7 +205,10 @@ bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, std::option
         }
         [[fallthrough]];
       case Item::Kind::Sample:
-        if (item.time >= w.from && item.time <= w.to && !first) first = item.time;
+        if (item.time >= w.from && item.time <= w.to) {
+          if (!span.first) span.first = item.time;
+          span.last = item.time;
+        }
         break;
     }
   }
@@ -205,7 +216,7 @@ bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, std::option
 
 /// Opens, binds and checks the log against `r`; then opens it again, bound, for feeding.
 std::unique_ptr<InputSource> prepare_log(const ReplayOptions& o, const std::string& format, ScenarioRunner& r,
-                                         const Window& w, std::optional<Time>& first) {
+                                         const Window& w, LogSpan& span) {
   auto check = open_input(o, format);
   if (!check) {
     std::fprintf(o.err, "%s\n", check.error().message.c_str());
@@ -215,7 +226,7 @@ std::unique_ptr<InputSource> prepare_log(const ReplayOptions& o, const std::stri
     std::fprintf(o.err, "%s\n", b.error().message.c_str());
     return nullptr;
   }
-  if (!check_log(**check, r, w, first, o.err)) return nullptr;
+  if (!check_log(**check, r, w, span, o.err)) return nullptr;
   auto feed = open_input(o, format);
   if (!feed) {
     std::fprintf(o.err, "%s\n", feed.error().message.c_str());
@@ -307,9 +318,17 @@ void print_notes(const InputSource& src, std::FILE* err) {
   for (const std::string& n : src.notes()) std::fprintf(err, "note: %s\n", n.c_str());
 }
 
-}  // namespace
+/// A replay ready to run: the system opened, the log checked and opened again for feeding.
+struct Prepared {
+  std::unique_ptr<ScenarioRunner> runner;
+  std::unique_ptr<InputSource> src;
+  Window window;
+  LogSpan span;
+};
 
-int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
+/// Opens `o.system` and checks `o.input` against it; says what is wrong on `o.err` and returns
+/// nullopt on bad input.
+std::optional<Prepared> prepare(const ReplayOptions& o, const FilterRegistry& registry) {
   const std::string format = o.format.empty() ? sniff(o.input) : o.format;
   // The period: asked for, else the recording's, else the system's smallest component period.
   std::optional<Time> period;
@@ -319,12 +338,24 @@ int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
       period = (*reader)->header().period;
     }
   }
-  auto r = open_system(o.system, period, o.input, registry, o.err);
-  if (!r) return 2;
-  const Window w = window_of(o);
-  std::optional<Time> first;
-  auto src = prepare_log(o, format, *r, w, first);
-  if (!src) return 2;
+  Prepared p;
+  p.runner = open_system(o.system, period, o.input, registry, o.err);
+  if (!p.runner) return std::nullopt;
+  p.window = window_of(o);
+  p.src = prepare_log(o, format, *p.runner, p.window, p.span);
+  if (!p.src) return std::nullopt;
+  return p;
+}
+
+}  // namespace
+
+int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
+  std::optional<Prepared> prepared = prepare(o, registry);
+  if (!prepared) return 2;
+  auto& r = prepared->runner;
+  auto& src = prepared->src;
+  const Window& w = prepared->window;
+  const std::optional<Time>& first = prepared->span.first;
 
   runner::RunOptions ro;
   ro.json = o.json;
@@ -463,13 +494,14 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   auto b = open_system(system_b, seconds_to_time(a->scenario().period), o.input, registry, o.err);
   if (!b) return 2;
   const Window w = window_of(o);
-  std::optional<Time> first;
+  LogSpan span;
   {  // The log must fit SYSTEM_B too.
-    std::optional<Time> unused;
+    LogSpan unused;
     if (!prepare_log(o, format, *b, w, unused)) return 2;
   }
-  auto src = prepare_log(o, format, *a, w, first);
+  auto src = prepare_log(o, format, *a, w, span);
   if (!src) return 2;
+  const std::optional<Time>& first = span.first;
   // Each input signal of A, as B's signal of the same name.
   std::unordered_map<const Signal*, Signal*> map;
   for (const std::string& name : input_signal_names(a->monitor())) {
@@ -593,5 +625,96 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   }
   return addresses == 0 ? 0 : 1;
 }
+
+// ---- ReplaySession ----------------------------------------------------------------------------
+
+struct ReplaySession::Impl {
+  Prepared p;
+  std::unique_ptr<Feeder> feeder;
+  runner::RunResult result;
+  Time start{}, end{}, period{};
+};
+
+ReplaySession::ReplaySession(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+
+ReplaySession::~ReplaySession() {
+  if (impl_ && impl_->p.runner) impl_->p.runner->finish(impl_->result);
+}
+
+Expected<std::unique_ptr<ReplaySession>> ReplaySession::open(const ReplayOptions& options,
+                                                             const FilterRegistry& registry) {
+  // The errors run_replay() prints, collected: the same code says them.
+  char* text = nullptr;
+  std::size_t size = 0;
+  std::FILE* err = ::open_memstream(&text, &size);
+  if (err == nullptr)
+    return fail(ErrorCode::Io, std::string("cannot collect the replay's errors: ") + std::strerror(errno));
+  ReplayOptions o = options;
+  o.err = err;
+  o.json = false;
+  o.record.clear();
+  std::optional<Prepared> prepared = prepare(o, registry);
+  std::fclose(err);
+  std::string errors(text != nullptr ? text : "", size);
+  std::free(text);
+  if (!prepared) {
+    while (!errors.empty() && errors.back() == '\n') errors.pop_back();
+    if (errors.empty()) errors = "cannot replay " + options.input + " through " + options.system;
+    return fail(ErrorCode::Parse, errors);
+  }
+  auto impl = std::make_unique<Impl>();
+  impl->p = std::move(*prepared);
+  ScenarioRunner& r = *impl->p.runner;
+  const Window& w = impl->p.window;
+  const LogSpan& span = impl->p.span;
+  impl->period = seconds_to_time(r.scenario().period);
+  impl->start = start_of(*impl->p.src, span.first, w);
+  r.start_at(impl->start);
+  // The first tick, as start_at() rounds it: the first multiple of the period at or after start.
+  const auto ticks_to = [&](Time t) {
+    const auto n = (t.count() + impl->period.count() - 1) / impl->period.count();
+    return Time{n * impl->period.count()};
+  };
+  impl->start = ticks_to(impl->start);
+  // run_replay() ticks until the last input is fed, then on to the recording's end (else the last
+  // input), never past --to.
+  Time end = span.end.value_or(span.last.value_or(impl->start));
+  if (end > w.to) end = w.to;
+  if (span.last && ticks_to(*span.last) > end) end = ticks_to(*span.last);
+  impl->end = std::max(end, impl->start);
+  runner::RunOptions quiet;
+  quiet.quiet = true;
+  quiet.inputs_path = "-";
+  if (!r.begin(quiet, impl->result)) {
+    std::string why;
+    for (const std::string& f : impl->result.failures) why += (why.empty() ? "" : "\n") + f;
+    return fail(ErrorCode::Io, why);
+  }
+  impl->feeder = std::make_unique<Feeder>(*impl->p.src, w);
+  Feeder* feeder = impl->feeder.get();
+  r.set_feed([feeder, &r](Time now) { feeder->feed(now, r, nullptr, nullptr); });
+  return std::unique_ptr<ReplaySession>(new ReplaySession(std::move(impl)));
+}
+
+ScenarioRunner& ReplaySession::runner() noexcept { return *impl_->p.runner; }
+const ScenarioRunner& ReplaySession::runner() const noexcept { return *impl_->p.runner; }
+Time ReplaySession::start() const noexcept { return impl_->start; }
+Time ReplaySession::end() const noexcept { return impl_->end; }
+Time ReplaySession::period() const noexcept { return impl_->period; }
+
+Time ReplaySession::now() const noexcept {
+  const Time t = impl_->p.runner->now();
+  return t < impl_->start ? impl_->start - impl_->period : t;
+}
+
+void ReplaySession::advance_to(Time t) {
+  if (t > impl_->end) t = impl_->end;
+  if (t <= impl_->p.runner->now()) return;
+  impl_->p.runner->advance_to(t, impl_->result);
+}
+
+std::uint64_t ReplaySession::samples() const noexcept { return impl_->feeder->fed(); }
+std::uint64_t ReplaySession::actions() const noexcept { return impl_->feeder->actions(); }
+std::vector<std::string> ReplaySession::notes() const { return impl_->p.src->notes(); }
 
 }  // namespace safecass::replay

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "local_view.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/json.hpp"
@@ -14,7 +15,6 @@
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
-#include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer {
 
@@ -56,7 +56,8 @@ struct InProcessSource::Impl {
   InProcessOptions options;
   std::string system_name;
   std::string description;
-  std::vector<std::pair<std::string, std::vector<ComponentId>>> coordinators;
+  detail::Coordinators coordinators;
+  std::vector<ConnectionView> connections;
   Time duration{};
   Time tick{};
   // Real-time driving: simulated time = base_sim + (wall - base_wall) * speed.
@@ -85,14 +86,6 @@ struct InProcessSource::Impl {
       if (options.log != nullptr) std::fprintf(options.log, "%s\n", result.failures[failures_reported].c_str());
     }
   }
-
-  /// The components of a coordinator of the system file, or of every coordinator for "SYSTEM".
-  const std::vector<ComponentId>* coordinator_components(std::string_view name) const {
-    for (const auto& [n, ids] : coordinators) {
-      if (n == name) return &ids;
-    }
-    return nullptr;
-  }
 };
 
 InProcessSource::InProcessSource(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -115,35 +108,21 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   impl->system_name = loaded.name;
   impl->duration = seconds_to_time(scenario.duration);
   impl->tick = seconds_to_time(scenario.period);
-  const auto& spec_coordinators = loaded.coordinators;
-  std::vector<std::string> all_components;
-  for (const spec::ComponentSpec& c : loaded.components) all_components.push_back(c.name);
   impl->description = "in-process: " + file_name(scenario.system) +
                       (options.scenario.empty() ? std::string() : ", scenario " + file_name(options.scenario));
   char speed[32];
   std::snprintf(speed, sizeof speed, "%g", options.speed);
   impl->description += std::string(", speed ") + speed;
 
-  Coordinator& co = impl->co();
-  auto ids_of = [&co](const std::vector<std::string>& names) {
-    std::vector<ComponentId> ids;
-    for (const std::string& n : names) {
-      if (auto id = co.find_component(n)) ids.push_back(*id);
-    }
-    return ids;
-  };
-  if (spec_coordinators.empty()) {
-    impl->coordinators.emplace_back(std::string(co.name()), ids_of(all_components));
-  } else {
-    for (const auto& [name, components] : spec_coordinators) impl->coordinators.emplace_back(name, ids_of(components));
-  }
+  impl->coordinators = detail::coordinators_of(loaded, impl->co());
 
   introspect::LocalOptions local;
   local.name = impl->system_name;
   local.period = to_seconds(impl->tick);
   local.scenario = options.scenario;
   local.duration = to_seconds(impl->duration);
-  impl->query = std::make_unique<introspect::LocalQuery>(co, impl->runner->monitor(), impl->registry, local);
+  impl->query = std::make_unique<introspect::LocalQuery>(impl->co(), impl->runner->monitor(), impl->registry, local);
+  impl->connections = detail::local_connections(*impl->query);
   Impl* self = impl.get();
   auto following = impl->query->follow([self](const introspect::HistoryEntry& e) {
     if (self->pending.size() >= kMaxPendingRecords) {
@@ -179,21 +158,11 @@ double InProcessSource::now() const { return to_seconds(impl_->now()); }
 bool InProcessSource::running() const { return impl_->now() < impl_->duration; }
 
 SystemView InProcessSource::view() const {
-  SystemView v;
+  SystemView v = detail::local_view(*impl_->query, impl_->coordinators, impl_->connections);
   v.system = impl_->system_name;
   v.description = impl_->description;
   v.t = now();
   v.running = running();
-  for (const auto& [name, ids] : impl_->coordinators) {
-    std::vector<introspect::StateRow> rows;
-    for (const ComponentId id : ids) {
-      std::vector<introspect::StateRow> part = impl_->query->component_rows(id);
-      rows.insert(rows.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
-    }
-    CoordinatorView cv = coordinator_view(name, rows);
-    v.state = std::max(v.state, cv.state);
-    v.coordinators.push_back(std::move(cv));
-  }
   return v;
 }
 
@@ -211,22 +180,7 @@ std::vector<std::string> InProcessSource::take_records() {
 }
 
 Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view address) const {
-  const Coordinator& co = impl_->co();
-  if (address.substr(0, 12) == "coordinator:") {
-    const std::string_view name = address.substr(12);
-    const auto* ids = impl_->coordinator_components(name);
-    if (ids == nullptr) return fail(ErrorCode::NotFound, "no coordinator '" + std::string(name) + "'");
-    std::vector<Explanation> all;
-    for (const ComponentId id : *ids) {
-      auto part = impl_->query->explain(co.component_name(id));
-      if (!part) return tl::unexpected(part.error());
-      all.insert(all.end(), part->conditions.begin(), part->conditions.end());
-    }
-    return all;
-  }
-  auto answer = impl_->query->explain(address);
-  if (!answer) return tl::unexpected(answer.error());
-  return std::move(answer->conditions);
+  return detail::local_explain(*impl_->query, impl_->co(), impl_->coordinators, address);
 }
 
 Expected<std::string> InProcessSource::generate(std::string_view event, std::string_view target) {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdio>
 #include <mutex>
@@ -37,7 +38,13 @@ double host_seconds() {
 }
 
 /// Seconds to the millisecond, in the confirmations of writes.
-std::string seconds_text(double t) { return fmt::format("{:.3f}", t); }
+/// When a write was done, as a live system's times are shown: wall-clock time, ISO 8601 in the
+/// local zone with milliseconds (the read model's formatter).
+std::string wall_now() {
+  return introspect::iso8601_local(
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
+          .count());
+}
 
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
@@ -77,6 +84,7 @@ struct MiddlewareSource::Impl {
   FilterRegistry registry;  // outlives the local monitors
   std::string system_name;
   std::string description;
+  std::vector<ConnectionView> connections;  ///< from the system file
   std::vector<std::unique_ptr<MiddlewareLink>> links;
 
   mutable std::mutex mutex;
@@ -299,6 +307,7 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
                     ") has no \"coordinators\": it runs as one process; view it in-process (--system without --ice)");
   }
   impl->system_name = system.name;
+  for (const spec::ConnectionSpec& c : system.connections) impl->connections.push_back({c.required, c.provided});
   std::string names;
   for (const auto& [name, components] : system.coordinators) {
     auto l = std::make_unique<MiddlewareLink>();
@@ -383,6 +392,12 @@ SystemView MiddlewareSource::view() const {
   v.description = impl_->description;
   v.t = now();
   v.running = running();
+  v.connections = impl_->connections;
+  // The records' times are the host's monotonic clock (host_seconds()): shown as wall-clock time.
+  v.host_clock = true;
+  v.wall_offset_ns = (std::chrono::duration_cast<Time>(std::chrono::system_clock::now().time_since_epoch()) -
+                      std::chrono::duration_cast<Time>(std::chrono::steady_clock::now().time_since_epoch()))
+                         .count();
   for (const auto& l : impl_->links) {
     CoordinatorView cv = coordinator_view(l->name, l->shown_rows);
     cv.status = l->shown_status;
@@ -452,7 +467,7 @@ Expected<std::string> MiddlewareSource::generate(std::string_view event, std::st
   if (!w) return tl::unexpected(w.error());
   if (auto r = w->second->generate(std::string(event), std::string(target)); !r) return tl::unexpected(r.error());
   return "generated " + std::string(event) + " on " + std::string(target) + " (coordinator " + w->first->name +
-         ") at t=" + seconds_text(now());
+         ") at " + wall_now();
 }
 
 Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
@@ -470,7 +485,7 @@ Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
     }
     done += (done.empty() ? "" : ", ") + l->name;
   }
-  return "broadcast " + std::string(event) + " on coordinators " + done + " at t=" + seconds_text(now()) + failed;
+  return "broadcast " + std::string(event) + " on coordinators " + done + " at " + wall_now() + failed;
 }
 
 Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
@@ -494,7 +509,7 @@ Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
                         : w->second->inject(request.target, request.samples);
   if (!r) return tl::unexpected(r.error());
   return (request.deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + request.target +
-         " (coordinator " + owner->name + ") at t=" + seconds_text(now());
+         " (coordinator " + owner->name + ") at " + wall_now();
 }
 
 Expected<std::string> MiddlewareSource::reset(std::string_view target, std::string_view reason) {
@@ -509,13 +524,13 @@ Expected<std::string> MiddlewareSource::reset(std::string_view target, std::stri
                                         (done.empty() ? "" : " (reset done on " + done + ")"));
       done += (done.empty() ? "" : ", ") + l->name;
     }
-    return "reset SYSTEM (coordinators " + done + ") at t=" + seconds_text(now()) + " (" + std::string(reason) + ")";
+    return "reset SYSTEM (coordinators " + done + ") at " + wall_now() + " (" + std::string(reason) + ")";
   }
   auto w = impl_->writer(target, "reset");
   if (!w) return tl::unexpected(w.error());
   if (auto r = w->second->reset(std::string(target), "viewer", std::string(reason)); !r)
     return tl::unexpected(r.error());
-  return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at t=" + seconds_text(now()) + " (" +
+  return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at " + wall_now() + " (" +
          std::string(reason) + ")";
 }
 

@@ -4,8 +4,11 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <set>
 #include <utility>
+
+#include <fmt/format.h>
 
 #include "safecass/introspect/json.hpp"
 #include "safecass/spec/json.hpp"
@@ -56,7 +59,28 @@ StateMap states_of(const SystemView& v) {
   return m;
 }
 
-std::string view_to_json(const SystemView& v) {
+std::string replay_json(const ReplayView& r) {
+  return Object()
+      .raw("start", seconds(r.start))
+      .raw("end", seconds(r.end))
+      .raw("period", seconds(r.period))
+      .boolean("playing", r.playing)
+      .num("speed", r.speed)
+      .str("busy", r.busy)
+      .text();
+}
+
+/// How the page shows times: scenario seconds, or (a live system) wall-clock time, the host
+/// clock's time + the offset, in milliseconds since the Unix epoch.
+std::string clock_json(const SystemView& v) {
+  if (!v.host_clock) return Object().str("base", "simulated").text();
+  return Object()
+      .str("base", "host")
+      .raw("wall_offset_ms", fmt::format("{}.{:06d}", v.wall_offset_ns / 1000000, std::abs(v.wall_offset_ns % 1000000)))
+      .text();
+}
+
+std::string view_to_json(const SystemView& v, const std::optional<ReplayView>& replay) {
   const std::string coordinators = array(v.coordinators, [](const CoordinatorView& co) {
     const std::string components = array(co.components, [](const ComponentView& c) {
       const std::string machines = array(c.machines, [](const MachineView& m) {
@@ -84,14 +108,20 @@ std::string view_to_json(const SystemView& v) {
         .raw("components", components)
         .text();
   });
-  return Object()
-      .str("system", v.system)
+  Object o;
+  o.str("system", v.system)
       .str("description", v.description)
       .raw("t", seconds(v.t))
       .boolean("running", v.running)
       .raw("state", state_text(v.state))
       .raw("coordinators", coordinators)
-      .text();
+      .raw("connections", array(v.connections,
+                                [](const ConnectionView& c) {
+                                  return Object().str("required", c.required).str("provided", c.provided).text();
+                                }))
+      .raw("clock", clock_json(v));
+  if (replay) o.raw("replay", replay_json(*replay));
+  return o.text();
 }
 
 std::string explanation_to_json(const Explanation& e) {
@@ -212,9 +242,10 @@ bool listed_record(std::string_view record_json) {
 
 Protocol::Protocol(ViewSource& source, ProtocolOptions options) : source_(source), options_(std::move(options)) {
   sent_ = states_of(source_.view());
+  generation_ = source_.generation();
 }
 
-std::string Protocol::view_json() const { return view_to_json(source_.view()); }
+std::string Protocol::view_json() const { return view_to_json(source_.view(), source_.replay()); }
 
 std::string Protocol::hello() const {
   return Object()
@@ -229,6 +260,20 @@ std::string Protocol::hello() const {
 std::string Protocol::update(long long now_ms) {
   source_.poll();
   std::vector<std::string> records = source_.take_records();
+  const std::optional<ReplayView> replay = source_.replay();
+  if (source_.generation() != generation_) {
+    // The picture started over (a replay went back in time): every page starts over with it.
+    generation_ = source_.generation();
+    recent_.clear();
+    for (std::string& r : records) {
+      if (!listed_record(r)) continue;
+      recent_.push_back(std::move(r));
+      if (recent_.size() > options_.recent) recent_.pop_front();
+    }
+    sent_ = states_of(source_.view());
+    last_time_ms_ = now_ms;
+    return hello();
+  }
   std::string listed = "[";
   for (std::string& r : records) {
     if (!listed_record(r)) continue;
@@ -252,17 +297,25 @@ std::string Protocol::update(long long now_ms) {
   changed += '}';
   if (changed.size() > 2 || listed.size() > 2) {
     last_time_ms_ = now_ms;
-    return Object()
-        .str("type", "update")
+    last_replay_ = replay ? replay_json(*replay) : std::string();
+    Object o;
+    o.str("type", "update")
         .raw("t", seconds(source_.now()))
         .boolean("running", source_.running())
         .raw("states", changed)
-        .raw("records", listed)
-        .text();
+        .raw("records", listed);
+    if (replay) o.raw("replay", last_replay_);
+    return o.text();
   }
-  if (now_ms - last_time_ms_ >= kTimeIntervalMs) {
+  // A replay's controls changed (paused, arrived where it was sent): said at once.
+  const std::string replay_now = replay ? replay_json(*replay) : std::string();
+  if (now_ms - last_time_ms_ >= kTimeIntervalMs || replay_now != last_replay_) {
     last_time_ms_ = now_ms;
-    return Object().str("type", "time").raw("t", seconds(source_.now())).boolean("running", source_.running()).text();
+    last_replay_ = replay_now;
+    Object o;
+    o.str("type", "time").raw("t", seconds(source_.now())).boolean("running", source_.running());
+    if (replay) o.raw("replay", replay_now);
+    return o.text();
   }
   return {};
 }
@@ -311,7 +364,7 @@ std::string Protocol::handle(std::string_view message) {
   }
   const spec::JsonValue* op = object.find("op");
   if (op == nullptr)
-    return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset)");
+    return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset, replay)");
   if (!op->is_string()) return error_reply(r.id, {}, "'op' must be a string");
   r.op = op->string;
   std::string problem;
@@ -394,7 +447,47 @@ std::string Protocol::handle(std::string_view message) {
     if (!done) return error_reply(r.id, r.op, done.error().message);
     return reply(r).str("text", *done).text();
   }
-  return error_reply(r.id, r.op, "unknown op '" + r.op + "' (view, explain, generate, broadcast, inject, reset)");
+  if (r.op == "replay") {
+    // Moving a replay in time changes what is shown, never the system or the log: no token.
+    problem = check_keys(object, {"id", "op", "action", "t", "speed"});
+    std::string action;
+    if (problem.empty()) problem = get_string(object, "action", action);
+    ReplayControl control;
+    if (problem.empty()) {
+      const spec::JsonValue* t = object.find("t");
+      const spec::JsonValue* speed = object.find("speed");
+      if (action == "play" || action == "pause" || action == "next") {
+        control.op = action == "play"    ? ReplayControl::Op::Play
+                     : action == "pause" ? ReplayControl::Op::Pause
+                                         : ReplayControl::Op::Next;
+        if (t != nullptr || speed != nullptr) problem = "action '" + action + "' takes neither 't' nor 'speed'";
+      } else if (action == "seek") {
+        control.op = ReplayControl::Op::Seek;
+        if (speed != nullptr)
+          problem = "action 'seek' takes 't' (seconds), not 'speed'";
+        else if (t == nullptr || !t->is_number())
+          problem = "action 'seek' needs 't', a number of seconds";
+        else
+          control.t = t->number;
+      } else if (action == "speed") {
+        control.op = ReplayControl::Op::Speed;
+        if (t != nullptr)
+          problem = "action 'speed' takes 'speed', not 't'";
+        else if (speed == nullptr || !speed->is_number())
+          problem = "action 'speed' needs 'speed', a number";
+        else
+          control.speed = speed->number;
+      } else {
+        problem = "unknown action '" + action + "' (play, pause, speed, seek, next)";
+      }
+    }
+    if (!problem.empty()) return error_reply(r.id, r.op, problem);
+    auto done = source_.control(control);
+    if (!done) return error_reply(r.id, r.op, done.error().message);
+    return reply(r).str("text", *done).text();
+  }
+  return error_reply(r.id, r.op,
+                     "unknown op '" + r.op + "' (view, explain, generate, broadcast, inject, reset, replay)");
 }
 
 }  // namespace safecass::viewer

@@ -222,6 +222,10 @@ private:
       return respond(req, http::status::ok, "text/javascript; charset=utf-8", std::string(web::kViewerJs));
     if (target == "/viewer.css")
       return respond(req, http::status::ok, "text/css; charset=utf-8", std::string(web::kViewerCss));
+    if (target == "/dagre.js")
+      return respond(req, http::status::ok, "text/javascript; charset=utf-8", std::string(web::kDagreJs));
+    if (target == "/dagre.esm.js.LEGAL.txt")
+      return respond(req, http::status::ok, "text/plain; charset=utf-8", std::string(web::kDagreLicense));
     if (target == "/api/view") return respond(req, http::status::ok, "application/json", server_.protocol.view_json());
     return respond(req, http::status::not_found, "text/plain", "not found: " + std::string(target) + "\n");
   }

@@ -11,12 +11,16 @@
 /// transitions are printed as `run` prints them. A recording replays through the system that made
 /// it to the same transitions, byte for byte.
 
+#include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/record/file_limits.hpp"
+#include "safecass/runner/scenario_runner.hpp"
 
 namespace safecass::replay {
 
@@ -45,5 +49,45 @@ int run_replay(const ReplayOptions& options, const FilterRegistry& registry);
 /// address, the intervals where their states differ with the first cause of each. Returns 0 when
 /// they never differ, 1 when they do, 2 for bad input.
 int run_replay_diff(const std::string& system_b, const ReplayOptions& options, const FilterRegistry& registry);
+
+/// A replay driven step by step, for interactive tools (`safecass viewer --replay`): the system
+/// is opened and the whole log checked exactly as run_replay() does (same errors, nothing runs on
+/// bad input), then the inputs are fed tick by tick only as far as asked. Nothing is printed or
+/// recorded; tools follow the runner's coordinator. Going back in time means opening a new
+/// session (a coordinator cannot run backwards).
+///
+/// Lifecycle: open() (the first tick not processed yet) → advance_to() any number of times, each
+/// target at or after the last → destroyed. Not thread-safe: one thread drives it.
+class ReplaySession {
+public:
+  /// `registry` must outlive the session; options.json/record/out are ignored. Errors: Parse,
+  /// with every line run_replay() prints for the same bad input ("file:line: reason"), one per
+  /// line.
+  static Expected<std::unique_ptr<ReplaySession>> open(const ReplayOptions& options, const FilterRegistry& registry);
+  ~ReplaySession();
+  ReplaySession(const ReplaySession&) = delete;
+  ReplaySession& operator=(const ReplaySession&) = delete;
+
+  runner::ScenarioRunner& runner() noexcept;
+  const runner::ScenarioRunner& runner() const noexcept;
+  /// The first and the last tick of the replay (run_replay() runs exactly these), and the tick.
+  Time start() const noexcept;
+  Time end() const noexcept;
+  Time period() const noexcept;
+  /// The last tick processed; before the first, start() - period().
+  Time now() const noexcept;
+  /// Processes every tick up to and including min(t, end()), feeding the inputs due.
+  void advance_to(Time t);
+  /// Samples and actions fed so far.
+  std::uint64_t samples() const noexcept;
+  std::uint64_t actions() const noexcept;
+  /// The log's notes (a torn last record, samples the recorder lost): run_replay()'s "note:" lines.
+  std::vector<std::string> notes() const;
+
+private:
+  struct Impl;
+  explicit ReplaySession(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
 
 }  // namespace safecass::replay

@@ -16,9 +16,16 @@
 ///   {"op":"inject","filter":F,"samples":[[...]...],"token":K}        shallow injection
 ///   {"op":"inject","signal":S,"samples":[[...]...],"token":K}        deep injection
 ///   {"op":"reset","target":A,"reason":TEXT,"token":K}
+///   {"op":"replay","action":"play"|"pause"|"next"}                   a replay's controls (no token:
+///   {"op":"replay","action":"seek","t":SECONDS}                       they change what is shown,
+///   {"op":"replay","action":"speed","speed":X}                        never the system or its log)
 /// VIEW = {"system","description","t","running","state","coordinators":[{"name","address","state",
 /// "status","components":[{"name","address","state","outstanding","machines":[{"address","kind",
-/// "name","state","outstanding"}]}]}]}. STATES holds only the addresses whose state or outstanding
+/// "name","state","outstanding"}]}]}],"connections":[{"required","provided"}],"clock":CLOCK[,"replay":REPLAY]}.
+/// CLOCK = {"base":"simulated"} (times are scenario seconds) or {"base":"host","wall_offset_ms":X}
+/// (a live system: wall-clock time = t * 1000 + X ms since the Unix epoch). REPLAY (a replay only,
+/// also in every "update" and "time") = {"start","end","period","playing","speed","busy"}; when a
+/// replay goes back in time every page gets a new "hello". STATES holds only the addresses whose state or outstanding
 /// event changed since the previous update; coordinator addresses are "coordinator:NAME", and a
 /// coordinator's "outstanding" is its status ("" in-process; "unreachable", "lost", ... live).
 /// RECORD is record_to_json()'s format.
@@ -28,6 +35,7 @@
 /// protocol was created with write access, and then unless the message carries the token.
 
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <map>
 #include <string>
@@ -77,6 +85,8 @@ private:
   std::map<std::string, std::pair<State, std::string>> sent_;  ///< last state pushed per address
   std::deque<std::string> recent_;
   long long last_time_ms_ = -1000000;
+  std::uint64_t generation_ = 0;  ///< the source's generation the pages were last greeted with
+  std::string last_replay_;       ///< the replay status last pushed
 };
 
 }  // namespace safecass::viewer

@@ -10,6 +10,8 @@
 /// no locking of its own against the server. A source fed by other threads (middleware callbacks)
 /// buffers what they deliver and hands it over in poll().
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -52,6 +54,31 @@ struct CoordinatorView {
   std::vector<ComponentView> components;
 };
 
+/// A connection of the system: a required interface and the provided interface it uses.
+struct ConnectionView {
+  std::string required;  ///< "CONTROL.ForceData" (component.interface)
+  std::string provided;  ///< "JR3.ForceData"
+};
+
+/// Where a replay stands (ViewSource::replay()).
+struct ReplayView {
+  double start = 0.0;   ///< the first tick, seconds of the recording's clock
+  double end = 0.0;     ///< the last tick
+  double period = 0.0;  ///< the tick
+  bool playing = false;
+  double speed = 1.0;  ///< recording seconds per wall-clock second while playing
+  /// Catching up: toward a time asked for ("seek") or to the next transition ("next"); "" when idle.
+  std::string busy;
+};
+
+/// A replay's controls: play, pause, speed, seek (to `t`) and run on to the next transition.
+struct ReplayControl {
+  enum class Op : std::uint8_t { Play, Pause, Speed, Seek, Next };
+  Op op = Op::Pause;
+  double t = 0.0;      ///< Seek: seconds
+  double speed = 1.0;  ///< Speed
+};
+
 /// The whole picture at one moment.
 struct SystemView {
   std::string system;       ///< system name
@@ -60,6 +87,11 @@ struct SystemView {
   bool running = true;      ///< a scenario still has steps to apply (false without one); always true live
   State state = State::Normal;
   std::vector<CoordinatorView> coordinators;
+  std::vector<ConnectionView> connections;  ///< in the system file's order
+  /// The times of a live system are the host's monotonic clock: shown as wall-clock time, the
+  /// time of the host clock + wall_offset_ns (ns since the Unix epoch). Otherwise scenario seconds.
+  bool host_clock = false;
+  std::int64_t wall_offset_ns = 0;
 };
 
 /// A fault-injection request: shallow into one filter's private input, or deep into a signal's
@@ -95,6 +127,18 @@ public:
   virtual Expected<std::string> broadcast(std::string_view event) = 0;
   virtual Expected<std::string> inject(const InjectRequest& request) = 0;
   virtual Expected<std::string> reset(std::string_view target, std::string_view reason) = 0;
+
+  // A replay (ReplaySource) can be moved in time; other sources are not replays.
+  /// Where the replay stands; nullopt for a source that is not a replay.
+  virtual std::optional<ReplayView> replay() const { return std::nullopt; }
+  /// Applies a replay control and says what was done. Errors: InvalidArgument (not a replay, a
+  /// time out of the replay's range, a bad speed); nothing changed then.
+  virtual Expected<std::string> control(const ReplayControl& /*control*/) {
+    return fail(ErrorCode::InvalidArgument, "this viewer shows a running system, not a replay");
+  }
+  /// Changes whenever the source's picture started over (a replay went back in time): the
+  /// records taken so far no longer lead to the current picture.
+  virtual std::uint64_t generation() const { return 0; }
 };
 
 }  // namespace safecass::viewer

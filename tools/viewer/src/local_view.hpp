@@ -1,0 +1,34 @@
+#pragma once
+// What the in-process sources (a scenario run, a replay) share: the picture of a system run in
+// this process through its read model (introspect::LocalQuery), and explain with the viewer's
+// coordinator addresses ("coordinator:NAME").
+
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "safecass/introspect/local_query.hpp"
+#include "safecass/spec/system.hpp"
+#include "safecass/viewer/source.hpp"
+
+namespace safecass::viewer::detail {
+
+/// The coordinators of a system file with their components (one named after the coordinator
+/// holding every component when the file names none).
+using Coordinators = std::vector<std::pair<std::string, std::vector<ComponentId>>>;
+
+Coordinators coordinators_of(const spec::SystemSpec& system, const Coordinator& co);
+
+/// SystemView::coordinators, state and connections, from the read model; the caller fills the rest.
+SystemView local_view(const introspect::LocalQuery& query, const Coordinators& coordinators,
+                      const std::vector<ConnectionView>& connections);
+
+/// The connections of the system, from the read model (`connection list`).
+std::vector<ConnectionView> local_connections(introspect::LocalQuery& query);
+
+/// Every active condition at `address`; "coordinator:NAME" gathers those of its components.
+Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
+                                                 const Coordinators& coordinators, std::string_view address);
+
+}  // namespace safecass::viewer::detail
