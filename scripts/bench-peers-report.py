@@ -70,7 +70,9 @@ def main():
         "ros_diagnostics_default": load(work, "diag_default_visibility"),
         "ros_diagnostics_fastest": load(work, "diag_fastest_visibility"),
     }
-    watch = {"safecass_supervisor": load(work, "safecass_watch"), "ros_diagnostic_aggregator": load(work, "aggregator_watch")}
+    watch = {"safecass_supervisor": load(work, "safecass_watch"),
+             "safecass_supervisor_states_only": load(work, "safecass_watch_states"),
+             "ros_diagnostic_aggregator": load(work, "aggregator_watch")}
     sm = load(work, "state_machines")
     safecass_ns, _ = gbench(sm, "BM_PeerSafecassEvent")
     msm_ns, _ = gbench(sm, "BM_PeerMsmEvent")
@@ -96,6 +98,7 @@ def main():
     sc, ice, ros = vis["safecass_over_icestorm"], vis["icestorm_raw"], vis["roscpp_raw"]
     dd, df = vis["ros_diagnostics_default"], vis["ros_diagnostics_fastest"]
     sup, agg = watch["safecass_supervisor"], watch["ros_diagnostic_aggregator"]
+    sup_states = watch["safecass_supervisor_states_only"]
     result = {
         "visibility_p99_ratio_vs_icestorm": ratio(get(sc, "p99_us"), get(ice, "p99_us")),
         "visibility_speedup_vs_ros_diagnostics_default": ratio(get(dd, "p50_us"), get(sc, "p50_us")),
@@ -107,6 +110,9 @@ def main():
         "visibility_p50_ratio_vs_icestorm": ratio(get(sc, "p50_us"), get(ice, "p50_us")),
         "visibility_p99_ratio_vs_roscpp": ratio(get(sc, "p99_us"), get(ros, "p99_us")),
         "visibility_speedup_vs_ros_diagnostics_fastest": ratio(get(df, "p50_us"), get(sc, "p50_us")),
+        # The supervisor following the service states only (--states-only), as the aggregator does.
+        "supervisor_states_only_cpu_ratio_vs_aggregator": ratio(get(sup_states, "cpu_s_per_10k_updates"),
+                                                                get(agg, "cpu_s_per_10k_updates")),
         "event_ns_ratio_vs_statechart": ratio(machines["safecass_ns_per_event"], machines["boost_statechart_ns_per_event"]),
         "scale_events_per_s": scale["events_per_s"],
         "memory_ratio_vs_aggregator_item": scale["memory_ratio_vs_aggregator_item"],
@@ -160,6 +166,8 @@ def main():
         ("visibility ROS diagnostics, fastest", lat(df)),
         ("supervisor CPU s / 10k updates, RSS", "—" if sup is None else
          f"{fmt(sup.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(sup.get('rss_bytes', 0) / 1e6)} MB"),
+        ("supervisor --states-only CPU s / 10k updates, RSS", "—" if sup_states is None else
+         f"{fmt(sup_states.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(sup_states.get('rss_bytes', 0) / 1e6)} MB"),
         ("aggregator CPU s / 10k updates, RSS", "—" if agg is None else
          f"{fmt(agg.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(agg.get('rss_bytes', 0) / 1e6)} MB"),
         ("ns per event: SAFECASS / MSM / Statechart",

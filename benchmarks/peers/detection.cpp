@@ -3,6 +3,7 @@
 // run by the native runtime in real time.
 //
 //   peer_detection --out FILE [--signals N] [--rate R] [--seconds S] [--components K]
+//                  [--history H]
 //
 // K components (default 1: one control loop) share the N signals. Each component's task runs at
 // R Hz: the native runtime runs its ACTIVE filters, then its body, which writes a new sample of
@@ -88,6 +89,7 @@ double process_cpu_seconds() {
 int main(int argc, char** argv) {
   std::string out_path = "peer-detection.json";
   int signals = 1000, components = 1;
+  std::size_t history = 1024;  // samples each signal's history buffer keeps (the Monitor's default)
   double rate = 1000.0, seconds = 30.0;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -99,6 +101,8 @@ int main(int argc, char** argv) {
       components = std::clamp(std::atoi(argv[i + 1]), 1, 100);
     else if (key == "--rate")
       rate = std::clamp(std::atof(argv[i + 1]), 1.0, 10000.0);
+    else if (key == "--history")
+      history = static_cast<std::size_t>(std::clamp(std::atoi(argv[i + 1]), 2, 1 << 20));
     else if (key == "--seconds")
       seconds = std::max(1.0, std::atof(argv[i + 1]));
     else {
@@ -113,7 +117,7 @@ int main(int argc, char** argv) {
   for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
   if (!load.ok()) return 2;
   Coordinator co("detection");  // steady_clock, as deployed
-  Monitor monitor(co, registry);
+  Monitor monitor(co, registry, history);
   if (auto built = spec::instantiate(*load.system, co, monitor); !built) {
     std::fprintf(stderr, "peer_detection: %s\n", built.error().message.c_str());
     return 2;
@@ -196,9 +200,10 @@ int main(int argc, char** argv) {
                 "{\n  \"signals\": %d,\n  \"filters\": %d,\n  \"components\": %d,\n  \"rate_hz\": %.0f,\n"
                 "  \"seconds\": %.2f,\n  \"cpu_s\": %.3f,\n  \"cpu_percent\": %.2f,\n  %s,\n"
                 "  \"crossings\": %d,\n  \"period_us\": %.0f,\n  \"other_transitions\": %llu,\n"
+                "  \"signal_history\": %zu,\n"
                 "  \"runtime\": \"native runtime, real time, ACTIVE filters in the component's task\"\n}\n",
                 signals, 3 * signals, components, rate, wall, cpu, cpu_percent, peers::latency_members(copy).c_str(),
-                crossings, period_us, static_cast<unsigned long long>(unexpected.load()));
+                crossings, period_us, static_cast<unsigned long long>(unexpected.load()), history);
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   return copy.size() >= static_cast<std::size_t>(crossings) * 9 / 10 ? 0 : 1;

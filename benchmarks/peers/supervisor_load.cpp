@@ -2,16 +2,18 @@
 // component statuses that each change R times a second, through a real IceStorm.
 //
 //   peer_supervisor_load --ice HOST:PORT --out FILE [--components N] [--rate R] [--seconds S]
+//                        [--states-only 1]
 //
 // Two processes. The child hosts the supervisor (middleware::Supervisor, the one `safecass
-// supervisor` runs; its output lines are counted, not written, as the ROS aggregator writes
-// none). The parent is one coordinator of N components C0..C{N-1}, each providing Status (its
-// service state follows the component's s_A); R times a second it raises (then clears) a fault
-// on every component's s_A, so each cycle changes all N statuses: N state updates (batched per
-// publishing cycle, signed) and the observer records of those transitions, as a deployed node
-// sends them. The supervisor's CPU time (user + system, /proc/PID/stat) is read when the feed
-// starts and after it ends (plus 300 ms to drain), and its RSS (/proc/PID/status) at the end.
-// Writes {"cpu_s", "updates", "cpu_s_per_10k_updates", "rss_bytes", ...} to FILE.
+// supervisor` runs; its output lines are counted, not formatted nor written, as the ROS
+// aggregator writes none). With --states-only 1 it follows the service states only
+// (`safecass supervisor --states-only`: no event records), the same content the aggregator gets. The parent is one
+// coordinator of N components C0..C{N-1}, each providing Status (its service state follows the component's s_A); R
+// times a second it raises (then clears) a fault on every component's s_A, so each cycle changes all N statuses: N
+// state updates (batched per publishing cycle, signed) and the observer records of those transitions, as a deployed
+// node sends them. The supervisor's CPU time (user + system, /proc/PID/stat) is read when the feed starts and after it
+// ends (plus 300 ms to drain), and its RSS (/proc/PID/status) at the end. Writes {"cpu_s", "updates",
+// "cpu_s_per_10k_updates", "rss_bytes", ...} to FILE.
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -66,13 +68,14 @@ char read_byte(int fd) {
 }
 
 /// The supervisor process: runs until its input closes, then writes "lines rows refused\n".
-int supervisor(const spec::SystemSpec& system, const middleware::IceEndpoint& ice, const std::string& keys, int in,
-               int out) {
+int supervisor(const spec::SystemSpec& system, const middleware::IceEndpoint& ice, const std::string& keys,
+               bool states_only, int in, int out) {
   std::atomic<std::uint64_t> lines{0};
   middleware::SupervisorOptions options;
   options.ice = ice;
   options.keys_dir = keys;
-  options.print = [&lines](const std::string&) { lines.fetch_add(1, std::memory_order_relaxed); };
+  options.records = !states_only;
+  options.output = [&lines](const middleware::SupervisorLine&) { lines.fetch_add(1, std::memory_order_relaxed); };
   auto sup = middleware::Supervisor::create(system, options);
   if (!sup || !(*sup)->start()) return 2;
   write_text(out, "r");
@@ -91,6 +94,7 @@ int main(int argc, char** argv) {
   std::string ice_text, out_path = "peer-supervisor-load.json";
   int components = 1000;
   double rate = 10.0, seconds = 30.0;
+  bool states_only = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice")
@@ -103,6 +107,8 @@ int main(int argc, char** argv) {
       rate = std::clamp(std::atof(argv[i + 1]), 0.1, 1000.0);
     else if (key == "--seconds")
       seconds = std::max(1.0, std::atof(argv[i + 1]));
+    else if (key == "--states-only")
+      states_only = std::atoi(argv[i + 1]) != 0;
     else {
       std::fprintf(stderr, "peer_supervisor_load: unknown option %s\n", key.c_str());
       return 2;
@@ -136,7 +142,7 @@ int main(int argc, char** argv) {
   if (child == 0) {
     ::close(to_child[1]);
     ::close(to_parent[0]);
-    std::_Exit(supervisor(system, *ice, keys, to_child[0], to_parent[1]));
+    std::_Exit(supervisor(system, *ice, keys, states_only, to_child[0], to_parent[1]));
   }
   ::close(to_child[0]);
   ::close(to_parent[1]);
@@ -231,13 +237,14 @@ int main(int argc, char** argv) {
       "  \"cpu_percent_of_one_core\": %.2f,\n  \"rss_bytes\": %.0f,\n  \"rss_before_feed_bytes\": %.0f,\n"
       "  \"hwm_bytes\": %.0f,\n  \"output_lines\": %llu,\n  \"view_rows\": %llu,\n  \"messages_refused\": %llu,\n"
       "  \"updates_missed\": %llu,\n  \"events_dropped\": %llu,\n  \"feeder_cpu_s_total\": %.3f,\n"
+      "  \"records_followed\": %s,\n"
       "  \"watcher\": \"SAFECASS supervisor, one process, fed by one coordinator through IceStorm\"\n}\n",
       components, rate, seconds, wall, static_cast<unsigned long long>(changes),
       static_cast<unsigned long long>(updates),
       static_cast<unsigned long long>(after.state_messages_published - before.state_messages_published),
       static_cast<unsigned long long>(records), cpu, per_10k, wall > 0 ? 100.0 * cpu / wall : 0.0, rss, rss_before, hwm,
       lines, rows, refused, static_cast<unsigned long long>(after.updates_missed),
-      static_cast<unsigned long long>(after.events_dropped), feeder_cpu);
+      static_cast<unsigned long long>(after.events_dropped), feeder_cpu, states_only ? "false" : "true");
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   return updates > 0 && rows >= static_cast<unsigned long long>(components) && refused == 0 ? 0 : 1;

@@ -217,6 +217,34 @@ bool shown_while_watching(const HistoryEntry& e) noexcept {
          (e.kind == RecordKind::Event && (e.outcome == Outcome::Masked || e.outcome == Outcome::Ignored));
 }
 
+// ---- live lines -------------------------------------------------------------------------------
+
+std::string live_line(const HistoryEntry& e) {
+  std::string out;
+  switch (e.kind) {
+    case RecordKind::Transition:
+    case RecordKind::ComponentTransition:
+      out.append(e.where()).append(" ").append(to_string(e.from)).append(" -> ").append(to_string(e.to));
+      if (!e.event.empty()) out.append(" ").append(e.event);
+      if (e.root) out.append(" (root ").append(e.root->origin).append(":").append(e.root->event).append(")");
+      return out;
+    case RecordKind::Reset: out.append("reset ").append(e.where()); break;
+    case RecordKind::Event:
+      out.append(e.where()).append(" ").append(to_string(e.outcome)).append(" ").append(e.event);
+      break;
+    case RecordKind::Injection: out.append(e.where()).append(" injection"); break;
+  }
+  if (!e.text.empty()) out.append(" (").append(e.text).append(")");
+  return out;
+}
+
+std::string live_state_line(std::string_view address, State state, std::string_view note) {
+  std::string out;
+  out.append(address).append(" ").append(to_string(state));
+  if (!note.empty()) out.append(" (").append(note).append(")");
+  return out;
+}
+
 // ---- explanations -----------------------------------------------------------------------------
 
 std::string explanation_text(const Explanation& e, const TimeFormat& time) {

@@ -57,30 +57,41 @@ std::string json_number_array(const std::vector<double>& items) {
   return a.text();
 }
 
-JsonObject& JsonObject::raw(std::string_view key, std::string_view json) {
+void JsonObject::key(std::string_view key) {
   if (text_.size() > 1) text_ += ',';
+  if (break_) {
+    text_ += '\n';
+    break_ = false;
+  }
   append_json_string(text_, key);
   text_ += ':';
+}
+
+JsonObject& JsonObject::raw(std::string_view key, std::string_view json) {
+  this->key(key);
   text_ += json;
   return *this;
 }
 
 JsonObject& JsonObject::str(std::string_view key, std::string_view value) {
-  if (text_.size() > 1) text_ += ',';
-  append_json_string(text_, key);
-  text_ += ':';
+  this->key(key);
   append_json_string(text_, value);
   return *this;
 }
 
-JsonArray& JsonArray::raw(std::string_view json) {
+void JsonArray::next() {
   if (text_.size() > 1) text_ += ',';
+  if (layout_ == Layout::OnePerLine) text_ += '\n';
+}
+
+JsonArray& JsonArray::raw(std::string_view json) {
+  next();
   text_ += json;
   return *this;
 }
 
 JsonArray& JsonArray::str(std::string_view value) {
-  if (text_.size() > 1) text_ += ',';
+  next();
   append_json_string(text_, value);
   return *this;
 }

@@ -59,14 +59,19 @@ bool from_hex(std::string_view hex, std::string& out, std::size_t size) {
   return true;
 }
 
-/// The bytes a signature covers.
-std::string signed_bytes(std::string_view kind, std::string_view signer, const Ice::ByteSeq& body) {
-  std::string text;
+/// Writes the bytes a signature covers into `text` (its storage is reused).
+void signed_bytes(std::string& text, std::string_view kind, std::string_view signer, const Ice::ByteSeq& body) {
+  text.clear();
   text.reserve(kContext.size() + kind.size() + signer.size() + body.size() + 3);
   text.append(kContext).push_back('\0');
   text.append(kind).push_back('\0');
   text.append(signer).push_back('\0');
   text.append(reinterpret_cast<const char*>(body.data()), body.size());
+}
+
+std::string signed_bytes(std::string_view kind, std::string_view signer, const Ice::ByteSeq& body) {
+  std::string text;
+  signed_bytes(text, kind, signer, body);
   return text;
 }
 
@@ -223,7 +228,10 @@ bool Keyring::verify(std::string_view signer, std::string_view kind, const Ice::
   const auto key = keys_.find(signer);
   if (key == keys_.end() || signature.size() != crypto_sign_BYTES) return false;
   try {
-    const std::string bytes = signed_bytes(kind, signer, body);
+    // One buffer per receiving thread, reused: checking a message allocates nothing once it has
+    // grown to the largest message seen.
+    thread_local std::string bytes;
+    signed_bytes(bytes, kind, signer, body);
     return ::crypto_sign_verify_detached(signature.data(), reinterpret_cast<const unsigned char*>(bytes.data()),
                                          bytes.size(), reinterpret_cast<const unsigned char*>(key->second.data())) == 0;
   } catch (...) {

@@ -89,19 +89,6 @@ wire::Root root_to_wire(const in::RootEntry& r) {
                     r.signal, r.value,  r.sample_time.count(), r.injected,          {}};
 }
 
-in::RootEntry root_from_wire(const wire::Root& w) {
-  in::RootEntry r;
-  r.event = w.event;
-  r.origin = w.origin;
-  r.time = Time{w.time};
-  r.filter = w.filter;
-  r.signal = w.signal;
-  r.value = w.value;
-  r.sample_time = Time{w.sampleTime};
-  r.injected = w.injected;
-  return r;
-}
-
 template <class WireRecord>
 void fill(const in::HistoryEntry& e, WireRecord& w) {
   w.time = e.time.count();
@@ -135,7 +122,21 @@ bool read(const WireRecord& w, in::HistoryEntry& e) {
   e.event = w.event;
   e.severity = w.severity;
   e.mirror = w.mirror;
-  if (w.hasRoot) e.root = root_from_wire(w.root);
+  if (w.hasRoot) {
+    // Field by field into the entry's own storage: an entry reused for every record of a stream
+    // (the supervisor's) does not allocate per record.
+    in::RootEntry& r = e.root ? *e.root : e.root.emplace();
+    r.event = w.root.event;
+    r.origin = w.root.origin;
+    r.time = Time{w.root.time};
+    r.filter = w.root.filter;
+    r.signal = w.root.signal;
+    r.value = w.root.value;
+    r.sample_time = Time{w.root.sampleTime};
+    r.injected = w.root.injected;
+  } else {
+    e.root.reset();
+  }
   e.text = w.text;
   return true;
 }

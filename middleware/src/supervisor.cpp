@@ -2,6 +2,7 @@
 
 #include "safecass/middleware/supervisor.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdio>
 #include <map>
@@ -9,12 +10,14 @@
 #include <optional>
 #include <set>
 #include <thread>
+#include <unordered_map>
 
 #include "auth.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/introspect/model.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/spec/load.hpp"
@@ -22,6 +25,17 @@
 namespace safecass::middleware {
 
 using namespace detail;
+
+namespace {
+/// Hashes std::string and std::string_view alike, so that a lookup by a view of a message's text
+/// makes no string.
+struct TextHash {
+  using is_transparent = void;
+  std::size_t operator()(std::string_view text) const noexcept { return std::hash<std::string_view>{}(text); }
+};
+template <class V>
+using TextMap = std::unordered_map<std::string, V, TextHash, std::equal_to<>>;
+}  // namespace
 
 struct Supervisor::Impl {
   const spec::SystemSpec& system;
@@ -41,10 +55,13 @@ struct Supervisor::Impl {
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool seen = false;
     bool lost = false;
+    /// Last state update applied per interface ("C.p") of this incarnation.
+    TextMap<std::int64_t> state_seq;
+    bool states_behind = false;  ///< the last heartbeat listed state updates not received
   };
   mutable std::mutex mutex;
   std::map<std::string, Peer, std::less<>> peers;
-  std::map<std::string, ViewRow, std::less<>> view;
+  TextMap<ViewRow> view;  ///< by address: one hash per record or update (view() sorts)
 
   std::shared_ptr<Ice::Communicator> ic;
   std::unique_ptr<Link> link;
@@ -60,15 +77,36 @@ struct Supervisor::Impl {
   std::atomic<bool> running{false};
   std::thread link_thread;
   std::thread watch_thread;
+  // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
+  // so that a steady stream of records and updates does not allocate per record.
+  introspect::HistoryEntry record_scratch;
+  std::string address_scratch;
+  std::string note_scratch;
 
   Impl(const spec::SystemSpec& s, SupervisorOptions o) : system(s), options(std::move(o)) {}
 
-  void print(const std::string& line) const {
+  void write_text(const std::string& line) const {
     if (options.print) {
       options.print(line);
     } else {
       std::printf("%s\n", line.c_str());
       std::fflush(stdout);
+    }
+  }
+  /// One output line; its text is made only if the consumer asks for it.
+  void emit(const SupervisorLine& line) const {
+    if (options.output) {
+      options.output(line);
+    } else {
+      write_text(line.text());
+    }
+  }
+  /// A notice of the supervisor's own.
+  void print(const std::string& line) const {
+    if (options.output) {
+      options.output(SupervisorLine::notice(line));
+    } else {
+      write_text(line);
     }
   }
 
@@ -99,6 +137,8 @@ struct Supervisor::Impl {
       peer.incarnation = seen;
       peer.last_event_seq = 0;
       peer.heartbeat_seq = 0;
+      peer.state_seq.clear();
+      peer.states_behind = false;
       if (restart) {
         for (auto it = view.begin(); it != view.end();) {
           it = it->second.coordinator == who ? view.erase(it) : std::next(it);
@@ -141,42 +181,56 @@ struct Supervisor::Impl {
       refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an invalid level");
       return;
     }
-    const std::string who = printable(m.coordinator);
-    std::string line;
+    const bool transition = m.kind == "transition" || m.kind == "component-transition";
+    const bool shown = transition || m.kind == "reset";
+    introspect::HistoryEntry& entry = record_scratch;
+    if (shown) {
+      if (!from_wire(m, entry)) {
+        refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an unknown kind or outcome");
+        return;
+      }
+      if (entry.machine.empty() && entry.component.empty()) {
+        // A record that names only its address: a machine, or the component of a component
+        // transition or a reset.
+        (entry.kind == RecordKind::Transition ? entry.machine : entry.component) = m.address;
+      }
+    }
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(m.coordinator);
       if (p == peers.end()) {
-        refuse(sender, "an event record of '" + who + "', which is not a coordinator of the system");
+        refuse(sender,
+               "an event record of '" + printable(m.coordinator) + "', which is not a coordinator of the system");
         return;
       }
       if (!fresh(p->second, m.coordinator, m.incarnation, "an event record")) return;
       if (m.seq <= p->second.last_event_seq) {
-        refuse(sender, "an event record of '" + who + "': seq " + std::to_string(m.seq) + " not above " +
-                           std::to_string(p->second.last_event_seq) + " (replayed)");
+        refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                           " not above " + std::to_string(p->second.last_event_seq) + " (replayed)");
         return;
       }
       if (p->second.last_event_seq != 0 && m.seq != p->second.last_event_seq + 1) {
-        print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event record(s) of '" + who +
-              "' missed");
+        print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event record(s) of '" +
+              printable(m.coordinator) + "' missed");
         p->second.refresh = true;  // the missed records may have changed rows: read them again
       }
       p->second.last_event_seq = m.seq;
-      if (m.kind != "transition" && m.kind != "component-transition" && m.kind != "reset") return;
-      if (m.kind == "reset") {
-        line = "[" + who + "] reset " + printable(m.address) + " (" + printable(m.text) + ")";
-      } else {
-        ViewRow& row = view[m.address];
-        row.coordinator = m.coordinator;
-        row.address = m.address;
-        row.state = to;
-        row.cause = to == State::Normal ? std::string() : m.rootOrigin + ":" + m.rootEvent;
-        line = "[" + who + "] " + printable(m.address) + " " + std::string(to_string(from)) + " -> " +
-               std::string(to_string(to)) + " " + printable(m.event) +
-               (m.rootEvent.empty() ? "" : " (root " + printable(m.rootOrigin) + ":" + printable(m.rootEvent) + ")");
+      if (!shown) return;
+      if (transition) {
+        auto row = view.find(m.address);
+        if (row == view.end()) row = view.emplace(m.address, ViewRow{}).first;
+        ViewRow& r = row->second;
+        r.coordinator = m.coordinator;  // assignments into the row's own storage: no allocation once sized
+        r.address = m.address;
+        r.state = to;
+        if (to == State::Normal) {
+          r.cause.clear();
+        } else {
+          r.cause.assign(m.rootOrigin).append(":").append(m.rootEvent);
+        }
       }
     }
-    print(line);
+    emit(SupervisorLine::of_record(m.coordinator, entry));
   }
 
   void on_updates(const wire::Signed& signed_batch) {
@@ -186,38 +240,60 @@ struct Supervisor::Impl {
   }
 
   void on_update(const std::string& from, const wire::StateUpdate& u) {
-    const std::string who = printable(u.coordinator);
     if (u.coordinator != from) {
-      refuse(from, "a state update naming '" + who + "' signed by '" + printable(from) + "'");
+      refuse(from, "a state update naming '" + printable(u.coordinator) + "' signed by '" + printable(from) + "'");
       return;
     }
     State s = State::Normal;
     if (!from_wire(u.state, s)) {
-      refuse(from, "a state update of '" + who + "' with an invalid level");
+      refuse(from, "a state update of '" + printable(u.coordinator) + "' with an invalid level");
       return;
     }
     const auto dot = u.iface.find('.');
     if (dot == std::string::npos) {
-      refuse(from, "a state update of '" + who + "': malformed interface '" + printable(u.iface) + "'");
+      refuse(from,
+             "a state update of '" + printable(u.coordinator) + "': malformed interface '" + printable(u.iface) + "'");
       return;
     }
-    const std::string address = u.iface.substr(0, dot) + ".s_S." + u.iface.substr(dot + 1);
-    std::string causes;
-    for (const wire::Root& r : u.roots) causes += (causes.empty() ? "" : ", ") + r.origin + ":" + r.event;
+    std::string& address = address_scratch;
+    address.assign(u.iface, 0, dot).append(".s_S.").append(u.iface, dot + 1);
+    // The note printed with the state: "roots a:b, c:d"; the view keeps the causes after "roots ".
+    constexpr std::string_view kRoots = "roots ";
+    std::string& note = note_scratch;
+    note.assign(kRoots);
+    for (const wire::Root& r : u.roots) {
+      if (note.size() > kRoots.size()) note.append(", ");
+      note.append(r.origin).append(":").append(r.event);
+    }
+    const std::string_view causes = std::string_view(note).substr(kRoots.size());
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(u.coordinator);
       if (p == peers.end()) {
-        refuse(from, "a state update of '" + who + "', which is not a coordinator of the system");
+        refuse(from, "a state update of '" + printable(u.coordinator) + "', which is not a coordinator of the system");
         return;
       }
       if (!fresh(p->second, u.coordinator, u.incarnation, "a state update")) return;
-      ViewRow& row = view[address];
-      if (row.address == address && row.state == s && row.cause == causes) return;
-      row = ViewRow{u.coordinator, address, s, causes};
+      // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
+      // applied is a replay (or a duplicate) and must not bring back an older state.
+      auto seq = p->second.state_seq.find(u.iface);
+      if (seq == p->second.state_seq.end()) seq = p->second.state_seq.emplace(u.iface, 0).first;
+      if (u.seq <= seq->second) {
+        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": seq " +
+                         std::to_string(u.seq) + " not above " + std::to_string(seq->second) + " (replayed)");
+        return;
+      }
+      seq->second = u.seq;  // a gap needs nothing more: this full state supersedes what was missed
+      auto row = view.find(address);
+      if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
+      ViewRow& r = row->second;
+      if (r.address == address && r.coordinator == u.coordinator && r.state == s && r.cause == causes) return;
+      r.coordinator = u.coordinator;
+      r.address = address;
+      r.state = s;
+      r.cause.assign(causes);
     }
-    print("[" + who + "] " + printable(address) + " " + std::string(to_string(s)) +
-          (causes.empty() ? "" : " (roots " + printable(causes) + ")"));
+    emit(SupervisorLine::of_state(u.coordinator, address, s, causes.empty() ? std::string_view() : note));
   }
 
   void on_beat(const wire::Signed& m) {
@@ -236,6 +312,7 @@ struct Supervisor::Impl {
       return;
     }
     std::vector<std::string> recovered;
+    bool resync = false;
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(h.coordinator);
@@ -264,7 +341,7 @@ struct Supervisor::Impl {
       // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
       // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
       // records may be on their way on the other topic): reported as missed.
-      const auto sent = h.lastSeq.find("events");
+      const auto sent = options.records ? h.lastSeq.find("events") : h.lastSeq.end();
       if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
         if (peer.events_behind) {
           print("supervisor: " + std::to_string(sent->second - peer.last_event_seq) + " event record(s) of '" +
@@ -278,6 +355,26 @@ struct Supervisor::Impl {
       } else {
         peer.events_behind = false;
       }
+      // Following states only, the same for the state streams: an update lost with nothing
+      // after it on its interface would leave the view of that service stale. Behind on two
+      // heartbeats in a row: the coordinator is asked to republish its full state. (Following
+      // the records, a gap in them already has the view refreshed.)
+      std::int64_t states_missed = 0;
+      for (const auto& [stream, last] : h.lastSeq) {
+        if (options.records) break;
+        if (stream.rfind("state:", 0) != 0) continue;
+        const auto applied = peer.state_seq.find(std::string_view(stream).substr(6));
+        const std::int64_t have = applied == peer.state_seq.end() ? 0 : applied->second;
+        if (last > have) states_missed += last - have;
+      }
+      if (states_missed > 0 && peer.states_behind) {
+        print("supervisor: " + std::to_string(states_missed) + " state update(s) of '" + printable(h.coordinator) +
+              "' missed; asking for its full state");
+        resync = true;
+        peer.states_behind = false;
+      } else {
+        peer.states_behind = states_missed > 0;
+      }
       if (!peer.seen) print("supervisor: coordinator '" + h.coordinator + "' is up");
       peer.seen = true;
       peer.last_heartbeat = steady_ns();
@@ -286,6 +383,7 @@ struct Supervisor::Impl {
         recovered = peer.components;
       }
     }
+    if (resync) request_resync(h.coordinator);
     if (recovered.empty()) return;
     print("supervisor: coordinator '" + h.coordinator + "' recovered");
     for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", c + ".s_F");
@@ -329,7 +427,12 @@ struct Supervisor::Impl {
         print("supervisor: cannot refresh the view of '" + who + "' after missed records: " + e.ice_id());
         continue;
       }
-      std::vector<std::string> lines;
+      struct Changed {
+        std::string address;
+        State state;
+        std::string note;
+      };
+      std::vector<Changed> lines;
       {
         std::lock_guard lock(mutex);
         for (const introspect::StateRow& r : rows) {
@@ -338,12 +441,11 @@ struct Supervisor::Impl {
           const std::string cause = r.state == State::Normal ? std::string() : causes[r.address];
           if (it != view.end() && it->second.state == r.state) continue;
           view[r.address] = ViewRow{name, r.address, r.state, cause};
-          lines.push_back("[" + who + "] " + printable(r.address) + " " + std::string(to_string(r.state)) +
-                          " (refreshed after missed records" + (cause.empty() ? "" : "; root " + printable(cause)) +
-                          ")");
+          lines.push_back(
+              Changed{r.address, r.state, "refreshed after missed records" + (cause.empty() ? "" : "; root " + cause)});
         }
       }
-      for (const std::string& l : lines) print(l);
+      for (const Changed& c : lines) emit(SupervisorLine::of_state(name, c.address, c.state, c.note));
     }
   }
 
@@ -461,14 +563,49 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   Impl* d = impl.get();
   impl->model.subscribe([d](const Record& r) {
     if (r.kind != RecordKind::Transition) return;
-    std::string line = "supervisor: " + d->model.address_of(r.machine) + " " + std::string(to_string(r.from)) + " -> " +
-                       std::string(to_string(r.to)) + " " + (r.event == kNoEvent ? "" : d->model.event(r.event).name);
-    if (r.root.event != kNoEvent) {
-      line += " (root " + d->model.address_of(r.root.origin) + ":" + d->model.event(r.root.event).name + ")";
-    }
-    d->print(line);
+    const introspect::HistoryEntry entry = introspect::history_entry(r, d->model);
+    d->emit(SupervisorLine::of_record({}, entry));
   });
   return std::unique_ptr<Supervisor>(new Supervisor(std::move(impl)));
+}
+
+SupervisorLine SupervisorLine::of_record(std::string_view coordinator,
+                                         const introspect::HistoryEntry& record) noexcept {
+  SupervisorLine l;
+  l.kind_ = Kind::Record;
+  l.coordinator_ = coordinator;
+  l.record_ = &record;
+  return l;
+}
+
+SupervisorLine SupervisorLine::of_state(std::string_view coordinator, std::string_view address, State state,
+                                        std::string_view note) noexcept {
+  SupervisorLine l;
+  l.kind_ = Kind::State;
+  l.coordinator_ = coordinator;
+  l.address_ = address;
+  l.state_ = state;
+  l.note_ = note;
+  return l;
+}
+
+SupervisorLine SupervisorLine::notice(std::string_view text) noexcept {
+  SupervisorLine l;
+  l.kind_ = Kind::Notice;
+  l.note_ = text;
+  return l;
+}
+
+std::string SupervisorLine::text() const {
+  switch (kind_) {
+    case Kind::Record:
+      if (coordinator_.empty()) return printable("supervisor: " + introspect::live_line(*record_));
+      return printable("[" + std::string(coordinator_) + "] " + introspect::live_line(*record_));
+    case Kind::State:
+      return printable("[" + std::string(coordinator_) + "] " + introspect::live_state_line(address_, state_, note_));
+    case Kind::Notice: break;
+  }
+  return std::string(note_);
 }
 
 Supervisor::Supervisor(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -482,7 +619,9 @@ Expected<void> Supervisor::start() {
     auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor",
                                                           protocol(d.options.tls) + " -h " + d.options.listen_host);
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
-    d.link->subscribe_to(kEventTopic, adapter->addWithUUID(std::make_shared<EventServant>(d)), Delivery::Stream);
+    if (d.options.records) {
+      d.link->subscribe_to(kEventTopic, adapter->addWithUUID(std::make_shared<EventServant>(d)), Delivery::Stream);
+    }
     auto state = adapter->addWithUUID(std::make_shared<StateServant>(d));
     for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state, Delivery::Stream);
     d.link->subscribe_to(kHeartbeatTopic, adapter->addWithUUID(std::make_shared<HeartbeatServant>(d)));
@@ -514,7 +653,9 @@ void Supervisor::stop() noexcept {
 std::vector<ViewRow> Supervisor::view() const {
   std::lock_guard lock(impl_->mutex);
   std::vector<ViewRow> out;
+  out.reserve(impl_->view.size());
   for (const auto& [_, row] : impl_->view) out.push_back(row);
+  std::sort(out.begin(), out.end(), [](const ViewRow& a, const ViewRow& b) { return a.address < b.address; });
   return out;
 }
 

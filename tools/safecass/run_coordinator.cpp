@@ -24,6 +24,7 @@
 #include "middleware_commands.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/native/runtime.hpp"
@@ -247,16 +248,9 @@ int run_coordinator(const RunArgs& args) {
   }
   co.subscribe([&co](const Record& r) {
     if (r.kind != RecordKind::Transition && r.kind != RecordKind::ComponentTransition) return;
-    std::string line =
-        "[" + std::string(co.name()) + "] " +
-        (r.machine != kNoMachine ? co.address_of(r.machine) : std::string(co.component_name(r.component))) + " " +
-        std::string(to_string(r.from)) + " -> " + std::string(to_string(r.to));
-    if (r.event != kNoEvent) line += " " + co.event(r.event).name;
-    if (r.root.event != kNoEvent) {
-      // root_origin() takes the coordinator's lock, which this thread holds (it is recursive).
-      line += " (root " + co.root_origin(r.root) + ":" + co.event(r.root.event).name + ")";
-    }
-    say(line);
+    // history_entry() resolves a remote root's origin with the coordinator's lock, which this
+    // thread holds (it is recursive).
+    say("[" + std::string(co.name()) + "] " + introspect::live_line(introspect::history_entry(r, co)));
   });
 
   // The durable history: opened before anything runs, so it holds every record of the process.

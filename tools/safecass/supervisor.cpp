@@ -1,5 +1,6 @@
 // `safecass supervisor SYSTEM --ice HOST:PORT [--lost-after MS] [--duration SECONDS]`: the
-// system-wide view of a multi-process system (DESIGN §4). Prints every transition as it arrives,
+// system-wide view of a multi-process system (DESIGN §4). Prints every transition as it arrives
+// (with --states-only: every service state),
 // marks a coordinator whose heartbeat stops as lost (EVT_COORDINATOR_LOST on its components and,
 // by propagation, on everything connected to them) and its recovery, and prints the view at exit.
 
@@ -32,6 +33,7 @@ struct SupervisorArgs {
   double duration = 0.0;
   std::string keys;
   bool insecure = false;
+  bool states_only = false;
   std::string tls;
   std::string listen;
 };
@@ -57,6 +59,7 @@ int run_supervisor(const SupervisorArgs& args) {
   options.lost_after = std::chrono::milliseconds(args.lost_after_ms);
   options.keys_dir = args.keys;
   options.insecure = args.insecure;
+  options.records = !args.states_only;
   options.tls.dir = args.tls;
   if (!args.listen.empty()) options.listen_host = args.listen;
   options.print = [](const std::string& line) {
@@ -85,8 +88,8 @@ int run_supervisor(const SupervisorArgs& args) {
   (*supervisor)->stop();
   options.print("safecass supervisor: system-wide view");
   for (const middleware::ViewRow& row : (*supervisor)->view()) {
-    options.print("  [" + row.coordinator + "] " + row.address + " " + std::string(to_string(row.state)) +
-                  (row.cause.empty() ? "" : " (" + row.cause + ")"));
+    options.print("  " +
+                  middleware::SupervisorLine::of_state(row.coordinator, row.address, row.state, row.cause).text());
   }
   for (const std::string& lost : (*supervisor)->lost()) options.print("  coordinator '" + lost + "' lost");
   return 0;
@@ -107,6 +110,9 @@ void add_supervisor_command(CLI::App& app, int& code) {
                   "the system's bus keys (safecass keys SYSTEM --out DIR; default $SAFECASS_KEYS)");
   cmd->add_flag("--insecure", args.insecure,
                 "accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
+  cmd->add_flag("--states-only", args.states_only,
+                "watch the service states only: no event records, so no per-machine transitions and no "
+                "system-wide history, at a fraction of the cost");
   cmd->add_option("--tls", args.tls, "mutual TLS; DIR holds ca.pem and supervisor.pem/.key (scripts/setup-tls)");
   cmd->add_option("--listen", args.listen, "the address to serve on (default 127.0.0.1)");
   cmd->callback([&code] { code = run_supervisor(args); });

@@ -48,10 +48,12 @@ std::string secs(double v) {
   return s == "-0" ? "0" : s;
 }
 
-/// A JSON string that is also safe inside an HTML <script> element: <, > and & are escaped.
-std::string quote(std::string_view s) {
+/// JSON text made safe inside an HTML <script> element: <, > and & (which JSON allows only inside
+/// strings) are written as \u003c, \u003e and \u0026.
+std::string script_safe(std::string_view json) {
   std::string out;
-  for (const char c : introspect::json_string(s)) {
+  out.reserve(json.size());
+  for (const char c : json) {
     switch (c) {
       case '<': out += "\\u003c"; break;
       case '>': out += "\\u003e"; break;
@@ -77,32 +79,26 @@ std::string html_escape(std::string_view s) {
   return out;
 }
 
-/// A parsed line written back as compact JSON, members in file order (comments dropped).
-void canonical(const JsonValue& v, std::string& out) {
+/// A parsed line written back as compact JSON by the JSON writer, members in file order
+/// (comments dropped).
+std::string canonical(const JsonValue& v) {
   switch (v.type) {
-    case JsonValue::Type::Null: out += "null"; return;
-    case JsonValue::Type::Bool: out += v.boolean ? "true" : "false"; return;
-    case JsonValue::Type::Number: out += num(v.number); return;
-    case JsonValue::Type::String: out += quote(v.string); return;
-    case JsonValue::Type::Array:
-      out += '[';
-      for (std::size_t i = 0; i < v.array.size(); ++i) {
-        if (i != 0) out += ',';
-        canonical(v.array[i], out);
-      }
-      out += ']';
-      return;
-    case JsonValue::Type::Object:
-      out += '{';
-      for (std::size_t i = 0; i < v.object.size(); ++i) {
-        if (i != 0) out += ',';
-        out += quote(v.object[i].key);
-        out += ':';
-        canonical(v.object[i].value, out);
-      }
-      out += '}';
-      return;
+    case JsonValue::Type::Null: return "null";
+    case JsonValue::Type::Bool: return v.boolean ? "true" : "false";
+    case JsonValue::Type::Number: return num(v.number);
+    case JsonValue::Type::String: return introspect::json_string(v.string);
+    case JsonValue::Type::Array: {
+      introspect::JsonArray a;
+      for (const JsonValue& item : v.array) a.raw(canonical(item));
+      return a.text();
+    }
+    case JsonValue::Type::Object: {
+      introspect::JsonObject o;
+      for (const auto& member : v.object) o.raw(member.key, canonical(member.value));
+      return o.text();
+    }
   }
+  return "null";
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -392,39 +388,35 @@ std::string marker_tip(const Lane& lane, const Marker& m) {
   return tip;
 }
 
-/// Writes JSON for the model, one bar, marker or band a line, so that golden diffs read well.
-class ModelWriter {
-public:
-  std::string out;
-
-  void lane(const Lane& l) {
-    // Each bar and marker is one object of the JSON writer, one a line so that golden diffs read
-    // well; strings go through quote() (JSON, safe inside <script>).
-    out += "{\"address\":" + quote(l.address) + ",\"kind\":" + (l.component ? "\"component\"" : "\"machine\"") +
-           ",\"bars\":[";
-    for (std::size_t i = 0; i < l.bars.size(); ++i) {
-      const Bar& b = l.bars[i];
-      out += i == 0 ? "\n" : ",\n";
-      introspect::JsonObject bar;
-      bar.raw("state", quote(b.state)).raw("from", num(b.from)).raw("to", b.to ? num(*b.to) : "null");
-      if (b.entered != nullptr) {
-        bar.integer("line", b.entered->line);
-        if (!b.entered->event.empty()) bar.raw("event", quote(b.entered->event));
-      }
-      out += bar.raw("tip", quote(bar_tip(l, b))).text();
+/// One lane of the model as JSON (the JSON writer), one bar or marker a line so that golden diffs
+/// read well. Not yet safe inside <script>: model_json() makes the whole text so.
+std::string lane_json(const Lane& l) {
+  using introspect::JsonArray;
+  using introspect::JsonObject;
+  JsonArray bars(JsonArray::Layout::OnePerLine);
+  for (const Bar& b : l.bars) {
+    JsonObject bar;
+    bar.str("state", b.state).raw("from", num(b.from)).raw("to", b.to ? num(*b.to) : "null");
+    if (b.entered != nullptr) {
+      bar.integer("line", b.entered->line);
+      if (!b.entered->event.empty()) bar.str("event", b.entered->event);
     }
-    out += "],\"markers\":[";
-    for (std::size_t i = 0; i < l.markers.size(); ++i) {
-      const Marker& m = l.markers[i];
-      out += i == 0 ? "\n" : ",\n";
-      introspect::JsonObject marker;
-      marker.raw("kind", quote(m.kind)).raw("t", num(m.record->t)).integer("line", m.record->line);
-      if (!m.record->event.empty()) marker.raw("event", quote(m.record->event));
-      out += marker.raw("tip", quote(marker_tip(l, m))).text();
-    }
-    out += "]}";
+    bars.raw(bar.str("tip", bar_tip(l, b)).text());
   }
-};
+  JsonArray markers(JsonArray::Layout::OnePerLine);
+  for (const Marker& m : l.markers) {
+    JsonObject marker;
+    marker.str("kind", m.kind).raw("t", num(m.record->t)).integer("line", m.record->line);
+    if (!m.record->event.empty()) marker.str("event", m.record->event);
+    markers.raw(marker.str("tip", marker_tip(l, m)).text());
+  }
+  return JsonObject()
+      .str("address", l.address)
+      .str("kind", l.component ? "component" : "machine")
+      .raw("bars", bars.text())
+      .raw("markers", markers.text())
+      .text();
+}
 
 }  // namespace
 
@@ -601,48 +593,43 @@ std::vector<const Lane*> ordered_machines(const Group& g) {
 }
 
 std::string model_json(const Model& m, std::size_t record_count) {
-  ModelWriter w;
-  w.out = "{\"start\":" + num(m.start) + ",\"end\":" + num(m.end) + ",\"records\":" + std::to_string(record_count) +
-          ",\"transitions\":" + std::to_string(m.transitions) + ",\"lanes\":" + std::to_string(m.lanes) +
-          ",\n\"overflows\":[";
-  for (std::size_t i = 0; i < m.overflows.size(); ++i) {
-    const auto& band = m.overflows[i];
-    w.out += i == 0 ? "\n" : ",\n";
+  using introspect::JsonArray;
+  using introspect::JsonObject;
+  JsonArray overflows(JsonArray::Layout::OnePerLine);
+  for (const auto& band : m.overflows) {
     const std::string tip = "The recorder dropped " + std::to_string(band.record->dropped) +
                             " records here (history line " + std::to_string(band.record->line) +
                             "): states in this interval may be incomplete.";
-    w.out += introspect::JsonObject()
-                 .integer("line", band.record->line)
-                 .integer("dropped", static_cast<long long>(band.record->dropped))
-                 .raw("from", num(band.from))
-                 .raw("to", band.to ? num(*band.to) : "null")
-                 .raw("tip", quote(tip))
-                 .text();
+    overflows.raw(JsonObject()
+                      .integer("line", band.record->line)
+                      .integer("dropped", static_cast<long long>(band.record->dropped))
+                      .raw("from", num(band.from))
+                      .raw("to", band.to ? num(*band.to) : "null")
+                      .str("tip", tip)
+                      .text());
   }
-  w.out += "],\n\"groups\":[";
-  for (std::size_t gi = 0; gi < m.groups.size(); ++gi) {
-    const Group& g = m.groups[gi];
-    w.out += gi == 0 ? "\n" : ",\n";
-    w.out += "{\"component\":" + quote(g.component) + ",\"lanes\":[\n";
-    w.lane(g.extended);
-    for (const Lane* l : ordered_machines(g)) {
-      w.out += ",\n";
-      w.lane(*l);
-    }
-    w.out += "]}";
+  JsonArray groups(JsonArray::Layout::OnePerLine);
+  for (const Group& g : m.groups) {
+    JsonArray lanes(JsonArray::Layout::OnePerLine);
+    lanes.raw(lane_json(g.extended));
+    for (const Lane* l : ordered_machines(g)) lanes.raw(lane_json(*l));
+    groups.raw(JsonObject().str("component", g.component).raw("lanes", lanes.text()).text());
   }
-  w.out += "]}";
-  return w.out;
+  JsonObject model;
+  model.raw("start", num(m.start))
+      .raw("end", num(m.end))
+      .integer("records", static_cast<long long>(record_count))
+      .integer("transitions", static_cast<long long>(m.transitions))
+      .integer("lanes", static_cast<long long>(m.lanes));
+  model.line_break().raw("overflows", overflows.text());
+  model.line_break().raw("groups", groups.text());
+  return script_safe(model.text());
 }
 
 std::string history_json(const std::vector<HistoryRecord>& records) {
-  if (records.empty()) return "[]";
-  std::string out = "[\n";
-  for (std::size_t i = 0; i < records.size(); ++i) {
-    if (i != 0) out += ",\n";
-    canonical(records[i].json, out);
-  }
-  return out + "\n]";
+  introspect::JsonArray lines(introspect::JsonArray::Layout::OnePerLine);
+  for (const HistoryRecord& r : records) lines.raw(canonical(r.json));
+  return script_safe(lines.text());
 }
 
 std::string summary_text(const Model& m, std::size_t record_count) {

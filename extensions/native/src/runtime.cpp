@@ -1,6 +1,10 @@
 #include "safecass/native/runtime.hpp"
 
+#include <time.h>
+
+#include <cerrno>
 #include <chrono>
+#include <cstdint>
 
 namespace safecass::native {
 
@@ -72,32 +76,54 @@ void Runtime::step(Time now) noexcept {
   }
 }
 
+namespace {
+
+std::int64_t monotonic_ns() noexcept {
+  timespec ts{};
+  ::clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+/// Sleeps until `deadline` (ns of CLOCK_MONOTONIC, the clock of std::chrono::steady_clock on
+/// Linux): an absolute deadline, so a period does not drift by the time spent computing the next
+/// wake-up or by a signal that interrupts the sleep.
+void sleep_until_ns(std::int64_t deadline) noexcept {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(deadline / 1'000'000'000);
+  ts.tv_nsec = static_cast<long>(deadline % 1'000'000'000);
+  while (::clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
+}
+
+}  // namespace
+
 void Runtime::start() {
   if (!threads_.empty()) return;
   stop_.store(false);
   for (Task& task : tasks_) {
     threads_.emplace_back([this, &task] {
       const MachineId framework = coordinator_.framework_machine(task.component);
-      auto next = std::chrono::steady_clock::now();
+      const std::int64_t period = task.period.count();
+      std::int64_t next = monotonic_ns();
       while (!stop_.load(std::memory_order_acquire)) {
-        const auto begin = std::chrono::steady_clock::now();
+        const std::int64_t begin = monotonic_ns();
         cycle(task, coordinator_.clock().now());
-        const auto spent = std::chrono::steady_clock::now() - begin;
-        const bool overran = spent > task.period;
+        const std::int64_t end = monotonic_ns();
+        const bool overran = end - begin > period;
         if (overran != task.overran) {
           task.overran = overran;
           coordinator_.generate(overran ? framework_event::kPeriodOverrun
                                         : framework_event::completion_of(framework_event::kPeriodOverrun),
                                 framework);
         }
-        next += task.period;
-        const auto now = std::chrono::steady_clock::now();
-        if (next < now) next = now;  // do not try to catch up missed cycles in a burst
-        std::this_thread::sleep_until(next);
+        next += period;
+        if (next < end) next = end;  // do not try to catch up missed cycles in a burst
+        sleep_until_ns(next);
       }
     });
   }
-  monitor_.start(monitor_period_);
+  // The monitor thread runs PASSIVE filters only: without any, it would only wake up for nothing.
+  if (monitor_.passive_count() > 0) monitor_.start(monitor_period_);
 }
 
 void Runtime::stop() noexcept {

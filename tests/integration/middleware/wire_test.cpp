@@ -37,6 +37,7 @@
 #include "safecass.h"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
@@ -492,6 +493,156 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   EXPECT_EQ(output().find("again"), std::string::npos) << "a replayed record is not printed\n" << output();
   EXPECT_GE((*supervisor)->messages_refused(), 3u);
   (*supervisor)->stop();
+}
+
+/// What a supervisor printed, kept by the test (the lines' text is made only here, on demand).
+struct SupervisorOutput {
+  std::mutex mutex;
+  std::string text;
+  std::size_t records = 0;  ///< Record lines of a coordinator (not of the supervisor's own model)
+  void operator()(const middleware::SupervisorLine& line) {
+    std::lock_guard lock(mutex);
+    if (line.kind() == middleware::SupervisorLine::Kind::Record && !line.coordinator().empty()) ++records;
+    text += line.text() + "\n";
+  }
+  std::string all() {
+    std::lock_guard lock(mutex);
+    return text;
+  }
+};
+
+std::optional<State> view_state(const middleware::Supervisor& s, const std::string& address) {
+  for (const middleware::ViewRow& row : s.view()) {
+    if (row.address == address) return row.state;
+  }
+  return std::nullopt;
+}
+
+TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  ASSERT_TRUE(supervisor) << supervisor.error().message;
+  ASSERT_TRUE((*supervisor)->start());
+  ASSERT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
+      << out.all();
+  const middleware::Supervisor& sup = **supervisor;
+
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
+  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
+  bus.send(*bus.provider, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
+  const auto refused = sup.messages_refused();
+  // The genuine, signed update 2 again: authentic, but older than what the view holds.
+  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() > refused; })) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
+  EXPECT_NE(out.all().find("for P.D0: seq 2 not above 3 (replayed)"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("[wire-p] P.s_S.D0 Error (roots P.s_A:EVT_E)"), std::string::npos) << out.all();
+  (*supervisor)->stop();
+}
+
+TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReportsMissedOnesAndLosesASilentCoordinator) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.lost_after = 300ms;
+  options.records = false;
+  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  ASSERT_TRUE(supervisor) << supervisor.error().message;
+  ASSERT_TRUE((*supervisor)->start());
+  ASSERT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
+      << out.all();
+  const middleware::Supervisor& sup = **supervisor;
+
+  bus.send(*bus.provider, {update("P.D1", 1, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D1") == State::Error; })) << out.all();
+  EXPECT_NE(out.all().find("[wire-p] P.s_S.D1 Error (roots P.s_A:EVT_E)\n"), std::string::npos) << out.all();
+
+  // A forged update (the attacker's key under the provider's name) changes nothing.
+  bus.send(*bus.attacker, {update("P.D1", 2, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() >= 1; })) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_S.D1"), State::Error);
+
+  // Event records are not followed: a genuine reset record prints nothing.
+  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
+  std::shared_ptr<IceStorm::TopicPrx> topic;
+  try {
+    topic = manager->retrieve("safecass.events");
+  } catch (const IceStorm::NoSuchTopic&) {
+    topic = manager->create("safecass.events");
+  }
+  auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
+  wire::EventMessage m{};
+  m.coordinator = "wire-p";
+  m.incarnation = kIncarnation;
+  m.seq = 1;
+  m.kind = "reset";
+  m.address = "P";
+  m.text = "operator: not followed";
+  events->records(
+      bus.provider->sign(middleware::detail::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
+
+  // An update the heartbeat lists but that never came: reported after two heartbeats.
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.last_sent["P.D2"] = 4;
+  }
+  EXPECT_TRUE(eventually([&] {
+    return out.all().find("supervisor: 4 state update(s) of 'wire-p' missed; asking for its full state") !=
+           std::string::npos;
+  })) << out.all();
+  EXPECT_EQ(out.all().find("not followed"), std::string::npos) << out.all();
+  EXPECT_EQ(out.records, 0u) << out.all();
+
+  // A coordinator that falls silent is lost: the view gets worse, never stale-green.
+  bus.beating.store(false);
+  EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
+  EXPECT_TRUE(eventually([&] { return sup.model().state(*sup.model().find_machine("P.s_F")) == State::Error; }))
+      << out.all();
+  (*supervisor)->stop();
+}
+
+TEST(Wire, SupervisorLinesAreTheReadModelsLiveLinesTaggedWithTheCoordinatorAndOnOneLine) {
+  introspect::HistoryEntry e;
+  e.kind = RecordKind::Transition;
+  e.machine = "JR3.s_A";
+  e.component = "JR3";
+  e.from = State::Normal;
+  e.to = State::Error;
+  e.event = "EVT_FORCE_ERROR";
+  e.root.emplace();
+  e.root->event = "EVT_FORCE_ERROR";
+  e.root->origin = "JR3.s_A";
+  EXPECT_EQ(introspect::live_line(e), "JR3.s_A Normal -> Error EVT_FORCE_ERROR (root JR3.s_A:EVT_FORCE_ERROR)");
+  EXPECT_EQ(middleware::SupervisorLine::of_record("robot", e).text(), "[robot] " + introspect::live_line(e));
+  EXPECT_EQ(middleware::SupervisorLine::of_record("", e).text(), "supervisor: " + introspect::live_line(e));
+  EXPECT_EQ(middleware::SupervisorLine::of_record("robot", e).record(), &e);
+  introspect::HistoryEntry reset;
+  reset.kind = RecordKind::Reset;
+  reset.component = "BMM";
+  reset.text = "operator\n[robot] FAKE";
+  EXPECT_EQ(middleware::SupervisorLine::of_record("robot", reset).text(),
+            "[robot] reset BMM (operator\\x0a[robot] FAKE)");
+  EXPECT_EQ(middleware::SupervisorLine::of_state("ui", "C.s_S.Out", State::Warning, "roots JR3.s_A:EVT_W").text(),
+            "[ui] C.s_S.Out Warning (roots JR3.s_A:EVT_W)");
+  EXPECT_EQ(middleware::SupervisorLine::of_state("ui", "C.s_S.Out", State::Normal, "").text(), "[ui] C.s_S.Out Normal");
+  EXPECT_EQ(middleware::SupervisorLine::notice("supervisor: coordinator 'ui' is up").kind(),
+            middleware::SupervisorLine::Kind::Notice);
 }
 
 TEST(Wire, ACoordinatorReportsAnotherProcessRunningUnderItsName) {

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/json.hpp"
 #include "safecass/trace/trace.hpp"
 
@@ -37,41 +38,57 @@ std::string filter_text(const FilterLink& f) {
   return out;
 }
 
-std::string q(std::string_view s) { return spec::json_quote(s); }
-
-std::string json_strings(const std::vector<std::string>& items) {
-  std::string out = "[";
-  for (std::size_t k = 0; k < items.size(); ++k) out += (k == 0 ? "" : ",") + q(items[k]);
-  return out + "]";
-}
+using introspect::JsonArray;
+using introspect::JsonObject;
 
 std::string json_where(const spec::Position& p) {
-  return "{\"file\":" + q(p.file) + ",\"line\":" + std::to_string(p.line) + ",\"column\":" + std::to_string(p.column) +
-         "}";
+  return JsonObject()
+      .str("file", p.file)
+      .integer("line", static_cast<long long>(p.line))
+      .integer("column", static_cast<long long>(p.column))
+      .text();
 }
 
 std::string json_filter(const FilterLink& f) {
-  return "{\"name\":" + q(f.name) + ",\"pipeline\":" + q(f.pipeline) + ",\"chain\":" + json_strings(f.chain) +
-         ",\"class\":" + q(f.type) + ",\"component\":" + q(f.component) + ",\"target\":" + q(f.target) +
-         ",\"signals\":" + q(f.signals) + ",\"threshold\":" + q(f.threshold) +
-         ",\"parameters\":" + json_strings(f.parameters) + ",\"execution\":" + q(f.execution) +
-         ",\"period\":" + q(f.period) + ",\"role\":" + q(f.role) + ",\"where\":" + json_where(f.where) + "}";
+  return JsonObject()
+      .str("name", f.name)
+      .str("pipeline", f.pipeline)
+      .strings("chain", f.chain)
+      .str("class", f.type)
+      .str("component", f.component)
+      .str("target", f.target)
+      .str("signals", f.signals)
+      .str("threshold", f.threshold)
+      .strings("parameters", f.parameters)
+      .str("execution", f.execution)
+      .str("period", f.period)
+      .str("role", f.role)
+      .raw("where", json_where(f.where))
+      .text();
 }
 
 std::string json_event(const EventLink& e) {
-  std::string out = "{\"name\":" + q(e.name) + ",\"component\":" + q(e.component) +
-                    ",\"role\":" + q(e.onset ? "onset" : "completion") + ",\"severity\":" + std::to_string(e.severity) +
-                    ",\"level\":" + q(e.level) + ",\"transitions\":" + q(e.transitions) +
-                    ",\"targets\":" + json_strings(e.targets) + ",\"latched\":" + (e.latched ? "true" : "false") +
-                    ",\"completion\":" + q(e.completion) + ",\"filters\":[";
-  for (std::size_t k = 0; k < e.filters.size(); ++k) out += (k == 0 ? "" : ",") + json_filter(e.filters[k]);
-  out += "],\"fired_by\":[";
-  for (std::size_t k = 0; k < e.fired_by.size(); ++k) {
-    out += std::string(k == 0 ? "" : ",") + "{\"scenario\":" + q(e.fired_by[k].scenario) +
-           ",\"transitions\":" + json_strings(e.fired_by[k].transitions) + "}";
+  JsonArray filters;
+  for (const FilterLink& f : e.filters) filters.raw(json_filter(f));
+  JsonArray fired_by;
+  for (const ScenarioUse& u : e.fired_by) {
+    fired_by.raw(JsonObject().str("scenario", u.scenario).strings("transitions", u.transitions).text());
   }
-  out += "],\"cleared_by\":" + json_strings(e.cleared_by) + ",\"where\":" + json_where(e.where) + "}";
-  return out;
+  return JsonObject()
+      .str("name", e.name)
+      .str("component", e.component)
+      .str("role", e.onset ? "onset" : "completion")
+      .integer("severity", e.severity)
+      .str("level", e.level)
+      .str("transitions", e.transitions)
+      .strings("targets", e.targets)
+      .boolean("latched", e.latched)
+      .str("completion", e.completion)
+      .raw("filters", filters.text())
+      .raw("fired_by", fired_by.text())
+      .strings("cleared_by", e.cleared_by)
+      .raw("where", json_where(e.where))
+      .text();
 }
 
 /// RFC 4180: a field with a comma, a quote, CR or LF is quoted, its quotes doubled.
@@ -152,55 +169,82 @@ std::string trace_text(const Trace& t) {
 }
 
 std::string trace_json(const Trace& t) {
-  std::string out = "{\"system\":" + q(t.system) + ",\"path\":" + q(t.system_path) +
-                    ",\"version\":" + q(tool_version()) + ",\"files\":[";
-  for (std::size_t k = 0; k < t.files.size(); ++k) {
-    out += std::string(k == 0 ? "" : ",") + "{\"path\":" + q(t.files[k].path) + ",\"sha256\":" + q(t.files[k].sha256) +
-           "}";
-  }
-  out += "],\"hazards\":[";
-  for (std::size_t k = 0; k < t.hazards.size(); ++k) {
-    const HazardTrace& h = t.hazards[k];
-    out += std::string(k == 0 ? "" : ",") + "{\"id\":" + q(h.id) + ",\"description\":" + q(h.description) +
-           ",\"events\":[";
-    for (std::size_t e = 0; e < h.events.size(); ++e) out += (e == 0 ? "" : ",") + json_event(h.events[e]);
-    out += "],\"reaction\":[";
-    for (std::size_t r = 0; r < h.reaction.size(); ++r) {
-      out += std::string(r == 0 ? "" : ",") + "{\"address\":" + q(h.reaction[r].address) +
-             ",\"level\":" + q(h.reaction[r].level) + ",\"checked_by\":" + json_strings(h.reaction[r].checked_by) +
-             ",\"where\":" + json_where(h.reaction[r].where) + "}";
+  JsonArray files;
+  for (const SpecFile& f : t.files) files.raw(JsonObject().str("path", f.path).str("sha256", f.sha256).text());
+  JsonArray hazards;
+  for (const HazardTrace& h : t.hazards) {
+    JsonArray events;
+    for (const EventLink& e : h.events) events.raw(json_event(e));
+    JsonArray reaction;
+    for (const ReactionLink& r : h.reaction) {
+      reaction.raw(JsonObject()
+                       .str("address", r.address)
+                       .str("level", r.level)
+                       .strings("checked_by", r.checked_by)
+                       .raw("where", json_where(r.where))
+                       .text());
     }
-    out += "],\"verify\":" + q(to_string(h.verified)) + ",\"verify_detail\":" + q(h.verify_detail) +
-           ",\"excerpt\":{\"scenario\":" + q(h.excerpt_scenario) +
-           ",\"components\":" + json_strings(h.excerpt_components) + "}" + ",\"where\":" + json_where(h.where) + "}";
+    hazards.raw(
+        JsonObject()
+            .str("id", h.id)
+            .str("description", h.description)
+            .raw("events", events.text())
+            .raw("reaction", reaction.text())
+            .str("verify", to_string(h.verified))
+            .str("verify_detail", h.verify_detail)
+            .raw("excerpt",
+                 JsonObject().str("scenario", h.excerpt_scenario).strings("components", h.excerpt_components).text())
+            .raw("where", json_where(h.where))
+            .text());
   }
-  out += "],\"unlinked\":[";
-  for (std::size_t k = 0; k < t.unlinked.size(); ++k) out += (k == 0 ? "" : ",") + json_event(t.unlinked[k]);
-  out += "],\"scenarios\":[";
-  for (std::size_t k = 0; k < t.scenarios.size(); ++k) {
-    const ScenarioResult& s = t.scenarios[k];
-    out += std::string(k == 0 ? "" : ",") + "{\"path\":" + q(s.path) + ",\"passed\":" + (s.passed ? "true" : "false") +
-           ",\"checks\":" + std::to_string(s.checks) + ",\"failures\":" + json_strings(s.failures) + "}";
+  JsonArray unlinked;
+  for (const EventLink& e : t.unlinked) unlinked.raw(json_event(e));
+  JsonArray scenarios;
+  for (const ScenarioResult& sc : t.scenarios) {
+    scenarios.raw(JsonObject()
+                      .str("path", sc.path)
+                      .boolean("passed", sc.passed)
+                      .integer("checks", static_cast<long long>(sc.checks))
+                      .strings("failures", sc.failures)
+                      .text());
   }
-  out += "],\"gaps\":[";
-  for (std::size_t k = 0; k < t.gaps.size(); ++k) {
-    const Gap& g = t.gaps[k];
-    out += std::string(k == 0 ? "" : ",") + "{\"severity\":" + q(to_string(g.severity)) + ",\"kind\":" + q(g.kind) +
-           ",\"hazard\":" + q(g.hazard) + ",\"subject\":" + q(g.subject) + ",\"message\":" + q(g.message) +
-           ",\"where\":" + json_where(g.where) + "}";
+  JsonArray gaps;
+  for (const Gap& g : t.gaps) {
+    gaps.raw(JsonObject()
+                 .str("severity", to_string(g.severity))
+                 .str("kind", g.kind)
+                 .str("hazard", g.hazard)
+                 .str("subject", g.subject)
+                 .str("message", g.message)
+                 .raw("where", json_where(g.where))
+                 .text());
   }
   const Coverage& c = t.coverage;
-  out += "],\"coverage\":{\"hazards\":" + std::to_string(c.hazards) +
-         ",\"hazards_detected\":" + std::to_string(c.hazards_detected) +
-         ",\"hazards_exercised\":" + std::to_string(c.hazards_exercised) +
-         ",\"reactions\":" + std::to_string(c.reactions) +
-         ",\"reactions_checked\":" + std::to_string(c.reactions_checked) +
-         ",\"events_defined\":" + std::to_string(c.events_defined) +
-         ",\"events_fired\":" + std::to_string(c.events_fired) +
-         ",\"transitions_defined\":" + std::to_string(c.transitions_defined) +
-         ",\"transitions_taken\":" + std::to_string(c.transitions_taken) + "},\"verify_source\":" + q(t.verify_source) +
-         ",\"error_gaps\":" + (t.has_error_gap() ? "true" : "false") + "}\n";
-  return out;
+  const std::string coverage = JsonObject()
+                                   .integer("hazards", static_cast<long long>(c.hazards))
+                                   .integer("hazards_detected", static_cast<long long>(c.hazards_detected))
+                                   .integer("hazards_exercised", static_cast<long long>(c.hazards_exercised))
+                                   .integer("reactions", static_cast<long long>(c.reactions))
+                                   .integer("reactions_checked", static_cast<long long>(c.reactions_checked))
+                                   .integer("events_defined", static_cast<long long>(c.events_defined))
+                                   .integer("events_fired", static_cast<long long>(c.events_fired))
+                                   .integer("transitions_defined", static_cast<long long>(c.transitions_defined))
+                                   .integer("transitions_taken", static_cast<long long>(c.transitions_taken))
+                                   .text();
+  return JsonObject()
+             .str("system", t.system)
+             .str("path", t.system_path)
+             .str("version", tool_version())
+             .raw("files", files.text())
+             .raw("hazards", hazards.text())
+             .raw("unlinked", unlinked.text())
+             .raw("scenarios", scenarios.text())
+             .raw("gaps", gaps.text())
+             .raw("coverage", coverage)
+             .str("verify_source", t.verify_source)
+             .boolean("error_gaps", t.has_error_gap())
+             .text() +
+         "\n";
 }
 
 std::string trace_csv(const Trace& t) {

@@ -178,7 +178,8 @@ private:
       invalid_sample(input, sample, true);
       return;
     }
-    if (invalid_[input] != 0) invalid_sample(input, sample, false);
+    // invalid_count_ (in the object's first cache line) spares the common case a look at invalid_.
+    if (invalid_count_ != 0 && invalid_[input] != 0) invalid_sample(input, sample, false);
     cursors_[input].keep();
     on_sample(input, sample);
   }
@@ -189,18 +190,8 @@ private:
   /// The first input's newest sample, judged again at `now` (the end of a shallow injection).
   void restore_reality(Time now) noexcept;
 
-  FilterConfig config_;
-  Coordinator* coordinator_;
-  MachineId target_;
-  ComponentId component_;
-  std::vector<Signal*> inputs_;
-  std::vector<Signal*> outputs_;
-  std::vector<SignalCursor> cursors_;  ///< per input; each keeps the input's newest finite sample
-  std::vector<SampleView> pending_;    ///< merge of several inputs: next sample of each
-  std::vector<char> has_pending_;
-  EventId onset_;
-  EventId completion_;
-  NameId name_id_;
+  // What every run() reads comes first, so that it shares the object's first cache line with the
+  // virtual table pointer (a monitor runs thousands of filters per tick: each line is a miss).
   // Why run() leaves its hot path, as bits of detour_: set_enabled() and inject() set them from
   // any thread; run_general() sets and clears kReenabled; kSeveralInputs is set at creation.
   static constexpr std::uint8_t kDisabled = 1;       ///< set_enabled(false)
@@ -210,10 +201,23 @@ private:
   static constexpr std::uint8_t kRestore = 16;       ///< a shallow injection ended: judge reality once
   std::atomic<std::uint8_t> detour_{0};
   std::atomic<bool> detected_{false};
-  std::vector<char> invalid_;      ///< per input: its last sample was not finite
-  std::size_t invalid_count_ = 0;  ///< inputs marked in invalid_
   bool current_injected_ = false;
-  bool ticks_ = true;  ///< on_tick is overridden (cleared by the default on its first call)
+  bool ticks_ = true;                  ///< on_tick is overridden (cleared by the default on its first call)
+  std::size_t invalid_count_ = 0;      ///< inputs marked in invalid_
+  std::vector<SignalCursor> cursors_;  ///< per input; each keeps the input's newest finite sample
+  std::vector<char> invalid_;          ///< per input: its last sample was not finite
+
+  FilterConfig config_;
+  Coordinator* coordinator_;
+  MachineId target_;
+  ComponentId component_;
+  std::vector<Signal*> inputs_;
+  std::vector<Signal*> outputs_;
+  std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
+  std::vector<char> has_pending_;
+  EventId onset_;
+  EventId completion_;
+  NameId name_id_;
 
   std::mutex injection_mutex_;  ///< guards injections_ and kInjection
   std::deque<std::vector<double>> injections_;

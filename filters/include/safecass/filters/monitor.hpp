@@ -55,6 +55,8 @@ public:
   void run_active(ComponentId component, Time now) noexcept;
   /// Runs every PASSIVE filter once, in creation order (one monitor tick).
   void tick(Time now) noexcept;
+  /// The number of PASSIVE filters (a runtime need not start the monitor thread without any).
+  std::size_t passive_count() const noexcept { return passive_.size(); }
 
   /// Starts the monitor thread: tick(clock.now()) every `period` of real time.
   void start(std::chrono::nanoseconds period = kDefaultPeriod);

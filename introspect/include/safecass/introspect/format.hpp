@@ -9,6 +9,7 @@
 /// times as seconds of the system's clock ("t":0.301000), the history-file format.
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "safecass/introspect/model.hpp"
@@ -57,6 +58,17 @@ std::string history_json(const HistoryEntry& e);
 /// Whether `watch` shows a record as it happens: transitions, resets, injections, and masked or
 /// ignored events.
 bool shown_while_watching(const HistoryEntry& e) noexcept;
+
+// ---- lines of a live log (`safecass run`, the supervisor) ----------------------------------------
+
+/// A record as one line of a live log, after the reporter's tag ("[robot] ", "supervisor: "):
+/// a transition "JR3.s_A Normal -> Error EVT_FORCE_ERROR (root JR3.s_A:EVT_FORCE_ERROR)", a reset
+/// "reset BMM (operator: why)", an event "JR3.s_A masked EVT_X", an injection "JR3.s_A injection
+/// (text)". Names are copied as they are: a caller that prints text from a message escapes it.
+std::string live_line(const HistoryEntry& e);
+/// A state as one line of a live log: "C.s_S.Out Error (roots JR3.s_A:EVT_X)"; the note in
+/// brackets is left out when empty.
+std::string live_state_line(std::string_view address, State state, std::string_view note);
 
 // ---- explanations -----------------------------------------------------------------------------
 

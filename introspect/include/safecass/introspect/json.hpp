@@ -8,6 +8,7 @@
 /// (JSON has neither). Seconds: fixed with six decimals (json_seconds), the history-file format.
 /// Thread-safety: free functions are pure; a JsonObject/JsonArray is used by one thread.
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,23 +48,35 @@ public:
   JsonObject& strings(std::string_view key, const std::vector<std::string>& items) {
     return raw(key, json_string_array(items));
   }
+  /// The next member starts a new line (a file that diffs well: one large member a line).
+  JsonObject& line_break() {
+    break_ = true;
+    return *this;
+  }
   /// The object's text.
   std::string text() const { return text_ + "}"; }
 
 private:
+  void key(std::string_view key);
   std::string text_ = "{";
+  bool break_ = false;
 };
 
 /// One JSON array of JSON texts: JsonArray().raw("1").raw("\"x\"").text() == [1,"x"].
 class JsonArray {
 public:
+  /// Compact, or each item on a line of its own: [\n1,\n"x"] (golden files that diff well).
+  enum class Layout : std::uint8_t { Compact, OnePerLine };
+  explicit JsonArray(Layout layout = Layout::Compact) : layout_(layout) {}
   JsonArray& raw(std::string_view json);
   JsonArray& str(std::string_view value);
   bool empty() const noexcept { return text_.size() == 1; }
   std::string text() const { return text_ + "]"; }
 
 private:
+  void next();
   std::string text_ = "[";
+  Layout layout_ = Layout::Compact;
 };
 
 }  // namespace safecass::introspect

@@ -11,17 +11,22 @@
 /// accessors are thread-safe. Lifecycle: create → start → stop (or destructor).
 
 #include <chrono>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
+#include "safecass/introspect/model.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/spec/system.hpp"
 
 namespace safecass::middleware {
+
+class SupervisorLine;
 
 struct SupervisorOptions {
   IceEndpoint ice;
@@ -34,8 +39,54 @@ struct SupervisorOptions {
   TlsOptions tls;
   /// Accept a non-loopback endpoint without TLS (docs/security.md).
   bool insecure = false;
-  /// Receives each output line (transitions as they arrive, lost/recovered). Default: stdout.
+  /// Follow the event records (safecass.events): every transition of every machine and component,
+  /// the system-wide history. false: the state topics and heartbeats only, so the view holds the
+  /// provided interfaces' service states with their root causes (what a status aggregator shows),
+  /// at a fraction of the cost; a lost or stale state stream is detected from the heartbeats and
+  /// resynchronised (docs/middleware.md, "The supervisor").
+  bool records = true;
+  /// Receives each output line (transitions as they arrive, states, lost/recovered). The line is
+  /// formatted only when the consumer calls text(). Default: `print`.
+  std::function<void(const SupervisorLine&)> output;
+  /// Receives the text of each output line when `output` is not set. Default: stdout.
   std::function<void(const std::string&)> print;
+};
+
+/// One line of the supervisor's output, formatted by the read model's formatter
+/// (introspect::live_line, live_state_line) only when text() is called: a consumer that counts or
+/// filters lines does not pay for their text. Valid only during the call that receives it.
+class SupervisorLine {
+public:
+  enum class Kind : std::uint8_t {
+    Record,  ///< a transition or reset a coordinator reported (or one in the supervisor's own model)
+    State,   ///< a service state a coordinator reported, a row refreshed, or a row of the view
+    Notice,  ///< the supervisor's own notices: connected, up, lost, recovered, missed, refused
+  };
+  /// "[COORDINATOR] " + introspect::live_line(record), or "supervisor: " + it for the supervisor's
+  /// own model (coordinator empty).
+  static SupervisorLine of_record(std::string_view coordinator, const introspect::HistoryEntry& record) noexcept;
+  /// "[COORDINATOR] " + introspect::live_state_line(address, state, note).
+  static SupervisorLine of_state(std::string_view coordinator, std::string_view address, State state,
+                                 std::string_view note) noexcept;
+  static SupervisorLine notice(std::string_view text) noexcept;
+
+  Kind kind() const noexcept { return kind_; }
+  /// The coordinator that reported it (empty: the supervisor itself).
+  std::string_view coordinator() const noexcept { return coordinator_; }
+  /// The record of a Record line, else nullptr.
+  const introspect::HistoryEntry* record() const noexcept { return record_; }
+  /// The line as printed: one line, names from messages escaped (no control character, so a
+  /// forged name cannot add a line).
+  std::string text() const;
+
+private:
+  SupervisorLine() = default;
+  Kind kind_ = Kind::Notice;
+  std::string_view coordinator_;
+  const introspect::HistoryEntry* record_ = nullptr;
+  std::string_view address_;
+  State state_ = State::Normal;
+  std::string_view note_;
 };
 
 /// One line of the system-wide view.
@@ -43,7 +94,7 @@ struct ViewRow {
   std::string coordinator;
   std::string address;
   State state = State::Normal;
-  std::string cause;  ///< "origin:event" of the last transition, empty when Normal
+  std::string cause;  ///< "origin:event" of the last transition (a service: "origin:event, ..."), empty when Normal
 };
 
 class Supervisor {
