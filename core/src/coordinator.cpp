@@ -113,7 +113,7 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
     completion.completes = spec.name;
     completion.counterpart = onset_id;
     const EventId completion_id = add_event_unchecked(std::move(completion));
-    events_[onset_id].counterpart = completion_id;
+    events_[to_index(onset_id)].counterpart = completion_id;
   }
   SAFECASS_ASSERT(events_.size() == framework_event::kCount);
 }
@@ -121,7 +121,7 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
 Coordinator::~Coordinator() = default;
 
 EventId Coordinator::add_event_unchecked(Event event) {
-  event.id = static_cast<EventId>(events_.size());
+  event.id = id_at<EventId>(events_.size());
   events_.push_back(std::move(event));
   event_table_.push_back(&events_.back());  // deque elements never move
   return events_.back().id;
@@ -139,7 +139,7 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
     return fail(ErrorCode::InvalidArgument,
                 "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
-  const auto id = static_cast<ComponentId>(components_.size());
+  const auto id = id_at<ComponentId>(components_.size());
   ComponentData& cd = components_.emplace_back();
   cd.name = std::string(name);
   cd.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
@@ -158,11 +158,11 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   m.iface = iface;
   m.address = std::move(address);
   m.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
-  const auto id = static_cast<MachineId>(machines_.size() - 1);
+  const auto id = id_at<MachineId>(machines_.size() - 1);
   ComponentData& c = components_[component];
   if (c.machine_count == 0) {
     c.first_machine = id;
-  } else if (c.first_machine + c.machine_count != id) {
+  } else if (to_index(c.first_machine) + c.machine_count != to_index(id)) {
     c.contiguous = false;
   }
   ++c.machine_count;
@@ -171,12 +171,12 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   summaries_.resize(machines_.size());
   visit_marks_.resize(machines_.size(), 0);
   if (work_.capacity() < machines_.size()) work_.reserve(2 * machines_.size());
-  return static_cast<MachineId>(machines_.size() - 1);
+  return id;
 }
 
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -198,8 +198,8 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 }
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -248,7 +248,7 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
     // A completion defined earlier may be waiting for this onset.
     for (Event& other : events_) {
       if (!other.is_onset && other.counterpart == kNoEvent && other.completes == def.name) {
-        other.counterpart = static_cast<EventId>(events_.size());
+        other.counterpart = id_at<EventId>(events_.size());
         e.counterpart = other.id;
       }
     }
@@ -263,12 +263,12 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
       e.completes = def.name.substr(1);
     }
     if (auto o = find_event(e.completes)) {
-      Event& target = events_[*o];
+      Event& target = events_[to_index(*o)];
       if (!target.is_onset) {
         return fail(ErrorCode::InvalidArgument, where + ": completes '" + e.completes + "', which is not an onset");
       }
       e.counterpart = *o;
-      if (target.counterpart == kNoEvent) target.counterpart = static_cast<EventId>(events_.size());
+      if (target.counterpart == kNoEvent) target.counterpart = id_at<EventId>(events_.size());
     }
   }
   return add_event_unchecked(std::move(e));
@@ -276,8 +276,8 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
 
 Expected<void> Coordinator::set_service(ComponentId component, std::string_view provided,
                                         const ServiceDependency& dependency) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
@@ -364,14 +364,14 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
                                                 ": a component cannot require its own service");
   }
   if (cc.required_connection[r] != kNoConnection) {
-    const Connection& old = connections_[cc.required_connection[r]];
+    const Connection& old = connections_[to_index(cc.required_connection[r])];
     return fail(ErrorCode::Duplicate,
                 "required interface " + std::string(client_required) + " is already connected to " +
                     components_[old.provider].name + "." +
                     std::string(interface_name(components_[old.provider].provided[old.provided])));
   }
   Lock lock(*this);
-  const auto id = static_cast<ConnectionId>(connections_.size());
+  const auto id = id_at<ConnectionId>(connections_.size());
   connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
   pc.provider_connections.push_back(id);
@@ -381,7 +381,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   // are all Normal there is nothing to carry (the common case while a system is being built).
   if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
   processing_ = true;
-  for (MachineId m = 0; m < machines_.size(); ++m) {
+  for (MachineId m : id_range<MachineId>(machines_.size())) {
     const std::vector<Condition> snapshot(machines_[m].conditions.begin(), machines_[m].conditions.end());
     for (const Condition& c : snapshot) {
       // Roots, and remote roots at the remote provided interface that holds them.
@@ -414,7 +414,7 @@ void Coordinator::rebuild_fanout(ComponentId provider_id) {
   const std::vector<MachineId> machines = component_machines(provider);
   for (MachineId m : machines) machines_[m].fanout.clear();
   for (ConnectionId k : provider.provider_connections) {
-    const Connection& conn = connections_[k];
+    const Connection& conn = connections_[to_index(k)];
     const MachineId client_machine = components_[conn.client].required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
     for (MachineId m : machines) {
@@ -545,8 +545,8 @@ NameId Coordinator::intern(std::string_view text) {
 
 std::string_view Coordinator::name_of(NameId id) const {
   std::lock_guard lock(names_mutex_);
-  if (id >= names_.size()) return {};
-  return names_[id];
+  if (to_index(id) >= names_.size()) return {};
+  return names_[to_index(id)];
 }
 
 // ---- reads -----------------------------------------------------------------------------------
@@ -567,7 +567,7 @@ State Coordinator::service_state(ComponentId component, std::uint32_t provided) 
 
 State Coordinator::coordinator_state() const noexcept {
   State s = State::Normal;
-  for (ComponentId c = 0; c < components_.size(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(components_.size())) {
     if (!components_[c].remote) s = s * extended_state(c);
   }
   return s;
@@ -658,7 +658,7 @@ void Coordinator::unsubscribe(SubscriptionId id) {
 
 void Coordinator::publish(Record record) {
   Lock lock(*this);
-  if (record.machine != kNoMachine && record.machine < machines_.size()) {
+  if (record.machine != kNoMachine && machines_.contains(record.machine)) {
     record.component = machines_[record.machine].component;
     record_machine(record.machine, record);
   } else {
@@ -686,8 +686,8 @@ void Coordinator::record_machine(MachineId id, Record& r) noexcept {
 // ---- event processing ------------------------------------------------------------------------
 
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
-  SAFECASS_ASSERT(event < event_table_.size());
-  SAFECASS_ASSERT(target < machines_.size() || event_table_[event]->is_broadcast());
+  SAFECASS_ASSERT(to_index(event) < event_table_.size());
+  SAFECASS_ASSERT(machines_.contains(target) || event_table_[to_index(event)]->is_broadcast());
   Lock lock(*this);
   if (processing_) {
     pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName});
@@ -702,7 +702,7 @@ void Coordinator::generate(EventId event, MachineId target, const SampleCause& c
 Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
   auto e = find_event(event);
   if (!e) return tl::unexpected(e.error());
-  const Event& ev = events_[*e];
+  const Event& ev = events_[to_index(*e)];
   if (!ev.is_onset && ev.counterpart == kNoEvent) {
     return fail(ErrorCode::InvalidState,
                 "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
@@ -720,9 +720,9 @@ Expected<void> Coordinator::generate(std::string_view event, std::string_view ta
 Expected<void> Coordinator::broadcast(std::string_view event) {
   auto e = find_event(event);
   if (!e) return tl::unexpected(e.error());
-  if (!events_[*e].is_broadcast()) {
+  if (!events_[to_index(*e)].is_broadcast()) {
     return fail(ErrorCode::InvalidArgument, "event '" + std::string(event) + "' has severity " +
-                                                std::to_string(events_[*e].severity) +
+                                                std::to_string(events_[to_index(*e)].severity) +
                                                 "; broadcasts need severity 251-255");
   }
   generate(*e, kNoMachine);
@@ -778,10 +778,10 @@ void Coordinator::drain_pending() noexcept {
 }
 
 void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
-  const Event& event = *event_table_[event_id];
+  const Event& event = *event_table_[to_index(event_id)];
   const Time now = clock_->now();
   if (event.is_broadcast()) {
-    for (ComponentId c = 0; c < components_.size(); ++c) {
+    for (ComponentId c : id_range<ComponentId>(components_.size())) {
       if (event.is_onset) {
         process_onset(event, components_[c].application, cause, now);
       } else {
@@ -809,7 +809,7 @@ void Coordinator::process_onset(const Event& event, MachineId target, const Samp
 
 void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
   MachineData& m = machines_[target];
-  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[event.counterpart];
+  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[to_index(event.counterpart)];
   const ConditionChange change = m.conditions.complete(onset);
   if (change.outcome == Outcome::Ignored) {
     Record r;
@@ -888,7 +888,7 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
   MachineData& m = machines_[id];
   const State state = m.conditions.state();
   const Condition* outstanding = m.conditions.outstanding();
-  MachineSummary& summary = summaries_[id];
+  MachineSummary& summary = summaries_[to_index(id)];
   summary.state = state;
   summary.event = outstanding == nullptr ? kNoEvent : outstanding->event;
   summary.severity = outstanding == nullptr ? 0 : outstanding->severity;
@@ -926,7 +926,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   // (Activation orders are unique, so the result does not depend on the order machines are seen.)
   const MachineSummary* best = nullptr;
   auto consider = [&](MachineId mid) {
-    const MachineSummary& cand = summaries_[mid];
+    const MachineSummary& cand = summaries_[to_index(mid)];
     if (cand.state != c.state || cand.event == kNoEvent) return;
     if (best == nullptr || cand.severity > best->severity ||
         (cand.severity == best->severity && cand.seq > best->seq)) {
@@ -934,7 +934,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
     }
   };
   if (c.contiguous) {
-    for (MachineId m = c.first_machine; m < c.first_machine + c.machine_count; ++m) consider(m);
+    for (MachineId m : id_range(c.first_machine, to_index(c.first_machine) + c.machine_count)) consider(m);
   } else {
     consider(c.framework);
     consider(c.application);
@@ -987,18 +987,18 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
   const std::uint64_t mark = ++visit_epoch_;
   work_.clear();
   work_.push_back(root.origin);
-  visit_marks_[root.origin] = mark;
+  visit_marks_[to_index(root.origin)] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
     for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
-      visit_marks_[e.to] = mark;
+      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
+      visit_marks_[to_index(e.to)] = mark;
       work_.push_back(e.to);
       if (machines_[e.to].conditions.find_mirror(root) >= 0) continue;
       Condition c;
       c.event = mirror_event;
       c.level = level;
-      c.severity = event_table_[mirror_event]->severity;
+      c.severity = event_table_[to_index(mirror_event)]->severity;
       c.mirror = true;
       c.via = e.via;
       c.first = c.last = now;
@@ -1013,12 +1013,12 @@ void Coordinator::propagate_clear(const RootCause& root, State level, Time now) 
   const std::uint64_t mark = ++visit_epoch_;
   work_.clear();
   work_.push_back(root.origin);
-  visit_marks_[root.origin] = mark;
+  visit_marks_[to_index(root.origin)] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
     for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
-      visit_marks_[e.to] = mark;
+      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
+      visit_marks_[to_index(e.to)] = mark;
       work_.push_back(e.to);
       const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
       if (i < 0) continue;
@@ -1034,7 +1034,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
   std::vector<MachineId> targets;
   switch (target.kind) {
     case Address::Kind::System:
-      for (MachineId m = 0; m < machines_.size(); ++m) targets.push_back(m);
+      for (MachineId m : id_range<MachineId>(machines_.size())) targets.push_back(m);
       break;
     case Address::Kind::Component:
     case Address::Kind::Service: {

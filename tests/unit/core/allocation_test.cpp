@@ -107,14 +107,14 @@ constexpr int kRounds = 100;
 struct Rig {
   SimulatedClock clock;
   Coordinator co{"alloc", &clock};
-  ComponentId single = 0;
-  MachineId single_app = 0;
+  ComponentId single{0};
+  MachineId single_app{0};
   std::vector<ComponentId> chain;
-  MachineId head_app = 0;
-  EventId onset = 0;
-  EventId completion = 0;
-  EventId warning = 0;
-  EventId warning_completion = 0;
+  MachineId head_app{0};
+  EventId onset{0};
+  EventId completion{0};
+  EventId warning{0};
+  EventId warning_completion{0};
 
   Rig() {
     single = *co.add_component("SINGLE");
@@ -186,7 +186,7 @@ TEST(CoreAllocation, LockFreeReadsAndDispatchAllocateNothing) {
       sink += static_cast<long>(rig.co.coordinator_state());
       rig.co.dispatch(
           rig.single, [&] { sink += 1; }, [&](const Event& e) { sink += e.severity; },
-          [&](const Event& e) { sink += e.id; });
+          [&](const Event& e) { sink += to_index(e.id); });
     }
   };
   read_everything();
@@ -225,12 +225,12 @@ TEST(CoreAllocation, WithAnObserverAndCallbacksOnEveryMachineTheHotPathsStillAll
   long records = 0;
   long callbacks = 0;
   rig.co.subscribe([&records](const Record&) { ++records; });
-  for (MachineId m = 0; m < rig.co.machine_count(); ++m) {
+  for (MachineId m : id_range<MachineId>(rig.co.machine_count())) {
     rig.co.on_machine(
         m, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});
   }
-  for (ComponentId c = 0; c < rig.co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(rig.co.component_count())) {
     rig.co.on_component(
         c, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});

@@ -184,8 +184,8 @@ struct CoordinatorOptions {
 namespace detail {
 /// A growable array whose elements never move: chunks of `kChunk` contiguous elements. Indexing is
 /// a shift, a mask and two loads, without allocation or lock; adding allocates one chunk per
-/// `kChunk` elements. Not thread-safe against a concurrent add.
-template <class T>
+/// `kChunk` elements. Not thread-safe against a concurrent add. Indexed by the id type `Id`.
+template <class T, class Id>
 class StableVector {
 public:
   static constexpr std::size_t kChunkBits = 6;
@@ -193,16 +193,21 @@ public:
 
   std::size_t size() const noexcept { return size_; }
   bool empty() const noexcept { return size_ == 0; }
-  T& operator[](std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-  const T& operator[](std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-  T& back() noexcept { return (*this)[size_ - 1]; }
+  T& operator[](Id id) noexcept { return at(to_index(id)); }
+  const T& operator[](Id id) const noexcept { return at(to_index(id)); }
+  /// True when `id` names an element.
+  bool contains(Id id) const noexcept { return to_index(id) < size_; }
+  T& back() noexcept { return at(size_ - 1); }
   /// Appends a default-constructed element and returns it.
   T& emplace_back() {
     if ((size_ >> kChunkBits) == chunks_.size()) chunks_.push_back(std::make_unique<T[]>(kChunk));
-    return (*this)[size_++];
+    return at(size_++);
   }
 
 private:
+  T& at(std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+  const T& at(std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+
   std::vector<std::unique_ptr<T[]>> chunks_;
   std::size_t size_ = 0;
 };
@@ -277,7 +282,7 @@ public:
   std::size_t component_count() const noexcept { return components_.size(); }
   std::size_t machine_count() const noexcept { return machines_.size(); }
   std::size_t event_count() const noexcept { return events_.size(); }
-  const Event& event(EventId id) const noexcept { return events_[id]; }
+  const Event& event(EventId id) const noexcept { return events_[to_index(id)]; }
   const std::vector<Connection>& connections() const noexcept { return connections_; }
   std::string_view component_name(ComponentId id) const noexcept;
   MachineId framework_machine(ComponentId id) const noexcept;
@@ -339,8 +344,8 @@ public:
     const StateSnapshot s = extended(component);
     switch (s.state) {
       case State::Normal: normal(); return;
-      case State::Warning: warning(events_[s.outstanding]); return;
-      case State::Error: error(events_[s.outstanding]); return;
+      case State::Warning: warning(events_[to_index(s.outstanding)]); return;
+      case State::Error: error(events_[to_index(s.outstanding)]); return;
     }
   }
 
@@ -507,8 +512,8 @@ private:
   // Machines and components live in chunks of contiguous elements: a fault that visits thousands
   // of machines walks memory in order instead of chasing one heap object per machine, and an
   // element never moves once added (references handed out stay valid while the model grows).
-  detail::StableVector<MachineData> machines_;
-  detail::StableVector<ComponentData> components_;
+  detail::StableVector<MachineData, MachineId> machines_;
+  detail::StableVector<ComponentData, ComponentId> components_;
   struct NameHash {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
