@@ -1,7 +1,9 @@
 #include "safecass/core/coordinator.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "safecass/core/assert.hpp"
@@ -51,25 +53,93 @@ constexpr FrameworkEventSpec kFrameworkEvents[] = {
 
 }  // namespace
 
-// ---- Ring ------------------------------------------------------------------------------------
+// ---- history -----------------------------------------------------------------------------------
 
-void Coordinator::Ring::push(const Record& r) noexcept {
-  // Runs for every record: no division, and the capacity read once (the copy may alias it).
+namespace {
+
+constexpr std::uint8_t pack_states(State from, State to, State level, bool mirror) noexcept {
+  return static_cast<std::uint8_t>(static_cast<unsigned>(from) | static_cast<unsigned>(to) << 2 |
+                                   static_cast<unsigned>(level) << 4 | (mirror ? 1u << 6 : 0u));
+}
+
+std::uint64_t bits(double v) noexcept {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+/// The same root cause: every field equal, the sample value bit for bit (a NaN equals itself).
+/// Runs for every record with a root, most often on two equal roots: plain loads, no call.
+bool same_root(const RootCause& a, const RootCause& b) noexcept {
+  return a.time == b.time && a.event == b.event && a.origin == b.origin && a.remote == b.remote &&
+         a.remote_origin == b.remote_origin && a.sample.filter == b.sample.filter &&
+         a.sample.signal == b.sample.signal && bits(a.sample.value) == bits(b.sample.value) &&
+         a.sample.sample_time == b.sample.sample_time && a.sample.injected == b.sample.injected;
+}
+
+/// A record without a root cause (resets, and the transitions they cause): every field at its
+/// default. Most records have a root event, so the first comparison decides.
+bool no_root(const RootCause& r) noexcept {
+  if (r.event != kNoEvent) return false;
+  static constexpr RootCause kDefault{};
+  return same_root(r, kDefault);
+}
+
+}  // namespace
+
+void Coordinator::History::push(const Record& r, std::uint32_t text) noexcept {
+  // Runs for every record: no division, and the capacity read once.
   const std::size_t capacity = items.size();
   if (capacity == 0) return;
-  items[next] = r;
+  std::uint32_t root = kNone;
+  if (!no_root(r.root)) {
+    if (last_root == kNone || !same_root(roots[last_root], r.root)) {
+      roots[next_root] = r.root;
+      last_root = static_cast<std::uint32_t>(next_root);
+      if (++next_root == capacity) next_root = 0;
+    }
+    root = last_root;
+  }
+  StoredRecord& s = items[next];
+  s.time = r.time.count();
+  s.seq = r.seq;
+  s.subject = r.kind == RecordKind::ComponentTransition ? to_index(r.component) : to_index(r.machine);
+  s.event = to_index(r.event);
+  s.via = to_index(r.via);
+  s.root = root;
+  s.text = text;
+  s.kind = r.kind;
+  s.outcome = r.outcome;
+  s.states = pack_states(r.from, r.to, r.level, r.mirror);
+  s.severity = r.severity;
   if (++next == capacity) next = 0;
   if (size < capacity) ++size;
 }
 
-void Coordinator::Ring::grow(std::size_t capacity) {
+void Coordinator::History::grow(std::size_t capacity) {
   if (capacity <= items.size()) return;
-  std::vector<Record> kept = ordered();
-  items = std::move(kept);
-  size = items.size();
-  next = size;
-  items.resize(capacity);
-  if (next == capacity) next = 0;
+  std::vector<StoredRecord> kept_items(capacity);
+  std::vector<RootCause> kept_roots(capacity);
+  const std::size_t old = items.size();
+  std::size_t roots_kept = 0;
+  std::uint32_t old_slot = kNone;
+  for (std::size_t k = 0; k < size; ++k) {
+    StoredRecord s = items[(next + old - size + k) % old];
+    if (s.root != kNone) {
+      // Records that share a root are consecutive (up to records without one): copy it once.
+      if (s.root != old_slot) {
+        old_slot = s.root;
+        kept_roots[roots_kept++] = roots[s.root];
+      }
+      s.root = static_cast<std::uint32_t>(roots_kept - 1);
+    }
+    kept_items[k] = s;
+  }
+  items = std::move(kept_items);
+  roots = std::move(kept_roots);
+  next = size == capacity ? 0 : size;
+  next_root = roots_kept == capacity ? 0 : roots_kept;
+  last_root = roots_kept == 0 ? kNone : static_cast<std::uint32_t>(roots_kept - 1);
 }
 
 void Coordinator::size_history() {
@@ -81,12 +151,40 @@ void Coordinator::size_history() {
   history_.grow(std::min(std::max(wanted, 2 * history_.items.size()), most));
 }
 
-std::vector<Record> Coordinator::Ring::ordered() const {
-  std::vector<Record> out;
-  out.reserve(size);
-  const std::size_t start = (next + items.size() - size) % std::max<std::size_t>(items.size(), 1);
-  for (std::size_t i = 0; i < size; ++i) out.push_back(items[(start + i) % items.size()]);
-  return out;
+std::string_view Coordinator::text_of(std::uint32_t text) const {
+  switch (text) {
+    case kNone: return {};
+    case kTextNoOnset: return ConditionSet::kIgnoredNoOnset;
+    case kTextNotActive: return ConditionSet::kIgnoredNotActive;
+    case kTextLatched: return ConditionSet::kIgnoredLatched;
+    case kTextNoLongerReported: return "no longer reported by the provider";
+    default: return name_of(NameId{text});
+  }
+}
+
+ComponentId Coordinator::stored_component(const StoredRecord& s) const noexcept {
+  if (s.kind == RecordKind::ComponentTransition) return ComponentId{s.subject};
+  return machines_[MachineId{s.subject}].component;
+}
+
+Record Coordinator::decode(const StoredRecord& s) const {
+  Record r;
+  r.kind = s.kind;
+  r.outcome = s.outcome;
+  r.time = Time{s.time};
+  r.seq = s.seq;
+  r.component = stored_component(s);
+  r.machine = s.kind == RecordKind::ComponentTransition ? kNoMachine : MachineId{s.subject};
+  r.event = EventId{s.event};
+  r.from = static_cast<State>(s.states & 3u);
+  r.to = static_cast<State>((s.states >> 2) & 3u);
+  r.level = static_cast<State>((s.states >> 4) & 3u);
+  r.mirror = (s.states & (1u << 6)) != 0;
+  r.severity = s.severity;
+  r.via = ConnectionId{s.via};
+  if (s.root != kNone) r.root = history_.roots[s.root];
+  r.text = text_of(s.text);
+  return r;
 }
 
 // ---- construction and configuration ----------------------------------------------------------
@@ -537,10 +635,10 @@ const ServiceDependency& Coordinator::service(ComponentId component, std::uint32
 NameId Coordinator::intern(std::string_view text) {
   std::lock_guard lock(names_mutex_);
   for (std::size_t i = 0; i < names_.size(); ++i) {
-    if (names_[i] == text) return static_cast<NameId>(i);
+    if (names_[i] == text) return id_at<NameId>(i);
   }
   names_.emplace_back(text);
-  return static_cast<NameId>(names_.size() - 1);
+  return id_at<NameId>(names_.size() - 1);
 }
 
 std::string_view Coordinator::name_of(NameId id) const {
@@ -597,14 +695,14 @@ std::optional<Condition> Coordinator::outstanding(MachineId id) const {
 }
 
 namespace {
-/// The newest `limit` records of `ring` (oldest first) that `keep` selects: one backwards pass.
-template <class Items, class Keep>
-std::vector<Record> newest(const Items& items, std::size_t next, std::size_t size, std::size_t limit, Keep keep) {
+/// The newest `limit` stored records that `keep` selects, decoded, oldest first: one backwards pass.
+template <class History, class Keep, class Decode>
+std::vector<Record> newest(const History& h, std::size_t limit, Keep keep, Decode decode) {
   std::vector<Record> out;
-  const std::size_t capacity = items.size();
-  for (std::size_t k = 0; k < size && out.size() < limit; ++k) {
-    const Record& r = items[(next + capacity - 1 - k) % capacity];
-    if (keep(r)) out.push_back(r);
+  const std::size_t capacity = h.items.size();
+  for (std::size_t k = 0; k < h.size && out.size() < limit; ++k) {
+    const auto& s = h.items[(h.next + capacity - 1 - k) % capacity];
+    if (keep(s)) out.push_back(decode(s));
   }
   std::reverse(out.begin(), out.end());
   return out;
@@ -613,23 +711,27 @@ std::vector<Record> newest(const Items& items, std::size_t next, std::size_t siz
 
 std::vector<Record> Coordinator::history(MachineId id) const {
   Lock lock(*this);
-  return newest(history_.items, history_.next, history_.size, options_.history_capacity,
-                [id](const Record& r) { return r.machine == id; });
+  return newest(
+      history_, options_.history_capacity,
+      [id](const StoredRecord& s) { return s.kind != RecordKind::ComponentTransition && s.subject == to_index(id); },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 std::vector<Record> Coordinator::component_history(ComponentId id) const {
   Lock lock(*this);
-  return newest(history_.items, history_.next, history_.size, options_.history_capacity, [id](const Record& r) {
-    return r.machine == kNoMachine && r.kind == RecordKind::ComponentTransition && r.component == id;
-  });
+  return newest(
+      history_, options_.history_capacity,
+      [id](const StoredRecord& s) { return s.kind == RecordKind::ComponentTransition && s.subject == to_index(id); },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 std::vector<Record> Coordinator::history(const Address& scope) const {
   if (scope.kind == Address::Kind::Machine) return history(scope.machine);
   Lock lock(*this);
   const bool system = scope.kind == Address::Kind::System;
-  return newest(history_.items, history_.next, history_.size, history_.size,
-                [&](const Record& r) { return system || r.component == scope.component; });
+  return newest(
+      history_, history_.size, [&](const StoredRecord& s) { return system || stored_component(s) == scope.component; },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 // ---- callbacks and observers -----------------------------------------------------------------
@@ -660,7 +762,8 @@ void Coordinator::publish(Record record) {
   Lock lock(*this);
   if (record.machine != kNoMachine && machines_.contains(record.machine)) {
     record.component = machines_[record.machine].component;
-    record_machine(record.machine, record);
+    // The history keeps texts by id: the monitor interns its injection texts already (a hit).
+    this->record(record, record.text.empty() ? kNone : to_index(intern(record.text)));
   } else {
     record.seq = ++record_seq_;
     emit(record);
@@ -677,9 +780,9 @@ void Coordinator::emit(const Record& r) noexcept {
   }
 }
 
-void Coordinator::record_machine(MachineId id, Record& r) noexcept {
+void Coordinator::record(Record& r, std::uint32_t text) noexcept {
   r.seq = ++record_seq_;
-  history_.push(r);
+  history_.push(r, text);
   if (!observers_.empty()) emit(r);
 }
 
@@ -823,10 +926,12 @@ void Coordinator::process_completion(const Event& event, MachineId target, Time 
     r.severity = event.severity;
     if (change.index >= 0) r.root = m.conditions[static_cast<std::size_t>(change.index)].root;
     r.text = change.reason;
-    record_machine(target, r);
+    record(r, change.reason == ConditionSet::kIgnoredLatched     ? kTextLatched
+              : change.reason == ConditionSet::kIgnoredNotActive ? kTextNotActive
+                                                                 : kTextNoOnset);
     return;
   }
-  record_removed(target, change, event.id, now, {});
+  record_removed(target, change, event.id, now, kNone);
   propagate_clear(change.removed.root, change.removed.level, now);
 }
 
@@ -851,17 +956,16 @@ void Coordinator::record_added(MachineId id, const ConditionChange& change, Time
   r.mirror = c.mirror;
   r.via = c.via;
   r.root = c.root;
-  record_machine(id, r);
+  record(r, kNone);
   update_machine(id, change.from, c.event, &c.root, now);
 }
 
-void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now,
-                                   std::string_view text) noexcept {
+void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now, std::uint32_t text) noexcept {
   record_removed(id, machines_[id].conditions.remove(i), event, now, text);
 }
 
 void Coordinator::record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
-                                 std::string_view text) noexcept {
+                                 std::uint32_t text) noexcept {
   MachineData& m = machines_[id];
   const Condition& removed = change.removed;
   Record r;
@@ -878,8 +982,8 @@ void Coordinator::record_removed(MachineId id, const ConditionChange& change, Ev
   r.mirror = removed.mirror;
   r.via = removed.via;
   r.root = removed.root;
-  r.text = text;
-  record_machine(id, r);
+  r.text = text_of(text);
+  record(r, text);
   update_machine(id, change.from, event, &removed.root, now);
 }
 
@@ -908,7 +1012,7 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
     r.from = old_state;
     r.to = state;
     if (root != nullptr) r.root = *root;
-    record_machine(id, r);
+    record(r, kNone);
     if (!m.callbacks.empty()) {
       const TransitionInfo info{m.component, id, transition_between(old_state, state), event, root, now};
       fire(m.callbacks, m.component, info, old_state, state);
@@ -953,7 +1057,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   r.from = old;
   r.to = c.state;
   if (root != nullptr) r.root = *root;
-  history_.push(r);
+  history_.push(r, kNone);
   if (!observers_.empty()) emit(r);
   if (c.callbacks.empty()) return;
   const TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
@@ -1024,7 +1128,7 @@ void Coordinator::propagate_clear(const RootCause& root, State level, Time now) 
       if (i < 0) continue;
       const EventId completion =
           framework_event::completion_of(machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
-      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, {});
+      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, kNone);
     }
   }
 }
@@ -1056,7 +1160,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
     r.machine = id;
     r.from = r.to = m.conditions.state();
     r.text = text;
-    record_machine(id, r);
+    record(r, to_index(reason));
   }
   // Warnings first, in every target machine, then errors: the component and the system then drop
   // once (E2N) instead of passing through a Warning that callbacks would react to.
@@ -1067,7 +1171,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
       for (std::int32_t i = m.conditions.find_lowest_root();
            i >= 0 && m.conditions[static_cast<std::size_t>(i)].level <= pass; i = m.conditions.find_lowest_root()) {
         const Condition c = m.conditions[static_cast<std::size_t>(i)];
-        remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
+        remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, to_index(reason));
         propagate_clear(c.root, c.level, now);
       }
     }

@@ -133,7 +133,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
       ++result.kept;
       continue;
     }
-    remove_condition(proxy, k, framework_event::completion_of(c.event), now, "no longer reported by the provider");
+    remove_condition(proxy, k, framework_event::completion_of(c.event), now, kTextNoLongerReported);
     propagate_clear(c.root, c.level, now);
     remote_roots_[c.root.remote].used = false;
     remote_roots_[c.root.remote].path.clear();

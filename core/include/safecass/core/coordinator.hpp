@@ -394,18 +394,53 @@ private:
     State min_level;
     ConnectionId via;
   };
-  struct Ring {
-    std::vector<Record> items;
+  /// A record as the history stores it (docs/semantics.md §8.3): 40 bytes instead of Record's
+  /// 120. The component of a machine record is its machine's, names and texts are ids resolved
+  /// when the history is read, and the root cause is a slot of History::roots, written once for
+  /// a run of records that share it (a propagation writes hundreds of records with one root).
+  struct StoredRecord {
+    Time::rep time = 0;
+    std::uint64_t seq = 0;
+    std::uint32_t subject = kNone;  ///< the machine; the component for component transitions
+    std::uint32_t event = kNone;
+    std::uint32_t via = kNone;
+    std::uint32_t root = kNone;  ///< slot in History::roots; kNone: no root cause
+    std::uint32_t text = kNone;  ///< a NameId, one of the kText* codes, or kNone
+    RecordKind kind = RecordKind::Event;
+    Outcome outcome = Outcome::None;
+    std::uint8_t states = 0;  ///< from | to << 2 | level << 4 | mirror << 6
+    std::uint8_t severity = 0;
+  };
+  /// Texts of ignored completions (static, never interned).
+  static constexpr std::uint32_t kTextNoOnset = kNone - 1;
+  static constexpr std::uint32_t kTextNotActive = kNone - 2;
+  static constexpr std::uint32_t kTextLatched = kNone - 3;
+  /// Text of a remote root's clear (apply_remote()).
+  static constexpr std::uint32_t kTextNoLongerReported = kNone - 4;
+  /// The text a code stands for (kNone: empty).
+  std::string_view text_of(std::uint32_t text) const;
+  /// The history: one ring of stored records and one ring of root causes of the same capacity.
+  /// A record refers to the root slot written last when it was stored; each record writes at most
+  /// one root, so while a record is in its ring, fewer than `capacity` roots were written after
+  /// its own and that root's slot has not been reused.
+  struct History {
+    std::vector<StoredRecord> items;
+    std::vector<RootCause> roots;
     std::size_t next = 0;
     std::size_t size = 0;
-    void push(const Record& r) noexcept;
-    std::vector<Record> ordered() const;
+    std::size_t next_root = 0;
+    std::uint32_t last_root = kNone;  ///< slot of the root written last
+    void push(const Record& r, std::uint32_t text) noexcept;
     /// Grows to `capacity` keeping the records in order (configuration time only).
     void grow(std::size_t capacity);
   };
   /// Sizes the history for the model configured so far (CoordinatorOptions).
   void size_history();
-  Ring history_;  ///< every machine and component record of this coordinator
+  /// The Record a stored record stands for.
+  Record decode(const StoredRecord& s) const;
+  /// The component a stored record is about.
+  ComponentId stored_component(const StoredRecord& s) const noexcept;
+  History history_;  ///< every machine and component record of this coordinator
   struct MachineData {
     ComponentId component = kNoComponent;
     MachineKind kind = MachineKind::Framework;
@@ -487,20 +522,21 @@ private:
   /// Adds a condition (root or mirror) to a machine and applies §2.4 step 2.
   void add_condition(MachineId id, const Condition& c, Time now) noexcept;
   /// Removes condition `index` of a machine; `completion` is the event recorded.
-  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::string_view text) noexcept;
+  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::uint32_t text) noexcept;
   void propagate_onset(const Condition& root) noexcept;
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
   /// Writes the event record of a condition just added (change.index) and publishes the machine.
   void record_added(MachineId id, const ConditionChange& change, Time now) noexcept;
   /// Writes the event record of a condition just removed and publishes the machine.
   void record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
-                      std::string_view text) noexcept;
+                      std::uint32_t text) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
   void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info, State from,
             State to) noexcept;
   void emit(const Record& r) noexcept;
-  void record_machine(MachineId id, Record& r) noexcept;
+  /// Numbers, stores and publishes a machine or component record; `text` as in StoredRecord.
+  void record(Record& r, std::uint32_t text) noexcept;
   std::vector<Explanation> explain_machine(MachineId id) const;
   std::vector<std::string> hop_path(MachineId holder, const Condition& c) const;
 
