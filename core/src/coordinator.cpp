@@ -220,6 +220,7 @@ Coordinator::~Coordinator() = default;
 
 EventId Coordinator::add_event_unchecked(Event event) {
   event.id = id_at<EventId>(events_.size());
+  event_index_.emplace(event.name, event.id);
   events_.push_back(std::move(event));
   event_table_.push_back(&events_.back());  // deque elements never move
   return events_.back().id;
@@ -538,9 +539,7 @@ Expected<ComponentId> Coordinator::find_component(std::string_view name) const {
 }
 
 Expected<EventId> Coordinator::find_event(std::string_view name) const {
-  for (const Event& e : events_) {
-    if (e.name == name) return e.id;
-  }
+  if (const auto it = event_index_.find(name); it != event_index_.end()) return it->second;
   return fail(ErrorCode::NotFound, "no event '" + std::string(name) + "'");
 }
 
@@ -634,11 +633,10 @@ const ServiceDependency& Coordinator::service(ComponentId component, std::uint32
 
 NameId Coordinator::intern(std::string_view text) {
   std::lock_guard lock(names_mutex_);
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    if (names_[i] == text) return id_at<NameId>(i);
-  }
-  names_.emplace_back(text);
-  return id_at<NameId>(names_.size() - 1);
+  if (const auto it = name_index_.find(text); it != name_index_.end()) return it->second;
+  const auto id = id_at<NameId>(names_.size());
+  name_index_.emplace(std::string_view(names_.emplace_back(text)), id);
+  return id;
 }
 
 std::string_view Coordinator::name_of(NameId id) const {
@@ -1083,6 +1081,8 @@ void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId compo
 // ---- propagation (DESIGN §2.6) ---------------------------------------------------------------
 
 void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
+  // A machine that feeds no connection (most s_A of a leaf, every s_R) propagates nothing.
+  if (machines_[root_condition.root.origin].fanout.empty()) return;
   const RootCause root = root_condition.root;
   const State level = root_condition.level;
   const Time now = root_condition.first;
@@ -1114,6 +1114,7 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
 }
 
 void Coordinator::propagate_clear(const RootCause& root, State level, Time now) noexcept {
+  if (machines_[root.origin].fanout.empty()) return;
   const std::uint64_t mark = ++visit_epoch_;
   work_.clear();
   work_.push_back(root.origin);

@@ -288,3 +288,36 @@ TEST(CoreAllocation, RefreshesIgnoredCompletionsMaskedOnsetsAndWarningPropagatio
 
 }  // namespace
 }  // namespace safecass
+
+namespace safecass {
+namespace {
+
+TEST(CoreAllocation, InterningAKnownNameAndAnEventWithFilterDataAllocateNothing) {
+  // A filter interns its names once, at configuration; looking a known name up again (the hash
+  // index of intern()) and generating events that carry filter data then allocate nothing.
+  Rig rig;
+  const NameId filter = rig.co.intern("force_limit");
+  const NameId signal = rig.co.intern("SINGLE.force");
+  for (int i = 0; i < kWarmUp; ++i) (void)rig.single_round();
+  bool ok = true;
+  const HeapUse use = heap_use_of([&] {
+    for (int i = 0; i < kRounds; ++i) {
+      ok = ok && rig.co.intern("force_limit") == filter && rig.co.intern("SINGLE.force") == signal;
+      SampleCause cause;
+      cause.filter = filter;
+      cause.signal = signal;
+      cause.value = 31.0 + i;
+      rig.co.generate(rig.onset, rig.single_app, cause);
+      ok = ok && rig.co.state(rig.single_app) == State::Error;
+      rig.co.generate(rig.completion, rig.single_app);
+      ok = ok && rig.co.state(rig.single_app) == State::Normal;
+    }
+  });
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(use.allocations, 0);
+  EXPECT_EQ(use.deallocations, 0);
+  EXPECT_EQ(rig.co.name_of(filter), "force_limit");
+}
+
+}  // namespace
+}  // namespace safecass

@@ -556,6 +556,7 @@ private:
   };
   std::unordered_map<std::string, ComponentId, NameHash, std::equal_to<>> component_index_;  ///< by name
   std::deque<Event> events_;
+  std::unordered_map<std::string, EventId, NameHash, std::equal_to<>> event_index_;  ///< by name
   std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
 
@@ -616,7 +617,9 @@ private:
   std::vector<std::uint32_t> free_remote_;
 
   mutable std::mutex names_mutex_;
-  std::deque<std::string> names_;
+  std::deque<std::string> names_;  ///< by NameId; elements never move
+  /// names_ by text (views of its elements): intern() finds a known text without allocating.
+  std::unordered_map<std::string_view, NameId, NameHash, std::equal_to<>> name_index_;
 };
 
 }  // namespace safecass
