@@ -14,7 +14,7 @@ struct FilterBench {
   Coordinator co{"bench", &clock};
   FilterRegistry registry;
   Monitor monitor{co, registry};
-  ComponentId component = 0;
+  ComponentId component{0};
 
   FilterBench() {
     register_builtin_filters(registry);

@@ -1,7 +1,9 @@
 #include "safecass/core/coordinator.hpp"
 
 #include <algorithm>
+#include <cstring>
 #include <string>
+#include <type_traits>
 #include <utility>
 
 #include "safecass/core/assert.hpp"
@@ -51,25 +53,93 @@ constexpr FrameworkEventSpec kFrameworkEvents[] = {
 
 }  // namespace
 
-// ---- Ring ------------------------------------------------------------------------------------
+// ---- history -----------------------------------------------------------------------------------
 
-void Coordinator::Ring::push(const Record& r) noexcept {
-  // Runs for every record: no division, and the capacity read once (the copy may alias it).
+namespace {
+
+constexpr std::uint8_t pack_states(State from, State to, State level, bool mirror) noexcept {
+  return static_cast<std::uint8_t>(static_cast<unsigned>(from) | static_cast<unsigned>(to) << 2 |
+                                   static_cast<unsigned>(level) << 4 | (mirror ? 1u << 6 : 0u));
+}
+
+std::uint64_t bits(double v) noexcept {
+  std::uint64_t b = 0;
+  std::memcpy(&b, &v, sizeof b);
+  return b;
+}
+
+/// The same root cause: every field equal, the sample value bit for bit (a NaN equals itself).
+/// Runs for every record with a root, most often on two equal roots: plain loads, no call.
+bool same_root(const RootCause& a, const RootCause& b) noexcept {
+  return a.time == b.time && a.event == b.event && a.origin == b.origin && a.remote == b.remote &&
+         a.remote_origin == b.remote_origin && a.sample.filter == b.sample.filter &&
+         a.sample.signal == b.sample.signal && bits(a.sample.value) == bits(b.sample.value) &&
+         a.sample.sample_time == b.sample.sample_time && a.sample.injected == b.sample.injected;
+}
+
+/// A record without a root cause (resets, and the transitions they cause): every field at its
+/// default. Most records have a root event, so the first comparison decides.
+bool no_root(const RootCause& r) noexcept {
+  if (r.event != kNoEvent) return false;
+  static constexpr RootCause kDefault{};
+  return same_root(r, kDefault);
+}
+
+}  // namespace
+
+void Coordinator::History::push(const Record& r, std::uint32_t text) noexcept {
+  // Runs for every record: no division, and the capacity read once.
   const std::size_t capacity = items.size();
   if (capacity == 0) return;
-  items[next] = r;
+  std::uint32_t root = kNone;
+  if (!no_root(r.root)) {
+    if (last_root == kNone || !same_root(roots[last_root], r.root)) {
+      roots[next_root] = r.root;
+      last_root = static_cast<std::uint32_t>(next_root);
+      if (++next_root == capacity) next_root = 0;
+    }
+    root = last_root;
+  }
+  StoredRecord& s = items[next];
+  s.time = r.time.count();
+  s.seq = r.seq;
+  s.subject = r.kind == RecordKind::ComponentTransition ? to_index(r.component) : to_index(r.machine);
+  s.event = to_index(r.event);
+  s.via = to_index(r.via);
+  s.root = root;
+  s.text = text;
+  s.kind = r.kind;
+  s.outcome = r.outcome;
+  s.states = pack_states(r.from, r.to, r.level, r.mirror);
+  s.severity = r.severity;
   if (++next == capacity) next = 0;
   if (size < capacity) ++size;
 }
 
-void Coordinator::Ring::grow(std::size_t capacity) {
+void Coordinator::History::grow(std::size_t capacity) {
   if (capacity <= items.size()) return;
-  std::vector<Record> kept = ordered();
-  items = std::move(kept);
-  size = items.size();
-  next = size;
-  items.resize(capacity);
-  if (next == capacity) next = 0;
+  std::vector<StoredRecord> kept_items(capacity);
+  std::vector<RootCause> kept_roots(capacity);
+  const std::size_t old = items.size();
+  std::size_t roots_kept = 0;
+  std::uint32_t old_slot = kNone;
+  for (std::size_t k = 0; k < size; ++k) {
+    StoredRecord s = items[(next + old - size + k) % old];
+    if (s.root != kNone) {
+      // Records that share a root are consecutive (up to records without one): copy it once.
+      if (s.root != old_slot) {
+        old_slot = s.root;
+        kept_roots[roots_kept++] = roots[s.root];
+      }
+      s.root = static_cast<std::uint32_t>(roots_kept - 1);
+    }
+    kept_items[k] = s;
+  }
+  items = std::move(kept_items);
+  roots = std::move(kept_roots);
+  next = size == capacity ? 0 : size;
+  next_root = roots_kept == capacity ? 0 : roots_kept;
+  last_root = roots_kept == 0 ? kNone : static_cast<std::uint32_t>(roots_kept - 1);
 }
 
 void Coordinator::size_history() {
@@ -81,12 +151,40 @@ void Coordinator::size_history() {
   history_.grow(std::min(std::max(wanted, 2 * history_.items.size()), most));
 }
 
-std::vector<Record> Coordinator::Ring::ordered() const {
-  std::vector<Record> out;
-  out.reserve(size);
-  const std::size_t start = (next + items.size() - size) % std::max<std::size_t>(items.size(), 1);
-  for (std::size_t i = 0; i < size; ++i) out.push_back(items[(start + i) % items.size()]);
-  return out;
+std::string_view Coordinator::text_of(std::uint32_t text) const {
+  switch (text) {
+    case kNone: return {};
+    case kTextNoOnset: return ConditionSet::kIgnoredNoOnset;
+    case kTextNotActive: return ConditionSet::kIgnoredNotActive;
+    case kTextLatched: return ConditionSet::kIgnoredLatched;
+    case kTextNoLongerReported: return "no longer reported by the provider";
+    default: return name_of(NameId{text});
+  }
+}
+
+ComponentId Coordinator::stored_component(const StoredRecord& s) const noexcept {
+  if (s.kind == RecordKind::ComponentTransition) return ComponentId{s.subject};
+  return machines_[MachineId{s.subject}].component;
+}
+
+Record Coordinator::decode(const StoredRecord& s) const {
+  Record r;
+  r.kind = s.kind;
+  r.outcome = s.outcome;
+  r.time = Time{s.time};
+  r.seq = s.seq;
+  r.component = stored_component(s);
+  r.machine = s.kind == RecordKind::ComponentTransition ? kNoMachine : MachineId{s.subject};
+  r.event = EventId{s.event};
+  r.from = static_cast<State>(s.states & 3u);
+  r.to = static_cast<State>((s.states >> 2) & 3u);
+  r.level = static_cast<State>((s.states >> 4) & 3u);
+  r.mirror = (s.states & (1u << 6)) != 0;
+  r.severity = s.severity;
+  r.via = ConnectionId{s.via};
+  if (s.root != kNone) r.root = history_.roots[s.root];
+  r.text = text_of(s.text);
+  return r;
 }
 
 // ---- construction and configuration ----------------------------------------------------------
@@ -113,7 +211,7 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
     completion.completes = spec.name;
     completion.counterpart = onset_id;
     const EventId completion_id = add_event_unchecked(std::move(completion));
-    events_[onset_id].counterpart = completion_id;
+    events_[to_index(onset_id)].counterpart = completion_id;
   }
   SAFECASS_ASSERT(events_.size() == framework_event::kCount);
 }
@@ -121,7 +219,8 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
 Coordinator::~Coordinator() = default;
 
 EventId Coordinator::add_event_unchecked(Event event) {
-  event.id = static_cast<EventId>(events_.size());
+  event.id = id_at<EventId>(events_.size());
+  event_index_.emplace(event.name, event.id);
   events_.push_back(std::move(event));
   event_table_.push_back(&events_.back());  // deque elements never move
   return events_.back().id;
@@ -139,7 +238,7 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
     return fail(ErrorCode::InvalidArgument,
                 "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
-  const auto id = static_cast<ComponentId>(components_.size());
+  const auto id = id_at<ComponentId>(components_.size());
   ComponentData& cd = components_.emplace_back();
   cd.name = std::string(name);
   cd.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
@@ -158,11 +257,11 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   m.iface = iface;
   m.address = std::move(address);
   m.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
-  const auto id = static_cast<MachineId>(machines_.size() - 1);
+  const auto id = id_at<MachineId>(machines_.size() - 1);
   ComponentData& c = components_[component];
   if (c.machine_count == 0) {
     c.first_machine = id;
-  } else if (c.first_machine + c.machine_count != id) {
+  } else if (to_index(c.first_machine) + c.machine_count != to_index(id)) {
     c.contiguous = false;
   }
   ++c.machine_count;
@@ -171,12 +270,12 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   summaries_.resize(machines_.size());
   visit_marks_.resize(machines_.size(), 0);
   if (work_.capacity() < machines_.size()) work_.reserve(2 * machines_.size());
-  return static_cast<MachineId>(machines_.size() - 1);
+  return id;
 }
 
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -198,8 +297,8 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 }
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
@@ -248,7 +347,7 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
     // A completion defined earlier may be waiting for this onset.
     for (Event& other : events_) {
       if (!other.is_onset && other.counterpart == kNoEvent && other.completes == def.name) {
-        other.counterpart = static_cast<EventId>(events_.size());
+        other.counterpart = id_at<EventId>(events_.size());
         e.counterpart = other.id;
       }
     }
@@ -263,12 +362,12 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
       e.completes = def.name.substr(1);
     }
     if (auto o = find_event(e.completes)) {
-      Event& target = events_[*o];
+      Event& target = events_[to_index(*o)];
       if (!target.is_onset) {
         return fail(ErrorCode::InvalidArgument, where + ": completes '" + e.completes + "', which is not an onset");
       }
       e.counterpart = *o;
-      if (target.counterpart == kNoEvent) target.counterpart = static_cast<EventId>(events_.size());
+      if (target.counterpart == kNoEvent) target.counterpart = id_at<EventId>(events_.size());
     }
   }
   return add_event_unchecked(std::move(e));
@@ -276,8 +375,8 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
 
 Expected<void> Coordinator::set_service(ComponentId component, std::string_view provided,
                                         const ServiceDependency& dependency) {
-  if (component >= components_.size())
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (!components_.contains(component))
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   ComponentData& c = components_[component];
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
@@ -364,14 +463,14 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
                                                 ": a component cannot require its own service");
   }
   if (cc.required_connection[r] != kNoConnection) {
-    const Connection& old = connections_[cc.required_connection[r]];
+    const Connection& old = connections_[to_index(cc.required_connection[r])];
     return fail(ErrorCode::Duplicate,
                 "required interface " + std::string(client_required) + " is already connected to " +
                     components_[old.provider].name + "." +
                     std::string(interface_name(components_[old.provider].provided[old.provided])));
   }
   Lock lock(*this);
-  const auto id = static_cast<ConnectionId>(connections_.size());
+  const auto id = id_at<ConnectionId>(connections_.size());
   connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
   pc.provider_connections.push_back(id);
@@ -381,7 +480,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   // are all Normal there is nothing to carry (the common case while a system is being built).
   if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
   processing_ = true;
-  for (MachineId m = 0; m < machines_.size(); ++m) {
+  for (MachineId m : id_range<MachineId>(machines_.size())) {
     const std::vector<Condition> snapshot(machines_[m].conditions.begin(), machines_[m].conditions.end());
     for (const Condition& c : snapshot) {
       // Roots, and remote roots at the remote provided interface that holds them.
@@ -414,7 +513,7 @@ void Coordinator::rebuild_fanout(ComponentId provider_id) {
   const std::vector<MachineId> machines = component_machines(provider);
   for (MachineId m : machines) machines_[m].fanout.clear();
   for (ConnectionId k : provider.provider_connections) {
-    const Connection& conn = connections_[k];
+    const Connection& conn = connections_[to_index(k)];
     const MachineId client_machine = components_[conn.client].required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
     for (MachineId m : machines) {
@@ -440,9 +539,7 @@ Expected<ComponentId> Coordinator::find_component(std::string_view name) const {
 }
 
 Expected<EventId> Coordinator::find_event(std::string_view name) const {
-  for (const Event& e : events_) {
-    if (e.name == name) return e.id;
-  }
+  if (const auto it = event_index_.find(name); it != event_index_.end()) return it->second;
   return fail(ErrorCode::NotFound, "no event '" + std::string(name) + "'");
 }
 
@@ -536,17 +633,16 @@ const ServiceDependency& Coordinator::service(ComponentId component, std::uint32
 
 NameId Coordinator::intern(std::string_view text) {
   std::lock_guard lock(names_mutex_);
-  for (std::size_t i = 0; i < names_.size(); ++i) {
-    if (names_[i] == text) return static_cast<NameId>(i);
-  }
-  names_.emplace_back(text);
-  return static_cast<NameId>(names_.size() - 1);
+  if (const auto it = name_index_.find(text); it != name_index_.end()) return it->second;
+  const auto id = id_at<NameId>(names_.size());
+  name_index_.emplace(std::string_view(names_.emplace_back(text)), id);
+  return id;
 }
 
 std::string_view Coordinator::name_of(NameId id) const {
   std::lock_guard lock(names_mutex_);
-  if (id >= names_.size()) return {};
-  return names_[id];
+  if (to_index(id) >= names_.size()) return {};
+  return names_[to_index(id)];
 }
 
 // ---- reads -----------------------------------------------------------------------------------
@@ -567,7 +663,7 @@ State Coordinator::service_state(ComponentId component, std::uint32_t provided) 
 
 State Coordinator::coordinator_state() const noexcept {
   State s = State::Normal;
-  for (ComponentId c = 0; c < components_.size(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(components_.size())) {
     if (!components_[c].remote) s = s * extended_state(c);
   }
   return s;
@@ -597,14 +693,14 @@ std::optional<Condition> Coordinator::outstanding(MachineId id) const {
 }
 
 namespace {
-/// The newest `limit` records of `ring` (oldest first) that `keep` selects: one backwards pass.
-template <class Items, class Keep>
-std::vector<Record> newest(const Items& items, std::size_t next, std::size_t size, std::size_t limit, Keep keep) {
+/// The newest `limit` stored records that `keep` selects, decoded, oldest first: one backwards pass.
+template <class History, class Keep, class Decode>
+std::vector<Record> newest(const History& h, std::size_t limit, Keep keep, Decode decode) {
   std::vector<Record> out;
-  const std::size_t capacity = items.size();
-  for (std::size_t k = 0; k < size && out.size() < limit; ++k) {
-    const Record& r = items[(next + capacity - 1 - k) % capacity];
-    if (keep(r)) out.push_back(r);
+  const std::size_t capacity = h.items.size();
+  for (std::size_t k = 0; k < h.size && out.size() < limit; ++k) {
+    const auto& s = h.items[(h.next + capacity - 1 - k) % capacity];
+    if (keep(s)) out.push_back(decode(s));
   }
   std::reverse(out.begin(), out.end());
   return out;
@@ -613,23 +709,27 @@ std::vector<Record> newest(const Items& items, std::size_t next, std::size_t siz
 
 std::vector<Record> Coordinator::history(MachineId id) const {
   Lock lock(*this);
-  return newest(history_.items, history_.next, history_.size, options_.history_capacity,
-                [id](const Record& r) { return r.machine == id; });
+  return newest(
+      history_, options_.history_capacity,
+      [id](const StoredRecord& s) { return s.kind != RecordKind::ComponentTransition && s.subject == to_index(id); },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 std::vector<Record> Coordinator::component_history(ComponentId id) const {
   Lock lock(*this);
-  return newest(history_.items, history_.next, history_.size, options_.history_capacity, [id](const Record& r) {
-    return r.machine == kNoMachine && r.kind == RecordKind::ComponentTransition && r.component == id;
-  });
+  return newest(
+      history_, options_.history_capacity,
+      [id](const StoredRecord& s) { return s.kind == RecordKind::ComponentTransition && s.subject == to_index(id); },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 std::vector<Record> Coordinator::history(const Address& scope) const {
   if (scope.kind == Address::Kind::Machine) return history(scope.machine);
   Lock lock(*this);
   const bool system = scope.kind == Address::Kind::System;
-  return newest(history_.items, history_.next, history_.size, history_.size,
-                [&](const Record& r) { return system || r.component == scope.component; });
+  return newest(
+      history_, history_.size, [&](const StoredRecord& s) { return system || stored_component(s) == scope.component; },
+      [this](const StoredRecord& s) { return decode(s); });
 }
 
 // ---- callbacks and observers -----------------------------------------------------------------
@@ -658,9 +758,10 @@ void Coordinator::unsubscribe(SubscriptionId id) {
 
 void Coordinator::publish(Record record) {
   Lock lock(*this);
-  if (record.machine != kNoMachine && record.machine < machines_.size()) {
+  if (record.machine != kNoMachine && machines_.contains(record.machine)) {
     record.component = machines_[record.machine].component;
-    record_machine(record.machine, record);
+    // The history keeps texts by id: the monitor interns its injection texts already (a hit).
+    this->record(record, record.text.empty() ? kNone : to_index(intern(record.text)));
   } else {
     record.seq = ++record_seq_;
     emit(record);
@@ -677,17 +778,17 @@ void Coordinator::emit(const Record& r) noexcept {
   }
 }
 
-void Coordinator::record_machine(MachineId id, Record& r) noexcept {
+void Coordinator::record(Record& r, std::uint32_t text) noexcept {
   r.seq = ++record_seq_;
-  history_.push(r);
+  history_.push(r, text);
   if (!observers_.empty()) emit(r);
 }
 
 // ---- event processing ------------------------------------------------------------------------
 
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
-  SAFECASS_ASSERT(event < event_table_.size());
-  SAFECASS_ASSERT(target < machines_.size() || event_table_[event]->is_broadcast());
+  SAFECASS_ASSERT(to_index(event) < event_table_.size());
+  SAFECASS_ASSERT(machines_.contains(target) || event_table_[to_index(event)]->is_broadcast());
   Lock lock(*this);
   if (processing_) {
     pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName});
@@ -702,7 +803,7 @@ void Coordinator::generate(EventId event, MachineId target, const SampleCause& c
 Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
   auto e = find_event(event);
   if (!e) return tl::unexpected(e.error());
-  const Event& ev = events_[*e];
+  const Event& ev = events_[to_index(*e)];
   if (!ev.is_onset && ev.counterpart == kNoEvent) {
     return fail(ErrorCode::InvalidState,
                 "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
@@ -720,9 +821,9 @@ Expected<void> Coordinator::generate(std::string_view event, std::string_view ta
 Expected<void> Coordinator::broadcast(std::string_view event) {
   auto e = find_event(event);
   if (!e) return tl::unexpected(e.error());
-  if (!events_[*e].is_broadcast()) {
+  if (!events_[to_index(*e)].is_broadcast()) {
     return fail(ErrorCode::InvalidArgument, "event '" + std::string(event) + "' has severity " +
-                                                std::to_string(events_[*e].severity) +
+                                                std::to_string(events_[to_index(*e)].severity) +
                                                 "; broadcasts need severity 251-255");
   }
   generate(*e, kNoMachine);
@@ -778,10 +879,10 @@ void Coordinator::drain_pending() noexcept {
 }
 
 void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
-  const Event& event = *event_table_[event_id];
+  const Event& event = *event_table_[to_index(event_id)];
   const Time now = clock_->now();
   if (event.is_broadcast()) {
-    for (ComponentId c = 0; c < components_.size(); ++c) {
+    for (ComponentId c : id_range<ComponentId>(components_.size())) {
       if (event.is_onset) {
         process_onset(event, components_[c].application, cause, now);
       } else {
@@ -809,7 +910,7 @@ void Coordinator::process_onset(const Event& event, MachineId target, const Samp
 
 void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
   MachineData& m = machines_[target];
-  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[event.counterpart];
+  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[to_index(event.counterpart)];
   const ConditionChange change = m.conditions.complete(onset);
   if (change.outcome == Outcome::Ignored) {
     Record r;
@@ -823,10 +924,12 @@ void Coordinator::process_completion(const Event& event, MachineId target, Time 
     r.severity = event.severity;
     if (change.index >= 0) r.root = m.conditions[static_cast<std::size_t>(change.index)].root;
     r.text = change.reason;
-    record_machine(target, r);
+    record(r, change.reason == ConditionSet::kIgnoredLatched     ? kTextLatched
+              : change.reason == ConditionSet::kIgnoredNotActive ? kTextNotActive
+                                                                 : kTextNoOnset);
     return;
   }
-  record_removed(target, change, event.id, now, {});
+  record_removed(target, change, event.id, now, kNone);
   propagate_clear(change.removed.root, change.removed.level, now);
 }
 
@@ -851,17 +954,16 @@ void Coordinator::record_added(MachineId id, const ConditionChange& change, Time
   r.mirror = c.mirror;
   r.via = c.via;
   r.root = c.root;
-  record_machine(id, r);
+  record(r, kNone);
   update_machine(id, change.from, c.event, &c.root, now);
 }
 
-void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now,
-                                   std::string_view text) noexcept {
+void Coordinator::remove_condition(MachineId id, std::size_t i, EventId event, Time now, std::uint32_t text) noexcept {
   record_removed(id, machines_[id].conditions.remove(i), event, now, text);
 }
 
 void Coordinator::record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
-                                 std::string_view text) noexcept {
+                                 std::uint32_t text) noexcept {
   MachineData& m = machines_[id];
   const Condition& removed = change.removed;
   Record r;
@@ -878,8 +980,8 @@ void Coordinator::record_removed(MachineId id, const ConditionChange& change, Ev
   r.mirror = removed.mirror;
   r.via = removed.via;
   r.root = removed.root;
-  r.text = text;
-  record_machine(id, r);
+  r.text = text_of(text);
+  record(r, text);
   update_machine(id, change.from, event, &removed.root, now);
 }
 
@@ -888,7 +990,7 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
   MachineData& m = machines_[id];
   const State state = m.conditions.state();
   const Condition* outstanding = m.conditions.outstanding();
-  MachineSummary& summary = summaries_[id];
+  MachineSummary& summary = summaries_[to_index(id)];
   summary.state = state;
   summary.event = outstanding == nullptr ? kNoEvent : outstanding->event;
   summary.severity = outstanding == nullptr ? 0 : outstanding->severity;
@@ -908,7 +1010,7 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
     r.from = old_state;
     r.to = state;
     if (root != nullptr) r.root = *root;
-    record_machine(id, r);
+    record(r, kNone);
     if (!m.callbacks.empty()) {
       const TransitionInfo info{m.component, id, transition_between(old_state, state), event, root, now};
       fire(m.callbacks, m.component, info, old_state, state);
@@ -926,7 +1028,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   // (Activation orders are unique, so the result does not depend on the order machines are seen.)
   const MachineSummary* best = nullptr;
   auto consider = [&](MachineId mid) {
-    const MachineSummary& cand = summaries_[mid];
+    const MachineSummary& cand = summaries_[to_index(mid)];
     if (cand.state != c.state || cand.event == kNoEvent) return;
     if (best == nullptr || cand.severity > best->severity ||
         (cand.severity == best->severity && cand.seq > best->seq)) {
@@ -934,7 +1036,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
     }
   };
   if (c.contiguous) {
-    for (MachineId m = c.first_machine; m < c.first_machine + c.machine_count; ++m) consider(m);
+    for (MachineId m : id_range(c.first_machine, to_index(c.first_machine) + c.machine_count)) consider(m);
   } else {
     consider(c.framework);
     consider(c.application);
@@ -953,7 +1055,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   r.from = old;
   r.to = c.state;
   if (root != nullptr) r.root = *root;
-  history_.push(r);
+  history_.push(r, kNone);
   if (!observers_.empty()) emit(r);
   if (c.callbacks.empty()) return;
   const TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
@@ -979,6 +1081,8 @@ void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId compo
 // ---- propagation (DESIGN §2.6) ---------------------------------------------------------------
 
 void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
+  // A machine that feeds no connection (most s_A of a leaf, every s_R) propagates nothing.
+  if (machines_[root_condition.root.origin].fanout.empty()) return;
   const RootCause root = root_condition.root;
   const State level = root_condition.level;
   const Time now = root_condition.first;
@@ -987,18 +1091,18 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
   const std::uint64_t mark = ++visit_epoch_;
   work_.clear();
   work_.push_back(root.origin);
-  visit_marks_[root.origin] = mark;
+  visit_marks_[to_index(root.origin)] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
     for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
-      visit_marks_[e.to] = mark;
+      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
+      visit_marks_[to_index(e.to)] = mark;
       work_.push_back(e.to);
       if (machines_[e.to].conditions.find_mirror(root) >= 0) continue;
       Condition c;
       c.event = mirror_event;
       c.level = level;
-      c.severity = event_table_[mirror_event]->severity;
+      c.severity = event_table_[to_index(mirror_event)]->severity;
       c.mirror = true;
       c.via = e.via;
       c.first = c.last = now;
@@ -1010,21 +1114,22 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
 }
 
 void Coordinator::propagate_clear(const RootCause& root, State level, Time now) noexcept {
+  if (machines_[root.origin].fanout.empty()) return;
   const std::uint64_t mark = ++visit_epoch_;
   work_.clear();
   work_.push_back(root.origin);
-  visit_marks_[root.origin] = mark;
+  visit_marks_[to_index(root.origin)] = mark;
   for (std::size_t head = 0; head < work_.size(); ++head) {
     const MachineId from = work_[head];
     for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[e.to] == mark) continue;
-      visit_marks_[e.to] = mark;
+      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
+      visit_marks_[to_index(e.to)] = mark;
       work_.push_back(e.to);
       const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
       if (i < 0) continue;
       const EventId completion =
           framework_event::completion_of(machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
-      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, {});
+      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, kNone);
     }
   }
 }
@@ -1034,7 +1139,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
   std::vector<MachineId> targets;
   switch (target.kind) {
     case Address::Kind::System:
-      for (MachineId m = 0; m < machines_.size(); ++m) targets.push_back(m);
+      for (MachineId m : id_range<MachineId>(machines_.size())) targets.push_back(m);
       break;
     case Address::Kind::Component:
     case Address::Kind::Service: {
@@ -1056,7 +1161,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
     r.machine = id;
     r.from = r.to = m.conditions.state();
     r.text = text;
-    record_machine(id, r);
+    record(r, to_index(reason));
   }
   // Warnings first, in every target machine, then errors: the component and the system then drop
   // once (E2N) instead of passing through a Warning that callbacks would react to.
@@ -1067,7 +1172,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
       for (std::int32_t i = m.conditions.find_lowest_root();
            i >= 0 && m.conditions[static_cast<std::size_t>(i)].level <= pass; i = m.conditions.find_lowest_root()) {
         const Condition c = m.conditions[static_cast<std::size_t>(i)];
-        remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, text);
+        remove_condition(id, static_cast<std::size_t>(i), kNoEvent, now, to_index(reason));
         propagate_clear(c.root, c.level, now);
       }
     }

@@ -64,21 +64,21 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
   std::vector<std::pair<MachineId, const Edge*>> edges;             // (from, edge)
   std::vector<MachineId> queue{origin};
   std::vector<bool> seen(machines_.size(), false);
-  seen[origin] = true;
-  for (std::size_t head = 0; head < queue.size() && !seen[holder]; ++head) {
+  seen[to_index(origin)] = true;
+  for (std::size_t head = 0; head < queue.size() && !seen[to_index(holder)]; ++head) {
     const MachineId from = queue[head];
     for (const Edge& e : machines_[from].fanout) {
-      if (condition.level < e.min_level || seen[e.to]) continue;
-      seen[e.to] = true;
-      parent_edge[e.to] = edges.size();
+      if (condition.level < e.min_level || seen[to_index(e.to)]) continue;
+      seen[to_index(e.to)] = true;
+      parent_edge[to_index(e.to)] = edges.size();
       edges.emplace_back(from, &e);
       queue.push_back(e.to);
     }
   }
   std::vector<std::string> reversed{machines_[holder].address};
-  for (MachineId at = holder; at != origin && parent_edge[at] != kUnseen;) {
-    const auto [from, edge] = edges[parent_edge[at]];
-    const Connection& conn = connections_[edge->via];
+  for (MachineId at = holder; at != origin && parent_edge[to_index(at)] != kUnseen;) {
+    const auto [from, edge] = edges[parent_edge[to_index(at)]];
+    const Connection& conn = connections_[to_index(edge->via)];
     const ComponentData& provider = components_[conn.provider];
     reversed.push_back(provider.name + ".s_S." + std::string(interface_name(provider.provided[conn.provided])));
     reversed.push_back(machines_[from].address);
@@ -108,7 +108,7 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
   for (const Condition* c : sorted) {
     Explanation e;
     e.machine = m.address;
-    e.event = events_[c->event].name;
+    e.event = events_[to_index(c->event)].name;
     e.level = c->level;
     e.severity = c->severity;
     e.mirror = c->mirror;
@@ -116,12 +116,12 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
     e.count = c->count;
     e.first = c->first;
     e.last = c->last;
-    e.root_event = events_[c->root.event].name;
+    e.root_event = events_[to_index(c->root.event)].name;
     e.root_origin = c->root.remote != kNone && c->root.remote < remote_roots_.size()
                         ? remote_roots_[c->root.remote].origin
                         : machines_[c->root.origin].address;
     e.root_time = c->root.time;
-    e.hazard = events_[c->root.event].hazard;
+    e.hazard = events_[to_index(c->root.event)].hazard;
     if (c->root.sample.filter != kNoName) e.filter = std::string(name_of(c->root.sample.filter));
     if (c->root.sample.signal != kNoName) e.signal = std::string(name_of(c->root.sample.signal));
     e.value = c->root.sample.value;
@@ -138,7 +138,7 @@ std::vector<Explanation> Coordinator::explain(const Address& address) const {
   std::vector<MachineId> machines;
   switch (address.kind) {
     case Address::Kind::System:
-      for (MachineId m = 0; m < machines_.size(); ++m) machines.push_back(m);
+      for (MachineId m : id_range<MachineId>(machines_.size())) machines.push_back(m);
       break;
     case Address::Kind::Component: {
       const ComponentData& c = components_[address.component];

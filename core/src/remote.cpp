@@ -44,20 +44,23 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   return *machine;
 }
 
-bool Coordinator::is_remote(ComponentId id) const noexcept { return id < components_.size() && components_[id].remote; }
+bool Coordinator::is_remote(ComponentId id) const noexcept {
+  return components_.contains(id) && components_[id].remote;
+}
 
 std::string Coordinator::root_origin(const RootCause& root) const {
   Lock lock(*this);
   if (root.remote_origin != kNoName) return std::string(name_of(root.remote_origin));
   if (root.remote != kNone && root.remote < remote_roots_.size()) return remote_roots_[root.remote].origin;
-  if (root.origin < machines_.size()) return machines_[root.origin].address;
+  if (machines_.contains(root.origin)) return machines_[root.origin].address;
   return {};
 }
 
 Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std::vector<RemoteRoot>& roots) {
-  if (proxy >= machines_.size() || machines_[proxy].kind != MachineKind::Provided ||
+  if (!machines_.contains(proxy) || machines_[proxy].kind != MachineKind::Provided ||
       !components_[machines_[proxy].component].remote) {
-    return fail(ErrorCode::NotFound, "machine " + std::to_string(proxy) + " is not a remote provided interface");
+    return fail(ErrorCode::NotFound,
+                "machine " + std::to_string(to_index(proxy)) + " is not a remote provided interface");
   }
   const std::string& where = machines_[proxy].address;
   // Check everything before changing anything.
@@ -69,7 +72,8 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
         "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
     auto e = find_event(r.event);
     if (!e) return fail(ErrorCode::InvalidArgument, what + ": no event '" + r.event + "' in this system");
-    if (!events_[*e].is_onset) return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
+    if (!events_[to_index(*e)].is_onset)
+      return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
     if (r.level == State::Normal) return fail(ErrorCode::InvalidArgument, what + ": level Normal is not a condition");
     if (r.origin.empty()) return fail(ErrorCode::InvalidArgument, what + ": empty origin");
     for (std::size_t j = 0; j < i; ++j) {
@@ -129,7 +133,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
       ++result.kept;
       continue;
     }
-    remove_condition(proxy, k, framework_event::completion_of(c.event), now, "no longer reported by the provider");
+    remove_condition(proxy, k, framework_event::completion_of(c.event), now, kTextNoLongerReported);
     propagate_clear(c.root, c.level, now);
     remote_roots_[c.root.remote].used = false;
     remote_roots_[c.root.remote].path.clear();
@@ -157,7 +161,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     Condition c;
     c.event = mirror_event;
     c.level = roots[i].level;
-    c.severity = event_table_[mirror_event]->severity;
+    c.severity = event_table_[to_index(mirror_event)]->severity;
     c.mirror = true;
     c.first = c.last = now;
     c.seq = ++condition_seq_;
@@ -180,7 +184,7 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
   // straight from the conditions: no Explanation (machine, event and hazard texts) per condition.
   Lock lock(*this);
   std::vector<RemoteRoot> out;
-  if (component >= components_.size() || service >= components_[component].provided.size()) return out;
+  if (!components_.contains(component) || service >= components_[component].provided.size()) return out;
   const ComponentData& c = components_[component];
   std::vector<EventId> ids;  // out[i]'s root event, compared by id rather than by name
   std::vector<const Condition*> sorted;
@@ -207,7 +211,7 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
         continue;
       }
       RemoteRoot r;
-      r.event = events_[k->root.event].name;
+      r.event = events_[to_index(k->root.event)].name;
       r.origin = origin;
       r.time = k->root.time;
       r.level = k->level;

@@ -189,8 +189,8 @@ Expected<Filter*> Monitor::add_filter(FilterConfig config) {
   if (execution == ExecutionMode::Passive) {
     passive_.push_back(raw);
   } else {
-    if (active_.size() <= component) active_.resize(component + 1);
-    active_[component].push_back(raw);
+    if (active_.size() <= to_index(component)) active_.resize(to_index(component) + std::size_t{1});
+    active_[to_index(component)].push_back(raw);
   }
   return raw;
 }
@@ -239,8 +239,8 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
 }
 
 void Monitor::run_active(ComponentId component, Time now) noexcept {
-  if (component >= active_.size()) return;
-  for (Filter* f : active_[component]) f->run(now);
+  if (to_index(component) >= active_.size()) return;
+  for (Filter* f : active_[to_index(component)]) f->run(now);
 }
 
 void Monitor::tick(Time now) noexcept {

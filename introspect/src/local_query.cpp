@@ -108,7 +108,7 @@ Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view componen
     return component_rows(*id);
   }
   out.push_back({"SYSTEM", RowKind::System, co_.coordinator_state(), {}});
-  for (ComponentId id = 0; id < co_.component_count(); ++id) {
+  for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
     if (co_.is_remote(id)) continue;
     std::vector<StateRow> rows = component_rows(id);
     out.insert(out.end(), std::make_move_iterator(rows.begin()), std::make_move_iterator(rows.end()));
@@ -196,7 +196,7 @@ Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
 
 Expected<std::vector<EventRow>> LocalQuery::event_list() {
   std::vector<EventRow> out;
-  for (EventId id = 0; id < co_.event_count(); ++id) {
+  for (EventId id : id_range<EventId>(co_.event_count())) {
     const Event& e = co_.event(id);
     EventRow r;
     r.name = e.name;
@@ -209,7 +209,7 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
     }
     r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.event(e.counterpart).name;
     r.latched = e.latched;
-    r.framework = id < framework_event::kCount;
+    r.framework = to_index(id) < framework_event::kCount;
     r.hazard = e.hazard;
     r.description = e.description;
     out.push_back(std::move(r));
@@ -238,7 +238,7 @@ Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
 
 Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
   std::vector<ServiceRow> out;
-  for (ComponentId id = 0; id < co_.component_count(); ++id) {
+  for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
     if (co_.is_remote(id)) continue;
     const auto& provided = co_.provided_machines(id);
     for (std::uint32_t i = 0; i < provided.size(); ++i) {
@@ -268,7 +268,7 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
   a.address = std::string(address);
   if (address == "SYSTEM") {
     a.state = co_.coordinator_state();
-    for (ComponentId id = 0; id < co_.component_count(); ++id) {
+    for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
       if (co_.is_remote(id)) continue;
       std::vector<Explanation> part = co_.explain(Address{Address::Kind::Component, id});
       a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()),
@@ -286,7 +286,7 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
 Expected<Names> LocalQuery::names() {
   Names n;
   n.addresses.emplace_back("SYSTEM");
-  for (ComponentId i = 0; i < co_.component_count(); ++i) {
+  for (ComponentId i : id_range<ComponentId>(co_.component_count())) {
     if (co_.is_remote(i)) continue;
     n.components.emplace_back(co_.component_name(i));
     n.addresses.emplace_back(co_.component_name(i));
@@ -294,12 +294,12 @@ Expected<Names> LocalQuery::names() {
       n.addresses.push_back(std::string(co_.component_name(i)) + ".s_S." + std::string(co_.interface_name(p)));
     }
   }
-  for (MachineId m = 0; m < co_.machine_count(); ++m) {
+  for (MachineId m : id_range<MachineId>(co_.machine_count())) {
     if (co_.is_remote(co_.machine_component(m))) continue;
     n.machines.push_back(co_.address_of(m));
     n.addresses.push_back(co_.address_of(m));
   }
-  for (EventId e = 0; e < co_.event_count(); ++e) n.events.push_back(co_.event(e).name);
+  for (EventId e : id_range<EventId>(co_.event_count())) n.events.push_back(co_.event(e).name);
   for (const auto& f : monitor_.filters()) n.filters.push_back(f->name());
   for (const FilterManifest* m : registry_.manifests()) n.filter_types.push_back(m->type);
   for (const auto& s : monitor_.signals().all()) n.signals.push_back(s->name());

@@ -38,17 +38,17 @@ HistoryEntry history_entry(const Record& r, const Coordinator& co) {
   e.time = r.time;
   e.kind = r.kind;
   e.outcome = r.outcome;
-  if (r.component != kNoComponent && r.component < co.component_count())
+  if (r.component != kNoComponent && to_index(r.component) < co.component_count())
     e.component = std::string(co.component_name(r.component));
-  if (r.machine != kNoMachine && r.machine < co.machine_count()) e.machine = co.address_of(r.machine);
-  if (r.event != kNoEvent && r.event < co.event_count()) e.event = co.event(r.event).name;
+  if (r.machine != kNoMachine && to_index(r.machine) < co.machine_count()) e.machine = co.address_of(r.machine);
+  if (r.event != kNoEvent && to_index(r.event) < co.event_count()) e.event = co.event(r.event).name;
   e.from = r.from;
   e.to = r.to;
   e.level = r.level;
   e.severity = r.severity;
   e.mirror = r.mirror;
-  if (r.root.event != kNoEvent && r.root.event < co.event_count() && r.root.origin != kNoMachine &&
-      r.root.origin < co.machine_count()) {
+  if (r.root.event != kNoEvent && to_index(r.root.event) < co.event_count() && r.root.origin != kNoMachine &&
+      to_index(r.root.origin) < co.machine_count()) {
     RootEntry root;
     root.event = co.event(r.root.event).name;
     // A root from another process names its origin there (interned when it arrived), not the

@@ -16,6 +16,7 @@
 #include "control.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
+#include "safecass/core/id_vector.hpp"
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
@@ -136,7 +137,7 @@ struct CoordinatorNode::Impl {
     OversizeLog oversize;  ///< publisher thread only
   };
   std::vector<std::unique_ptr<Stream>> streams;
-  std::vector<std::vector<std::size_t>> streams_of;  ///< by ComponentId
+  IdVector<std::vector<std::size_t>, ComponentId> streams_of;
 
   /// A remote provided interface held here (under peer_mutex).
   struct Held {
@@ -229,7 +230,7 @@ struct CoordinatorNode::Impl {
     {
       std::lock_guard lock(queue_mutex);
       // Records of stand-ins for remote components are that component's process's to publish.
-      if (r.kind != RecordKind::Event && !(r.component < co.component_count() && co.is_remote(r.component))) {
+      if (r.kind != RecordKind::Event && !(to_index(r.component) < co.component_count() && co.is_remote(r.component))) {
         if (records.size() < kQueueCapacity) {
           records.push_back(r);
           wake = (records.size() == 1 && !publisher_holds_events) || records.size() == kMaxBatch;
@@ -237,7 +238,7 @@ struct CoordinatorNode::Impl {
           events_dropped.fetch_add(1, std::memory_order_relaxed);
         }
       }
-      if (r.component < streams_of.size()) {
+      if (streams_of.contains(r.component)) {
         for (std::size_t i : streams_of[r.component]) {
           wake = wake || !streams[i]->dirty;
           streams[i]->dirty = true;
@@ -662,7 +663,7 @@ struct CoordinatorNode::Impl {
     h.seq = ++heartbeat_seq;
     for (const auto& s : streams) h.lastSeq["state:" + s->iface] = s->seq.load();
     h.lastSeq["events"] = event_seq.load();
-    for (ComponentId c = 0; c < co.component_count(); ++c) {
+    for (ComponentId c : id_range<ComponentId>(co.component_count())) {
       if (!co.is_remote(c)) h.components.emplace_back(co.component_name(c));
     }
     {
@@ -911,7 +912,7 @@ struct CoordinatorNode::Impl {
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is gone (no heartbeat for " + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
-      for (ComponentId c = 0; c < co.component_count(); ++c) {
+      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
         if (!co.is_remote(c)) co.generate(framework_event::kSupervisorLost, co.framework_machine(c));
       }
       return;
@@ -927,7 +928,7 @@ struct CoordinatorNode::Impl {
     peer.lost = false;
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
-      for (ComponentId c = 0; c < co.component_count(); ++c) {
+      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
         if (!co.is_remote(c)) {
           co.generate(framework_event::completion_of(framework_event::kSupervisorLost), co.framework_machine(c));
         }
@@ -1024,7 +1025,7 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   impl->drops = std::make_unique<DropLog>([d](const std::string& line) { d->log(line); });
   impl->incarnation = new_incarnation();
   impl->streams_of.resize(coordinator.component_count());
-  for (ComponentId c = 0; c < coordinator.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(coordinator.component_count())) {
     if (coordinator.is_remote(c)) {
       for (MachineId m : coordinator.provided_machines(c)) {
         const std::string iface =

@@ -51,7 +51,7 @@ const std::vector<FrameworkEvent>& framework_events() {
   static const std::vector<FrameworkEvent> events = [] {
     std::vector<FrameworkEvent> out;
     const Coordinator probe("framework-events");
-    for (EventId id = 0; id < framework_event::kCount; ++id) {
+    for (EventId id : id_range<EventId>(framework_event::kCount)) {
       const Event& e = probe.event(id);
       FrameworkEvent f;
       f.name = e.name;

@@ -889,7 +889,7 @@ private:
           sizes_known = false;
           continue;
         }
-        scratch.push_back(std::make_unique<Signal>(qualify(name, tc), 0, size, 1));
+        scratch.push_back(std::make_unique<Signal>(qualify(name, tc), ComponentId{0}, size, 1));
         input_sites.emplace_back(scratch.back()->name(), site);
       }
     }

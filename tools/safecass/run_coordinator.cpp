@@ -349,7 +349,7 @@ int run_coordinator(const RunArgs& args) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::size_t local = 0;
-  for (ComponentId c = 0; c < co.component_count(); ++c) local += co.is_remote(c) ? 0 : 1;
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) local += co.is_remote(c) ? 0 : 1;
   say("safecass run: coordinator '" + args.coordinator + "' of system '" + system.name + "', " + std::to_string(local) +
       " components, pid " + std::to_string(::getpid()) +
       (args.ice.empty() ? std::string(", no middleware") : ", IceStorm " + args.ice) +

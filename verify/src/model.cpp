@@ -88,7 +88,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       Broadcast bc;
       bc.event = event;
       if (e.counterpart != kNoEvent) bc.completion = co.event(e.counterpart).name;
-      for (ComponentId c = 0; c < co.component_count(); ++c) {
+      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
         if (co.is_remote(c)) continue;
         Root r;
         r.event = event;
@@ -157,16 +157,16 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
 
   // Reachability, from the coordinator itself: a root of each level at each machine that holds
   // roots, and where its mirrors land.
-  reach_error_.assign(machines, std::vector<bool>(machines, false));
-  reach_warning_.assign(machines, std::vector<bool>(machines, false));
-  for (MachineId origin = 0; origin < machines; ++origin) {
+  reach_error_.assign(machines, IdVector<bool, MachineId>(machines, false));
+  reach_warning_.assign(machines, IdVector<bool, MachineId>(machines, false));
+  for (MachineId origin : id_range<MachineId>(machines)) {
     if (at_machine_[origin].empty()) continue;
     for (const bool error : {true, false}) {
       const EventId probe = error ? framework_event::kServiceFailure : framework_event::kServiceDegraded;
       co.generate(probe, origin);
       auto& reach = error ? reach_error_[origin] : reach_warning_[origin];
       reach[origin] = true;
-      for (MachineId m = 0; m < machines; ++m) {
+      for (MachineId m : id_range<MachineId>(machines)) {
         for (const Condition& c : co.conditions(m)) {
           if (c.mirror && c.root.origin == origin) reach[m] = true;
         }
@@ -184,8 +184,8 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
     }
     return out;
   };
-  std::vector<std::vector<std::size_t>> machine_error(machines), machine_warning(machines);
-  for (MachineId m = 0; m < machines; ++m) {
+  IdVector<std::vector<std::size_t>, MachineId> machine_error(machines), machine_warning(machines);
+  for (MachineId m : id_range<MachineId>(machines)) {
     machine_error[m] = machine_roots(m, true);
     machine_warning[m] = machine_roots(m, false);
   }
@@ -206,7 +206,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
   std::vector<MachineId> all;
   std::map<std::string, spec::Position, std::less<>> component_where;
   for (const spec::ComponentSpec& c : system_->components) component_where[c.name] = c.where;
-  for (ComponentId c = 0; c < co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
     if (co.is_remote(c)) continue;
     std::vector<MachineId> ms{co.framework_machine(c), co.application_machine(c)};
     for (MachineId p : co.provided_machines(c)) ms.push_back(p);
@@ -214,7 +214,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
     all.insert(all.end(), ms.begin(), ms.end());
   }
   make("SYSTEM", all, {});
-  for (ComponentId c = 0; c < co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
     if (co.is_remote(c)) continue;
     const std::string name(co.component_name(c));
     const spec::Position where = component_where[name];
@@ -239,7 +239,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
 
   // Which levels each root can take: a fixpoint over the machines' possible states.
   can_.assign(roots_.size(), {false, false, false});
-  std::vector<std::array<bool, 3>> possible(machines, {true, false, false});
+  IdVector<std::array<bool, 3>, MachineId> possible(machines, {true, false, false});
   for (bool changed = true; changed;) {
     changed = false;
     for (std::size_t i = 0; i < roots_.size(); ++i) {
@@ -253,7 +253,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
         }
       }
     }
-    for (MachineId m = 0; m < machines; ++m) {
+    for (MachineId m : id_range<MachineId>(machines)) {
       for (std::size_t i : machine_error[m]) {
         if (can_[i][2] && !possible[m][2]) possible[m][2] = changed = true;
       }

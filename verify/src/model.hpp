@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/id_vector.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/spec/formula.hpp"
 #include "safecass/verify/verify.hpp"
@@ -109,10 +110,10 @@ private:
   std::vector<Root> roots_;
   std::vector<Broadcast> broadcasts_;
   std::vector<AddressInfo> addresses_;
-  std::vector<std::vector<std::size_t>> at_machine_;
+  IdVector<std::vector<std::size_t>, MachineId> at_machine_;
   std::vector<std::array<bool, 3>> can_;
-  std::vector<std::vector<bool>> reach_error_;    ///< [machine][machine]: an Error root reaches it
-  std::vector<std::vector<bool>> reach_warning_;  ///< ... a Warning root
+  IdVector<IdVector<bool, MachineId>, MachineId> reach_error_;    ///< [machine][machine]: an Error root reaches it
+  IdVector<IdVector<bool, MachineId>, MachineId> reach_warning_;  ///< ... a Warning root
 };
 
 }  // namespace safecass::verify::detail

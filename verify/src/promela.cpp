@@ -198,7 +198,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
       body += "       w" + std::to_string(c) + " = 0; e" + std::to_string(c) + " = 0;\n";
     }
     out += "  /* reset " + comment(co.address_of(m)) + " */\n";
-    out += step("(" + guard + ")", body, "reset " + std::to_string(m));
+    out += step("(" + guard + ")", body, "reset " + std::to_string(to_index(m)));
   }
   if (spec.classes.empty()) out += "  :: skip\n";
   out += "  od\n}\n";

@@ -317,7 +317,7 @@ private:
         if (!done) problem = "the trail's step '" + line + "' has no counterpart in the coordinator";
       } else if (kind == "reset") {
         const auto m = static_cast<MachineId>(a);
-        if (m >= co.machine_count()) continue;
+        if (to_index(m) >= co.machine_count()) continue;
         steps.push_back(Step{Step::Kind::Reset, "", co.address_of(m)});
         (void)co.reset(co.address_of(m), "verify", "counterexample");
       } else if (kind == "bon" || kind == "boff") {

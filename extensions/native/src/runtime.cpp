@@ -14,8 +14,8 @@ Runtime::Runtime(Monitor& monitor, Time monitor_period)
 Runtime::~Runtime() { stop(); }
 
 Expected<void> Runtime::add_task(ComponentId component, Time period, Body body) {
-  if (component >= coordinator_.component_count()) {
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(component));
+  if (to_index(component) >= coordinator_.component_count()) {
+    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   }
   const std::string name(coordinator_.component_name(component));
   if (period <= Time{0}) return fail(ErrorCode::InvalidArgument, "task of '" + name + "': period must be positive");
@@ -34,7 +34,7 @@ Expected<void> Runtime::set_body(ComponentId component, Body body) {
       return {};
     }
   }
-  return fail(ErrorCode::NotFound, "component id " + std::to_string(component) + " has no task");
+  return fail(ErrorCode::NotFound, "component id " + std::to_string(to_index(component)) + " has no task");
 }
 
 void Runtime::cycle(Task& task, Time now) noexcept {

@@ -546,7 +546,7 @@ void Bridge::Impl::publish_diagnostics() {
   const Coordinator& co = *coordinator;
   diagnostic_msgs::DiagnosticArray array;
   array.header.stamp = ros::Time::now();
-  for (ComponentId c = 0; c < co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
     std::vector<MachineId> machines{co.framework_machine(c), co.application_machine(c)};
     for (MachineId m : co.provided_machines(c)) machines.push_back(m);
     for (MachineId m : co.required_machines(c)) machines.push_back(m);

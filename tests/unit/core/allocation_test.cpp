@@ -107,14 +107,14 @@ constexpr int kRounds = 100;
 struct Rig {
   SimulatedClock clock;
   Coordinator co{"alloc", &clock};
-  ComponentId single = 0;
-  MachineId single_app = 0;
+  ComponentId single{0};
+  MachineId single_app{0};
   std::vector<ComponentId> chain;
-  MachineId head_app = 0;
-  EventId onset = 0;
-  EventId completion = 0;
-  EventId warning = 0;
-  EventId warning_completion = 0;
+  MachineId head_app{0};
+  EventId onset{0};
+  EventId completion{0};
+  EventId warning{0};
+  EventId warning_completion{0};
 
   Rig() {
     single = *co.add_component("SINGLE");
@@ -186,7 +186,7 @@ TEST(CoreAllocation, LockFreeReadsAndDispatchAllocateNothing) {
       sink += static_cast<long>(rig.co.coordinator_state());
       rig.co.dispatch(
           rig.single, [&] { sink += 1; }, [&](const Event& e) { sink += e.severity; },
-          [&](const Event& e) { sink += e.id; });
+          [&](const Event& e) { sink += to_index(e.id); });
     }
   };
   read_everything();
@@ -225,12 +225,12 @@ TEST(CoreAllocation, WithAnObserverAndCallbacksOnEveryMachineTheHotPathsStillAll
   long records = 0;
   long callbacks = 0;
   rig.co.subscribe([&records](const Record&) { ++records; });
-  for (MachineId m = 0; m < rig.co.machine_count(); ++m) {
+  for (MachineId m : id_range<MachineId>(rig.co.machine_count())) {
     rig.co.on_machine(
         m, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});
   }
-  for (ComponentId c = 0; c < rig.co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(rig.co.component_count())) {
     rig.co.on_component(
         c, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});
@@ -284,6 +284,39 @@ TEST(CoreAllocation, RefreshesIgnoredCompletionsMaskedOnsetsAndWarningPropagatio
   EXPECT_TRUE(ok);
   EXPECT_EQ(use.allocations, 0);
   EXPECT_EQ(use.deallocations, 0);
+}
+
+}  // namespace
+}  // namespace safecass
+
+namespace safecass {
+namespace {
+
+TEST(CoreAllocation, InterningAKnownNameAndAnEventWithFilterDataAllocateNothing) {
+  // A filter interns its names once, at configuration; looking a known name up again (the hash
+  // index of intern()) and generating events that carry filter data then allocate nothing.
+  Rig rig;
+  const NameId filter = rig.co.intern("force_limit");
+  const NameId signal = rig.co.intern("SINGLE.force");
+  for (int i = 0; i < kWarmUp; ++i) (void)rig.single_round();
+  bool ok = true;
+  const HeapUse use = heap_use_of([&] {
+    for (int i = 0; i < kRounds; ++i) {
+      ok = ok && rig.co.intern("force_limit") == filter && rig.co.intern("SINGLE.force") == signal;
+      SampleCause cause;
+      cause.filter = filter;
+      cause.signal = signal;
+      cause.value = 31.0 + i;
+      rig.co.generate(rig.onset, rig.single_app, cause);
+      ok = ok && rig.co.state(rig.single_app) == State::Error;
+      rig.co.generate(rig.completion, rig.single_app);
+      ok = ok && rig.co.state(rig.single_app) == State::Normal;
+    }
+  });
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(use.allocations, 0);
+  EXPECT_EQ(use.deallocations, 0);
+  EXPECT_EQ(rig.co.name_of(filter), "force_limit");
 }
 
 }  // namespace

@@ -157,7 +157,7 @@ TEST(ServiceState, ServiceEntryErrorsNameTheServiceAndChangeNothing) {
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
   EXPECT_EQ(c.co.service(c.comp("C"), 0).propagate, E);
 
-  r = c.co.set_service(99, "p", ServiceDependency{});
+  r = c.co.set_service(ComponentId{99}, "p", ServiceDependency{});
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
 }

@@ -32,7 +32,7 @@ struct Chain : Gcm {
     for (int k = 0; k < kThreads; ++k) {
       components.push_back(component("C" + std::to_string(k), {"Out"}, {"In"}));
       onsets.push_back(pair("EVT_F" + std::to_string(k), 50 + k, State::Error));
-      completions.push_back(onsets.back() + 1);
+      completions.push_back(EventId{to_index(onsets.back()) + 1});
     }
     for (int k = 1; k < kThreads; ++k) {
       test::must(co.connect("C" + std::to_string(k) + ".In", "C" + std::to_string(k - 1) + ".Out"), "connect");

@@ -30,9 +30,9 @@ constexpr State N = State::Normal;
 constexpr State W = State::Warning;
 constexpr State E = State::Error;
 
-constexpr EventId kX = 100;
-constexpr EventId kB = 200;
-constexpr EventId kMirrorRoot = 300;
+constexpr EventId kX{100};
+constexpr EventId kB{200};
+constexpr EventId kMirrorRoot{300};
 constexpr Time kNow{std::chrono::seconds(7)};
 
 /// The event of a row (DESIGN §2.3 for the levels: onset_level()).
@@ -257,19 +257,19 @@ ConditionSet build(const std::string& text, std::uint8_t x_severity, std::uint64
       case 'B':
         c.event = kB;
         c.severity = 40;
-        c.root = RootCause{kB, 1, c.first, {}};
+        c.root = RootCause{kB, MachineId{1}, c.first, {}};
         break;
       case 'X':
         c.event = kX;
         c.severity = x_severity;
-        c.root = RootCause{kX, 1, c.first, {}};
+        c.root = RootCause{kX, MachineId{1}, c.first, {}};
         break;
       case 'M':
         c.event = kX;  // a mirror carrying the subject's event: only roots may be completed
         c.severity = c.level == E ? 220 : 215;
         c.mirror = true;
-        c.via = 0;
-        c.root = RootCause{kMirrorRoot, 9, c.first, {}};
+        c.via = ConnectionId{0};
+        c.root = RootCause{kMirrorRoot, MachineId{9}, c.first, {}};
         break;
       default: ADD_FAILURE() << "bad token " << t;
     }
@@ -313,7 +313,7 @@ TEST_P(ConditionSetTable, FollowsTheSeverityPolicy) {
   ConditionChange change;
   std::size_t removed_by_reset = 0;
   if (is_onset(row.op)) {
-    change = set.onset(onset, RootCause{kX, 1, kNow, {}}, kNow, activations);
+    change = set.onset(onset, RootCause{kX, MachineId{1}, kNow, {}}, kNow, activations);
   } else if (row.op == Op::Reset) {
     removed_by_reset = set.reset();
   } else {
@@ -446,22 +446,22 @@ TEST(ConditionSet, OutstandingFallsBackToTheNextConditionWhenTheOutstandingClear
   std::uint64_t activations = 0;
   ConditionSet set;
   Event high = onset_event(Op::WarningOnset, false);
-  high.id = 1;
+  high.id = EventId{1};
   high.severity = 30;
   Event error = onset_event(Op::ErrorOnset, false);
-  error.id = 2;
+  error.id = EventId{2};
   error.severity = 50;
-  EXPECT_EQ(set.onset(high, RootCause{1, 0, kNow, {}}, kNow, activations).outcome, Outcome::Raised);
-  const ConditionChange raised = set.onset(error, RootCause{2, 0, kNow, {}}, kNow, activations);
+  EXPECT_EQ(set.onset(high, RootCause{EventId{1}, MachineId{0}, kNow, {}}, kNow, activations).outcome, Outcome::Raised);
+  const ConditionChange raised = set.onset(error, RootCause{EventId{2}, MachineId{0}, kNow, {}}, kNow, activations);
   EXPECT_EQ(raised.outcome, Outcome::Raised);
   EXPECT_EQ(raised.from, W);
   EXPECT_EQ(raised.to, E);
-  EXPECT_EQ(set.outstanding_event(), 2u);
-  EXPECT_EQ(set.onset(high, RootCause{1, 0, kNow, {}}, kNow, activations).outcome, Outcome::None);
+  EXPECT_EQ(set.outstanding_event(), EventId{2});
+  EXPECT_EQ(set.onset(high, RootCause{EventId{1}, MachineId{0}, kNow, {}}, kNow, activations).outcome, Outcome::None);
   const ConditionChange cleared = set.complete(&error);
   EXPECT_EQ(cleared.outcome, Outcome::Cleared);
   EXPECT_EQ(cleared.to, W);
-  EXPECT_EQ(set.outstanding_event(), 1u);
+  EXPECT_EQ(set.outstanding_event(), EventId{1});
   EXPECT_EQ(set.complete(&high).to, N);
   EXPECT_EQ(set.outstanding(), nullptr);
 }
@@ -470,23 +470,23 @@ TEST(ConditionSet, EqualSeverityTiesGoToTheMostRecentActivationNotTheMostRecentR
   std::uint64_t activations = 0;
   ConditionSet set;
   Event a = onset_event(Op::ErrorOnset, false);
-  a.id = 1;
+  a.id = EventId{1};
   Event b = onset_event(Op::ErrorOnset, false);
-  b.id = 2;
-  set.onset(a, RootCause{1, 0, kNow, {}}, kNow, activations);
-  set.onset(b, RootCause{2, 0, kNow, {}}, kNow, activations);
-  EXPECT_EQ(set.outstanding_event(), 2u);
-  set.onset(a, RootCause{1, 0, kNow, {}}, kNow + std::chrono::seconds(1), activations);  // refresh
-  EXPECT_EQ(set.outstanding_event(), 2u);
+  b.id = EventId{2};
+  set.onset(a, RootCause{EventId{1}, MachineId{0}, kNow, {}}, kNow, activations);
+  set.onset(b, RootCause{EventId{2}, MachineId{0}, kNow, {}}, kNow, activations);
+  EXPECT_EQ(set.outstanding_event(), EventId{2});
+  set.onset(a, RootCause{EventId{1}, MachineId{0}, kNow, {}}, kNow + std::chrono::seconds(1), activations);  // refresh
+  EXPECT_EQ(set.outstanding_event(), EventId{2});
 }
 
 TEST(ConditionSet, AMirrorIsFoundByItsRootCauseOnly) {
   std::uint64_t activations = 0;
   ConditionSet set = build("M:E", 60, activations);
-  EXPECT_EQ(set.find_mirror(RootCause{kMirrorRoot, 9, {}, {}}), 0);
-  EXPECT_EQ(set.find_mirror(RootCause{kMirrorRoot, 8, {}, {}}), -1) << "another origin";
-  EXPECT_EQ(set.find_mirror(RootCause{kX, 9, {}, {}}), -1) << "another event";
-  RootCause remote{kMirrorRoot, 9, {}, {}};
+  EXPECT_EQ(set.find_mirror(RootCause{kMirrorRoot, MachineId{9}, {}, {}}), 0);
+  EXPECT_EQ(set.find_mirror(RootCause{kMirrorRoot, MachineId{8}, {}, {}}), -1) << "another origin";
+  EXPECT_EQ(set.find_mirror(RootCause{kX, MachineId{9}, {}, {}}), -1) << "another event";
+  RootCause remote{kMirrorRoot, MachineId{9}, {}, {}};
   remote.remote = 3;
   EXPECT_EQ(set.find_mirror(remote), -1) << "another remote root";
   EXPECT_EQ(set.find_root(kX), -1) << "a mirror is not a root";
@@ -514,15 +514,16 @@ TEST(ConditionSet, SeededRandomChangesKeepStateAndOutstandingConsistentWhateverT
     return (seed >> 8) % n;
   };
   for (int step = 0; step < 5000; ++step) {
-    const EventId id = next(8);
+    const EventId id{next(8)};
     Event e;
     e.id = id;
-    e.severity = static_cast<std::uint8_t>(10 + 10 * (id % 4));
-    e.transitions = id % 2 == 0 ? TransitionSet{Transition::N2W} : TransitionSet{Transition::N2E, Transition::W2E};
-    e.latched = id == 7;
+    e.severity = static_cast<std::uint8_t>(10 + 10 * (to_index(id) % 4));
+    e.transitions =
+        to_index(id) % 2 == 0 ? TransitionSet{Transition::N2W} : TransitionSet{Transition::N2E, Transition::W2E};
+    e.latched = id == EventId{7};
     switch (next(4)) {
       case 0:
-      case 1: set.onset(e, RootCause{id, 0, kNow, {}}, kNow, activations); break;
+      case 1: set.onset(e, RootCause{id, MachineId{0}, kNow, {}}, kNow, activations); break;
       case 2: set.complete(&e); break;
       default:
         if (next(20) == 0) set.reset();

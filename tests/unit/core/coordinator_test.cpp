@@ -113,9 +113,9 @@ TEST(BadInput, AProvidedAndARequiredInterfaceMayShareAName) {
 TEST(BadInput, InterfacesOfAnUnknownComponentOrWithInvalidNamesAreRejected) {
   Model m;
   expect_rejected<MachineId>(
-      m, [&] { return m.co.add_provided(77, "X"); }, ErrorCode::NotFound, "77");
+      m, [&] { return m.co.add_provided(ComponentId{77}, "X"); }, ErrorCode::NotFound, "77");
   expect_rejected<MachineId>(
-      m, [&] { return m.co.add_required(77, "X"); }, ErrorCode::NotFound, "77");
+      m, [&] { return m.co.add_required(ComponentId{77}, "X"); }, ErrorCode::NotFound, "77");
   expect_rejected<MachineId>(
       m, [&] { return m.co.add_provided(m.comp("JR3"), "a.b"); }, ErrorCode::InvalidArgument, "a.b");
   expect_rejected<MachineId>(

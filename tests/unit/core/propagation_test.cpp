@@ -99,7 +99,7 @@ TEST(Propagation, TheMirrorIsServiceFailureAtErrorAndKeepsTheRootCause) {
   EXPECT_EQ(g.co.event(m.event).name, "EVT_SERVICE_FAILURE");
   EXPECT_EQ(m.severity, 220);
   EXPECT_EQ(m.level, E);
-  EXPECT_EQ(m.via, 0u);
+  EXPECT_EQ(m.via, ConnectionId{0});
   EXPECT_EQ(m.root.event, g.id("EVT_FORCE_ERROR"));
   EXPECT_EQ(m.root.origin, g.machine("JR3.s_A"));
   EXPECT_EQ(m.root.time, seconds_to_time(1.5));

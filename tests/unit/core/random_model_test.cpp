@@ -22,6 +22,8 @@
 #include <utility>
 #include <vector>
 
+#include "safecass/core/id_vector.hpp"
+
 #include "safecass/core/coordinator.hpp"
 
 namespace safecass {
@@ -265,11 +267,11 @@ std::vector<MachineId> machines_of(const Coordinator& co, ComponentId c) {
   return out;
 }
 
-std::vector<std::vector<Hop>> read_hops(const Coordinator& co) {
-  std::vector<std::vector<Hop>> hops(co.machine_count());
+IdVector<std::vector<Hop>, MachineId> read_hops(const Coordinator& co) {
+  IdVector<std::vector<Hop>, MachineId> hops(co.machine_count());
   const auto& conns = co.connections();
-  for (ConnectionId k = 0; k < conns.size(); ++k) {
-    const Connection& conn = conns[k];
+  for (ConnectionId k : id_range<ConnectionId>(conns.size())) {
+    const Connection& conn = conns[to_index(k)];
     const MachineId client = co.required_machines(conn.client)[conn.required];
     const State min_level = co.service(conn.provider, conn.provided).propagate;
     for (MachineId m : machines_of(co, conn.provider)) {
@@ -280,10 +282,10 @@ std::vector<std::vector<Hop>> read_hops(const Coordinator& co) {
 }
 
 /// True when the machine graph (hops passable at Error) contains a cycle.
-bool has_cycle(const std::vector<std::vector<Hop>>& hops) {
-  std::vector<int> color(hops.size(), 0);
-  std::vector<std::pair<std::size_t, std::size_t>> stack;
-  for (std::size_t s = 0; s < hops.size(); ++s) {
+bool has_cycle(const IdVector<std::vector<Hop>, MachineId>& hops) {
+  IdVector<int, MachineId> color(hops.size(), 0);
+  std::vector<std::pair<MachineId, std::size_t>> stack;
+  for (MachineId s : hops.ids()) {
     if (color[s] != 0) continue;
     stack.push_back({s, 0});
     color[s] = 1;
@@ -361,7 +363,7 @@ public:
   const EventInfo& info(EventId e) const { return events_.at(e); }
   const std::vector<RootModel>& roots(MachineId m) const { return roots_[m]; }
   const std::vector<MirrorModel>& mirrors(MachineId m) const { return mirrors_[m]; }
-  const std::vector<std::vector<Hop>>& hops() const { return hops_; }
+  const IdVector<std::vector<Hop>, MachineId>& hops() const { return hops_; }
 
   State state(MachineId m) const {
     State s = State::Normal;
@@ -373,7 +375,8 @@ public:
   void generate(EventId e, MachineId target, Time now, const SampleCause& cause) {
     const EventInfo& ev = info(e);
     if (ev.broadcast) {
-      for (ComponentId c = 0; c < co_.component_count(); ++c) apply(e, co_.application_machine(c), now, cause);
+      for (ComponentId c : id_range<ComponentId>(co_.component_count()))
+        apply(e, co_.application_machine(c), now, cause);
       return;
     }
     apply(e, target, now, cause);
@@ -396,7 +399,7 @@ public:
   /// The active roots, for choosing a completion to send.
   std::vector<std::pair<MachineId, EventId>> active_roots() const {
     std::vector<std::pair<MachineId, EventId>> out;
-    for (MachineId m = 0; m < roots_.size(); ++m) {
+    for (MachineId m : id_range<MachineId>(roots_.size())) {
       for (const RootModel& r : roots_[m]) out.push_back({m, r.event});
     }
     return out;
@@ -454,9 +457,9 @@ private:
   /// reachable from O by hops each of which X's level passes; never in O itself.
   void recompute() {
     for (auto& v : mirrors_) v.clear();
-    std::vector<char> seen(hops_.size());
+    IdVector<char, MachineId> seen(hops_.size());
     std::vector<MachineId> queue;
-    for (MachineId o = 0; o < roots_.size(); ++o) {
+    for (MachineId o : id_range<MachineId>(roots_.size())) {
       for (const RootModel& r : roots_[o]) {
         std::fill(seen.begin(), seen.end(), 0);
         queue.assign(1, o);
@@ -475,9 +478,9 @@ private:
 
   const Coordinator& co_;
   std::map<EventId, EventInfo> events_;
-  std::vector<std::vector<RootModel>> roots_;
-  std::vector<std::vector<MirrorModel>> mirrors_;
-  std::vector<std::vector<Hop>> hops_;
+  IdVector<std::vector<RootModel>, MachineId> roots_;
+  IdVector<std::vector<MirrorModel>, MachineId> mirrors_;
+  IdVector<std::vector<Hop>, MachineId> hops_;
   std::vector<ExpectedRecord> expected_;
 };
 
@@ -527,8 +530,8 @@ public:
         }
       }
     }
-    for (ComponentId c = 0; c < spec_.components.size(); ++c) {
-      const ComponentSpec& cs = spec_.components[c];
+    for (ComponentId c : id_range<ComponentId>(spec_.components.size())) {
+      const ComponentSpec& cs = spec_.components[to_index(c)];
       for (std::size_t p = 0; p < cs.provided.size(); ++p) {
         if (cs.services[p]) {
           if (auto ok = co_.set_service(c, cs.provided[p], *cs.services[p]); !ok) return ok.error().message;
@@ -568,7 +571,7 @@ public:
           .push_back(ids.at(def.name));
     }
     // Framework events (§2.7): every event the spec did not define; their definitions are data.
-    for (EventId id = 0; id < co_.event_count(); ++id) {
+    for (EventId id : id_range<EventId>(co_.event_count())) {
       if (events.count(id) != 0) continue;
       const Event& ev = co_.event(id);
       EventInfo e;
@@ -589,10 +592,11 @@ public:
 
     filter_name_ = co_.intern("random_filter");
     signal_name_ = co_.intern("C0.signal");
-    for (MachineId m = 0; m < co_.machine_count(); ++m) {
-      co_.on_machine(m, callbacks(false, m));
+    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
+      co_.on_machine(m, callbacks(false, to_index(m)));
     }
-    for (ComponentId c = 0; c < co_.component_count(); ++c) co_.on_component(c, callbacks(true, c));
+    for (ComponentId c : id_range<ComponentId>(co_.component_count()))
+      co_.on_component(c, callbacks(true, to_index(c)));
     co_.subscribe([this](const Record& r) { records_.push_back(r); });
     machine_state_.assign(co_.machine_count(), State::Normal);
     component_state_.assign(co_.component_count(), State::Normal);
@@ -615,7 +619,7 @@ public:
     if (roll < 430) {
       // An onset on a random machine; a quarter of them with the data of a filter that fired.
       const EventId e = rng_.pick(onsets_);
-      const MachineId m = rng_.below(co_.machine_count());
+      const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
       SampleCause cause;
       if (rng_.chance(0.25)) {
         cause.filter = filter_name_;
@@ -657,7 +661,7 @@ public:
         m = origin;
       } else {
         e = rng_.pick(completions_);
-        m = rng_.below(co_.machine_count());
+        m = id_at<MachineId>(rng_.below(co_.machine_count()));
       }
       op << "generate " << co_.event(e).name << " on " << co_.address_of(m);
       const bool orphan = !oracle_->info(e).clears.has_value();
@@ -677,7 +681,7 @@ public:
       if (rng_.chance(0.5)) {
         if (!co_.broadcast(co_.event(e).name)) return op.str() + ": broadcast failed";
       } else {
-        co_.generate(e, rng_.below(co_.machine_count()));  // the target of a broadcast is ignored
+        co_.generate(e, id_at<MachineId>(rng_.below(co_.machine_count())));  // the target of a broadcast is ignored
       }
       oracle_->generate(e, kNoMachine, now, {});
     } else if (roll < 920) {
@@ -686,16 +690,16 @@ public:
       std::string target;
       std::vector<MachineId> machines;
       if (kind < 8) {
-        const MachineId m = rng_.below(co_.machine_count());
+        const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
         target = co_.address_of(m);
         machines = {m};
       } else if (kind < 16) {
-        const ComponentId c = rng_.below(co_.component_count());
+        const ComponentId c = id_at<ComponentId>(rng_.below(co_.component_count()));
         target = std::string(co_.component_name(c));
         machines = machines_of(co_, c);
       } else {
         target = kind < 19 ? "SYSTEM" : "rand";
-        for (MachineId m = 0; m < co_.machine_count(); ++m) machines.push_back(m);
+        for (MachineId m : id_range<MachineId>(co_.machine_count())) machines.push_back(m);
       }
       op << "reset " << target;
       if (!co_.reset(target, "random", "step " + std::to_string(n))) return op.str() + ": reset failed";
@@ -748,7 +752,7 @@ private:
       calls_.push_back(CallbackCall{Phase::Transition, component, id, State::Normal, State::Normal, info});
     };
     cb.on_entry = [this, component, id](State s) {
-      const State now = component ? co_.extended_state(id) : co_.state(id);
+      const State now = component ? co_.extended_state(ComponentId{id}) : co_.state(MachineId{id});
       calls_.push_back(CallbackCall{Phase::Entry, component, id, s, now, {}});
     };
     return cb;
@@ -757,8 +761,8 @@ private:
   /// The configuration reads back as the spec wrote it.
   std::string check_read_back() {
     if (co_.component_count() != spec_.components.size()) return "component count";
-    for (ComponentId c = 0; c < spec_.components.size(); ++c) {
-      const ComponentSpec& cs = spec_.components[c];
+    for (ComponentId c : id_range<ComponentId>(spec_.components.size())) {
+      const ComponentSpec& cs = spec_.components[to_index(c)];
       if (co_.component_name(c) != cs.name) return "component name";
       if (co_.provided_machines(c).size() != cs.provided.size()) return "provided count of " + cs.name;
       if (co_.required_machines(c).size() != cs.required.size()) return "required count of " + cs.name;
@@ -780,9 +784,9 @@ private:
     const Oracle& o = *oracle_;
     std::set<std::uint64_t> seqs;
     std::size_t total_conditions = 0;
-    std::vector<State> states(co_.machine_count());
+    IdVector<State, MachineId> states(co_.machine_count());
 
-    for (MachineId m = 0; m < co_.machine_count(); ++m) {
+    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
       const std::string& at = co_.address_of(m);
       const std::vector<Condition> conds = co_.conditions(m);
       // Roots: exactly the oracle's, with level, count, times, severity and cause.
@@ -830,8 +834,8 @@ private:
         if (c.count != 1) return at + ": " + what + " was refreshed";
         if (c.first != it->first || c.root.time != it->first) return at + ": " + what + " times";
         if (!same_cause(c.root.sample, it->cause)) return at + ": " + what + " lost the sample cause";
-        if (c.via >= co_.connections().size()) return at + ": " + what + " names no connection";
-        const Connection& via = co_.connections()[c.via];
+        if (to_index(c.via) >= co_.connections().size()) return at + ": " + what + " names no connection";
+        const Connection& via = co_.connections()[to_index(c.via)];
         if (co_.required_machines(via.client)[via.required] != m)
           return at + ": " + what + " arrived via another machine's connection";
       }
@@ -876,7 +880,7 @@ private:
 
     // Components: extended state = product of its machines; outstanding over its machines.
     State all = State::Normal;
-    for (ComponentId c = 0; c < co_.component_count(); ++c) {
+    for (ComponentId c : id_range<ComponentId>(co_.component_count())) {
       const std::string name(co_.component_name(c));
       State ext = State::Normal;
       const Condition* best = nullptr;
@@ -927,7 +931,7 @@ private:
 
     // The product is order-independent: fold the machine states in several random orders.
     {
-      std::vector<State> shuffled = states;
+      std::vector<State> shuffled(states.begin(), states.end());
       State expected = State::Normal;
       for (State s : states) expected = worse(expected, s);
       if (expected != all) return "product of machine states differs from the product of components";
@@ -956,22 +960,24 @@ private:
       const CallbackCall& x = calls_[i];
       const CallbackCall& t = calls_[i + 1];
       const CallbackCall& n = calls_[i + 2];
-      const std::string who = x.component ? std::string(co_.component_name(x.id)) : co_.address_of(x.id);
+      const std::string who =
+          x.component ? std::string(co_.component_name(ComponentId{x.id})) : co_.address_of(MachineId{x.id});
       if (x.phase != Phase::Exit || t.phase != Phase::Transition || n.phase != Phase::Entry) {
         return who + ": callbacks out of order (want on_exit, on_transition, on_entry)";
       }
       if (t.component != x.component || n.component != x.component || t.id != x.id || n.id != x.id) {
         return who + ": a transition's callbacks are interleaved with another's";
       }
-      State& tracked = x.component ? component_state_[x.id] : machine_state_[x.id];
+      State& tracked = x.component ? component_state_[ComponentId{x.id}] : machine_state_[MachineId{x.id}];
       if (x.state != tracked)
         return who + ": on_exit(" + std::string(to_string(x.state)) + ") but the state was " +
                std::string(to_string(tracked));
       if (x.state == n.state) return who + ": a transition to the same state";
       if (t.info.transition != expected_transition(x.state, n.state))
         return who + ": on_transition names the wrong transition";
-      if (x.component ? (t.info.component != x.id || t.info.machine != kNoMachine)
-                      : (t.info.machine != x.id || t.info.component != co_.machine_component(x.id))) {
+      if (x.component
+              ? (t.info.component != ComponentId{x.id} || t.info.machine != kNoMachine)
+              : (t.info.machine != MachineId{x.id} || t.info.component != co_.machine_component(MachineId{x.id}))) {
         return who + ": on_transition names the wrong machine or component";
       }
       if (n.read_back != n.state) return who + ": on_entry(new) runs before the new state can be read";
@@ -979,10 +985,10 @@ private:
       ++triples[{x.component, x.id}];
     }
     calls_.clear();
-    for (MachineId m = 0; m < co_.machine_count(); ++m) {
+    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
       if (machine_state_[m] != co_.state(m)) return co_.address_of(m) + ": a state change fired no callbacks";
     }
-    for (ComponentId c = 0; c < co_.component_count(); ++c) {
+    for (ComponentId c : id_range<ComponentId>(co_.component_count())) {
       if (component_state_[c] != co_.extended_state(c))
         return std::string(co_.component_name(c)) + ": a change fired no callbacks";
     }
@@ -999,15 +1005,15 @@ private:
       if (r.kind == RecordKind::Transition) {
         ++coverage_.machine_transitions;
         if (r.from == r.to) return "a Transition record without a change";
-        ++recorded[{false, r.machine}];
+        ++recorded[{false, to_index(r.machine)}];
       }
-      if (r.kind == RecordKind::ComponentTransition) ++recorded[{true, r.component}];
+      if (r.kind == RecordKind::ComponentTransition) ++recorded[{true, to_index(r.component)}];
       if (r.kind == RecordKind::Reset) {
         if (r.text != reset_text_) return "reset record text '" + std::string(r.text) + "'";
         resets.push_back(r.machine);
       }
       if (r.kind != RecordKind::Event) continue;
-      const std::string at = r.machine < co_.machine_count() ? co_.address_of(r.machine) : "?";
+      const std::string at = to_index(r.machine) < co_.machine_count() ? co_.address_of(r.machine) : "?";
       // Every Event record is consistent with its outcome (§2.4).
       bool consistent = true;
       switch (r.outcome) {
@@ -1051,7 +1057,7 @@ private:
 
   /// explain() lists every condition with a hop path from its origin that the model allows.
   std::string check_explain() {
-    const MachineId m = rng_.below(co_.machine_count());
+    const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
     const std::string& at = co_.address_of(m);
     const auto why = co_.explain(at);
     if (!why) return at + ": explain failed";
@@ -1082,7 +1088,7 @@ private:
           return what + ": hop path leaves through a service that does not depend on " + x.path[i - 1];
         bool ok = false;
         for (const Hop& h : hops[*from]) {
-          const Connection& k = co_.connections()[h.via];
+          const Connection& k = co_.connections()[to_index(h.via)];
           if (h.to == *to && k.provider == svc->component && k.provided == svc->service &&
               rank(level) >= rank(h.min_level))
             ok = true;
@@ -1110,8 +1116,8 @@ private:
   std::vector<CallbackCall> calls_;
   std::vector<Record> records_;
   std::uint64_t last_record_seq_ = 0;
-  std::vector<State> machine_state_;
-  std::vector<State> component_state_;
+  IdVector<State, MachineId> machine_state_;
+  IdVector<State, ComponentId> component_state_;
   std::vector<std::string> last_ops_;
   std::size_t expected_reset_clears_ = 0;
   std::vector<MachineId> expected_resets_;

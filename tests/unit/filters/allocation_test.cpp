@@ -60,7 +60,7 @@ struct Rig {
   Coordinator co{"alloc", &clock};
   FilterRegistry registry;
   Monitor monitor{co, registry};
-  ComponentId component = 0;
+  ComponentId component{0};
   Rig() {
     register_builtin_filters(registry);
     component = *co.add_component("C");

@@ -77,7 +77,7 @@ protected:
   Coordinator co_;
   FilterRegistry registry_;
   Monitor monitor_;
-  ComponentId component_ = 0;
+  ComponentId component_{0};
   std::vector<std::string> events_;  ///< names of the events processed on the stream, in order
   std::vector<double> values_;       ///< the sample value each carried
 };

@@ -81,9 +81,9 @@ TEST_F(MonitorTest, MonitorThreadRunsPassiveFiltersInRealTimeAndStops) {
   monitor.start(std::chrono::milliseconds(1));
   EXPECT_TRUE(monitor.running());
   x->push(real.now(), 5.0);
-  for (int i = 0; i < 2000 && co.extended_state(0) != State::Error; ++i)
+  for (int i = 0; i < 2000 && co.extended_state(ComponentId{0}) != State::Error; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  EXPECT_EQ(co.extended_state(0), State::Error);
+  EXPECT_EQ(co.extended_state(ComponentId{0}), State::Error);
   monitor.stop();
   EXPECT_FALSE(monitor.running());
 }

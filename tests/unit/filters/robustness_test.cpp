@@ -34,7 +34,7 @@ struct Rig {
   Coordinator co{"rig", &clock};
   FilterRegistry registry;
   Monitor monitor{co, registry};
-  ComponentId c = 0;
+  ComponentId c{0};
   struct Entry {
     std::string machine, event;
     Time time{};

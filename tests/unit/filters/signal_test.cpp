@@ -10,7 +10,7 @@ namespace safecass {
 namespace {
 
 TEST(HistoryBuffer, ReadsBackWhatWasPushedWithTimeAndInjectionMark) {
-  Signal s("C.force", 0, 3, 8);
+  Signal s("C.force", ComponentId{0}, 3, 8);
   const double a[] = {1, 2, 3};
   const double b[] = {4, 5, 6};
   s.push(Time{10}, a);
@@ -28,7 +28,7 @@ TEST(HistoryBuffer, ReadsBackWhatWasPushedWithTimeAndInjectionMark) {
 }
 
 TEST(SignalCursor, AKeptSampleStaysReadableWhileLaterSamplesAreReadUntilTheNextKeep) {
-  Signal s("C.v", 0, 2, 8);
+  Signal s("C.v", ComponentId{0}, 2, 8);
   const double a[] = {1, 2};
   const double b[] = {3, 4};
   const double c[] = {5, 6};
@@ -59,7 +59,7 @@ TEST(HistoryBuffer, RingIsRoundedUpToAPowerOfTwoAndAllButTheSlotBeingWrittenAreR
 }
 
 TEST(HistoryBuffer, SlowReaderSkipsOverwrittenSamplesAndCountsThem) {
-  Signal s("C.x", 0, 1, 4);
+  Signal s("C.x", ComponentId{0}, 1, 4);
   SignalCursor cursor(&s);
   for (int i = 0; i < 10; ++i) s.push(Time{i}, static_cast<double>(i));
   std::vector<double> seen;
@@ -70,7 +70,7 @@ TEST(HistoryBuffer, SlowReaderSkipsOverwrittenSamplesAndCountsThem) {
 }
 
 TEST(HistoryBuffer, LatestReturnsTheNewestSampleAndFalseWhenEmpty) {
-  Signal s("C.x", 0, 1, 4);
+  Signal s("C.x", ComponentId{0}, 1, 4);
   Time t{};
   double v = 0;
   EXPECT_FALSE(s.latest(t, &v));
@@ -85,7 +85,7 @@ TEST(HistoryBuffer, LatestReturnsTheNewestSampleAndFalseWhenEmpty) {
 // (each sample's elements are equal, so a torn read would show).
 TEST(HistoryBuffer, ConcurrentReadersSeeEverySampleInOrderAndNeverTorn) {
   constexpr int kSamples = 20000;
-  Signal s("C.v", 0, 4, 1 << 16);
+  Signal s("C.v", ComponentId{0}, 4, 1 << 16);
   std::atomic<bool> go{false};
   std::vector<std::thread> readers;
   std::vector<int> errors(3, 0);
@@ -121,7 +121,7 @@ TEST(HistoryBuffer, ConcurrentReadersSeeEverySampleInOrderAndNeverTorn) {
 }
 
 TEST(HistoryBuffer, InjectedSamplesAreReadInTheOrderTheyWereWrittenAmongTheWriterSamples) {
-  Signal s("C.x", 0, 1, 16);
+  Signal s("C.x", ComponentId{0}, 1, 16);
   s.inject(Time{1}, std::vector<double>{100}.data());  // before any written sample
   s.push(Time{2}, 1.0);
   s.push(Time{3}, 2.0);
@@ -138,7 +138,7 @@ TEST(HistoryBuffer, InjectedSamplesAreReadInTheOrderTheyWereWrittenAmongTheWrite
 }
 
 TEST(HistoryBuffer, LatestIsTheNewestSampleWhetherWrittenOrInjected) {
-  Signal s("C.x", 0, 1, 16);
+  Signal s("C.x", ComponentId{0}, 1, 16);
   Time t{};
   double v = 0;
   bool injected = false;
@@ -154,7 +154,7 @@ TEST(HistoryBuffer, LatestIsTheNewestSampleWhetherWrittenOrInjected) {
 }
 
 TEST(HistoryBuffer, SkipToEndSkipsInjectedSamplesToo) {
-  Signal s("C.x", 0, 1, 16);
+  Signal s("C.x", ComponentId{0}, 1, 16);
   SignalCursor cursor(&s);
   s.push(Time{1}, 1.0);
   s.inject(Time{1}, std::vector<double>{5}.data());
@@ -171,7 +171,7 @@ TEST(HistoryBuffer, SkipToEndSkipsInjectedSamplesToo) {
 TEST(HistoryBuffer, InjectionFromAnotherThreadNeverRacesTheWriter) {
   constexpr int kWritten = 20000;
   constexpr int kInjected = 2000;
-  Signal s("C.v", 0, 2, 1 << 16);
+  Signal s("C.v", ComponentId{0}, 2, 1 << 16);
   std::atomic<bool> go{false};
   int written_seen = 0;
   int injected_seen = 0;
@@ -221,13 +221,13 @@ TEST(HistoryBuffer, InjectionFromAnotherThreadNeverRacesTheWriter) {
 
 TEST(SignalRegistry, RejectsMalformedNamesZeroSizeAndSizeConflicts) {
   SignalRegistry reg;
-  EXPECT_FALSE(reg.add("nodot", 0, 1));
-  EXPECT_FALSE(reg.add("C.x", 0, 0));
-  ASSERT_TRUE(reg.add("C.x", 0, 3));
-  auto again = reg.add("C.x", 0, 3);
+  EXPECT_FALSE(reg.add("nodot", ComponentId{0}, 1));
+  EXPECT_FALSE(reg.add("C.x", ComponentId{0}, 0));
+  ASSERT_TRUE(reg.add("C.x", ComponentId{0}, 3));
+  auto again = reg.add("C.x", ComponentId{0}, 3);
   ASSERT_TRUE(again);
   EXPECT_EQ(*again, reg.find("C.x"));
-  auto conflict = reg.add("C.x", 0, 1);
+  auto conflict = reg.add("C.x", ComponentId{0}, 1);
   ASSERT_FALSE(conflict);
   EXPECT_NE(conflict.error().message.find("size 3"), std::string::npos);
   EXPECT_EQ(reg.all().size(), 1u);

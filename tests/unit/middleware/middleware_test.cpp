@@ -70,7 +70,7 @@ TEST(RemoteProviders, TheRobotCoordinatorHasNoRemoteProvider) {
   const auto before = co.connections().size();
   ASSERT_TRUE(connect_remote_providers(*r.load.system, "robot", co));
   EXPECT_EQ(co.connections().size(), before);
-  for (ComponentId c = 0; c < co.component_count(); ++c) EXPECT_FALSE(co.is_remote(c));
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) EXPECT_FALSE(co.is_remote(c));
 }
 
 TEST(RemoteProviders, AnUnknownCoordinatorIsNotFound) {

@@ -403,7 +403,7 @@ namespace {
 /// Every address of a system worth comparing: machines, service states, components, SYSTEM.
 std::vector<std::string> addresses_of(const Coordinator& co) {
   std::vector<std::string> out;
-  for (ComponentId c = 0; c < co.component_count(); ++c) {
+  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
     out.emplace_back(co.component_name(c));
     out.push_back(co.address_of(co.framework_machine(c)));
     out.push_back(co.address_of(co.application_machine(c)));

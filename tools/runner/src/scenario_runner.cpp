@@ -154,7 +154,7 @@ Diagnostics ScenarioRunner::check_names() {
   std::vector<std::string> filter_names;
   for (const auto& f : monitor_->filters()) filter_names.push_back(f->name());
   std::vector<std::string> event_names;
-  for (EventId e = 0; e < coordinator_.event_count(); ++e) event_names.push_back(coordinator_.event(e).name);
+  for (EventId e : id_range<EventId>(coordinator_.event_count())) event_names.push_back(coordinator_.event(e).name);
   const std::vector<std::string> address_names = addresses();
   const auto no_address = [&](const std::string& address, const std::string& message) {
     return message + spec::did_you_mean(address, address_names);
@@ -428,7 +428,7 @@ void ScenarioRunner::finish(RunResult& result) {
     recorder_->close();
     result.record = recorder_->status();
   }
-  for (EventId e = framework_event::kCount; e < coordinator_.event_count(); ++e) {
+  for (EventId e : id_range(EventId{framework_event::kCount}, coordinator_.event_count())) {
     const Event& ev = coordinator_.event(e);
     for (Transition t :
          {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {

@@ -347,7 +347,7 @@ tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOption
         sr.history += '\n';
       }
       if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent &&
-          r.event >= framework_event::kCount) {
+          to_index(r.event) >= framework_event::kCount) {
         const Event& e = rc.event(r.event);
         if (e.is_onset) {
           run.first_onset.emplace(r.event, r.time);
@@ -557,7 +557,7 @@ tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOption
   for (const FilterFacts& f : filters) {
     if (f.onset == kNoEvent || linked_onsets.count(f.onset) != 0) continue;
     const Event& e = co.event(f.onset);
-    if (e.id < framework_event::kCount) continue;
+    if (to_index(e.id) < framework_event::kCount) continue;
     gap(Severity::Info, "filter-without-hazard", "", f.link.name,
         "filter " + f.link.name + " generates " + e.name + ", which is linked to no declared hazard", f.link.where);
     if (std::none_of(trace.unlinked.begin(), trace.unlinked.end(),
@@ -587,7 +587,7 @@ tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOption
     fired.insert(r.result.coverage.events_fired.begin(), r.result.coverage.events_fired.end());
     taken.insert(r.result.coverage.taken.begin(), r.result.coverage.taken.end());
   }
-  for (EventId e = framework_event::kCount; e < co.event_count(); ++e) {
+  for (EventId e : id_range(EventId{framework_event::kCount}, co.event_count())) {
     const Event& ev = co.event(e);
     ++cv.events_defined;
     cv.events_fired += fired.count(ev.name) != 0 ? 1 : 0;

@@ -184,8 +184,8 @@ struct CoordinatorOptions {
 namespace detail {
 /// A growable array whose elements never move: chunks of `kChunk` contiguous elements. Indexing is
 /// a shift, a mask and two loads, without allocation or lock; adding allocates one chunk per
-/// `kChunk` elements. Not thread-safe against a concurrent add.
-template <class T>
+/// `kChunk` elements. Not thread-safe against a concurrent add. Indexed by the id type `Id`.
+template <class T, class Id>
 class StableVector {
 public:
   static constexpr std::size_t kChunkBits = 6;
@@ -193,16 +193,21 @@ public:
 
   std::size_t size() const noexcept { return size_; }
   bool empty() const noexcept { return size_ == 0; }
-  T& operator[](std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-  const T& operator[](std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-  T& back() noexcept { return (*this)[size_ - 1]; }
+  T& operator[](Id id) noexcept { return at(to_index(id)); }
+  const T& operator[](Id id) const noexcept { return at(to_index(id)); }
+  /// True when `id` names an element.
+  bool contains(Id id) const noexcept { return to_index(id) < size_; }
+  T& back() noexcept { return at(size_ - 1); }
   /// Appends a default-constructed element and returns it.
   T& emplace_back() {
     if ((size_ >> kChunkBits) == chunks_.size()) chunks_.push_back(std::make_unique<T[]>(kChunk));
-    return (*this)[size_++];
+    return at(size_++);
   }
 
 private:
+  T& at(std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+  const T& at(std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
+
   std::vector<std::unique_ptr<T[]>> chunks_;
   std::size_t size_ = 0;
 };
@@ -277,7 +282,7 @@ public:
   std::size_t component_count() const noexcept { return components_.size(); }
   std::size_t machine_count() const noexcept { return machines_.size(); }
   std::size_t event_count() const noexcept { return events_.size(); }
-  const Event& event(EventId id) const noexcept { return events_[id]; }
+  const Event& event(EventId id) const noexcept { return events_[to_index(id)]; }
   const std::vector<Connection>& connections() const noexcept { return connections_; }
   std::string_view component_name(ComponentId id) const noexcept;
   MachineId framework_machine(ComponentId id) const noexcept;
@@ -339,8 +344,8 @@ public:
     const StateSnapshot s = extended(component);
     switch (s.state) {
       case State::Normal: normal(); return;
-      case State::Warning: warning(events_[s.outstanding]); return;
-      case State::Error: error(events_[s.outstanding]); return;
+      case State::Warning: warning(events_[to_index(s.outstanding)]); return;
+      case State::Error: error(events_[to_index(s.outstanding)]); return;
     }
   }
 
@@ -389,18 +394,53 @@ private:
     State min_level;
     ConnectionId via;
   };
-  struct Ring {
-    std::vector<Record> items;
+  /// A record as the history stores it (docs/semantics.md §8.3): 40 bytes instead of Record's
+  /// 120. The component of a machine record is its machine's, names and texts are ids resolved
+  /// when the history is read, and the root cause is a slot of History::roots, written once for
+  /// a run of records that share it (a propagation writes hundreds of records with one root).
+  struct StoredRecord {
+    Time::rep time = 0;
+    std::uint64_t seq = 0;
+    std::uint32_t subject = kNone;  ///< the machine; the component for component transitions
+    std::uint32_t event = kNone;
+    std::uint32_t via = kNone;
+    std::uint32_t root = kNone;  ///< slot in History::roots; kNone: no root cause
+    std::uint32_t text = kNone;  ///< a NameId, one of the kText* codes, or kNone
+    RecordKind kind = RecordKind::Event;
+    Outcome outcome = Outcome::None;
+    std::uint8_t states = 0;  ///< from | to << 2 | level << 4 | mirror << 6
+    std::uint8_t severity = 0;
+  };
+  /// Texts of ignored completions (static, never interned).
+  static constexpr std::uint32_t kTextNoOnset = kNone - 1;
+  static constexpr std::uint32_t kTextNotActive = kNone - 2;
+  static constexpr std::uint32_t kTextLatched = kNone - 3;
+  /// Text of a remote root's clear (apply_remote()).
+  static constexpr std::uint32_t kTextNoLongerReported = kNone - 4;
+  /// The text a code stands for (kNone: empty).
+  std::string_view text_of(std::uint32_t text) const;
+  /// The history: one ring of stored records and one ring of root causes of the same capacity.
+  /// A record refers to the root slot written last when it was stored; each record writes at most
+  /// one root, so while a record is in its ring, fewer than `capacity` roots were written after
+  /// its own and that root's slot has not been reused.
+  struct History {
+    std::vector<StoredRecord> items;
+    std::vector<RootCause> roots;
     std::size_t next = 0;
     std::size_t size = 0;
-    void push(const Record& r) noexcept;
-    std::vector<Record> ordered() const;
+    std::size_t next_root = 0;
+    std::uint32_t last_root = kNone;  ///< slot of the root written last
+    void push(const Record& r, std::uint32_t text) noexcept;
     /// Grows to `capacity` keeping the records in order (configuration time only).
     void grow(std::size_t capacity);
   };
   /// Sizes the history for the model configured so far (CoordinatorOptions).
   void size_history();
-  Ring history_;  ///< every machine and component record of this coordinator
+  /// The Record a stored record stands for.
+  Record decode(const StoredRecord& s) const;
+  /// The component a stored record is about.
+  ComponentId stored_component(const StoredRecord& s) const noexcept;
+  History history_;  ///< every machine and component record of this coordinator
   struct MachineData {
     ComponentId component = kNoComponent;
     MachineKind kind = MachineKind::Framework;
@@ -482,20 +522,21 @@ private:
   /// Adds a condition (root or mirror) to a machine and applies §2.4 step 2.
   void add_condition(MachineId id, const Condition& c, Time now) noexcept;
   /// Removes condition `index` of a machine; `completion` is the event recorded.
-  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::string_view text) noexcept;
+  void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::uint32_t text) noexcept;
   void propagate_onset(const Condition& root) noexcept;
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
   /// Writes the event record of a condition just added (change.index) and publishes the machine.
   void record_added(MachineId id, const ConditionChange& change, Time now) noexcept;
   /// Writes the event record of a condition just removed and publishes the machine.
   void record_removed(MachineId id, const ConditionChange& change, EventId event, Time now,
-                      std::string_view text) noexcept;
+                      std::uint32_t text) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
   void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info, State from,
             State to) noexcept;
   void emit(const Record& r) noexcept;
-  void record_machine(MachineId id, Record& r) noexcept;
+  /// Numbers, stores and publishes a machine or component record; `text` as in StoredRecord.
+  void record(Record& r, std::uint32_t text) noexcept;
   std::vector<Explanation> explain_machine(MachineId id) const;
   std::vector<std::string> hop_path(MachineId holder, const Condition& c) const;
 
@@ -507,14 +548,15 @@ private:
   // Machines and components live in chunks of contiguous elements: a fault that visits thousands
   // of machines walks memory in order instead of chasing one heap object per machine, and an
   // element never moves once added (references handed out stay valid while the model grows).
-  detail::StableVector<MachineData> machines_;
-  detail::StableVector<ComponentData> components_;
+  detail::StableVector<MachineData, MachineId> machines_;
+  detail::StableVector<ComponentData, ComponentId> components_;
   struct NameHash {
     using is_transparent = void;
     std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
   };
   std::unordered_map<std::string, ComponentId, NameHash, std::equal_to<>> component_index_;  ///< by name
   std::deque<Event> events_;
+  std::unordered_map<std::string, EventId, NameHash, std::equal_to<>> event_index_;  ///< by name
   std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
 
@@ -575,7 +617,9 @@ private:
   std::vector<std::uint32_t> free_remote_;
 
   mutable std::mutex names_mutex_;
-  std::deque<std::string> names_;
+  std::deque<std::string> names_;  ///< by NameId; elements never move
+  /// names_ by text (views of its elements): intern() finds a known text without allocating.
+  std::unordered_map<std::string_view, NameId, NameHash, std::equal_to<>> name_index_;
 };
 
 }  // namespace safecass

@@ -57,19 +57,19 @@ constexpr State onset_level(TransitionSet transitions, State current) noexcept {
 /// The framework events every coordinator defines (DESIGN §2.7), with fixed ids.
 /// Each onset's completion has the next id.
 namespace framework_event {
-inline constexpr EventId kServiceFailure = 0;      ///< EVT_SERVICE_FAILURE (220)
-inline constexpr EventId kServiceDegraded = 2;     ///< EVT_SERVICE_DEGRADED (215)
-inline constexpr EventId kThreadException = 4;     ///< EVT_THREAD_EXCEPTION (210)
-inline constexpr EventId kPeriodOverrun = 6;       ///< EVT_PERIOD_OVERRUN (205)
-inline constexpr EventId kStale = 8;               ///< EVT_STALE (230)
-inline constexpr EventId kCallbackException = 10;  ///< EVT_CALLBACK_EXCEPTION (210)
-inline constexpr EventId kCoordinatorLost = 12;    ///< EVT_COORDINATOR_LOST (240)
-inline constexpr EventId kInvalidSample = 14;      ///< EVT_INVALID_SAMPLE (225): NaN or infinite input
+inline constexpr EventId kServiceFailure{0};      ///< EVT_SERVICE_FAILURE (220)
+inline constexpr EventId kServiceDegraded{2};     ///< EVT_SERVICE_DEGRADED (215)
+inline constexpr EventId kThreadException{4};     ///< EVT_THREAD_EXCEPTION (210)
+inline constexpr EventId kPeriodOverrun{6};       ///< EVT_PERIOD_OVERRUN (205)
+inline constexpr EventId kStale{8};               ///< EVT_STALE (230)
+inline constexpr EventId kCallbackException{10};  ///< EVT_CALLBACK_EXCEPTION (210)
+inline constexpr EventId kCoordinatorLost{12};    ///< EVT_COORDINATOR_LOST (240)
+inline constexpr EventId kInvalidSample{14};      ///< EVT_INVALID_SAMPLE (225): NaN or infinite input
 /// EVT_SUPERVISOR_LOST (235, a warning): the supervisor that watches the whole system stopped
 /// sending heartbeats, so nothing system-wide watches this process (DESIGN §4).
-inline constexpr EventId kSupervisorLost = 16;
-inline constexpr EventId kCount = 18;
-constexpr EventId completion_of(EventId onset) noexcept { return onset + 1; }
+inline constexpr EventId kSupervisorLost{16};
+inline constexpr std::uint32_t kCount = 18;  ///< how many framework events (ids 0 to kCount - 1)
+constexpr EventId completion_of(EventId onset) noexcept { return EventId{to_index(onset) + 1}; }
 }  // namespace framework_event
 
 }  // namespace safecass
