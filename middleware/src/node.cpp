@@ -22,7 +22,7 @@ namespace safecass::middleware {
 
 using namespace detail;
 
-Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
   IceEndpoint e;
   std::string_view port = text;
   if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
@@ -74,8 +74,8 @@ bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
 }
 }  // namespace
 
-Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
-                                        Coordinator& coordinator) {
+[[nodiscard]] Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
+                                                      Coordinator& coordinator) {
   const auto where = placement(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == coordinator_name; })) {

@@ -44,7 +44,7 @@ struct ViewerArgs {
 };
 
 /// The source: the system in this process, or (--ice) the live system through the middleware.
-Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
+[[nodiscard]] Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
   if (args.ice.empty()) {
     if (!args.token_files.empty()) {
       return fail(ErrorCode::InvalidArgument, "safecass viewer: --token-file is for a live system (--ice)");
