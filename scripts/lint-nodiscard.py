@@ -8,8 +8,9 @@ Looks, line by line, for a declaration or definition whose return type is `Expec
 unqualified function name and `(`: declarations in headers, in-class definitions and functions
 local to a .cpp file. Out-of-class definitions (`Expected<X> Class::f(`) and friend declarations
 are skipped: the attribute is on the function's own declaration (and C++ forbids attributes on a
-friend declaration that is not a definition). Lambdas (`-> Expected<...>`), `std::function<Expected<...>(...)>` and
-comments are not declarations of functions and are skipped. Prints FILE:LINE: and the line for
+friend declaration that is not a definition). Lambdas (`-> Expected<...>`),
+`std::function<Expected<...>(...)>` and comments are not declarations of functions and are
+skipped. A trailing return type counts when the line reads `auto f(... -> Expected<...>`. Prints FILE:LINE: and the line for
 each declaration without `[[nodiscard]]` (on the same line or the line before); exits 1 if any.
 --fix inserts `[[nodiscard]] ` in front of each such declaration instead.
 """
@@ -82,6 +83,10 @@ def check(path, lines):
             break
         kind = next((t for t in RETURN_TYPES if rest.startswith(t)), None)
         if kind is None:
+            trailing = re.match(r"auto\s+([A-Za-z_][A-Za-z0-9_]*)\s*\(", rest)
+            if trailing and re.search(r"\)\s*(const\s*)?(noexcept\s*)?->\s*(" + "|".join(re.escape(t) for t in RETURN_TYPES) + ")", rest):
+                if not has_attr and not (i > 0 and strip_comment(lines[i - 1]).rstrip().endswith("[[nodiscard]]")):
+                    yield i, insert_at
             continue
         end = close_angle(rest, len(kind) - 1)
         if end < 0:

@@ -84,7 +84,7 @@ struct RemoteClient::Impl {
 
   /// Runs one request, turning every failure into an Error.
   template <class F>
-  auto call(const char* what, F&& f) -> Expected<decltype(f())> {
+  [[nodiscard]] auto call(const char* what, F&& f) -> Expected<decltype(f())> {
     try {
       if constexpr (std::is_void_v<decltype(f())>) {
         f();
