@@ -446,6 +446,7 @@ struct CoordinatorNode::Impl {
       for (std::size_t i = first; i < first + n; ++i) {
         Stream& s = *of[i];
         s.seq.store(updates[i].seq);
+        // NOLINTNEXTLINE(bugprone-use-after-move): a cut update is always sent alone (n == 1), so full moves once
         s.last = cut ? std::move(full) : std::move(updates[i].roots);
         updates_published.fetch_add(1, std::memory_order_relaxed);
       }
