@@ -93,21 +93,41 @@ bench-peers: deps
 bench-verify: build
 	@./$(BUILD)/bin/bench_verify $(BUILD)/bench-verify.json
 
-# The sanitizer runs take every test (CTEST_ARGS); with SANITIZER_SUBSET=ci (what .ci/run uses) the
-# named subset of docs/contributing.md, "Continuous integration".
-SANITIZER_CI_ARGS := -LE 'known-defect|packaging' -E '^(browser\.|viewer_ice\.|ViewerBacksOffWhenOutOfFileDescriptors$$)'
-SANITIZER_ARGS = $(if $(filter ci,$(SANITIZER_SUBSET)),$(SANITIZER_CI_ARGS),$(CTEST_ARGS))
+# The sanitizer runs. Without SANITIZER_SUBSET: the whole tree is built and every test runs
+# (CTEST_ARGS). With SANITIZER_SUBSET=ci (what .ci/run uses): only the test folders named below
+# are built (their `<folder>/all` targets and the `safecass` command they start) and run, folder
+# by folder; docs/contributing.md, "Continuous integration", says which and why.
+ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/middleware \
+  tests/unit/tools tests/unit/replay tests/unit/trace tests/unit/verify tests/integration/middleware
+TSAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/record tests/unit/middleware tests/unit/tools \
+  tests/integration/middleware
+# Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
+# invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.
+ASAN_CI_ARGS := -LE known-defect -E '^ViewerBacksOffWhenOutOfFileDescriptors$$'
+TSAN_CI_ARGS := -LE known-defect -E '^middleware\.tls\.'
+TSAN_ENV = TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}"
+
+# $(call sanitize,PRESET,CI_DIRS,CI_ARGS,ENV)
+define sanitize
+	@test -f $(BUILD)/$(1)/build.ninja || cmake --preset $(1) >/dev/null
+	@if [ "$(SANITIZER_SUBSET)" = ci ]; then \
+	  cmake --build $(BUILD)/$(1) -j $(JOBS) --target safecass $(addsuffix /all,$(2)) || exit 1; \
+	  failed=""; for d in $(2); do \
+	    echo "== $(1): $$d"; \
+	    $(4) ctest --test-dir $(BUILD)/$(1)/$$d --output-on-failure -j $(JOBS) $(3) || failed="$$failed $$d"; \
+	  done; \
+	  if [ -n "$$failed" ]; then echo "$(1): failures in$$failed"; exit 1; fi; \
+	elif [ -n "$(SANITIZER_SUBSET)" ]; then echo "SANITIZER_SUBSET=$(SANITIZER_SUBSET): unknown subset (ci)"; exit 2; \
+	else \
+	  cmake --build $(BUILD)/$(1) -j $(JOBS) && $(4) ctest --test-dir $(BUILD)/$(1) --output-on-failure -j $(JOBS) $(CTEST_ARGS); \
+	fi
+endef
 
 asan: deps
-	@test -f $(BUILD)/asan/build.ninja || cmake --preset asan >/dev/null
-	@cmake --build $(BUILD)/asan -j $(JOBS)
-	@ctest --test-dir $(BUILD)/asan --output-on-failure -j $(JOBS) $(SANITIZER_ARGS)
+	$(call sanitize,asan,$(ASAN_CI_DIRS),$(ASAN_CI_ARGS),)
 
 tsan: deps
-	@test -f $(BUILD)/tsan/build.ninja || cmake --preset tsan >/dev/null
-	@cmake --build $(BUILD)/tsan -j $(JOBS)
-	@TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}" \
-	  ctest --test-dir $(BUILD)/tsan --output-on-failure -j $(JOBS) $(SANITIZER_ARGS)
+	$(call sanitize,tsan,$(TSAN_CI_DIRS),$(TSAN_CI_ARGS),$(TSAN_ENV))
 
 # Debian packages (CPack): libsafecass-dev (libraries, headers, CMake config, pkg-config) and
 # safecass (the command and its man pages), in build/packages/ (docs/contributing.md, "Packages").
@@ -115,8 +135,8 @@ package: build
 	@cd $(BUILD) && cpack
 	@ls $(BUILD)/packages/*.deb
 
-# clang-format (check only) and clang-tidy over build/compile_commands.json (scripts/lint).
-# LINT=format or LINT=tidy runs one of them; CI runs LINT=tidy (docs/contributing.md, "Lint").
+# clang-format (check only), the [[nodiscard]] check and clang-tidy over build/compile_commands.json
+# (scripts/lint). LINT=format, LINT=nodiscard or LINT=tidy runs one of them (docs/contributing.md, "Lint").
 LINT ?= all
 lint: build
 	@./scripts/lint --$(LINT) $(BUILD)

@@ -297,7 +297,7 @@ std::string value_text(double v) {
 
 /// The rule of every injection path (console, scenario, middleware, viewer): injected values are
 /// finite. A NaN or infinite value is refused as a whole, naming the first one.
-Expected<void> check_finite(std::string_view what, const std::vector<std::vector<double>>& samples) {
+[[nodiscard]] Expected<void> check_finite(std::string_view what, const std::vector<std::vector<double>>& samples) {
   for (std::size_t i = 0; i < samples.size(); ++i) {
     for (std::size_t k = 0; k < samples[i].size(); ++k) {
       if (std::isfinite(samples[i][k])) continue;

@@ -128,7 +128,8 @@ std::string default_output_name(std::string_view filter, std::string_view compon
   return out;
 }
 
-Expected<Params> check_params(const FilterManifest& manifest, const Params& given_as_written, std::string_view filter) {
+[[nodiscard]] Expected<Params> check_params(const FilterManifest& manifest, const Params& given_as_written,
+                                            std::string_view filter) {
   const std::string where = "filter '" + std::string(filter) + "' (" + manifest.type + ")";
   // Aliases (the 2016 names) stand for their parameter; both at once is ambiguous.
   Params renamed;

@@ -2,7 +2,8 @@
 
 namespace safecass {
 
-Expected<std::vector<std::size_t>> scalar_shape(const FilterManifest& manifest, const FilterShape& shape) {
+[[nodiscard]] Expected<std::vector<std::size_t>> scalar_shape(const FilterManifest& manifest,
+                                                              const FilterShape& shape) {
   for (const Signal* s : shape.inputs) {
     if (s->size() != 1) {
       return fail(ErrorCode::InvalidArgument, "filter '" + shape.filter + "' (" + manifest.type + "): input '" +

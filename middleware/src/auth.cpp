@@ -76,7 +76,7 @@ std::string signed_bytes(std::string_view kind, std::string_view signer, const I
 }
 
 /// Reads a small regular file (no FIFO, no device: a key file is never either).
-Expected<std::string> read_small_file(const std::string& path, struct stat* info = nullptr) {
+[[nodiscard]] Expected<std::string> read_small_file(const std::string& path, struct stat* info = nullptr) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
   if (fd < 0) {
     const ErrorCode code = errno == ENOENT ? ErrorCode::NotFound : ErrorCode::Io;
@@ -103,8 +103,8 @@ bool valid_signer_name(std::string_view name) {
 
 /// Writes `text` to a new file `path` with `mode`; an existing file is replaced only when
 /// `replace` and it is a regular file of ours that `is_ours` recognises.
-Expected<void> write_new_file(const std::string& path, const std::string& text, mode_t mode, bool replace,
-                              std::string_view what) {
+[[nodiscard]] Expected<void> write_new_file(const std::string& path, const std::string& text, mode_t mode, bool replace,
+                                            std::string_view what) {
   struct stat st {};
   if (::lstat(path.c_str(), &st) == 0) {
     if (!replace) return fail(ErrorCode::Duplicate, path + ": exists (pass --replace to create new keys)");
@@ -128,8 +128,8 @@ Expected<void> write_new_file(const std::string& path, const std::string& text, 
 
 // ---- public: keys.hpp -------------------------------------------------------------------------
 
-Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
-                                                   bool replace) {
+[[nodiscard]] Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
+                                                                 bool replace) {
   if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
   std::vector<std::string> names;
   for (const auto& [name, _] : system.coordinators) {
@@ -173,7 +173,7 @@ Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& syste
   return names;
 }
 
-Expected<std::string> bus_keys_dir(std::string_view given) {
+[[nodiscard]] Expected<std::string> bus_keys_dir(std::string_view given) {
   if (!given.empty()) return std::string(given);
   const char* env = std::getenv("SAFECASS_KEYS");
   if (env != nullptr && *env != '\0') return std::string(env);

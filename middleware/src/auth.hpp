@@ -34,7 +34,7 @@ inline constexpr std::string_view kKindResync = "resync";
 class Keyring {
 public:
   /// Errors: Io (unreadable), Parse (a malformed line, with file:line).
-  static Expected<Keyring> load(const std::string& dir);
+  [[nodiscard]] static Expected<Keyring> load(const std::string& dir);
   bool knows(std::string_view signer) const { return keys_.find(signer) != keys_.end(); }
   /// True when `signature` is `signer`'s signature of (kind, body).
   bool verify(std::string_view signer, std::string_view kind, const Ice::ByteSeq& body,
@@ -49,7 +49,7 @@ class Signer {
 public:
   /// Loads DIR/NAME.secret. Errors: NotFound (no key for NAME: how to create one), Denied (the
   /// file is readable by others than its owner, or owned by someone else), Parse, Io.
-  static Expected<Signer> load(const std::string& dir, std::string_view name);
+  [[nodiscard]] static Expected<Signer> load(const std::string& dir, std::string_view name);
   const std::string& name() const noexcept { return name_; }
   wire::Signed sign(std::string_view kind, Ice::ByteSeq body) const;
 

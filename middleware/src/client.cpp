@@ -84,7 +84,7 @@ struct RemoteClient::Impl {
 
   /// Runs one request, turning every failure into an Error.
   template <class F>
-  auto call(const char* what, F&& f) -> Expected<decltype(f())> {
+  [[nodiscard]] auto call(const char* what, F&& f) -> Expected<decltype(f())> {
     try {
       if constexpr (std::is_void_v<decltype(f())>) {
         f();
@@ -181,8 +181,8 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
   return out;
 }
 
-Expected<std::vector<introspect::HistoryEntry>> entries_from_wire(const wire::RecordEntrySeq& seq,
-                                                                  const std::string& who) {
+[[nodiscard]] Expected<std::vector<introspect::HistoryEntry>> entries_from_wire(const wire::RecordEntrySeq& seq,
+                                                                                const std::string& who) {
   std::vector<introspect::HistoryEntry> out;
   out.reserve(seq.size());
   for (const wire::RecordEntry& w : seq) {

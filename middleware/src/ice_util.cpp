@@ -9,8 +9,8 @@
 
 namespace safecass::middleware {
 
-Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
-                               std::initializer_list<std::string_view> hosts) {
+[[nodiscard]] Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
+                                             std::initializer_list<std::string_view> hosts) {
   if (tls.enabled()) {
     for (const std::string& file :
          {tls.dir + "/ca.pem", tls.dir + "/" + tls.name + ".pem", tls.dir + "/" + tls.name + ".key"}) {

@@ -23,7 +23,7 @@ namespace safecass::middleware {
 
 using namespace detail;
 
-Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
   IceEndpoint e;
   std::string_view port = text;
   if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
@@ -75,8 +75,8 @@ bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
 }
 }  // namespace
 
-Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
-                                        Coordinator& coordinator) {
+[[nodiscard]] Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
+                                                      Coordinator& coordinator) {
   const auto where = placement(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == coordinator_name; })) {
@@ -447,6 +447,7 @@ struct CoordinatorNode::Impl {
       for (std::size_t i = first; i < first + n; ++i) {
         Stream& s = *of[i];
         s.seq.store(updates[i].seq);
+        // NOLINTNEXTLINE(bugprone-use-after-move): a cut update is always sent alone (n == 1), so full moves once
         s.last = cut ? std::move(full) : std::move(updates[i].roots);
         updates_published.fetch_add(1, std::memory_order_relaxed);
       }

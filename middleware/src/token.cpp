@@ -87,7 +87,7 @@ std::string not_ours(int fd) {
 bool same_file(const struct stat& a, const struct stat& b) { return a.st_dev == b.st_dev && a.st_ino == b.st_ino; }
 
 /// Checks that `dir` is a directory of ours that nobody else can enter (and no symbolic link).
-Expected<void> check_private_dir(const std::string& dir) {
+[[nodiscard]] Expected<void> check_private_dir(const std::string& dir) {
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0) return fail(ErrorCode::Io, "token directory " + dir + ": " + reason());
   if (!S_ISDIR(st.st_mode))
@@ -105,7 +105,7 @@ Expected<void> check_private_dir(const std::string& dir) {
 
 /// The private directory for default token files: $XDG_RUNTIME_DIR/safecass (kept), or a new
 /// mkdtemp directory (`made` is true: it is removed with the file).
-Expected<std::string> private_directory(bool& made) {
+[[nodiscard]] Expected<std::string> private_directory(bool& made) {
   made = false;
   const char* runtime = std::getenv("XDG_RUNTIME_DIR");
   if (runtime != nullptr && runtime[0] == '/') {
@@ -142,7 +142,7 @@ std::string file_name_part(std::string_view name) {
 
 }  // namespace
 
-Expected<std::string> make_token() {
+[[nodiscard]] Expected<std::string> make_token() {
   unsigned char bytes[kTokenDigits / 2];
   std::size_t got = 0;
   while (got < sizeof bytes) {
@@ -248,7 +248,7 @@ Expected<std::unique_ptr<TokenFile>> TokenFile::create_default(std::string_view 
   return file;
 }
 
-Expected<std::string> read_token_file(const std::string& path) {
+[[nodiscard]] Expected<std::string> read_token_file(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
   if (fd < 0) return fail(ErrorCode::Io, "cannot read token file " + path + ": " + reason());
   struct stat st {};

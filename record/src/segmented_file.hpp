@@ -22,7 +22,7 @@ namespace safecass::detail {
 class SegmentedFile {
 public:
   /// Creates or truncates `path`. Errors: Io, with the reason alone (the caller names the file).
-  static Expected<SegmentedFile> open(std::string path, FileLimits options);
+  [[nodiscard]] static Expected<SegmentedFile> open(std::string path, FileLimits options);
   SegmentedFile() = default;
   SegmentedFile(SegmentedFile&& other) noexcept;
   SegmentedFile& operator=(SegmentedFile&& other) noexcept;

@@ -35,7 +35,7 @@ struct Fd {
 
 }  // namespace
 
-Expected<std::string> read_regular_file(const std::string& path, std::size_t max_bytes) {
+[[nodiscard]] Expected<std::string> read_regular_file(const std::string& path, std::size_t max_bytes) {
   const std::string what = "cannot read file '" + path + "': ";
   // O_NONBLOCK: opening a FIFO that has no writer returns at once instead of waiting for one.
   Fd file{::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY)};

@@ -14,7 +14,7 @@ class Parser {
 public:
   explicit Parser(std::string_view text) : text_(text) {}
 
-  tl::expected<Formula, FormulaError> run() {
+  [[nodiscard]] tl::expected<Formula, FormulaError> run() {
     Formula f = equiv();
     if (!error_.message.empty()) return tl::unexpected(error_);
     skip();
@@ -228,7 +228,7 @@ void Formula::atoms(std::vector<const Formula*>& out) const {
   for (const Formula& f : operands) f.atoms(out);
 }
 
-tl::expected<Formula, FormulaError> parse_formula(std::string_view text) { return Parser(text).run(); }
+[[nodiscard]] tl::expected<Formula, FormulaError> parse_formula(std::string_view text) { return Parser(text).run(); }
 
 std::string_view to_string(Formula::Compare c) noexcept {
   switch (c) {

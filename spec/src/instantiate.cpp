@@ -15,8 +15,8 @@ tl::unexpected<Error> in(std::string_view what, const Error& e) {
 
 }  // namespace
 
-Expected<void> instantiate(const SystemSpec& system, Coordinator& coordinator, Monitor& monitor,
-                           std::string_view only_coordinator) {
+[[nodiscard]] Expected<void> instantiate(const SystemSpec& system, Coordinator& coordinator, Monitor& monitor,
+                                         std::string_view only_coordinator) {
   std::set<std::string, std::less<>> local;
   if (!only_coordinator.empty()) {
     const auto it = std::find_if(system.coordinators.begin(), system.coordinators.end(),

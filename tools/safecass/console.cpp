@@ -49,7 +49,7 @@ class QueryBackend final : public Backend {
 public:
   QueryBackend(Target target, ConsoleOptions options) : target_(std::move(target)), options_(options) {}
 
-  Expected<void> init() {
+  [[nodiscard]] Expected<void> init() {
     auto clock = target_.query->clock();
     if (!clock) return tl::unexpected(clock.error());
     time_ = in::TimeFormat(*clock);

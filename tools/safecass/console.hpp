@@ -76,8 +76,8 @@ public:
 
   /// Loads and builds the system. `system` may be empty when `scenario` names its system.
   /// Errors: Io/Parse/InvalidArgument with every diagnostic of the system or scenario, one per line.
-  static Expected<std::unique_ptr<Console>> open(const std::string& system, const std::string& scenario,
-                                                 ConsoleOptions options);
+  [[nodiscard]] static Expected<std::unique_ptr<Console>> open(const std::string& system, const std::string& scenario,
+                                                               ConsoleOptions options);
   ~Console();
   Console(const Console&) = delete;
   Console& operator=(const Console&) = delete;

@@ -18,11 +18,9 @@ using middleware::RemoteClient;
 
 namespace {
 
-Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, const std::string& coordinator,
-                                                       const std::string& token, int timeout_ms,
-                                                       const std::string& keys, bool insecure,
-                                                       const std::string& tls = {},
-                                                       const std::string& read_token = {}) {
+[[nodiscard]] Expected<std::unique_ptr<RemoteClient>> connect_client(
+    const std::string& ice, const std::string& coordinator, const std::string& token, int timeout_ms,
+    const std::string& keys, bool insecure, const std::string& tls = {}, const std::string& read_token = {}) {
   auto endpoint = middleware::parse_ice_endpoint(ice);
   if (!endpoint) return fail(ErrorCode::Parse, endpoint.error().message);  // names --ice and its text
   middleware::ClientOptions o;
@@ -41,7 +39,7 @@ Expected<std::unique_ptr<RemoteClient>> connect_client(const std::string& ice, c
 
 }  // namespace
 
-Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
+[[nodiscard]] Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args) {
   std::string token;
   if (!args.token_file.empty()) {
     auto t = middleware::read_token_file(args.token_file);

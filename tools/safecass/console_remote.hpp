@@ -22,7 +22,7 @@ namespace safecass::tools {
 /// The names TAB completes (components, machines, events, filters, signals) are fetched once here.
 /// Errors: Parse (a malformed --ice), Io (an unreadable token file; IceStorm or the coordinator
 /// unreachable or silent within the timeout).
-Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args);
+[[nodiscard]] Expected<std::unique_ptr<Console>> connect_console(const ConsoleArgs& args);
 
 /// `safecass timeline --ice HOST:PORT --coordinator NAME --html OUT`: the page of
 /// `safecass timeline` drawn from the live history of one coordinator (every state and event

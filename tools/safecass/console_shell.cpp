@@ -27,7 +27,7 @@ std::string_view trim(std::string_view s) {
 
 /// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
 /// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
-Expected<std::vector<std::string>> tokenize(std::string_view line) {
+[[nodiscard]] Expected<std::vector<std::string>> tokenize(std::string_view line) {
   std::vector<std::string> words;
   std::size_t i = 0;
   while (i < line.size()) {
@@ -76,7 +76,7 @@ std::string not_finite(std::string_view word) {
 }  // namespace
 
 /// Numbers separated by commas and/or blanks. Errors name the offending text.
-Expected<std::vector<double>> parse_numbers(std::string_view text) {
+[[nodiscard]] Expected<std::vector<double>> parse_numbers(std::string_view text) {
   std::vector<double> values;
   std::size_t i = 0;
   while (i < text.size()) {
@@ -96,7 +96,7 @@ Expected<std::vector<double>> parse_numbers(std::string_view text) {
 }
 
 /// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector).
-Expected<std::vector<double>> parse_sample(std::string_view word) {
+[[nodiscard]] Expected<std::vector<double>> parse_sample(std::string_view word) {
   if (!word.empty() && word.front() == '[') {
     if (word.back() != ']') return fail(ErrorCode::Parse, "'" + std::string(word) + "': a vector sample ends with ']'");
     auto values = parse_numbers(word.substr(1, word.size() - 2));
@@ -117,7 +117,7 @@ std::optional<long> parse_count(std::string_view s) {
   return v;
 }
 
-Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words) {
+[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words) {
   std::vector<std::vector<double>> samples;
   for (const std::string& w : words) {
     auto s = parse_sample(w);
@@ -127,7 +127,8 @@ Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::
   return samples;
 }
 
-Expected<std::vector<std::vector<double>>> parse_sample_file(const std::string& file, std::string_view text) {
+[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_sample_file(const std::string& file,
+                                                                           std::string_view text) {
   std::vector<std::vector<double>> samples;
   std::istringstream lines{std::string(text)};
   std::string line;

@@ -37,21 +37,22 @@ inline std::string json_list(const std::vector<std::string>& items) { return int
 
 /// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
 /// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
-Expected<std::vector<std::string>> tokenize(std::string_view line);
+[[nodiscard]] Expected<std::vector<std::string>> tokenize(std::string_view line);
 std::optional<double> parse_number(std::string_view s);
 /// The values of injected samples: numbers separated by commas and/or blanks. Errors name the
 /// offending text: not a number, or not finite (`nan`, `inf`, `-inf`: injected values must be
 /// finite, the rule of every injection path, docs/filters.md).
-Expected<std::vector<double>> parse_numbers(std::string_view text);
+[[nodiscard]] Expected<std::vector<double>> parse_numbers(std::string_view text);
 /// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector) of finite numbers.
-Expected<std::vector<double>> parse_sample(std::string_view word);
+[[nodiscard]] Expected<std::vector<double>> parse_sample(std::string_view word);
 /// Every word as a sample. Errors: the first word that is not one.
-Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words);
+[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words);
 /// A whole number above 0.
 std::optional<long> parse_count(std::string_view s);
 /// The samples of a `filter dinload` file: one per line, numbers separated by spaces or commas,
 /// '#' starts a comment. Errors: "FILE:LINE: what", or "FILE: no samples".
-Expected<std::vector<std::vector<double>>> parse_sample_file(const std::string& file, std::string_view text);
+[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_sample_file(const std::string& file,
+                                                                           std::string_view text);
 /// "1 sample", "3 samples".
 std::string count_text(std::size_t n);
 
@@ -142,6 +143,6 @@ struct Target {
 
 /// The console's one backend: every command runs against `target.query`. Errors: as the query's
 /// (a live coordinator that does not answer while the names are fetched: Io).
-Expected<std::unique_ptr<Backend>> make_backend(Target target, ConsoleOptions options);
+[[nodiscard]] Expected<std::unique_ptr<Backend>> make_backend(Target target, ConsoleOptions options);
 
 }  // namespace safecass::tools::console

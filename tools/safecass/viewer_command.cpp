@@ -48,7 +48,7 @@ struct ViewerArgs {
 };
 
 /// The source: the system in this process, or (--ice) the live system through the middleware.
-Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
+[[nodiscard]] Expected<std::unique_ptr<viewer::ViewSource>> open_source(const ViewerArgs& args) {
   if (!args.replay.empty()) {
     if (!args.ice.empty() || !args.scenario.empty()) {
       return fail(ErrorCode::InvalidArgument,

@@ -69,7 +69,8 @@ struct AddressInfo {
 class Model {
 public:
   /// Builds the system into a coordinator (one process: every component) and derives the model.
-  static Expected<std::unique_ptr<Model>> build(const spec::SystemSpec& system, const FilterRegistry& registry);
+  [[nodiscard]] static Expected<std::unique_ptr<Model>> build(const spec::SystemSpec& system,
+                                                              const FilterRegistry& registry);
 
   const spec::SystemSpec& system() const { return *system_; }
   Coordinator& coordinator() { return *coordinator_; }
@@ -102,7 +103,7 @@ public:
 
 private:
   Model() = default;
-  Expected<void> derive(const FilterRegistry& registry);
+  [[nodiscard]] Expected<void> derive(const FilterRegistry& registry);
 
   const spec::SystemSpec* system_ = nullptr;
   std::unique_ptr<Coordinator> coordinator_;

@@ -21,7 +21,7 @@ std::string shell_quote(const std::string& word) {
   return out + "'";
 }
 
-Expected<CommandResult> run_command(const std::string& dir, const std::string& command) {
+[[nodiscard]] Expected<CommandResult> run_command(const std::string& dir, const std::string& command) {
   const std::string line = "cd " + shell_quote(dir) + " && { " + command + "; } 2>&1";
   FILE* pipe = ::popen(line.c_str(), "r");
   if (pipe == nullptr) return fail(ErrorCode::Io, "cannot run '" + command + "'");
@@ -57,7 +57,7 @@ WorkDir::~WorkDir() {
   fs::remove_all(path_, ec);
 }
 
-Expected<std::string> spin_version(const std::string& spin) {
+[[nodiscard]] Expected<std::string> spin_version(const std::string& spin) {
   auto r = run_command("/", shell_quote(spin) + " -V");
   if (!r || r->status != 0 || r->output.find("Spin Version") == std::string::npos) {
     return fail(ErrorCode::Io,
@@ -68,7 +68,7 @@ Expected<std::string> spin_version(const std::string& spin) {
   return v;
 }
 
-Expected<void> compiler_check(const std::string& cc) {
+[[nodiscard]] Expected<void> compiler_check(const std::string& cc) {
   auto r = run_command("/", shell_quote(cc) + " --version");
   if (!r || r->status != 0) {
     return fail(ErrorCode::Io,
@@ -126,8 +126,8 @@ bool write_file(const std::string& path, const std::string& text) {
 
 }  // namespace
 
-Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
-                              const PanOptions& options) {
+[[nodiscard]] Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
+                                            const PanOptions& options) {
   const std::string pml = name + ".pml";
   if (!write_file(dir + "/" + pml, model)) return fail(ErrorCode::Io, "cannot write '" + dir + "/" + pml + "'");
   auto gen = run_command(dir, shell_quote(options.spin) + " -a " + shell_quote(pml));
@@ -146,8 +146,9 @@ Expected<std::string> compile(const std::string& dir, const std::string& name, c
   return binary;
 }
 
-Expected<PanResult> check_claim(const std::string& dir, const std::string& name, const std::string& binary,
-                                const std::string& claim, const PanOptions& options) {
+[[nodiscard]] Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
+                                              const std::string& binary, const std::string& claim,
+                                              const PanOptions& options) {
   std::error_code ec;
   const std::string trail = dir + "/" + name + ".pml.trail";
   fs::remove(trail, ec);
@@ -181,8 +182,9 @@ Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
   return r;
 }
 
-Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model, unsigned seed,
-                                                  std::size_t steps, const std::string& spin) {
+[[nodiscard]] Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model,
+                                                                unsigned seed, std::size_t steps,
+                                                                const std::string& spin) {
   const std::string pml = "simulation.pml";
   if (!write_file(dir + "/" + pml, model)) return fail(ErrorCode::Io, "cannot write '" + dir + "/" + pml + "'");
   auto r = run_command(

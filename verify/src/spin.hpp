@@ -17,7 +17,7 @@ struct CommandResult {
 };
 
 /// Runs `command` with /bin/sh in `dir`. Errors: Io (cannot start it).
-Expected<CommandResult> run_command(const std::string& dir, const std::string& command);
+[[nodiscard]] Expected<CommandResult> run_command(const std::string& dir, const std::string& command);
 
 /// Single-quotes a word for /bin/sh.
 std::string shell_quote(const std::string& word);
@@ -26,7 +26,7 @@ std::string shell_quote(const std::string& word);
 /// destructor unless `keep`.
 class WorkDir {
 public:
-  static Expected<WorkDir> create(const std::string& given);
+  [[nodiscard]] static Expected<WorkDir> create(const std::string& given);
   WorkDir(WorkDir&& other) noexcept;
   WorkDir& operator=(WorkDir&&) = delete;
   WorkDir(const WorkDir&) = delete;
@@ -60,23 +60,25 @@ struct PanResult {
 /// Writes `model` as `name`.pml in `dir`, generates SPIN's verifier and compiles it (once for
 /// all the model's claims). Safety verifiers search breadth-first, so a trail is a shortest one.
 /// Returns the verifier's file name in `dir`. Errors: Io (SPIN or the compiler failed).
-Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
-                              const PanOptions& options);
+[[nodiscard]] Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
+                                            const PanOptions& options);
 
 /// Checks claim `claim` with the verifier `binary` of model `name`; on a violation, replays the
 /// trail (pan -r). Errors: Io.
-Expected<PanResult> check_claim(const std::string& dir, const std::string& name, const std::string& binary,
-                                const std::string& claim, const PanOptions& options);
+[[nodiscard]] Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
+                                              const std::string& binary, const std::string& claim,
+                                              const PanOptions& options);
 
 /// SPIN's random simulation of `model` for at most `steps` steps with seed `seed`: the "@ ..."
 /// lines it printed. Errors: Io.
-Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model, unsigned seed,
-                                                  std::size_t steps, const std::string& spin);
+[[nodiscard]] Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model,
+                                                                unsigned seed, std::size_t steps,
+                                                                const std::string& spin);
 
 /// An Io error unless the C compiler `cc` runs.
-Expected<void> compiler_check(const std::string& cc);
+[[nodiscard]] Expected<void> compiler_check(const std::string& cc);
 
 /// "Spin Version 6.5.2 -- ..." or an Io error saying SPIN is not installed.
-Expected<std::string> spin_version(const std::string& spin);
+[[nodiscard]] Expected<std::string> spin_version(const std::string& spin);
 
 }  // namespace safecass::verify::detail

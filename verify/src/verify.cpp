@@ -507,7 +507,8 @@ private:
 
 }  // namespace
 
-Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry, const Options& options) {
+[[nodiscard]] Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry,
+                                      const Options& options) {
   const auto start = std::chrono::steady_clock::now();
   auto built = Model::build(system, registry);
   if (!built) return tl::unexpected(built.error());
@@ -664,8 +665,8 @@ Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& re
   return report;
 }
 
-Expected<Simulation> simulate(const spec::SystemSpec& system, const FilterRegistry& registry, unsigned seed,
-                              std::size_t steps, const Options& options) {
+[[nodiscard]] Expected<Simulation> simulate(const spec::SystemSpec& system, const FilterRegistry& registry,
+                                            unsigned seed, std::size_t steps, const Options& options) {
   auto built = Model::build(system, registry);
   if (!built) return tl::unexpected(built.error());
   Model& model = **built;
@@ -722,7 +723,7 @@ Expected<Simulation> simulate(const spec::SystemSpec& system, const FilterRegist
   return sim;
 }
 
-Expected<std::string> promela(const spec::SystemSpec& system, const FilterRegistry& registry) {
+[[nodiscard]] Expected<std::string> promela(const spec::SystemSpec& system, const FilterRegistry& registry) {
   auto built = Model::build(system, registry);
   if (!built) return tl::unexpected(built.error());
   Model& model = **built;

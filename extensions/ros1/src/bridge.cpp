@@ -111,7 +111,7 @@ struct Bridge::Impl {
   std::atomic<std::uint64_t> messages{0}, bad_messages{0}, published{0}, ingested{0}, bad_statuses{0}, graph_checks{0},
       graph_problem_count{0};
 
-  Expected<void> bind();
+  [[nodiscard]] Expected<void> bind();
   template <class M>
   void on_message(Topic& t, const M& msg);
   void on_diagnostics(const ros::MessageEvent<diagnostic_msgs::DiagnosticArray const>& event);

@@ -14,7 +14,7 @@ std::string_view to_string(MessageType type) noexcept {
   return "?";
 }
 
-Expected<MessageType> parse_message_type(std::string_view name) {
+[[nodiscard]] Expected<MessageType> parse_message_type(std::string_view name) {
   for (MessageType t : {MessageType::Float64, MessageType::WrenchStamped, MessageType::JointState}) {
     if (name == to_string(t)) return t;
   }
@@ -70,7 +70,7 @@ bool split_index(std::string_view part, std::string_view& name, int& index) {
 
 }  // namespace
 
-Expected<FieldPath> parse_field_path(MessageType type, std::string_view path) {
+[[nodiscard]] Expected<FieldPath> parse_field_path(MessageType type, std::string_view path) {
   const std::string where = "field path '" + std::string(path) + "' of " + std::string(to_string(type));
   auto bad = [&](const std::string& why) { return fail(ErrorCode::InvalidArgument, where + ": " + why); };
   FieldPath out;

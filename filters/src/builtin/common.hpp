@@ -51,7 +51,7 @@ inline ParamSpec persistence_unit_param() {
 }
 
 /// Inputs and outputs all of the same size as the first input.
-Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, const FilterShape& s);
+[[nodiscard]] Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, const FilterShape& s);
 
 void register_detection(FilterRegistry& r);
 void register_transforms(FilterRegistry& r);

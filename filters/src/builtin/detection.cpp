@@ -95,7 +95,7 @@ public:
     m.outputs = {"output_signal"};
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     const double lo = std::get<double>(s.params.at("min"));
     const double hi = std::get<double>(s.params.at("max"));
     const double h = std::get<double>(s.params.at("hysteresis"));
@@ -174,7 +174,9 @@ public:
     m.outputs = {"output_signal"};
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{1}; }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>{1};
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {

@@ -8,7 +8,9 @@ namespace safecass::builtin {
 
 namespace {
 
-Expected<std::vector<std::size_t>> any_input_no_output(const FilterShape&) { return std::vector<std::size_t>(1, 1); }
+[[nodiscard]] Expected<std::vector<std::size_t>> any_input_no_output(const FilterShape&) {
+  return std::vector<std::size_t>(1, 1);
+}
 
 /// At least `count` occurrences (rising edges of a non-zero input) within the last `window`
 /// seconds → onset; fewer → completion.
@@ -86,7 +88,9 @@ public:
     m.outputs = {"output_signal"};
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return any_input_no_output(s); }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    return any_input_no_output(s);
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -137,7 +141,9 @@ public:
     m.outputs = {"output_signal"};
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return any_input_no_output(s); }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    return any_input_no_output(s);
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -226,7 +232,7 @@ public:
     m.outputs = {"output_signal"};
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     if (s.inputs.size() != 2) {
       return fail(ErrorCode::InvalidArgument,
                   "filter '" + s.filter +

@@ -7,7 +7,7 @@
 
 namespace safecass::builtin {
 
-Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, const FilterShape& s) {
+[[nodiscard]] Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, const FilterShape& s) {
   const std::size_t size = s.inputs.empty() ? 1 : s.inputs[0]->size();
   for (const Signal* in : s.inputs) {
     if (in->size() != size) {
@@ -22,7 +22,7 @@ Expected<std::vector<std::size_t>> same_size_shape(const FilterManifest& m, cons
 namespace {
 
 template <class T>
-Expected<std::vector<std::size_t>> same_size(const FilterShape& s) {
+[[nodiscard]] Expected<std::vector<std::size_t>> same_size(const FilterShape& s) {
   static const FilterManifest m = [] {
     FilterManifest x = T::manifest();
     x.type = T::kType;
@@ -57,7 +57,9 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Derivative>(s); }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    return same_size<Derivative>(s);
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -106,7 +108,9 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<MovingAverage>(s); }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    return same_size<MovingAverage>(s);
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -183,7 +187,9 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{1}; }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>{1};
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -228,7 +234,7 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     const bool one = s.params.count("input_signal") > 0;
     const bool two = s.params.count("input_signals") > 0;
     if (one == two) {
@@ -298,7 +304,7 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
     if ((s.params.count("input_signal") > 0) == (s.params.count("input_signals") > 0)) {
       return fail(ErrorCode::InvalidArgument,
                   "filter '" + s.filter + "' (Vectorize): give either 'input_signals' or 'input_signal'");
@@ -349,7 +355,9 @@ public:
     m.default_output = true;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) { return same_size<Bypass>(s); }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
+    return same_size<Bypass>(s);
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
@@ -372,7 +380,9 @@ public:
     m.generates_events = false;
     return m;
   }
-  static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) { return std::vector<std::size_t>{}; }
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>{};
+  }
 
 protected:
   void on_sample(std::size_t, const SampleView&) noexcept override {}

@@ -29,7 +29,8 @@ protected:
   }
 
   /// Like make(), but returns the error instead of failing the test.
-  Expected<Filter*> try_make(const std::string& type, Params params, DetectionMode mode = DetectionMode::Edge) {
+  [[nodiscard]] Expected<Filter*> try_make(const std::string& type, Params params,
+                                           DetectionMode mode = DetectionMode::Edge) {
     FilterConfig c;
     c.type = type;
     c.target.component = "C";

@@ -154,11 +154,17 @@ public:
     out.swap(records);
     return out;
   }
-  Expected<std::vector<Explanation>> explain(std::string_view) const override { return std::vector<Explanation>{}; }
-  Expected<std::string> generate(std::string_view, std::string_view) override { return fail(ErrorCode::Denied, "no"); }
-  Expected<std::string> broadcast(std::string_view) override { return fail(ErrorCode::Denied, "no"); }
-  Expected<std::string> inject(const InjectRequest&) override { return fail(ErrorCode::Denied, "no"); }
-  Expected<std::string> reset(std::string_view, std::string_view) override { return fail(ErrorCode::Denied, "no"); }
+  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view) const override {
+    return std::vector<Explanation>{};
+  }
+  [[nodiscard]] Expected<std::string> generate(std::string_view, std::string_view) override {
+    return fail(ErrorCode::Denied, "no");
+  }
+  [[nodiscard]] Expected<std::string> broadcast(std::string_view) override { return fail(ErrorCode::Denied, "no"); }
+  [[nodiscard]] Expected<std::string> inject(const InjectRequest&) override { return fail(ErrorCode::Denied, "no"); }
+  [[nodiscard]] Expected<std::string> reset(std::string_view, std::string_view) override {
+    return fail(ErrorCode::Denied, "no");
+  }
 
   SystemView v;
   std::vector<std::string> records;

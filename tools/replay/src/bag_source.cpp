@@ -30,7 +30,7 @@ class BagSource final : public InputSource {
 public:
   BagSource(std::string path, ros1::Mapping mapping) : path_(std::move(path)), mapping_(std::move(mapping)) {}
 
-  Expected<void> open() {
+  [[nodiscard]] Expected<void> open() {
     try {
       bag_.open(path_, rosbag::bagmode::Read);
       rosbag::View all(bag_);
@@ -41,7 +41,7 @@ public:
     return {};
   }
 
-  Expected<void> bind(Monitor& monitor) override {
+  [[nodiscard]] Expected<void> bind(Monitor& monitor) override {
     std::vector<std::string> topics;
     for (const ros1::TopicMapping& t : mapping_.topics) {
       Topic topic{t, {}};
@@ -198,7 +198,7 @@ private:
 
 }  // namespace
 
-Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping) {
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping) {
   ros1::MappingLoad m = ros1::load_mapping(mapping);
   if (!m.mapping) {
     std::string all;

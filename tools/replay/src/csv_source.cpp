@@ -36,7 +36,7 @@ public:
   CsvSource(int fd, std::string path) : fd_(fd), path_(std::move(path)), buffer_(kBuffer) {}
   ~CsvSource() override { ::close(fd_); }
 
-  Expected<void> bind(Monitor& monitor) override {
+  [[nodiscard]] Expected<void> bind(Monitor& monitor) override {
     std::string_view line;
     if (!read_line(line)) {
       if (!error_.empty()) return fail(ErrorCode::Io, error_);
@@ -326,7 +326,7 @@ private:
 
 }  // namespace
 
-Expected<std::unique_ptr<InputSource>> open_csv(const std::string& path) {
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_csv(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return fail(ErrorCode::Io, "cannot read CSV log '" + path + "': " + std::strerror(errno));
   return std::unique_ptr<InputSource>(new CsvSource(fd, path));

@@ -17,7 +17,7 @@ std::vector<std::string> input_signal_names(const Monitor& monitor) {
   return out;
 }
 
-Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name) {
+[[nodiscard]] Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name) {
   Signal* s = monitor.signals().find(name);
   if (s == nullptr) {
     return fail(ErrorCode::NotFound, "unknown signal '" + name + "': the system has no such signal" +
@@ -40,7 +40,7 @@ class RecordingSource final : public InputSource {
 public:
   explicit RecordingSource(std::unique_ptr<InputLogReader> reader) : reader_(std::move(reader)) {}
 
-  Expected<void> bind(Monitor& monitor) override {
+  [[nodiscard]] Expected<void> bind(Monitor& monitor) override {
     monitor_ = &monitor;
     return {};
   }

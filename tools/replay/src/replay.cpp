@@ -45,7 +45,7 @@ std::string sniff(const std::string& path) {
   return "csv";
 }
 
-Expected<std::unique_ptr<InputSource>> open_input(const ReplayOptions& o, const std::string& format) {
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_input(const ReplayOptions& o, const std::string& format) {
   if (format.empty()) {
     const int fd = ::open(o.input.c_str(), O_RDONLY | O_CLOEXEC);
     const int error = errno;

@@ -30,8 +30,8 @@ System::System(spec::SystemSpec spec, const FilterRegistry& registry, const Syst
 
 System::~System() { runtime_.stop(); }
 
-Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const FilterRegistry& registry,
-                                             const SystemOptions& options) {
+[[nodiscard]] Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const FilterRegistry& registry,
+                                                           const SystemOptions& options) {
   const std::string file = system.path;
   std::unique_ptr<System> built(new System(std::move(system), registry, options));
   Coordinator& co = built->coordinator_;
@@ -51,8 +51,8 @@ Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const Filt
   return built;
 }
 
-Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
-                                            const SystemOptions& options, Diagnostics* notes) {
+[[nodiscard]] Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
+                                                          const SystemOptions& options, Diagnostics* notes) {
   spec::LoadResult loaded = spec::load_system(path, registry);
   Diagnostics errors = keep_errors(std::move(loaded.diagnostics), notes);
   if (!errors.empty()) return tl::unexpected(std::move(errors));

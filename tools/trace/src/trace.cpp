@@ -104,7 +104,7 @@ std::optional<Time> cleared_at(const RunFacts& run, const Coordinator& co, Event
 
 /// Reads `safecass verify --json` output: one JSON object per line; `{"kind":"hazard","name":ID,
 /// "result":"holds"|"violated"|"undecided"}` gives a hazard's verdict.
-tl::expected<std::map<std::string, Verdict>, Diagnostics> read_verify(const std::string& path) {
+[[nodiscard]] tl::expected<std::map<std::string, Verdict>, Diagnostics> read_verify(const std::string& path) {
   auto text = spec::read_regular_file(path);
   if (!text) return tl::unexpected(Diagnostics{error_at(spec::Position{path, 0, 0}, text.error().message)});
   std::map<std::string, Verdict> out;
@@ -178,8 +178,8 @@ bool Trace::has_error_gap() const noexcept {
   return std::any_of(gaps.begin(), gaps.end(), [](const Gap& g) { return g.severity == Severity::Error; });
 }
 
-tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
-                                                               const FilterRegistry& registry) {
+[[nodiscard]] tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
+                                                                             const FilterRegistry& registry) {
   Trace trace;
   trace.system_path = options.system;
 

@@ -51,8 +51,9 @@ std::vector<ConnectionView> local_connections(introspect::LocalQuery& query) {
   return out;
 }
 
-Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
-                                                 const Coordinators& coordinators, std::string_view address) {
+[[nodiscard]] Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
+                                                               const Coordinators& coordinators,
+                                                               std::string_view address) {
   if (address.substr(0, 12) == "coordinator:") {
     const std::string_view name = address.substr(12);
     const auto it =

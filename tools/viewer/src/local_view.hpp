@@ -28,7 +28,8 @@ SystemView local_view(const introspect::LocalQuery& query, const Coordinators& c
 std::vector<ConnectionView> local_connections(introspect::LocalQuery& query);
 
 /// Every active condition at `address`; "coordinator:NAME" gathers those of its components.
-Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
-                                                 const Coordinators& coordinators, std::string_view address);
+[[nodiscard]] Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
+                                                               const Coordinators& coordinators,
+                                                               std::string_view address);
 
 }  // namespace safecass::viewer::detail

@@ -126,7 +126,7 @@ struct MiddlewareSource::Impl {
                             host_seconds()));
   }
 
-  Expected<std::unique_ptr<RemoteClient>> connect(const MiddlewareLink& l) const {
+  [[nodiscard]] Expected<std::unique_ptr<RemoteClient>> connect(const MiddlewareLink& l) const {
     middleware::ClientOptions o;
     o.ice = ice;
     o.coordinator = l.name;
@@ -244,7 +244,7 @@ struct MiddlewareSource::Impl {
   }
 
   /// The request connection of `l`, or an Io error saying that it does not answer.
-  Expected<std::shared_ptr<RemoteClient>> requests(const MiddlewareLink& l) const {
+  [[nodiscard]] Expected<std::shared_ptr<RemoteClient>> requests(const MiddlewareLink& l) const {
     std::lock_guard lock(mutex);
     if (!l.requests) {
       return fail(ErrorCode::Io, "coordinator '" + l.name + "' is " +
@@ -255,8 +255,8 @@ struct MiddlewareSource::Impl {
   }
 
   /// The request connection of the coordinator owning `target` for a write.
-  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer(std::string_view target,
-                                                                             std::string_view what) const {
+  [[nodiscard]] Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer(
+      std::string_view target, std::string_view what) const {
     if (!options.allow_write)
       return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
     MiddlewareLink* l = owner(target);
@@ -267,7 +267,7 @@ struct MiddlewareSource::Impl {
     return writer_of(*l);
   }
 
-  Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer_of(MiddlewareLink& l) const {
+  [[nodiscard]] Expected<std::pair<MiddlewareLink*, std::shared_ptr<RemoteClient>>> writer_of(MiddlewareLink& l) const {
     if (!options.allow_write)
       return fail(ErrorCode::Denied, "refused: this viewer is read-only (start it with --allow-write)");
     if (l.token.empty()) {

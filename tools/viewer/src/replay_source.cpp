@@ -29,7 +29,7 @@ std::string file_name(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
-Expected<void> check_speed(double speed) {
+[[nodiscard]] Expected<void> check_speed(double speed) {
   if (!std::isfinite(speed) || speed <= 0.0 || speed > 1000.0) {
     return fail(ErrorCode::InvalidArgument,
                 "the speed must be above 0 and at most 1000 (recording seconds per second)");
@@ -72,7 +72,7 @@ struct ReplaySource::Impl {
 
   /// Opens a new replay of the log from its start, processed up to its first tick; the current
   /// one is kept when that fails.
-  Expected<void> restart() {
+  [[nodiscard]] Expected<void> restart() {
     auto opened = replay::ReplaySession::open(options, registry);
     if (!opened) return tl::unexpected(opened.error());
     close();

@@ -226,22 +226,23 @@ public:
 
   // ---- configuration -------------------------------------------------------------------------
   /// Errors: Duplicate, InvalidArgument (empty or dotted name).
-  Expected<ComponentId> add_component(std::string_view name);
+  [[nodiscard]] Expected<ComponentId> add_component(std::string_view name);
   /// Adds provided interface `name` (machine C.s_P.name). Errors: NotFound, Duplicate, InvalidArgument.
-  Expected<MachineId> add_provided(ComponentId component, std::string_view name);
+  [[nodiscard]] Expected<MachineId> add_provided(ComponentId component, std::string_view name);
   /// Adds required interface `name` (machine C.s_R.name). Errors: NotFound, Duplicate, InvalidArgument.
-  Expected<MachineId> add_required(ComponentId component, std::string_view name);
+  [[nodiscard]] Expected<MachineId> add_required(ComponentId component, std::string_view name);
   /// Errors: Duplicate name, InvalidArgument (severity outside 1–255, empty or mixed transitions,
   /// `completes`/`latched` on the wrong kind of event, completion with no onset name).
-  Expected<EventId> add_event(const EventDef& def);
+  [[nodiscard]] Expected<EventId> add_event(const EventDef& def);
   /// Sets the service dependency entry of a provided interface.
   /// Errors: NotFound (component, provided or required interface), InvalidArgument (propagate
   /// Normal), InvalidState (a machine of the component holds a condition: the mirrors it feeds
   /// would no longer match the entry).
-  Expected<void> set_service(ComponentId component, std::string_view provided, const ServiceDependency& dependency);
+  [[nodiscard]] Expected<void> set_service(ComponentId component, std::string_view provided,
+                                           const ServiceDependency& dependency);
   /// Connects `client_required` ("C.r") to `provider_provided` ("P.p").
   /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected).
-  Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
+  [[nodiscard]] Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
 
   // ---- remote providers (cross-process propagation, DESIGN §2.6 and §4) --------------------
   /// Declares provided interface `provider_provided` ("P.p") of a component that runs in another
@@ -251,7 +252,8 @@ public:
   /// the provider's propagation level for the service. Configuration call.
   /// Errors: InvalidArgument (malformed, propagate Normal), Duplicate (P is a local component, or
   /// P.p was declared already).
-  Expected<MachineId> add_remote_provided(std::string_view provider_provided, State propagate = State::Error);
+  [[nodiscard]] Expected<MachineId> add_remote_provided(std::string_view provider_provided,
+                                                        State propagate = State::Error);
   /// True when `id` was added by add_remote_provided().
   bool is_remote(ComponentId id) const noexcept;
   /// Replaces, as a whole, the set of roots held by remote provided interface `remote_provided`
@@ -263,7 +265,8 @@ public:
   /// Errors (nothing is changed): NotFound (not a remote provided interface), InvalidArgument
   /// (unknown or non-onset event, level Normal, empty origin), InvalidState (called from a
   /// callback or observer).
-  Expected<RemoteApplyResult> apply_remote(MachineId remote_provided, const std::vector<RemoteRoot>& roots);
+  [[nodiscard]] Expected<RemoteApplyResult> apply_remote(MachineId remote_provided,
+                                                         const std::vector<RemoteRoot>& roots);
   /// The full state another process needs for service `service` (a provided interface index of a
   /// local component): one RemoteRoot per root active at s_S.p (any level), with the shortest
   /// hop path that brings it to a machine feeding the service. Takes the lock; allocates.
@@ -272,12 +275,12 @@ public:
   std::string root_origin(const RootCause& root) const;
 
   // ---- lookup --------------------------------------------------------------------------------
-  Expected<ComponentId> find_component(std::string_view name) const;
-  Expected<EventId> find_event(std::string_view name) const;
+  [[nodiscard]] Expected<ComponentId> find_component(std::string_view name) const;
+  [[nodiscard]] Expected<EventId> find_event(std::string_view name) const;
   /// Parses an address (see Address). Errors: Parse, NotFound.
-  Expected<Address> resolve(std::string_view address) const;
+  [[nodiscard]] Expected<Address> resolve(std::string_view address) const;
   /// Resolves an address that must name one state machine.
-  Expected<MachineId> find_machine(std::string_view address) const;
+  [[nodiscard]] Expected<MachineId> find_machine(std::string_view address) const;
 
   std::size_t component_count() const noexcept { return components_.size(); }
   std::size_t machine_count() const noexcept { return machines_.size(); }
@@ -309,13 +312,13 @@ public:
   void generate(EventId event, MachineId target, const SampleCause& cause = {}) noexcept;
   /// Name-based form for tools. Errors: NotFound (event or address), InvalidArgument (address is
   /// not a machine), InvalidState (completion of an onset that was never defined).
-  Expected<void> generate(std::string_view event, std::string_view target);
+  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target);
   /// Processes a broadcast event (severity 251–255) on s_A of every component.
-  Expected<void> broadcast(std::string_view event);
+  [[nodiscard]] Expected<void> broadcast(std::string_view event);
   /// Clears every condition originating in `target` (machine, component, SYSTEM or the
   /// coordinator's name), latched ones too, and records who and why. Mirrored conditions whose
   /// root is outside the target and still active stay: the fault they report is still present.
-  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why);
+  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why);
   void reset(const Address& target, std::string_view who, std::string_view why);
 
   // ---- lock-free reads -----------------------------------------------------------------------
@@ -372,7 +375,7 @@ public:
   std::size_t history_size() const noexcept { return history_.items.size(); }
   /// Every active condition at `address` (machine, service, component, SYSTEM) with its root
   /// cause and hop path. Errors: as resolve().
-  Expected<std::vector<Explanation>> explain(std::string_view address) const;
+  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const;
   std::vector<Explanation> explain(const Address& address) const;
 
   // ---- callbacks and observers ---------------------------------------------------------------

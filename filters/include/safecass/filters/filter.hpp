@@ -117,7 +117,7 @@ public:
   /// run after the queue ran out judges the first input's newest real sample once, as a new
   /// sample, even when the signal has not changed since (a sensor that publishes only on change).
   /// Errors: InvalidArgument when a sample's size is not the input's.
-  Expected<void> inject(const std::vector<std::vector<double>>& samples);
+  [[nodiscard]] Expected<void> inject(const std::vector<std::vector<double>>& samples);
   /// Forgets internal state and the detection (no completion is sent: the machine is reset
   /// separately). Call from the thread that runs the filter.
   void reset() noexcept;

@@ -39,14 +39,14 @@ public:
 
   /// Declares signal "Component.signal" of `size` doubles. Errors: NotFound (component),
   /// InvalidArgument, Duplicate (different size).
-  Expected<Signal*> add_signal(std::string_view name, std::size_t size = 1);
+  [[nodiscard]] Expected<Signal*> add_signal(std::string_view name, std::size_t size = 1);
 
   /// Creates a filter: checks its type, parameters, target, events and input/output sizes; on any
   /// error nothing is created and the message names the filter and the parameter.
-  Expected<Filter*> add_filter(FilterConfig config);
+  [[nodiscard]] Expected<Filter*> add_filter(FilterConfig config);
   /// Creates a chain: each stage without an input reads the previous stage's output; intermediate
   /// outputs without a name are called "<name>.<stage index>". All stages or none.
-  Expected<std::vector<Filter*>> add_pipeline(std::string_view name, std::vector<FilterConfig> stages);
+  [[nodiscard]] Expected<std::vector<Filter*>> add_pipeline(std::string_view name, std::vector<FilterConfig> stages);
 
   Filter* find_filter(std::string_view name) const noexcept;
   const std::vector<std::unique_ptr<Filter>>& filters() const noexcept { return filters_; }
@@ -66,17 +66,19 @@ public:
   /// Shallow injection into one filter (see Filter::inject); recorded on the observer stream.
   /// Errors: NotFound (no such filter), InvalidArgument (a wrong size, or a NaN or infinite value:
   /// injected values must be finite, docs/filters.md); then nothing is queued.
-  Expected<void> inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples);
+  [[nodiscard]] Expected<void> inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples);
   /// Deep injection: `samples` written into the signal's history buffer at time `at`, marked as
   /// injected; every consumer sees them; recorded on the observer stream. Errors: NotFound,
   /// InvalidArgument (a wrong size, or a non-finite value); then nothing is written.
-  Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples, Time at);
+  [[nodiscard]] Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples,
+                                           Time at);
 
   /// Resolves a signal name as a filter of `component` would: bare names belong to it.
   std::string qualify(std::string_view signal, std::string_view component) const;
 
 private:
-  Expected<FilterInit> prepare(FilterConfig config, std::vector<std::pair<std::string, std::size_t>>& new_outputs);
+  [[nodiscard]] Expected<FilterInit> prepare(FilterConfig config,
+                                             std::vector<std::pair<std::string, std::size_t>>& new_outputs);
   void record_injection(MachineId machine, std::string text);
 
   Coordinator& coordinator_;

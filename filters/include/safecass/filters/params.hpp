@@ -86,6 +86,7 @@ std::string default_output_name(std::string_view filter, std::string_view compon
 /// Checks `given` against `manifest` and fills in defaults: unknown names, wrong types,
 /// out-of-range values and missing required parameters are errors naming the parameter.
 /// `filter` names the filter instance in messages.
-Expected<Params> check_params(const FilterManifest& manifest, const Params& given, std::string_view filter);
+[[nodiscard]] Expected<Params> check_params(const FilterManifest& manifest, const Params& given,
+                                            std::string_view filter);
 
 }  // namespace safecass

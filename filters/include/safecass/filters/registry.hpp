@@ -37,7 +37,7 @@ using ShapeCheck = std::function<Expected<std::vector<std::size_t>>(const Filter
 using FilterFactory = std::function<std::unique_ptr<Filter>(FilterInit)>;
 
 /// The default ShapeCheck: every input must be a scalar; every output is a scalar.
-Expected<std::vector<std::size_t>> scalar_shape(const FilterManifest& manifest, const FilterShape& shape);
+[[nodiscard]] Expected<std::vector<std::size_t>> scalar_shape(const FilterManifest& manifest, const FilterShape& shape);
 
 namespace detail {
 template <class T, class = void>
@@ -57,7 +57,7 @@ public:
 
   /// Registers type T under `type`. Errors: Duplicate.
   template <class T>
-  Expected<void> add(std::string type) {
+  [[nodiscard]] Expected<void> add(std::string type) {
     FilterManifest m = T::manifest();
     m.type = type;
     ShapeCheck shape;
@@ -70,9 +70,10 @@ public:
         std::move(shape));
   }
   /// Registers a type from its parts. An empty `shape` means scalar_shape. Errors: Duplicate.
-  Expected<void> add(std::string type, FilterManifest manifest, FilterFactory factory, ShapeCheck shape = {});
+  [[nodiscard]] Expected<void> add(std::string type, FilterManifest manifest, FilterFactory factory,
+                                   ShapeCheck shape = {});
   /// Makes `alias` another name of `type` (the 2016 names: "FilterThreshold" → "Threshold").
-  Expected<void> alias(std::string alias, std::string type);
+  [[nodiscard]] Expected<void> alias(std::string alias, std::string type);
 
   /// The entry for a type or alias, or nullptr.
   const Entry* find(std::string_view type) const noexcept;

@@ -289,7 +289,7 @@ public:
   /// Creates `name` ("Component.signal") of `size` doubles. Errors: Duplicate (with a different
   /// size), InvalidArgument (size 0, malformed name). Creating an existing signal with the same
   /// size returns it.
-  Expected<Signal*> add(std::string_view name, ComponentId component, std::size_t size);
+  [[nodiscard]] Expected<Signal*> add(std::string_view name, ComponentId component, std::size_t size);
   Signal* find(std::string_view name) const noexcept;
   const std::vector<std::unique_ptr<Signal>>& all() const noexcept { return signals_; }
   /// Removes the signals created after the first `count` (undoing a failed configuration step).

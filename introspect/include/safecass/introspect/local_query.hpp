@@ -34,23 +34,26 @@ public:
   LocalQuery(Coordinator& co, Monitor& monitor, const FilterRegistry& registry, LocalOptions options = {});
 
   std::string name() const override;
-  Expected<ClockInfo> clock() override;
-  Expected<std::vector<StateRow>> state_list(std::string_view component = {}) override;
-  Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last, HistoryFilter filter) override;
-  Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
-  Expected<std::vector<FilterRow>> filter_list() override;
-  Expected<FilterInfo> filter_info(std::string_view name) override;
-  Expected<std::vector<EventRow>> event_list() override;
-  Expected<std::vector<ConnectionRow>> connection_list() override;
-  Expected<std::vector<ServiceRow>> service_list() override;
-  Expected<ExplainAnswer> explain(std::string_view address) override;
-  Expected<Names> names() override;
-  Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) override;
-  Expected<void> generate(std::string_view event, std::string_view target) override;
-  Expected<void> broadcast(std::string_view event) override;
-  Expected<void> inject(std::string_view filter, const std::vector<std::vector<double>>& samples) override;
-  Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override;
-  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
+  [[nodiscard]] Expected<ClockInfo> clock() override;
+  [[nodiscard]] Expected<std::vector<StateRow>> state_list(std::string_view component = {}) override;
+  [[nodiscard]] Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last,
+                                                            HistoryFilter filter) override;
+  [[nodiscard]] Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
+  [[nodiscard]] Expected<std::vector<FilterRow>> filter_list() override;
+  [[nodiscard]] Expected<FilterInfo> filter_info(std::string_view name) override;
+  [[nodiscard]] Expected<std::vector<EventRow>> event_list() override;
+  [[nodiscard]] Expected<std::vector<ConnectionRow>> connection_list() override;
+  [[nodiscard]] Expected<std::vector<ServiceRow>> service_list() override;
+  [[nodiscard]] Expected<ExplainAnswer> explain(std::string_view address) override;
+  [[nodiscard]] Expected<Names> names() override;
+  [[nodiscard]] Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) override;
+  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;
+  [[nodiscard]] Expected<void> broadcast(std::string_view event) override;
+  [[nodiscard]] Expected<void> inject(std::string_view filter,
+                                      const std::vector<std::vector<double>>& samples) override;
+  [[nodiscard]] Expected<void> inject_deep(std::string_view signal,
+                                           const std::vector<std::vector<double>>& samples) override;
+  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
 
   /// The rows of one component (its extended state, s_F, s_A, each s_P, s_R and s_S), in the
   /// order of state_list(). For tools that show a coordinator before it answers.

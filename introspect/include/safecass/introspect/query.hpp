@@ -38,45 +38,47 @@ public:
 
   /// The coordinator (or in-process system) this query answers for.
   virtual std::string name() const = 0;
-  virtual Expected<ClockInfo> clock() = 0;
+  [[nodiscard]] virtual Expected<ClockInfo> clock() = 0;
 
   // ---- reads -----------------------------------------------------------------------------------
   /// SYSTEM (the product over the components), then for each component in declaration order its
   /// extended state, s_F, s_A, each s_P, each s_R and each s_S. With `component`: that
   /// component's rows alone, without SYSTEM. Errors: NotFound.
-  virtual Expected<std::vector<StateRow>> state_list(std::string_view component = {}) = 0;
+  [[nodiscard]] virtual Expected<std::vector<StateRow>> state_list(std::string_view component = {}) = 0;
   /// The last `last` records (0: all that are kept) about `scope` (SYSTEM or empty, a component,
   /// a service — its component — or a machine), oldest first. Errors: as resolving the address.
-  virtual Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last,
-                                                      HistoryFilter filter = HistoryFilter::All) = 0;
+  [[nodiscard]] virtual Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last,
+                                                                    HistoryFilter filter = HistoryFilter::All) = 0;
   /// The records kept whose sequence number is above `seq`, oldest first, at most `max`: how a
   /// follower fills a gap in the pushed stream.
-  virtual Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) = 0;
-  virtual Expected<std::vector<FilterRow>> filter_list() = 0;
+  [[nodiscard]] virtual Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) = 0;
+  [[nodiscard]] virtual Expected<std::vector<FilterRow>> filter_list() = 0;
   /// A filter (by name) or a filter type. Errors: NotFound.
-  virtual Expected<FilterInfo> filter_info(std::string_view name) = 0;
-  virtual Expected<std::vector<EventRow>> event_list() = 0;
-  virtual Expected<std::vector<ConnectionRow>> connection_list() = 0;
-  virtual Expected<std::vector<ServiceRow>> service_list() = 0;
+  [[nodiscard]] virtual Expected<FilterInfo> filter_info(std::string_view name) = 0;
+  [[nodiscard]] virtual Expected<std::vector<EventRow>> event_list() = 0;
+  [[nodiscard]] virtual Expected<std::vector<ConnectionRow>> connection_list() = 0;
+  [[nodiscard]] virtual Expected<std::vector<ServiceRow>> service_list() = 0;
   /// Errors: as resolving the address.
-  virtual Expected<ExplainAnswer> explain(std::string_view address) = 0;
+  [[nodiscard]] virtual Expected<ExplainAnswer> explain(std::string_view address) = 0;
   /// The names TAB completes.
-  virtual Expected<Names> names() = 0;
+  [[nodiscard]] virtual Expected<Names> names() = 0;
 
   // ---- the record stream ---------------------------------------------------------------------
   /// Calls `sink` for every record from now on, in order and each once (a remote query fills
   /// gaps from records_since()). Errors: Io (a remote stream cannot be subscribed to).
-  virtual Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) = 0;
+  [[nodiscard]] virtual Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) = 0;
 
   // ---- writes (the caller checked its own write access; a remote system checks its token) -----
-  virtual Expected<void> generate(std::string_view event, std::string_view target) = 0;
-  virtual Expected<void> broadcast(std::string_view event) = 0;
+  [[nodiscard]] virtual Expected<void> generate(std::string_view event, std::string_view target) = 0;
+  [[nodiscard]] virtual Expected<void> broadcast(std::string_view event) = 0;
   /// Shallow: queued into one filter's private input. Errors: NotFound, InvalidArgument.
-  virtual Expected<void> inject(std::string_view filter, const std::vector<std::vector<double>>& samples) = 0;
+  [[nodiscard]] virtual Expected<void> inject(std::string_view filter,
+                                              const std::vector<std::vector<double>>& samples) = 0;
   /// Deep: written into the signal's history at the system's current time. Errors: NotFound,
   /// InvalidArgument (more samples than the signal's history holds, not finite).
-  virtual Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) = 0;
-  virtual Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) = 0;
+  [[nodiscard]] virtual Expected<void> inject_deep(std::string_view signal,
+                                                   const std::vector<std::vector<double>>& samples) = 0;
+  [[nodiscard]] virtual Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) = 0;
 };
 
 }  // namespace safecass::introspect

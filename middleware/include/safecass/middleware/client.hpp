@@ -60,38 +60,41 @@ struct ClientOptions {
 class RemoteClient final : public introspect::SystemQuery {
 public:
   /// Errors: Io (IceStorm or the coordinator unreachable; no heartbeat from it within timeout).
-  static Expected<std::unique_ptr<RemoteClient>> connect(ClientOptions options);
+  [[nodiscard]] static Expected<std::unique_ptr<RemoteClient>> connect(ClientOptions options);
   ~RemoteClient() override;
   RemoteClient(const RemoteClient&) = delete;
   RemoteClient& operator=(const RemoteClient&) = delete;
 
   /// The coordinator's name as it reports it.
-  Expected<std::string> coordinator();
+  [[nodiscard]] Expected<std::string> coordinator();
 
   std::string name() const override;
-  Expected<introspect::ClockInfo> clock() override;
-  Expected<std::vector<introspect::StateRow>> state_list(std::string_view component = {}) override;
-  Expected<std::vector<introspect::HistoryEntry>> history(
+  [[nodiscard]] Expected<introspect::ClockInfo> clock() override;
+  [[nodiscard]] Expected<std::vector<introspect::StateRow>> state_list(std::string_view component = {}) override;
+  [[nodiscard]] Expected<std::vector<introspect::HistoryEntry>> history(
       std::string_view scope, std::size_t last,
       introspect::HistoryFilter filter = introspect::HistoryFilter::All) override;
-  Expected<std::vector<introspect::HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) override;
-  Expected<std::vector<introspect::FilterRow>> filter_list() override;
-  Expected<introspect::FilterInfo> filter_info(std::string_view name) override;
-  Expected<std::vector<introspect::EventRow>> event_list() override;
-  Expected<std::vector<introspect::ConnectionRow>> connection_list() override;
-  Expected<std::vector<introspect::ServiceRow>> service_list() override;
-  Expected<introspect::ExplainAnswer> explain(std::string_view address) override;
-  Expected<introspect::Names> names() override;
+  [[nodiscard]] Expected<std::vector<introspect::HistoryEntry>> records_since(std::uint64_t seq,
+                                                                              std::size_t max) override;
+  [[nodiscard]] Expected<std::vector<introspect::FilterRow>> filter_list() override;
+  [[nodiscard]] Expected<introspect::FilterInfo> filter_info(std::string_view name) override;
+  [[nodiscard]] Expected<std::vector<introspect::EventRow>> event_list() override;
+  [[nodiscard]] Expected<std::vector<introspect::ConnectionRow>> connection_list() override;
+  [[nodiscard]] Expected<std::vector<introspect::ServiceRow>> service_list() override;
+  [[nodiscard]] Expected<introspect::ExplainAnswer> explain(std::string_view address) override;
+  [[nodiscard]] Expected<introspect::Names> names() override;
   /// Errors: Io (IceStorm cannot be reached to subscribe).
-  Expected<std::unique_ptr<introspect::Subscription>> follow(introspect::RecordSink sink) override;
-  Expected<void> generate(std::string_view event, std::string_view target) override;
-  Expected<void> broadcast(std::string_view event) override;
-  Expected<void> inject(std::string_view filter, const std::vector<std::vector<double>>& samples) override;
-  Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override;
-  Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
+  [[nodiscard]] Expected<std::unique_ptr<introspect::Subscription>> follow(introspect::RecordSink sink) override;
+  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;
+  [[nodiscard]] Expected<void> broadcast(std::string_view event) override;
+  [[nodiscard]] Expected<void> inject(std::string_view filter,
+                                      const std::vector<std::vector<double>>& samples) override;
+  [[nodiscard]] Expected<void> inject_deep(std::string_view signal,
+                                           const std::vector<std::vector<double>>& samples) override;
+  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
   /// `text`: one sample per line, numbers separated by spaces or commas ('#' comments), parsed by
   /// the coordinator.
-  Expected<void> filter_dinload(const std::string& signal, const std::string& text);
+  [[nodiscard]] Expected<void> filter_dinload(const std::string& signal, const std::string& text);
 
   /// Records refused on the events topic (unauthenticated, forged, replayed or malformed) since
   /// connect(), and gaps filled from the coordinator's history.

@@ -29,12 +29,12 @@ inline constexpr std::string_view kSupervisorSigner = "supervisor";
 /// of the paths that is not a key written by this function is never overwritten.
 /// Errors: InvalidArgument (no coordinators, a coordinator named "supervisor"), Duplicate (keys
 /// exist and not `replace`), Io (with the path and the reason).
-Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
-                                                   bool replace = false);
+[[nodiscard]] Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
+                                                                 bool replace = false);
 
 /// The key directory: `given` when not empty, else $SAFECASS_KEYS.
 /// Errors: NotFound (neither, with how to create keys).
-Expected<std::string> bus_keys_dir(std::string_view given);
+[[nodiscard]] Expected<std::string> bus_keys_dir(std::string_view given);
 
 /// True when `host` is a loopback address or "localhost" (a message to it does not leave the host).
 bool is_loopback_host(std::string_view host) noexcept;

@@ -47,7 +47,7 @@ struct IceEndpoint {
   int port = 0;
 };
 /// Parses "HOST:PORT" or "PORT". Errors: Parse (with what was wrong).
-Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
 
 /// Mutual TLS (IceSSL) on every connection of a process: to IceStorm, from IceStorm to its
 /// subscribers, and to and from Control endpoints (docs/security.md). `dir` holds the system's
@@ -61,8 +61,8 @@ struct TlsOptions {
 
 /// Checks the TLS files of `tls` (when enabled) and that `hosts` are loopback unless TLS or
 /// `insecure`. `who` names the caller in the message. Errors: InvalidArgument, NotFound.
-Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
-                               std::initializer_list<std::string_view> hosts);
+[[nodiscard]] Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
+                                             std::initializer_list<std::string_view> hosts);
 
 /// The host's monotonic clock (CLOCK_MONOTONIC, epoch: boot), the same in every process of the
 /// host: root times and latencies can be compared across the processes of one machine.
@@ -85,8 +85,8 @@ inline constexpr std::size_t kDefaultMaxMessageBytes = std::size_t{4096 - 64} * 
 /// component of `coordinator_name` requires (Coordinator::add_remote_provided, with the
 /// provider's propagation level) and makes those connections. Call after spec::instantiate(...,
 /// coordinator_name). Errors: NotFound (no such coordinator), as the coordinator reports.
-Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
-                                        Coordinator& coordinator);
+[[nodiscard]] Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
+                                                      Coordinator& coordinator);
 
 struct NodeOptions {
   IceEndpoint ice;                        ///< IceStorm
@@ -154,17 +154,18 @@ public:
   /// names this process in the system's "coordinators". Nothing touches the network before
   /// start(). Errors: NotFound (unknown coordinator name, no keys), InvalidArgument (bad options,
   /// a non-loopback endpoint without `insecure`), Denied/Parse/Io (the keys, as keys.hpp says).
-  static Expected<std::unique_ptr<CoordinatorNode>> create(Coordinator& coordinator, Monitor& monitor,
-                                                           const FilterRegistry& registry,
-                                                           const spec::SystemSpec& system, std::string coordinator_name,
-                                                           NodeOptions options);
+  [[nodiscard]] static Expected<std::unique_ptr<CoordinatorNode>> create(Coordinator& coordinator, Monitor& monitor,
+                                                                         const FilterRegistry& registry,
+                                                                         const spec::SystemSpec& system,
+                                                                         std::string coordinator_name,
+                                                                         NodeOptions options);
   ~CoordinatorNode();
   CoordinatorNode(const CoordinatorNode&) = delete;
   CoordinatorNode& operator=(const CoordinatorNode&) = delete;
 
   /// Creates the Ice communicator and its adapter and starts the threads; the node connects to
   /// IceStorm in the background (and keeps retrying). Errors: Io (the adapter cannot listen).
-  Expected<void> start();
+  [[nodiscard]] Expected<void> start();
   /// Stops the threads and shuts the communicator down. Idempotent.
   void stop() noexcept;
 

@@ -100,13 +100,14 @@ struct ViewRow {
 class Supervisor {
 public:
   /// `system` must outlive the supervisor. Errors: as spec::instantiate.
-  static Expected<std::unique_ptr<Supervisor>> create(const spec::SystemSpec& system, SupervisorOptions options);
+  [[nodiscard]] static Expected<std::unique_ptr<Supervisor>> create(const spec::SystemSpec& system,
+                                                                    SupervisorOptions options);
   ~Supervisor();
   Supervisor(const Supervisor&) = delete;
   Supervisor& operator=(const Supervisor&) = delete;
 
   /// Connects to IceStorm in the background (retrying) and starts watching heartbeats.
-  Expected<void> start();
+  [[nodiscard]] Expected<void> start();
   void stop() noexcept;
 
   /// The last known state of every address a coordinator reported, sorted by address.

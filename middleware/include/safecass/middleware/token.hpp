@@ -30,7 +30,7 @@ namespace safecass::middleware {
 
 /// A new secret: 32 random bytes (getrandom) as 64 lowercase hex digits. Errors: Io when the
 /// system has no random source.
-Expected<std::string> make_token();
+[[nodiscard]] Expected<std::string> make_token();
 
 /// A token file created by this process and held (locked) until it is removed.
 ///
@@ -42,10 +42,10 @@ public:
   /// Creates a token file at `path` with a new secret (the rules in this file's comment).
   /// Errors: Io, with the path and the reason: the path exists and is not a token file of ours
   /// (what it is), the token file of a running process, a symbolic link, a missing directory.
-  static Expected<std::unique_ptr<TokenFile>> create(const std::string& path);
+  [[nodiscard]] static Expected<std::unique_ptr<TokenFile>> create(const std::string& path);
   /// create() at the default place: "<private directory>/<name>-<pid>.token" (`name`: the
   /// coordinator's name, or "viewer"). Errors: Io (no usable private directory, with the reason).
-  static Expected<std::unique_ptr<TokenFile>> create_default(std::string_view name);
+  [[nodiscard]] static Expected<std::unique_ptr<TokenFile>> create_default(std::string_view name);
 
   ~TokenFile();
   TokenFile(const TokenFile&) = delete;
@@ -68,7 +68,7 @@ private:
 /// Reads a token file (a regular file of at most 4 KiB whose first line is 64 hex digits; a FIFO
 /// or device is refused without blocking). Errors: Io (with the path and the reason), Parse (not
 /// a token).
-Expected<std::string> read_token_file(const std::string& path);
+[[nodiscard]] Expected<std::string> read_token_file(const std::string& path);
 
 /// Compares in time independent of where the strings differ. An empty `expected` (no token
 /// configured) matches nothing.

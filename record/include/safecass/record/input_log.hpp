@@ -94,7 +94,7 @@ public:
 
   /// Opens `path` and reads its header. Errors: Io (cannot read), Parse (not a recording, with
   /// the reason).
-  static Expected<std::unique_ptr<InputLogReader>> open(const std::string& path);
+  [[nodiscard]] static Expected<std::unique_ptr<InputLogReader>> open(const std::string& path);
   ~InputLogReader();
   InputLogReader(const InputLogReader&) = delete;
   InputLogReader& operator=(const InputLogReader&) = delete;

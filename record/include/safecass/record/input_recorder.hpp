@@ -83,8 +83,8 @@ class InputRecorder {
 public:
   /// Creates `path`, writes the header and declares the input signals of `monitor`. Errors: Io
   /// (with the path and the reason), InvalidArgument (more than 65534 input signals).
-  static Expected<std::unique_ptr<InputRecorder>> open(Monitor& monitor, const std::string& path,
-                                                       InputRecorderOptions options = {});
+  [[nodiscard]] static Expected<std::unique_ptr<InputRecorder>> open(Monitor& monitor, const std::string& path,
+                                                                     InputRecorderOptions options = {});
   ~InputRecorder();
   InputRecorder(const InputRecorder&) = delete;
   InputRecorder& operator=(const InputRecorder&) = delete;

@@ -67,8 +67,8 @@ std::string record_status_json(const RecordStatus& status);
 class Recorder {
 public:
   /// Opens `path` for writing (creates or truncates). Errors: Io, with the path and the reason.
-  static Expected<std::unique_ptr<Recorder>> open(Coordinator& coordinator, const std::string& path,
-                                                  std::size_t capacity = 65536, FileLimits limits = {});
+  [[nodiscard]] static Expected<std::unique_ptr<Recorder>> open(Coordinator& coordinator, const std::string& path,
+                                                                std::size_t capacity = 65536, FileLimits limits = {});
   ~Recorder();
   Recorder(const Recorder&) = delete;
   Recorder& operator=(const Recorder&) = delete;

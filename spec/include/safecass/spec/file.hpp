@@ -23,6 +23,7 @@ inline constexpr std::size_t kMaxInputFileBytes = std::size_t{64} << 20;
 /// `max_bytes` bytes. Errors (Io), each "cannot read file 'PATH': why": "no such file", the
 /// system's reason ("Permission denied"), "not a regular file (a directory|a FIFO|a character
 /// device|a block device|a socket)", "larger than 64 MiB (N bytes)". Thread-safe.
-Expected<std::string> read_regular_file(const std::string& path, std::size_t max_bytes = kMaxInputFileBytes);
+[[nodiscard]] Expected<std::string> read_regular_file(const std::string& path,
+                                                      std::size_t max_bytes = kMaxInputFileBytes);
 
 }  // namespace safecass::spec

@@ -54,7 +54,7 @@ struct FormulaError {
 };
 
 /// Parses `text`. Never throws.
-tl::expected<Formula, FormulaError> parse_formula(std::string_view text);
+[[nodiscard]] tl::expected<Formula, FormulaError> parse_formula(std::string_view text);
 
 /// The formula written back in the grammar above, fully parenthesised.
 std::string to_string(const Formula& f);

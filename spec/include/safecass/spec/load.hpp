@@ -53,7 +53,7 @@ LoadResult load_system_from_text(std::string_view text, const std::string& name,
 /// system is defined either way. Errors name the thing (NotFound for an unknown coordinator,
 /// otherwise what the coordinator or monitor reported). On error the coordinator and monitor are
 /// partly configured: discard them. Precondition: load_system() reported no errors.
-Expected<void> instantiate(const SystemSpec& system, Coordinator& coordinator, Monitor& monitor,
-                           std::string_view only_coordinator = {});
+[[nodiscard]] Expected<void> instantiate(const SystemSpec& system, Coordinator& coordinator, Monitor& monitor,
+                                         std::string_view only_coordinator = {});
 
 }  // namespace safecass::spec

@@ -71,7 +71,8 @@ struct Report {
 /// Verifies `system` (loaded without errors). Errors: NotFound (an unknown `property`), Io (SPIN or
 /// the compiler cannot be run, a file cannot be written), InvalidArgument (the system cannot be
 /// built into a coordinator).
-Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry, const Options& options);
+[[nodiscard]] Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry,
+                                      const Options& options);
 
 /// A step of the model, as applied to a coordinator: an onset or a completion (`event` on
 /// `target`; a broadcast has an empty target), or a reset of machine `target`.
@@ -92,11 +93,11 @@ struct Simulation {
 
 /// Runs the whole model (no slicing, no merging) for `steps` steps with SPIN's random simulation
 /// seeded with `seed`. Errors as verify().
-Expected<Simulation> simulate(const spec::SystemSpec& system, const FilterRegistry& registry, unsigned seed,
-                              std::size_t steps, const Options& options = {});
+[[nodiscard]] Expected<Simulation> simulate(const spec::SystemSpec& system, const FilterRegistry& registry,
+                                            unsigned seed, std::size_t steps, const Options& options = {});
 
 /// The text of the model of the whole system (for people and tests), one property per check.
-Expected<std::string> promela(const spec::SystemSpec& system, const FilterRegistry& registry);
+[[nodiscard]] Expected<std::string> promela(const spec::SystemSpec& system, const FilterRegistry& registry);
 
 std::string_view to_string(PropertyResult::Kind kind) noexcept;
 std::string_view to_string(PropertyResult::Verdict verdict) noexcept;

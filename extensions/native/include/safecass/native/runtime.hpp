@@ -36,9 +36,9 @@ public:
 
   /// Adds the periodic task of `component`. Errors: InvalidArgument (period ≤ 0, task exists),
   /// NotFound (component).
-  Expected<void> add_task(ComponentId component, Time period, Body body = {});
+  [[nodiscard]] Expected<void> add_task(ComponentId component, Time period, Body body = {});
   /// Sets the body of an existing task (e.g. the application's control loop).
-  Expected<void> set_body(ComponentId component, Body body);
+  [[nodiscard]] Expected<void> set_body(ComponentId component, Body body);
 
   /// Simulated time: runs the tasks due at `now` (in the order they were added), then the monitor
   /// tick if due. Call with non-decreasing times.

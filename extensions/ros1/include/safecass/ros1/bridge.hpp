@@ -54,8 +54,9 @@ public:
   /// coordinator (named after the mapping's coordinator, or the system) and monitor. `clock` must
   /// outlive the bridge (null: a SteadyClock). Errors: Parse (every diagnostic, one per line),
   /// NotFound (unknown component, interface, signal, event), InvalidArgument (sizes).
-  static Expected<std::unique_ptr<Bridge>> create(const std::string& mapping_path, const FilterRegistry& registry,
-                                                  const Clock* clock = nullptr);
+  [[nodiscard]] static Expected<std::unique_ptr<Bridge>> create(const std::string& mapping_path,
+                                                                const FilterRegistry& registry,
+                                                                const Clock* clock = nullptr);
   ~Bridge();
   Bridge(const Bridge&) = delete;
   Bridge& operator=(const Bridge&) = delete;
@@ -67,10 +68,10 @@ public:
   /// Runs `body` every `period` on the spinning thread, after `component`'s ACTIVE filters (the
   /// component's own loop; use dispatch() inside). A body that throws raises
   /// EVT_THREAD_EXCEPTION on s_F until a cycle completes. Errors: NotFound, InvalidArgument.
-  Expected<void> add_loop(std::string_view component, Time period, Body body);
+  [[nodiscard]] Expected<void> add_loop(std::string_view component, Time period, Body body);
 
   /// Connects to ROS. Call after ros::init(). Errors: InvalidState (already started, no master).
-  Expected<void> start();
+  [[nodiscard]] Expected<void> start();
   /// Stops timers and threads, unsubscribes. Idempotent; the destructor calls it.
   void stop() noexcept;
 

@@ -32,7 +32,7 @@ enum class MessageType : std::uint8_t { Float64, WrenchStamped, JointState };
 /// "std_msgs/Float64", "geometry_msgs/WrenchStamped", "sensor_msgs/JointState".
 std::string_view to_string(MessageType type) noexcept;
 /// Parses a ROS message type name. Errors: NotFound (names the supported types).
-Expected<MessageType> parse_message_type(std::string_view name);
+[[nodiscard]] Expected<MessageType> parse_message_type(std::string_view name);
 
 /// A parsed field path: which part of a message, and which element of it.
 struct FieldPath {
@@ -49,7 +49,7 @@ struct FieldPath {
 
 /// Parses `path` for messages of `type`. Errors: InvalidArgument, with a message that names the
 /// path, the part that is wrong and what would be accepted.
-Expected<FieldPath> parse_field_path(MessageType type, std::string_view path);
+[[nodiscard]] Expected<FieldPath> parse_field_path(MessageType type, std::string_view path);
 
 /// The four levels of `diagnostic_msgs/DiagnosticStatus`, with the same byte values.
 enum class DiagnosticLevel : std::uint8_t { Ok = 0, Warn = 1, Error = 2, Stale = 3 };

@@ -16,6 +16,6 @@ namespace safecass::replay {
 
 /// Opens `bag` with `mapping`. Errors: Io (cannot read), Parse (the mapping's diagnostics; a bag
 /// rosbag cannot open, such as a truncated one, with rosbag's reason).
-Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping);
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping);
 
 }  // namespace safecass::replay

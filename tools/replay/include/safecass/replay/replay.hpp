@@ -63,7 +63,8 @@ public:
   /// `registry` must outlive the session; options.json/record/out are ignored. Errors: Parse,
   /// with every line run_replay() prints for the same bad input ("file:line: reason"), one per
   /// line.
-  static Expected<std::unique_ptr<ReplaySession>> open(const ReplayOptions& options, const FilterRegistry& registry);
+  [[nodiscard]] static Expected<std::unique_ptr<ReplaySession>> open(const ReplayOptions& options,
+                                                                     const FilterRegistry& registry);
   ~ReplaySession();
   ReplaySession(const ReplaySession&) = delete;
   ReplaySession& operator=(const ReplaySession&) = delete;

@@ -36,7 +36,7 @@ public:
   virtual ~InputSource() = default;
   /// Resolves the log's signal names against `monitor` (input signals only: a filter's output is
   /// computed by the replayed system, never fed). Errors: Parse, with where and why.
-  virtual Expected<void> bind(Monitor& monitor) = 0;
+  [[nodiscard]] virtual Expected<void> bind(Monitor& monitor) = 0;
   virtual Item next() = 0;
   /// After Item::Kind::Error.
   virtual const std::string& error() const = 0;
@@ -59,12 +59,12 @@ public:
 std::vector<std::string> input_signal_names(const Monitor& monitor);
 /// Resolves `name` to an input signal of `monitor`, or says why not ("no signal 'X' in the
 /// system; did you mean 'Y'?", "signal 'X' is computed by filter F; ...").
-Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name);
+[[nodiscard]] Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name);
 
 std::unique_ptr<InputSource> open_recording(std::unique_ptr<InputLogReader> reader);
 /// A CSV log: a header naming a time column ("time" or "t", seconds) and one column per scalar
 /// signal ("Component.signal") or per element of a vector ("Component.signal[i]"); one row per
 /// time. An empty cell is no sample of that signal in that row. Errors: Io.
-Expected<std::unique_ptr<InputSource>> open_csv(const std::string& path);
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_csv(const std::string& path);
 
 }  // namespace safecass::replay

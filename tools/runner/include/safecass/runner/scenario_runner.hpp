@@ -88,11 +88,12 @@ public:
   /// no period run at the scenario's period) and checks every name the scenario uses (signals,
   /// sizes, events, filters, addresses). Every problem is returned with its position, and then
   /// nothing was built. Warnings of the system file are appended to `notes` when given.
-  static Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source, const FilterRegistry& registry,
-                                                      Diagnostics* notes = nullptr);
+  [[nodiscard]] static Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source,
+                                                                    const FilterRegistry& registry,
+                                                                    Diagnostics* notes = nullptr);
   /// The same from parts already loaded. `registry` must outlive the runner.
-  static Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
-                                                      const FilterRegistry& registry);
+  [[nodiscard]] static Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
+                                                                    const FilterRegistry& registry);
   ~ScenarioRunner();
   ScenarioRunner(const ScenarioRunner&) = delete;
   ScenarioRunner& operator=(const ScenarioRunner&) = delete;

@@ -76,13 +76,14 @@ private:
 
 /// Builds a loaded specification: instantiates the (local) components, their filters and
 /// connections, and adds each local component's task. `registry` must outlive the System.
-Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const FilterRegistry& registry,
-                                             const SystemOptions& options = {});
+[[nodiscard]] Opened<std::unique_ptr<System>> build_system(spec::SystemSpec system, const FilterRegistry& registry,
+                                                           const SystemOptions& options = {});
 
 /// Loads the system file and builds it. Diagnostics that are not errors (warnings, notes) are
 /// appended to `notes` when given; errors are the unexpected side and nothing is built.
-Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
-                                            const SystemOptions& options = {}, Diagnostics* notes = nullptr);
+[[nodiscard]] Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
+                                                          const SystemOptions& options = {},
+                                                          Diagnostics* notes = nullptr);
 
 /// Keeps the errors of `diagnostics` and moves the others (warnings, notes) to `notes`, or drops
 /// them when `notes` is null. Returns the errors, in their order.

@@ -163,8 +163,8 @@ struct TraceOptions {
 /// scenario does not load, a scenario names what the system lacks, the verify file is unreadable
 /// or not a verify result; each with file:line:col. A scenario whose expectations fail is not an
 /// error here: it is run to the end and reported as a scenario-failed gap.
-tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
-                                                               const FilterRegistry& registry);
+[[nodiscard]] tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
+                                                                             const FilterRegistry& registry);
 
 /// The matrix as text for a terminal: per hazard its chain, then the gaps, then the summary.
 std::string trace_text(const Trace& trace);

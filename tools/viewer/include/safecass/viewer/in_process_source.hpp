@@ -30,7 +30,7 @@ public:
   /// Loads and builds the system (and scenario) and processes the tick at t = 0.
   /// Errors: InvalidArgument (no system, bad speed), Io/Parse/InvalidArgument with every
   /// diagnostic of the files, one per line.
-  static Expected<std::unique_ptr<InProcessSource>> open(const InProcessOptions& options);
+  [[nodiscard]] static Expected<std::unique_ptr<InProcessSource>> open(const InProcessOptions& options);
   ~InProcessSource() override;
   InProcessSource(const InProcessSource&) = delete;
   InProcessSource& operator=(const InProcessSource&) = delete;
@@ -40,11 +40,11 @@ public:
   double now() const override;
   bool running() const override;
   std::vector<std::string> take_records() override;
-  Expected<std::vector<Explanation>> explain(std::string_view address) const override;
-  Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  Expected<std::string> broadcast(std::string_view event) override;
-  Expected<std::string> inject(const InjectRequest& request) override;
-  Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
+  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
+  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
+  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
+  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
 
   /// Advances the simulated clock to `t` (seconds) at once, ignoring the wall clock; later polls
   /// continue from there. For tests.

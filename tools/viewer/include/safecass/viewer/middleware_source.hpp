@@ -54,7 +54,7 @@ public:
   /// do not answer are not an error. Errors: Parse (--ice, the system file: every diagnostic),
   /// InvalidArgument (a system without coordinators, a token file for an unknown coordinator),
   /// Io (a token file that cannot be read).
-  static Expected<std::unique_ptr<MiddlewareSource>> open(const MiddlewareOptions& options);
+  [[nodiscard]] static Expected<std::unique_ptr<MiddlewareSource>> open(const MiddlewareOptions& options);
   /// Stops the threads (each finishes its request in progress, at most `timeout`).
   ~MiddlewareSource() override;
   MiddlewareSource(const MiddlewareSource&) = delete;
@@ -65,11 +65,11 @@ public:
   double now() const override;
   bool running() const override;
   std::vector<std::string> take_records() override;
-  Expected<std::vector<Explanation>> explain(std::string_view address) const override;
-  Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  Expected<std::string> broadcast(std::string_view event) override;
-  Expected<std::string> inject(const InjectRequest& request) override;
-  Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
+  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
+  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
+  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
+  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
 
   /// The status of a coordinator: "" (answering), "connecting", "unreachable" or "lost".
   /// For tests and the start-up message.

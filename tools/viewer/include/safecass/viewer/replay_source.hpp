@@ -34,7 +34,7 @@ class ReplaySource final : public ViewSource {
 public:
   /// Errors: InvalidArgument (no system, bad speed), Parse with every problem of the files, one
   /// per line ("file:line: reason").
-  static Expected<std::unique_ptr<ReplaySource>> open(const ReplaySourceOptions& options);
+  [[nodiscard]] static Expected<std::unique_ptr<ReplaySource>> open(const ReplaySourceOptions& options);
   ~ReplaySource() override;
   ReplaySource(const ReplaySource&) = delete;
   ReplaySource& operator=(const ReplaySource&) = delete;
@@ -44,15 +44,15 @@ public:
   double now() const override;
   bool running() const override;
   std::vector<std::string> take_records() override;
-  Expected<std::vector<Explanation>> explain(std::string_view address) const override;
+  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
   /// Refused: a replay is read-only.
-  Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  Expected<std::string> broadcast(std::string_view event) override;
-  Expected<std::string> inject(const InjectRequest& request) override;
-  Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
+  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
+  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
+  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
 
   std::optional<ReplayView> replay() const override;
-  Expected<std::string> control(const ReplayControl& control) override;
+  [[nodiscard]] Expected<std::string> control(const ReplayControl& control) override;
   std::uint64_t generation() const override;
 
   /// Polls until the replay is idle (a seek or a next has arrived): for tests.

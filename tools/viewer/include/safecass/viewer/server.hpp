@@ -69,8 +69,8 @@ class Server {
 public:
   /// Binds and listens. Errors: InvalidArgument (bad address), Io (cannot bind: the port is in
   /// use or not allowed). `source` must outlive the server.
-  static Expected<std::unique_ptr<Server>> open(ViewSource& source, const ProtocolOptions& protocol,
-                                                const ServerOptions& options);
+  [[nodiscard]] static Expected<std::unique_ptr<Server>> open(ViewSource& source, const ProtocolOptions& protocol,
+                                                              const ServerOptions& options);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;

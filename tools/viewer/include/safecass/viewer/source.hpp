@@ -119,21 +119,21 @@ public:
   virtual std::vector<std::string> take_records() = 0;
   /// Every active condition at `address` (SYSTEM, a coordinator name, C, C.s_F, …) with its
   /// root cause and hop path. Errors: NotFound / Parse for an unknown or malformed address.
-  virtual Expected<std::vector<Explanation>> explain(std::string_view address) const = 0;
+  [[nodiscard]] virtual Expected<std::vector<Explanation>> explain(std::string_view address) const = 0;
 
   // Write operations. The server checks write access and the token before calling them; each
   // returns one line saying what was done, or an error that says what is wrong and changes nothing.
-  virtual Expected<std::string> generate(std::string_view event, std::string_view target) = 0;
-  virtual Expected<std::string> broadcast(std::string_view event) = 0;
-  virtual Expected<std::string> inject(const InjectRequest& request) = 0;
-  virtual Expected<std::string> reset(std::string_view target, std::string_view reason) = 0;
+  [[nodiscard]] virtual Expected<std::string> generate(std::string_view event, std::string_view target) = 0;
+  [[nodiscard]] virtual Expected<std::string> broadcast(std::string_view event) = 0;
+  [[nodiscard]] virtual Expected<std::string> inject(const InjectRequest& request) = 0;
+  [[nodiscard]] virtual Expected<std::string> reset(std::string_view target, std::string_view reason) = 0;
 
   // A replay (ReplaySource) can be moved in time; other sources are not replays.
   /// Where the replay stands; nullopt for a source that is not a replay.
   virtual std::optional<ReplayView> replay() const { return std::nullopt; }
   /// Applies a replay control and says what was done. Errors: InvalidArgument (not a replay, a
   /// time out of the replay's range, a bad speed); nothing changed then.
-  virtual Expected<std::string> control(const ReplayControl& /*control*/) {
+  [[nodiscard]] virtual Expected<std::string> control(const ReplayControl& /*control*/) {
     return fail(ErrorCode::InvalidArgument, "this viewer shows a running system, not a replay");
   }
   /// Changes whenever the source's picture started over (a replay went back in time): the
