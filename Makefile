@@ -97,10 +97,8 @@ bench-verify: build
 # (CTEST_ARGS). With SANITIZER_SUBSET=ci (what .ci/run uses): only the test folders named below
 # are built (their `<folder>/all` targets and the `safecass` command they start) and run, folder
 # by folder; docs/contributing.md, "Continuous integration", says which and why.
-ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/middleware \
-  tests/unit/tools tests/unit/replay tests/unit/trace tests/unit/verify tests/integration/middleware
-TSAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/record tests/unit/middleware tests/unit/tools \
-  tests/integration/middleware
+ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/replay
+TSAN_CI_DIRS := tests/unit/core tests/unit/record
 # Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
 # invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.
 ASAN_CI_ARGS := -LE known-defect -E '^ViewerBacksOffWhenOutOfFileDescriptors$$'
