@@ -98,7 +98,7 @@ bench-verify: build
 # are built (their `<folder>/all` targets and the `safecass` command they start) and run, folder
 # by folder; docs/contributing.md, "Continuous integration", says which and why.
 ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/replay
-TSAN_CI_DIRS := tests/unit/core tests/unit/record
+TSAN_CI_DIRS := tests/unit/core
 # Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
 # invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.
 ASAN_CI_ARGS := -LE known-defect -E '^ViewerBacksOffWhenOutOfFileDescriptors$$'

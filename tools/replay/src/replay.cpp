@@ -11,6 +11,7 @@
 #include <cstring>
 #include <unordered_map>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/replay/source.hpp"
 #include "safecass/runner/scenario_runner.hpp"
@@ -26,11 +27,7 @@ namespace {
 
 using runner::ScenarioRunner;
 
-std::string secs(Time t) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
+std::string secs(Time t) { return introspect::seconds_text(t); }
 
 /// The format of a log from its first bytes: a recording's header, a bag's "#ROSBAG", else CSV.
 std::string sniff(const std::string& path) {
