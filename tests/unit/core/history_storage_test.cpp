@@ -4,8 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <vector>
 
@@ -41,7 +41,8 @@ void expect_same(const Record& a, const Record& b, std::size_t i) {
   EXPECT_EQ(a.root.time, b.root.time);
   EXPECT_EQ(a.root.sample.filter, b.root.sample.filter);
   EXPECT_EQ(a.root.sample.signal, b.root.sample.signal);
-  EXPECT_EQ(0, std::memcmp(&a.root.sample.value, &b.root.sample.value, sizeof(double)));
+  // Bit for bit, so that a NaN value stored and read back counts as equal.
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(a.root.sample.value), std::bit_cast<std::uint64_t>(b.root.sample.value));
   EXPECT_EQ(a.root.sample.sample_time, b.root.sample.sample_time);
   EXPECT_EQ(a.root.sample.injected, b.root.sample.injected);
   EXPECT_EQ(a.root.remote, b.root.remote);
