@@ -17,6 +17,8 @@ packages=(
   libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev libfmt-dev
   clang libclang-rt-14-dev
 )
+# `make lint` (scripts/lint): clang-format and clang-tidy 14.
+packages+=(clang-format clang-tidy)
 # ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (`safecass
 # replay` of a bag), the messages,
 # diagnostic_aggregator and rosdiagnostic; unshare/ip for the loopback-only test namespace.
