@@ -31,9 +31,6 @@ std::string_view to_string(NodeKind kind) noexcept {
 
 namespace {
 
-/// Records waiting for take_records() beyond this are dropped and counted (a bound on memory if
-/// nobody polls; in practice the server takes them every poll).
-constexpr std::size_t kMaxPendingRecords = 100000;
 /// At most this many ticks are processed per poll, so that a poll never holds the event loop
 /// for long; the clock catches up over the next polls.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
@@ -65,8 +62,7 @@ struct InProcessSource::Impl {
   Time base_sim{};
   std::unique_ptr<introspect::LocalQuery> query;        // what the source reads and writes through
   std::unique_ptr<introspect::Subscription> following;  // the records, for take_records()
-  std::vector<std::string> pending;
-  std::uint64_t dropped = 0;
+  detail::PendingRecords pending;
 
   ~Impl() {
     following.reset();  // before the query and the runner
@@ -124,13 +120,7 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   impl->query = std::make_unique<introspect::LocalQuery>(impl->co(), impl->runner->monitor(), impl->registry, local);
   impl->connections = detail::local_connections(*impl->query);
   Impl* self = impl.get();
-  auto following = impl->query->follow([self](const introspect::HistoryEntry& e) {
-    if (self->pending.size() >= kMaxPendingRecords) {
-      ++self->dropped;
-      return;
-    }
-    self->pending.push_back(introspect::history_json(e));
-  });
+  auto following = impl->query->follow([self](const introspect::HistoryEntry& e) { self->pending.push(e); });
   if (!following) return tl::unexpected(following.error());
   impl->following = std::move(*following);
   impl->runner->advance_to(Time{0}, impl->result);
@@ -166,18 +156,7 @@ SystemView InProcessSource::view() const {
   return v;
 }
 
-std::vector<std::string> InProcessSource::take_records() {
-  std::vector<std::string> out;
-  out.swap(impl_->pending);
-  if (impl_->dropped != 0) {
-    out.push_back(introspect::JsonObject()
-                      .str("kind", "overflow")
-                      .integer("dropped", static_cast<long long>(impl_->dropped))
-                      .text());
-    impl_->dropped = 0;
-  }
-  return out;
-}
+std::vector<std::string> InProcessSource::take_records() { return impl_->pending.take(); }
 
 Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view address) const {
   return detail::local_explain(*impl_->query, impl_->co(), impl_->coordinators, address);

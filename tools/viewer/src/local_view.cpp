@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <iterator>
 
+#include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer::detail {
@@ -70,6 +72,30 @@ std::vector<ConnectionView> local_connections(introspect::LocalQuery& query) {
   auto answer = query.explain(address);
   if (!answer) return tl::unexpected(answer.error());
   return std::move(answer->conditions);
+}
+
+void PendingRecords::push(const introspect::HistoryEntry& e) {
+  if (records_.size() >= kLimit) {
+    ++dropped_;
+    return;
+  }
+  records_.push_back(introspect::history_json(e));
+}
+
+std::vector<std::string> PendingRecords::take() {
+  std::vector<std::string> out;
+  out.swap(records_);
+  if (dropped_ != 0) {
+    out.push_back(
+        introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(dropped_)).text());
+    dropped_ = 0;
+  }
+  return out;
+}
+
+void PendingRecords::clear() {
+  records_.clear();
+  dropped_ = 0;
 }
 
 }  // namespace safecass::viewer::detail

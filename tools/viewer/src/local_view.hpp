@@ -3,6 +3,8 @@
 // this process through its read model (introspect::LocalQuery), and explain with the viewer's
 // coordinator addresses ("coordinator:NAME").
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -31,5 +33,20 @@ std::vector<ConnectionView> local_connections(introspect::LocalQuery& query);
 [[nodiscard]] Expected<std::vector<Explanation>> local_explain(introspect::LocalQuery& query, const Coordinator& co,
                                                                const Coordinators& coordinators,
                                                                std::string_view address);
+
+/// The records a local source has produced and the server has not taken yet, as JSON lines.
+/// Bounded: past kLimit a record is dropped and counted (memory stays bounded if nobody polls;
+/// the server takes them every poll), and take() ends with an overflow line saying how many.
+class PendingRecords {
+public:
+  static constexpr std::size_t kLimit = 100000;
+  void push(const introspect::HistoryEntry& e);
+  std::vector<std::string> take();
+  void clear();
+
+private:
+  std::vector<std::string> records_;
+  std::uint64_t dropped_ = 0;
+};
 
 }  // namespace safecass::viewer::detail

@@ -17,8 +17,6 @@ namespace safecass::viewer {
 
 namespace {
 
-/// Records waiting for take_records() beyond this are dropped and counted (as InProcessSource).
-constexpr std::size_t kMaxPendingRecords = 100000;
 /// At most this many ticks per poll, so that a poll never holds the event loop for long.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
 
@@ -50,8 +48,7 @@ struct ReplaySource::Impl {
   detail::Coordinators coordinators;
   std::vector<ConnectionView> connections;
   std::string system_name;
-  std::vector<std::string> pending;
-  std::uint64_t dropped = 0;
+  detail::PendingRecords pending;
   std::uint64_t generation = 0;
   bool transition_seen = false;  // since the last "next" began
   // Controls. Playing: replay time = base_sim + (wall - base_wall) * speed.
@@ -88,14 +85,9 @@ struct ReplaySource::Impl {
     query = std::make_unique<introspect::LocalQuery>(r.coordinator(), r.monitor(), registry, local);
     connections = detail::local_connections(*query);
     pending.clear();
-    dropped = 0;
     auto follow = query->follow([this](const introspect::HistoryEntry& e) {
       if (e.kind == RecordKind::Transition || e.kind == RecordKind::ComponentTransition) transition_seen = true;
-      if (pending.size() >= kMaxPendingRecords) {
-        ++dropped;
-        return;
-      }
-      pending.push_back(introspect::history_json(e));
+      pending.push(e);
     });
     if (!follow) return tl::unexpected(follow.error());
     following = std::move(*follow);
@@ -189,18 +181,7 @@ double ReplaySource::now() const { return to_seconds(impl_->now()); }
 
 bool ReplaySource::running() const { return !impl_->at_end(); }
 
-std::vector<std::string> ReplaySource::take_records() {
-  std::vector<std::string> out;
-  out.swap(impl_->pending);
-  if (impl_->dropped != 0) {
-    out.push_back(introspect::JsonObject()
-                      .str("kind", "overflow")
-                      .integer("dropped", static_cast<long long>(impl_->dropped))
-                      .text());
-    impl_->dropped = 0;
-  }
-  return out;
-}
+std::vector<std::string> ReplaySource::take_records() { return impl_->pending.take(); }
 
 Expected<std::vector<Explanation>> ReplaySource::explain(std::string_view address) const {
   return detail::local_explain(*impl_->query, impl_->session->runner().coordinator(), impl_->coordinators, address);
