@@ -134,10 +134,11 @@ package: build
 	@ls $(BUILD)/packages/*.deb
 
 # clang-format (check only), the [[nodiscard]] check and clang-tidy over build/compile_commands.json
-# (scripts/lint). LINT=format, LINT=nodiscard or LINT=tidy runs one of them (docs/contributing.md, "Lint").
-LINT ?= all
+# (scripts/lint). LINT_CHECK=format, =nodiscard or =tidy runs one of them (docs/contributing.md, "Lint").
+# (Not LINT: GNU make defines LINT = lint itself.)
+LINT_CHECK ?= all
 lint: build
-	@./scripts/lint --$(LINT) $(BUILD)
+	@./scripts/lint --$(LINT_CHECK) $(BUILD)
 
 clean:
 	rm -rf $(BUILD)
