@@ -75,7 +75,11 @@ int supervisor(const spec::SystemSpec& system, const middleware::IceEndpoint& ic
   options.ice = ice;
   options.keys_dir = keys;
   options.records = !states_only;
-  options.output = [&lines](const middleware::SupervisorLine&) { lines.fetch_add(1, std::memory_order_relaxed); };
+  options.output = [&lines](const middleware::SupervisorLine& line) {
+    lines.fetch_add(1, std::memory_order_relaxed);
+    // Its own notices (refusals, missed records, lost peers) go to the part's log: a failed run says why.
+    if (line.kind() == middleware::SupervisorLine::Kind::Notice) std::fprintf(stderr, "%s\n", line.text().c_str());
+  };
   auto sup = middleware::Supervisor::create(system, options);
   if (!sup || !(*sup)->start()) return 2;
   write_text(out, "r");

@@ -1,23 +1,17 @@
 // explain(): each active condition with its root cause and the path of hops it took (DESIGN §2.6).
 
+#include <fmt/format.h>
+
 #include <algorithm>
-#include <cstdio>
 
 #include "safecass/core/coordinator.hpp"
 
 namespace safecass {
 
 namespace {
-std::string seconds_text(Time t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6f", to_seconds(t));
-  return buf;
-}
-std::string number_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
+// The read model's formats (introspect::json_seconds, introspect::short_number), which sits above core.
+std::string seconds_text(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
+std::string number_text(double v) { return fmt::format("{:g}", v); }
 }  // namespace
 
 std::string to_string(const Explanation& e) {

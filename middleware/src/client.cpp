@@ -203,6 +203,8 @@ public:
       : client_(client), sink_(std::move(sink)), last_(last) {}
 
   void records(wire::Signed batch, const Ice::Current&) override;
+  /// Subscription::catch_up(): the records after the last delivered, from the history.
+  [[nodiscard]] Expected<std::size_t> catch_up();
 
   void stop() {
     std::lock_guard lock(mutex_);
@@ -210,6 +212,10 @@ public:
   }
 
 private:
+  /// Delivers the kept records above last_ and below `below` (0: all); under mutex_. Io when the
+  /// coordinator does not answer.
+  [[nodiscard]] Expected<std::size_t> deliver_kept(std::uint64_t below);
+
   RemoteClient::Impl& client_;
   introspect::RecordSink sink_;
   std::mutex mutex_;  // stopped_ and the sink's calls
@@ -226,6 +232,7 @@ public:
         adapter_(std::move(adapter)),
         topic_(std::move(topic)),
         proxy_(std::move(proxy)) {}
+  [[nodiscard]] Expected<std::size_t> catch_up() override { return follower_->catch_up(); }
   ~RemoteSubscription() override {
     follower_->stop();
     try {
@@ -269,20 +276,10 @@ void Follower::records(wire::Signed batch, const Ice::Current&) {
     if (seq <= last_) continue;  // already delivered (a gap filled from the history had it)
     if (seq > last_ + 1) {
       // A gap: a message was lost or a record was too large for the bus. The coordinator's
-      // history has them; deliver them first, in order.
+      // history has them; deliver them first, in order. (If the coordinator does not answer, the
+      // records after the gap still go out.)
       ++client_.gaps;
-      try {
-        auto missed = entries_from_wire(client_.control->recordsSince(static_cast<long long>(last_), 0), coordinator);
-        if (missed) {
-          for (const introspect::HistoryEntry& e : *missed) {
-            if (e.seq >= seq) break;
-            sink_(e);
-            last_ = e.seq;
-          }
-        }
-      } catch (const Ice::Exception&) {
-        // The coordinator did not answer: the records after the gap still go out.
-      }
+      (void)deliver_kept(seq);
     }
     introspect::HistoryEntry e;
     if (!from_wire(m, e)) {
@@ -292,6 +289,34 @@ void Follower::records(wire::Signed batch, const Ice::Current&) {
     sink_(e);
     last_ = seq;
   }
+}
+
+Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {
+  try {
+    auto kept =
+        entries_from_wire(client_.control->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
+    if (!kept) return tl::unexpected(kept.error());
+    std::size_t n = 0;
+    for (const introspect::HistoryEntry& e : *kept) {
+      if (below != 0 && e.seq >= below) break;
+      if (e.seq <= last_) continue;
+      sink_(e);
+      last_ = e.seq;
+      ++n;
+    }
+    return n;
+  } catch (const Ice::Exception& e) {
+    return fail(ErrorCode::Io,
+                "records: coordinator '" + client_.options.coordinator + "' did not answer (" + e.ice_id() + ")");
+  }
+}
+
+Expected<std::size_t> Follower::catch_up() {
+  std::lock_guard lock(mutex_);
+  if (stopped_) return std::size_t{0};
+  auto n = deliver_kept(0);
+  if (n && *n > 0) ++client_.gaps;
+  return n;
 }
 
 std::string RemoteClient::name() const { return impl_->options.coordinator; }

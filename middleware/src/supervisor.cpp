@@ -44,11 +44,31 @@ struct Supervisor::Impl {
   Coordinator model{"supervisor"};
   std::unique_ptr<Monitor> monitor;
 
+  /// Event records not received between two that were: IceStorm forwards a topic's messages
+  /// without the "ordered" QoS, so a batch can arrive after the next one. A record of an open gap
+  /// is accepted when it comes; what is still missing kReorderGrace after the gap opened is
+  /// reported missed (and forgotten: it is then refused like a replay).
+  struct Gap {
+    std::int64_t first = 0;      ///< first missing seq
+    std::int64_t last = 0;       ///< last missing seq
+    std::int64_t opened_ns = 0;  ///< steady clock
+  };
+  static constexpr std::chrono::milliseconds kReorderGrace{250};
+  static constexpr std::size_t kMaxGaps = 64;  ///< more open gaps than this: the oldest is reported at once
+
   struct Peer {
     std::vector<std::string> components;
     std::int64_t last_heartbeat = 0;
     std::int64_t incarnation = 0;
-    std::int64_t last_event_seq = 0;
+    std::int64_t last_event_seq = 0;  ///< the highest record seq received (or listed when joining)
+    std::vector<Gap> gaps;            ///< below last_event_seq, oldest first
+    /// Where the supervisor joined this incarnation's record stream: at its first heartbeat (which
+    /// lists the last record sent, so a record lost after it is a gap, even the first ones) or at
+    /// its first record, whichever came first. Records up to joined_at were sent before; any still
+    /// on their way are accepted, in order, above before_join.
+    bool joined = false;
+    std::int64_t joined_at = 0;
+    std::int64_t before_join = 0;
     std::int64_t heartbeat_seq = 0;
     bool events_behind = false;  ///< the last heartbeat listed event records not received
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
@@ -136,6 +156,10 @@ struct Supervisor::Impl {
       const bool restart = peer.incarnation != 0;
       peer.incarnation = seen;
       peer.last_event_seq = 0;
+      peer.gaps.clear();
+      peer.joined = false;
+      peer.joined_at = 0;
+      peer.before_join = 0;
       peer.heartbeat_seq = 0;
       peer.state_seq.clear();
       peer.states_behind = false;
@@ -162,6 +186,55 @@ struct Supervisor::Impl {
                                                                            ++resync_seq, who})));
     } catch (const Ice::Exception&) {
       // The link thread notices and reconnects.
+    }
+  }
+
+  /// Records first..last of `peer` did not come: wait kReorderGrace for them (report_gaps()).
+  void open_gap(Peer& peer, const std::string& who, std::int64_t first, std::int64_t last) {
+    if (peer.gaps.size() >= kMaxGaps) {
+      report_missed(peer, who, peer.gaps.front());
+      peer.gaps.erase(peer.gaps.begin());
+    }
+    peer.gaps.push_back(Gap{first, last, steady_ns()});
+  }
+
+  /// A record below the highest received: true when it was missing (it is then no longer), false
+  /// when it was received already or reported missed (a replay or a duplicate).
+  static bool fill_gap(Peer& peer, std::int64_t seq) {
+    for (auto it = peer.gaps.begin(); it != peer.gaps.end(); ++it) {
+      if (seq < it->first || seq > it->last) continue;
+      if (it->first == it->last) {
+        peer.gaps.erase(it);
+      } else if (seq == it->first) {
+        ++it->first;
+      } else if (seq == it->last) {
+        --it->last;
+      } else {
+        const Gap upper{seq + 1, it->last, it->opened_ns};
+        it->last = seq - 1;
+        peer.gaps.insert(std::next(it), upper);
+      }
+      return true;
+    }
+    return false;
+  }
+
+  void report_missed(Peer& peer, const std::string& who, const Gap& gap) {
+    print("supervisor: " + std::to_string(gap.last - gap.first + 1) + " event record(s) of '" + printable(who) +
+          "' missed (seq " + std::to_string(gap.first) +
+          (gap.first == gap.last ? std::string() : ".." + std::to_string(gap.last)) + ")");
+    peer.refresh = true;  // the missed records may have changed rows: read them again
+  }
+
+  /// Reports the gaps still open kReorderGrace after they opened (watch loop).
+  void report_gaps(std::int64_t now) {
+    const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
+    std::lock_guard lock(mutex);
+    for (auto& [name, peer] : peers) {
+      while (!peer.gaps.empty() && now - peer.gaps.front().opened_ns >= grace) {
+        report_missed(peer, name, peer.gaps.front());
+        peer.gaps.erase(peer.gaps.begin());
+      }
     }
   }
 
@@ -203,30 +276,42 @@ struct Supervisor::Impl {
                "an event record of '" + printable(m.coordinator) + "', which is not a coordinator of the system");
         return;
       }
-      if (!fresh(p->second, m.coordinator, m.incarnation, "an event record")) return;
-      if (m.seq <= p->second.last_event_seq) {
-        refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                           " not above " + std::to_string(p->second.last_event_seq) + " (replayed)");
-        return;
+      Peer& peer = p->second;
+      if (!fresh(peer, m.coordinator, m.incarnation, "an event record")) return;
+      if (!peer.joined) {
+        peer.joined = true;
+        peer.joined_at = m.seq - 1;
+        peer.last_event_seq = m.seq;
+      } else if (m.seq <= peer.joined_at && m.seq > peer.before_join) {
+        peer.before_join = m.seq;  // sent before the supervisor joined, still on its way
+      } else if (m.seq <= peer.last_event_seq) {
+        if (!fill_gap(peer, m.seq)) {
+          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                             " not above " + std::to_string(peer.last_event_seq) + " and not missing (replayed)");
+          return;
+        }
+      } else {
+        if (m.seq != peer.last_event_seq + 1) {
+          open_gap(peer, m.coordinator, peer.last_event_seq + 1, m.seq - 1);
+        }
+        peer.last_event_seq = m.seq;
       }
-      if (p->second.last_event_seq != 0 && m.seq != p->second.last_event_seq + 1) {
-        print("supervisor: " + std::to_string(m.seq - p->second.last_event_seq - 1) + " event record(s) of '" +
-              printable(m.coordinator) + "' missed");
-        p->second.refresh = true;  // the missed records may have changed rows: read them again
-      }
-      p->second.last_event_seq = m.seq;
       if (!shown) return;
       if (transition) {
         auto row = view.find(m.address);
         if (row == view.end()) row = view.emplace(m.address, ViewRow{}).first;
         ViewRow& r = row->second;
-        r.coordinator = m.coordinator;  // assignments into the row's own storage: no allocation once sized
-        r.address = m.address;
-        r.state = to;
-        if (to == State::Normal) {
-          r.cause.clear();
-        } else {
-          r.cause.assign(m.rootOrigin).append(":").append(m.rootEvent);
+        // A record that arrived late never takes a row back to an older state.
+        if (r.record_seq < m.seq || r.coordinator != m.coordinator) {
+          r.coordinator = m.coordinator;  // assignments into the row's own storage: no allocation once sized
+          r.address = m.address;
+          r.state = to;
+          r.record_seq = m.seq;
+          if (to == State::Normal) {
+            r.cause.clear();
+          } else {
+            r.cause.assign(m.rootOrigin).append(":").append(m.rootEvent);
+          }
         }
       }
     }
@@ -342,12 +427,14 @@ struct Supervisor::Impl {
       // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
       // records may be on their way on the other topic): reported as missed.
       const auto sent = options.records ? h.lastSeq.find("events") : h.lastSeq.end();
-      if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
+      if (sent != h.lastSeq.end() && !peer.joined) {
+        peer.joined = true;
+        peer.joined_at = sent->second;
+        peer.last_event_seq = sent->second;
+      } else if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
         if (peer.events_behind) {
-          print("supervisor: " + std::to_string(sent->second - peer.last_event_seq) + " event record(s) of '" +
-                h.coordinator + "' missed");
+          report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
           peer.last_event_seq = sent->second;
-          peer.refresh = true;
           peer.events_behind = false;
         } else {
           peer.events_behind = true;
@@ -440,7 +527,7 @@ struct Supervisor::Impl {
           if (it == view.end() && r.state == State::Normal) continue;  // never reported, still Normal
           const std::string cause = r.state == State::Normal ? std::string() : causes[r.address];
           if (it != view.end() && it->second.state == r.state) continue;
-          view[r.address] = ViewRow{name, r.address, r.state, cause};
+          view[r.address] = ViewRow{name, r.address, r.state, cause, peers[name].last_event_seq};
           lines.push_back(
               Changed{r.address, r.state, "refreshed after missed records" + (cause.empty() ? "" : "; root " + cause)});
         }
@@ -452,8 +539,9 @@ struct Supervisor::Impl {
   void watch_loop() {
     while (running.load()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      refresh_missed();
       const std::int64_t now = steady_ns();
+      report_gaps(now);
+      refresh_missed();
       std::vector<std::pair<std::string, std::vector<std::string>>> lost_now;
       {
         std::lock_guard lock(mutex);

@@ -327,6 +327,9 @@ private:
         std::this_thread::sleep_for(std::min<std::chrono::steady_clock::duration>(
             std::chrono::milliseconds(50), until - std::chrono::steady_clock::now()));
       }
+      // The last records of the watch may have been lost on the bus with nothing after them to
+      // reveal the gap: fetch what the stream did not deliver before stopping.
+      if (auto caught = (*sub)->catch_up(); !caught) out.line(caught.error().message);
       sub->reset();  // no record arrives after this
       for (std::string& l : take_captured()) out.line(std::move(l));
     }

@@ -275,12 +275,12 @@ int run_coordinator(const RunArgs& args) {
     o.limits.max_bytes = args.max_bytes;
     o.period = system_options.component_period;
     o.clock = "steady";
-    auto opened = InputRecorder::open(monitor, inputs_path, o);
-    if (!opened) {
-      std::fprintf(stderr, "safecass run: %s\n", opened.error().message.c_str());
+    auto input_recorder = InputRecorder::open(monitor, inputs_path, o);
+    if (!input_recorder) {
+      std::fprintf(stderr, "safecass run: %s\n", input_recorder.error().message.c_str());
       return 2;
     }
-    inputs = std::move(*opened);
+    inputs = std::move(*input_recorder);
     inputs->start_polling();
   }
 

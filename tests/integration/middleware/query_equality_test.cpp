@@ -177,7 +177,9 @@ TEST_P(ConsoleReadCommand, AnswersTheSameInProcessAndRemote) {
     ASSERT_TRUE(remote) << why;
     const tools::ConsoleReply want = local->execute(GetParam().line);
     const tools::ConsoleReply got = remote->execute(GetParam().line);
-    if (!json) EXPECT_FALSE(want.out.empty() && want.err.empty()) << "the command answers something";
+    if (!json) {
+      EXPECT_FALSE(want.out.empty() && want.err.empty()) << "the command answers something";
+    }
     EXPECT_EQ(got.ok, want.ok) << GetParam().line;
     EXPECT_EQ(normalised(got.out, "robot"), normalised(want.out, "robot"))
         << GetParam().line << (json ? " (--json)" : "");
@@ -201,7 +203,7 @@ INSTANTIATE_TEST_SUITE_P(
         ReadCommand{"explain_system", "explain SYSTEM"}, ReadCommand{"explain_machine", "explain JR3.s_A"},
         ReadCommand{"explain_service", "explain CONTROL.s_S.Command"}, ReadCommand{"time", "time"},
         ReadCommand{"unknown_name", "explain NOPE"}),
-    [](const ::testing::TestParamInfo<ReadCommand>& info) { return std::string(info.param.name); });
+    [](const ::testing::TestParamInfo<ReadCommand>& command) { return std::string(command.param.name); });
 
 }  // namespace
 }  // namespace safecass

@@ -127,6 +127,7 @@ struct Bus {
   std::optional<Signer> provider, other, supervisor, attacker;
   // The provider's heartbeat, sent by a thread while `beating`: the last seq of each stream.
   std::map<std::string, std::int64_t> last_sent;
+  std::optional<std::int64_t> events_sent;  ///< the last event record listed, when the heartbeat lists one
   std::atomic<bool> beating{true};
   std::atomic<bool> running{true};
   std::int64_t beat_seq = 0;
@@ -199,6 +200,7 @@ struct Bus {
       h.seq = ++beat_seq;
       if (name == "wire-p") {
         for (const auto& [iface, seq] : last_sent) h.lastSeq["state:" + iface] = seq;
+        if (events_sent) h.lastSeq["events"] = *events_sent;
       }
     }
     heartbeat_pub->beat(key.sign(middleware::detail::kKindHeartbeat, encode(ice.communicator(), h)));
@@ -615,6 +617,132 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   EXPECT_TRUE(eventually([&] { return sup.model().state(*sup.model().find_machine("P.s_F")) == State::Error; }))
       << out.all();
   (*supervisor)->stop();
+}
+
+/// Publishes hand-made event records of 'wire-p' (signed with its key) in the order given:
+/// record `seq` takes P.s_A to Error (odd seq) or back to Normal (even seq).
+struct RecordSender {
+  explicit RecordSender(Bus& bus) : bus_(bus) {
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+        bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
+    std::shared_ptr<IceStorm::TopicPrx> topic;
+    try {
+      topic = manager->retrieve("safecass.events");
+    } catch (const IceStorm::NoSuchTopic&) {
+      topic = manager->create("safecass.events");
+    }
+    // Twoway: each batch is in IceStorm before the next is sent, so the order is the order sent.
+    events_ = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_twoway());
+  }
+
+  void send(const std::vector<std::int64_t>& seqs) {
+    wire::EventMessageSeq batch;
+    for (std::int64_t seq : seqs) batch.push_back(record(seq));
+    events_->records(bus_.provider->sign(middleware::detail::kKindEvents, encode(bus_.ice.communicator(), batch)));
+  }
+
+private:
+  static wire::EventMessage record(std::int64_t seq) {
+    wire::EventMessage m{};
+    m.coordinator = "wire-p";
+    m.incarnation = kIncarnation;
+    m.seq = seq;
+    m.kind = "transition";
+    m.address = "P.s_A";
+    m.machine = "P.s_A";
+    m.component = "P";
+    m.event = seq % 2 == 1 ? "EVT_E" : "/EVT_E";
+    m.from = seq % 2 == 1 ? wire::Level::Normal : wire::Level::Error;
+    m.to = seq % 2 == 1 ? wire::Level::Error : wire::Level::Normal;
+    m.level = m.to;
+    m.rootOrigin = "P.s_A";
+    m.rootEvent = "EVT_E";
+    return m;
+  }
+
+  Bus& bus_;
+  std::shared_ptr<wire::EventTopicPrx> events_;
+};
+
+/// A supervisor with records on, started once 'wire-p' is up (its first heartbeat seen).
+std::unique_ptr<middleware::Supervisor> start_record_supervisor(Bus& bus, SupervisorOutput& out) {
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  EXPECT_TRUE(supervisor) << supervisor.error().message;
+  if (!supervisor || !(*supervisor)->start()) return nullptr;
+  EXPECT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
+      << out.all();
+  return std::move(*supervisor);
+}
+
+TEST(Wire, ASupervisorAcceptsEventRecordsThatArriveLateAndReportsMissedOnlyThoseThatNeverCome) {
+  // IceStorm forwards a topic's messages without ordering them: a batch can overtake the one
+  // before it. A late record is authentic and new: it belongs in the history, it is not "missed"
+  // and not a replay, and it never takes a row of the view back to an older state.
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  const auto supervisor = start_record_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+  RecordSender records(bus);
+
+  records.send({1});
+  records.send({4, 5});  // 2 and 3 overtaken
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << out.all();
+  records.send({2, 3});  // late: 2 would take P.s_A to Normal, but 5 (Error) is newer
+  ASSERT_TRUE(eventually([&] { return out.records >= 5; })) << out.all();
+  std::this_thread::sleep_for(400ms);  // longer than the supervisor's wait for late records
+  EXPECT_EQ(out.records, 5u) << out.all();
+  EXPECT_EQ(sup.messages_refused(), 0u) << out.all();
+  EXPECT_EQ(out.all().find("missed"), std::string::npos) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << out.all();
+
+  // Received once already: a replay, refused.
+  records.send({2});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 1; })) << out.all();
+  EXPECT_NE(out.all().find("seq 2 not above 5 and not missing (replayed)"), std::string::npos) << out.all();
+
+  // 6 and 7 never come: reported missed, once, with their numbers.
+  records.send({8});
+  ASSERT_TRUE(eventually([&] { return out.all().find("missed") != std::string::npos; })) << out.all();
+  EXPECT_NE(out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 6..7)"), std::string::npos)
+      << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << out.all();
+  // Once reported missed, a record that still comes is refused: it was already accounted for.
+  records.send({7});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 2; })) << out.all();
+  EXPECT_EQ(out.records, 6u) << out.all();
+  supervisor->stop();
+}
+
+TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeatListedNoneSent) {
+  // The heartbeat the supervisor saw said no record was sent yet: record 3 arriving first means 1
+  // and 2 were lost (an IceStorm restart just after the coordinator's first records), not that
+  // the supervisor joined the stream at 3.
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.events_sent = 0;
+  }
+  SupervisorOutput out;
+  const auto supervisor = start_record_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  RecordSender records(bus);
+
+  records.send({3});
+  ASSERT_TRUE(eventually([&] { return out.all().find("missed") != std::string::npos; })) << out.all();
+  EXPECT_NE(out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 1..2)"), std::string::npos)
+      << out.all();
+  EXPECT_EQ(out.records, 1u) << out.all();
+  EXPECT_EQ(supervisor->messages_refused(), 0u) << out.all();
+  supervisor->stop();
 }
 
 TEST(Wire, SupervisorLinesAreTheReadModelsLiveLinesTaggedWithTheCoordinatorAndOnOneLine) {

@@ -262,7 +262,9 @@ async function test() {
     'the graph shows PENDANT (ui process) in Error');
   check(await page.locator('#graph .gedge').count() === 4, 'the graph has the four connections of robodoc.json');
   fs.mkdirSync(out, { recursive: true });
-  await page.screenshot({ path: path.join(out, 'viewer_ice.png'), fullPage: true });
+  // A picture for the reader, not a check: a machine too loaded to render it in time says so.
+  await page.screenshot({ path: path.join(out, 'viewer_ice.png'), fullPage: true })
+    .catch((e) => console.log(`note: no screenshot (${e.message.split('\n')[0]})`));
 
   // How late was each transition pushed? The update's clock minus the root transition's time:
   // both the host's monotonic clock (every process of the host shares it).

@@ -95,6 +95,9 @@ struct ViewRow {
   std::string address;
   State state = State::Normal;
   std::string cause;  ///< "origin:event" of the last transition (a service: "origin:event, ..."), empty when Normal
+  /// The coordinator's record that set it (its seq), so that a record arriving late never takes
+  /// the row back to an older state; 0 when a state update set it.
+  std::int64_t record_seq = 0;
 };
 
 class Supervisor {
