@@ -47,11 +47,13 @@ struct Supervisor::Impl {
   /// Event records not received between two that were: IceStorm forwards a topic's messages
   /// without the "ordered" QoS, so a batch can arrive after the next one. A record of an open gap
   /// is accepted when it comes; what is still missing kReorderGrace after the gap opened is
-  /// reported missed (and forgotten: it is then refused like a replay).
+  /// reported missed. A reported record that still comes is accepted too (it is authentic and
+  /// was never received), and said to be late once per reported gap.
   struct Gap {
     std::int64_t first = 0;      ///< first missing seq
     std::int64_t last = 0;       ///< last missing seq
     std::int64_t opened_ns = 0;  ///< steady clock
+    bool late_said = false;      ///< reported gaps: a late record of it was said
   };
   static constexpr std::chrono::milliseconds kReorderGrace{250};
   static constexpr std::size_t kMaxGaps = 64;  ///< more open gaps than this: the oldest is reported at once
@@ -62,6 +64,7 @@ struct Supervisor::Impl {
     std::int64_t incarnation = 0;
     std::int64_t last_event_seq = 0;  ///< the highest record seq received (or listed when joining)
     std::vector<Gap> gaps;            ///< below last_event_seq, oldest first
+    std::vector<Gap> reported;        ///< gaps reported missed (the newest kMaxGaps), oldest first
     /// Where the supervisor joined this incarnation's record stream: at its first heartbeat (which
     /// lists the last record sent, so a record lost after it is a gap, even the first ones) or at
     /// its first record, whichever came first. Records up to joined_at were sent before; any still
@@ -157,6 +160,7 @@ struct Supervisor::Impl {
       peer.incarnation = seen;
       peer.last_event_seq = 0;
       peer.gaps.clear();
+      peer.reported.clear();
       peer.joined = false;
       peer.joined_at = 0;
       peer.before_join = 0;
@@ -198,32 +202,56 @@ struct Supervisor::Impl {
     peer.gaps.push_back(Gap{first, last, steady_ns()});
   }
 
-  /// A record below the highest received: true when it was missing (it is then no longer), false
-  /// when it was received already or reported missed (a replay or a duplicate).
-  static bool fill_gap(Peer& peer, std::int64_t seq) {
-    for (auto it = peer.gaps.begin(); it != peer.gaps.end(); ++it) {
+  static std::string seq_range(const Gap& gap) {
+    return std::to_string(gap.first) + (gap.first == gap.last ? std::string() : ".." + std::to_string(gap.last));
+  }
+
+  /// Takes `seq` out of the gap of `gaps` that holds it; the gap as it was, or nothing when no gap
+  /// holds it.
+  static std::optional<Gap> take(std::vector<Gap>& gaps, std::int64_t seq) {
+    for (auto it = gaps.begin(); it != gaps.end(); ++it) {
       if (seq < it->first || seq > it->last) continue;
+      const Gap was = *it;
       if (it->first == it->last) {
-        peer.gaps.erase(it);
+        gaps.erase(it);
       } else if (seq == it->first) {
         ++it->first;
       } else if (seq == it->last) {
         --it->last;
       } else {
-        const Gap upper{seq + 1, it->last, it->opened_ns};
+        Gap upper = *it;
+        upper.first = seq + 1;
         it->last = seq - 1;
-        peer.gaps.insert(std::next(it), upper);
+        gaps.insert(std::next(it), upper);
       }
-      return true;
+      return was;
     }
-    return false;
+    return std::nullopt;
+  }
+
+  /// A record below the highest received: true when it was never received (it fills an open gap,
+  /// or arrives after its gap was reported missed, which is said once per gap), false when it was
+  /// received already (a replay or a duplicate).
+  bool fill_gap(Peer& peer, const std::string& who, std::int64_t seq) {
+    if (take(peer.gaps, seq)) return true;
+    const auto reported = take(peer.reported, seq);
+    if (!reported) return false;
+    if (!reported->late_said) {
+      print("supervisor: event record(s) of '" + printable(who) + "' reported missed (seq " + seq_range(*reported) +
+            ") arrive late; accepted");
+      for (Gap& g : peer.reported) {
+        if (g.first >= reported->first && g.last <= reported->last) g.late_said = true;
+      }
+    }
+    return true;
   }
 
   void report_missed(Peer& peer, const std::string& who, const Gap& gap) {
     print("supervisor: " + std::to_string(gap.last - gap.first + 1) + " event record(s) of '" + printable(who) +
-          "' missed (seq " + std::to_string(gap.first) +
-          (gap.first == gap.last ? std::string() : ".." + std::to_string(gap.last)) + ")");
+          "' missed (seq " + seq_range(gap) + ")");
     peer.refresh = true;  // the missed records may have changed rows: read them again
+    if (peer.reported.size() >= kMaxGaps) peer.reported.erase(peer.reported.begin());
+    peer.reported.push_back(gap);
   }
 
   /// Reports the gaps still open kReorderGrace after they opened (watch loop).
@@ -285,9 +313,9 @@ struct Supervisor::Impl {
       } else if (m.seq <= peer.joined_at && m.seq > peer.before_join) {
         peer.before_join = m.seq;  // sent before the supervisor joined, still on its way
       } else if (m.seq <= peer.last_event_seq) {
-        if (!fill_gap(peer, m.seq)) {
+        if (!fill_gap(peer, m.coordinator, m.seq)) {
           refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                             " not above " + std::to_string(peer.last_event_seq) + " and not missing (replayed)");
+                             " not above " + std::to_string(peer.last_event_seq) + " and received already (replayed)");
           return;
         }
       } else {
