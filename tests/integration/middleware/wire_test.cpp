@@ -148,15 +148,6 @@ struct Bus {
     EXPECT_TRUE(middleware::connect_remote_providers(*load.system, "wire-c", co));
     for (const char* d : {"P.D0", "P.D1", "P.D2", "P.D3"}) last_sent[d] = 0;
 
-    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-        ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
-    auto topic = [&](const std::string& name) {
-      try {
-        return manager->retrieve(name);
-      } catch (const IceStorm::NoSuchTopic&) {
-        return manager->create(name);
-      }
-    };
     state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(topic("safecass.state.wire-p")->getPublisher()->ice_oneway());
     heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(topic("safecass.heartbeat")->getPublisher());
     beat_thread = std::thread([this] {
@@ -185,6 +176,17 @@ struct Bus {
     running.store(false);
     if (beat_thread.joinable()) beat_thread.join();
     if (node) node->stop();
+  }
+
+  /// The IceStorm topic `name` of the fixture (created when it does not exist yet).
+  std::shared_ptr<IceStorm::TopicPrx> topic(const std::string& name) const {
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+        ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
+    try {
+      return manager->retrieve(name);
+    } catch (const IceStorm::NoSuchTopic&) {
+      return manager->create(name);
+    }
   }
 
   /// A heartbeat of `name` signed by `key`, listing the streams' last numbers.
@@ -440,14 +442,7 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   EXPECT_EQ((*supervisor)->lost(), std::vector<std::string>{"wire-p"});
 
   // A forged event record cannot add a line; a genuine one with a newline in it stays on one line.
-  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
-  std::shared_ptr<IceStorm::TopicPrx> topic;
-  try {
-    topic = manager->retrieve("safecass.events");
-  } catch (const IceStorm::NoSuchTopic&) {
-    topic = manager->create("safecass.events");
-  }
+  const auto topic = bus.topic("safecass.events");
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
   auto record = [](std::int64_t seq, const std::string& kind, const std::string& address, const std::string& text) {
     wire::EventMessage m{};  // every field set: an indeterminate bool is undefined behaviour (UBSan)
@@ -580,14 +575,7 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   EXPECT_EQ(view_state(sup, "P.s_S.D1"), State::Error);
 
   // Event records are not followed: a genuine reset record prints nothing.
-  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
-  std::shared_ptr<IceStorm::TopicPrx> topic;
-  try {
-    topic = manager->retrieve("safecass.events");
-  } catch (const IceStorm::NoSuchTopic&) {
-    topic = manager->create("safecass.events");
-  }
+  const auto topic = bus.topic("safecass.events");
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
   wire::EventMessage m{};
   m.coordinator = "wire-p";
@@ -623,14 +611,7 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
 /// record `seq` takes P.s_A to Error (odd seq) or back to Normal (even seq).
 struct RecordSender {
   explicit RecordSender(Bus& bus) : bus_(bus) {
-    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-        bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
-    std::shared_ptr<IceStorm::TopicPrx> topic;
-    try {
-      topic = manager->retrieve("safecass.events");
-    } catch (const IceStorm::NoSuchTopic&) {
-      topic = manager->create("safecass.events");
-    }
+    const auto topic = bus.topic("safecass.events");
     // Twoway: each batch is in IceStorm before the next is sent, so the order is the order sent.
     events_ = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_twoway());
   }
@@ -809,14 +790,7 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
   ASSERT_TRUE(eventually([&] { return (*node)->stats().connected; }, 10000ms));
   std::this_thread::sleep_for(500ms);  // start-up republishes done
 
-  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-      bus.ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port));
-  std::shared_ptr<IceStorm::TopicPrx> topic;
-  try {
-    topic = manager->retrieve("safecass.resync");
-  } catch (const IceStorm::NoSuchTopic&) {
-    topic = manager->create("safecass.resync");
-  }
+  const auto topic = bus.topic("safecass.resync");
   auto resync = Ice::uncheckedCast<wire::ResyncTopicPrx>(topic->getPublisher());
   const auto before = (*node)->stats().updates_published;
   const auto start = std::chrono::steady_clock::now();
