@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -137,6 +138,9 @@ struct TwoProcesses {
 
   std::string token_file() const { return p.scratch + "/" + tag + "-robot.token"; }
   void start_robot() {
+    // A token file left by an earlier run (a process killed before it could remove it) must not be
+    // read as this robot's.
+    std::remove(token_file().c_str());
     robot = std::make_unique<Process>(
         std::vector<std::string>{p.bin, "run", p.system, "--coordinator", "robot", "--scenario", p.feed, "--ice", ice,
                                  "--allow-write", "--token-file", token_file(), "--duration", "40"},

@@ -308,6 +308,20 @@ async function test() {
     return el !== null && el.getAttribute('data-state') === 'Normal';
   }), cleared, { timeout: 5000 }).catch(() => {});
   for (const a of cleared) check(await stateOf(page, a) === 'Normal', `${a} is Normal again`);
+  const late = [];
+  for (const a of cleared) if (await stateOf(page, a) !== 'Normal') late.push(a);
+  if (late.length > 0) {
+    // What the coordinators say now, and whether the page catches up later: what a failure needs.
+    for (const who of ['robot', 'ui']) {
+      const rows = await run(safecass, ['console', '--ice', ice, '--coordinator', who, '-c', 'state list']);
+      console.log(`--- ${who} state list, 5 s after the write (exit ${rows.code}):\n${rows.stdout}${rows.stderr}`);
+    }
+    const since = Date.now();
+    const caught = await page.waitForFunction((addresses) => addresses.every((a) =>
+      document.querySelector(`[data-address="${a}"]`)?.getAttribute('data-state') === 'Normal'), late, { timeout: 15000 })
+      .then(() => true).catch(() => false);
+    console.log(`--- the page showed ${late.join(', ')} Normal ${caught ? `${Date.now() - since} ms later` : 'not even 15 s later'}`);
+  }
 
   // ui stops: the page shows it lost.
   await stopPid(ui.pid);
