@@ -734,6 +734,35 @@ TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeat
   supervisor->stop();
 }
 
+TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
+  // The first heartbeat the supervisor saw listed 5 records sent: 4 and 5 may still be on the
+  // events topic. They are authentic and new to it: accepted, in order, neither missed nor
+  // replays; once received, a second copy is a replay.
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.events_sent = 5;
+  }
+  SupervisorOutput out;
+  const auto supervisor = start_record_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  RecordSender records(bus);
+
+  records.send({4, 5});
+  records.send({6});
+  ASSERT_TRUE(eventually([&] { return out.records == 3u; })) << out.all();
+  std::this_thread::sleep_for(400ms);  // longer than the supervisor's wait for late records
+  EXPECT_EQ(out.all().find("missed"), std::string::npos) << out.all();
+  EXPECT_EQ(supervisor->messages_refused(), 0u) << out.all();
+  EXPECT_EQ(view_state(*supervisor, "P.s_A"), State::Normal) << out.all();  // 6: back to Normal
+  records.send({5});
+  ASSERT_TRUE(eventually([&] { return supervisor->messages_refused() == 1u; })) << out.all();
+  EXPECT_EQ(out.records, 3u) << out.all();
+  supervisor->stop();
+}
+
 TEST(Wire, SupervisorLinesAreTheReadModelsLiveLinesTaggedWithTheCoordinatorAndOnOneLine) {
   introspect::HistoryEntry e;
   e.kind = RecordKind::Transition;

@@ -150,9 +150,9 @@ struct MiddlewareSource::Impl {
   }
 
   /// The thread of one coordinator: connect, follow its pushed records, and fetch its state list
-  /// once when it answers and again after each batch of records (never on a timer). Every
-  /// `retry` without records it asks for the records after the last one pushed: that checks
-  /// that the coordinator still answers and delivers a lost record that no later one revealed.
+  /// once when it answers and again after each batch of records. Every `retry` without records it
+  /// asks for the records after the last one pushed (that checks that the coordinator still
+  /// answers and delivers a lost record that no later one revealed) and fetches the list again.
   void follow(MiddlewareLink& l) {
     std::unique_ptr<RemoteClient> reader;
     std::unique_ptr<introspect::Subscription> records;

@@ -8,11 +8,12 @@
 /// heartbeat on IceStorm) and follows the records the coordinator pushes on the events topic
 /// (RemoteClient::follow: signed, in order, gaps filled from its history by sequence number), so
 /// every transition reaches the page, however short; it fetches the coordinator's state list
-/// (the read model's rows) when it first answers and again after each batch of records, never on a
-/// timer. The server thread takes the records in poll(), which never waits on the network. Every
-/// `retry` without records the thread asks the coordinator for the records after the last one
-/// pushed (Subscription::catch_up): that checks that it still answers, and a record lost on the
-/// bus with no later one to reveal the gap still reaches the page within `retry`. A coordinator
+/// (the read model's rows) when it first answers and again after each batch of records. The
+/// server thread takes the records in poll(), which never waits on the network. Every `retry`
+/// without records the thread asks the coordinator for the records after the last one pushed
+/// (Subscription::catch_up: that checks that it still answers, and a record lost on the bus with
+/// no later one to reveal the gap still reaches the page within `retry`) and fetches the state
+/// list again. A coordinator
 /// that does not answer is shown with the status "unreachable" (never
 /// answered) or "lost" (answered before), keeps its last known states, and is tried again every
 /// `retry`. Clicking a state (explain) and the write operations go to the coordinator that owns
