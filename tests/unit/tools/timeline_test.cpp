@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
@@ -55,9 +57,12 @@ std::string script_data(const std::string& page, const std::string& id) {
   return page.substr(begin + open.size(), end - begin - open.size());
 }
 
+/// A directory of this test's own: ctest runs each case as its own process, several at once, and
+/// a case removes its directory when it ends.
 std::filesystem::path temp_dir() {
+  const ::testing::TestInfo* test = ::testing::UnitTest::GetInstance()->current_test_info();
   const auto dir = std::filesystem::temp_directory_path() /
-                   ("safecass_timeline_test_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+                   ("safecass_timeline_test_" + std::to_string(::getpid()) + "_" + test->name());
   std::filesystem::create_directories(dir);
   return dir;
 }
