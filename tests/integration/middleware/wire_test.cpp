@@ -645,8 +645,14 @@ private:
   std::shared_ptr<wire::EventTopicPrx> events_;
 };
 
-/// A supervisor with records on, started once 'wire-p' is up (its first heartbeat seen).
-std::unique_ptr<middleware::Supervisor> start_record_supervisor(Bus& bus, SupervisorOutput& out) {
+/// A supervisor with records on, started once 'wire-p' is up (its first heartbeat seen). With
+/// `events_sent`, wire-p's heartbeats list that many event records sent.
+std::unique_ptr<middleware::Supervisor> start_record_supervisor(Bus& bus, SupervisorOutput& out,
+                                                                std::optional<std::int64_t> events_sent = {}) {
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.events_sent = events_sent;
+  }
   middleware::SupervisorOptions options;
   options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
   options.keys_dir = bus.keys;
@@ -716,12 +722,8 @@ TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeat
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
-  {
-    std::lock_guard lock(bus.mutex);
-    bus.events_sent = 0;
-  }
   SupervisorOutput out;
-  const auto supervisor = start_record_supervisor(bus, out);
+  const auto supervisor = start_record_supervisor(bus, out, 0);
   ASSERT_TRUE(supervisor);
   RecordSender records(bus);
 
@@ -741,12 +743,8 @@ TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
-  {
-    std::lock_guard lock(bus.mutex);
-    bus.events_sent = 5;
-  }
   SupervisorOutput out;
-  const auto supervisor = start_record_supervisor(bus, out);
+  const auto supervisor = start_record_supervisor(bus, out, 5);
   ASSERT_TRUE(supervisor);
   RecordSender records(bus);
 
