@@ -103,6 +103,7 @@ struct Supervisor::Impl {
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
   introspect::HistoryEntry record_scratch;
+  std::string late_note;  ///< dispatch thread: the note of a record printed late
   std::string address_scratch;
   std::string note_scratch;
 
@@ -296,6 +297,7 @@ struct Supervisor::Impl {
         (entry.kind == RecordKind::Transition ? entry.machine : entry.component) = m.address;
       }
     }
+    bool late = false;  // below a record received before it: printed as late
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(m.coordinator);
@@ -313,6 +315,7 @@ struct Supervisor::Impl {
       } else if (m.seq <= peer.joined_at && m.seq > peer.before_join) {
         peer.before_join = m.seq;  // sent before the supervisor joined, still on its way
       } else if (m.seq <= peer.last_event_seq) {
+        late = true;  // it fills a gap below a record received before it
         if (!fill_gap(peer, m.coordinator, m.seq)) {
           refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
                              " not above " + std::to_string(peer.last_event_seq) + " and received already (replayed)");
@@ -343,7 +346,10 @@ struct Supervisor::Impl {
         }
       }
     }
-    emit(SupervisorLine::of_record(m.coordinator, entry));
+    if (late) {
+      late_note.assign("late: seq ").append(std::to_string(m.seq)).append(" arrived after newer records");
+    }
+    emit(SupervisorLine::of_record(m.coordinator, entry, late ? std::string_view(late_note) : std::string_view()));
   }
 
   void on_updates(const wire::Signed& signed_batch) {
@@ -685,12 +691,13 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   return std::unique_ptr<Supervisor>(new Supervisor(std::move(impl)));
 }
 
-SupervisorLine SupervisorLine::of_record(std::string_view coordinator,
-                                         const introspect::HistoryEntry& record) noexcept {
+SupervisorLine SupervisorLine::of_record(std::string_view coordinator, const introspect::HistoryEntry& record,
+                                         std::string_view note) noexcept {
   SupervisorLine l;
   l.kind_ = Kind::Record;
   l.coordinator_ = coordinator;
   l.record_ = &record;
+  l.note_ = note;
   return l;
 }
 
@@ -714,9 +721,12 @@ SupervisorLine SupervisorLine::notice(std::string_view text) noexcept {
 
 std::string SupervisorLine::text() const {
   switch (kind_) {
-    case Kind::Record:
-      if (coordinator_.empty()) return printable("supervisor: " + introspect::live_line(*record_));
-      return printable("[" + std::string(coordinator_) + "] " + introspect::live_line(*record_));
+    case Kind::Record: {
+      std::string line = coordinator_.empty() ? "supervisor: " : "[" + std::string(coordinator_) + "] ";
+      line += introspect::live_line(*record_);
+      if (!note_.empty()) line.append(" (").append(note_).append(")");
+      return printable(line);
+    }
     case Kind::State:
       return printable("[" + std::string(coordinator_) + "] " + introspect::live_state_line(address_, state_, note_));
     case Kind::Notice: break;

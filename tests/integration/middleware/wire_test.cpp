@@ -688,6 +688,10 @@ TEST(Wire, ASupervisorAcceptsEventRecordsThatArriveLateAndReportsMissedThoseThat
   EXPECT_EQ(sup.messages_refused(), 0u) << out.all();
   EXPECT_EQ(out.all().find("missed"), std::string::npos) << out.all();
   EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << out.all();
+  // Printed after newer ones, each late record says so; the others do not.
+  EXPECT_NE(out.all().find("/EVT_E (late: seq 2 arrived after newer records)"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("EVT_E (late: seq 3 arrived after newer records)"), std::string::npos) << out.all();
+  EXPECT_EQ(out.all().find("seq 4 arrived"), std::string::npos) << out.all();
 
   // Received once already: a replay, refused.
   records.send({2});
@@ -707,6 +711,7 @@ TEST(Wire, ASupervisorAcceptsEventRecordsThatArriveLateAndReportsMissedThoseThat
   EXPECT_NE(out.all().find("supervisor: event record(s) of 'wire-p' reported missed (seq 6..7) arrive late; accepted"),
             std::string::npos)
       << out.all();
+  EXPECT_NE(out.all().find("(late: seq 7 arrived after newer records)"), std::string::npos) << out.all();
   EXPECT_EQ(sup.messages_refused(), 1u) << out.all();
   EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << out.all();
   records.send({7});

@@ -63,8 +63,10 @@ public:
     Notice,  ///< the supervisor's own notices: connected, up, lost, recovered, missed, refused
   };
   /// "[COORDINATOR] " + introspect::live_line(record), or "supervisor: " + it for the supervisor's
-  /// own model (coordinator empty).
-  static SupervisorLine of_record(std::string_view coordinator, const introspect::HistoryEntry& record) noexcept;
+  /// own model (coordinator empty); with a note, " (NOTE)" after it (a record that arrived after
+  /// newer ones says so).
+  static SupervisorLine of_record(std::string_view coordinator, const introspect::HistoryEntry& record,
+                                  std::string_view note = {}) noexcept;
   /// "[COORDINATOR] " + introspect::live_state_line(address, state, note).
   static SupervisorLine of_state(std::string_view coordinator, std::string_view address, State state,
                                  std::string_view note) noexcept;
