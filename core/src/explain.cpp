@@ -9,7 +9,8 @@
 namespace safecass {
 
 namespace {
-// The read model's formats (introspect::json_seconds, introspect::short_number), which sits above core.
+// The formats of the read model's introspect::json_seconds and short_number (introspect sits above
+// core, so they cannot be called from here).
 std::string seconds_text(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
 std::string number_text(double v) { return fmt::format("{:g}", v); }
 }  // namespace

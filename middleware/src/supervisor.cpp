@@ -556,12 +556,13 @@ struct Supervisor::Impl {
       std::vector<Changed> lines;
       {
         std::lock_guard lock(mutex);
+        const std::int64_t record_seq = peers.at(name).last_event_seq;  // the rows are as of this record
         for (const introspect::StateRow& r : rows) {
           const auto it = view.find(r.address);
           if (it == view.end() && r.state == State::Normal) continue;  // never reported, still Normal
           const std::string cause = r.state == State::Normal ? std::string() : causes[r.address];
           if (it != view.end() && it->second.state == r.state) continue;
-          view[r.address] = ViewRow{name, r.address, r.state, cause, peers[name].last_event_seq};
+          view[r.address] = ViewRow{name, r.address, r.state, cause, record_seq};
           lines.push_back(
               Changed{r.address, r.state, "refreshed after missed records" + (cause.empty() ? "" : "; root " + cause)});
         }

@@ -665,59 +665,72 @@ std::unique_ptr<middleware::Supervisor> start_record_supervisor(Bus& bus, Superv
   return std::move(*supervisor);
 }
 
+/// wire-p's bus with a supervisor following its records (started once wire-p is up) and a sender
+/// of hand-made records. With `events_sent`, wire-p's heartbeats list that many records sent.
+struct RecordedBus {
+  Bus bus;
+  SupervisorOutput out;
+  std::unique_ptr<middleware::Supervisor> supervisor;
+  RecordSender records{bus};
+  explicit RecordedBus(std::optional<std::int64_t> events_sent = {})
+      : supervisor(start_record_supervisor(bus, out, events_sent)) {}
+  RecordedBus(const RecordedBus&) = delete;
+  RecordedBus& operator=(const RecordedBus&) = delete;
+  ~RecordedBus() {
+    if (supervisor) supervisor->stop();
+  }
+};
+
 TEST(Wire, ASupervisorAcceptsEventRecordsThatArriveLateAndReportsMissedThoseThatDoNotComeInTime) {
   // IceStorm forwards a topic's messages without ordering them: a batch can overtake the one
   // before it. A late record is authentic and new: it belongs in the history, it is not "missed"
   // and not a replay, and it never takes a row of the view back to an older state.
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
-  Bus bus;
-  ASSERT_TRUE(bus.node);
-  SupervisorOutput out;
-  const auto supervisor = start_record_supervisor(bus, out);
-  ASSERT_TRUE(supervisor);
-  const middleware::Supervisor& sup = *supervisor;
-  RecordSender records(bus);
+  RecordedBus r;
+  ASSERT_TRUE(r.bus.node);
+  ASSERT_TRUE(r.supervisor);
+  const middleware::Supervisor& sup = *r.supervisor;
 
-  records.send({1});
-  records.send({4, 5});  // 2 and 3 overtaken
-  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << out.all();
-  records.send({2, 3});  // late: 2 would take P.s_A to Normal, but 5 (Error) is newer
-  ASSERT_TRUE(eventually([&] { return out.records >= 5; })) << out.all();
+  r.records.send({1});
+  r.records.send({4, 5});  // 2 and 3 overtaken
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << r.out.all();
+  r.records.send({2, 3});  // late: 2 would take P.s_A to Normal, but 5 (Error) is newer
+  ASSERT_TRUE(eventually([&] { return r.out.records >= 5; })) << r.out.all();
   std::this_thread::sleep_for(400ms);  // longer than the supervisor's wait for late records
-  EXPECT_EQ(out.records, 5u) << out.all();
-  EXPECT_EQ(sup.messages_refused(), 0u) << out.all();
-  EXPECT_EQ(out.all().find("missed"), std::string::npos) << out.all();
-  EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << out.all();
+  EXPECT_EQ(r.out.records, 5u) << r.out.all();
+  EXPECT_EQ(sup.messages_refused(), 0u) << r.out.all();
+  EXPECT_EQ(r.out.all().find("missed"), std::string::npos) << r.out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << r.out.all();
   // Printed after newer ones, each late record says so; the others do not.
-  EXPECT_NE(out.all().find("/EVT_E (late: seq 2 arrived after newer records)"), std::string::npos) << out.all();
-  EXPECT_NE(out.all().find("EVT_E (late: seq 3 arrived after newer records)"), std::string::npos) << out.all();
-  EXPECT_EQ(out.all().find("seq 4 arrived"), std::string::npos) << out.all();
+  EXPECT_NE(r.out.all().find("/EVT_E (late: seq 2 arrived after newer records)"), std::string::npos) << r.out.all();
+  EXPECT_NE(r.out.all().find("EVT_E (late: seq 3 arrived after newer records)"), std::string::npos) << r.out.all();
+  EXPECT_EQ(r.out.all().find("seq 4 arrived"), std::string::npos) << r.out.all();
 
   // Received once already: a replay, refused.
-  records.send({2});
-  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 1; })) << out.all();
-  EXPECT_NE(out.all().find("seq 2 not above 5 and received already (replayed)"), std::string::npos) << out.all();
+  r.records.send({2});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 1; })) << r.out.all();
+  EXPECT_NE(r.out.all().find("seq 2 not above 5 and received already (replayed)"), std::string::npos) << r.out.all();
 
   // 6 and 7 never come: reported missed, once, with their numbers.
-  records.send({8});
-  ASSERT_TRUE(eventually([&] { return out.all().find("missed") != std::string::npos; })) << out.all();
-  EXPECT_NE(out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 6..7)"), std::string::npos)
-      << out.all();
-  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << out.all();
+  r.records.send({8});
+  ASSERT_TRUE(eventually([&] { return r.out.all().find("missed") != std::string::npos; })) << r.out.all();
+  EXPECT_NE(r.out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 6..7)"), std::string::npos)
+      << r.out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << r.out.all();
   // Reported missed, then it comes after all: authentic and never received, so accepted, and said
   // to be late; the view keeps the newer state of 8. Once received, it is a replay like any other.
-  records.send({7});
-  ASSERT_TRUE(eventually([&] { return out.records == 7u; })) << out.all();
-  EXPECT_NE(out.all().find("supervisor: event record(s) of 'wire-p' reported missed (seq 6..7) arrive late; accepted"),
-            std::string::npos)
-      << out.all();
-  EXPECT_NE(out.all().find("(late: seq 7 arrived after newer records)"), std::string::npos) << out.all();
-  EXPECT_EQ(sup.messages_refused(), 1u) << out.all();
-  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << out.all();
-  records.send({7});
-  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 2; })) << out.all();
-  EXPECT_EQ(out.records, 7u) << out.all();
-  supervisor->stop();
+  r.records.send({7});
+  ASSERT_TRUE(eventually([&] { return r.out.records == 7u; })) << r.out.all();
+  EXPECT_NE(
+      r.out.all().find("supervisor: event record(s) of 'wire-p' reported missed (seq 6..7) arrive late; accepted"),
+      std::string::npos)
+      << r.out.all();
+  EXPECT_NE(r.out.all().find("(late: seq 7 arrived after newer records)"), std::string::npos) << r.out.all();
+  EXPECT_EQ(sup.messages_refused(), 1u) << r.out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << r.out.all();
+  r.records.send({7});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 2; })) << r.out.all();
+  EXPECT_EQ(r.out.records, 7u) << r.out.all();
 }
 
 TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeatListedNoneSent) {
@@ -725,20 +738,17 @@ TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeat
   // and 2 were lost (an IceStorm restart just after the coordinator's first records), not that
   // the supervisor joined the stream at 3.
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
-  Bus bus;
-  ASSERT_TRUE(bus.node);
-  SupervisorOutput out;
-  const auto supervisor = start_record_supervisor(bus, out, 0);
-  ASSERT_TRUE(supervisor);
-  RecordSender records(bus);
+  RecordedBus r(0);
+  ASSERT_TRUE(r.bus.node);
+  ASSERT_TRUE(r.supervisor);
+  const middleware::Supervisor& sup = *r.supervisor;
 
-  records.send({3});
-  ASSERT_TRUE(eventually([&] { return out.all().find("missed") != std::string::npos; })) << out.all();
-  EXPECT_NE(out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 1..2)"), std::string::npos)
-      << out.all();
-  EXPECT_EQ(out.records, 1u) << out.all();
-  EXPECT_EQ(supervisor->messages_refused(), 0u) << out.all();
-  supervisor->stop();
+  r.records.send({3});
+  ASSERT_TRUE(eventually([&] { return r.out.all().find("missed") != std::string::npos; })) << r.out.all();
+  EXPECT_NE(r.out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 1..2)"), std::string::npos)
+      << r.out.all();
+  EXPECT_EQ(r.out.records, 1u) << r.out.all();
+  EXPECT_EQ(sup.messages_refused(), 0u) << r.out.all();
 }
 
 TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
@@ -746,24 +756,21 @@ TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
   // events topic. They are authentic and new to it: accepted, in order, neither missed nor
   // replays; once received, a second copy is a replay.
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
-  Bus bus;
-  ASSERT_TRUE(bus.node);
-  SupervisorOutput out;
-  const auto supervisor = start_record_supervisor(bus, out, 5);
-  ASSERT_TRUE(supervisor);
-  RecordSender records(bus);
+  RecordedBus r(5);
+  ASSERT_TRUE(r.bus.node);
+  ASSERT_TRUE(r.supervisor);
+  const middleware::Supervisor& sup = *r.supervisor;
 
-  records.send({4, 5});
-  records.send({6});
-  ASSERT_TRUE(eventually([&] { return out.records == 3u; })) << out.all();
+  r.records.send({4, 5});
+  r.records.send({6});
+  ASSERT_TRUE(eventually([&] { return r.out.records == 3u; })) << r.out.all();
   std::this_thread::sleep_for(400ms);  // longer than the supervisor's wait for late records
-  EXPECT_EQ(out.all().find("missed"), std::string::npos) << out.all();
-  EXPECT_EQ(supervisor->messages_refused(), 0u) << out.all();
-  EXPECT_EQ(view_state(*supervisor, "P.s_A"), State::Normal) << out.all();  // 6: back to Normal
-  records.send({5});
-  ASSERT_TRUE(eventually([&] { return supervisor->messages_refused() == 1u; })) << out.all();
-  EXPECT_EQ(out.records, 3u) << out.all();
-  supervisor->stop();
+  EXPECT_EQ(r.out.all().find("missed"), std::string::npos) << r.out.all();
+  EXPECT_EQ(sup.messages_refused(), 0u) << r.out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << r.out.all();  // 6: back to Normal
+  r.records.send({5});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 1u; })) << r.out.all();
+  EXPECT_EQ(r.out.records, 3u) << r.out.all();
 }
 
 TEST(Wire, SupervisorLinesAreTheReadModelsLiveLinesTaggedWithTheCoordinatorAndOnOneLine) {
