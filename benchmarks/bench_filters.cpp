@@ -89,5 +89,33 @@ void BM_MonitorTick(benchmark::State& state) {
 }
 BENCHMARK(BM_MonitorTick)->Arg(1000);
 
+// One cycle of the control loop of `make bench-peers` item 4, without its real-time wait: N
+// signals each get a new sample, then the component's ACTIVE filters run (a Threshold, a
+// Watchdog and a MovingAverage per signal); no event. Its time per iteration over the 1 ms
+// period is the CPU share of detection that the filters and signals cost, without the loop's
+// sleep and wake-up (peer_detection measures those too, in real time).
+void BM_DetectionCycle(benchmark::State& state) {
+  FilterBench b;
+  const auto n = static_cast<int>(state.range(0));
+  std::vector<Signal*> signals;
+  for (int i = 0; i < n; ++i) {
+    const std::string s = "s" + std::to_string(i);
+    signals.push_back(*b.monitor.add_signal("C." + s));
+    b.add("Threshold",
+          {{"input_signal", s}, {"threshold", 10.0}, {"hysteresis", 1.0}, {"event_onset", std::string("EVT_X")}});
+    b.add("Watchdog", {{"input_signal", s}, {"timeout", 0.05}});
+    b.add("MovingAverage", {{"input_signal", s}, {"window", 10.0}, {"output_signal", s + "_mean"}});
+  }
+  std::int64_t t = 0;
+  for (auto _ : state) {
+    t += 1'000'000;  // 1 ms
+    for (Signal* s : signals) s->push(Time{t}, 1.0);
+    b.monitor.run_active(b.component, Time{t});
+  }
+  state.SetItemsProcessed(state.iterations() * n * 3);
+  if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
+}
+BENCHMARK(BM_DetectionCycle)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
 }  // namespace safecass

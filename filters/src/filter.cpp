@@ -5,31 +5,34 @@
 
 namespace safecass {
 
-Filter::Filter(FilterInit init)
-    : config_(std::move(init.config)),
-      coordinator_(init.coordinator),
-      target_(init.target),
-      component_(init.component),
-      inputs_(std::move(init.inputs)),
-      outputs_(std::move(init.outputs)),
-      onset_(init.onset),
-      completion_(init.completion),
-      name_id_(init.name_id) {
+Filter::Filter(FilterInit init) : cold_(std::make_unique<Cold>()) {
+  Cold& c = *cold_;
+  c.config = std::move(init.config);
+  c.coordinator = init.coordinator;
+  c.target = init.target;
+  c.component = init.component;
+  c.onset = init.onset;
+  c.completion = init.completion;
+  c.name_id = init.name_id;
+  c.inputs = std::move(init.inputs);
+  c.outputs = std::move(init.outputs);
   detour_.store(
-      static_cast<std::uint8_t>((config_.enabled ? 0 : kDisabled) | (inputs_.size() == 1 ? 0 : kSeveralInputs)));
-  cursors_.reserve(inputs_.size());
-  for (Signal* s : inputs_) {
-    cursors_.emplace_back(s);
-    cursors_.back().skip_to_end();
-  }
-  invalid_.assign(inputs_.size(), 0);
-  pending_.resize(inputs_.size());
-  has_pending_.assign(inputs_.size(), 0);
+      static_cast<std::uint8_t>((c.config.enabled ? 0 : kDisabled) | (c.inputs.size() == 1 ? 0 : kSeveralInputs)));
+  if (!c.outputs.empty()) output0_ = c.outputs[0];
+  if (!c.inputs.empty()) first_ = SignalCursor(c.inputs[0]);
+  c.more_cursors.reserve(c.inputs.size() > 1 ? c.inputs.size() - 1 : 0);
+  for (std::size_t i = 1; i < c.inputs.size(); ++i) c.more_cursors.emplace_back(c.inputs[i]);
+  for (std::size_t i = 0; i < c.inputs.size(); ++i) cursor(i).skip_to_end();
+  c.invalid.assign(c.inputs.size(), 0);
+  c.pending.resize(c.inputs.size());
+  c.has_pending.assign(c.inputs.size(), 0);
 }
+
+Filter::~Filter() = default;
 
 std::uint64_t Filter::missed_samples() const noexcept {
   std::uint64_t n = 0;
-  for (const SignalCursor& c : cursors_) n += c.missed();
+  for (std::size_t i = 0; i < cold_->inputs.size(); ++i) n += cursor(i).missed();
   return n;
 }
 
@@ -40,7 +43,7 @@ void Filter::run_general(Time now) noexcept {
     return;
   }
   if ((detour & kReenabled) != 0) {
-    for (SignalCursor& c : cursors_) c.skip_to_end();
+    for (std::size_t i = 0; i < cold_->inputs.size(); ++i) cursor(i).skip_to_end();
     detour_.fetch_and(static_cast<std::uint8_t>(~kReenabled), std::memory_order_acq_rel);
   }
   const bool injected_run = (detour & kInjection) != 0 && run_injection(now);
@@ -48,17 +51,17 @@ void Filter::run_general(Time now) noexcept {
   // reality, so its end restores reality even when the real signal has not changed since.
   const bool restore = !injected_run && (detour & kRestore) != 0;
   if (restore) detour_.fetch_and(static_cast<std::uint8_t>(~kRestore), std::memory_order_acq_rel);
-  if (inputs_.size() == 1) {
+  if (cold_->inputs.size() == 1) {
     // The hot path: one input, its new samples in order.
     if (!injected_run) {
       bool any = false;
-      cursors_[0].read_new([this, &any](const SampleView& sample) noexcept {
+      first_.read_new([this, &any](const SampleView& sample) noexcept {
         any = true;
         deliver(0, sample);
       });
       if (restore && !any) restore_reality(now);
     }
-  } else if (!inputs_.empty()) {
+  } else if (!cold_->inputs.empty()) {
     run_merged(injected_run, restore, now);
   }
   current_injected_ = false;
@@ -68,95 +71,102 @@ void Filter::run_general(Time now) noexcept {
 bool Filter::run_injection(Time now) noexcept {
   const double* staged;
   {
-    std::lock_guard lock(injection_mutex_);
-    if (injections_.empty()) {
+    std::lock_guard lock(cold_->injection_mutex);
+    auto& injections = cold_->injections;
+    if (injections.empty()) {
       detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
       return false;
     }
-    staged = cursors_[0].stage(injections_.front().data());
-    injections_.pop_front();
-    if (injections_.empty()) {
+    staged = first_.stage(injections.front().data());
+    injections.pop_front();
+    if (injections.empty()) {
       // The last injected sample: the next run restores reality.
       detour_.fetch_or(kRestore, std::memory_order_acq_rel);
       detour_.fetch_and(static_cast<std::uint8_t>(~kInjection), std::memory_order_acq_rel);
     }
   }
   // A shallow injection replaces the first input's samples for this run.
-  cursors_[0].skip_to_end();
-  deliver(0, SampleView{now, staged, inputs_[0]->size(), true});
+  first_.skip_to_end();
+  deliver(0, SampleView{now, staged, cold_->inputs[0]->size(), true});
   return true;
 }
 
 void Filter::restore_reality(Time now) noexcept {
   SampleView sample;
-  if (!cursors_[0].stage_latest(sample)) return;  // the signal never had a sample: nothing to restore
+  if (!first_.stage_latest(sample)) return;  // the signal never had a sample: nothing to restore
   sample.time = now;
   deliver(0, sample);
 }
 
 void Filter::run_merged(bool injected_run, bool restore, Time now) noexcept {
   // Several inputs: deliver their new samples merged in time order (ties: input order).
-  for (std::size_t i = 0; i < inputs_.size(); ++i) {
-    has_pending_[i] = !(i == 0 && injected_run) && cursors_[i].next(pending_[i]);
+  const std::size_t n = cold_->inputs.size();
+  auto& pending = cold_->pending;
+  auto& has_pending = cold_->has_pending;
+  for (std::size_t i = 0; i < n; ++i) {
+    has_pending[i] = !(i == 0 && injected_run) && cursor(i).next(pending[i]);
   }
-  if (restore && !has_pending_[0] && cursors_[0].stage_latest(pending_[0])) {
+  if (restore && !has_pending[0] && first_.stage_latest(pending[0])) {
     // The end of a shallow injection into the first input: its real value, judged as new, after
     // the other inputs' samples of this run.
-    pending_[0].time = now;
-    has_pending_[0] = true;
+    pending[0].time = now;
+    has_pending[0] = true;
   }
   for (;;) {
-    std::size_t best = inputs_.size();
-    for (std::size_t i = 0; i < inputs_.size(); ++i) {
-      if (has_pending_[i] && (best == inputs_.size() || pending_[i].time < pending_[best].time)) best = i;
+    std::size_t best = n;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (has_pending[i] && (best == n || pending[i].time < pending[best].time)) best = i;
     }
-    if (best == inputs_.size()) break;
-    deliver(best, pending_[best]);
-    has_pending_[best] = cursors_[best].next(pending_[best]);
+    if (best == n) break;
+    deliver(best, pending[best]);
+    has_pending[best] = cursor(best).next(pending[best]);
   }
 }
 
 Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
-  if (inputs_.empty()) return fail(ErrorCode::InvalidArgument, "filter '" + name() + "' has no input to inject into");
-  const std::size_t size = inputs_[0]->size();
+  const std::vector<Signal*>& inputs = cold_->inputs;
+  if (inputs.empty()) return fail(ErrorCode::InvalidArgument, "filter '" + name() + "' has no input to inject into");
+  const std::size_t size = inputs[0]->size();
   for (std::size_t i = 0; i < samples.size(); ++i) {
     if (samples[i].size() != size) {
       return fail(ErrorCode::InvalidArgument, "filter '" + name() + "': injected sample " + std::to_string(i + 1) +
                                                   " has " + std::to_string(samples[i].size()) + " values; input '" +
-                                                  inputs_[0]->name() + "' has size " + std::to_string(size));
+                                                  inputs[0]->name() + "' has size " + std::to_string(size));
     }
   }
-  std::lock_guard lock(injection_mutex_);
-  injections_.insert(injections_.end(), samples.begin(), samples.end());
-  if (!injections_.empty()) detour_.fetch_or(kInjection, std::memory_order_acq_rel);
+  std::lock_guard lock(cold_->injection_mutex);
+  cold_->injections.insert(cold_->injections.end(), samples.begin(), samples.end());
+  if (!cold_->injections.empty()) detour_.fetch_or(kInjection, std::memory_order_acq_rel);
   return {};
 }
 
 void Filter::reset() noexcept {
   detected_.store(false, std::memory_order_release);
-  std::fill(invalid_.begin(), invalid_.end(), 0);
+  std::fill(cold_->invalid.begin(), cold_->invalid.end(), 0);
   invalid_count_ = 0;
-  for (SignalCursor& c : cursors_) c.forget();
+  for (std::size_t i = 0; i < cold_->inputs.size(); ++i) cursor(i).forget();
   on_reset();
 }
 
 void Filter::report_change(bool detected, double value, Time sample_time, std::size_t input) noexcept {
   const bool was = detected_.load(std::memory_order_relaxed);
-  const SampleCause cause{name_id_, input < inputs_.size() ? inputs_[input]->name_id() : kNoName, value, sample_time,
+  const Cold& c = *cold_;
+  const SampleCause cause{c.name_id, input < c.inputs.size() ? c.inputs[input]->name_id() : kNoName, value, sample_time,
                           current_injected_};
   if (detected) {
-    if (was && config_.detection == DetectionMode::Edge) return;
+    if (was && c.config.detection == DetectionMode::Edge) return;
     detected_.store(true, std::memory_order_release);
-    if (onset_ != kNoEvent) coordinator_->generate(onset_, target_, cause);
+    if (c.onset != kNoEvent) c.coordinator->generate(c.onset, c.target, cause);
     return;
   }
   detected_.store(false, std::memory_order_release);
-  if (completion_ != kNoEvent) coordinator_->generate(completion_, target_, cause);
+  if (c.completion != kNoEvent) c.coordinator->generate(c.completion, c.target, cause);
 }
 
 void Filter::invalid_sample(std::size_t input, const SampleView& sample, bool invalid) noexcept {
-  if ((invalid_[input] != 0) == invalid) return;
-  invalid_[input] = invalid ? 1 : 0;
+  std::vector<char>& marks = cold_->invalid;
+  if ((marks[input] != 0) == invalid) return;
+  marks[input] = invalid ? 1 : 0;
   const bool was_raised = invalid_count_ > 0;
   invalid_count_ = invalid ? invalid_count_ + 1 : invalid_count_ - 1;
   // One condition for the filter: raised by the first bad input, cleared when none is left.
@@ -171,26 +181,27 @@ void Filter::invalid_sample(std::size_t input, const SampleView& sample, bool in
       }
     }
   }
-  const SampleCause cause{name_id_, inputs_[input]->name_id(), value, sample.time, current_injected_};
+  const Cold& c = *cold_;
+  const SampleCause cause{c.name_id, c.inputs[input]->name_id(), value, sample.time, current_injected_};
   const EventId event =
       invalid ? framework_event::kInvalidSample : framework_event::completion_of(framework_event::kInvalidSample);
-  coordinator_->generate(event, coordinator_->framework_machine(component_), cause);
+  c.coordinator->generate(event, c.coordinator->framework_machine(c.component), cause);
 }
 
 double Filter::number(std::string_view param) const {
-  const auto it = config_.params.find(param);
-  return it == config_.params.end() ? 0.0 : std::get<double>(it->second);
+  const auto it = cold_->config.params.find(param);
+  return it == cold_->config.params.end() ? 0.0 : std::get<double>(it->second);
 }
 
 const std::string& Filter::text(std::string_view param) const {
   static const std::string kEmpty;
-  const auto it = config_.params.find(param);
-  return it == config_.params.end() ? kEmpty : std::get<std::string>(it->second);
+  const auto it = cold_->config.params.find(param);
+  return it == cold_->config.params.end() ? kEmpty : std::get<std::string>(it->second);
 }
 
 bool Filter::flag(std::string_view param) const {
-  const auto it = config_.params.find(param);
-  return it != config_.params.end() && std::get<bool>(it->second);
+  const auto it = cold_->config.params.find(param);
+  return it != cold_->config.params.end() && std::get<bool>(it->second);
 }
 
 }  // namespace safecass

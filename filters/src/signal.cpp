@@ -19,7 +19,7 @@ HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity)
       words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * (width + kHeader))) {}
 
 Signal::Signal(std::string name, ComponentId component, std::size_t size, std::size_t history)
-    : name_(std::move(name)), component_(component), buffer_(size, history) {}
+    : buffer_(size, history), name_(std::move(name)), component_(component) {}
 
 void Signal::inject(Time time, const double* values) {
   std::lock_guard lock(inject_mutex_);
@@ -59,20 +59,23 @@ bool Signal::latest(Time& time, double* out, bool* injected) const noexcept {
 }
 
 SignalCursor::SignalCursor(const Signal* signal)
-    : signal_(signal), scratch_(signal != nullptr ? 2 * signal->size() : 0), reading_(scratch_.data()) {}
+    : signal_(signal),
+      width_(signal != nullptr ? static_cast<std::uint32_t>(signal->size()) : 0),
+      wide_(width_ > 1 ? std::make_unique<double[]>(2 * std::size_t{width_}) : nullptr) {}
 
 const double* SignalCursor::stage(const double* values) noexcept {
-  std::copy(values, values + signal_->size(), reading_);
-  return reading_;
+  double* into = reading();
+  std::copy(values, values + width_, into);
+  return into;
 }
 
 bool SignalCursor::stage_latest(SampleView& out) noexcept {
   if (signal_ == nullptr) return false;
   skip_to_end();
   bool injected = false;
-  if (!signal_->latest(out.time, reading_, &injected)) return false;
-  out.data = reading_;
-  out.size = signal_->size();
+  if (!signal_->latest(out.time, reading(), &injected)) return false;
+  out.data = reading();
+  out.size = width_;
   out.injected = injected;
   return true;
 }
@@ -87,7 +90,7 @@ bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexce
     }
     std::uint64_t key = 0;
     Time t{};
-    if (!inj.read(injected_next_, t, reading_, &key)) {
+    if (!inj.read(injected_next_, t, reading(), &key)) {
       ++missed_;  // overwritten while we copied it
       ++injected_next_;
       continue;
@@ -100,8 +103,8 @@ bool SignalCursor::next_merged(const HistoryBuffer& inj, SampleView& out) noexce
     }
     ++injected_next_;
     out.time = t;
-    out.data = reading_;
-    out.size = signal_->size();
+    out.data = reading();
+    out.size = width_;
     out.injected = true;
     return true;
   }

@@ -88,12 +88,13 @@ class MovingAverage final : public Filter {
 public:
   static constexpr const char* kType = "MovingAverage";
   explicit MovingAverage(FilterInit init)
-      : Filter(std::move(init)),
-        size_(inputs()[0]->size()),
-        window_(static_cast<std::size_t>(number("window"))),
-        ring_(window_ * size_, 0.0),
-        sum_(size_, 0.0),
-        out_(size_, 0.0) {}
+      : Filter(std::move(init)), window_(static_cast<std::size_t>(number("window"))), size_(inputs()[0]->size()) {
+    const std::size_t values = (window_ + 2) * size_;  // the ring, the running sum, the output
+    if (values > kInline) heap_.assign(values, 0.0);
+    ring_ = values > kInline ? heap_.data() : inline_;
+    sum_ = ring_ + window_ * size_;
+    out_ = sum_ + size_;
+  }
   static FilterManifest manifest() {
     FilterManifest m;
     m.doc = "moving average over the last window samples (element-wise)";
@@ -128,16 +129,16 @@ protected:
     if (count_ < window_) ++count_;
     // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
     if (next_ == 0) {
-      std::fill(sum_.begin(), sum_.end(), 0.0);
+      std::fill(sum_, sum_ + size_, 0.0);
       for (std::size_t k = 0; k < count_; ++k)
         for (std::size_t i = 0; i < size_; ++i) sum_[i] += ring_[k * size_ + i];
     }
     for (std::size_t i = 0; i < size_; ++i) out_[i] = sum_[i] / static_cast<double>(count_);
-    write(0, s.time, out_.data());
+    write(0, s.time, out_);
   }
   void on_reset() noexcept override {
     count_ = next_ = 0;
-    std::fill(sum_.begin(), sum_.end(), 0.0);
+    std::fill(sum_, sum_ + size_, 0.0);
   }
 
 private:
@@ -157,13 +158,19 @@ private:
     write(0, s.time, sum_[0] / static_cast<double>(count_));
   }
 
-  std::size_t size_;
+  // A small average (a scalar's window of up to 14 samples) keeps its ring, sum and output inside
+  // the object, next to the filter's hot fields (docs/filters.md, "Memory layout"); a larger one
+  // in heap_.
+  static constexpr std::size_t kInline = 16;
   std::size_t window_;
-  std::vector<double> ring_;
-  std::vector<double> sum_;
-  std::vector<double> out_;
+  std::size_t size_;
   std::size_t next_ = 0;
   std::size_t count_ = 0;
+  double* ring_ = nullptr;  ///< window_ samples of size_ values
+  double* sum_ = nullptr;   ///< size_ values: the running sum
+  double* out_ = nullptr;   ///< size_ values: the average written
+  double inline_[kInline] = {};
+  std::vector<double> heap_;
 };
 
 /// L2 (default), L1 or L∞ norm of a vector.

@@ -53,6 +53,33 @@ TEST(SignalCursor, AKeptSampleStaysReadableWhileLaterSamplesAreReadUntilTheNextK
   EXPECT_EQ(cursor.kept(), nullptr);
 }
 
+// A scalar's two samples live inside the cursor (not on the heap): a cursor that moves, as in a
+// growing vector of cursors, must still hold its kept sample and go on reading where it stopped.
+TEST(SignalCursor, AMovedCursorKeepsItsKeptSampleAndGoesOnReadingWhereItStopped) {
+  for (std::size_t width : {std::size_t{1}, std::size_t{3}}) {
+    Signal s("C.v", ComponentId{0}, width, 8);
+    for (int k = 1; k <= 3; ++k) {
+      const std::vector<double> sample(width, static_cast<double>(k));
+      s.push(Time{k}, sample.data());
+    }
+    SignalCursor first(&s);
+    SampleView v;
+    ASSERT_TRUE(first.next(v));
+    first.keep();                // sample 1
+    ASSERT_TRUE(first.next(v));  // sample 2, read but not kept
+    SignalCursor moved(std::move(first));
+    ASSERT_NE(moved.kept(), nullptr) << width;
+    EXPECT_EQ(std::vector<double>(moved.kept(), moved.kept() + width), std::vector<double>(width, 1.0)) << width;
+    ASSERT_TRUE(moved.next(v)) << width;
+    EXPECT_EQ(std::vector<double>(v.data, v.data + v.size), std::vector<double>(width, 3.0)) << width;
+    moved.keep();
+    SignalCursor assigned;
+    assigned = std::move(moved);
+    EXPECT_EQ(std::vector<double>(assigned.kept(), assigned.kept() + width), std::vector<double>(width, 3.0)) << width;
+    EXPECT_FALSE(assigned.next(v)) << "every sample was read: " << width;
+  }
+}
+
 TEST(HistoryBuffer, RingIsRoundedUpToAPowerOfTwoAndAllButTheSlotBeingWrittenAreReadable) {
   HistoryBuffer b(1, 1000);
   EXPECT_EQ(b.capacity(), 1023u);

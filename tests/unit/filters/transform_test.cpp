@@ -112,6 +112,29 @@ TEST_F(MovingAverageFilter, VectorAverageIsElementWise) {
   EXPECT_EQ(out[2].value, (Values{4, 40}));
 }
 
+// A small window keeps its ring inside the filter, a large one on the heap: the same average.
+TEST_F(MovingAverageFilter, AWindowTooLargeToKeepInsideTheFilterAveragesTheSame) {
+  Signal* x = signal("x");
+  make("MovingAverage", io("x", "small", {{"window", 14.0}}));
+  make("MovingAverage", io("x", "large", {{"window", 15.0}}));
+  for (int k = 1; k <= 40; ++k) {
+    push(x, k, static_cast<double>(k));
+    run_all(k);
+  }
+  const Values a = values_of("small");
+  const Values b = values_of("large");
+  ASSERT_EQ(a.size(), 40u);
+  ASSERT_EQ(b.size(), 40u);
+  for (int k = 1; k <= 40; ++k) {
+    const auto i = static_cast<std::size_t>(k - 1);
+    const int n14 = std::min(k, 14);
+    const int n15 = std::min(k, 15);
+    // The mean of k - n + 1 … k.
+    EXPECT_DOUBLE_EQ(a[i], k - (n14 - 1) / 2.0) << k;
+    EXPECT_DOUBLE_EQ(b[i], k - (n15 - 1) / 2.0) << k;
+  }
+}
+
 TEST_F(MovingAverageFilter, LongRunStaysAccurateAfterAHugeValueLeavesTheWindow) {
   // A running sum alone would keep the rounding error of 1e17 forever (its ulp is 16); the
   // filter must be exact again once the spike has left the window.

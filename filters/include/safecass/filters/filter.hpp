@@ -24,6 +24,7 @@
 #include <cmath>
 #include <cstddef>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -73,19 +74,19 @@ struct FilterInit {
 
 class Filter {
 public:
-  virtual ~Filter() = default;
   Filter(const Filter&) = delete;
   Filter& operator=(const Filter&) = delete;
 
-  const std::string& name() const noexcept { return config_.name; }
-  const std::string& type() const noexcept { return config_.type; }
-  const FilterConfig& config() const noexcept { return config_; }
-  ExecutionMode execution() const noexcept { return config_.execution; }
-  DetectionMode detection() const noexcept { return config_.detection; }
-  ComponentId component() const noexcept { return component_; }
-  MachineId target() const noexcept { return target_; }
-  const std::vector<Signal*>& inputs() const noexcept { return inputs_; }
-  const std::vector<Signal*>& outputs() const noexcept { return outputs_; }
+  virtual ~Filter();
+  const std::string& name() const noexcept { return cold_->config.name; }
+  const std::string& type() const noexcept { return cold_->config.type; }
+  const FilterConfig& config() const noexcept { return cold_->config; }
+  ExecutionMode execution() const noexcept { return cold_->config.execution; }
+  DetectionMode detection() const noexcept { return cold_->config.detection; }
+  ComponentId component() const noexcept { return cold_->component; }
+  MachineId target() const noexcept { return cold_->target; }
+  const std::vector<Signal*>& inputs() const noexcept { return cold_->inputs; }
+  const std::vector<Signal*>& outputs() const noexcept { return cold_->outputs; }
 
   bool enabled() const noexcept { return (detour_.load(std::memory_order_acquire) & kDisabled) == 0; }
   /// A disabled filter skips its runs; its unread samples are dropped when it is enabled again.
@@ -108,7 +109,7 @@ public:
       run_general(now);
       return;
     }
-    cursors_[0].read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
+    first_.read_new([this](const SampleView& sample) noexcept { deliver(0, sample); });
     current_injected_ = false;
     if (ticks_) on_tick(now);
   }
@@ -136,18 +137,18 @@ protected:
   }
   /// Writes a sample of output `output` (size doubles must match the output signal).
   void write(std::size_t output, Time time, const double* values) noexcept {
-    if (output < outputs_.size() && outputs_[output] != nullptr) outputs_[output]->push(time, values);
+    if (Signal* s = output_signal(output)) s->push(time, values);
   }
   void write(std::size_t output, Time time, double value) noexcept { write(output, time, &value); }
-  bool has_output(std::size_t output) const noexcept { return output < outputs_.size() && outputs_[output] != nullptr; }
+  bool has_output(std::size_t output) const noexcept { return output_signal(output) != nullptr; }
   /// The newest value of input `input` seen by this filter (zero-order hold), or nullptr.
   const double* held(std::size_t input) const noexcept {
-    return input < cursors_.size() ? cursors_[input].kept() : nullptr;
+    return input < cold_->inputs.size() ? cursor(input).kept() : nullptr;
   }
   /// Whether the sample being processed was injected.
   bool current_injected() const noexcept { return current_injected_; }
 
-  const Params& params() const noexcept { return config_.params; }
+  const Params& params() const noexcept { return cold_->config.params; }
   double number(std::string_view param) const;
   const std::string& text(std::string_view param) const;
   bool flag(std::string_view param) const;
@@ -178,10 +179,19 @@ private:
       invalid_sample(input, sample, true);
       return;
     }
-    // invalid_count_ (in the object's first cache line) spares the common case a look at invalid_.
-    if (invalid_count_ != 0 && invalid_[input] != 0) invalid_sample(input, sample, false);
-    cursors_[input].keep();
+    // invalid_count_ (in the object's first cache line) spares the common case a look at the
+    // inputs' marks.
+    if (invalid_count_ != 0 && cold_->invalid[input] != 0) invalid_sample(input, sample, false);
+    cursor(input).keep();
     on_sample(input, sample);
+  }
+  SignalCursor& cursor(std::size_t input) noexcept { return input == 0 ? first_ : cold_->more_cursors[input - 1]; }
+  const SignalCursor& cursor(std::size_t input) const noexcept {
+    return input == 0 ? first_ : cold_->more_cursors[input - 1];
+  }
+  Signal* output_signal(std::size_t output) const noexcept {
+    if (output == 0) return output0_;
+    return output < cold_->outputs.size() ? cold_->outputs[output] : nullptr;
   }
   /// run() for everything but the hot path: disabled, re-enabled, injected, several inputs.
   void run_general(Time now) noexcept;
@@ -190,8 +200,11 @@ private:
   /// The first input's newest sample, judged again at `now` (the end of a shallow injection).
   void restore_reality(Time now) noexcept;
 
-  // What every run() reads comes first, so that it shares the object's first cache line with the
-  // virtual table pointer (a monitor runs thousands of filters per tick: each line is a miss).
+  // The filter's layout (docs/filters.md, "Memory layout"): a monitor runs thousands of filters
+  // per cycle, and each cache line one of them touches is a likely miss. So what run() and the
+  // common on_sample() need (flags, the first input's cursor with a scalar's samples, the first
+  // output) is in the object's first two lines with the virtual table pointer, a derived filter's
+  // own state right after them, and everything else in one separate block, cold_.
   // Why run() leaves its hot path, as bits of detour_: set_enabled() and inject() set them from
   // any thread; run_general() sets and clears kReenabled; kSeveralInputs is set at creation.
   static constexpr std::uint8_t kDisabled = 1;       ///< set_enabled(false)
@@ -202,25 +215,30 @@ private:
   std::atomic<std::uint8_t> detour_{0};
   std::atomic<bool> detected_{false};
   bool current_injected_ = false;
-  bool ticks_ = true;                  ///< on_tick is overridden (cleared by the default on its first call)
-  std::size_t invalid_count_ = 0;      ///< inputs marked in invalid_
-  std::vector<SignalCursor> cursors_;  ///< per input; each keeps the input's newest finite sample
-  std::vector<char> invalid_;          ///< per input: its last sample was not finite
+  bool ticks_ = true;                ///< on_tick is overridden (cleared by the default on its first call)
+  std::uint32_t invalid_count_ = 0;  ///< inputs marked in cold_->invalid
+  Signal* output0_ = nullptr;        ///< the first output, or nullptr
+  SignalCursor first_;               ///< the first input's cursor; it keeps the newest finite sample
 
-  FilterConfig config_;
-  Coordinator* coordinator_;
-  MachineId target_;
-  ComponentId component_;
-  std::vector<Signal*> inputs_;
-  std::vector<Signal*> outputs_;
-  std::vector<SampleView> pending_;  ///< merge of several inputs: next sample of each
-  std::vector<char> has_pending_;
-  EventId onset_;
-  EventId completion_;
-  NameId name_id_;
-
-  std::mutex injection_mutex_;  ///< guards injections_ and kInjection
-  std::deque<std::vector<double>> injections_;
+  /// What the hot path does not read: configuration, the other inputs, injections.
+  struct Cold {
+    FilterConfig config;
+    Coordinator* coordinator = nullptr;
+    MachineId target = kNoMachine;
+    ComponentId component = kNoComponent;
+    EventId onset = kNoEvent;
+    EventId completion = kNoEvent;
+    NameId name_id = kNoName;
+    std::vector<Signal*> inputs;
+    std::vector<Signal*> outputs;
+    std::vector<SignalCursor> more_cursors;  ///< inputs after the first
+    std::vector<char> invalid;               ///< per input: its last sample was not finite
+    std::vector<SampleView> pending;         ///< merge of several inputs: next sample of each
+    std::vector<char> has_pending;
+    std::mutex injection_mutex;  ///< guards injections and kInjection
+    std::deque<std::vector<double>> injections;
+  };
+  std::unique_ptr<Cold> cold_;
 };
 
 }  // namespace safecass

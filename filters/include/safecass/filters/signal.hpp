@@ -125,15 +125,19 @@ private:
     std::memcpy(&value, &bits, sizeof value);
     return value;
   }
+  // Every reader loads the head along with these fields (they never change after construction),
+  // so the head shares their cache line: a reader of a signal touches one line besides the slot.
   std::size_t width_;
   std::size_t stride_;  ///< words per slot
   std::size_t mask_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
-  alignas(64) std::atomic<std::uint64_t> head_{0};
+  std::atomic<std::uint64_t> head_{0};
 };
 
 /// A named signal with its history buffer and, after the first deep injection, its injection ring.
-class Signal {
+/// What every read and write touches (the injection ring's pointer, the buffer's fields and head)
+/// is in the object's first cache line; the name and the injection's lock come after.
+class alignas(64) Signal {
 public:
   Signal(std::string name, ComponentId component, std::size_t size, std::size_t history);
 
@@ -165,11 +169,11 @@ public:
   bool latest(Time& time, double* out, bool* injected = nullptr) const noexcept;
 
 private:
+  std::atomic<const HistoryBuffer*> injections_{nullptr};
+  HistoryBuffer buffer_;
   std::string name_;
   ComponentId component_;
   NameId name_id_ = kNoName;
-  HistoryBuffer buffer_;
-  std::atomic<const HistoryBuffer*> injections_{nullptr};
   std::unique_ptr<HistoryBuffer> injection_ring_;  ///< owns *injections_
   std::mutex inject_mutex_;
 };
@@ -198,8 +202,9 @@ public:
   /// Calls `f(sample)` for every unread sample, in order: the same samples as repeated next()
   /// calls, with the history buffer's head read once per sample instead of twice. Lock-free,
   /// allocation-free as long as `f` is.
+  /// Always inlined: it is the loop of every filter's run() (docs/filters.md, "Memory layout").
   template <class F>
-  void read_new(F&& f) noexcept(noexcept(f(std::declval<const SampleView&>()))) {
+  [[gnu::always_inline]] void read_new(F&& f) noexcept(noexcept(f(std::declval<const SampleView&>()))) {
     if (signal_ == nullptr) return;
     SampleView sample;
     if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) {
@@ -213,11 +218,12 @@ public:
       missed_ += end - next_ - b.capacity();
       next_ = end - b.capacity();
     }
-    sample.size = signal_->size();
+    sample.size = width_;
     while (next_ < end) {
-      if (b.read_published(next_, sample.time, reading_, end)) {
+      double* const into = reading();  // f() may keep() the sample: the next goes to the other half
+      if (b.read_published(next_, sample.time, into, end)) {
         ++next_;
-        sample.data = reading_;
+        sample.data = into;
         f(static_cast<const SampleView&>(sample));
       } else {
         ++missed_;  // overwritten while we copied it
@@ -232,13 +238,13 @@ public:
   /// stay readable, as kept(), until the next keep(): the samples after it are read into the
   /// other buffer. A filter holds the last valid sample of an input this way, without a copy.
   void keep() noexcept {
-    kept_ = reading_;
-    reading_ = reading_ == scratch_.data() ? scratch_.data() + signal_->size() : scratch_.data();
+    kept_ = static_cast<std::int8_t>(reading_);
+    reading_ ^= 1U;
   }
   /// The sample of the last keep(), or nullptr.
-  const double* kept() const noexcept { return kept_; }
+  const double* kept() const noexcept { return kept_ < 0 ? nullptr : storage() + kept_ * width_; }
   /// Forgets the kept sample.
-  void forget() noexcept { kept_ = nullptr; }
+  void forget() noexcept { kept_ = -1; }
   /// Copies `values` (size() doubles from elsewhere, e.g. a shallow injection) to where the next
   /// sample would be read, so that it can be kept like one; returns that copy.
   const double* stage(const double* values) noexcept;
@@ -259,10 +265,10 @@ private:
         missed_ += end - next_ - b.capacity();
         next_ = end - b.capacity();
       }
-      if (b.read(next_, out.time, reading_)) {
+      if (b.read(next_, out.time, reading())) {
         ++next_;
-        out.data = reading_;
-        out.size = signal_->size();
+        out.data = reading();
+        out.size = width_;
         out.injected = false;
         return true;
       }
@@ -271,14 +277,22 @@ private:
     }
   }
   bool next_merged(const HistoryBuffer& inj, SampleView& out) noexcept;
+  /// Two samples: the kept one and the one being read. A scalar's are inside the cursor (read
+  /// with the cursor's own cache line); a vector's in wide_. Halves are kept as indices, not
+  /// pointers, so that a cursor can move.
+  double* storage() noexcept { return width_ == 1 ? small_ : wide_.get(); }
+  const double* storage() const noexcept { return width_ == 1 ? small_ : wide_.get(); }
+  double* reading() noexcept { return storage() + reading_ * width_; }
 
   const Signal* signal_ = nullptr;
   std::uint64_t next_ = 0;           ///< next sample of the history buffer
   std::uint64_t injected_next_ = 0;  ///< next sample of the injection ring
   std::uint64_t missed_ = 0;
-  std::vector<double> scratch_;   ///< two samples: the kept one and the one being read
-  double* reading_ = nullptr;     ///< the half of scratch_ the next sample is read into
-  const double* kept_ = nullptr;  ///< the other half once keep() was called
+  std::uint32_t width_ = 0;   ///< doubles per sample (the signal's size)
+  std::uint8_t reading_ = 0;  ///< the half the next sample is read into
+  std::int8_t kept_ = -1;     ///< the half of the last keep(); -1: none
+  double small_[2] = {0.0, 0.0};
+  std::unique_ptr<double[]> wide_;  ///< 2 × width_ values, for a vector signal
 };
 
 /// The signals of one coordinator, by name. Signals are created during configuration; their
