@@ -194,9 +194,9 @@ double Filter::number(std::string_view param) const {
 }
 
 const std::string& Filter::text(std::string_view param) const {
-  static const std::string kEmpty;
+  static const std::string empty;
   const auto it = cold_->config.params.find(param);
-  return it == cold_->config.params.end() ? kEmpty : std::get<std::string>(it->second);
+  return it == cold_->config.params.end() ? empty : std::get<std::string>(it->second);
 }
 
 bool Filter::flag(std::string_view param) const {

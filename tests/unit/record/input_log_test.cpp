@@ -357,7 +357,9 @@ TEST_F(InputRecording, WithAByteLimitTheFileRotatesEachSegmentReadsAloneAndOldOn
     EXPECT_EQ(error, "") << p;
     // A rotated segment holds samples; the open one may hold only the end record when the last
     // rotation came just before close (the writer thread's batching decides, not the test).
-    if (p != path) EXPECT_THAT(items, HasSubstr("S C.x ")) << p;
+    if (p != path) {
+      EXPECT_THAT(items, HasSubstr("S C.x ")) << p;
+    }
   }
   struct stat st {};
   EXPECT_NE(::stat((path + ".3").c_str(), &st), 0) << "at most keep=2 old segments";

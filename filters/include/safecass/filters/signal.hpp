@@ -242,7 +242,9 @@ public:
     reading_ ^= 1U;
   }
   /// The sample of the last keep(), or nullptr.
-  const double* kept() const noexcept { return kept_ < 0 ? nullptr : storage() + kept_ * width_; }
+  const double* kept() const noexcept {
+    return kept_ < 0 ? nullptr : storage() + static_cast<std::size_t>(kept_) * width_;
+  }
   /// Forgets the kept sample.
   void forget() noexcept { kept_ = -1; }
   /// Copies `values` (size() doubles from elsewhere, e.g. a shallow injection) to where the next
@@ -282,7 +284,7 @@ private:
   /// pointers, so that a cursor can move.
   double* storage() noexcept { return width_ == 1 ? small_ : wide_.get(); }
   const double* storage() const noexcept { return width_ == 1 ? small_ : wide_.get(); }
-  double* reading() noexcept { return storage() + reading_ * width_; }
+  double* reading() noexcept { return storage() + static_cast<std::size_t>(reading_) * width_; }
 
   const Signal* signal_ = nullptr;
   std::uint64_t next_ = 0;           ///< next sample of the history buffer
