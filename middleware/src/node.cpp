@@ -391,12 +391,13 @@ struct CoordinatorNode::Impl {
   /// An event record too large for one message on its own: its text is cut to what fits, on a
   /// UTF-8 boundary, and marked; logged and counted. False when it does not fit even without its
   /// text: then it is not sent (logged, counted as dropped).
-  bool cut_text(wire::EventMessage& m, std::size_t size) {
+  bool cut_text(wire::EventMessage& m, RecordKind kind, std::size_t size) {
     const std::size_t limit = options.max_message_bytes;
     oversized_messages.fetch_add(1, std::memory_order_relaxed);
-    const std::string what = "middleware: " + name + ": event record seq " + std::to_string(m.seq) + " (" + m.kind +
-                             " of " + printable(m.address) + ") is " + std::to_string(size) + " bytes, over the " +
-                             std::to_string(limit) + "-byte message limit: ";
+    const std::string what = "middleware: " + name + ": event record seq " + std::to_string(m.seq) + " (" +
+                             std::string(to_string(kind)) + " of " +
+                             printable(m.machine.empty() ? m.component : m.machine) + ") is " + std::to_string(size) +
+                             " bytes, over the " + std::to_string(limit) + "-byte message limit: ";
     std::string text = std::move(m.text);
     const std::string mark = " [cut: " + std::to_string(text.size()) + " bytes]";
     m.text.clear();
@@ -473,7 +474,7 @@ struct CoordinatorNode::Impl {
           part.resize(n);
           event_seq.store(seq_before + static_cast<std::int64_t>(n));  // the others go next, with these numbers
           body = encode(ic, part);
-          if (body.size() > options.max_message_bytes && !cut_text(part[0], body.size())) {
+          if (body.size() > options.max_message_bytes && !cut_text(part[0], pending[sent].kind, body.size())) {
             sent += 1;  // dropped (logged, counted): its number stays used, a gap receivers see
             continue;
           }

@@ -15,28 +15,50 @@ State level_of(wire::Level l) {
   return s;
 }
 
-bool kind_of(std::string_view text, RecordKind& out) {
-  for (const RecordKind k : {RecordKind::Event, RecordKind::Transition, RecordKind::ComponentTransition,
-                             RecordKind::Reset, RecordKind::Injection}) {
-    if (to_string(k) == text) {
-      out = k;
-      return true;
-    }
+wire::RecordKind kind_to_wire(RecordKind k) noexcept {
+  switch (k) {
+    case RecordKind::Event: return wire::RecordKind::Event;
+    case RecordKind::Transition: return wire::RecordKind::Transition;
+    case RecordKind::ComponentTransition: return wire::RecordKind::ComponentTransition;
+    case RecordKind::Reset: return wire::RecordKind::Reset;
+    case RecordKind::Injection: return wire::RecordKind::Injection;
+  }
+  return wire::RecordKind::Event;
+}
+
+bool kind_of(wire::RecordKind k, RecordKind& out) noexcept {
+  switch (k) {
+    case wire::RecordKind::Event: out = RecordKind::Event; return true;
+    case wire::RecordKind::Transition: out = RecordKind::Transition; return true;
+    case wire::RecordKind::ComponentTransition: out = RecordKind::ComponentTransition; return true;
+    case wire::RecordKind::Reset: out = RecordKind::Reset; return true;
+    case wire::RecordKind::Injection: out = RecordKind::Injection; return true;
   }
   return false;
 }
 
-bool outcome_of(std::string_view text, Outcome& out) {
-  if (text.empty()) {
-    out = Outcome::None;
-    return true;
+wire::RecordOutcome outcome_to_wire(Outcome o) noexcept {
+  switch (o) {
+    case Outcome::None: return wire::RecordOutcome::NoOutcome;
+    case Outcome::Raised: return wire::RecordOutcome::Raised;
+    case Outcome::Override: return wire::RecordOutcome::Override;
+    case Outcome::Joined: return wire::RecordOutcome::Joined;
+    case Outcome::Masked: return wire::RecordOutcome::Masked;
+    case Outcome::Cleared: return wire::RecordOutcome::Cleared;
+    case Outcome::Ignored: return wire::RecordOutcome::Ignored;
   }
-  for (const Outcome o :
-       {Outcome::Raised, Outcome::Override, Outcome::Joined, Outcome::Masked, Outcome::Cleared, Outcome::Ignored}) {
-    if (outcome_text(o) == text) {
-      out = o;
-      return true;
-    }
+  return wire::RecordOutcome::NoOutcome;
+}
+
+bool outcome_of(wire::RecordOutcome o, Outcome& out) noexcept {
+  switch (o) {
+    case wire::RecordOutcome::NoOutcome: out = Outcome::None; return true;
+    case wire::RecordOutcome::Raised: out = Outcome::Raised; return true;
+    case wire::RecordOutcome::Override: out = Outcome::Override; return true;
+    case wire::RecordOutcome::Joined: out = Outcome::Joined; return true;
+    case wire::RecordOutcome::Masked: out = Outcome::Masked; return true;
+    case wire::RecordOutcome::Cleared: out = Outcome::Cleared; return true;
+    case wire::RecordOutcome::Ignored: out = Outcome::Ignored; return true;
   }
   return false;
 }
@@ -92,18 +114,13 @@ wire::Root root_to_wire(const in::RootEntry& r) {
 template <class WireRecord>
 void fill(const in::HistoryEntry& e, WireRecord& w) {
   w.time = e.time.count();
-  w.kind = std::string(to_string(e.kind));
-  w.outcome = std::string(outcome_text(e.outcome));
-  w.address = e.machine.empty() ? e.component : e.machine;
+  w.kind = kind_to_wire(e.kind);
+  w.outcome = outcome_to_wire(e.outcome);
   w.event = e.event;
   w.from = to_wire(e.from);
   w.to = to_wire(e.to);
   w.level = to_wire(e.level);
   w.mirror = e.mirror;
-  if (e.root) {
-    w.rootEvent = e.root->event;
-    w.rootOrigin = e.root->origin;
-  }
   w.text = e.text;
   w.component = e.component;
   w.machine = e.machine;

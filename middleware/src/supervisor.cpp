@@ -283,18 +283,19 @@ struct Supervisor::Impl {
       refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an invalid level");
       return;
     }
-    const bool transition = m.kind == "transition" || m.kind == "component-transition";
-    const bool shown = transition || m.kind == "reset";
+    const bool transition = m.kind == wire::RecordKind::Transition || m.kind == wire::RecordKind::ComponentTransition;
+    const bool shown = transition || m.kind == wire::RecordKind::Reset;
     introspect::HistoryEntry& entry = record_scratch;
     if (shown) {
       if (!from_wire(m, entry)) {
         refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an unknown kind or outcome");
         return;
       }
-      if (entry.machine.empty() && entry.component.empty()) {
-        // A record that names only its address: a machine, or the component of a component
-        // transition or a reset.
-        (entry.kind == RecordKind::Transition ? entry.machine : entry.component) = m.address;
+      // The address a transition's row is kept under: its machine, or its component.
+      if (m.kind == wire::RecordKind::Transition ? m.machine.empty() : m.component.empty()) {
+        refuse(sender, "an event record of '" + printable(m.coordinator) + "' that names no " +
+                           (m.kind == wire::RecordKind::Transition ? "machine" : "component"));
+        return;
       }
     }
     bool late = false;  // below a record received before it: printed as late
@@ -329,19 +330,20 @@ struct Supervisor::Impl {
       }
       if (!shown) return;
       if (transition) {
-        auto row = view.find(m.address);
-        if (row == view.end()) row = view.emplace(m.address, ViewRow{}).first;
+        const std::string& address = m.machine.empty() ? m.component : m.machine;
+        auto row = view.find(address);
+        if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
         ViewRow& r = row->second;
         // A record that arrived late never takes a row back to an older state.
         if (r.record_seq < m.seq || r.coordinator != m.coordinator) {
           r.coordinator = m.coordinator;  // assignments into the row's own storage: no allocation once sized
-          r.address = m.address;
+          r.address = address;
           r.state = to;
           r.record_seq = m.seq;
-          if (to == State::Normal) {
+          if (to == State::Normal || !m.hasRoot) {
             r.cause.clear();
           } else {
-            r.cause.assign(m.rootOrigin).append(":").append(m.rootEvent);
+            r.cause.assign(m.root.origin).append(":").append(m.root.event);
           }
         }
       }

@@ -396,7 +396,7 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
         if (m.coordinator == "over-p") seen.push_back(m);
       }
     }
-    return !seen.empty() && seen.back().kind == "reset";
+    return !seen.empty() && seen.back().kind == wire::RecordKind::Reset;
   })) << bus.provider.all_log();
   for (std::size_t i = 0; i < seen.size(); ++i)
     EXPECT_EQ(seen[i].seq, static_cast<std::int64_t>(i + 1)) << "in order, none lost";

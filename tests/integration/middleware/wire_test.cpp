@@ -446,13 +446,14 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   // A forged event record cannot add a line; a genuine one with a newline in it stays on one line.
   const auto topic = bus.topic("safecass.events");
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(topic->getPublisher()->ice_oneway());
-  auto record = [](std::int64_t seq, const std::string& kind, const std::string& address, const std::string& text) {
+  // A machine's transition (machine: the address) or a component's reset (component: the address).
+  auto record = [](std::int64_t seq, wire::RecordKind kind, const std::string& address, const std::string& text) {
     wire::EventMessage m{};  // every field set: an indeterminate bool is undefined behaviour (UBSan)
     m.coordinator = "wire-p";
     m.incarnation = kIncarnation;
     m.seq = seq;
     m.kind = kind;
-    m.address = address;
+    (kind == wire::RecordKind::Transition ? m.machine : m.component) = address;
     m.event = "EVT_E";
     m.from = wire::Level::Error;
     m.to = wire::Level::Normal;
@@ -461,19 +462,20 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
     return m;
   };
   auto ic = bus.ice.communicator();
-  events->records(
-      bus.attacker->sign(middleware::detail::kKindEvents,
-                         encode(ic, wire::EventMessageSeq{record(1, "transition", "P.s_A\n[wire-p] FORGED", "")})));
-  events->records(
-      bus.provider->sign(middleware::detail::kKindEvents,
-                         encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "operator\n[wire-p] FAKE LINE")})));
+  events->records(bus.attacker->sign(
+      middleware::detail::kKindEvents,
+      encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Transition, "P.s_A\n[wire-p] FORGED", "")})));
+  events->records(bus.provider->sign(
+      middleware::detail::kKindEvents,
+      encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "operator\n[wire-p] FAKE LINE")})));
   ASSERT_TRUE(eventually([&] { return output().find("[wire-p] reset P (") != std::string::npos; })) << output();
   EXPECT_NE(output().find("[wire-p] reset P (operator\\x0a[wire-p] FAKE LINE)"), std::string::npos) << output();
   EXPECT_EQ(output().find("\n[wire-p] FAKE LINE"), std::string::npos) << output();
   EXPECT_EQ(output().find("FORGED"), std::string::npos) << output();
   // The same genuine record again is a replay.
-  events->records(bus.provider->sign(middleware::detail::kKindEvents,
-                                     encode(ic, wire::EventMessageSeq{record(1, "reset", "P", "again")})));
+  events->records(
+      bus.provider->sign(middleware::detail::kKindEvents,
+                         encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "again")})));
 
   // Back with a newer incarnation (a restart): its view is refreshed. The old incarnation still
   // beating beside it is a second process with the same name, and is reported.
@@ -583,8 +585,8 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   m.coordinator = "wire-p";
   m.incarnation = kIncarnation;
   m.seq = 1;
-  m.kind = "reset";
-  m.address = "P";
+  m.kind = wire::RecordKind::Reset;
+  m.component = "P";
   m.text = "operator: not followed";
   events->records(
       bus.provider->sign(middleware::detail::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
@@ -621,28 +623,29 @@ struct RecordSender {
   void send(const std::vector<std::int64_t>& seqs) {
     wire::EventMessageSeq batch;
     for (std::int64_t seq : seqs) batch.push_back(record(seq));
+    send_batch(batch);
+  }
+
+  void send_batch(const wire::EventMessageSeq& batch) {
     events_->records(bus_.provider->sign(middleware::detail::kKindEvents, encode(bus_.ice.communicator(), batch)));
   }
 
-private:
   static wire::EventMessage record(std::int64_t seq) {
     wire::EventMessage m{};
     m.coordinator = "wire-p";
     m.incarnation = kIncarnation;
     m.seq = seq;
-    m.kind = "transition";
-    m.address = "P.s_A";
+    m.kind = wire::RecordKind::Transition;
     m.machine = "P.s_A";
     m.component = "P";
     m.event = seq % 2 == 1 ? "EVT_E" : "/EVT_E";
     m.from = seq % 2 == 1 ? wire::Level::Normal : wire::Level::Error;
     m.to = seq % 2 == 1 ? wire::Level::Error : wire::Level::Normal;
     m.level = m.to;
-    m.rootOrigin = "P.s_A";
-    m.rootEvent = "EVT_E";
     return m;
   }
 
+private:
   Bus& bus_;
   std::shared_ptr<wire::EventTopicPrx> events_;
 };
@@ -751,6 +754,35 @@ TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeat
       << r.out.all();
   EXPECT_EQ(r.out.records, 1u) << r.out.all();
   EXPECT_EQ(sup.messages_refused(), 0u) << r.out.all();
+}
+
+TEST(Wire, ASupervisorRefusesATransitionRecordThatNamesNoMachineAndItChangesNothing) {
+  // A record's address is its machine (or, for a component's records, its component). A signed
+  // transition record without one has no row to be shown under: refused, and its number is not
+  // taken, so the record that follows with that number is accepted.
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  RecordedBus r;
+  ASSERT_TRUE(r.bus.node);
+  ASSERT_TRUE(r.supervisor);
+  const middleware::Supervisor& sup = *r.supervisor;
+
+  wire::EventMessage nameless = RecordSender::record(1);
+  nameless.machine.clear();
+  wire::EventMessage no_component = RecordSender::record(1);
+  no_component.kind = wire::RecordKind::ComponentTransition;
+  no_component.machine.clear();
+  no_component.component.clear();
+  r.records.send_batch(wire::EventMessageSeq{nameless, no_component});
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 2; })) << r.out.all();
+  EXPECT_EQ(r.out.records, 0u) << r.out.all();
+  EXPECT_FALSE(view_state(sup, "").has_value()) << r.out.all();
+
+  r.records.send({1});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << r.out.all();
+  EXPECT_EQ(r.out.records, 1u) << r.out.all();
+  EXPECT_EQ(sup.messages_refused(), 2u) << r.out.all();
+  EXPECT_EQ(r.out.all().find("missed"), std::string::npos) << r.out.all();
+  EXPECT_FALSE(view_state(sup, "").has_value()) << r.out.all();
 }
 
 TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
