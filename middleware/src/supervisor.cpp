@@ -330,9 +330,9 @@ struct Supervisor::Impl {
       }
       if (!shown) return;
       if (transition) {
-        const std::string& address = m.machine.empty() ? m.component : m.machine;
+        const std::string_view address = entry.where();  // checked above: a machine, or a component
         auto row = view.find(address);
-        if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
+        if (row == view.end()) row = view.emplace(std::string(address), ViewRow{}).first;
         ViewRow& r = row->second;
         // A record that arrived late never takes a row back to an older state.
         if (r.record_seq < m.seq || r.coordinator != m.coordinator) {
