@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo test stress-test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan package lint clean
 
 all: build
 
@@ -23,7 +23,11 @@ build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
 
 # The case study of the paper (examples/robodoc) in simulated time; the history lands in build/demo/.
-demo: build
+# It builds only what it runs (the `safecass` command, robodoc_demo and their libraries); `make
+# test` builds the rest of the tree.
+DEMO_TARGETS := safecass robodoc_demo
+demo: configure
+	@cmake --build $(BUILD) -j $(JOBS) --target $(DEMO_TARGETS)
 	@mkdir -p $(BUILD)/demo
 	@./$(BUILD)/bin/robodoc_demo examples/robodoc/story.json $(BUILD)/demo/robodoc-history.jsonl
 	@./$(BUILD)/bin/safecass timeline $(BUILD)/demo/robodoc-history.jsonl --html $(BUILD)/demo/timeline.html
@@ -44,8 +48,16 @@ ros-demo: configure
 	@cmake --build $(BUILD) -j $(JOBS) --target ros_robodoc_control ros_robodoc_jr3
 	@./scripts/ros-demo.sh $(BUILD)
 
+# Every test; a test that fails is run once more alone and named in the summary as retried
+# (scripts/run-tests), which ends with what ran: ctest's count and the fuzz smoke run's executions.
 test: build fuzz-smoke
-	@ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS) $(CTEST_ARGS)
+	@JOBS=$(JOBS) ./scripts/run-tests $(BUILD) --fuzz-log $(FUZZ)/smoke.log $(CTEST_ARGS)
+
+# The tests that start processes (label `processes`), STRESS_RUNS times (default 5) beside two busy
+# loops with ctest -j2 and no retry: every run must pass (scripts/stress-test).
+STRESS_RUNS ?= 5
+stress-test: build
+	@./scripts/stress-test $(BUILD) $(STRESS_RUNS)
 
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
@@ -95,8 +107,9 @@ bench-verify: build
 
 # The sanitizer runs. Without SANITIZER_SUBSET: the whole tree is built and every test runs
 # (CTEST_ARGS). With SANITIZER_SUBSET=ci (what .ci/run uses): only the test folders named below
-# are built (their `<folder>/all` targets and the `safecass` command they start) and run, folder
-# by folder; docs/contributing.md, "Continuous integration", says which and why.
+# are built (their `<folder>/all` targets: the test programs and the libraries they link) and run,
+# folder by folder; docs/contributing.md, "Continuous integration", says which and why. No test of
+# these folders starts the `safecass` command; a folder whose tests do adds it to the targets.
 ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/replay
 TSAN_CI_DIRS := tests/unit/core
 # Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
@@ -109,7 +122,7 @@ TSAN_ENV = TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:
 define sanitize
 	@test -f $(BUILD)/$(1)/build.ninja || cmake --preset $(1) >/dev/null
 	@if [ "$(SANITIZER_SUBSET)" = ci ]; then \
-	  cmake --build $(BUILD)/$(1) -j $(JOBS) --target safecass $(addsuffix /all,$(2)) || exit 1; \
+	  cmake --build $(BUILD)/$(1) -j $(JOBS) --target $(addsuffix /all,$(2)) || exit 1; \
 	  failed=""; for d in $(2); do \
 	    echo "== $(1): $$d"; \
 	    $(4) ctest --test-dir $(BUILD)/$(1)/$$d --output-on-failure -j $(JOBS) $(3) || failed="$$failed $$d"; \
@@ -133,8 +146,9 @@ package: build
 	@cd $(BUILD) && cpack
 	@ls $(BUILD)/packages/*.deb
 
-# clang-format (check only), the [[nodiscard]] check and clang-tidy over build/compile_commands.json
-# (scripts/lint). LINT_CHECK=format, =nodiscard or =tidy runs one of them (docs/contributing.md, "Lint").
+# clang-format (check only), the [[nodiscard]] check and clang-tidy over the sources changed since
+# the tidied baseline of .ci/tidy-baseline (scripts/lint). LINT_CHECK=format, =nodiscard or =tidy
+# runs one of them; LINT_CHECK=tidy-all runs clang-tidy over every source (docs/contributing.md, "Lint").
 # (Not LINT: GNU make defines LINT = lint itself.)
 LINT_CHECK ?= all
 lint: build

@@ -1,0 +1,88 @@
+#!/usr/bin/env python3
+"""The sources clang-tidy checks (scripts/lint --tidy, --tidy-all), one absolute path per line.
+
+  lint-tidy-files.py COMPILE_COMMANDS [--changed-since-baseline]
+
+Every source of the project's own targets in COMPILE_COMMANDS (under the source tree, not under a
+build tree, not generated). With --changed-since-baseline, only those that changed since the
+tidied baseline commit named in .ci/tidy-baseline (committed, staged, unstaged or untracked), and
+those that include a changed header by the path written in their #include; every source when
+.clang-tidy changed since then, or when the baseline commit is not in this clone's history. The
+baseline moves only after a clean whole-tree run (scripts/lint --tidy-all). Says on stderr which scope it chose and why. Standard library only.
+"""
+import json
+import os
+import re
+import subprocess
+import sys
+
+BASELINE_FILE = ".ci/tidy-baseline"
+INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]', re.M)
+
+
+def git(*args):
+    return subprocess.run(["git", *args], capture_output=True, text=True, check=False)
+
+
+def changed_files():
+    """The changed paths (relative to the root), or None when the whole tree must be checked."""
+    base = ""
+    try:
+        for line in open(BASELINE_FILE, encoding="utf-8"):
+            m = re.match(r"^([0-9a-f]{40})\b", line)
+            if m:
+                base = m.group(1)
+                break
+    except OSError:
+        pass
+    if not base or git("cat-file", "-e", base + "^{commit}").returncode != 0:
+        print(f"tidy: the baseline commit of {BASELINE_FILE} is not in this clone's history: every source",
+              file=sys.stderr)
+        return None
+    diff = git("diff", "--name-only", base, "--")
+    others = git("ls-files", "--others", "--exclude-standard")
+    if diff.returncode != 0 or others.returncode != 0:
+        print(f"tidy: git cannot list the changes since {base[:12]}: every source", file=sys.stderr)
+        return None
+    changed = set(diff.stdout.split()) | set(others.stdout.split())
+    if ".clang-tidy" in changed:
+        print(f"tidy: .clang-tidy changed since {base[:12]}: every source", file=sys.stderr)
+        return None
+    print(f"tidy: the sources changed since the tidied baseline {base[:12]} and those including a changed header",
+          file=sys.stderr)
+    return changed
+
+
+def includes_changed_header(rel, path, headers):
+    try:
+        text = open(path, encoding="utf-8", errors="replace").read()
+    except OSError:
+        return False
+    for name in INCLUDE.findall(text):
+        beside = os.path.normpath(os.path.join(os.path.dirname(rel), name))
+        if any(h == beside or h.endswith("/" + name) for h in headers):
+            return True
+    return False
+
+
+def main():
+    if len(sys.argv) not in (2, 3) or (len(sys.argv) == 3 and sys.argv[2] != "--changed-since-baseline"):
+        print(__doc__.strip().splitlines()[2], file=sys.stderr)
+        return 2
+    root = os.getcwd()
+    changed = changed_files() if len(sys.argv) == 3 else None
+    headers = [c for c in changed or () if c.endswith((".hpp", ".h"))]
+    seen = set()
+    for entry in json.load(open(sys.argv[1], encoding="utf-8")):
+        path = os.path.normpath(os.path.join(entry["directory"], entry["file"]))
+        rel = os.path.relpath(path, root)
+        if rel.startswith("..") or rel.startswith("build") or "/generated/" in rel or path in seen:
+            continue
+        seen.add(path)
+        if changed is None or rel in changed or (headers and includes_changed_header(rel, path, headers)):
+            print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
