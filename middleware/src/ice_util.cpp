@@ -89,15 +89,16 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
   }
 }
 
-void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
+bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
                Delivery delivery) {
   IceStorm::QoS qos;
   if (delivery == Delivery::Ordered) qos["reliability"] = "ordered";  // needs a twoway subscriber
   try {
     topic->subscribeAndGetPublisher(
         qos, delivery == Delivery::Ordered ? subscriber->ice_twoway() : subscriber->ice_oneway());
+    return true;
   } catch (const IceStorm::AlreadySubscribed&) {
-    // IceStorm kept the subscription (its database survived a restart): nothing to do.
+    return false;  // IceStorm kept the subscription (e.g. its database survived a restart)
   }
 }
 
@@ -133,7 +134,10 @@ namespace safecass::middleware::detail {
 void Link::connect(const std::vector<std::string>& publish_on) {
   manager_ = topic_manager(ic_, ice_, tls_);
   manager_->ice_ping();
-  for (const Subscription& s : subscriptions_) subscribe(topic(manager_, s.topic), s.subscriber, s.delivery);
+  for (Subscription& s : subscriptions_) {
+    s.proxy = topic(manager_, s.topic);
+    (void)subscribe(s.proxy, s.subscriber, s.delivery);
+  }
   publishers_.clear();
   for (const std::string& name : publish_on) {
     publishers_.emplace_back(name, topic(manager_, name)->getPublisher()->ice_oneway());
@@ -150,6 +154,22 @@ std::shared_ptr<Ice::ObjectPrx> Link::publisher(const std::string& name) const {
 void Link::ping() const {
   if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
   manager_->ice_ping();
+}
+
+std::string join(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
+  return text;
+}
+
+std::vector<std::string> Link::resubscribe_lost() {
+  if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
+  std::vector<std::string> made;
+  for (Subscription& s : subscriptions_) {
+    if (s.proxy == nullptr) s.proxy = topic(manager_, s.topic);
+    if (subscribe(s.proxy, s.subscriber, s.delivery)) made.push_back(s.topic);
+  }
+  return made;
 }
 
 }  // namespace safecass::middleware::detail

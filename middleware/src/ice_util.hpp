@@ -5,9 +5,11 @@
 #include <Ice/Ice.h>
 #include <IceStorm/IceStorm.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "safecass.h"
 #include "safecass/core/coordinator.hpp"
@@ -24,6 +26,12 @@ inline std::string state_topic(std::string_view coordinator) {
 inline constexpr const char* kEventTopic = "safecass.events";
 inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
 inline constexpr const char* kResyncTopic = "safecass.resync";
+
+/// Every this many heartbeat periods a process's link checks that IceStorm still holds each of
+/// its subscriptions (Link::resubscribe_lost); in between it only pings IceStorm.
+inline constexpr std::uint64_t kResubscribeCheckEvery = 3;
+/// "a, b, c": topic names in one log line.
+std::string join(const std::vector<std::string>& names);
 
 /// A communicator that fails fast (short connect and invocation timeouts, no retries) so that a
 /// dead IceStorm is noticed quickly; one dispatch thread keeps updates in order.
@@ -44,8 +52,9 @@ enum class Delivery {
   Stream,   ///< oneway subscriber: batched, in order over one connection; a loss shows as a gap in
             ///< sequence numbers and is repaired by a resync (state updates, event records)
 };
-/// Subscribes `subscriber`; an existing subscription is kept.
-void subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
+/// Subscribes `subscriber`; an existing subscription is kept. Returns true when IceStorm did not
+/// hold it (a new subscription), false when it was already there.
+bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
                Delivery delivery = Delivery::Ordered);
 
 wire::Level to_wire(State s) noexcept;
@@ -68,7 +77,7 @@ public:
   /// Registers a subscriber of `topic` (used by every connect()).
   void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber,
                     Delivery delivery = Delivery::Ordered) {
-    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery});
+    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery, nullptr});
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.
   void connect(const std::vector<std::string>& publish_on);
@@ -76,6 +85,12 @@ public:
   std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
   /// Throws when IceStorm does not answer.
   void ping() const;
+  /// Makes again every subscription that IceStorm no longer holds, and returns their topics (empty:
+  /// all were there). IceStorm drops a twoway subscriber whose delivery failed or timed out (a
+  /// process starved or stopped for longer than IceStorm's send timeout), and a subscription can
+  /// be removed from outside; without this check such a process would go on unaware that nothing
+  /// reaches it. Throws Ice exceptions when IceStorm cannot be reached (it also serves as ping()).
+  std::vector<std::string> resubscribe_lost();
 
 private:
   std::shared_ptr<Ice::Communicator> ic_;
@@ -86,6 +101,7 @@ private:
     std::string topic;
     std::shared_ptr<Ice::ObjectPrx> subscriber;
     Delivery delivery;
+    std::shared_ptr<IceStorm::TopicPrx> proxy;  ///< set by connect()
   };
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;

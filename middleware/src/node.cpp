@@ -205,8 +205,9 @@ struct CoordinatorNode::Impl {
   Coordinator::SubscriptionId subscription = 0;
 
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
-      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, state_messages_published{0},
-      event_messages_published{0}, providers_lost{0}, duplicates_seen{0}, oversized_messages{0}, roots_truncated{0};
+      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, resubscriptions{0},
+      state_messages_published{0}, event_messages_published{0}, providers_lost{0}, duplicates_seen{0},
+      oversized_messages{0}, roots_truncated{0};
   OversizeLog record_oversize;  ///< publisher thread only
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
@@ -588,6 +589,9 @@ struct CoordinatorNode::Impl {
 
   // -- link thread --
   void link_loop() {
+    std::uint64_t link_checks = 0;
+    std::uint64_t failed_connects = 0;
+    std::int64_t last_down_report = 0;
     bool reported_down = false;
     std::int64_t connected_at = 0;
     const auto period = options.heartbeat;
@@ -609,21 +613,38 @@ struct CoordinatorNode::Impl {
           log("middleware: " + name + ": connected to IceStorm at " + options.ice.host + ":" +
               std::to_string(options.ice.port) + "; resynchronising");
           reported_down = false;
+          failed_connects = 0;
           mark_all(true);
           resync_pub->resync(resync_request(""));
           resyncs_requested.fetch_add(1);
         } catch (const Ice::Exception& e) {
-          if (!reported_down) {
+          // Said once, then every 5 s while it lasts, so a reconnection that keeps failing shows why.
+          const std::int64_t now = steady_ns();
+          ++failed_connects;
+          if (!reported_down || now - last_down_report > std::chrono::nanoseconds(std::chrono::seconds(5)).count()) {
             log("middleware: " + name + ": IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port) +
-                " unreachable (" + std::string(e.ice_id()) + "); running locally, retrying");
+                " unreachable (" + std::string(e.ice_id()) +
+                (reported_down ? ", " + std::to_string(failed_connects) + " attempts so far" : std::string()) +
+                "); running locally, retrying");
             reported_down = true;
+            last_down_report = now;
           }
           sleep_for(std::chrono::milliseconds(200));
           continue;
         }
       }
       try {
-        link->ping();
+        if (++link_checks % kResubscribeCheckEvery != 0) {
+          link->ping();
+        } else if (const std::vector<std::string> made = link->resubscribe_lost(); !made.empty()) {
+          // What arrived on those topics meanwhile is lost: every provider republishes its state.
+          log("middleware: " + name + ": IceStorm no longer held the subscription to " + join(made) +
+              " (dropped as undeliverable, or removed); subscribed again, resynchronising");
+          resubscriptions.fetch_add(made.size());
+          mark_all(true);
+          resync_pub->resync(resync_request(""));
+          resyncs_requested.fetch_add(1);
+        }
         heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, heartbeat())));
         honour_pending_resyncs();
         const std::int64_t now = steady_ns();
@@ -1141,6 +1162,7 @@ NodeStats CoordinatorNode::stats() const {
   s.events_dropped = d.events_dropped.load();
   s.resyncs_requested = d.resyncs_requested.load();
   s.connects = d.connects.load();
+  s.resubscriptions = d.resubscriptions.load();
   s.state_messages_published = d.state_messages_published.load();
   s.event_messages_published = d.event_messages_published.load();
   s.connected = d.connected.load();

@@ -599,6 +599,7 @@ struct Supervisor::Impl {
   }
 
   void link_loop() {
+    std::uint64_t link_checks = 0;
     bool connected = false;
     bool reported = false;
     while (running.load()) {
@@ -615,7 +616,14 @@ struct Supervisor::Impl {
           reported = false;
           print("supervisor: connected to IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port));
         }
-        link->ping();
+        if (++link_checks % kResubscribeCheckEvery != 0) {
+          link->ping();
+        } else if (const std::vector<std::string> made = link->resubscribe_lost(); !made.empty()) {
+          // What arrived on those topics meanwhile is lost: every coordinator republishes its state.
+          print("supervisor: IceStorm no longer held the subscription to " + join(made) +
+                " (dropped as undeliverable, or removed); subscribed again, resynchronising");
+          request_resync("");
+        }
         // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
         wire::Heartbeat h;
         h.coordinator = std::string(kSupervisorSigner);

@@ -519,6 +519,48 @@ std::optional<State> view_state(const middleware::Supervisor& s, const std::stri
   return std::nullopt;
 }
 
+// IceStorm drops a twoway subscriber whose delivery fails or times out (a process starved, or a
+// message it cannot decode), and anyone who reaches IceStorm can unsubscribe anybody: a process
+// that did not notice would go on with nothing reaching it. Here every subscription of the
+// provider's state topic and of the heartbeat topic is removed from outside.
+TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLongerHolds) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  ASSERT_TRUE(supervisor) << supervisor.error().message;
+  ASSERT_TRUE((*supervisor)->start());
+  ASSERT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
+      << out.all();
+  const middleware::Supervisor& sup = **supervisor;
+
+  std::size_t removed = 0;
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat"}) {
+    auto t = bus.topic(name);
+    for (const Ice::Identity& subscriber : t->getSubscribers()) {
+      t->unsubscribe(bus.ice->stringToProxy(Ice::identityToString(subscriber)));
+      ++removed;
+    }
+  }
+  ASSERT_GE(removed, 4u) << "the node and the supervisor each subscribe to both topics";
+  EXPECT_TRUE(eventually([&] { return bus.node->stats().resubscriptions >= 2; }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(
+      eventually([&] { return out.all().find("no longer held the subscription") != std::string::npos; }, 3000ms))
+      << out.all();
+  EXPECT_NE(bus.all_log().find("subscribed again, resynchronising"), std::string::npos) << bus.all_log();
+
+  // What the provider sends now reaches both views.
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; })) << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
+  (*supervisor)->stop();
+}
+
 TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;

@@ -24,6 +24,7 @@ namespace {
 
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 const std::string kSystem = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
 
@@ -166,8 +167,11 @@ public:
     return fail(ErrorCode::Denied, "no");
   }
 
+  std::uint64_t view_version() const override { return version; }
+
   SystemView v;
   std::vector<std::string> records;
+  std::uint64_t version = 0;
 };
 
 TEST(ViewerLiveDiff, ProtocolShowsALiveCoordinatorsStatusInTheViewAndPushesItsChanges) {
@@ -186,6 +190,27 @@ TEST(ViewerLiveDiff, ProtocolShowsALiveCoordinatorsStatusInTheViewAndPushesItsCh
   EXPECT_THAT(update, HasSubstr("\"coordinator:ui\":[\"Normal\",\"\"]"));
   EXPECT_THAT(update, HasSubstr("\"kind\":\"coordinator\""));
   EXPECT_EQ(protocol.update(1001), "");  // nothing new
+}
+
+// A live system's records announce a change before the state list that shows it is fetched: the
+// poll that takes the records can still see the old states, and the next one the new states with
+// no record. The page must get them then (once the viewer_ice test saw PENDANT stay Error).
+TEST(ViewerLiveDiff, ProtocolPushesStatesThatArriveInALaterPollThanTheirRecords) {
+  FakeSource source;
+  source.v.coordinators.push_back(
+      coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Error, "EVT_SERVICE_FAILURE"}}));
+  Protocol protocol(source, {});
+  (void)protocol.view_json();
+
+  source.records.push_back(coordinator_record("ui", "PENDANT Error -> Normal", 1.0));
+  const std::string with_record = protocol.update(1000);  // the state list is not fetched yet
+  EXPECT_THAT(with_record, Not(HasSubstr("\"PENDANT\":[\"Normal\"")));
+
+  source.v.coordinators.back() =
+      coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Normal, ""}});
+  ++source.version;  // the state list arrived, with no record in this poll
+  EXPECT_THAT(protocol.update(1010), HasSubstr("\"PENDANT\":[\"Normal\",\"\"]"));
+  EXPECT_EQ(protocol.update(1020), "");  // nothing new
 }
 
 }  // namespace

@@ -420,6 +420,8 @@ std::vector<std::string> MiddlewareSource::take_records() {
   return out;
 }
 
+std::uint64_t MiddlewareSource::view_version() const { return impl_->shown_version; }  // server thread, as poll()
+
 std::string MiddlewareSource::status(std::string_view coordinator) const {
   std::lock_guard lock(impl_->mutex);
   const MiddlewareLink* l = impl_->link_named(coordinator);

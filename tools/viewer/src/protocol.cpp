@@ -284,7 +284,11 @@ std::string Protocol::update(long long now_ms) {
   }
   listed += ']';
   std::string changed = "{";
-  if (!records.empty()) {  // every change of state comes with a record
+  // A change of state comes with a record, or (a live system's state list, fetched after the
+  // records that announced it) with a new view_version(): a state list that arrives in a later
+  // poll than its records must still reach the page.
+  if (!records.empty() || source_.view_version() != view_version_) {
+    view_version_ = source_.view_version();
     StateMap now = states_of(source_.view());
     for (const auto& [address, state] : now) {
       const auto it = sent_.find(address);

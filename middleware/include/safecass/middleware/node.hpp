@@ -136,7 +136,10 @@ struct NodeStats {
   std::uint64_t event_messages_published = 0;  ///< Ice messages carrying the event records
   std::uint64_t events_dropped = 0;            ///< observer queue overflow (never silent: counted here)
   std::uint64_t resyncs_requested = 0;
-  std::uint64_t connects = 0;          ///< successful (re)connections to IceStorm
+  std::uint64_t connects = 0;  ///< successful (re)connections to IceStorm
+  /// Subscriptions IceStorm no longer held (dropped as undeliverable, or removed from outside),
+  /// noticed within kResubscribeCheckEvery heartbeat periods and made again, with a resync.
+  std::uint64_t resubscriptions = 0;
   std::uint64_t messages_refused = 0;  ///< unauthenticated, forged, replayed or malformed bus messages
   std::uint64_t providers_lost = 0;    ///< times a provider coordinator was declared lost
   std::uint64_t duplicates_seen = 0;   ///< heartbeats of another process using this node's name

@@ -68,6 +68,8 @@ public:
   double now() const override;
   bool running() const override;
   std::vector<std::string> take_records() override;
+  /// Changes when poll() took new state lists or statuses: they arrive after their records.
+  std::uint64_t view_version() const override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
   [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
   [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;

@@ -85,8 +85,9 @@ private:
   std::map<std::string, std::pair<State, std::string>> sent_;  ///< last state pushed per address
   std::deque<std::string> recent_;
   long long last_time_ms_ = -1000000;
-  std::uint64_t generation_ = 0;  ///< the source's generation the pages were last greeted with
-  std::string last_replay_;       ///< the replay status last pushed
+  std::uint64_t generation_ = 0;    ///< the source's generation the pages were last greeted with
+  std::uint64_t view_version_ = 0;  ///< the source's view_version() when the states were last compared
+  std::string last_replay_;         ///< the replay status last pushed
 };
 
 }  // namespace safecass::viewer

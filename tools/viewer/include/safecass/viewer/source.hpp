@@ -136,6 +136,11 @@ public:
   [[nodiscard]] virtual Expected<std::string> control(const ReplayControl& /*control*/) {
     return fail(ErrorCode::InvalidArgument, "this viewer shows a running system, not a replay");
   }
+  /// Changes whenever view() may show other states than at the last call, when the change can come
+  /// without a record in the same poll(): a live system's state list arrives after the records
+  /// that announced it (MiddlewareSource). A source whose every change of state comes with a
+  /// record keeps the default.
+  virtual std::uint64_t view_version() const { return 0; }
   /// Changes whenever the source's picture started over (a replay went back in time): the
   /// records taken so far no longer lead to the current picture.
   virtual std::uint64_t generation() const { return 0; }
