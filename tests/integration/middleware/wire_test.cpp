@@ -170,7 +170,15 @@ struct Bus {
     node = std::move(*n);
     EXPECT_TRUE(node->start());
     EXPECT_TRUE(eventually([&] { return node->stats().connected; }, 10000ms));
-    std::this_thread::sleep_for(300ms);  // the node's subscriptions are in place
+    // The node's subscriptions are in place: IceStorm lists a subscriber on each of its topics.
+    EXPECT_TRUE(eventually(
+        [&] {
+          for (const char* t : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+            if (topic(t)->getSubscribers().empty()) return false;
+          }
+          return true;
+        },
+        10000ms));
   }
   ~Bus() {
     running.store(false);
