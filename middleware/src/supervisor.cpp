@@ -98,6 +98,7 @@ struct Supervisor::Impl {
   std::int64_t heartbeat_seq = 0;
   std::atomic<std::int64_t> resync_seq{0};
   std::atomic<bool> running{false};
+  std::atomic<std::int64_t> watching_since{0};  ///< steady_ns() of the first connection to IceStorm
   std::thread link_thread;
   std::thread watch_thread;
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
@@ -579,20 +580,28 @@ struct Supervisor::Impl {
       const std::int64_t now = steady_ns();
       report_gaps(now);
       refresh_missed();
+      // A coordinator of the system file that was never heard from is lost too, once the bound
+      // has passed since the supervisor connected: silence is never taken for health.
+      const std::int64_t since = watching_since.load();
       std::vector<std::pair<std::string, std::vector<std::string>>> lost_now;
+      std::vector<std::string> never_heard;
       {
         std::lock_guard lock(mutex);
         for (auto& [name, peer] : peers) {
-          if (!peer.seen || peer.lost) continue;
-          if (now - peer.last_heartbeat > std::chrono::nanoseconds(options.lost_after).count()) {
-            peer.lost = true;
-            lost_now.emplace_back(name, peer.components);
-          }
+          if (peer.lost) continue;
+          const std::int64_t last = peer.seen ? peer.last_heartbeat : since;
+          if (last == 0 || now - last <= std::chrono::nanoseconds(options.lost_after).count()) continue;
+          peer.lost = true;
+          lost_now.emplace_back(name, peer.components);
+          if (!peer.seen) never_heard.push_back(name);
         }
       }
       for (const auto& [name, components] : lost_now) {
+        const bool never = std::find(never_heard.begin(), never_heard.end(), name) != never_heard.end();
         print("supervisor: coordinator '" + name + "' lost: no heartbeat for " +
-              std::to_string(options.lost_after.count()) + " ms; EVT_COORDINATOR_LOST on its components");
+              std::to_string(options.lost_after.count()) + " ms" +
+              (never ? " (never heard from since the supervisor connected)" : "") +
+              "; EVT_COORDINATOR_LOST on its components");
         for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", c + ".s_F");
       }
     }
@@ -615,6 +624,9 @@ struct Supervisor::Impl {
           connected = true;
           reported = false;
           print("supervisor: connected to IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port));
+          // From now on every coordinator of the system file is watched, heard from or not.
+          std::int64_t unset = 0;
+          (void)watching_since.compare_exchange_strong(unset, steady_ns());
         }
         if (++link_checks % kResubscribeCheckEvery != 0) {
           link->ping();

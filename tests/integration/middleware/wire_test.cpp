@@ -527,6 +527,21 @@ std::optional<State> view_state(const middleware::Supervisor& s, const std::stri
   return std::nullopt;
 }
 
+/// A supervisor of the bus's system (records on) printing into `out`, started and waited for until
+/// it printed `ready` (by default: wire-p's first heartbeat seen); null when it did not start.
+std::unique_ptr<middleware::Supervisor> start_supervisor(Bus& bus, SupervisorOutput& out,
+                                                         const std::string& ready = "coordinator 'wire-p' is up") {
+  middleware::SupervisorOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
+  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
+  EXPECT_TRUE(supervisor) << supervisor.error().message;
+  if (!supervisor || !(*supervisor)->start()) return nullptr;
+  EXPECT_TRUE(eventually([&] { return out.all().find(ready) != std::string::npos; })) << out.all();
+  return std::move(*supervisor);
+}
+
 // IceStorm drops a twoway subscriber whose delivery fails or times out (a process starved, or a
 // message it cannot decode), and anyone who reaches IceStorm can unsubscribe anybody: a process
 // that did not notice would go on with nothing reaching it. Here every subscription of the
@@ -536,16 +551,9 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   Bus bus;
   ASSERT_TRUE(bus.node);
   SupervisorOutput out;
-  middleware::SupervisorOptions options;
-  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
-  options.keys_dir = bus.keys;
-  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
-  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
-  ASSERT_TRUE(supervisor) << supervisor.error().message;
-  ASSERT_TRUE((*supervisor)->start());
-  ASSERT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
-      << out.all();
-  const middleware::Supervisor& sup = **supervisor;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
 
   std::size_t removed = 0;
   for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat"}) {
@@ -566,7 +574,40 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; })) << bus.all_log();
   EXPECT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
-  (*supervisor)->stop();
+  supervisor->stop();
+}
+
+// A coordinator of the system file that never sends a heartbeat the supervisor can believe (not
+// started, or signing with a key the keyring does not hold) is lost once the bound has passed
+// since the supervisor connected, and recovers with its first authentic heartbeat.
+TEST(Wire, TheSupervisorReportsLostACoordinatorOfTheSystemItNeverHeardFrom) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(false);  // wire-p is silent from the start
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out, "supervisor: connected to IceStorm");
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+
+  // Heartbeats naming wire-p under a key the keyring does not hold are not believed either.
+  for (int i = 0; i < 10 && sup.lost().empty(); ++i) {
+    bus.beat(*bus.attacker, "wire-p", kIncarnation);
+    std::this_thread::sleep_for(100ms);
+  }
+  EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
+  EXPECT_EQ(sup.model().state(*sup.model().find_machine("P.s_F")), State::Error) << out.all();
+  EXPECT_NE(out.all().find("coordinator 'wire-p' lost: no heartbeat for 600 ms (never heard from since the "
+                           "supervisor connected)"),
+            std::string::npos)
+      << out.all();
+  EXPECT_EQ(out.all().find("coordinator 'wire-c' lost"), std::string::npos) << "wire-c beats: " << out.all();
+
+  bus.beating.store(true);  // its first authentic heartbeat: up, and recovered
+  EXPECT_TRUE(eventually([&] { return sup.lost().empty(); })) << out.all();
+  EXPECT_TRUE(eventually([&] { return sup.model().state(*sup.model().find_machine("P.s_F")) == State::Normal; }))
+      << out.all();
+  supervisor->stop();
 }
 
 TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack) {
@@ -574,16 +615,9 @@ TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack)
   Bus bus;
   ASSERT_TRUE(bus.node);
   SupervisorOutput out;
-  middleware::SupervisorOptions options;
-  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
-  options.keys_dir = bus.keys;
-  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
-  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
-  ASSERT_TRUE(supervisor) << supervisor.error().message;
-  ASSERT_TRUE((*supervisor)->start());
-  ASSERT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
-      << out.all();
-  const middleware::Supervisor& sup = **supervisor;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
 
   bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
@@ -598,7 +632,7 @@ TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack)
   EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
   EXPECT_NE(out.all().find("for P.D0: seq 2 not above 3 (replayed)"), std::string::npos) << out.all();
   EXPECT_NE(out.all().find("[wire-p] P.s_S.D0 Error (roots P.s_A:EVT_E)"), std::string::npos) << out.all();
-  (*supervisor)->stop();
+  supervisor->stop();
 }
 
 TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReportsMissedOnesAndLosesASilentCoordinator) {
@@ -708,16 +742,7 @@ std::unique_ptr<middleware::Supervisor> start_record_supervisor(Bus& bus, Superv
     std::lock_guard lock(bus.mutex);
     bus.events_sent = events_sent;
   }
-  middleware::SupervisorOptions options;
-  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
-  options.keys_dir = bus.keys;
-  options.output = [&out](const middleware::SupervisorLine& line) { out(line); };
-  auto supervisor = middleware::Supervisor::create(*bus.load.system, options);
-  EXPECT_TRUE(supervisor) << supervisor.error().message;
-  if (!supervisor || !(*supervisor)->start()) return nullptr;
-  EXPECT_TRUE(eventually([&] { return out.all().find("coordinator 'wire-p' is up") != std::string::npos; }))
-      << out.all();
-  return std::move(*supervisor);
+  return start_supervisor(bus, out);
 }
 
 /// wire-p's bus with a supervisor following its records (started once wire-p is up) and a sender

@@ -31,7 +31,8 @@ class SupervisorLine;
 struct SupervisorOptions {
   IceEndpoint ice;
   std::string listen_host = "127.0.0.1";
-  /// A coordinator is lost when no heartbeat arrived for this long.
+  /// A coordinator is lost when no heartbeat arrived for this long: since its last one, or, for
+  /// one never heard from, since the supervisor first connected to IceStorm.
   std::chrono::milliseconds lost_after{600};
   /// The system's bus keys (keys.hpp; the supervisor signs as "supervisor"). Empty: $SAFECASS_KEYS.
   std::string keys_dir;
