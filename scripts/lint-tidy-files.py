@@ -8,7 +8,8 @@ build tree, not generated). With --changed-since-baseline, only those that chang
 tidied baseline commit named in .ci/tidy-baseline (committed, staged, unstaged or untracked), and
 those that include a changed header by the path written in their #include; every source when
 .clang-tidy changed since then, or when the baseline commit is not in this clone's history. The
-baseline moves only after a clean whole-tree run (scripts/lint --tidy-all). Says on stderr which scope it chose and why. Standard library only.
+baseline moves only after a clean whole-tree run (scripts/lint --tidy-all). Says on stderr which
+scope it chose and why. Standard library only.
 """
 import json
 import os

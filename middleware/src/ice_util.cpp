@@ -156,13 +156,18 @@ void Link::ping() const {
   manager_->ice_ping();
 }
 
-std::string join(const std::vector<std::string>& names) {
-  std::string text;
-  for (const std::string& n : names) text += (text.empty() ? "" : ", ") + n;
-  return text;
+std::string resubscribed_line(const std::vector<std::string>& topics) {
+  std::string names;
+  for (const std::string& t : topics) names += (names.empty() ? "" : ", ") + t;
+  return "IceStorm no longer held the subscription to " + names +
+         " (dropped as undeliverable, or removed); subscribed again, resynchronising";
 }
 
-std::vector<std::string> Link::resubscribe_lost() {
+std::vector<std::string> Link::check() {
+  if (++checks_ % kResubscribeCheckEvery != 0) {
+    ping();
+    return {};
+  }
   if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
   std::vector<std::string> made;
   for (Subscription& s : subscriptions_) {

@@ -28,10 +28,10 @@ inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
 inline constexpr const char* kResyncTopic = "safecass.resync";
 
 /// Every this many heartbeat periods a process's link checks that IceStorm still holds each of
-/// its subscriptions (Link::resubscribe_lost); in between it only pings IceStorm.
+/// its subscriptions (Link::check); in between it only pings IceStorm.
 inline constexpr std::uint64_t kResubscribeCheckEvery = 3;
-/// "a, b, c": topic names in one log line.
-std::string join(const std::vector<std::string>& names);
+/// The log line (without the process's prefix) for subscriptions Link::check made again.
+std::string resubscribed_line(const std::vector<std::string>& topics);
 
 /// A communicator that fails fast (short connect and invocation timeouts, no retries) so that a
 /// dead IceStorm is noticed quickly; one dispatch thread keeps updates in order.
@@ -85,12 +85,14 @@ public:
   std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
   /// Throws when IceStorm does not answer.
   void ping() const;
-  /// Makes again every subscription that IceStorm no longer holds, and returns their topics (empty:
-  /// all were there). IceStorm drops a twoway subscriber whose delivery failed or timed out (a
-  /// process starved or stopped for longer than IceStorm's send timeout), and a subscription can
-  /// be removed from outside; without this check such a process would go on unaware that nothing
-  /// reaches it. Throws Ice exceptions when IceStorm cannot be reached (it also serves as ping()).
-  std::vector<std::string> resubscribe_lost();
+  /// Called once a heartbeat period: pings IceStorm, and every kResubscribeCheckEvery-th call
+  /// instead makes again each subscription IceStorm no longer holds, returning their topics (empty:
+  /// all were there; the caller resynchronises otherwise). IceStorm drops a twoway subscriber whose
+  /// delivery failed or timed out (a process starved or stopped for longer than IceStorm's send
+  /// timeout), and a subscription can be removed from outside; without this check such a process
+  /// would go on unaware that nothing reaches it. Throws Ice exceptions when IceStorm cannot be
+  /// reached.
+  std::vector<std::string> check();
 
 private:
   std::shared_ptr<Ice::Communicator> ic_;
@@ -105,6 +107,7 @@ private:
   };
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
+  std::uint64_t checks_ = 0;
 };
 
 }  // namespace safecass::middleware::detail

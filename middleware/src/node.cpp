@@ -589,7 +589,6 @@ struct CoordinatorNode::Impl {
 
   // -- link thread --
   void link_loop() {
-    std::uint64_t link_checks = 0;
     std::uint64_t failed_connects = 0;
     std::int64_t last_down_report = 0;
     bool reported_down = false;
@@ -634,12 +633,9 @@ struct CoordinatorNode::Impl {
         }
       }
       try {
-        if (++link_checks % kResubscribeCheckEvery != 0) {
-          link->ping();
-        } else if (const std::vector<std::string> made = link->resubscribe_lost(); !made.empty()) {
+        if (const std::vector<std::string> made = link->check(); !made.empty()) {
           // What arrived on those topics meanwhile is lost: every provider republishes its state.
-          log("middleware: " + name + ": IceStorm no longer held the subscription to " + join(made) +
-              " (dropped as undeliverable, or removed); subscribed again, resynchronising");
+          log("middleware: " + name + ": " + resubscribed_line(made));
           resubscriptions.fetch_add(made.size());
           mark_all(true);
           resync_pub->resync(resync_request(""));

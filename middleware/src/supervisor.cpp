@@ -583,8 +583,12 @@ struct Supervisor::Impl {
       // A coordinator of the system file that was never heard from is lost too, once the bound
       // has passed since the supervisor connected: silence is never taken for health.
       const std::int64_t since = watching_since.load();
-      std::vector<std::pair<std::string, std::vector<std::string>>> lost_now;
-      std::vector<std::string> never_heard;
+      struct Lost {
+        std::string name;
+        std::vector<std::string> components;
+        bool never_heard;
+      };
+      std::vector<Lost> lost_now;
       {
         std::lock_guard lock(mutex);
         for (auto& [name, peer] : peers) {
@@ -592,15 +596,13 @@ struct Supervisor::Impl {
           const std::int64_t last = peer.seen ? peer.last_heartbeat : since;
           if (last == 0 || now - last <= std::chrono::nanoseconds(options.lost_after).count()) continue;
           peer.lost = true;
-          lost_now.emplace_back(name, peer.components);
-          if (!peer.seen) never_heard.push_back(name);
+          lost_now.push_back(Lost{name, peer.components, !peer.seen});
         }
       }
-      for (const auto& [name, components] : lost_now) {
-        const bool never = std::find(never_heard.begin(), never_heard.end(), name) != never_heard.end();
+      for (const auto& [name, components, never_heard] : lost_now) {
         print("supervisor: coordinator '" + name + "' lost: no heartbeat for " +
               std::to_string(options.lost_after.count()) + " ms" +
-              (never ? " (never heard from since the supervisor connected)" : "") +
+              (never_heard ? " (never heard from since the supervisor connected)" : "") +
               "; EVT_COORDINATOR_LOST on its components");
         for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", c + ".s_F");
       }
@@ -608,7 +610,6 @@ struct Supervisor::Impl {
   }
 
   void link_loop() {
-    std::uint64_t link_checks = 0;
     bool connected = false;
     bool reported = false;
     while (running.load()) {
@@ -628,12 +629,9 @@ struct Supervisor::Impl {
           std::int64_t unset = 0;
           (void)watching_since.compare_exchange_strong(unset, steady_ns());
         }
-        if (++link_checks % kResubscribeCheckEvery != 0) {
-          link->ping();
-        } else if (const std::vector<std::string> made = link->resubscribe_lost(); !made.empty()) {
+        if (const std::vector<std::string> made = link->check(); !made.empty()) {
           // What arrived on those topics meanwhile is lost: every coordinator republishes its state.
-          print("supervisor: IceStorm no longer held the subscription to " + join(made) +
-                " (dropped as undeliverable, or removed); subscribed again, resynchronising");
+          print("supervisor: " + resubscribed_line(made));
           request_resync("");
         }
         // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
