@@ -278,7 +278,10 @@ wire::Signed Signer::sign(std::string_view kind, Ice::ByteSeq body) const {
   return m;
 }
 
-void DropLog::drop(const std::string& source, const std::string& what) {
+void DropLog::drop(const std::string& raw_source, const std::string& what) {
+  constexpr std::size_t kMaxSource = 64;
+  constexpr std::size_t kMaxLine = 1024;
+  const std::string source = raw_source.size() <= kMaxSource ? raw_source : printable(raw_source, kMaxSource);
   const std::int64_t now =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
   std::string line;
@@ -291,7 +294,7 @@ void DropLog::drop(const std::string& source, const std::string& what) {
       ++s.suppressed;
       return;
     }
-    line = what;
+    line = what.size() <= kMaxLine ? what : what.substr(0, kMaxLine) + "...(cut)";
     if (s.suppressed > 0) line += " (" + std::to_string(s.suppressed) + " more from this source in the last second)";
     s.last_logged = now;
     s.suppressed = 0;
@@ -304,10 +307,11 @@ std::uint64_t DropLog::count() const {
   return count_;
 }
 
-std::string printable(std::string_view text) {
+std::string printable(std::string_view text, std::size_t max) {
   std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
+  const std::string_view shown = text.substr(0, max);
+  out.reserve(shown.size() + 24);
+  for (const char c : shown) {
     const auto u = static_cast<unsigned char>(c);
     if (c == '\\') {
       out += "\\\\";
@@ -320,6 +324,7 @@ std::string printable(std::string_view text) {
       out += c;
     }
   }
+  if (shown.size() < text.size()) out += "...(+" + std::to_string(text.size() - shown.size()) + " bytes)";
   return out;
 }
 

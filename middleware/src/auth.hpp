@@ -93,7 +93,9 @@ std::string open_signed(const Keyring& keys, const std::shared_ptr<Ice::Communic
 }
 
 /// Counts refused messages and logs them, at most one line per source per second (a flood of
-/// forgeries must not become a flood of log lines), with the number suppressed since.
+/// forgeries must not become a flood of log lines), with the number suppressed since. Sources are
+/// kept capped (printable(source, 64)) and at most 256 of them, lines at most 1,024 bytes: memory
+/// and log growth stay bounded whatever arrives.
 class DropLog {
 public:
   explicit DropLog(std::function<void(const std::string&)> log) : log_(std::move(log)) {}
@@ -111,9 +113,12 @@ private:
   std::uint64_t count_ = 0;
 };
 
+/// The most bytes of one string from a message that printable() shows by default.
+inline constexpr std::size_t kMaxPrintable = 160;
 /// Escapes control characters and backslashes so that a string from a message can be printed on
-/// one line (a forged or odd name cannot inject lines into a log or a terminal).
-std::string printable(std::string_view text);
+/// one line (a forged or odd name cannot inject lines into a log or a terminal), and caps it: at
+/// most `max` bytes of it are shown, then "...(+N bytes)" (a 128 KB name is not a 128 KB line).
+std::string printable(std::string_view text, std::size_t max = kMaxPrintable);
 
 /// The freshness rule for incarnations, shared by every receiver: a message of an incarnation older
 /// than the newest seen from `who` is a replay, or a second process with that name. Returns why it

@@ -11,6 +11,7 @@
 #include "control.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
+#include "receiver.hpp"
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
@@ -29,9 +30,11 @@ ErrorCode code_of(const std::string& text) {
   return ErrorCode::InvalidArgument;
 }
 
-/// Waits for an authenticated heartbeat of one coordinator and keeps its Control proxy: the
-/// proxy a write token is sent to comes only from a message signed by that coordinator's key
-/// (a spoofed heartbeat naming it is refused here, so the token cannot be lured elsewhere).
+/// Waits for authenticated heartbeats of one coordinator and keeps the Control proxies they name:
+/// the proxy a write token is sent to comes only from a message signed by that coordinator's key
+/// (a spoofed heartbeat naming it is refused here), and is used only once the process there has
+/// proved itself alive by signing a nonce of ours (a replayed heartbeat of a dead process names
+/// an endpoint anyone may now serve).
 class Finder final : public wire::HeartbeatTopic {
 public:
   Finder(std::string coordinator, const Keyring& keys, std::shared_ptr<Ice::Communicator> ic)
@@ -45,6 +48,7 @@ public:
       return;
     }
     if (h.coordinator != coordinator_ || h.control.empty()) return;
+    if (std::find(tried_.begin(), tried_.end(), h.control) != tried_.end() || control_ == h.control) return;
     control_ = h.control;
     cv_.notify_all();
   }
@@ -52,10 +56,15 @@ public:
     std::lock_guard lock(mutex_);
     return refused_;
   }
-  std::string wait(std::chrono::milliseconds timeout) {
+  /// The next endpoint named by an authenticated heartbeat that was not tried yet (empty: none
+  /// came until `until`).
+  std::string next(std::chrono::steady_clock::time_point until) {
     std::unique_lock lock(mutex_);
-    cv_.wait_for(lock, timeout, [&] { return !control_.empty(); });
-    return control_;
+    cv_.wait_until(lock, until, [&] { return !control_.empty(); });
+    std::string out = std::move(control_);
+    control_.clear();
+    if (!out.empty() && tried_.size() < 64) tried_.push_back(out);
+    return out;
   }
 
 private:
@@ -66,6 +75,7 @@ private:
   std::mutex mutex_;
   std::condition_variable cv_;
   std::string control_;
+  std::vector<std::string> tried_;
 };
 
 }  // namespace
@@ -77,6 +87,7 @@ struct RemoteClient::Impl {
   std::unique_ptr<Keyring> keys;
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> gaps{0};
+  std::int64_t incarnation = 0;  ///< of the coordinator process proven alive at connect()
 
   ~Impl() {
     if (ic) ic->destroy();
@@ -122,41 +133,57 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     adapter->activate();
     auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), kHeartbeatTopic);
     subscribe(heartbeat, proxy);
-    const std::string control = finder->wait(o.timeout);
+    // Each endpoint an authentic heartbeat names is asked for a proof of life before anything
+    // else is sent to it; one that cannot give one (a replayed heartbeat of a dead process, an
+    // impostor on its port) is passed over for the next.
+    const auto until = std::chrono::steady_clock::now() + o.timeout;
+    std::shared_ptr<wire::ControlPrx> found;
+    std::string unproven;  // why the last endpoint tried was not taken
+    for (std::string control = finder->next(until); !control.empty(); control = finder->next(until)) {
+      auto prx = impl->ic->stringToProxy(control);
+      // Requests and the token go in clear over TCP: only to this host, unless the endpoint is TLS
+      // (mutual, with this system's CA) or the user accepts otherwise.
+      for (const auto& endpoint : prx->ice_getEndpoints()) {
+        auto info = endpoint->getInfo();
+        const bool secure = info != nullptr && info->secure();
+        while (info != nullptr && std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info) == nullptr)
+          info = info->underlying;
+        const auto ip = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info);
+        const bool allowed = ip != nullptr && (is_loopback_host(ip->host) || o.insecure || (secure && o.tls.enabled()));
+        if (!allowed) {
+          return fail(ErrorCode::Denied,
+                      "coordinator '" + o.coordinator + "' serves its operations at '" + printable(control) +
+                          "', which is not on this host and not TLS: refused "
+                          "without --insecure (requests and the token would cross the network unencrypted)");
+        }
+      }
+      auto candidate =
+          Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
+      auto beat = prove_now(impl->ic, *keys, o.coordinator, candidate);
+      if (!beat) {
+        unproven = beat.error().message;
+        continue;
+      }
+      impl->incarnation = beat->incarnation;
+      found = candidate;
+      break;
+    }
     try {
       heartbeat->unsubscribe(proxy);
     } catch (const Ice::Exception&) {
     }
     adapter->destroy();
-    if (control.empty()) {
+    if (found == nullptr) {
       const std::uint64_t refused = finder->refused();
       return fail(ErrorCode::Io,
                   "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " + o.ice.host +
                       ":" + std::to_string(o.ice.port) + " within " + std::to_string(o.timeout.count()) + " ms" +
+                      (unproven.empty() ? "" : " from a process that proved itself alive (" + unproven + ")") +
                       (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
     }
-    auto prx = impl->ic->stringToProxy(control);
-    // Requests and the token go in clear over TCP: only to this host, unless the endpoint is TLS
-    // (mutual, with this system's CA) or the user accepts otherwise.
-    for (const auto& endpoint : prx->ice_getEndpoints()) {
-      auto info = endpoint->getInfo();
-      const bool secure = info != nullptr && info->secure();
-      while (info != nullptr && std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info) == nullptr)
-        info = info->underlying;
-      const auto ip = std::dynamic_pointer_cast<Ice::IPEndpointInfo>(info);
-      const bool allowed = ip != nullptr && (is_loopback_host(ip->host) || o.insecure || (secure && o.tls.enabled()));
-      if (!allowed) {
-        return fail(ErrorCode::Denied,
-                    "coordinator '" + o.coordinator + "' serves its operations at '" + printable(control) +
-                        "', which is not on this host and not TLS: refused "
-                        "without --insecure (requests and the token would cross the network unencrypted)");
-      }
-    }
-    impl->control =
-        Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
+    impl->control = found;
     const std::string& credential = o.read_token.empty() ? o.token : o.read_token;
     if (!credential.empty()) impl->control = impl->control->ice_context({{kReadCredentialKey, credential}});
-    impl->control->ice_ping();
     impl->keys = std::make_unique<Keyring>(std::move(*keys));
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io, "cannot reach coordinator '" + o.coordinator + "': " + e.what());
@@ -200,7 +227,7 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
 class Follower final : public wire::EventTopic {
 public:
   Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
-      : client_(client), sink_(std::move(sink)), last_(last) {}
+      : client_(client), sink_(std::move(sink)), last_(last), incarnation_(client.incarnation) {}
 
   void records(wire::Signed batch, const Ice::Current&) override;
   /// Subscription::catch_up(): the records after the last delivered, from the history.
@@ -220,8 +247,8 @@ private:
   introspect::RecordSink sink_;
   std::mutex mutex_;  // stopped_ and the sink's calls
   bool stopped_ = false;
-  std::uint64_t last_;            ///< the last record delivered (its coordinator-wide seq)
-  std::int64_t incarnation_ = 0;  ///< of the coordinator process the records come from
+  std::uint64_t last_;        ///< the last record delivered (its coordinator-wide seq)
+  std::int64_t incarnation_;  ///< of the coordinator process proven alive, whose records are followed
 };
 
 class RemoteSubscription final : public introspect::Subscription {
@@ -268,9 +295,15 @@ void Follower::records(wire::Signed batch, const Ice::Current&) {
       continue;
     }
     if (m.incarnation > incarnation_) {
-      // A restarted coordinator numbers its records from 1 again.
-      if (incarnation_ != 0) last_ = 0;
+      // A process not proven alive: a restart of the coordinator (followed once the endpoint
+      // proves it), or a replay of a run that is over (refused).
+      auto beat = prove_now(client_.ic, *client_.keys, coordinator, client_.control);
+      if (!beat || beat->incarnation != m.incarnation) {
+        ++client_.refused;
+        continue;
+      }
       incarnation_ = m.incarnation;
+      last_ = 0;  // a restarted coordinator numbers its records from 1 again
     }
     const auto seq = static_cast<std::uint64_t>(m.recordSeq);
     if (seq <= last_) continue;  // already delivered (a gap filled from the history had it)
@@ -403,7 +436,7 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto proxy = adapter->addWithUUID(follower);
     adapter->activate();
     auto events = topic(topic_manager(impl_->ic, o.ice, o.tls), kEventTopic);
-    subscribe(events, proxy, Delivery::Stream);
+    subscribe(events, proxy);
     return std::unique_ptr<introspect::Subscription>(
         std::make_unique<RemoteSubscription>(follower, adapter, events, proxy));
   } catch (const Ice::Exception& e) {

@@ -65,6 +65,8 @@ public:
   explicit ControlServant(ControlContext c)
       : c_(std::move(c)), query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
 
+  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override { return c_.prove(nonce); }
+
   std::string coordinator(const Ice::Current& current) override {
     check_read(current);
     return c_.name;

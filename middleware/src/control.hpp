@@ -22,6 +22,8 @@ struct ControlContext {
   std::function<void(const std::string&)> log;
   std::string read_token;          ///< empty: reads are open to every local client
   introspect::LocalOptions clock;  ///< how its times read (NodeOptions::clock)
+  /// The process's signed proof of life for a receiver's nonce (Alive::prove).
+  std::function<wire::Signed(const Ice::ByteSeq& nonce)> prove;
 };
 
 /// The request-context key that carries the read credential.

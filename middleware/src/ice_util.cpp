@@ -62,6 +62,9 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
   init.properties->setProperty("Ice.RetryIntervals", "-1");
   init.properties->setProperty("Ice.Warn.Connections", "0");
+  // A message that fails to dispatch is counted and logged, rate-limited, by the servant's Guard
+  // (receiver.hpp): Ice's own warning would print a line for each one of a flood.
+  init.properties->setProperty("Ice.Warn.Dispatch", "0");
   init.properties->setProperty("Ice.ThreadPool.Server.Size", "1");
   init.properties->setProperty("Ice.ThreadPool.Server.SizeMax", "1");
   init.properties->setProperty("Ice.ACM.Client.Timeout", "0");
@@ -89,13 +92,9 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
   }
 }
 
-bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
-               Delivery delivery) {
-  IceStorm::QoS qos;
-  if (delivery == Delivery::Ordered) qos["reliability"] = "ordered";  // needs a twoway subscriber
+bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber) {
   try {
-    topic->subscribeAndGetPublisher(
-        qos, delivery == Delivery::Ordered ? subscriber->ice_twoway() : subscriber->ice_oneway());
+    topic->subscribeAndGetPublisher(IceStorm::QoS{}, subscriber->ice_oneway());
     return true;
   } catch (const IceStorm::AlreadySubscribed&) {
     return false;  // IceStorm kept the subscription (e.g. its database survived a restart)
@@ -136,7 +135,7 @@ void Link::connect(const std::vector<std::string>& publish_on) {
   manager_->ice_ping();
   for (Subscription& s : subscriptions_) {
     s.proxy = topic(manager_, s.topic);
-    (void)subscribe(s.proxy, s.subscriber, s.delivery);
+    (void)subscribe(s.proxy, s.subscriber);
   }
   publishers_.clear();
   for (const std::string& name : publish_on) {
@@ -172,7 +171,7 @@ std::vector<std::string> Link::check() {
   std::vector<std::string> made;
   for (Subscription& s : subscriptions_) {
     if (s.proxy == nullptr) s.proxy = topic(manager_, s.topic);
-    if (subscribe(s.proxy, s.subscriber, s.delivery)) made.push_back(s.topic);
+    if (subscribe(s.proxy, s.subscriber)) made.push_back(s.topic);
   }
   return made;
 }

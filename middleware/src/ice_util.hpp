@@ -46,16 +46,12 @@ std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<I
 /// Retrieves a topic, creating it when it does not exist yet.
 std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicManagerPrx>& manager,
                                           const std::string& name);
-/// How IceStorm delivers to a subscriber.
-enum class Delivery {
-  Ordered,  ///< twoway subscriber, "ordered" reliability: one event at a time, in order (heartbeats, resync)
-  Stream,   ///< oneway subscriber: batched, in order over one connection; a loss shows as a gap in
-            ///< sequence numbers and is repaired by a resync (state updates, event records)
-};
-/// Subscribes `subscriber`; an existing subscription is kept. Returns true when IceStorm did not
-/// hold it (a new subscription), false when it was already there.
-bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber,
-               Delivery delivery = Delivery::Ordered);
+/// Subscribes `subscriber` oneway (IceStorm's default reliability): batched, in order over one
+/// connection. A message the subscriber cannot decode fails there alone: IceStorm never learns of
+/// it, so one bad message drops nobody's subscription (a twoway subscriber whose dispatch fails is
+/// dropped). A loss shows as a gap in sequence numbers and is repaired by a resync. Returns true
+/// when IceStorm did not hold the subscription (a new one), false when it was already there.
+bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber);
 
 wire::Level to_wire(State s) noexcept;
 /// Errors: a value outside the enum (a malformed message).
@@ -75,9 +71,8 @@ public:
   Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice, TlsOptions tls = {})
       : ic_(std::move(ic)), ice_(std::move(ice)), tls_(std::move(tls)) {}
   /// Registers a subscriber of `topic` (used by every connect()).
-  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber,
-                    Delivery delivery = Delivery::Ordered) {
-    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), delivery, nullptr});
+  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber) {
+    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), nullptr});
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.
   void connect(const std::vector<std::string>& publish_on);
@@ -102,7 +97,6 @@ private:
   struct Subscription {
     std::string topic;
     std::shared_ptr<Ice::ObjectPrx> subscriber;
-    Delivery delivery;
     std::shared_ptr<IceStorm::TopicPrx> proxy;  ///< set by connect()
   };
   std::vector<Subscription> subscriptions_;

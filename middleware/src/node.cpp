@@ -16,6 +16,7 @@
 #include "control.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
+#include "receiver.hpp"
 #include "safecass/core/id_vector.hpp"
 #include "safecass/middleware/keys.hpp"
 
@@ -142,25 +143,26 @@ struct CoordinatorNode::Impl {
   /// A remote provided interface held here (under peer_mutex).
   struct Held {
     MachineId proxy;
-    std::string provider;  ///< the coordinator that runs the provider
-    std::int64_t incarnation = 0;
-    std::int64_t last_seq = 0;
-    bool behind = false;  ///< a heartbeat said we missed its last update
+    std::string provider;           ///< the coordinator that runs the provider
+    std::int64_t incarnation = 0;   ///< of the provider process whose update the held state is
+    std::int64_t last_seq = 0;      ///< the last update applied, of that incarnation
+    bool behind = false;            ///< a heartbeat said we missed its last update
+    std::int64_t behind_since = 0;  ///< steady ns of the first heartbeat that showed it behind (0: caught up)
   };
   std::map<std::string, Held, std::less<>> held;
   /// Another signer on the bus (a coordinator, or the supervisor), as its authenticated
   /// messages describe it (under peer_mutex).
   struct Peer {
-    std::int64_t incarnation = 0;    ///< the newest seen; older ones are replays or a duplicate
-    std::int64_t heartbeat_seq = 0;  ///< last accepted heartbeat of that incarnation
-    std::int64_t resync_seq = 0;     ///< last accepted resync request of that incarnation
-    std::int64_t last_resync = 0;    ///< when we last asked it to republish
-    std::int64_t last_beat = 0;      ///< steady ns of its last accepted heartbeat (0: never)
-    std::int64_t last_honoured = 0;  ///< when we last republished at its request
-    bool resync_pending = false;     ///< a request arrived too soon after the last one
-    bool provider = false;           ///< it runs a provider of an interface held here
-    bool lost = false;               ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
-    std::vector<MachineId> feeds;    ///< required interfaces here that it feeds
+    PeerFreshness fresh;                  ///< its proven process, heartbeats and state streams
+    std::int64_t resync_incarnation = 0;  ///< of its last accepted resync request
+    std::int64_t resync_seq = 0;          ///< last accepted resync request of that incarnation
+    std::int64_t last_resync = 0;         ///< when we last asked it to republish
+    std::int64_t last_beat = 0;           ///< steady ns of its last accepted heartbeat (0: never)
+    std::int64_t last_honoured = 0;       ///< when we last republished at its request
+    bool resync_pending = false;          ///< a request arrived too soon after the last one
+    bool provider = false;                ///< it runs a provider of an interface held here
+    bool lost = false;                    ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
+    std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
   std::mutex peer_mutex;  ///< held, peers; taken before the coordinator's lock, never after
@@ -172,9 +174,6 @@ struct CoordinatorNode::Impl {
   bool any_dirty = true;
   bool publisher_holds_events = false;  ///< the publisher has event records it has not sent yet
   static constexpr std::size_t kQueueCapacity = 65536;
-  /// The furthest a state stream may jump ahead in one update (even a signed one: a sequence
-  /// number cannot push a stream into the future and freeze it).
-  static constexpr std::int64_t kMaxSeqJump = std::int64_t{1} << 20;
   /// Updates (or records) per Ice message: one message carries every interface that changed.
   static constexpr std::size_t kMaxBatch = 256;
   /// How long event records may wait behind state updates.
@@ -194,11 +193,12 @@ struct CoordinatorNode::Impl {
   std::atomic<bool> connected{false};
   std::atomic<std::int64_t> last_own_heartbeat{0};
   std::atomic<std::int64_t> event_seq{0};
-  std::int64_t heartbeat_seq = 0;  ///< link thread
+  std::atomic<std::int64_t> heartbeat_seq{0};  ///< the last heartbeat sent
   std::atomic<std::int64_t> resync_seq{0};
   std::optional<Signer> signer;
   std::optional<Keyring> keyring;
-  std::unique_ptr<DropLog> drops;
+  std::shared_ptr<DropLog> drops;
+  std::unique_ptr<Prover> prover;  ///< proves peers' processes alive (destroyed after the communicator)
   std::thread watch_thread;
   std::thread publisher_thread;
   std::thread link_thread;
@@ -207,7 +207,7 @@ struct CoordinatorNode::Impl {
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
       events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, resubscriptions{0},
       state_messages_published{0}, event_messages_published{0}, providers_lost{0}, duplicates_seen{0},
-      oversized_messages{0}, roots_truncated{0};
+      oversized_messages{0}, roots_truncated{0}, updates_unproven{0};
   OversizeLog record_oversize;  ///< publisher thread only
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
@@ -674,12 +674,14 @@ struct CoordinatorNode::Impl {
     return signer->sign(kKindResync, encode(ic, r));
   }
 
-  wire::Heartbeat heartbeat() {
+  /// The next heartbeat (`next`), or the current one, as the last heartbeat sent said it, with
+  /// the streams' numbers of now (a proof of life).
+  wire::Heartbeat heartbeat(bool next = true) {
     wire::Heartbeat h;
     h.coordinator = name;
     h.incarnation = incarnation;
     h.time = steady_ns();
-    h.seq = ++heartbeat_seq;
+    h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
     for (const auto& s : streams) h.lastSeq["state:" + s->iface] = s->seq.load();
     h.lastSeq["events"] = event_seq.load();
     for (ComponentId c : id_range<ComponentId>(co.component_count())) {
@@ -698,22 +700,6 @@ struct CoordinatorNode::Impl {
   /// Refuses a message: counted, logged (rate-limited per source).
   void refuse(const std::string& source, const std::string& what) {
     drops->drop(source, "middleware: " + name + ": refused " + what);
-  }
-
-  /// The freshness rule shared by every stream: an incarnation older than the newest seen from
-  /// that signer is a replay (or a second process with the same name, which the heartbeat
-  /// reports); a newer one is a restart. Returns false when the message must be dropped.
-  bool fresh_incarnation(Peer& peer, std::int64_t seen, const std::string& from, std::string_view what) {
-    if (const std::string why = older_incarnation(what, from, seen, peer.incarnation); !why.empty()) {
-      refuse(from, why);
-      return false;
-    }
-    if (seen > peer.incarnation) {
-      peer.incarnation = seen;
-      peer.heartbeat_seq = 0;
-      peer.resync_seq = 0;
-    }
-    return true;
   }
 
   void on_updates(const wire::Signed& m) {
@@ -747,29 +733,23 @@ struct CoordinatorNode::Impl {
       return;
     }
     Peer& peer = peers[u.coordinator];
-    if (!fresh_incarnation(peer, u.incarnation, from, "a state update")) {
-      updates_rejected.fetch_add(1);
-      return;
+    std::int64_t missed = 0;
+    std::string why;
+    switch (peer.fresh.stream("state:" + u.iface, u.incarnation, u.seq, missed, why)) {
+      case PeerFreshness::Verdict::Accept: break;
+      case PeerFreshness::Verdict::Unproven:
+        // A process not proven alive yet (a restart, or a replay of an earlier run): its state is
+        // taken once its heartbeat is proven, from a republish.
+        updates_unproven.fetch_add(1);
+        return;
+      case PeerFreshness::Verdict::Refuse:
+        updates_rejected.fetch_add(1);
+        refuse(from, what() + ": " + why);
+        return;
     }
-    if (u.incarnation != h.incarnation) {
-      h.incarnation = u.incarnation;
-      h.last_seq = 0;
-    }
-    if (u.seq <= h.last_seq) {
-      updates_rejected.fetch_add(1);
-      refuse(from, what() + ": stale or repeated (last applied " + std::to_string(h.last_seq) + ")");
-      return;
-    }
-    if (u.seq - h.last_seq > kMaxSeqJump) {
-      updates_rejected.fetch_add(1);
-      refuse(from, what() + ": jumps more than " + std::to_string(kMaxSeqJump) + " ahead of " +
-                       std::to_string(h.last_seq) + "; asking for a republish instead");
-      h.behind = true;
-      return;
-    }
-    if (h.last_seq != 0 && u.seq != h.last_seq + 1) {
-      updates_missed.fetch_add(static_cast<std::uint64_t>(u.seq - h.last_seq - 1));
-      log("middleware: " + name + ": " + what() + ": " + std::to_string(u.seq - h.last_seq - 1) +
+    if (missed > 0 && h.incarnation == u.incarnation) {
+      updates_missed.fetch_add(static_cast<std::uint64_t>(missed));
+      log("middleware: " + name + ": " + what() + ": " + std::to_string(missed) +
           " update(s) missed; this full state supersedes them");
     }
     std::vector<RemoteRoot> roots;
@@ -798,8 +778,10 @@ struct CoordinatorNode::Impl {
       refuse(from, what() + ": nothing changed: " + applied.error().message);
       return;
     }
+    h.incarnation = u.incarnation;
     h.last_seq = u.seq;
     h.behind = false;
+    h.behind_since = 0;
     updates_applied.fetch_add(1);
   }
 
@@ -827,18 +809,47 @@ struct CoordinatorNode::Impl {
       }
       return;
     }
-    std::lock_guard lock(peer_mutex);
-    Peer& peer = peers[hb.coordinator];
-    const std::int64_t known = peer.incarnation;
-    if (!fresh_incarnation(peer, hb.incarnation, m.signer, "a heartbeat")) return;
-    if (hb.seq <= peer.heartbeat_seq) {
-      refuse(m.signer, "a heartbeat of '" + printable(hb.coordinator) + "': seq " + std::to_string(hb.seq) +
-                           " not above " + std::to_string(peer.heartbeat_seq) + " (replayed)");
+    if (const std::string why = incarnation_out_of_bounds("a heartbeat", m.signer, hb.incarnation); !why.empty()) {
+      refuse(m.signer + "/incarnation", why);  // its own line: not hidden behind another refusal
       return;
     }
-    peer.heartbeat_seq = hb.seq;
+    std::lock_guard lock(peer_mutex);
+    Peer& peer = peers[hb.coordinator];  // a keyring name: bounded
+    std::string why;
+    switch (peer.fresh.heartbeat(hb.incarnation, hb.seq, why)) {
+      case PeerFreshness::Verdict::Accept: break;
+      case PeerFreshness::Verdict::Unproven:
+        // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
+        prover->ask(hb.coordinator, hb.control);
+        return;
+      case PeerFreshness::Verdict::Refuse:
+        refuse(m.signer, "a heartbeat of '" + printable(hb.coordinator) + "': " + why);
+        return;
+    }
+    believe(hb, peer, now, false);
+  }
+
+  /// A proof of life of `who` (Prover, on an Ice thread): its process is believed from now on.
+  void on_proven(const std::string& who, const wire::Heartbeat& beat) {
+    std::lock_guard lock(peer_mutex);
+    Peer& peer = peers[who];
+    const std::int64_t before = peer.fresh.incarnation();
+    if (std::string why; !peer.fresh.proven(beat, why)) {
+      refuse(who, "a proof of life of '" + printable(who) + "': " + why);
+      return;
+    }
+    if (peer.provider && before != beat.incarnation) {
+      log("middleware: " + name + ": coordinator '" + who + "' proved alive (incarnation " +
+          std::to_string(beat.incarnation) + ")");
+    }
+    believe(beat, peer, steady_ns(), true);
+  }
+
+  /// An authentic, fresh heartbeat of `peer` (under peer_mutex): it is alive; what it lists
+  /// sent that is not held here is asked for, and a loss clears once everything is held.
+  void believe(const wire::Heartbeat& hb, Peer& peer, std::int64_t now, bool proof) {
     peer.last_beat = now;
-    bool need = known != 0 && known != hb.incarnation;
+    bool need = proof;  // a process just proven: nothing it sent before is taken, ask for all
     bool caught_up = true;
     for (auto& [iface, h] : held) {
       if (h.provider != hb.coordinator) continue;
@@ -850,8 +861,14 @@ struct CoordinatorNode::Impl {
       // provider is asked at once: its clients stay in Error until they have its state.
       if (behind && (h.behind || peer.lost)) need = true;
       h.behind = behind;
+      if (!behind) {
+        h.behind_since = 0;
+      } else if (h.behind_since == 0) {
+        h.behind_since = now;  // lost if not caught up within the loss bound (watch_loop)
+      }
     }
     if (peer.lost && caught_up) recover(hb.coordinator, peer);
+    if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
     std::shared_ptr<wire::ResyncTopicPrx> pub;
@@ -863,7 +880,9 @@ struct CoordinatorNode::Impl {
     try {
       pub->resync(resync_request(hb.coordinator));
       resyncs_requested.fetch_add(1);
-      log("middleware: " + name + ": missed state of coordinator '" + hb.coordinator + "'; asked it to republish");
+      if (!proof) {
+        log("middleware: " + name + ": missed state of coordinator '" + hb.coordinator + "'; asked it to republish");
+      }
     } catch (const Ice::Exception&) {
       // The link thread notices and reconnects.
     }
@@ -885,7 +904,23 @@ struct CoordinatorNode::Impl {
     {
       std::lock_guard lock(peer_mutex);
       Peer& peer = peers[r.requester];
-      if (!fresh_incarnation(peer, r.incarnation, m.signer, "a resync request")) return;
+      // A resync request only asks for a republish: its own numbers keep replays from costing
+      // more than one, and say nothing of whether its sender is alive.
+      if (r.incarnation < peer.resync_incarnation) {
+        refuse(m.signer,
+               "a resync request of '" + printable(r.requester) +
+                   "': " + older_incarnation("a resync request", r.requester, r.incarnation, peer.resync_incarnation));
+        return;
+      }
+      if (r.incarnation > peer.resync_incarnation) {
+        if (const std::string why = incarnation_out_of_bounds("a resync request", r.requester, r.incarnation);
+            !why.empty()) {
+          refuse(m.signer, why);
+          return;
+        }
+        peer.resync_incarnation = r.incarnation;
+        peer.resync_seq = 0;
+      }
       if (r.seq <= peer.resync_seq) {
         refuse(m.signer, "a resync request of '" + printable(r.requester) + "': seq " + std::to_string(r.seq) +
                              " not above " + std::to_string(peer.resync_seq) + " (replayed)");
@@ -925,11 +960,10 @@ struct CoordinatorNode::Impl {
   // -- watch thread: fail toward safe on loss (DESIGN §4) --
 
   /// Raises the loss of a peer (under peer_mutex; the coordinator's lock is taken after it).
-  void declare_lost(const std::string& who, Peer& peer, std::int64_t silent_ns) {
+  void declare_lost(const std::string& who, Peer& peer, const std::string& silent) {
     peer.lost = true;
-    const std::string silent = std::to_string(silent_ns / 1'000'000) + " ms";
     if (who == kSupervisorSigner) {
-      log("middleware: " + name + ": the supervisor is gone (no heartbeat for " + silent +
+      log("middleware: " + name + ": the supervisor is gone (" + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
       for (ComponentId c : id_range<ComponentId>(co.component_count())) {
         if (!co.is_remote(c)) co.generate(framework_event::kSupervisorLost, co.framework_machine(c));
@@ -937,8 +971,8 @@ struct CoordinatorNode::Impl {
       return;
     }
     providers_lost.fetch_add(1);
-    log("middleware: " + name + ": coordinator '" + who + "' lost (no heartbeat for " + silent +
-        "); EVT_COORDINATOR_LOST on the " + std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
+    log("middleware: " + name + ": coordinator '" + who + "' lost (" + silent + "); EVT_COORDINATOR_LOST on the " +
+        std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
     for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
   }
 
@@ -971,7 +1005,21 @@ struct CoordinatorNode::Impl {
         const bool watched = peer.provider || (who == kSupervisorSigner && peer.last_beat != 0);
         if (!watched) continue;
         const std::int64_t since = peer.last_beat != 0 ? peer.last_beat : started;
-        if (now - since > bound) declare_lost(who, peer, now - since);
+        if (now - since > bound) {
+          declare_lost(who, peer,
+                       (peer.last_beat != 0 ? "no heartbeat for " : "no heartbeat proven alive for ") +
+                           std::to_string((now - since) / 1'000'000) + " ms");
+          continue;
+        }
+        // A stream its heartbeats show ahead of what is held here, not caught up within the
+        // bound (a lost subscription, updates dropped on the way): as bad as a silent provider.
+        for (const auto& [iface, h] : held) {
+          if (h.provider != who || h.behind_since == 0 || now - h.behind_since <= bound) continue;
+          declare_lost(who, peer,
+                       "its heartbeats list state of " + iface + " not received for " +
+                           std::to_string((now - h.behind_since) / 1'000'000) + " ms");
+          break;
+        }
       }
     }
   }
@@ -1041,7 +1089,7 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   impl->keyring = std::move(*keyring);
   impl->signer = std::move(*signer);
   Impl* d = impl.get();
-  impl->drops = std::make_unique<DropLog>([d](const std::string& line) { d->log(line); });
+  impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->log(line); });
   impl->incarnation = new_incarnation();
   impl->streams_of.resize(coordinator.component_count());
   for (ComponentId c : id_range<ComponentId>(coordinator.component_count())) {
@@ -1090,19 +1138,31 @@ Expected<void> CoordinatorNode::start() {
                                  (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);
     const std::string id = "safecass-" + d.name + "-" + std::to_string(d.incarnation);
-    auto state = d.adapter->add(std::make_shared<StateServant>(d), Ice::Identity{"state", id});
-    auto heartbeat = d.adapter->add(std::make_shared<HeartbeatServant>(d), Ice::Identity{"heartbeat", id});
-    auto resync = d.adapter->add(std::make_shared<ResyncServant>(d), Ice::Identity{"resync", id});
-    ControlContext context{d.co,
-                           d.monitor,
-                           d.registry,
-                           d.name,
-                           d.options.allow_write,
-                           d.options.token,
-                           [&d](const std::string& line) { d.log(line); },
-                           d.options.read_token,
-                           d.options.clock};
-    auto control = d.adapter->add(make_control(context), Ice::Identity{"control-" + d.name, "safecass"});
+    const std::string who = "middleware: " + d.name;
+    d.prover = std::make_unique<Prover>(
+        d.ic, *d.keyring, [&d](const std::string& signer, const wire::Heartbeat& beat) { d.on_proven(signer, beat); },
+        [&d](const std::string& signer, const std::string& why) {
+          d.drops->drop(signer, "middleware: " + d.name + ": '" + printable(signer) + "' not proven alive: " + why);
+        },
+        d.options.heartbeat);
+    auto guarded = [&](std::shared_ptr<Ice::Object> servant) {
+      return std::make_shared<Guard>(std::move(servant), d.drops, who);
+    };
+    auto state = d.adapter->add(guarded(std::make_shared<StateServant>(d)), Ice::Identity{"state", id});
+    auto heartbeat = d.adapter->add(guarded(std::make_shared<HeartbeatServant>(d)), Ice::Identity{"heartbeat", id});
+    auto resync = d.adapter->add(guarded(std::make_shared<ResyncServant>(d)), Ice::Identity{"resync", id});
+    ControlContext context{
+        d.co,
+        d.monitor,
+        d.registry,
+        d.name,
+        d.options.allow_write,
+        d.options.token,
+        [&d](const std::string& line) { d.log(line); },
+        d.options.read_token,
+        d.options.clock,
+        [&d](const Ice::ByteSeq& nonce) { return make_proof(*d.signer, d.ic, nonce, d.heartbeat(false)); }};
+    auto control = d.adapter->add(guarded(make_control(context)), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
     std::vector<std::string> providers;  // the coordinators whose interfaces this one holds
@@ -1111,7 +1171,7 @@ Expected<void> CoordinatorNode::start() {
         providers.push_back(h.provider);
       }
     }
-    for (const std::string& provider : providers) d.link->subscribe_to(state_topic(provider), state, Delivery::Stream);
+    for (const std::string& provider : providers) d.link->subscribe_to(state_topic(provider), state);
     d.link->subscribe_to(kHeartbeatTopic, heartbeat);
     d.link->subscribe_to(kResyncTopic, resync);
     d.adapter->activate();
@@ -1167,6 +1227,7 @@ NodeStats CoordinatorNode::stats() const {
   s.duplicates_seen = d.duplicates_seen.load();
   s.oversized_messages = d.oversized_messages.load();
   s.roots_truncated = d.roots_truncated.load();
+  s.updates_unproven = d.updates_unproven.load();
   return s;
 }
 

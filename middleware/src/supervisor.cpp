@@ -15,6 +15,7 @@
 #include "auth.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
+#include "receiver.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
@@ -61,26 +62,29 @@ struct Supervisor::Impl {
   struct Peer {
     std::vector<std::string> components;
     std::int64_t last_heartbeat = 0;
-    std::int64_t incarnation = 0;
+    PeerFreshness fresh;  ///< its proven process, heartbeats and state streams
+    /// The newest incarnation heard from but not proven yet, and the lowest number of its records
+    /// it was heard to have sent (its first heartbeat's list, or its first record's number - 1):
+    /// what it sent above that before its proof was not taken, and is reported missed.
+    std::int64_t unproven_incarnation = 0;
+    std::int64_t unproven_floor = 0;
     std::int64_t last_event_seq = 0;  ///< the highest record seq received (or listed when joining)
     std::vector<Gap> gaps;            ///< below last_event_seq, oldest first
     std::vector<Gap> reported;        ///< gaps reported missed (the newest kMaxGaps), oldest first
-    /// Where the supervisor joined this incarnation's record stream: at its first heartbeat (which
-    /// lists the last record sent, so a record lost after it is a gap, even the first ones) or at
-    /// its first record, whichever came first. Records up to joined_at were sent before; any still
-    /// on their way are accepted, in order, above before_join.
+    /// Where the supervisor joined this incarnation's record stream: at the proof of life of the
+    /// process (which lists the last record sent, so a record lost after it is a gap, even the
+    /// first ones). Records up to joined_at were sent before: any still on their way are not
+    /// taken (they cannot be told from replays); those sent since the supervisor first heard of
+    /// the process were reported missed at the proof.
     bool joined = false;
     std::int64_t joined_at = 0;
-    std::int64_t before_join = 0;
-    std::int64_t heartbeat_seq = 0;
     bool events_behind = false;  ///< the last heartbeat listed event records not received
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool seen = false;
     bool lost = false;
-    /// Last state update applied per interface ("C.p") of this incarnation.
-    TextMap<std::int64_t> state_seq;
-    bool states_behind = false;  ///< the last heartbeat listed state updates not received
+    bool states_behind = false;     ///< the last heartbeat listed state updates not received
+    std::int64_t behind_since = 0;  ///< steady ns since its heartbeats list state not received (0: none)
   };
   mutable std::mutex mutex;
   std::map<std::string, Peer, std::less<>> peers;
@@ -93,9 +97,12 @@ struct Supervisor::Impl {
   std::mutex link_mutex;  ///< resync_pub, written by the link thread, read by the dispatch thread
   std::optional<Signer> signer;
   std::optional<Keyring> keyring;
-  std::unique_ptr<DropLog> drops;
+  std::shared_ptr<DropLog> drops;
+  std::unique_ptr<Prover> prover;  ///< proves coordinators alive (destroyed after the communicator)
+  std::unique_ptr<Members> members;
+  std::string alive;  ///< the proxy of its Alive object, named in its heartbeats
   std::int64_t incarnation = new_incarnation();
-  std::int64_t heartbeat_seq = 0;
+  std::atomic<std::int64_t> heartbeat_seq{0};
   std::atomic<std::int64_t> resync_seq{0};
   std::atomic<bool> running{false};
   std::atomic<std::int64_t> watching_since{0};  ///< steady_ns() of the first connection to IceStorm
@@ -107,6 +114,7 @@ struct Supervisor::Impl {
   std::string late_note;  ///< dispatch thread: the note of a record printed late
   std::string address_scratch;
   std::string note_scratch;
+  std::string stream_scratch;
 
   Impl(const spec::SystemSpec& s, SupervisorOptions o) : system(s), options(std::move(o)) {}
 
@@ -149,35 +157,75 @@ struct Supervisor::Impl {
     return true;
   }
 
-  /// The freshness rule (see node.cpp): an older incarnation is a replay or a duplicate name.
-  /// Under `mutex`. A newer incarnation is a restart: the view of that coordinator is dropped
-  /// (its republished state replaces it) and it is asked to republish.
-  bool fresh(Peer& peer, const std::string& who, std::int64_t seen, std::string_view what) {
-    if (const std::string why = older_incarnation(what, who, seen, peer.incarnation); !why.empty()) {
-      refuse(who, why);
-      return false;
+  /// A process not proven yet, of `incarnation`, was heard to have sent `sent` records (under
+  /// `mutex`): see Peer::unproven_floor.
+  static void heard_unproven(Peer& peer, std::int64_t incarnation, std::int64_t sent) {
+    if (incarnation < peer.unproven_incarnation) return;
+    if (incarnation > peer.unproven_incarnation) {
+      peer.unproven_incarnation = incarnation;
+      peer.unproven_floor = sent;
+    } else {
+      peer.unproven_floor = std::min(peer.unproven_floor, sent);
     }
-    if (seen > peer.incarnation) {
-      const bool restart = peer.incarnation != 0;
-      peer.incarnation = seen;
-      peer.last_event_seq = 0;
-      peer.gaps.clear();
-      peer.reported.clear();
-      peer.joined = false;
-      peer.joined_at = 0;
-      peer.before_join = 0;
-      peer.heartbeat_seq = 0;
-      peer.state_seq.clear();
-      peer.states_behind = false;
-      if (restart) {
-        for (auto it = view.begin(); it != view.end();) {
-          it = it->second.coordinator == who ? view.erase(it) : std::next(it);
-        }
-        print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
-        request_resync(who);
+  }
+
+  /// A stream message of incarnation `seen` of `who` (under `mutex`): true when it is of the process
+  /// proven alive. An older one is a replay (refused); a newer one is a process not proven alive
+  /// yet, dropped until its heartbeat is proven (receiver.hpp).
+  bool current(Peer& peer, const std::string& who, std::int64_t seen, std::string_view what) {
+    if (seen == peer.fresh.incarnation()) return true;
+    if (seen < peer.fresh.incarnation()) refuse(who, older_incarnation(what, who, seen, peer.fresh.incarnation()));
+    return false;
+  }
+
+  /// `beat` of `who` was proven by an answer to our nonce (Prover, on an Ice thread).
+  void on_proven(const std::string& who, const wire::Heartbeat& beat) {
+    bool resync = false;
+    std::vector<std::string> recovered;
+    {
+      std::lock_guard lock(mutex);
+      const auto p = peers.find(who);
+      if (p == peers.end()) return;
+      Peer& peer = p->second;
+      const std::int64_t known = peer.fresh.incarnation();
+      if (std::string why; !peer.fresh.proven(beat, why)) {
+        refuse(who, "a proof of life of '" + printable(who) + "': " + why);
+        return;
       }
+      if (beat.incarnation != known) {
+        // A new process: what the view held of an earlier one goes; its records join at what the
+        // proof lists as sent, and those it sent before (dropped, unproven) are reported missed.
+        if (known != 0) {
+          for (auto it = view.begin(); it != view.end();) {
+            it = it->second.coordinator == who ? view.erase(it) : std::next(it);
+          }
+          print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
+        }
+        const auto sent = beat.lastSeq.find("events");
+        const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
+        peer.joined = options.records;
+        peer.joined_at = joined;
+        peer.last_event_seq = joined;
+        peer.gaps.clear();
+        peer.reported.clear();
+        peer.events_behind = false;
+        peer.states_behind = false;
+        peer.behind_since = 0;
+        const std::int64_t heard =
+            peer.unproven_incarnation == beat.incarnation ? std::min(peer.unproven_floor, joined) : joined;
+        if (options.records && heard < joined) {
+          print("supervisor: " + std::to_string(joined - heard) + " event record(s) of '" + printable(who) +
+                "' missed (seq " + seq_range(Gap{heard + 1, joined, 0}) +
+                ", sent before it proved itself alive to the supervisor); its view is read again");
+          peer.refresh = true;
+        }
+        peer.unproven_incarnation = 0;
+        resync = true;
+      }
+      believe(beat, peer, recovered, resync);
     }
-    return true;
+    if (resync) request_resync(who);
+    announce_recovered(who, recovered);
   }
 
   void request_resync(const std::string& who) {
@@ -299,6 +347,13 @@ struct Supervisor::Impl {
         return;
       }
     }
+    // A member speaks only for the components the system file assigns to it.
+    for (const std::string* named : {&m.component, &m.machine}) {
+      if (named->empty() || members->runs(m.coordinator, Members::component_of(*named))) continue;
+      refuse(sender, "an event record of '" + printable(m.coordinator) + "' about '" + printable(*named) +
+                         "', a component it does not run");
+      return;
+    }
     bool late = false;  // below a record received before it: printed as late
     {
       std::lock_guard lock(mutex);
@@ -309,13 +364,24 @@ struct Supervisor::Impl {
         return;
       }
       Peer& peer = p->second;
-      if (!fresh(peer, m.coordinator, m.incarnation, "an event record")) return;
+      if (!current(peer, m.coordinator, m.incarnation, "an event record")) {
+        if (m.incarnation > peer.fresh.incarnation()) heard_unproven(peer, m.incarnation, m.seq - 1);
+        return;
+      }
+      if (m.seq - std::max(peer.last_event_seq, peer.joined_at) > kMaxSeqJump) {
+        refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                           " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
+        return;
+      }
       if (!peer.joined) {
         peer.joined = true;
         peer.joined_at = m.seq - 1;
         peer.last_event_seq = m.seq;
-      } else if (m.seq <= peer.joined_at && m.seq > peer.before_join) {
-        peer.before_join = m.seq;  // sent before the supervisor joined, still on its way
+      } else if (m.seq <= peer.joined_at) {
+        // Sent before the process proved itself alive to the supervisor, still on its way: it may
+        // as well be a replay of an older record, so it is not taken (reported missed at the
+        // proof when sent since the supervisor first heard of the process).
+        return;
       } else if (m.seq <= peer.last_event_seq) {
         late = true;  // it fills a gap below a record received before it
         if (!fill_gap(peer, m.coordinator, m.seq)) {
@@ -395,17 +461,25 @@ struct Supervisor::Impl {
         refuse(from, "a state update of '" + printable(u.coordinator) + "', which is not a coordinator of the system");
         return;
       }
-      if (!fresh(p->second, u.coordinator, u.incarnation, "a state update")) return;
-      // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
-      // applied is a replay (or a duplicate) and must not bring back an older state.
-      auto seq = p->second.state_seq.find(u.iface);
-      if (seq == p->second.state_seq.end()) seq = p->second.state_seq.emplace(u.iface, 0).first;
-      if (u.seq <= seq->second) {
-        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": seq " +
-                         std::to_string(u.seq) + " not above " + std::to_string(seq->second) + " (replayed)");
+      if (!members->runs(u.coordinator, Members::component_of(u.iface))) {
+        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) +
+                         ", a component it does not run");
         return;
       }
-      seq->second = u.seq;  // a gap needs nothing more: this full state supersedes what was missed
+      // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
+      // applied is a replay (or a duplicate) and must not bring back an older state; a gap needs
+      // nothing more: this full state supersedes what was missed.
+      std::string& stream = stream_scratch;
+      stream.assign("state:").append(u.iface);
+      std::int64_t missed = 0;
+      std::string why;
+      switch (p->second.fresh.stream(stream, u.incarnation, u.seq, missed, why)) {
+        case PeerFreshness::Verdict::Accept: break;
+        case PeerFreshness::Verdict::Unproven: return;  // taken from its republish once proven
+        case PeerFreshness::Verdict::Refuse:
+          refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": " + why);
+          return;
+      }
       auto row = view.find(address);
       if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
       ViewRow& r = row->second;
@@ -433,6 +507,10 @@ struct Supervisor::Impl {
       }
       return;
     }
+    if (const std::string why = incarnation_out_of_bounds("a heartbeat", h.coordinator, h.incarnation); !why.empty()) {
+      refuse(m.signer + "/incarnation", why);  // its own line: not hidden behind another refusal
+      return;
+    }
     std::vector<std::string> recovered;
     bool resync = false;
     {
@@ -443,73 +521,91 @@ struct Supervisor::Impl {
         return;
       }
       Peer& peer = p->second;
-      const std::int64_t known = peer.incarnation;
-      if (!fresh(peer, h.coordinator, h.incarnation, "a heartbeat")) {
-        // An older incarnation still beating while a newer one runs: two processes, one name.
-        if (known != 0 && steady_ns() - peer.last_heartbeat <= std::chrono::nanoseconds(options.lost_after).count()) {
-          drops->drop(h.coordinator + "/duplicate",
-                      "supervisor: two processes run coordinator '" + printable(h.coordinator) + "' (incarnations " +
-                          std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
+      const std::int64_t known = peer.fresh.incarnation();
+      std::string why;
+      switch (peer.fresh.heartbeat(h.incarnation, h.seq, why)) {
+        case PeerFreshness::Verdict::Accept: break;
+        case PeerFreshness::Verdict::Unproven: {
+          // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
+          const auto sent = h.lastSeq.find("events");
+          if (sent != h.lastSeq.end() && h.incarnation > known) heard_unproven(peer, h.incarnation, sent->second);
+          prover->ask(h.coordinator, h.control);
+          return;
         }
-        return;
+        case PeerFreshness::Verdict::Refuse:
+          // An older incarnation still beating while a newer one runs: two processes, one name.
+          if (h.incarnation < known &&
+              steady_ns() - peer.last_heartbeat <= std::chrono::nanoseconds(options.lost_after).count()) {
+            drops->drop(h.coordinator + "/duplicate",
+                        "supervisor: two processes run coordinator '" + printable(h.coordinator) + "' (incarnations " +
+                            std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
+          } else {
+            refuse(m.signer, "a heartbeat of '" + printable(h.coordinator) + "': " + why);
+          }
+          return;
       }
-      if (h.seq <= peer.heartbeat_seq) {
-        refuse(m.signer, "a heartbeat of '" + printable(h.coordinator) + "': seq " + std::to_string(h.seq) +
-                             " not above " + std::to_string(peer.heartbeat_seq) + " (replayed)");
-        return;
-      }
-      peer.heartbeat_seq = h.seq;
-      peer.control = h.control;
-      // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
-      // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
-      // records may be on their way on the other topic): reported as missed.
-      const auto sent = options.records ? h.lastSeq.find("events") : h.lastSeq.end();
-      if (sent != h.lastSeq.end() && !peer.joined) {
-        peer.joined = true;
-        peer.joined_at = sent->second;
-        peer.last_event_seq = sent->second;
-      } else if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
-        if (peer.events_behind) {
-          report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
-          peer.last_event_seq = sent->second;
-          peer.events_behind = false;
-        } else {
-          peer.events_behind = true;
-        }
-      } else {
-        peer.events_behind = false;
-      }
-      // Following states only, the same for the state streams: an update lost with nothing
-      // after it on its interface would leave the view of that service stale. Behind on two
-      // heartbeats in a row: the coordinator is asked to republish its full state. (Following
-      // the records, a gap in them already has the view refreshed.)
-      std::int64_t states_missed = 0;
-      for (const auto& [stream, last] : h.lastSeq) {
-        if (options.records) break;
-        if (stream.rfind("state:", 0) != 0) continue;
-        const auto applied = peer.state_seq.find(std::string_view(stream).substr(6));
-        const std::int64_t have = applied == peer.state_seq.end() ? 0 : applied->second;
-        if (last > have) states_missed += last - have;
-      }
-      if (states_missed > 0 && peer.states_behind) {
-        print("supervisor: " + std::to_string(states_missed) + " state update(s) of '" + printable(h.coordinator) +
-              "' missed; asking for its full state");
-        resync = true;
-        peer.states_behind = false;
-      } else {
-        peer.states_behind = states_missed > 0;
-      }
-      if (!peer.seen) print("supervisor: coordinator '" + h.coordinator + "' is up");
-      peer.seen = true;
-      peer.last_heartbeat = steady_ns();
-      if (peer.lost) {
-        peer.lost = false;
-        recovered = peer.components;
-      }
+      believe(h, peer, recovered, resync);
     }
     if (resync) request_resync(h.coordinator);
+    announce_recovered(h.coordinator, recovered);
+  }
+
+  /// An authentic heartbeat of the proven process of `h.coordinator` (under `mutex`).
+  void believe(const wire::Heartbeat& h, Peer& peer, std::vector<std::string>& recovered, bool& resync) {
+    peer.control = h.control;
+    // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
+    // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
+    // records may be on their way on the other topic): reported as missed.
+    const auto sent = options.records ? h.lastSeq.find("events") : h.lastSeq.end();
+    if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
+      if (peer.events_behind) {
+        report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
+        peer.last_event_seq = sent->second;
+        peer.events_behind = false;
+      } else {
+        peer.events_behind = true;
+      }
+    } else {
+      peer.events_behind = false;
+    }
+    // Following states only, the same for the state streams: an update lost with nothing
+    // after it on its interface would leave the view of that service stale. Behind on two
+    // heartbeats in a row: the coordinator is asked to republish its full state; behind for
+    // longer than the loss bound: lost (watch_loop). (Following the records, a gap in them
+    // already has the view refreshed.)
+    std::int64_t states_missed = 0;
+    for (const auto& [stream, last] : h.lastSeq) {
+      if (options.records) break;
+      if (stream.rfind("state:", 0) != 0) continue;
+      const std::int64_t have = peer.fresh.last(stream);
+      if (last > have) states_missed += last - have;
+    }
+    const std::int64_t now = steady_ns();
+    if (states_missed > 0 && peer.states_behind) {
+      print("supervisor: " + std::to_string(states_missed) + " state update(s) of '" + printable(h.coordinator) +
+            "' missed; asking for its full state");
+      resync = true;
+      peer.states_behind = false;
+    } else {
+      peer.states_behind = states_missed > 0;
+    }
+    if (states_missed == 0) {
+      peer.behind_since = 0;
+    } else if (peer.behind_since == 0) {
+      peer.behind_since = now;
+    }
+    if (!peer.seen) print("supervisor: coordinator '" + h.coordinator + "' is up");
+    peer.seen = true;
+    peer.last_heartbeat = now;
+    if (peer.lost && peer.behind_since == 0) {
+      peer.lost = false;
+      recovered = peer.components;
+    }
+  }
+
+  void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
     if (recovered.empty()) return;
-    print("supervisor: coordinator '" + h.coordinator + "' recovered");
+    print("supervisor: coordinator '" + who + "' recovered");
     for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", c + ".s_F");
   }
 
@@ -586,27 +682,46 @@ struct Supervisor::Impl {
       struct Lost {
         std::string name;
         std::vector<std::string> components;
-        bool never_heard;
+        std::string why;
       };
       std::vector<Lost> lost_now;
+      const std::int64_t bound = std::chrono::nanoseconds(options.lost_after).count();
+      const std::string bound_text = std::to_string(options.lost_after.count()) + " ms";
       {
         std::lock_guard lock(mutex);
         for (auto& [name, peer] : peers) {
           if (peer.lost) continue;
           const std::int64_t last = peer.seen ? peer.last_heartbeat : since;
-          if (last == 0 || now - last <= std::chrono::nanoseconds(options.lost_after).count()) continue;
-          peer.lost = true;
-          lost_now.push_back(Lost{name, peer.components, !peer.seen});
+          if (last != 0 && now - last > bound) {
+            peer.lost = true;
+            lost_now.push_back(Lost{name, peer.components,
+                                    "no heartbeat for " + bound_text +
+                                        (peer.seen ? "" : " (never proven alive since the supervisor connected)")});
+          } else if (peer.behind_since != 0 && now - peer.behind_since > bound) {
+            // Its heartbeats list state updates not received, for longer than the bound: a lost
+            // subscription or updates dropped on the way are as bad as silence.
+            peer.lost = true;
+            lost_now.push_back(
+                Lost{name, peer.components, "state updates listed by its heartbeats not received for " + bound_text});
+          }
         }
       }
-      for (const auto& [name, components, never_heard] : lost_now) {
-        print("supervisor: coordinator '" + name + "' lost: no heartbeat for " +
-              std::to_string(options.lost_after.count()) + " ms" +
-              (never_heard ? " (never heard from since the supervisor connected)" : "") +
-              "; EVT_COORDINATOR_LOST on its components");
+      for (const auto& [name, components, why] : lost_now) {
+        print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
         for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", c + ".s_F");
       }
     }
+  }
+
+  /// The next heartbeat (`next`), or the last one sent (a proof of life).
+  wire::Heartbeat heartbeat(bool next) {
+    wire::Heartbeat h;
+    h.coordinator = std::string(kSupervisorSigner);
+    h.incarnation = incarnation;
+    h.time = steady_ns();
+    h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
+    h.control = alive;
+    return h;
   }
 
   void link_loop() {
@@ -635,12 +750,7 @@ struct Supervisor::Impl {
           request_resync("");
         }
         // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
-        wire::Heartbeat h;
-        h.coordinator = std::string(kSupervisorSigner);
-        h.incarnation = incarnation;
-        h.time = steady_ns();
-        h.seq = ++heartbeat_seq;
-        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, h)));
+        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, heartbeat(true))));
       } catch (const Ice::Exception& e) {
         if (!reported) print("supervisor: IceStorm unreachable (" + std::string(e.ice_id()) + "); retrying");
         reported = true;
@@ -677,6 +787,16 @@ public:
 private:
   Supervisor::Impl& d_;
 };
+class AliveServant final : public wire::Alive {
+public:
+  explicit AliveServant(Supervisor::Impl& d) : d_(d) {}
+  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override {
+    return make_proof(*d_.signer, d_.ic, nonce, d_.heartbeat(false));
+  }
+
+private:
+  Supervisor::Impl& d_;
+};
 }  // namespace
 
 Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec& system, SupervisorOptions options) {
@@ -697,12 +817,13 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   impl->signer = std::move(*signer);
   {
     Impl* d = impl.get();
-    impl->drops = std::make_unique<DropLog>([d](const std::string& line) { d->print(line); });
+    impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->print(line); });
   }
   register_builtin_filters(impl->registry);
   impl->monitor = std::make_unique<Monitor>(impl->model, impl->registry);
   if (auto r = spec::instantiate(system, impl->model, *impl->monitor); !r) return tl::unexpected(r.error());
   for (const auto& [name, components] : system.coordinators) impl->peers[name].components = components;
+  impl->members = std::make_unique<Members>(system);
   Impl* d = impl.get();
   impl->model.subscribe([d](const Record& r) {
     if (r.kind != RecordKind::Transition) return;
@@ -766,12 +887,20 @@ Expected<void> Supervisor::start() {
     auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor",
                                                           protocol(d.options.tls) + " -h " + d.options.listen_host);
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
-    if (d.options.records) {
-      d.link->subscribe_to(kEventTopic, adapter->addWithUUID(std::make_shared<EventServant>(d)), Delivery::Stream);
-    }
-    auto state = adapter->addWithUUID(std::make_shared<StateServant>(d));
-    for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state, Delivery::Stream);
-    d.link->subscribe_to(kHeartbeatTopic, adapter->addWithUUID(std::make_shared<HeartbeatServant>(d)));
+    d.prover = std::make_unique<Prover>(
+        d.ic, *d.keyring, [&d](const std::string& who, const wire::Heartbeat& beat) { d.on_proven(who, beat); },
+        [&d](const std::string& who, const std::string& why) {
+          d.drops->drop(who, "supervisor: '" + printable(who) + "' not proven alive: " + why);
+        },
+        std::chrono::milliseconds(100));
+    auto guarded = [&](std::shared_ptr<Ice::Object> servant) {
+      return adapter->addWithUUID(std::make_shared<Guard>(std::move(servant), d.drops, "supervisor"));
+    };
+    if (d.options.records) d.link->subscribe_to(kEventTopic, guarded(std::make_shared<EventServant>(d)));
+    auto state = guarded(std::make_shared<StateServant>(d));
+    for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state);
+    d.link->subscribe_to(kHeartbeatTopic, guarded(std::make_shared<HeartbeatServant>(d)));
+    d.alive = guarded(std::make_shared<AliveServant>(d))->ice_toString();
     adapter->activate();
   } catch (const Ice::Exception& e) {
     if (d.ic) d.ic->destroy();

@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "receiver.hpp"
 #include "safecass.h"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
@@ -106,6 +107,20 @@ Signer load_signer(const std::string& dir, const std::string& name) {
   return *s;
 }
 
+struct Bus;
+
+/// The proof of life (wire::Alive) of a process the test plays (wire-p, or the supervisor), as a
+/// real process serves it: its current heartbeat, signed with its key, for the asker's nonce.
+class FakeAlive final : public wire::Alive {
+public:
+  FakeAlive(Bus& bus, std::string name) : bus_(bus), name_(std::move(name)) {}
+  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override;
+
+private:
+  Bus& bus_;
+  std::string name_;
+};
+
 /// The coordinator node "wire-c" on the fixture's IceStorm, and the test as everybody else: the
 /// real "wire-p" and supervisor (the system's keys), and an attacker (keys of its own).
 struct Bus {
@@ -131,6 +146,11 @@ struct Bus {
   std::atomic<bool> beating{true};
   std::atomic<bool> running{true};
   std::int64_t beat_seq = 0;
+  std::int64_t newest = kIncarnation;  ///< the newest incarnation wire-p's key beat with: the one it proves
+  std::shared_ptr<Ice::ObjectAdapter> adapter;
+  std::string alive_proxy;             ///< named by wire-p's genuine heartbeats
+  std::atomic<bool> proving{true};     ///< wire-p answers nonces (else with nothing signed)
+  std::string supervisor_alive_proxy;  ///< named by the supervisor's genuine heartbeats
   std::thread beat_thread;
 
   Bus() {
@@ -148,6 +168,10 @@ struct Bus {
     EXPECT_TRUE(middleware::connect_remote_providers(*load.system, "wire-c", co));
     for (const char* d : {"P.D0", "P.D1", "P.D2", "P.D3"}) last_sent[d] = 0;
 
+    adapter = ice->createObjectAdapterWithEndpoints("ProviderAlive", "tcp -h 127.0.0.1");
+    alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "wire-p"))->ice_toString();
+    supervisor_alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "supervisor"))->ice_toString();
+    adapter->activate();
     state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(topic("safecass.state.wire-p")->getPublisher()->ice_oneway());
     heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(topic("safecass.heartbeat")->getPublisher());
     beat_thread = std::thread([this] {
@@ -179,11 +203,16 @@ struct Bus {
           return true;
         },
         10000ms));
+    // The node believes wire-p once its process has answered the node's nonce.
+    EXPECT_TRUE(
+        eventually([&] { return all_log().find("coordinator 'wire-p' proved alive") != std::string::npos; }, 10000ms))
+        << all_log();
   }
   ~Bus() {
     running.store(false);
     if (beat_thread.joinable()) beat_thread.join();
     if (node) node->stop();
+    adapter->destroy();
   }
 
   /// The IceStorm topic `name` of the fixture (created when it does not exist yet).
@@ -197,8 +226,22 @@ struct Bus {
     }
   }
 
-  /// A heartbeat of `name` signed by `key`, listing the streams' last numbers.
+  /// wire-p's heartbeat as it stands (under mutex): the streams' last numbers.
+  wire::Heartbeat provider_heartbeat(std::int64_t incarnation, std::int64_t seq) {
+    wire::Heartbeat h;
+    h.coordinator = "wire-p";
+    h.incarnation = incarnation;
+    h.seq = seq;
+    h.control = alive_proxy;
+    for (const auto& [iface, last] : last_sent) h.lastSeq["state:" + iface] = last;
+    if (events_sent) h.lastSeq["events"] = *events_sent;
+    return h;
+  }
+  /// A heartbeat of `name` signed by `key`, listing the streams' last numbers. wire-p's genuine
+  /// heartbeats name its Alive object unless `control` is given.
   void beat(const Signer& key, const std::string& name, std::int64_t incarnation, std::string control = {}) {
+    if (control.empty() && name == "wire-p" && &key == &*provider) control = alive_proxy;
+    if (control.empty() && name == "supervisor" && &key == &*supervisor) control = supervisor_alive_proxy;
     wire::Heartbeat h;
     h.coordinator = name;
     h.incarnation = incarnation;
@@ -208,6 +251,7 @@ struct Bus {
     {
       std::lock_guard lock(mutex);
       h.seq = ++beat_seq;
+      if (&key == &*provider) newest = std::max(newest, incarnation);
       if (name == "wire-p") {
         for (const auto& [iface, seq] : last_sent) h.lastSeq["state:" + iface] = seq;
         if (events_sent) h.lastSeq["events"] = *events_sent;
@@ -238,6 +282,21 @@ struct Bus {
     return false;
   }
 };
+
+wire::Signed FakeAlive::prove(Ice::ByteSeq nonce, const Ice::Current&) {
+  std::lock_guard lock(bus_.mutex);
+  if (name_ == "wire-p" && !bus_.proving.load()) return {};
+  if (name_ == "wire-p") {
+    return middleware::detail::make_proof(*bus_.provider, bus_.ice.communicator(), nonce,
+                                          bus_.provider_heartbeat(bus_.newest, bus_.beat_seq));
+  }
+  wire::Heartbeat h;
+  h.coordinator = name_;
+  h.incarnation = kIncarnation;
+  h.seq = bus_.beat_seq;
+  h.control = bus_.supervisor_alive_proxy;
+  return middleware::detail::make_proof(*bus_.supervisor, bus_.ice.communicator(), nonce, h);
+}
 
 TEST(Wire, ABadUpdateInABatchIsRefusedAloneAndTheOthersApply) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
@@ -597,7 +656,7 @@ TEST(Wire, TheSupervisorReportsLostACoordinatorOfTheSystemItNeverHeardFrom) {
   }
   EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
   EXPECT_EQ(sup.model().state(*sup.model().find_machine("P.s_F")), State::Error) << out.all();
-  EXPECT_NE(out.all().find("coordinator 'wire-p' lost: no heartbeat for 600 ms (never heard from since the "
+  EXPECT_NE(out.all().find("coordinator 'wire-p' lost: no heartbeat for 600 ms (never proven alive since the "
                            "supervisor connected)"),
             std::string::npos)
       << out.all();
@@ -630,7 +689,7 @@ TEST(Wire, TheSupervisorRefusesAReplayedStateUpdateSoAnOlderStateNeverComesBack)
   bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return sup.messages_refused() > refused; })) << out.all();
   EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
-  EXPECT_NE(out.all().find("for P.D0: seq 2 not above 3 (replayed)"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("for P.D0: seq 2 not above 3 (stale or replayed)"), std::string::npos) << out.all();
   EXPECT_NE(out.all().find("[wire-p] P.s_S.D0 Error (roots P.s_A:EVT_E)"), std::string::npos) << out.all();
   supervisor->stop();
 }
@@ -860,26 +919,48 @@ TEST(Wire, ASupervisorRefusesATransitionRecordThatNamesNoMachineAndItChangesNoth
   EXPECT_FALSE(view_state(sup, "").has_value()) << r.out.all();
 }
 
-TEST(Wire, ASupervisorAcceptsRecordsSentBeforeItJoinedThatAreStillOnTheirWay) {
-  // The first heartbeat the supervisor saw listed 5 records sent: 4 and 5 may still be on the
-  // events topic. They are authentic and new to it: accepted, in order, neither missed nor
-  // replays; once received, a second copy is a replay.
+TEST(Wire, ASupervisorReportsMissedAndDoesNotTakeRecordsSentBeforeTheirCoordinatorProvedItselfAlive) {
+  // 1. Its first heartbeat and its proof of life listed 5 records sent: 4 and 5 may still be on
+  // the events topic, or be replays of records of long ago. A newcomer cannot tell them apart:
+  // neither is taken as current (they were sent before it heard of wire-p: not missed either).
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   RecordedBus r(5);
   ASSERT_TRUE(r.bus.node);
   ASSERT_TRUE(r.supervisor);
   const middleware::Supervisor& sup = *r.supervisor;
-
   r.records.send({4, 5});
   r.records.send({6});
-  ASSERT_TRUE(eventually([&] { return r.out.records == 3u; })) << r.out.all();
-  std::this_thread::sleep_for(400ms);  // longer than the supervisor's wait for late records
-  EXPECT_EQ(r.out.all().find("missed"), std::string::npos) << r.out.all();
-  EXPECT_EQ(sup.messages_refused(), 0u) << r.out.all();
+  ASSERT_TRUE(eventually([&] { return r.out.records == 1u; })) << r.out.all();
+  std::this_thread::sleep_for(300ms);
+  EXPECT_EQ(r.out.records, 1u) << "4 and 5 are not printed as current\n" << r.out.all();
   EXPECT_EQ(view_state(sup, "P.s_A"), State::Normal) << r.out.all();  // 6: back to Normal
-  r.records.send({5});
-  ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 1u; })) << r.out.all();
-  EXPECT_EQ(r.out.records, 3u) << r.out.all();
+  EXPECT_EQ(r.out.all().find("missed"), std::string::npos) << r.out.all();
+
+  // 2. A supervisor that hears of wire-p (a heartbeat listing 6 records sent) but cannot prove it
+  // alive yet drops records 7 and 8; once proven, the proof lists 8 sent: both are reported
+  // missed, and the view is read again.
+  r.bus.proving.store(false);
+  SupervisorOutput out;
+  auto late = start_supervisor(r.bus, out, "supervisor: connected to IceStorm");
+  ASSERT_TRUE(late);
+  {
+    std::lock_guard lock(r.bus.mutex);
+    r.bus.events_sent = 6;
+  }
+  EXPECT_TRUE(eventually([&] { return out.all().find("not proven alive") != std::string::npos; })) << out.all();
+  r.records.send({7, 8});
+  {
+    std::lock_guard lock(r.bus.mutex);
+    r.bus.events_sent = 8;
+  }
+  std::this_thread::sleep_for(200ms);
+  r.bus.proving.store(true);
+  EXPECT_TRUE(eventually([&] {
+    return out.all().find("2 event record(s) of 'wire-p' missed (seq 7..8, sent before it proved itself alive") !=
+           std::string::npos;
+  })) << out.all();
+  EXPECT_EQ(out.records, 0u) << out.all();
+  late->stop();
 }
 
 TEST(Wire, SupervisorLinesAreTheReadModelsLiveLinesTaggedWithTheCoordinatorAndOnOneLine) {
@@ -960,6 +1041,199 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
 TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {
   EXPECT_EQ(middleware::detail::printable("robot"), "robot");
   EXPECT_EQ(middleware::detail::printable("a\nb\rc\x1b[2J\\"), "a\\x0ab\\x0dc\\x1b[2J\\\\");
+  // Capped: a 128 KB name is not a 128 KB line.
+  const std::string huge(128 * 1024, 'n');
+  const std::string shown = middleware::detail::printable(huge);
+  EXPECT_EQ(shown, std::string(middleware::detail::kMaxPrintable, 'n') + "...(+" +
+                       std::to_string(huge.size() - middleware::detail::kMaxPrintable) + " bytes)");
+}
+
+/// An Alive endpoint that answers every nonce with a proof it recorded earlier (a genuine proof of
+/// the real process, signed for another nonce), and counts what it was asked.
+class ReplayingAlive final : public wire::Alive {
+public:
+  explicit ReplayingAlive(wire::Signed recorded) : recorded_(std::move(recorded)) {}
+  wire::Signed prove(Ice::ByteSeq, const Ice::Current&) override {
+    ++asked;
+    return recorded_;
+  }
+  std::atomic<int> asked{0};
+
+private:
+  wire::Signed recorded_;
+};
+
+/// A dead process's heartbeats, recorded and replayed, name an endpoint an impostor now serves.
+struct Impostor {
+  std::shared_ptr<Ice::ObjectAdapter> adapter;
+  std::shared_ptr<ReplayingAlive> alive;
+  std::string proxy;
+  explicit Impostor(Bus& bus) {
+    std::lock_guard lock(bus.mutex);
+    const Ice::ByteSeq old_nonce(middleware::detail::kNonceBytes, 7);
+    alive = std::make_shared<ReplayingAlive>(middleware::detail::make_proof(
+        *bus.provider, bus.ice.communicator(), old_nonce, bus.provider_heartbeat(kIncarnation, bus.beat_seq)));
+    adapter = bus.ice->createObjectAdapterWithEndpoints("", "tcp -h 127.0.0.1");
+    proxy = adapter->add(alive, Ice::stringToIdentity("safecass/control-wire-p"))->ice_toString();
+    adapter->activate();
+  }
+  ~Impostor() { adapter->destroy(); }
+};
+
+// Attack: a process that starts after wire-p died is fed wire-p's recorded heartbeats (genuine
+// signatures, rising numbers) naming an endpoint an impostor serves with a recorded proof. A
+// heartbeat is believed only on a signed answer to the newcomer's own nonce: the newcomer's view
+// stays Error (wire-p lost), the supervisor never says it is up, and the console sends no token.
+TEST(Wire, ANewcomerBelievesNoReplayedHeartbeatOfAProcessThatCannotProveItselfAlive) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;  // the node wire-c starts while wire-p lives, and proves it
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(false);  // wire-p dies
+  Impostor impostor(bus);
+  std::atomic<bool> replaying{true};
+  std::thread replayer([&] {
+    while (replaying.load()) {
+      bus.beat(*bus.provider, "wire-p", kIncarnation + 1, impostor.proxy);  // as recorded, of a later run
+      std::this_thread::sleep_for(50ms);
+    }
+  });
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out, "supervisor: connected to IceStorm");
+  ASSERT_TRUE(supervisor);
+  EXPECT_TRUE(eventually([&] { return supervisor->lost() == std::vector<std::string>{"wire-p"}; }, 3000ms))
+      << out.all();
+  EXPECT_EQ(out.all().find("coordinator 'wire-p' is up"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("an answer to another nonce (a recorded proof)"), std::string::npos) << out.all();
+  // The node had proven wire-p's earlier process; the replayed later one is not believed either.
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+
+  middleware::ClientOptions o;
+  o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  o.coordinator = "wire-p";
+  o.token = std::string(64, 'a');
+  o.keys_dir = bus.keys;
+  o.timeout = 800ms;
+  auto lured = middleware::RemoteClient::connect(o);
+  ASSERT_FALSE(lured);
+  EXPECT_NE(lured.error().message.find("an answer to another nonce"), std::string::npos) << lured.error().message;
+  EXPECT_GE(impostor.alive->asked.load(), 1) << "asked only for a proof: the impostor is no Control, so any "
+                                                "other request (and the token) would have failed the connect";
+  replaying.store(false);
+  replayer.join();
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
+  supervisor->stop();
+}
+
+// Attack: every subscription of the provider's state topic is removed from outside, so its
+// updates no longer reach the client, while its heartbeats (on another topic) still do. A stream
+// that heartbeats show ahead of what the receiver holds, not caught up within the loss bound,
+// counts as lost, as a silent provider does; it clears once the state is held again.
+TEST(Wire, AStateStreamItsHeartbeatsShowAheadAndNotCaughtUpWithinTheBoundCountsAsLost) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.last_sent["P.D0"] = 1;  // sent (the heartbeats say so) but never received
+  }
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+  EXPECT_NE(bus.all_log().find("coordinator 'wire-p' lost (its heartbeats list state of P.D0 not received"),
+            std::string::npos)
+      << bus.all_log();
+  bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; }, 3000ms)) << bus.all_log();
+  EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+// Attack: one message that does not decode, published on each topic. IceStorm drops a twoway
+// subscriber whose dispatch fails; every subscription is oneway, so nobody is dropped, the
+// message is counted once, and a flood of them is one log line a second, not a line each.
+TEST(Wire, UndecodableMessagesDropNoSubscriptionAndAreLoggedAtMostOnceASecond) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const auto refused_before = bus.node->stats().messages_refused;
+  // A well-formed request whose parameter is 3 bytes that are no wire::Signed.
+  Ice::ByteSeq garbage;
+  {
+    Ice::OutputStream encoded(bus.ice.communicator());
+    encoded.startEncapsulation();
+    for (Ice::Byte b : {Ice::Byte{1}, Ice::Byte{2}, Ice::Byte{3}}) encoded.write(b);
+    encoded.endEncapsulation();
+    encoded.finished(garbage);
+  }
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+    auto pub = bus.topic(name)->getPublisher()->ice_oneway();
+    const char* op = std::string(name) == "safecass.heartbeat" ? "beat"
+                     : std::string(name) == "safecass.resync"  ? "resync"
+                                                               : "updates";
+    Ice::ByteSeq ignored;
+    for (int i = 0; i < 500; ++i) pub->ice_invoke(op, Ice::OperationMode::Normal, garbage, ignored);
+  }
+  ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused - refused_before >= 1000; })) << bus.all_log();
+  std::this_thread::sleep_for(300ms);
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+    EXPECT_FALSE(bus.topic(name)->getSubscribers().empty()) << name;
+  }
+  EXPECT_EQ(bus.node->stats().resubscriptions, 0u) << "nobody was dropped\n" << bus.all_log();
+  std::size_t lines = 0;
+  for (std::size_t at = bus.all_log().find("does not decode"); at != std::string::npos;
+       at = bus.all_log().find("does not decode", at + 1))
+    ++lines;
+  EXPECT_GE(lines, 1u) << bus.all_log();
+  EXPECT_LE(lines, 3u) << "1,000 undecodable messages in well under a second\n" << bus.all_log();
+  // Everything still flows: an update reaches the node and the supervisor.
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; })) << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return view_state(*supervisor, "P.s_S.D0") == State::Error; })) << out.all();
+  supervisor->stop();
+}
+
+// Attack: members that sign as themselves but speak for others, or push a stream far ahead.
+// wire-c (a member, its own key) reports wire-p's component P Normal; wire-p's own update jumps
+// 2^21 ahead; a heartbeat carries an incarnation near 2^63. None changes the supervisor's view,
+// and none freezes a stream: wire-p's next genuine update applies.
+TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJumpAndClockBounds) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
+  const auto refused = sup.messages_refused();
+
+  auto ic = bus.ice.communicator();
+  // wire-c, on its own topic and signing as itself, about wire-p's component.
+  auto own = Ice::uncheckedCast<wire::StateTopicPrx>(bus.topic("safecass.state.wire-c")->getPublisher()->ice_oneway());
+  wire::StateUpdate lie = update("P.D0", 2, "", wire::Level::Normal);
+  lie.coordinator = "wire-c";
+  own->updates(bus.other->sign(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
+  // wire-p itself, 2^21 ahead (sent raw: its heartbeats do not list it).
+  bus.state_pub->updates(bus.provider->sign(
+      middleware::detail::kKindState,
+      encode(ic, wire::StateUpdateSeq{update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)})));
+  // wire-p's key, an incarnation near 2^63: refused, it does not lock wire-p out.
+  bus.beat(*bus.provider, "wire-p", std::numeric_limits<std::int64_t>::max() - 1);
+  ASSERT_TRUE(eventually([&] { return sup.messages_refused() >= refused + 3; })) << out.all();
+  EXPECT_NE(out.all().find("for P.D0, a component it does not run"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("jumps more than 1048576 ahead"), std::string::npos) << out.all();
+  EXPECT_NE(out.all().find("more than 60 s ahead of this host's clock"), std::string::npos) << out.all();
+  EXPECT_TRUE(eventually([&] {
+    return bus.all_log().find("more than 60 s ahead of this host's clock") != std::string::npos;
+  })) << bus.all_log();
+  EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
+  EXPECT_TRUE(sup.lost().empty()) << out.all();
+  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  EXPECT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
+  supervisor->stop();
 }
 
 }  // namespace

@@ -148,6 +148,8 @@ struct NodeStats {
   /// record too large even without its text is dropped and also counted in events_dropped.
   std::uint64_t oversized_messages = 0;
   std::uint64_t roots_truncated = 0;  ///< roots left out of those state updates (the least severe)
+  std::uint64_t updates_unproven =
+      0;  ///< state updates of a provider process not proven alive yet (dropped; taken from its republish once proven)
   bool connected = false;
 };
 

@@ -1,0 +1,248 @@
+// The receiver's checks (receiver.hpp, DESIGN §7 "The bus, precisely").
+
+#include "receiver.hpp"
+
+#include <sodium.h>
+
+#include "ice_util.hpp"
+
+namespace safecass::middleware::detail {
+
+std::string incarnation_out_of_bounds(std::string_view what, std::string_view who, std::int64_t incarnation) {
+  const std::int64_t limit = new_incarnation() + std::chrono::nanoseconds(kIncarnationMargin).count();
+  if (incarnation > 0 && incarnation <= limit) return {};
+  return std::string(what) + " of '" + printable(who) + "': incarnation " + std::to_string(incarnation) +
+         (incarnation <= 0 ? " is not a start time" : " is more than 60 s ahead of this host's clock");
+}
+
+// ---- Members ------------------------------------------------------------------------------------
+
+Members::Members(const spec::SystemSpec& system) {
+  for (const auto& [coordinator, components] : system.coordinators) {
+    coordinators_.emplace(coordinator, true);
+    for (const std::string& c : components) owner_.emplace(c, coordinator);
+  }
+}
+
+bool Members::is_member(std::string_view coordinator) const { return coordinators_.contains(coordinator); }
+
+bool Members::runs(std::string_view coordinator, std::string_view component) const {
+  const auto it = owner_.find(component);
+  return it != owner_.end() && it->second == coordinator;
+}
+
+std::string_view Members::component_of(std::string_view address) { return address.substr(0, address.find('.')); }
+
+// ---- PeerFreshness ------------------------------------------------------------------------------
+
+PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
+  if (incarnation < incarnation_) {
+    why = "incarnation " + std::to_string(incarnation) + " is older than " + std::to_string(incarnation_) +
+          " (a replay, or two processes with one name)";
+    return Verdict::Refuse;
+  }
+  if (incarnation != incarnation_) {
+    unproven_ = std::max(unproven_, incarnation);
+    return Verdict::Unproven;
+  }
+  if (seq <= heartbeat_seq_) {
+    why = "seq " + std::to_string(seq) + " not above " + std::to_string(heartbeat_seq_) + " (replayed)";
+    return Verdict::Refuse;
+  }
+  heartbeat_seq_ = seq;
+  return Verdict::Accept;
+}
+
+PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq,
+                                             std::int64_t& missed, std::string& why) {
+  missed = 0;
+  if (incarnation < incarnation_) {
+    why = "incarnation " + std::to_string(incarnation) + " is older than " + std::to_string(incarnation_) +
+          " (a replay, or two processes with one name)";
+    return Verdict::Refuse;
+  }
+  if (incarnation != incarnation_) {
+    unproven_ = std::max(unproven_, incarnation);
+    return Verdict::Unproven;
+  }
+  auto it = streams_.find(stream);
+  if (it == streams_.end()) it = streams_.emplace(std::string(stream), Stream{}).first;
+  Stream& s = it->second;
+  if (seq <= s.last) {
+    // At or below what the proof listed: sent before the process proved itself alive (still on
+    // its way) or a replay; either way not taken, and what it held comes again in the republish
+    // asked for at the proof.
+    if (s.from_proof) return Verdict::Unproven;
+    why = "seq " + std::to_string(seq) + " not above " + std::to_string(s.last) + " (stale or replayed)";
+    return Verdict::Refuse;
+  }
+  if (seq - s.last > kMaxSeqJump) {
+    why = "seq " + std::to_string(seq) + " jumps more than " + std::to_string(kMaxSeqJump) + " ahead of " +
+          std::to_string(s.last);
+    return Verdict::Refuse;
+  }
+  missed = seq - s.last - 1;
+  s.last = seq;
+  s.from_proof = false;
+  return Verdict::Accept;
+}
+
+bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why) {
+  if (beat.incarnation < incarnation_) {
+    why = "a proof of incarnation " + std::to_string(beat.incarnation) + ", older than " + std::to_string(incarnation_);
+    return false;
+  }
+  if (beat.incarnation == incarnation_) {
+    heartbeat_seq_ = std::max<std::int64_t>(heartbeat_seq_, beat.seq);
+  } else {
+    incarnation_ = beat.incarnation;
+    heartbeat_seq_ = beat.seq;
+    streams_.clear();
+  }
+  if (unproven_ <= incarnation_) unproven_ = 0;
+  // What the process had sent when it answered: anything at or below it that arrives later is
+  // old; what it sends next is above it.
+  for (const auto& [stream, last] : beat.lastSeq) {
+    Stream& have = streams_[stream];
+    if (last > have.last) have = Stream{last, true};
+  }
+  return true;
+}
+
+std::int64_t PeerFreshness::last(std::string_view stream) const {
+  const auto it = streams_.find(stream);
+  return it == streams_.end() ? 0 : it->second.last;
+}
+
+// ---- Prover -------------------------------------------------------------------------------------
+
+Prover::Prover(std::shared_ptr<Ice::Communicator> ic, const Keyring& keys,
+               std::function<void(const std::string&, const wire::Heartbeat&)> on_proven,
+               std::function<void(const std::string&, const std::string&)> on_refused, std::chrono::milliseconds retry)
+    : ic_(std::move(ic)),
+      keys_(keys),
+      on_proven_(std::move(on_proven)),
+      on_refused_(std::move(on_refused)),
+      retry_ns_(std::chrono::nanoseconds(retry).count()) {}
+
+namespace {
+std::string fresh_nonce() {
+  std::string nonce(kNonceBytes, '\0');
+  ::randombytes_buf(nonce.data(), nonce.size());
+  return nonce;
+}
+Ice::ByteSeq bytes_of(const std::string& s) { return Ice::ByteSeq(s.begin(), s.end()); }
+
+/// Why `answer` is not `signer`'s proof of `nonce` (empty: it is, and `beat` is what it proves).
+std::string check_proof(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys, const std::string& signer,
+                        const std::string& nonce, const wire::Signed& answer, wire::Heartbeat& beat) {
+  if (answer.signer != signer) return "an answer signed '" + printable(answer.signer) + "', not by '" + signer + "'";
+  wire::Proof proof;
+  if (std::string why = open_signed(keys, ic, answer, kKindProof, proof); !why.empty()) return why;
+  if (proof.nonce != bytes_of(nonce)) return "an answer to another nonce (a recorded proof)";
+  if (proof.beat.coordinator != signer) return "a proof naming '" + printable(proof.beat.coordinator) + "'";
+  if (std::string why = incarnation_out_of_bounds("a proof", signer, proof.beat.incarnation); !why.empty()) return why;
+  beat = std::move(proof.beat);
+  return {};
+}
+}  // namespace
+
+void Prover::done(const std::string& signer, const std::string& nonce, const wire::Signed* answer,
+                  const std::string& error) {
+  {
+    std::lock_guard lock(mutex_);
+    const auto it = questions_.find(signer);
+    if (it == questions_.end() || it->second.nonce != nonce) return;  // superseded
+    it->second.open = false;
+  }
+  wire::Heartbeat beat;
+  const std::string why = answer != nullptr ? check_proof(ic_, keys_, signer, nonce, *answer, beat) : error;
+  if (why.empty()) {
+    on_proven_(signer, beat);
+  } else if (on_refused_) {
+    on_refused_(signer, why);
+  }
+}
+
+void Prover::ask(const std::string& signer, const std::string& endpoint) {
+  if (endpoint.empty()) return;
+  std::shared_ptr<wire::AlivePrx> alive;
+  std::string nonce;
+  {
+    std::lock_guard lock(mutex_);
+    Question& q = questions_[signer];  // signers are keyring names: bounded
+    const std::int64_t now = steady_ns();
+    if (q.open || (q.asked != 0 && now - q.asked < retry_ns_)) return;
+    try {
+      alive = Ice::uncheckedCast<wire::AlivePrx>(ic_->stringToProxy(endpoint))->ice_invocationTimeout(1000);
+    } catch (const Ice::Exception&) {
+      q.asked = now;  // a heartbeat naming no endpoint we can use: not proven, asked again later
+      return;
+    }
+    q.nonce = fresh_nonce();
+    q.asked = now;
+    q.open = true;
+    nonce = q.nonce;
+  }
+  try {
+    alive->proveAsync(
+        bytes_of(nonce), [this, signer, nonce](wire::Signed answer) { done(signer, nonce, &answer, {}); },
+        [this, signer, nonce](std::exception_ptr e) {
+          std::string what = "its endpoint did not answer";
+          try {
+            std::rethrow_exception(e);
+          } catch (const Ice::Exception& ex) {
+            what += std::string(" (") + ex.ice_id() + ")";
+          } catch (...) {
+          }
+          done(signer, nonce, nullptr, what);
+        });
+  } catch (const Ice::Exception& e) {
+    done(signer, nonce, nullptr, std::string("cannot ask it (") + e.ice_id() + ")");
+  }
+}
+
+Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
+                                    const std::string& signer, const std::shared_ptr<wire::AlivePrx>& alive) {
+  const std::string nonce = fresh_nonce();
+  wire::Signed answer;
+  try {
+    answer = alive->prove(bytes_of(nonce));
+  } catch (const Ice::Exception& e) {
+    return fail(ErrorCode::Io, "'" + printable(signer) + "' did not answer a proof of life (" + e.ice_id() + ")");
+  }
+  wire::Heartbeat beat;
+  if (std::string why = check_proof(ic, keys, signer, nonce, answer, beat); !why.empty()) {
+    return fail(ErrorCode::Denied, "'" + printable(signer) + "' gave no valid proof of life: " + why);
+  }
+  return beat;
+}
+
+wire::Signed make_proof(const Signer& signer, const std::shared_ptr<Ice::Communicator>& ic, const Ice::ByteSeq& nonce,
+                        wire::Heartbeat beat) {
+  if (nonce.size() != kNonceBytes) return {};
+  return signer.sign(kKindProof, encode(ic, wire::Proof{nonce, std::move(beat)}));
+}
+
+// ---- Guard --------------------------------------------------------------------------------------
+
+bool Guard::dispatch(Ice::Request& request) {
+  try {
+    return servant_->ice_dispatch(request);
+  } catch (const Ice::MarshalException&) {
+    log_->drop("(undecodable)",
+               what_ + ": refused a message that does not decode (" + printable(request.getCurrent().operation) + ")");
+    throw;
+  } catch (const Ice::RequestFailedException&) {
+    log_->drop("(unknown operation)", what_ + ": refused a request for an unknown object or operation (" +
+                                          printable(request.getCurrent().operation) + ")");
+    throw;
+  } catch (const Ice::UserException&) {
+    throw;  // an answer (OperationError), not a failure
+  } catch (const std::exception& e) {
+    log_->drop("(dispatch)", what_ + ": a request failed: " + printable(e.what()));
+    throw;
+  }
+}
+
+}  // namespace safecass::middleware::detail

@@ -1,0 +1,154 @@
+#pragma once
+// Internal: the checks every receiver of the bus makes (DESIGN §7 "The bus, precisely"), once,
+// for coordinators, the supervisor and every follower (watch, viewer, timeline):
+// - Guard: every servant of the bus is dispatched through it; what cannot be decoded is counted
+//   and logged at most once per second, never by Ice line by line;
+// - Members: a member speaks only for the components the system file assigns to it;
+// - Freshness: an incarnation is believed only once proven by a signed answer to a nonce of
+//   this receiver (Prover), is bounded by the receiver's clock, and an older one is dropped;
+//   each stream's numbers only rise, and never jump more than kMaxSeqJump in one message.
+
+#include <Ice/Ice.h>
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+
+#include "auth.hpp"
+#include "safecass.h"
+#include "safecass/spec/system.hpp"
+
+namespace safecass::middleware::detail {
+
+inline constexpr std::string_view kKindProof = "proof";
+/// Bytes of a receiver's nonce (wire::Alive::prove).
+inline constexpr std::size_t kNonceBytes = 16;
+/// How far ahead of the receiver's clock an incarnation (the sender's start time) may be: the
+/// clocks of the hosts of one system differ by less. A larger one is refused, so that no member
+/// can lock itself out of its own later runs with an incarnation near 2^63.
+inline constexpr std::chrono::seconds kIncarnationMargin{60};
+/// The furthest a stream may jump ahead in one message, even a signed one: a sequence number
+/// cannot push a stream into the future and freeze it.
+inline constexpr std::int64_t kMaxSeqJump = std::int64_t{1} << 20;
+
+/// Why `incarnation` (of `who`, in `what`) is refused: it is not positive, or it lies further in
+/// the future than kIncarnationMargin. Empty when it is acceptable.
+std::string incarnation_out_of_bounds(std::string_view what, std::string_view who, std::int64_t incarnation);
+
+/// The coordinator each component runs in, as the system file assigns them.
+class Members {
+public:
+  explicit Members(const spec::SystemSpec& system);
+  /// True when `coordinator` is a coordinator of the system.
+  bool is_member(std::string_view coordinator) const;
+  /// True when the system file assigns `component` to `coordinator`.
+  bool runs(std::string_view coordinator, std::string_view component) const;
+  /// The component of an interface or address "Component.rest".
+  static std::string_view component_of(std::string_view address);
+
+private:
+  std::map<std::string, std::string, std::less<>> owner_;  // component -> coordinator
+  std::map<std::string, bool, std::less<>> coordinators_;
+};
+
+/// What one receiver believes of one peer's process: the proven incarnation, its heartbeats' and
+/// streams' last numbers. Not thread-safe: the owner holds its own lock.
+class PeerFreshness {
+public:
+  enum class Verdict {
+    Accept,    ///< believed: the caller applies it
+    Refuse,    ///< a replay, an older process, a jump: `why` says which
+    Unproven,  ///< a process this receiver has not proven alive yet (ask it: Prover), or a
+               ///< message it sent before it proved itself alive: dropped, without blame
+  };
+  /// A heartbeat of incarnation `incarnation`, number `seq`.
+  Verdict heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why);
+  /// A message of stream `stream` (e.g. "state:C.p"): on Accept `missed` is the number of
+  /// messages of the stream skipped (0 for the first one after a proof).
+  Verdict stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed,
+                 std::string& why);
+  /// A proof of `beat` (checked by the Prover): its incarnation becomes the believed one, and its
+  /// heartbeat and stream numbers the floor below which everything is a replay. Returns false,
+  /// with `why`, when it is older than the believed one.
+  bool proven(const wire::Heartbeat& beat, std::string& why);
+  /// The believed incarnation (0: none proven yet).
+  std::int64_t incarnation() const noexcept { return incarnation_; }
+  /// The last number accepted on `stream` (0: none).
+  std::int64_t last(std::string_view stream) const;
+  /// The newest incarnation seen but not proven (0: none).
+  std::int64_t unproven() const noexcept { return unproven_; }
+
+private:
+  struct Stream {
+    std::int64_t last = 0;    ///< the last number accepted, or listed by the proof
+    bool from_proof = false;  ///< `last` is the proof's: nothing accepted since
+  };
+  std::int64_t incarnation_ = 0;
+  std::int64_t unproven_ = 0;
+  std::int64_t heartbeat_seq_ = 0;
+  std::map<std::string, Stream, std::less<>> streams_;
+};
+
+/// Asks a peer's Alive endpoint (named in its heartbeat) to sign a fresh nonce, and checks the
+/// answer: kind "proof", signed by the peer's key, the nonce ours. At most one question per peer
+/// at a time, and one per `retry` after a failure. Answers are delivered to `on_proven` on an Ice
+/// thread, outside any lock of the caller.
+class Prover {
+public:
+  Prover(std::shared_ptr<Ice::Communicator> ic, const Keyring& keys,
+         std::function<void(const std::string& signer, const wire::Heartbeat& beat)> on_proven,
+         std::function<void(const std::string& signer, const std::string& why)> on_refused,
+         std::chrono::milliseconds retry);
+  /// Asks `signer`, whose heartbeat names `endpoint`, unless a question is on its way.
+  void ask(const std::string& signer, const std::string& endpoint);
+
+private:
+  struct Question {
+    std::string nonce;
+    std::int64_t asked = 0;  ///< steady ns
+    bool open = false;
+  };
+  void done(const std::string& signer, const std::string& nonce, const wire::Signed* answer, const std::string& error);
+
+  std::shared_ptr<Ice::Communicator> ic_;
+  const Keyring& keys_;
+  std::function<void(const std::string&, const wire::Heartbeat&)> on_proven_;
+  std::function<void(const std::string&, const std::string&)> on_refused_;
+  std::int64_t retry_ns_;
+  std::mutex mutex_;
+  std::map<std::string, Question, std::less<>> questions_;
+};
+
+/// Asks `alive`, which claims to be `signer`'s, to sign a fresh nonce and waits for the answer:
+/// the heartbeat it proves, or why not (Io: no answer; Denied: no valid proof).
+[[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
+                                                  const std::string& signer,
+                                                  const std::shared_ptr<wire::AlivePrx>& alive);
+
+/// The signed answer to `nonce` of a process whose current heartbeat is `beat` (Alive::prove).
+wire::Signed make_proof(const Signer& signer, const std::shared_ptr<Ice::Communicator>& ic, const Ice::ByteSeq& nonce,
+                        wire::Heartbeat beat);
+
+/// Dispatches a bus servant: anything that fails to dispatch (an undecodable message, an unknown
+/// operation) is counted and logged at most once per second with the number since, instead of
+/// Ice's warning for each one (Ice.Warn.Dispatch is off).
+class Guard final : public Ice::DispatchInterceptor {
+public:
+  Guard(std::shared_ptr<Ice::Object> servant, std::shared_ptr<DropLog> log, std::string what)
+      : servant_(std::move(servant)), log_(std::move(log)), what_(std::move(what)) {}
+  bool dispatch(Ice::Request& request) override;
+
+private:
+  std::shared_ptr<Ice::Object> servant_;
+  std::shared_ptr<DropLog> log_;
+  std::string what_;
+};
+
+}  // namespace safecass::middleware::detail
