@@ -21,7 +21,12 @@ namespace safecass::middleware {
 
 namespace {
 
-constexpr std::string_view kContext = "safecass.bus.v1";
+constexpr std::string_view kContext = "safecass.bus.v1";       // signed messages
+constexpr std::string_view kSealContext = "safecass.bus.v2";   // sealed messages
+constexpr std::string_view kPairContext = "safecass.pair.v1";  // pairwise keys
+constexpr std::size_t kTagBytes = 16;
+constexpr std::size_t kDigestBytes = 32;
+constexpr std::size_t kPairKeyBytes = 32;
 constexpr std::string_view kSecretTag = "ed25519-secret";
 constexpr std::size_t kMaxKeyFile = 64 * 1024;
 
@@ -202,6 +207,7 @@ Expected<Keyring> Keyring::load(const std::string& dir) {
                 "bus keyring: " + text.error().message + " (create keys with `safecass keys SYSTEM --out DIR`)");
   }
   Keyring ring;
+  std::map<std::string, std::string> keys;  // sorted: every process numbers the members alike
   std::istringstream lines(*text);
   std::string line;
   int number = 0;
@@ -216,30 +222,37 @@ Expected<Keyring> Keyring::load(const std::string& dir) {
         !from_hex(hex, key, crypto_sign_PUBLICKEYBYTES)) {
       return fail(ErrorCode::Parse, path + ":" + std::to_string(number) + ": expected 'NAME ed25519 HEX-PUBLIC-KEY'");
     }
-    if (!ring.keys_.emplace(name, std::move(key)).second) {
+    if (!ring.index_.emplace(name, 0).second) {
       return fail(ErrorCode::Parse, path + ":" + std::to_string(number) + ": '" + name + "' listed twice");
     }
+    keys.emplace(name, std::move(key));
+  }
+  for (auto& [name, key] : keys) {
+    ring.index_[name] = ring.names_.size();
+    ring.names_.push_back(name);
+    ring.keys_.push_back(std::move(key));
   }
   return ring;
 }
 
 bool Keyring::verify(std::string_view signer, std::string_view kind, const Ice::ByteSeq& body,
                      const Ice::ByteSeq& signature) const noexcept {
-  const auto key = keys_.find(signer);
-  if (key == keys_.end() || signature.size() != crypto_sign_BYTES) return false;
+  const auto at = index_.find(signer);
+  if (at == index_.end() || signature.size() != crypto_sign_BYTES) return false;
+  const std::string& key = keys_[at->second];
   try {
     // One buffer per receiving thread, reused: checking a message allocates nothing once it has
     // grown to the largest message seen.
     thread_local std::string bytes;
     signed_bytes(bytes, kind, signer, body);
     return ::crypto_sign_verify_detached(signature.data(), reinterpret_cast<const unsigned char*>(bytes.data()),
-                                         bytes.size(), reinterpret_cast<const unsigned char*>(key->second.data())) == 0;
+                                         bytes.size(), reinterpret_cast<const unsigned char*>(key.data())) == 0;
   } catch (...) {
     return false;
   }
 }
 
-Expected<Signer> Signer::load(const std::string& dir, std::string_view name) {
+Expected<Signer> Signer::load(const std::string& dir, std::string_view name, const Keyring& keyring) {
   if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
   const std::string path = dir + "/" + std::string(name) + ".secret";
   struct stat st {};
@@ -263,7 +276,87 @@ Expected<Signer> Signer::load(const std::string& dir, std::string_view name) {
                            crypto_sign_SECRETKEYBYTES);
   ::sodium_memzero(text->data(), text->size());
   if (!ok) return fail(ErrorCode::Parse, path + ": not a SAFECASS secret key");
+  const auto me = keyring.index_.find(name);
+  if (me == keyring.index_.end()) {
+    return fail(ErrorCode::InvalidArgument, "'" + s.name_ + "' is not in the keyring of " + dir);
+  }
+  s.index_ = me->second;
+  s.members_ = keyring.index_;
+  // The key shared with each member: X25519 of this secret and that member's public key (both
+  // Ed25519 keys, mapped to Curve25519), hashed with both names. The other member derives the same.
+  unsigned char curve_sk[crypto_scalarmult_curve25519_BYTES];
+  if (::crypto_sign_ed25519_sk_to_curve25519(curve_sk, reinterpret_cast<const unsigned char*>(s.secret_.data())) != 0) {
+    return fail(ErrorCode::InvalidArgument, path + ": the key cannot be used for pairwise keys");
+  }
+  s.pair_.resize(keyring.size());
+  for (std::size_t i = 0; i < keyring.size(); ++i) {
+    if (i == s.index_) continue;
+    unsigned char curve_pk[crypto_scalarmult_curve25519_BYTES];
+    unsigned char shared[crypto_scalarmult_BYTES];
+    if (::crypto_sign_ed25519_pk_to_curve25519(curve_pk,
+                                               reinterpret_cast<const unsigned char*>(keyring.keys_[i].data())) != 0 ||
+        ::crypto_scalarmult(shared, curve_sk, curve_pk) != 0) {
+      ::sodium_memzero(curve_sk, sizeof curve_sk);
+      return fail(ErrorCode::InvalidArgument, dir + "/keyring: the key of '" + keyring.names_[i] + "' is unusable");
+    }
+    const std::string& low = std::min(s.name_, keyring.names_[i]);
+    const std::string& high = std::max(s.name_, keyring.names_[i]);
+    std::string info(kPairContext);
+    info.append(1, '\0').append(low).append(1, '\0').append(high);
+    s.pair_[i].assign(kPairKeyBytes, '\0');
+    ::crypto_generichash(reinterpret_cast<unsigned char*>(s.pair_[i].data()), kPairKeyBytes,
+                         reinterpret_cast<const unsigned char*>(info.data()), info.size(), shared, sizeof shared);
+    ::sodium_memzero(shared, sizeof shared);
+  }
+  ::sodium_memzero(curve_sk, sizeof curve_sk);
   return s;
+}
+
+namespace {
+/// The digest a seal's tags authenticate: BLAKE2b-256 of context, kind, signer and body.
+void seal_digest(unsigned char* digest, std::string_view kind, std::string_view signer, const Ice::ByteSeq& body) {
+  crypto_generichash_state h;
+  ::crypto_generichash_init(&h, nullptr, 0, kDigestBytes);
+  const auto add = [&h](std::string_view part) {
+    ::crypto_generichash_update(&h, reinterpret_cast<const unsigned char*>(part.data()), part.size());
+  };
+  add(kSealContext);
+  add(std::string_view("\0", 1));
+  add(kind);
+  add(std::string_view("\0", 1));
+  add(signer);
+  add(std::string_view("\0", 1));
+  ::crypto_generichash_update(&h, body.data(), body.size());
+  ::crypto_generichash_final(&h, digest, kDigestBytes);
+}
+void seal_tag(unsigned char* tag, const unsigned char* digest, const std::string& pair_key) {
+  ::crypto_generichash(tag, kTagBytes, digest, kDigestBytes, reinterpret_cast<const unsigned char*>(pair_key.data()),
+                       pair_key.size());
+}
+}  // namespace
+
+wire::Signed Signer::seal(std::string_view kind, Ice::ByteSeq body) const {
+  wire::Signed m;
+  m.signer = name_;
+  m.kind = std::string(kind);
+  unsigned char digest[kDigestBytes];
+  seal_digest(digest, kind, name_, body);
+  m.tags.assign(pair_.size() * kTagBytes, 0);
+  for (std::size_t i = 0; i < pair_.size(); ++i) {
+    if (i != index_) seal_tag(m.tags.data() + i * kTagBytes, digest, pair_[i]);
+  }
+  m.body = std::move(body);
+  return m;
+}
+
+bool Signer::opens(const wire::Signed& m) const noexcept {
+  const auto from = members_.find(m.signer);
+  if (from == members_.end() || from->second == index_ || m.tags.size() != pair_.size() * kTagBytes) return false;
+  unsigned char digest[kDigestBytes];
+  unsigned char tag[kTagBytes];
+  seal_digest(digest, m.kind, m.signer, m.body);
+  seal_tag(tag, digest, pair_[from->second]);
+  return ::sodium_memcmp(tag, m.tags.data() + index_ * kTagBytes, kTagBytes) == 0;
 }
 
 wire::Signed Signer::sign(std::string_view kind, Ice::ByteSeq body) const {

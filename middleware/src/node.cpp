@@ -444,7 +444,7 @@ struct CoordinatorNode::Impl {
           body = encode_range(updates, first, 1);
         }
       }
-      pub->updates(signer->sign(kKindState, std::move(body)));
+      pub->updates(signer->seal(kKindState, std::move(body)));
       state_messages_published.fetch_add(1, std::memory_order_relaxed);
       for (std::size_t i = first; i < first + n; ++i) {
         Stream& s = *of[i];
@@ -482,7 +482,7 @@ struct CoordinatorNode::Impl {
           body = encode(ic, part);
         }
         try {
-          pub->records(signer->sign(kKindEvents, std::move(body)));
+          pub->records(signer->seal(kKindEvents, std::move(body)));
         } catch (...) {
           event_seq.store(seq_before);  // not sent: the same numbers go out after the reconnection
           throw;
@@ -671,7 +671,7 @@ struct CoordinatorNode::Impl {
   /// A signed request that `target` (empty: everybody) republish its full state.
   wire::Signed resync_request(const std::string& target) {
     const wire::ResyncRequest r{name, incarnation, ++resync_seq, target};
-    return signer->sign(kKindResync, encode(ic, r));
+    return signer->seal(kKindResync, encode(ic, r));
   }
 
   /// The next heartbeat (`next`), or the current one, as the last heartbeat sent said it, with
@@ -704,7 +704,7 @@ struct CoordinatorNode::Impl {
 
   void on_updates(const wire::Signed& m) {
     wire::StateUpdateSeq batch;
-    if (const std::string why = open_signed(*keyring, ic, m, kKindState, batch); !why.empty()) {
+    if (const std::string why = open_sealed(*signer, ic, m, kKindState, batch); !why.empty()) {
       updates_rejected.fetch_add(1);
       refuse(m.signer, "a state message signed '" + printable(m.signer) + "': " + why);
       return;
@@ -890,7 +890,7 @@ struct CoordinatorNode::Impl {
 
   void on_resync(const wire::Signed& m) {
     wire::ResyncRequest r;
-    if (const std::string why = open_signed(*keyring, ic, m, kKindResync, r); !why.empty()) {
+    if (const std::string why = open_sealed(*signer, ic, m, kKindResync, r); !why.empty()) {
       refuse(m.signer, "a resync request signed '" + printable(m.signer) + "': " + why);
       return;
     }
@@ -1084,7 +1084,7 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   if (!dir) return tl::unexpected(dir.error());
   auto keyring = Keyring::load(*dir);
   if (!keyring) return tl::unexpected(keyring.error());
-  auto signer = Signer::load(*dir, impl->name);
+  auto signer = Signer::load(*dir, impl->name, *keyring);
   if (!signer) return tl::unexpected(signer.error());
   impl->keyring = std::move(*keyring);
   impl->signer = std::move(*signer);

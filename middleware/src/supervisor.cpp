@@ -147,10 +147,12 @@ struct Supervisor::Impl {
     drops->drop(source, "supervisor: refused " + what);
   }
 
-  /// Checks a signed message and that every record in it names its signer as its coordinator.
+  /// Checks an authenticated message (heartbeats signed, every other kind sealed) and decodes it.
   template <class Seq>
   bool open(const wire::Signed& m, std::string_view kind, Seq& out) {
-    if (const std::string why = open_signed(*keyring, ic, m, kind, out); !why.empty()) {
+    const std::string why =
+        kind == kKindHeartbeat ? open_signed(*keyring, ic, m, kind, out) : open_sealed(*signer, ic, m, kind, out);
+    if (!why.empty()) {
       refuse(m.signer, "a " + std::string(kind) + " message signed '" + printable(m.signer) + "': " + why);
       return false;
     }
@@ -236,7 +238,7 @@ struct Supervisor::Impl {
     }
     if (pub == nullptr) return;
     try {
-      pub->resync(signer->sign(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner), incarnation,
+      pub->resync(signer->seal(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner), incarnation,
                                                                            ++resync_seq, who})));
     } catch (const Ice::Exception&) {
       // The link thread notices and reconnects.
@@ -811,7 +813,7 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   if (!dir) return tl::unexpected(dir.error());
   auto keyring = Keyring::load(*dir);
   if (!keyring) return tl::unexpected(keyring.error());
-  auto signer = Signer::load(*dir, kSupervisorSigner);
+  auto signer = Signer::load(*dir, kSupervisorSigner, *keyring);
   if (!signer) return tl::unexpected(signer.error());
   impl->keyring = std::move(*keyring);
   impl->signer = std::move(*signer);

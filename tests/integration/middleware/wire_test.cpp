@@ -102,7 +102,9 @@ wire::StateUpdate update(const std::string& iface, std::int64_t seq, const std::
 }
 
 Signer load_signer(const std::string& dir, const std::string& name) {
-  auto s = Signer::load(dir, name);
+  auto keyring = Keyring::load(dir);
+  EXPECT_TRUE(keyring) << (keyring ? "" : keyring.error().message);
+  auto s = Signer::load(dir, name, *keyring);
   EXPECT_TRUE(s) << (s ? "" : s.error().message);
   return *s;
 }
@@ -261,7 +263,7 @@ struct Bus {
   }
   /// Publishes `batch` signed by `key`; a genuine batch also advances what the heartbeat lists.
   void send(const Signer& key, const wire::StateUpdateSeq& batch) {
-    state_pub->updates(key.sign(middleware::detail::kKindState, encode(ice.communicator(), batch)));
+    state_pub->updates(key.seal(middleware::detail::kKindState, encode(ice.communicator(), batch)));
     if (&key != &*provider) return;
     std::lock_guard lock(mutex);
     for (const wire::StateUpdate& u : batch) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.seq);
@@ -347,12 +349,12 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   // 3. Signed by another coordinator of the system (a real key) but naming wire-p.
   bus.send(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
   // 4. Claiming wire-p as signer with another key's signature, and with no signature at all.
-  wire::Signed relabelled = bus.other->sign(
+  wire::Signed relabelled = bus.other->seal(
       middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
   relabelled.signer = "wire-p";
   bus.state_pub->updates(relabelled);
   wire::Signed unsigned_message = relabelled;
-  unsigned_message.signature.clear();
+  unsigned_message.tags.clear();
   bus.state_pub->updates(unsigned_message);
   // 5. A replay of wire-p's genuine first message.
   bus.send(*bus.provider, raise);
@@ -371,7 +373,7 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   EXPECT_EQ(bus.state("C.s_R.D0"), State::Normal) << "nothing forged or replayed changed the state\n" << bus.all_log();
   EXPECT_EQ(bus.node->stats().updates_applied, before.updates_applied);
   EXPECT_EQ(bus.node->stats().messages_refused - before.messages_refused, 9u);
-  EXPECT_NE(bus.all_log().find("bad signature"), std::string::npos) << bus.all_log();
+  EXPECT_NE(bus.all_log().find("bad seal"), std::string::npos) << bus.all_log();
 
   // The stream is not frozen: wire-p's next genuine update applies at once.
   bus.send(*bus.provider, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
@@ -529,10 +531,10 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
     return m;
   };
   auto ic = bus.ice.communicator();
-  events->records(bus.attacker->sign(
+  events->records(bus.attacker->seal(
       middleware::detail::kKindEvents,
       encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Transition, "P.s_A\n[wire-p] FORGED", "")})));
-  events->records(bus.provider->sign(
+  events->records(bus.provider->seal(
       middleware::detail::kKindEvents,
       encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "operator\n[wire-p] FAKE LINE")})));
   ASSERT_TRUE(eventually([&] { return output().find("[wire-p] reset P (") != std::string::npos; })) << output();
@@ -541,7 +543,7 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   EXPECT_EQ(output().find("FORGED"), std::string::npos) << output();
   // The same genuine record again is a replay.
   events->records(
-      bus.provider->sign(middleware::detail::kKindEvents,
+      bus.provider->seal(middleware::detail::kKindEvents,
                          encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "again")})));
 
   // Back with a newer incarnation (a restart): its view is refreshed. The old incarnation still
@@ -732,7 +734,7 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   m.component = "P";
   m.text = "operator: not followed";
   events->records(
-      bus.provider->sign(middleware::detail::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
+      bus.provider->seal(middleware::detail::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
 
   // An update the heartbeat lists but that never came: reported after two heartbeats.
   {
@@ -770,7 +772,7 @@ struct RecordSender {
   }
 
   void send_batch(const wire::EventMessageSeq& batch) {
-    events_->records(bus_.provider->sign(middleware::detail::kKindEvents, encode(bus_.ice.communicator(), batch)));
+    events_->records(bus_.provider->seal(middleware::detail::kKindEvents, encode(bus_.ice.communicator(), batch)));
   }
 
   static wire::EventMessage record(std::int64_t seq) {
@@ -1024,7 +1026,7 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
   const auto before = (*node)->stats().updates_published;
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t i = 1; i <= 300; ++i) {
-    resync->resync(bus.supervisor->sign(
+    resync->resync(bus.supervisor->seal(
         middleware::detail::kKindResync,
         encode(bus.ice.communicator(), wire::ResyncRequest{"supervisor", kIncarnation, i, "wire-p"})));
   }
@@ -1215,9 +1217,9 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
   auto own = Ice::uncheckedCast<wire::StateTopicPrx>(bus.topic("safecass.state.wire-c")->getPublisher()->ice_oneway());
   wire::StateUpdate lie = update("P.D0", 2, "", wire::Level::Normal);
   lie.coordinator = "wire-c";
-  own->updates(bus.other->sign(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
+  own->updates(bus.other->seal(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
   // wire-p itself, 2^21 ahead (sent raw: its heartbeats do not list it).
-  bus.state_pub->updates(bus.provider->sign(
+  bus.state_pub->updates(bus.provider->seal(
       middleware::detail::kKindState,
       encode(ic, wire::StateUpdateSeq{update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)})));
   // wire-p's key, an incarnation near 2^63: refused, it does not lock wire-p out.
