@@ -1240,3 +1240,136 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
 
 }  // namespace
 }  // namespace safecass
+
+namespace safecass {
+namespace {
+
+/// Resident set size of this process, in KiB.
+long rss_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::strtol(line.c_str() + 6, nullptr, 10);
+  }
+  return 0;
+}
+
+// Attack: a flood of 20,000 bad messages on each topic (undecodable bytes, forged seals and
+// signatures, signer names of 1 KiB holding newlines and escape codes) while the provider raises a
+// genuine fault. Both the coordinator and the supervisor see the fault (its latency is printed),
+// their logs stay a few lines a second, and memory does not grow with the flood. A second burst of 300 messages with
+// 128 KiB signer names grows neither.
+TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogsNorMemory) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  auto ic = bus.ice.communicator();
+  Ice::ByteSeq garbage;
+  {
+    Ice::OutputStream encoded(ic);
+    encoded.startEncapsulation();
+    for (Ice::Byte b : {Ice::Byte{1}, Ice::Byte{2}, Ice::Byte{3}}) encoded.write(b);
+    encoded.endEncapsulation();
+    encoded.finished(garbage);
+  }
+  const std::string evil_name = std::string(1024, 'x') + "\n[wire-p] P.s_A Error -> Normal\x1b[2J";
+  struct Topic {
+    const char* name;
+    const char* operation;
+  };
+  const std::vector<Topic> topics{{"safecass.state.wire-p", "updates"},
+                                  {"safecass.events", "records"},
+                                  {"safecass.heartbeat", "beat"},
+                                  {"safecass.resync", "resync"}};
+  const std::size_t log_before = bus.all_log().size();
+  const std::size_t out_before = out.all().size();
+  const long rss_before = rss_kib();
+  constexpr int kPerTopic = 20000;
+  std::atomic<bool> flooding{true};
+  std::thread flood([&] {
+    std::vector<std::shared_ptr<Ice::ObjectPrx>> pubs;
+    for (const Topic& t : topics) pubs.push_back(bus.topic(t.name)->getPublisher()->ice_batchOneway());
+    // Forged: an attacker's seal and signature under a hostile signer name.
+    wire::Signed forged = bus.attacker->seal(
+        middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 99, "", wire::Level::Normal)}));
+    forged.signer = evil_name;
+    Ice::ByteSeq forged_bytes;
+    {
+      Ice::OutputStream encoded(ic);
+      encoded.startEncapsulation();
+      encoded.write(forged);
+      encoded.endEncapsulation();
+      encoded.finished(forged_bytes);
+    }
+    Ice::ByteSeq ignored;
+    for (int i = 0; i < kPerTopic; ++i) {
+      for (std::size_t t = 0; t < topics.size(); ++t) {
+        pubs[t]->ice_invoke(topics[t].operation, Ice::OperationMode::Normal, i % 2 == 0 ? garbage : forged_bytes,
+                            ignored);
+      }
+      if (i % 200 == 199) {
+        for (auto& p : pubs) p->ice_flushBatchRequests();
+      }
+    }
+    for (auto& p : pubs) p->ice_flushBatchRequests();
+    flooding.store(false);
+  });
+  // In the middle of the flood, wire-p raises a genuine fault.
+  ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused > 2000; }, 20000ms)) << bus.all_log();
+  const auto sent = std::chrono::steady_clock::now();
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  bool node_saw = false, supervisor_saw = false;
+  std::chrono::steady_clock::duration node_after{}, supervisor_after{};
+  while (std::chrono::steady_clock::now() - sent < 10s && !(node_saw && supervisor_saw)) {
+    if (!node_saw && bus.state("C.s_R.D0") == State::Error) {
+      node_saw = true;
+      node_after = std::chrono::steady_clock::now() - sent;
+    }
+    if (!supervisor_saw && view_state(*supervisor, "P.s_S.D0") == State::Error) {
+      supervisor_saw = true;
+      supervisor_after = std::chrono::steady_clock::now() - sent;
+    }
+    std::this_thread::sleep_for(200us);
+  }
+  const bool mid_flood = flooding.load();
+  flood.join();
+  auto ms = [](std::chrono::steady_clock::duration d) {
+    return static_cast<double>(std::chrono::duration_cast<std::chrono::microseconds>(d).count()) / 1000.0;
+  };
+  std::printf("[flood] fault seen by the coordinator after %.1f ms, by the supervisor after %.1f ms%s\n",
+              ms(node_after), ms(supervisor_after), mid_flood ? " (during the flood)" : "");
+  EXPECT_TRUE(node_saw) << bus.all_log();
+  EXPECT_TRUE(supervisor_saw) << out.all();
+  // The fault waits in IceStorm's and the receivers' queues behind the flood on its own topic
+  // (50-130 ms on an idle machine, docs/security.md); it is seen, within 2 s even beside two busy
+  // loops.
+  EXPECT_LT(ms(node_after), 2000.0);
+  EXPECT_LT(ms(supervisor_after), 2000.0);
+
+  // Then 300 forged messages with 128 KiB signer names (64 MB of log before names were capped).
+  {
+    wire::Signed huge = bus.attacker->seal(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{}));
+    huge.signer = std::string(128 * 1024, 'n');
+    for (int i = 0; i < 300; ++i) bus.state_pub->updates(huge);
+  }
+  ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused >= 4u * kPerTopic / 4; }, 20000ms));
+  std::this_thread::sleep_for(500ms);
+  const std::size_t logged = bus.all_log().size() - log_before;
+  const std::size_t printed = out.all().size() - out_before;
+  const long grown = rss_kib() - rss_before;
+  std::printf(
+      "[flood] %llu messages refused by the coordinator; its log grew %zu bytes, the supervisor's %zu; RSS %+ld KiB\n",
+      static_cast<unsigned long long>(bus.node->stats().messages_refused), logged, printed, grown);
+  EXPECT_LT(logged, 64u * 1024u) << "a few capped lines a second, not one per message";
+  EXPECT_LT(printed, 64u * 1024u) << out.all().substr(out_before, 4096);
+  EXPECT_EQ(out.all().find("\n[wire-p] P.s_A Error -> Normal"), std::string::npos) << "no injected line";
+  EXPECT_EQ(bus.all_log().find('\x1b'), std::string::npos) << "no terminal escape reaches a log";
+  EXPECT_LT(grown, 32L * 1024L) << "memory does not grow with the flood";
+  supervisor->stop();
+}
+
+}  // namespace
+}  // namespace safecass
