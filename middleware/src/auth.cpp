@@ -28,7 +28,7 @@ constexpr std::size_t kTagBytes = 16;
 constexpr std::size_t kDigestBytes = 32;
 constexpr std::size_t kPairKeyBytes = 32;
 constexpr std::string_view kSecretTag = "ed25519-secret";
-constexpr std::size_t kMaxKeyFile = 64 * 1024;
+constexpr std::size_t kMaxKeyFile = std::size_t{64} * 1024;
 
 bool sodium_ready() noexcept {
   static const bool ready = ::sodium_init() >= 0;

@@ -35,7 +35,7 @@ std::string_view Members::component_of(std::string_view address) { return addres
 
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
-PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
+PeerFreshness::Verdict PeerFreshness::of_incarnation(std::int64_t incarnation, std::string& why) {
   if (incarnation < incarnation_) {
     why = "incarnation " + std::to_string(incarnation) + " is older than " + std::to_string(incarnation_) +
           " (a replay, or two processes with one name)";
@@ -45,6 +45,11 @@ PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::i
     unproven_ = std::max(unproven_, incarnation);
     return Verdict::Unproven;
   }
+  return Verdict::Accept;
+}
+
+PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
+  if (const Verdict v = of_incarnation(incarnation, why); v != Verdict::Accept) return v;
   if (seq <= heartbeat_seq_) {
     why = "seq " + std::to_string(seq) + " not above " + std::to_string(heartbeat_seq_) + " (replayed)";
     return Verdict::Refuse;
@@ -56,15 +61,7 @@ PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::i
 PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq,
                                              std::int64_t& missed, std::string& why) {
   missed = 0;
-  if (incarnation < incarnation_) {
-    why = "incarnation " + std::to_string(incarnation) + " is older than " + std::to_string(incarnation_) +
-          " (a replay, or two processes with one name)";
-    return Verdict::Refuse;
-  }
-  if (incarnation != incarnation_) {
-    unproven_ = std::max(unproven_, incarnation);
-    return Verdict::Unproven;
-  }
+  if (const Verdict v = of_incarnation(incarnation, why); v != Verdict::Accept) return v;
   auto it = streams_.find(stream);
   if (it == streams_.end()) it = streams_.emplace(std::string(stream), Stream{}).first;
   Stream& s = it->second;
@@ -186,8 +183,8 @@ void Prover::ask(const std::string& signer, const std::string& endpoint) {
   }
   try {
     alive->proveAsync(
-        bytes_of(nonce), [this, signer, nonce](wire::Signed answer) { done(signer, nonce, &answer, {}); },
-        [this, signer, nonce](std::exception_ptr e) {
+        bytes_of(nonce), [this, signer, nonce](const wire::Signed& answer) { done(signer, nonce, &answer, {}); },
+        [this, signer, nonce](const std::exception_ptr& e) {
           std::string what = "its endpoint did not answer";
           try {
             std::rethrow_exception(e);

@@ -86,6 +86,8 @@ public:
   std::int64_t unproven() const noexcept { return unproven_; }
 
 private:
+  /// The incarnation rule alone: older refused, another one not proven, or the believed one.
+  Verdict of_incarnation(std::int64_t incarnation, std::string& why);
   struct Stream {
     std::int64_t last = 0;    ///< the last number accepted, or listed by the proof
     bool from_proof = false;  ///< `last` is the proof's: nothing accepted since

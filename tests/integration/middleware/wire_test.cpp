@@ -1044,7 +1044,7 @@ TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {
   EXPECT_EQ(middleware::detail::printable("robot"), "robot");
   EXPECT_EQ(middleware::detail::printable("a\nb\rc\x1b[2J\\"), "a\\x0ab\\x0dc\\x1b[2J\\\\");
   // Capped: a 128 KB name is not a 128 KB line.
-  const std::string huge(128 * 1024, 'n');
+  const std::string huge(std::size_t{128} * 1024, 'n');
   const std::string shown = middleware::detail::printable(huge);
   EXPECT_EQ(shown, std::string(middleware::detail::kMaxPrintable, 'n') + "...(+" +
                        std::to_string(huge.size() - middleware::detail::kMaxPrintable) + " bytes)");
@@ -1352,7 +1352,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   // Then 300 forged messages with 128 KiB signer names (64 MB of log before names were capped).
   {
     wire::Signed huge = bus.attacker->seal(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{}));
-    huge.signer = std::string(128 * 1024, 'n');
+    huge.signer = std::string(std::size_t{128} * 1024, 'n');
     for (int i = 0; i < 300; ++i) bus.state_pub->updates(huge);
   }
   ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused >= 4u * kPerTopic / 4; }, 20000ms));
