@@ -199,8 +199,9 @@ void Prover::ask(const std::string& signer, const std::string& endpoint) {
   }
 }
 
-Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
-                                    const std::string& signer, const std::shared_ptr<wire::AlivePrx>& alive) {
+[[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
+                                                  const std::string& signer,
+                                                  const std::shared_ptr<wire::AlivePrx>& alive) {
   const std::string nonce = fresh_nonce();
   wire::Signed answer;
   try {
