@@ -1373,3 +1373,66 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
 
 }  // namespace
 }  // namespace safecass
+
+namespace safecass {
+namespace {
+
+// Attack: `console --ice watch` is fed event records of wire-c as sealed by wire-c's own key, of
+// an earlier run (an older incarnation) and of a run that never proved itself alive (a later
+// one). A follower believes nothing it cannot check: it follows the incarnation proven at
+// connect and reads the records from that process's history, so it shows only what wire-c
+// really recorded.
+TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  middleware::ClientOptions o;
+  o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  o.coordinator = "wire-c";
+  o.keys_dir = bus.keys;
+  o.timeout = 3000ms;
+  auto client = middleware::RemoteClient::connect(o);
+  ASSERT_TRUE(client) << client.error().message;
+  std::mutex mutex;
+  std::vector<std::string> shown;
+  auto follow = (*client)->follow([&](const introspect::HistoryEntry& e) {
+    std::lock_guard lock(mutex);
+    shown.push_back(e.event + " " + e.text);
+  });
+  ASSERT_TRUE(follow) << follow.error().message;
+  ASSERT_TRUE(eventually([&] { return !bus.topic("safecass.events")->getSubscribers().empty(); }));
+
+  // Records "of wire-c", sealed with its key, naming incarnations it does not run.
+  auto events = Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_twoway());
+  auto record = [](std::int64_t incarnation, std::int64_t seq, const std::string& text) {
+    wire::EventMessage m{};
+    m.coordinator = "wire-c";
+    m.incarnation = incarnation;
+    m.seq = seq;
+    m.recordSeq = seq;
+    m.kind = wire::RecordKind::Reset;
+    m.component = "C";
+    m.event = "FAKE";
+    m.text = text;
+    return m;
+  };
+  const std::int64_t refused = static_cast<std::int64_t>((*client)->records_refused());
+  auto ic = bus.ice.communicator();
+  for (std::int64_t incarnation : {std::int64_t{1}, std::numeric_limits<std::int64_t>::max() / 2}) {
+    events->records(bus.other->seal(middleware::detail::kKindEvents,
+                                    encode(ic, wire::EventMessageSeq{record(incarnation, 1, "not this run")})));
+  }
+  ASSERT_TRUE(eventually([&] { return static_cast<std::int64_t>((*client)->records_refused()) >= refused + 2; }));
+  // What wire-c really records is shown.
+  ASSERT_TRUE(bus.co.reset("C", "operator", "real").has_value());
+  ASSERT_TRUE(eventually([&] {
+    std::lock_guard lock(mutex);
+    return std::any_of(shown.begin(), shown.end(),
+                       [](const std::string& s) { return s.find("real") != std::string::npos; });
+  })) << "the real record";
+  std::lock_guard lock(mutex);
+  for (const std::string& s : shown) EXPECT_EQ(s.find("not this run"), std::string::npos) << s;
+}
+
+}  // namespace
+}  // namespace safecass
