@@ -35,11 +35,11 @@ ErrorCode code_of(const std::string& text) {
 /// (a spoofed heartbeat naming it is refused here), and is used only once the process there has
 /// proved itself alive by signing a nonce of ours (a replayed heartbeat of a dead process names
 /// an endpoint anyone may now serve).
-class Finder final : public wire::HeartbeatTopic {
+class Finder final {
 public:
   Finder(std::string coordinator, const Keyring& keys, std::shared_ptr<Ice::Communicator> ic)
       : coordinator_(std::move(coordinator)), keys_(keys), ic_(std::move(ic)) {}
-  void beat(wire::Signed m, const Ice::Current&) override {
+  void on_beat(const wire::Signed& m) {
     if (m.signer != coordinator_) return;  // other coordinators' heartbeats, or forgeries of them
     wire::Heartbeat h;
     std::lock_guard lock(mutex_);
@@ -88,6 +88,8 @@ struct RemoteClient::Impl {
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> gaps{0};
   std::int64_t incarnation = 0;  ///< of the coordinator process proven alive at connect()
+  /// Counts the bus messages that do not decode (a client logs nothing of its own).
+  std::shared_ptr<DropLog> undecodable = std::make_shared<DropLog>(nullptr);
 
   ~Impl() {
     if (ic) ic->destroy();
@@ -129,7 +131,8 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     impl->ic = make_communicator(o.tls);
     auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", protocol(o.tls) + " -h 127.0.0.1");
     auto finder = std::make_shared<Finder>(o.coordinator, *keys, impl->ic);
-    auto proxy = adapter->addWithUUID(finder);
+    auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
+        impl->ic, "beat", [finder](const wire::Signed& m) { finder->on_beat(m); }, impl->undecodable, "console"));
     adapter->activate();
     auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), kHeartbeatTopic);
     subscribe(heartbeat, proxy);
@@ -224,12 +227,12 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
 
 /// Follows one coordinator's records on the events topic. Runs on the client communicator's one
 /// dispatch thread, so records reach the sink in order.
-class Follower final : public wire::EventTopic {
+class Follower final {
 public:
   Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
       : client_(client), sink_(std::move(sink)), last_(last), incarnation_(client.incarnation) {}
 
-  void records(wire::Signed batch, const Ice::Current&) override;
+  void on_records(const wire::Signed& batch);
   /// Subscription::catch_up(): the records after the last delivered, from the history.
   [[nodiscard]] Expected<std::size_t> catch_up();
 
@@ -279,7 +282,7 @@ private:
 
 }  // namespace
 
-void Follower::records(wire::Signed batch, const Ice::Current&) {
+void Follower::on_records(const wire::Signed& batch) {
   // Records on the bus are sealed for the members of the system; a follower holds only the
   // keyring, so it cannot check them. It takes a batch as a doorbell: what the batch says is
   // not believed, it only says when to read the records, from the coordinator's own history at
@@ -430,7 +433,9 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
                                                                protocol(o.tls) + " -h 127.0.0.1");
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
-    auto proxy = adapter->addWithUUID(follower);
+    auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
+        impl_->ic, "records", [follower](const wire::Signed& m) { follower->on_records(m); }, impl_->undecodable,
+        "console"));
     adapter->activate();
     auto events = topic(topic_manager(impl_->ic, o.ice, o.tls), kEventTopic);
     subscribe(events, proxy);
@@ -473,7 +478,7 @@ Expected<void> RemoteClient::reset(std::string_view target, std::string_view who
   });
 }
 
-std::uint64_t RemoteClient::records_refused() const { return impl_->refused.load(); }
+std::uint64_t RemoteClient::records_refused() const { return impl_->refused.load() + impl_->undecodable->count(); }
 std::uint64_t RemoteClient::gaps_filled() const { return impl_->gaps.load(); }
 
 }  // namespace safecass::middleware

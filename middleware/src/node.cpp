@@ -1029,37 +1029,6 @@ struct CoordinatorNode::Impl {
   }
 };
 
-namespace {
-
-class StateServant final : public wire::StateTopic {
-public:
-  explicit StateServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void updates(wire::Signed batch, const Ice::Current&) override { impl_.on_updates(batch); }
-
-private:
-  CoordinatorNode::Impl& impl_;
-};
-
-class HeartbeatServant final : public wire::HeartbeatTopic {
-public:
-  explicit HeartbeatServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void beat(wire::Signed h, const Ice::Current&) override { impl_.on_beat(h); }
-
-private:
-  CoordinatorNode::Impl& impl_;
-};
-
-class ResyncServant final : public wire::ResyncTopic {
-public:
-  explicit ResyncServant(CoordinatorNode::Impl& impl) : impl_(impl) {}
-  void resync(wire::Signed request, const Ice::Current&) override { impl_.on_resync(request); }
-
-private:
-  CoordinatorNode::Impl& impl_;
-};
-
-}  // namespace
-
 Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& coordinator, Monitor& monitor,
                                                                    const FilterRegistry& registry,
                                                                    const spec::SystemSpec& system,
@@ -1148,9 +1117,13 @@ Expected<void> CoordinatorNode::start() {
     auto guarded = [&](std::shared_ptr<Ice::Object> servant) {
       return std::make_shared<Guard>(std::move(servant), d.drops, who);
     };
-    auto state = d.adapter->add(guarded(std::make_shared<StateServant>(d)), Ice::Identity{"state", id});
-    auto heartbeat = d.adapter->add(guarded(std::make_shared<HeartbeatServant>(d)), Ice::Identity{"heartbeat", id});
-    auto resync = d.adapter->add(guarded(std::make_shared<ResyncServant>(d)), Ice::Identity{"resync", id});
+    auto subscriber = [&](const char* operation, void (Impl::*handle)(const wire::Signed&)) {
+      return std::make_shared<TopicSubscriber>(
+          d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops, who);
+    };
+    auto state = d.adapter->add(subscriber("updates", &Impl::on_updates), Ice::Identity{"state", id});
+    auto heartbeat = d.adapter->add(subscriber("beat", &Impl::on_beat), Ice::Identity{"heartbeat", id});
+    auto resync = d.adapter->add(subscriber("resync", &Impl::on_resync), Ice::Identity{"resync", id});
     ControlContext context{
         d.co,
         d.monitor,

@@ -222,6 +222,48 @@ wire::Signed make_proof(const Signer& signer, const std::shared_ptr<Ice::Communi
   return signer.sign(kKindProof, encode(ic, wire::Proof{nonce, std::move(beat)}));
 }
 
+// ---- TopicSubscriber ----------------------------------------------------------------------------
+
+TopicSubscriber::TopicSubscriber(std::shared_ptr<Ice::Communicator> ic, std::string operation,
+                                 std::function<void(const wire::Signed&)> handler, std::shared_ptr<DropLog> log,
+                                 std::string who)
+    : ic_(std::move(ic)),
+      operation_(std::move(operation)),
+      handler_(std::move(handler)),
+      log_(std::move(log)),
+      who_(std::move(who)) {}
+
+bool TopicSubscriber::ice_invoke(std::pair<const Ice::Byte*, const Ice::Byte*> in, std::vector<Ice::Byte>& out,
+                                 const Ice::Current& current) {
+  if (current.requestId != 0) {  // a twoway request (IceStorm sends oneway): an empty answer
+    Ice::OutputStream answer(ic_);
+    answer.writeEmptyEncapsulation(current.encoding);
+    answer.finished(out);
+  }
+  if (current.operation != operation_) {
+    log_->drop("(unknown operation)",
+               who_ + ": refused a message for an unknown operation (" + printable(current.operation) + ")");
+    return true;
+  }
+  wire::Signed m;
+  bool whole = false;
+  try {
+    Ice::InputStream encaps(ic_, in);
+    encaps.startEncapsulation();
+    encaps.read(m);
+    encaps.endEncapsulation();
+    whole = encaps.pos() == static_cast<std::size_t>(in.second - in.first);
+  } catch (...) {
+    whole = false;
+  }
+  if (!whole) {
+    log_->drop("(undecodable)", who_ + ": refused a message that does not decode (" + operation_ + ")");
+    return true;
+  }
+  handler_(m);
+  return true;
+}
+
 // ---- Guard --------------------------------------------------------------------------------------
 
 bool Guard::dispatch(Ice::Request& request) {

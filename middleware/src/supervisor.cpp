@@ -765,30 +765,6 @@ struct Supervisor::Impl {
 
 namespace {
 
-class EventServant final : public wire::EventTopic {
-public:
-  explicit EventServant(Supervisor::Impl& d) : d_(d) {}
-  void records(wire::Signed batch, const Ice::Current&) override { d_.on_events(batch); }
-
-private:
-  Supervisor::Impl& d_;
-};
-class StateServant final : public wire::StateTopic {
-public:
-  explicit StateServant(Supervisor::Impl& d) : d_(d) {}
-  void updates(wire::Signed batch, const Ice::Current&) override { d_.on_updates(batch); }
-
-private:
-  Supervisor::Impl& d_;
-};
-class HeartbeatServant final : public wire::HeartbeatTopic {
-public:
-  explicit HeartbeatServant(Supervisor::Impl& d) : d_(d) {}
-  void beat(wire::Signed h, const Ice::Current&) override { d_.on_beat(h); }
-
-private:
-  Supervisor::Impl& d_;
-};
 class AliveServant final : public wire::Alive {
 public:
   explicit AliveServant(Supervisor::Impl& d) : d_(d) {}
@@ -898,10 +874,14 @@ Expected<void> Supervisor::start() {
     auto guarded = [&](std::shared_ptr<Ice::Object> servant) {
       return adapter->addWithUUID(std::make_shared<Guard>(std::move(servant), d.drops, "supervisor"));
     };
-    if (d.options.records) d.link->subscribe_to(kEventTopic, guarded(std::make_shared<EventServant>(d)));
-    auto state = guarded(std::make_shared<StateServant>(d));
+    auto subscriber = [&](const char* operation, void (Impl::*handle)(const wire::Signed&)) {
+      return adapter->addWithUUID(std::make_shared<TopicSubscriber>(
+          d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops, "supervisor"));
+    };
+    if (d.options.records) d.link->subscribe_to(kEventTopic, subscriber("records", &Impl::on_events));
+    auto state = subscriber("updates", &Impl::on_updates);
     for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state);
-    d.link->subscribe_to(kHeartbeatTopic, guarded(std::make_shared<HeartbeatServant>(d)));
+    d.link->subscribe_to(kHeartbeatTopic, subscriber("beat", &Impl::on_beat));
     d.alive = guarded(std::make_shared<AliveServant>(d))->ice_toString();
     adapter->activate();
   } catch (const Ice::Exception& e) {

@@ -1344,7 +1344,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   EXPECT_TRUE(node_saw) << bus.all_log();
   EXPECT_TRUE(supervisor_saw) << out.all();
   // The fault waits in IceStorm's and the receivers' queues behind the flood on its own topic
-  // (50-130 ms on an idle machine, docs/security.md); it is seen, within 2 s even beside two busy
+  // (40-90 ms on an idle machine, docs/security.md); it is seen, within 2 s even beside two busy
   // loops.
   EXPECT_LT(ms(node_after), 2000.0);
   EXPECT_LT(ms(supervisor_after), 2000.0);
