@@ -295,7 +295,7 @@ struct CoordinatorNode::Impl {
     of.push_back(&s);
   }
 
-  // -- message size (publisher thread): every body is measured before it is signed and sent --
+  // -- message size (publisher thread): every body is measured before it is sealed and sent --
 
   /// Bytes of the size prefix of a sequence (or string) of `n` elements in the Ice encoding.
   static std::size_t size_prefix(std::size_t n) noexcept { return n < 255 ? 1 : 5; }
@@ -668,7 +668,7 @@ struct CoordinatorNode::Impl {
     }
   }
 
-  /// A signed request that `target` (empty: everybody) republish its full state.
+  /// A sealed request that `target` (empty: everybody) republish its full state.
   wire::Signed resync_request(const std::string& target) {
     const wire::ResyncRequest r{name, incarnation, ++resync_seq, target};
     return signer->seal(kKindResync, encode(ic, r));

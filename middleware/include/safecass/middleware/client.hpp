@@ -12,9 +12,10 @@
 ///   auto why = (*client)->explain("PENDANT");               // Expected<introspect::ExplainAnswer>
 ///   auto done = (*client)->generate("EVT_FORCE_ERROR", "JR3.s_A");  // a write: needs the token
 /// ```
-/// connect() finds the coordinator by listening to the heartbeats on IceStorm: the first one
-/// signed by that coordinator's key (the system's keyring) gives its Control endpoint, which must
-/// be on this host unless `insecure`. Requests and the token go only there.
+/// connect() finds the coordinator by listening to the heartbeats on IceStorm: one signed by that
+/// coordinator's key (the system's keyring) gives its Control endpoint, which must be on this host
+/// unless `insecure`, and which must prove itself alive (sign a nonce of the client's) before
+/// anything else is sent to it. Requests and the token go only there.
 ///
 /// Every call is a synchronous request/reply with a timeout. Errors carry the coordinator's
 /// answer: Denied (a write without --allow-write or with a wrong token), NotFound / Parse /
@@ -53,10 +54,10 @@ struct ClientOptions {
 /// The SystemQuery of one live coordinator process (the read model's remote implementation):
 /// every read is one request to the coordinator's Control object, answered by the coordinator's
 /// own LocalQuery, so it carries every field an in-process answer has. follow() subscribes to the
-/// coordinator's records on the events topic (pushed, never polled): each signed batch is
-/// checked against the keyring, records are delivered in order and once, and a gap in their
-/// sequence numbers (a lost message, a record too large for the bus) is filled from the
-/// coordinator's history (Control::recordsSince) before the records after it.
+/// coordinator's records on the events topic (pushed, never polled): a client holds only the
+/// keyring and cannot check a sealed batch, so each one is a doorbell: the records it announces
+/// that were not delivered yet are read from the coordinator's history (Control::recordsSince) at
+/// the endpoint proven alive, and delivered in order and once.
 class RemoteClient final : public introspect::SystemQuery {
 public:
   /// Errors: Io (IceStorm or the coordinator unreachable; no heartbeat from it within timeout).

@@ -1,7 +1,9 @@
 #pragma once
 /// @file keys.hpp
 /// The keys of an authenticated bus (DESIGN §7, docs/security.md): every message on every topic is
-/// signed by the coordinator it names, with an Ed25519 key of its own.
+/// authenticated as coming from the member it names: heartbeats and proofs of life signed with its
+/// Ed25519 key, every other message sealed with the keys it shares with each other member (derived
+/// from the same Ed25519 keys: nothing else to create).
 ///
 /// A system's key directory holds
 /// - `keyring`: one line per signer, `NAME ed25519 HEX-PUBLIC-KEY` (readable by every process of
