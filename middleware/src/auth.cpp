@@ -421,12 +421,6 @@ std::string printable(std::string_view text, std::size_t max) {
   return out;
 }
 
-std::string older_incarnation(std::string_view what, std::string_view who, std::int64_t seen, std::int64_t newest) {
-  if (seen >= newest) return {};
-  return std::string(what) + " of '" + printable(who) + "': incarnation " + std::to_string(seen) + " is older than " +
-         std::to_string(newest) + " (a replay, or two processes named '" + printable(who) + "')";
-}
-
 std::int64_t new_incarnation() noexcept {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   const std::int64_t ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now).count();

@@ -155,11 +155,6 @@ private:
   std::uint64_t count_ = 0;
 };
 
-/// The freshness rule for incarnations, shared by every receiver: a message of an incarnation older
-/// than the newest seen from `who` is a replay, or a second process with that name. Returns why it
-/// is refused, or empty when `seen` is not older than `newest`.
-std::string older_incarnation(std::string_view what, std::string_view who, std::int64_t seen, std::int64_t newest);
-
 /// An incarnation for a process starting now: its start time in ns since the epoch, so a
 /// restart always has a larger one than any earlier run.
 std::int64_t new_incarnation() noexcept;

@@ -45,22 +45,11 @@ using namespace detail;
 }
 
 namespace {
-std::string component_of(std::string_view address) { return std::string(address.substr(0, address.find('.'))); }
-
 const spec::ComponentSpec* find_spec(const spec::SystemSpec& system, std::string_view name) {
   for (const auto& c : system.components) {
     if (c.name == name) return &c;
   }
   return nullptr;
-}
-
-/// Which coordinator runs each component ("" when the system declares no coordinators).
-std::map<std::string, std::string, std::less<>> placement(const spec::SystemSpec& system) {
-  std::map<std::string, std::string, std::less<>> where;
-  for (const auto& [coordinator, components] : system.coordinators) {
-    for (const std::string& c : components) where[c] = coordinator;
-  }
-  return where;
 }
 
 bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
@@ -78,18 +67,18 @@ bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
 
 [[nodiscard]] Expected<void> connect_remote_providers(const spec::SystemSpec& system, std::string_view coordinator_name,
                                                       Coordinator& coordinator) {
-  const auto where = placement(system);
+  const Members members(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == coordinator_name; })) {
     return fail(ErrorCode::NotFound,
                 "system '" + system.name + "' has no coordinator '" + std::string(coordinator_name) + "'");
   }
   for (const spec::ConnectionSpec& k : system.connections) {
-    const std::string client = component_of(k.required);
-    const std::string provider = component_of(k.provided);
-    const auto c = where.find(client);
-    const auto p = where.find(provider);
-    if (c == where.end() || p == where.end() || c->second != coordinator_name || p->second == coordinator_name)
+    const std::string_view client = Members::component_of(k.required);
+    const std::string provider(Members::component_of(k.provided));
+    const std::string_view runs_provider = members.coordinator_of(provider);
+    if (members.coordinator_of(client) != coordinator_name || runs_provider.empty() ||
+        runs_provider == coordinator_name)
       continue;
     State propagate = State::Error;
     if (const spec::ComponentSpec* spec = find_spec(system, provider)) {
@@ -116,7 +105,7 @@ struct CoordinatorNode::Impl {
   std::string name;
   NodeOptions options;
   std::int64_t incarnation = 0;
-  std::map<std::string, std::string, std::less<>> where;
+  Members members;  ///< which coordinator runs each component
 
   /// Log lines about messages too large to send whole (publisher thread): at most one per second
   /// per interface (and one for event records), with the number of similar ones in between. The
@@ -165,7 +154,8 @@ struct CoordinatorNode::Impl {
     std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
-  std::mutex peer_mutex;  ///< held, peers; taken before the coordinator's lock, never after
+  std::mutex peer_mutex;       ///< held, peers; taken before the coordinator's lock, never after
+  std::string stream_scratch;  ///< under peer_mutex: a stream's name, its storage reused per update
   std::int64_t started = 0;
 
   std::mutex queue_mutex;
@@ -211,7 +201,7 @@ struct CoordinatorNode::Impl {
   OversizeLog record_oversize;  ///< publisher thread only
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
-      : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)) {}
+      : co(c), monitor(m), registry(r), system(s), name(std::move(n)), options(std::move(o)), members(s) {}
 
   void log(const std::string& line) const {
     if (options.log) {
@@ -682,8 +672,8 @@ struct CoordinatorNode::Impl {
     h.incarnation = incarnation;
     h.time = steady_ns();
     h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
-    for (const auto& s : streams) h.lastSeq["state:" + s->iface] = s->seq.load();
-    h.lastSeq["events"] = event_seq.load();
+    for (const auto& s : streams) h.lastSeq[state_stream(s->iface)] = s->seq.load();
+    h.lastSeq[std::string(kEventsStream)] = event_seq.load();
     for (ComponentId c : id_range<ComponentId>(co.component_count())) {
       if (!co.is_remote(c)) h.components.emplace_back(co.component_name(c));
     }
@@ -729,13 +719,15 @@ struct CoordinatorNode::Impl {
     Held& h = it->second;
     if (u.coordinator != h.provider) {
       updates_rejected.fetch_add(1);
-      refuse(from, what() + ": " + component_of(u.iface) + " runs in coordinator '" + h.provider + "'");
+      refuse(from,
+             what() + ": " + std::string(Members::component_of(u.iface)) + " runs in coordinator '" + h.provider + "'");
       return;
     }
     Peer& peer = peers[u.coordinator];
     std::int64_t missed = 0;
     std::string why;
-    switch (peer.fresh.stream("state:" + u.iface, u.incarnation, u.seq, missed, why)) {
+    state_stream(stream_scratch, u.iface);
+    switch (peer.fresh.stream(stream_scratch, u.incarnation, u.seq, missed, why)) {
       case PeerFreshness::Verdict::Accept: break;
       case PeerFreshness::Verdict::Unproven:
         // A process not proven alive yet (a restart, or a replay of an earlier run): its state is
@@ -853,7 +845,8 @@ struct CoordinatorNode::Impl {
     bool caught_up = true;
     for (auto& [iface, h] : held) {
       if (h.provider != hb.coordinator) continue;
-      const auto s = hb.lastSeq.find("state:" + iface);
+      state_stream(stream_scratch, iface);
+      const auto s = hb.lastSeq.find(stream_scratch);
       const std::int64_t have = h.incarnation == hb.incarnation ? h.last_seq : 0;
       const bool behind = s == hb.lastSeq.end() || s->second > have;
       caught_up = caught_up && !behind;
@@ -907,9 +900,8 @@ struct CoordinatorNode::Impl {
       // A resync request only asks for a republish: its own numbers keep replays from costing
       // more than one, and say nothing of whether its sender is alive.
       if (r.incarnation < peer.resync_incarnation) {
-        refuse(m.signer,
-               "a resync request of '" + printable(r.requester) +
-                   "': " + older_incarnation("a resync request", r.requester, r.incarnation, peer.resync_incarnation));
+        refuse(m.signer, "a resync request of '" + printable(r.requester) +
+                             "': " + older_incarnation(r.incarnation, peer.resync_incarnation));
         return;
       }
       if (r.incarnation > peer.resync_incarnation) {
@@ -1038,7 +1030,6 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
     return fail(ErrorCode::InvalidArgument, "middleware: heartbeat period must be positive");
   auto impl =
       std::make_unique<Impl>(coordinator, monitor, registry, system, std::move(coordinator_name), std::move(options));
-  impl->where = placement(system);
   if (std::none_of(system.coordinators.begin(), system.coordinators.end(),
                    [&](const auto& c) { return c.first == impl->name; })) {
     return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + impl->name + "'");
@@ -1066,8 +1057,7 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
       for (MachineId m : coordinator.provided_machines(c)) {
         const std::string iface =
             std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(m));
-        const auto w = impl->where.find(coordinator.component_name(c));
-        const std::string provider = w == impl->where.end() ? std::string() : w->second;
+        const std::string provider(impl->members.coordinator_of(coordinator.component_name(c)));
         impl->held.emplace(iface, Impl::Held{m, provider});
         if (!provider.empty()) impl->peers[provider].provider = true;
       }
@@ -1087,9 +1077,9 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   // The required interfaces each provider coordinator feeds: where its loss is raised.
   for (const Connection& k : coordinator.connections()) {
     if (!coordinator.is_remote(k.provider) || coordinator.is_remote(k.client)) continue;
-    const auto w = impl->where.find(coordinator.component_name(k.provider));
-    if (w == impl->where.end()) continue;
-    impl->peers[w->second].feeds.push_back(coordinator.required_machines(k.client)[k.required]);
+    const std::string_view provider = impl->members.coordinator_of(coordinator.component_name(k.provider));
+    if (provider.empty()) continue;
+    impl->peers[std::string(provider)].feeds.push_back(coordinator.required_machines(k.client)[k.required]);
   }
   return std::unique_ptr<CoordinatorNode>(new CoordinatorNode(std::move(impl)));
 }

@@ -15,16 +15,23 @@ std::string incarnation_out_of_bounds(std::string_view what, std::string_view wh
          (incarnation <= 0 ? " is not a start time" : " is more than 60 s ahead of this host's clock");
 }
 
+std::string older_incarnation(std::int64_t seen, std::int64_t newest) {
+  return "incarnation " + std::to_string(seen) + " is older than " + std::to_string(newest) +
+         " (a replay, or two processes with one name)";
+}
+
 // ---- Members ------------------------------------------------------------------------------------
 
 Members::Members(const spec::SystemSpec& system) {
   for (const auto& [coordinator, components] : system.coordinators) {
-    coordinators_.emplace(coordinator, true);
     for (const std::string& c : components) owner_.emplace(c, coordinator);
   }
 }
 
-bool Members::is_member(std::string_view coordinator) const { return coordinators_.contains(coordinator); }
+std::string_view Members::coordinator_of(std::string_view component) const {
+  const auto it = owner_.find(component);
+  return it == owner_.end() ? std::string_view() : std::string_view(it->second);
+}
 
 bool Members::runs(std::string_view coordinator, std::string_view component) const {
   const auto it = owner_.find(component);
@@ -35,21 +42,16 @@ std::string_view Members::component_of(std::string_view address) { return addres
 
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
-PeerFreshness::Verdict PeerFreshness::of_incarnation(std::int64_t incarnation, std::string& why) {
+PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::string& why) const {
   if (incarnation < incarnation_) {
-    why = "incarnation " + std::to_string(incarnation) + " is older than " + std::to_string(incarnation_) +
-          " (a replay, or two processes with one name)";
+    why = older_incarnation(incarnation, incarnation_);
     return Verdict::Refuse;
   }
-  if (incarnation != incarnation_) {
-    unproven_ = std::max(unproven_, incarnation);
-    return Verdict::Unproven;
-  }
-  return Verdict::Accept;
+  return incarnation == incarnation_ ? Verdict::Accept : Verdict::Unproven;
 }
 
 PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
-  if (const Verdict v = of_incarnation(incarnation, why); v != Verdict::Accept) return v;
+  if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
   if (seq <= heartbeat_seq_) {
     why = "seq " + std::to_string(seq) + " not above " + std::to_string(heartbeat_seq_) + " (replayed)";
     return Verdict::Refuse;
@@ -61,7 +63,7 @@ PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::i
 PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq,
                                              std::int64_t& missed, std::string& why) {
   missed = 0;
-  if (const Verdict v = of_incarnation(incarnation, why); v != Verdict::Accept) return v;
+  if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
   auto it = streams_.find(stream);
   if (it == streams_.end()) it = streams_.emplace(std::string(stream), Stream{}).first;
   Stream& s = it->second;
@@ -96,7 +98,6 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why) {
     heartbeat_seq_ = beat.seq;
     streams_.clear();
   }
-  if (unproven_ <= incarnation_) unproven_ = 0;
   // What the process had sent when it answered: anything at or below it that arrives later is
   // old; what it sends next is above it.
   for (const auto& [stream, last] : beat.lastSeq) {

@@ -39,24 +39,39 @@ inline constexpr std::chrono::seconds kIncarnationMargin{60};
 /// cannot push a stream into the future and freeze it.
 inline constexpr std::int64_t kMaxSeqJump = std::int64_t{1} << 20;
 
+/// Why a message of incarnation `seen` is refused when `newest` is the one believed: a replay, or a
+/// second process with the same name.
+std::string older_incarnation(std::int64_t seen, std::int64_t newest);
+
 /// Why `incarnation` (of `who`, in `what`) is refused: it is not positive, or it lies further in
 /// the future than kIncarnationMargin. Empty when it is acceptable.
 std::string incarnation_out_of_bounds(std::string_view what, std::string_view who, std::int64_t incarnation);
+
+/// The names of a peer's streams in its heartbeat's list (wire::Heartbeat::lastSeq): its event
+/// records, and the state of each provided interface "C.p".
+inline constexpr std::string_view kEventsStream = "events";
+inline constexpr std::string_view kStateStreamPrefix = "state:";
+/// Writes the name of the state stream of interface `iface` into `out` (its storage is reused).
+inline void state_stream(std::string& out, std::string_view iface) { out.assign(kStateStreamPrefix).append(iface); }
+inline std::string state_stream(std::string_view iface) {
+  std::string out;
+  state_stream(out, iface);
+  return out;
+}
 
 /// The coordinator each component runs in, as the system file assigns them.
 class Members {
 public:
   explicit Members(const spec::SystemSpec& system);
-  /// True when `coordinator` is a coordinator of the system.
-  bool is_member(std::string_view coordinator) const;
   /// True when the system file assigns `component` to `coordinator`.
   bool runs(std::string_view coordinator, std::string_view component) const;
+  /// The coordinator the system file assigns `component` to; empty when none.
+  std::string_view coordinator_of(std::string_view component) const;
   /// The component of an interface or address "Component.rest".
   static std::string_view component_of(std::string_view address);
 
 private:
   std::map<std::string, std::string, std::less<>> owner_;  // component -> coordinator
-  std::map<std::string, bool, std::less<>> coordinators_;
 };
 
 /// What one receiver believes of one peer's process: the proven incarnation, its heartbeats' and
@@ -69,10 +84,14 @@ public:
     Unproven,  ///< a process this receiver has not proven alive yet (ask it: Prover), or a
                ///< message it sent before it proved itself alive: dropped, without blame
   };
+  /// The incarnation rule alone, for a message of `incarnation`: older than the believed one
+  /// refused, another one not proven, the believed one accepted.
+  Verdict process(std::int64_t incarnation, std::string& why) const;
   /// A heartbeat of incarnation `incarnation`, number `seq`.
   Verdict heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why);
-  /// A message of stream `stream` (e.g. "state:C.p"): on Accept `missed` is the number of
-  /// messages of the stream skipped (0 for the first one after a proof).
+  /// A message of stream `stream` (state_stream(), kEventsStream): on Accept `missed` is the
+  /// number of messages of the stream skipped since the last one accepted, or since the count the
+  /// proof listed.
   Verdict stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed,
                  std::string& why);
   /// A proof of `beat` (checked by the Prover): its incarnation becomes the believed one, and its
@@ -83,18 +102,13 @@ public:
   std::int64_t incarnation() const noexcept { return incarnation_; }
   /// The last number accepted on `stream` (0: none).
   std::int64_t last(std::string_view stream) const;
-  /// The newest incarnation seen but not proven (0: none).
-  std::int64_t unproven() const noexcept { return unproven_; }
 
 private:
-  /// The incarnation rule alone: older refused, another one not proven, or the believed one.
-  Verdict of_incarnation(std::int64_t incarnation, std::string& why);
   struct Stream {
     std::int64_t last = 0;    ///< the last number accepted, or listed by the proof
     bool from_proof = false;  ///< `last` is the proof's: nothing accepted since
   };
   std::int64_t incarnation_ = 0;
-  std::int64_t unproven_ = 0;
   std::int64_t heartbeat_seq_ = 0;
   std::map<std::string, Stream, std::less<>> streams_;
 };

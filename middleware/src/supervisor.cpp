@@ -175,9 +175,10 @@ struct Supervisor::Impl {
   /// proven alive. An older one is a replay (refused); a newer one is a process not proven alive
   /// yet, dropped until its heartbeat is proven (receiver.hpp).
   bool current(Peer& peer, const std::string& who, std::int64_t seen, std::string_view what) {
-    if (seen == peer.fresh.incarnation()) return true;
-    if (seen < peer.fresh.incarnation()) refuse(who, older_incarnation(what, who, seen, peer.fresh.incarnation()));
-    return false;
+    std::string why;
+    const PeerFreshness::Verdict v = peer.fresh.process(seen, why);
+    if (v == PeerFreshness::Verdict::Refuse) refuse(who, std::string(what) + " of '" + printable(who) + "': " + why);
+    return v == PeerFreshness::Verdict::Accept;
   }
 
   /// `beat` of `who` was proven by an answer to our nonce (Prover, on an Ice thread).
@@ -203,7 +204,7 @@ struct Supervisor::Impl {
           }
           print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
         }
-        const auto sent = beat.lastSeq.find("events");
+        const auto sent = beat.lastSeq.find(std::string(kEventsStream));
         const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
         peer.joined = options.records;
         peer.joined_at = joined;
@@ -472,7 +473,7 @@ struct Supervisor::Impl {
       // applied is a replay (or a duplicate) and must not bring back an older state; a gap needs
       // nothing more: this full state supersedes what was missed.
       std::string& stream = stream_scratch;
-      stream.assign("state:").append(u.iface);
+      state_stream(stream, u.iface);
       std::int64_t missed = 0;
       std::string why;
       switch (p->second.fresh.stream(stream, u.incarnation, u.seq, missed, why)) {
@@ -529,8 +530,8 @@ struct Supervisor::Impl {
         case PeerFreshness::Verdict::Accept: break;
         case PeerFreshness::Verdict::Unproven: {
           // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
-          const auto sent = h.lastSeq.find("events");
-          if (sent != h.lastSeq.end() && h.incarnation > known) heard_unproven(peer, h.incarnation, sent->second);
+          const auto sent = h.lastSeq.find(std::string(kEventsStream));
+          if (sent != h.lastSeq.end()) heard_unproven(peer, h.incarnation, sent->second);
           prover->ask(h.coordinator, h.control);
           return;
         }
@@ -558,7 +559,7 @@ struct Supervisor::Impl {
     // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
     // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
     // records may be on their way on the other topic): reported as missed.
-    const auto sent = options.records ? h.lastSeq.find("events") : h.lastSeq.end();
+    const auto sent = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
     if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
       if (peer.events_behind) {
         report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
@@ -578,7 +579,7 @@ struct Supervisor::Impl {
     std::int64_t states_missed = 0;
     for (const auto& [stream, last] : h.lastSeq) {
       if (options.records) break;
-      if (stream.rfind("state:", 0) != 0) continue;
+      if (!std::string_view(stream).starts_with(kStateStreamPrefix)) continue;
       const std::int64_t have = peer.fresh.last(stream);
       if (last > have) states_missed += last - have;
     }
