@@ -43,6 +43,9 @@ std::string_view Members::component_of(std::string_view address) { return addres
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
 PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::string& why) const {
+  // No process proven yet (a proof's incarnation is always positive): nothing is taken, whatever
+  // incarnation a message names, zero included.
+  if (incarnation_ == 0) return Verdict::Unproven;
   if (incarnation < incarnation_) {
     why = older_incarnation(incarnation, incarnation_);
     return Verdict::Refuse;

@@ -76,7 +76,6 @@ struct Supervisor::Impl {
     /// first ones). Records up to joined_at were sent before: any still on their way are not
     /// taken (they cannot be told from replays); those sent since the supervisor first heard of
     /// the process were reported missed at the proof.
-    bool joined = false;
     std::int64_t joined_at = 0;
     bool events_behind = false;  ///< the last heartbeat listed event records not received
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
@@ -206,7 +205,6 @@ struct Supervisor::Impl {
         }
         const auto sent = beat.lastSeq.find(std::string(kEventsStream));
         const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
-        peer.joined = options.records;
         peer.joined_at = joined;
         peer.last_event_seq = joined;
         peer.gaps.clear();
@@ -371,16 +369,12 @@ struct Supervisor::Impl {
         if (m.incarnation > peer.fresh.incarnation()) heard_unproven(peer, m.incarnation, m.seq - 1);
         return;
       }
-      if (m.seq - std::max(peer.last_event_seq, peer.joined_at) > kMaxSeqJump) {
+      if (m.seq - peer.last_event_seq > kMaxSeqJump) {
         refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
                            " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
         return;
       }
-      if (!peer.joined) {
-        peer.joined = true;
-        peer.joined_at = m.seq - 1;
-        peer.last_event_seq = m.seq;
-      } else if (m.seq <= peer.joined_at) {
+      if (m.seq <= peer.joined_at) {
         // Sent before the process proved itself alive to the supervisor, still on its way: it may
         // as well be a replay of an older record, so it is not taken (reported missed at the
         // proof when sent since the supervisor first heard of the process).

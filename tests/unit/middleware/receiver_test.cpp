@@ -1,0 +1,87 @@
+// The receiver's freshness rules (middleware/src/receiver.hpp, DESIGN §7 "The bus, precisely"),
+// without a bus: what one receiver believes of one peer's process.
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+
+#include "receiver.hpp"
+
+namespace safecass::middleware::detail {
+namespace {
+
+using Verdict = PeerFreshness::Verdict;
+
+constexpr std::int64_t kRun = 1'000'000;  // a proven process's incarnation
+
+wire::Heartbeat proof(std::int64_t incarnation, std::int64_t seq, std::int64_t state_sent) {
+  wire::Heartbeat beat;
+  beat.coordinator = "robot";
+  beat.incarnation = incarnation;
+  beat.seq = seq;
+  beat.lastSeq[state_stream("JR3.ForceData")] = state_sent;
+  return beat;
+}
+
+TEST(PeerFreshness, NothingOfAPeerIsTakenBeforeItsProcessIsProvenNotEvenOfIncarnationZero) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  for (std::int64_t incarnation : {std::int64_t{0}, std::int64_t{-1}, kRun}) {
+    EXPECT_EQ(peer.heartbeat(incarnation, 1, why), Verdict::Unproven) << incarnation;
+    EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), incarnation, 1, missed, why), Verdict::Unproven)
+        << incarnation;
+    EXPECT_EQ(peer.process(incarnation, why), Verdict::Unproven) << incarnation;
+  }
+}
+
+TEST(PeerFreshness, AfterAProofOnlyThatProcessIsTakenAnOlderOneIsRefusedANewerOneIsUnproven) {
+  PeerFreshness peer;
+  std::string why;
+  ASSERT_TRUE(peer.proven(proof(kRun, 7, 0), why)) << why;
+  EXPECT_EQ(peer.process(kRun, why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse) << "a repeated heartbeat is a replay";
+  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Refuse) << "at or below the proof's number";
+  EXPECT_EQ(peer.process(kRun - 1, why), Verdict::Refuse);
+  EXPECT_NE(why.find("is older than"), std::string::npos) << why;
+  EXPECT_EQ(peer.process(kRun + 1, why), Verdict::Unproven) << "a restart is believed once it is proven";
+  EXPECT_FALSE(peer.proven(proof(kRun - 1, 50, 0), why)) << "a proof of an older process";
+  EXPECT_EQ(peer.incarnation(), kRun);
+}
+
+TEST(PeerFreshness, AStreamMessageAtOrBelowTheProofsCountIsDroppedWithoutBlameAndTheNextIsTaken) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  const std::string stream = state_stream("JR3.ForceData");
+  ASSERT_TRUE(peer.proven(proof(kRun, 1, 5), why)) << why;
+  EXPECT_EQ(peer.stream(stream, kRun, 5, missed, why), Verdict::Unproven) << "sent before the proof";
+  EXPECT_EQ(peer.stream(stream, kRun, 6, missed, why), Verdict::Accept);
+  EXPECT_EQ(missed, 0);
+  EXPECT_EQ(peer.stream(stream, kRun, 6, missed, why), Verdict::Refuse) << "taken once: a repeat is a replay";
+  EXPECT_EQ(peer.stream(stream, kRun, 9, missed, why), Verdict::Accept);
+  EXPECT_EQ(missed, 2) << "7 and 8 skipped";
+  EXPECT_EQ(peer.last(stream), 9);
+}
+
+TEST(PeerFreshness, AStreamCannotJumpMoreThanTwoToTheTwentyAheadEvenFromItsOwnProcess) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  const std::string stream = state_stream("JR3.ForceData");
+  ASSERT_TRUE(peer.proven(proof(kRun, 1, 0), why)) << why;
+  EXPECT_EQ(peer.stream(stream, kRun, kMaxSeqJump + 1, missed, why), Verdict::Refuse);
+  EXPECT_NE(why.find("jumps more than"), std::string::npos) << why;
+  EXPECT_EQ(peer.stream(stream, kRun, 1, missed, why), Verdict::Accept) << "the stream is not frozen";
+}
+
+TEST(IncarnationBounds, AnIncarnationNotPositiveOrMoreThanAMinuteAheadOfTheClockIsRefused) {
+  EXPECT_TRUE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation()).empty());
+  EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", 0).empty());
+  EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation() + 61'000'000'000).empty());
+}
+
+}  // namespace
+}  // namespace safecass::middleware::detail
