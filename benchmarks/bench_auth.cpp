@@ -80,7 +80,7 @@ struct Bus {
     }
     char dir[] = "/tmp/safecass-bench-keys-XXXXXX";
     if (::mkdtemp(dir) == nullptr) return;
-    if (!safecass::middleware::create_bus_keys(system, dir, true)) return;
+    if (!safecass::middleware::create_bus_keys(system, dir, safecass::middleware::KeyOptions::replacing())) return;
     auto keyring = safecass::middleware::detail::Keyring::load(dir);
     if (!keyring) return;
     // The supervisor sends; every coordinator receives.

@@ -66,6 +66,7 @@ def main():
     vis = {
         "safecass_over_icestorm": load(work, "safecass_visibility"),
         "icestorm_raw": load(work, "icestorm_visibility"),
+        "icestorm_raw_tls": load(work, "icestorm_tls_visibility"),
         "roscpp_raw": load(work, "ros_visibility"),
         "ros_diagnostics_default": load(work, "diag_default_visibility"),
         "ros_diagnostics_fastest": load(work, "diag_fastest_visibility"),
@@ -95,7 +96,10 @@ def main():
     }
     scale["memory_ratio_vs_aggregator_item"] = ratio(scale["bytes_per_component"], scale["aggregator_bytes_per_item"])
 
-    sc, ice, ros = vis["safecass_over_icestorm"], vis["icestorm_raw"], vis["roscpp_raw"]
+    # SAFECASS runs its bus over mutual TLS (members only at the broker): its transport's floor is
+    # raw IceStorm over the same TLS; the plain-TCP ratios are reported beside.
+    sc, ice, ros = vis["safecass_over_icestorm"], vis["icestorm_raw_tls"], vis["roscpp_raw"]
+    ice_plain = vis["icestorm_raw"]
     dd, df = vis["ros_diagnostics_default"], vis["ros_diagnostics_fastest"]
     sup, agg = watch["safecass_supervisor"], watch["ros_diagnostic_aggregator"]
     sup_states = watch["safecass_supervisor_states_only"]
@@ -108,6 +112,9 @@ def main():
         "detection_p99_us": get(detection, "p99_us"),
         # More ratios, same definitions.
         "visibility_p50_ratio_vs_icestorm": ratio(get(sc, "p50_us"), get(ice, "p50_us")),
+        "visibility_p99_ratio_vs_icestorm_plain_tcp": ratio(get(sc, "p99_us"), get(ice_plain, "p99_us")),
+        "visibility_p50_ratio_vs_icestorm_plain_tcp": ratio(get(sc, "p50_us"), get(ice_plain, "p50_us")),
+        "icestorm_tls_p50_ratio_vs_plain_tcp": ratio(get(ice, "p50_us"), get(ice_plain, "p50_us")),
         "visibility_p99_ratio_vs_roscpp": ratio(get(sc, "p99_us"), get(ros, "p99_us")),
         "visibility_speedup_vs_ros_diagnostics_fastest": ratio(get(df, "p50_us"), get(sc, "p50_us")),
         # The supervisor following the service states only (--states-only), as the aggregator does.
@@ -159,8 +166,9 @@ def main():
         return "—" if p is None else f"{fmt(p.get('p50_us'))} / {fmt(p.get('p99_us'))} / {fmt(p.get('max_us'))} µs (n={p.get('samples')})"
 
     rows = [
-        ("visibility SAFECASS over IceStorm (p50/p99/max)", lat(sc)),
-        ("visibility raw IceStorm", lat(ice)),
+        ("visibility SAFECASS over IceStorm, TLS (p50/p99/max)", lat(sc)),
+        ("visibility raw IceStorm, same TLS", lat(ice)),
+        ("visibility raw IceStorm, plain TCP", lat(ice_plain)),
         ("visibility raw roscpp", lat(ros)),
         ("visibility ROS diagnostics, defaults", lat(dd)),
         ("visibility ROS diagnostics, fastest", lat(df)),

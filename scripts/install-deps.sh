@@ -37,6 +37,8 @@ command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
 # Every bus message is signed (Ed25519, libsodium); `safecass trace` hashes the spec files with it.
 packages+=(libsodium-dev)
+# `safecass keys` makes the system's CA and the members' TLS certificates with OpenSSL's library.
+packages+=(libssl-dev)
 # `safecass verify` translates a system into Promela and model-checks it with SPIN (the verifier
 # it generates is compiled with the system's gcc, from build-essential).
 packages+=(spin)

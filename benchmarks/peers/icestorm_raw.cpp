@@ -1,7 +1,10 @@
 // The transport's floor (`make bench-peers`, item 1): a raw IceStorm publisher and subscriber in
 // two processes, no SAFECASS on either side, carrying one struct per onset and completion.
 //
-//   peer_icestorm_raw --ice HOST:PORT --out FILE [--samples N]
+//   peer_icestorm_raw --ice HOST:PORT --out FILE [--samples N] [--tls DIR]
+//
+// --tls DIR: over mutual TLS with the certificates of a key directory (`safecass keys`), as a
+// SAFECASS process runs the bus by default; the reader certificate is presented.
 //
 // Same as bench_middleware's latency phase, on the same IceStorm: the same Ice properties as
 // every SAFECASS process (middleware/src/ice_util.cpp), a oneway publisher and a oneway
@@ -13,6 +16,7 @@
 // Writes {"p50_us", "p99_us", "max_us", "samples", "message_bytes", ...} to FILE.
 
 #include <Ice/Ice.h>
+#include <IceSSL/IceSSL.h>
 #include <IceStorm/IceStorm.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -41,10 +45,25 @@ std::int64_t now_ns() {
       .count();
 }
 
-/// The Ice properties of every SAFECASS process (plain TCP on loopback).
+/// With --tls DIR: mutual TLS as a SAFECASS process runs it, presenting DIR's reader certificate
+/// (raw IceStorm over the same TLS as the system); else plain TCP.
+std::string g_tls_dir;
+std::string protocol() { return g_tls_dir.empty() ? "tcp" : "ssl"; }
+
+/// The Ice properties of every SAFECASS process.
 std::shared_ptr<Ice::Communicator> communicator() {
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
+  if (!g_tls_dir.empty()) {
+    Ice::registerIceSSL(false);
+    init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
+    init.properties->setProperty("IceSSL.DefaultDir", g_tls_dir);
+    init.properties->setProperty("IceSSL.CAs", "ca.pem");
+    init.properties->setProperty("IceSSL.CertFile", "reader.pem");
+    init.properties->setProperty("IceSSL.KeyFile", "reader.key");
+    init.properties->setProperty("IceSSL.VerifyPeer", "2");
+    init.properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
+  }
   init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
   init.properties->setProperty("Ice.Override.ConnectTimeout", "500");
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
@@ -59,8 +78,8 @@ std::shared_ptr<Ice::Communicator> communicator() {
 
 std::shared_ptr<IceStorm::TopicPrx> fault_topic(const std::shared_ptr<Ice::Communicator>& ic, const std::string& host,
                                                 int port, const std::string& name) {
-  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-      ic->stringToProxy("SafecassIceStorm/TopicManager:tcp -h " + host + " -p " + std::to_string(port) + " -t 2000"));
+  auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(
+      "SafecassIceStorm/TopicManager:" + protocol() + " -h " + host + " -p " + std::to_string(port) + " -t 2000"));
   try {
     return manager->retrieve(name);
   } catch (const IceStorm::NoSuchTopic&) {
@@ -184,6 +203,8 @@ int main(int argc, char** argv) {
       out_path = argv[i + 1];
     else if (key == "--samples")
       samples = std::max(10, std::atoi(argv[i + 1]));
+    else if (key == "--tls")
+      g_tls_dir = argv[i + 1];
     else {
       std::fprintf(stderr, "peer_icestorm_raw: unknown option %s\n", key.c_str());
       return 2;
@@ -230,7 +251,7 @@ int main(int argc, char** argv) {
   auto ic = communicator();
   auto servant = std::make_shared<Subscriber>();
   try {
-    auto adapter = ic->createObjectAdapterWithEndpoints("RawSubscriber", "tcp -h 127.0.0.1");
+    auto adapter = ic->createObjectAdapterWithEndpoints("RawSubscriber", protocol() + " -h 127.0.0.1");
     auto proxy = adapter->addWithUUID(servant);
     adapter->activate();
     auto topic = fault_topic(ic, host, port, topic_name);

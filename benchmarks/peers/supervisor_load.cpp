@@ -2,7 +2,10 @@
 // component statuses that each change R times a second, through a real IceStorm.
 //
 //   peer_supervisor_load --ice HOST:PORT --out FILE [--components N] [--rate R] [--seconds S]
-//                        [--states-only 1]
+//                        [--states-only 1] [--ca DIR]
+//
+// --ca DIR: the key directory whose CA the IceStorm admits (scripts/start-icestorm --keys DIR);
+// the run's own keys are signed by it, and the bus runs over mutual TLS as deployed.
 //
 // Two processes. The child hosts the supervisor (middleware::Supervisor, the one `safecass
 // supervisor` runs; its output lines are counted, not formatted nor written, as the ROS
@@ -99,6 +102,7 @@ int main(int argc, char** argv) {
   int components = 1000;
   double rate = 10.0, seconds = 30.0;
   bool states_only = false;
+  middleware::KeyOptions key_options = middleware::KeyOptions::replacing();
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice")
@@ -113,6 +117,8 @@ int main(int argc, char** argv) {
       seconds = std::max(1.0, std::atof(argv[i + 1]));
     else if (key == "--states-only")
       states_only = std::atoi(argv[i + 1]) != 0;
+    else if (key == "--ca")
+      key_options.ca_dir = argv[i + 1];
     else {
       std::fprintf(stderr, "peer_supervisor_load: unknown option %s\n", key.c_str());
       return 2;
@@ -138,7 +144,10 @@ int main(int argc, char** argv) {
     std::string dir;
     ~RemoveKeys() { std::filesystem::remove_all(dir); }
   } remove_keys{keys};
-  if (!middleware::create_bus_keys(system, keys, true)) return 2;
+  if (auto made = middleware::create_bus_keys(system, keys, key_options); !made) {
+    std::fprintf(stderr, "peer_supervisor_load: %s\n", made.error().message.c_str());
+    return 2;
+  }
 
   int to_child[2], to_parent[2];
   if (::pipe(to_child) != 0 || ::pipe(to_parent) != 0) return 2;

@@ -2,7 +2,10 @@
 // loopback).
 //
 //   bench_middleware --ice HOST:PORT --out FILE [--samples N] [--seconds S] [--interfaces K]
-//                    [--pause-us P]
+//                    [--pause-us P] [--ca DIR]
+//
+// --ca DIR: the key directory whose CA the IceStorm admits (scripts/start-icestorm --keys DIR);
+// the run's own keys are signed by it, and the bus runs over mutual TLS as deployed.
 //
 // Two processes: this one forks a provider ("sensor": JR3 provides ForceData) and runs the client
 // ("robot": CONTROL requires JR3.ForceData through a remote provided interface). Both use the
@@ -47,7 +50,8 @@ using namespace safecass;
 
 namespace {
 std::string g_keys;  ///< the bus keys of the benchmark's system (a private temporary directory)
-}
+std::string g_ca;    ///< --ca DIR: the key directory whose CA signs them (empty: a CA of their own)
+}  // namespace
 using namespace std::chrono_literals;
 
 namespace {
@@ -220,6 +224,8 @@ int main(int argc, char** argv) {
       seconds = std::max(0.2, std::atof(argv[i + 1]));
     else if (key == "--interfaces")
       interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
+    else if (key == "--ca")
+      g_ca = argv[i + 1];
     else if (key == "--pause-us")
       pause = std::chrono::microseconds(std::clamp(std::atoi(argv[i + 1]), 0, 1000000));
     else {
@@ -240,8 +246,13 @@ int main(int argc, char** argv) {
     FilterRegistry registry;
     register_builtin_filters(registry);
     auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
-    if (!load.ok() || !middleware::create_bus_keys(*load.system, g_keys, true)) {
-      std::fprintf(stderr, "bench_middleware: cannot create bus keys in %s\n", g_keys.c_str());
+    middleware::KeyOptions options = middleware::KeyOptions::replacing();
+    options.ca_dir = g_ca;
+    auto made = load.ok() ? middleware::create_bus_keys(*load.system, g_keys, options)
+                          : Expected<std::vector<std::string>>(fail(ErrorCode::Parse, "the system does not load"));
+    if (!made) {
+      std::fprintf(stderr, "bench_middleware: cannot create bus keys in %s: %s\n", g_keys.c_str(),
+                   made.error().message.c_str());
       return 2;
     }
   }

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "certificates.hpp"
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware {
@@ -114,8 +115,10 @@ bool valid_signer_name(std::string_view name) {
   if (::lstat(path.c_str(), &st) == 0) {
     if (!replace) return fail(ErrorCode::Duplicate, path + ": exists (pass --replace to create new keys)");
     auto old = read_small_file(path);
-    const bool ours = S_ISREG(st.st_mode) && st.st_uid == ::geteuid() && old &&
-                      (old->rfind(std::string(kSecretTag), 0) == 0 || old->rfind("# SAFECASS bus keyring", 0) == 0);
+    const bool ours =
+        S_ISREG(st.st_mode) && st.st_uid == ::geteuid() && old &&
+        (old->rfind(std::string(kSecretTag), 0) == 0 || old->rfind("# SAFECASS bus keyring", 0) == 0 ||
+         old->rfind("-----BEGIN CERTIFICATE-----", 0) == 0 || old->rfind("-----BEGIN PRIVATE KEY-----", 0) == 0);
     if (!ours)
       return fail(ErrorCode::Io, path + ": exists and is not a SAFECASS " + std::string(what) + "; not replaced");
     if (::unlink(path.c_str()) != 0) return fail(ErrorCode::Io, path + ": " + std::strerror(errno));
@@ -129,17 +132,93 @@ bool valid_signer_name(std::string_view name) {
   return {};
 }
 
+/// "IP:ADDRESS" (IPv4 or IPv6) or "DNS:NAME" (letters, digits, '-' and '.').
+bool valid_address(std::string_view a) {
+  if (a.rfind("IP:", 0) == 0) {
+    const std::string ip(a.substr(3));
+    unsigned char buffer[sizeof(in6_addr)];
+    return ::inet_pton(AF_INET, ip.c_str(), buffer) == 1 || ::inet_pton(AF_INET6, ip.c_str(), buffer) == 1;
+  }
+  if (a.rfind("DNS:", 0) != 0 || a.size() == 4 || a.size() > 4 + 253) return false;
+  return std::all_of(a.begin() + 4, a.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '.';
+  });
+}
+
+/// The CA of `dir` (ca.pem and ca.key), or NotFound when it holds neither.
+[[nodiscard]] Expected<detail::Pem> read_ca(const std::string& dir) {
+  auto certificate = read_small_file(dir + "/ca.pem");
+  auto key = read_small_file(dir + "/ca.key");
+  if (certificate && key) return detail::Pem{*certificate, *key};
+  if (!certificate && certificate.error().code == ErrorCode::NotFound && !key &&
+      key.error().code == ErrorCode::NotFound) {
+    return fail(ErrorCode::NotFound, dir + " holds no CA (ca.pem, ca.key)");
+  }
+  return fail(ErrorCode::Io, (certificate ? key.error() : certificate.error()).message +
+                                 " (ca.pem and ca.key go together: restore the missing one, give the directory of "
+                                 "the CA's key with --ca DIR, or remove ca.pem to make a new CA, and then every "
+                                 "certificate)");
+}
+
+/// The system's CA for `dir`: that of `ca_dir` when given (its ca.pem copied to `dir`); else kept
+/// when `dir` holds one (so that the certificates made again stay trusted); else made.
+[[nodiscard]] Expected<detail::Pem> system_ca(const std::string& dir, std::string_view system_name,
+                                              const std::string& ca_dir) {
+  if (!ca_dir.empty()) {
+    auto ca = read_ca(ca_dir);
+    if (!ca) return ca;
+    if (auto r = write_new_file(dir + "/ca.pem", ca->certificate, 0644, true, "CA"); !r) {
+      return tl::unexpected(r.error());
+    }
+    return ca;
+  }
+  auto kept = read_ca(dir);
+  if (kept || kept.error().code != ErrorCode::NotFound) return kept;
+  auto ca = detail::make_ca(system_name);
+  if (!ca) return ca;
+  if (auto r = write_new_file(dir + "/ca.key", ca->key, 0600, false, "CA key"); !r) return tl::unexpected(r.error());
+  if (auto r = write_new_file(dir + "/ca.pem", ca->certificate, 0644, false, "CA"); !r) {
+    return tl::unexpected(r.error());
+  }
+  return ca;
+}
+
+/// A certificate signed by the system's CA for each of `names`, as NAME.pem and NAME.key.
+[[nodiscard]] Expected<void> write_certificates(const std::string& dir, const detail::Pem& ca,
+                                                const std::vector<std::string>& names,
+                                                const std::vector<std::string>& addresses) {
+  for (const std::string& name : names) {
+    auto made = detail::make_certificate(ca, name, addresses);
+    if (!made) return tl::unexpected(made.error());
+    if (auto r = write_new_file(dir + "/" + name + ".key", made->key, 0600, true, "TLS key"); !r) return r;
+    if (auto r = write_new_file(dir + "/" + name + ".pem", made->certificate, 0644, true, "certificate"); !r) return r;
+  }
+  return {};
+}
+
 }  // namespace
 
 // ---- public: keys.hpp -------------------------------------------------------------------------
 
 [[nodiscard]] Expected<std::vector<std::string>> create_bus_keys(const spec::SystemSpec& system, const std::string& dir,
-                                                                 bool replace) {
+                                                                 const KeyOptions& options) {
   if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
+  const bool replace = options.replace;
+  for (const std::string& a : options.addresses) {
+    if (!valid_address(a)) {
+      return fail(ErrorCode::InvalidArgument,
+                  "address '" + detail::printable(a) + "': expected IP:ADDRESS or DNS:NAME (e.g. IP:10.0.0.5)");
+    }
+  }
+  if (!options.ca_dir.empty()) {
+    if (auto ca = read_ca(options.ca_dir); !ca) return tl::unexpected(ca.error());
+  }
   std::vector<std::string> names;
   for (const auto& [name, _] : system.coordinators) {
-    if (name == kSupervisorSigner) {
-      return fail(ErrorCode::InvalidArgument, "coordinator name '" + name + "' is reserved for the supervisor's key");
+    if (name == kSupervisorSigner || name == kBrokerCertificate || name == kReaderCertificate || name == "ca") {
+      return fail(ErrorCode::InvalidArgument, "coordinator name '" + name +
+                                                  "' is reserved (supervisor, icestorm, reader and ca name the "
+                                                  "system's other keys and certificates)");
     }
     if (!valid_signer_name(name)) {
       return fail(ErrorCode::InvalidArgument, "coordinator name '" + detail::printable(name) +
@@ -162,6 +241,8 @@ bool valid_signer_name(std::string_view name) {
       }
     }
   }
+  auto ca = system_ca(dir, system.name, options.ca_dir);
+  if (!ca) return tl::unexpected(ca.error());
   std::string keyring = "# SAFECASS bus keyring of system '" + system.name + "': NAME ed25519 PUBLIC-KEY\n";
   for (const std::string& name : names) {
     unsigned char pk[crypto_sign_PUBLICKEYBYTES];
@@ -175,6 +256,10 @@ bool valid_signer_name(std::string_view name) {
     keyring += name + " ed25519 " + to_hex(pk, sizeof pk) + "\n";
   }
   if (auto r = write_new_file(dir + "/keyring", keyring, 0644, true, "keyring"); !r) return tl::unexpected(r.error());
+  std::vector<std::string> certified = names;
+  certified.emplace_back(kBrokerCertificate);
+  certified.emplace_back(kReaderCertificate);
+  if (auto r = write_certificates(dir, *ca, certified, options.addresses); !r) return tl::unexpected(r.error());
   return names;
 }
 

@@ -118,10 +118,10 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
   auto impl = std::make_unique<Impl>();
   impl->options = std::move(options);
   const ClientOptions& o = impl->options;
-  if (impl->options.tls.enabled() && impl->options.tls.name.empty()) impl->options.tls.name = "console";
-  if (auto r = check_transport("console", o.tls, o.insecure, {o.ice.host}); !r) return tl::unexpected(r.error());
   auto dir = bus_keys_dir(o.keys_dir);
   if (!dir) return tl::unexpected(dir.error());
+  impl->options.tls = tls_from_keys(*dir, impl->options.tls, kReaderCertificate);
+  if (auto r = check_transport("console", o.tls, o.insecure, {o.ice.host}); !r) return tl::unexpected(r.error());
   auto keys = Keyring::load(*dir);
   if (!keys) return tl::unexpected(keys.error());
   if (!keys->knows(o.coordinator)) {

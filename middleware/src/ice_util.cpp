@@ -9,6 +9,13 @@
 
 namespace safecass::middleware {
 
+TlsOptions tls_from_keys(const std::string& keys_dir, TlsOptions given, std::string_view name) {
+  struct stat st {};
+  if (!given.enabled() && ::stat((keys_dir + "/ca.pem").c_str(), &st) == 0) given.dir = keys_dir;
+  if (given.enabled() && given.name.empty()) given.name = std::string(name);
+  return given;
+}
+
 [[nodiscard]] Expected<void> check_transport(std::string_view who, const TlsOptions& tls, bool insecure,
                                              std::initializer_list<std::string_view> hosts) {
   if (tls.enabled()) {
@@ -16,8 +23,9 @@ namespace safecass::middleware {
          {tls.dir + "/ca.pem", tls.dir + "/" + tls.name + ".pem", tls.dir + "/" + tls.name + ".key"}) {
       struct stat st {};
       if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) {
-        return fail(ErrorCode::NotFound, std::string(who) + ": TLS: " + file +
-                                             " is missing (create certificates with scripts/setup-tls DIR NAME...)");
+        return fail(ErrorCode::NotFound,
+                    std::string(who) + ": TLS: " + file +
+                        " is missing (`safecass keys SYSTEM --out DIR` makes the system's certificates)");
       }
     }
     return {};
@@ -29,7 +37,8 @@ namespace safecass::middleware {
           ErrorCode::InvalidArgument,
           std::string(who) + ": '" + std::string(host) +
               "' is not a loopback address and the bus would cross "
-              "the network unencrypted: use --tls DIR (mutual TLS, docs/security.md), or --insecure to accept that");
+              "the network unencrypted: use keys with the system's certificates (`safecass keys SYSTEM --out DIR`, "
+              "mutual TLS, docs/security.md), or --insecure to accept that");
     }
   }
   return {};
@@ -38,6 +47,12 @@ namespace safecass::middleware {
 }  // namespace safecass::middleware
 
 namespace safecass::middleware::detail {
+
+std::string plain_tcp_warning(const std::string& keys_dir) {
+  return "no TLS certificates in " + keys_dir +
+         " (ca.pem): the bus runs over plain TCP and IceStorm admits any local process; make the keys again "
+         "with `safecass keys SYSTEM --out DIR --replace` and start IceStorm with --keys DIR (docs/security.md)";
+}
 
 std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
   Ice::InitializationData init;

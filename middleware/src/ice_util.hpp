@@ -53,6 +53,10 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
 /// when IceStorm did not hold the subscription (a new one), false when it was already there.
 bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber);
 
+/// The warning of a process whose key directory holds no TLS certificates (keys made by an
+/// earlier `safecass keys`): IceStorm then admits any local process.
+std::string plain_tcp_warning(const std::string& keys_dir);
+
 wire::Level to_wire(State s) noexcept;
 /// Errors: a value outside the enum (a malformed message).
 bool from_wire(wire::Level l, State& out) noexcept;

@@ -1034,20 +1034,21 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                    [&](const auto& c) { return c.first == impl->name; })) {
     return fail(ErrorCode::NotFound, "system '" + system.name + "' has no coordinator '" + impl->name + "'");
   }
-  if (impl->options.tls.enabled() && impl->options.tls.name.empty()) impl->options.tls.name = impl->name;
+  auto dir = bus_keys_dir(impl->options.keys_dir);
+  if (!dir) return tl::unexpected(dir.error());
+  impl->options.tls = tls_from_keys(*dir, impl->options.tls, impl->name);
   if (auto r = check_transport("middleware: " + impl->name, impl->options.tls, impl->options.insecure,
                                {impl->options.ice.host, impl->options.listen_host});
       !r) {
     return tl::unexpected(r.error());
   }
-  auto dir = bus_keys_dir(impl->options.keys_dir);
-  if (!dir) return tl::unexpected(dir.error());
   auto keyring = Keyring::load(*dir);
   if (!keyring) return tl::unexpected(keyring.error());
   auto signer = Signer::load(*dir, impl->name, *keyring);
   if (!signer) return tl::unexpected(signer.error());
   impl->keyring = std::move(*keyring);
   impl->signer = std::move(*signer);
+  if (!impl->options.tls.enabled()) impl->log("middleware: " + impl->name + ": " + plain_tcp_warning(*dir));
   Impl* d = impl.get();
   impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->log(line); });
   impl->incarnation = new_incarnation();

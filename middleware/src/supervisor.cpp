@@ -774,20 +774,21 @@ private:
 
 Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec& system, SupervisorOptions options) {
   if (options.ice.port <= 0) return fail(ErrorCode::InvalidArgument, "supervisor: no IceStorm port given");
-  if (options.tls.enabled() && options.tls.name.empty()) options.tls.name = std::string(kSupervisorSigner);
+  auto dir = bus_keys_dir(options.keys_dir);
+  if (!dir) return tl::unexpected(dir.error());
+  options.tls = tls_from_keys(*dir, options.tls, kSupervisorSigner);
   if (auto r = check_transport("supervisor", options.tls, options.insecure, {options.ice.host, options.listen_host});
       !r) {
     return tl::unexpected(r.error());
   }
   auto impl = std::make_unique<Impl>(system, std::move(options));
-  auto dir = bus_keys_dir(impl->options.keys_dir);
-  if (!dir) return tl::unexpected(dir.error());
   auto keyring = Keyring::load(*dir);
   if (!keyring) return tl::unexpected(keyring.error());
   auto signer = Signer::load(*dir, kSupervisorSigner, *keyring);
   if (!signer) return tl::unexpected(signer.error());
   impl->keyring = std::move(*keyring);
   impl->signer = std::move(*signer);
+  if (!impl->options.tls.enabled()) impl->print("supervisor: " + plain_tcp_warning(*dir));
   {
     Impl* d = impl.get();
     impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->print(line); });

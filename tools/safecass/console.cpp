@@ -595,7 +595,8 @@ void add_console_command(CLI::App& app, int& code) {
   cmd->add_option("--read-token-file", args->read_token_file,
                   "with --ice: the coordinator's read credential file (when it was started with one)");
   cmd->add_option("--tls", args->tls,
-                  "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
+                  "with --ice: the certificates' directory (ca.pem, reader.pem/.key) when not the key directory, which "
+                  "is used when it holds ca.pem");
   cmd->add_option("--token-file", args->token_file, "with --ice: the coordinator's token file (writes need it)");
   cmd->add_option("--timeout", args->timeout_ms,
                   "with --ice: milliseconds to wait for the coordinator and each answer (default 2000)")

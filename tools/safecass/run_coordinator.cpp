@@ -194,7 +194,8 @@ void add_middleware_options(CLI::App& run, RunArgs& args) {
   run.add_flag("--insecure", args.insecure,
                "with --ice: accept a non-loopback IceStorm or listening address without TLS (unencrypted)");
   run.add_option("--tls", args.tls,
-                 "with --ice: mutual TLS; DIR holds ca.pem and <coordinator>.pem/.key (scripts/setup-tls)");
+                 "with --ice: the certificates' directory (ca.pem, <coordinator>.pem/.key) when not the key directory, "
+                 "which is used when it holds ca.pem");
   run.add_option("--listen", args.listen, "with --ice: the address to serve on (default 127.0.0.1)");
   run.add_option("--read-token-file", args.read_token_file,
                  "with --ice: reads (state, history, explain...) need the credential this file will hold (mode 0600)");

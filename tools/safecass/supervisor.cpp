@@ -113,7 +113,9 @@ void add_supervisor_command(CLI::App& app, int& code) {
   cmd->add_flag("--states-only", args.states_only,
                 "watch the service states only: no event records, so no per-machine transitions and no "
                 "system-wide history, at a fraction of the cost");
-  cmd->add_option("--tls", args.tls, "mutual TLS; DIR holds ca.pem and supervisor.pem/.key (scripts/setup-tls)");
+  cmd->add_option("--tls", args.tls,
+                  "the certificates' directory (ca.pem, supervisor.pem/.key) when not the key directory, which is "
+                  "used when it holds ca.pem");
   cmd->add_option("--listen", args.listen, "the address to serve on (default 127.0.0.1)");
   cmd->callback([&code] { code = run_supervisor(args); });
 }
@@ -121,12 +123,22 @@ void add_supervisor_command(CLI::App& app, int& code) {
 void add_keys_command(CLI::App& app, int& code) {
   static std::string system;
   static std::string out;
-  static bool replace = false;
-  auto* cmd = app.add_subcommand(
-      "keys", "Create the bus keys of a multi-process system: a key pair per coordinator and for the supervisor");
+  static middleware::KeyOptions options;
+  auto* cmd = app.add_subcommand("keys",
+                                 "Create the keys of a multi-process system: a signing key pair per coordinator and "
+                                 "for the supervisor, and the TLS certificates of the system's CA that admit them, "
+                                 "IceStorm and the tools to the broker");
   cmd->add_option("SYSTEM", system, "the system file")->required();
   cmd->add_option("--out", out, "the key directory (created with mode 0700)")->required();
-  cmd->add_flag("--replace", replace, "replace existing keys (every process must then restart with the new ones)");
+  cmd->add_flag("--replace", options.replace,
+                "replace existing keys and certificates (every process must then restart with the new ones); "
+                "the CA in the directory is kept");
+  cmd->add_option("--address", options.addresses,
+                  "another address the processes are reached at, for the certificates (IP:10.0.0.5 or "
+                  "DNS:robot.local; repeatable)");
+  cmd->add_option("--ca", options.ca_dir,
+                  "sign with the CA of this key directory (its ca.pem and ca.key): systems that share one "
+                  "IceStorm share its CA (only ca.pem is copied)");
   cmd->callback([&code] {
     FilterRegistry registry;
     register_builtin_filters(registry);
@@ -136,7 +148,7 @@ void add_keys_command(CLI::App& app, int& code) {
       code = 2;
       return;
     }
-    auto names = middleware::create_bus_keys(*load.system, out, replace);
+    auto names = middleware::create_bus_keys(*load.system, out, options);
     if (!names) {
       std::fprintf(stderr, "safecass keys: %s\n", names.error().message.c_str());
       code = 2;
@@ -144,6 +156,10 @@ void add_keys_command(CLI::App& app, int& code) {
     }
     for (const std::string& n : *names) std::printf("%s/%s.secret\n", out.c_str(), n.c_str());
     std::printf("%s/keyring\n", out.c_str());
+    std::printf("%s/ca.pem\n", out.c_str());
+    for (const std::string& n : *names) std::printf("%s/%s.pem\n", out.c_str(), n.c_str());
+    std::printf("%s/%s.pem\n%s/%s.pem\n", out.c_str(), std::string(middleware::kBrokerCertificate).c_str(), out.c_str(),
+                std::string(middleware::kReaderCertificate).c_str());
     code = 0;
   });
 }

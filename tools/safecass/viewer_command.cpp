@@ -234,7 +234,8 @@ void add_viewer_command(CLI::App& app, int& code) {
   cmd->add_option("--keys", args->keys,
                   "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");
   cmd->add_option("--tls", args->tls,
-                  "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key (scripts/setup-tls)");
+                  "with --ice: the certificates' directory (ca.pem, reader.pem/.key) when not the key directory, which "
+                  "is used when it holds ca.pem");
   cmd->add_option("--read-token-file", args->read_token_files,
                   "with --ice: COORDINATOR=FILE, a coordinator's read credential (repeatable)");
   cmd->add_option("--ice", args->ice,

@@ -33,17 +33,18 @@ class LiveSystem:
         env_file = os.path.join(self.scratch, "icestorm.env")
         if os.path.exists(env_file):
             os.unlink(env_file)
+        # The bus is authenticated and IceStorm admits only the system's certificates: the system's
+        # keys, inherited by IceStorm and every process started here.
+        keys = os.path.join(self.scratch, "keys")
+        subprocess.run([self.binary, "keys", os.path.join(self.source, "examples/robodoc/robodoc.json"), "--out", keys,
+                        "--replace"], check=True, stdout=subprocess.DEVNULL, timeout=20)
+        os.environ["SAFECASS_KEYS"] = keys
         subprocess.run([os.path.join(self.source, "scripts", "start-icestorm"), "--port", "0", "--dir",
                         os.path.join(self.scratch, "icestorm"), "--env", env_file],
                        check=True, stdout=subprocess.DEVNULL, timeout=20)
         values = dict(line.strip().split("=", 1) for line in open(env_file) if "=" in line)
         self.icestorm_pid = int(values["ICESTORM_PID"])
         self.port = int(values["ICESTORM_PORT"])
-        # The bus is authenticated: the system's keys, inherited by every process started here.
-        keys = os.path.join(self.scratch, "keys")
-        subprocess.run([self.binary, "keys", os.path.join(self.source, "examples/robodoc/robodoc.json"), "--out", keys,
-                        "--replace"], check=True, stdout=subprocess.DEVNULL, timeout=20)
-        os.environ["SAFECASS_KEYS"] = keys
         if os.path.exists(self.token_file):
             os.unlink(self.token_file)
         with open(self.log, "w") as log:

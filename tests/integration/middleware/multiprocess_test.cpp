@@ -30,6 +30,7 @@
 #include <thread>
 #include <vector>
 
+#include "fixture.hpp"
 #include "safecass/core/coordinator.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
@@ -645,7 +646,7 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
     register_builtin_filters(registry);
     auto load = spec::load_system_from_text(text, "burst.json", registry);
     ASSERT_TRUE(load.ok());
-    ASSERT_TRUE(middleware::create_bus_keys(*load.system, keys, true));
+    ASSERT_TRUE(fixture::make_keys(*load.system, keys));
   }
   Node provider(text, "burst-s", keys), client(text, "burst-a", keys);
   ASSERT_TRUE(provider.node && client.node);

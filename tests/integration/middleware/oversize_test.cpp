@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "fixture.hpp"
 #include "safecass.h"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
@@ -187,15 +188,10 @@ struct Bus {
   spec::LoadResult load;
   Node provider, client;
   std::size_t limit;
-  Ice::CommunicatorHolder ice{Ice::initialize([] {
-    Ice::InitializationData init;
-    init.properties = Ice::createProperties();
-    init.properties->setProperty("Ice.MessageSizeMax", "4096");
-    return init;
-  }())};
+  Ice::CommunicatorHolder ice;  ///< the taps': presents the reader's certificate (made with the keys)
   std::shared_ptr<Ice::ObjectAdapter> adapter;
-  std::shared_ptr<StateTap> states = std::make_shared<StateTap>(ice.communicator());
-  std::shared_ptr<EventTap> events = std::make_shared<EventTap>(ice.communicator());
+  std::shared_ptr<StateTap> states;
+  std::shared_ptr<EventTap> events;
   std::vector<std::pair<std::shared_ptr<IceStorm::TopicPrx>, std::shared_ptr<Ice::ObjectPrx>>> taps;
 
   Bus(int warnings, int errors, std::size_t name_length = 150, std::size_t provider_limit = kLimit)
@@ -203,10 +199,12 @@ struct Bus {
     register_builtin_filters(registry);
     load = spec::load_system_from_text(system_text(warnings, errors, name_length), "over.json", registry);
     EXPECT_TRUE(load.ok());
-    EXPECT_TRUE(middleware::create_bus_keys(*load.system, keys, true));
+    EXPECT_TRUE(fixture::make_keys(*load.system, keys));
+    ice = Ice::CommunicatorHolder(fixture::communicator(keys, "reader", {{"Ice.MessageSizeMax", "4096"}}));
+    states = std::make_shared<StateTap>(ice.communicator());
+    events = std::make_shared<EventTap>(ice.communicator());
 
-    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-        ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ice->stringToProxy(fixture::topic_manager(port)));
     auto topic = [&](const std::string& name) {
       try {
         return manager->retrieve(name);
@@ -214,7 +212,7 @@ struct Bus {
         return manager->create(name);
       }
     };
-    adapter = ice->createObjectAdapterWithEndpoints("OversizeTaps", "tcp -h 127.0.0.1");
+    adapter = ice->createObjectAdapterWithEndpoints("OversizeTaps", fixture::kAdapterEndpoint);
     adapter->activate();
     for (const auto& [name, servant] : std::vector<std::pair<std::string, std::shared_ptr<Ice::Object>>>{
              {"safecass.state.over-p", states}, {"safecass.events", events}}) {

@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Mutual TLS across processes (DESIGN §7, docs/security.md), against a real IceBox:
-# - robot and ui coordinators, a console and IceStorm all on ssl endpoints with the system's CA:
-#   a fault generated through the console on the robot reaches the ui;
-# - a console without a certificate, or with a certificate of another CA, is refused;
+# Members only at the broker, and mutual TLS across processes (DESIGN §7, docs/security.md), against
+# a real IceBox, set up with the one key command (`safecass keys`) and nothing else:
+# - IceStorm, robot and ui coordinators, a console and the timeline all on ssl endpoints with the
+#   system's CA (found through SAFECASS_KEYS): a fault generated through the console on the robot
+#   reaches the ui;
+# - a console or an IceStorm administrator without a certificate, or with one of another CA, is
+#   refused;
 # - a non-loopback endpoint without TLS is refused by every command.
 #   tls_test.sh SAFECASS_BIN SOURCE_DIR SCRATCH
 set -uo pipefail
@@ -23,64 +26,82 @@ check() {  # check DESCRIPTION COMMAND...
   if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
 }
 
-"$src/scripts/setup-tls" certs robot ui >/dev/null || { echo "setup-tls failed"; exit 1; }
-"$src/scripts/setup-tls" other-ca console >/dev/null || { echo "setup-tls (other CA) failed"; exit 1; }
 "$bin" keys "$system" --out keys --replace >/dev/null 2>&1 || { echo "keys failed"; exit 1; }
+"$bin" keys "$system" --out other-system --replace >/dev/null 2>&1 || { echo "keys (other CA) failed"; exit 1; }
 export SAFECASS_KEYS="$scratch/keys"
-icestorm=$("$src/scripts/start-icestorm" --port 0 --dir ice --env ice.env --tls certs) || { echo "start-icestorm --tls failed"; exit 1; }
+icestorm=$("$src/scripts/start-icestorm" --port 0 --dir ice --env ice.env) || { echo "start-icestorm failed"; exit 1; }
 port=$(sed -n 's/^ICESTORM_PORT=//p' ice.env)
 grep -q "ssl -h 127.0.0.1 -p $port" ice/icebox.config
-check "IceStorm's endpoints are TLS" test $? -eq 0
+check "IceStorm's endpoints are TLS, from the keys alone" test $? -eq 0
 
-"$bin" run "$system" --coordinator robot --ice "127.0.0.1:$port" --tls certs --duration 30 \
+"$bin" run "$system" --coordinator robot --ice "127.0.0.1:$port" --duration 30 \
   --scenario "$src/tests/integration/middleware/robot_feed.json" --allow-write --token-file "$scratch/robot.token" \
   > robot.log 2>&1 & pids+=($!)
-"$bin" run "$system" --coordinator ui --ice "127.0.0.1:$port" --tls certs --duration 30 > ui.log 2>&1 & pids+=($!)
+"$bin" run "$system" --coordinator ui --ice "127.0.0.1:$port" --duration 30 > ui.log 2>&1 & pids+=($!)
 
 console() { "$bin" console --ice "127.0.0.1:$port" --timeout 3000 "$@"; }
 for _ in $(seq 1 50); do
-  console --coordinator ui --tls certs -c "state list PENDANT" > state.txt 2>/dev/null && break
+  console --coordinator ui -c "state list PENDANT" > state.txt 2>/dev/null && break
   sleep 0.2
 done
 check "the ui answers a console over TLS" grep -q "PENDANT.s_R.Status  Normal" state.txt
 for _ in $(seq 1 10); do  # a loaded machine may need a second try for a TLS handshake
-  console --coordinator robot --tls certs --token-file "$scratch/robot.token" --allow-write \
+  console --coordinator robot --token-file "$scratch/robot.token" --allow-write \
     -c "event generate EVT_FORCE_ERROR JR3.s_A" > generate.txt 2>&1 && break
   sleep 0.3
 done
 check "a write over TLS is accepted with the token" grep -q "generated EVT_FORCE_ERROR on JR3.s_A" generate.txt
 seen=1
 for _ in $(seq 1 50); do
-  console --coordinator ui --tls certs -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  Error" && { seen=0; break; }
+  console --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  Error" && { seen=0; break; }
   sleep 0.1
 done
 check "the fault crossed from robot to ui over TLS" test $seen -eq 0
 
 for _ in $(seq 1 10); do
-  "$bin" timeline --ice "127.0.0.1:$port" --coordinator ui --tls certs --html timeline.html > timeline.txt 2>&1 && break
+  "$bin" timeline --ice "127.0.0.1:$port" --coordinator ui --html timeline.html > timeline.txt 2>&1 && break
   sleep 0.3
 done
 check "timeline --ice draws a live history over TLS" test -s timeline.html
 
-console --coordinator ui -c "state list PENDANT" > plain.txt 2>&1
-check "a console without TLS is refused" test $? -ne 0
-mkdir -p wrong && cp other-ca/ca.pem other-ca/console.pem other-ca/console.key wrong/
-console --coordinator ui --tls wrong -c "state list PENDANT" > wrong.txt 2>&1
+# Without certificates (a key directory holding only the keyring), or with another CA's.
+mkdir -p no-certs && chmod 700 no-certs && cp keys/keyring no-certs/
+SAFECASS_KEYS="$scratch/no-certs" console --coordinator ui -c "state list PENDANT" > plain.txt 2>&1
+check "a console without a certificate is refused" test $? -ne 0
+SAFECASS_KEYS="$scratch/other-system" console --coordinator ui -c "state list PENDANT" > wrong.txt 2>&1
 check "a console with another CA's certificate is refused" test $? -ne 0
+timeout 20 icestormadmin --Ice.Default.Timeout=2000 \
+  --IceStormAdmin.TopicManager.Default="SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p $port" \
+  -e "topics; destroy safecass.heartbeat" > admin.txt 2>&1
+check "icestormadmin without a certificate can neither list nor destroy a topic" test $? -ne 0
+seen=1
+for _ in $(seq 1 30); do
+  console --coordinator robot --token-file "$scratch/robot.token" --allow-write \
+    -c "event generate /EVT_FORCE_ERROR JR3.s_A" > clear.txt 2>&1 || { sleep 0.3; continue; }
+  break
+done
+for _ in $(seq 1 50); do
+  console --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  Normal" && { seen=0; break; }
+  sleep 0.1
+done
+check "and the ui still follows the robot" test $seen -eq 0
 
-"$src/scripts/start-icestorm" --port 0 --dir ice2 --host 192.0.2.1 > far.txt 2>&1
-check "start-icestorm refuses a non-loopback host without --tls" test $? -eq 2
-"$bin" run "$system" --coordinator ui --ice 192.0.2.1:4061 --duration 1 > far-run.txt 2>&1
+(unset SAFECASS_KEYS; "$src/scripts/start-icestorm" --port 0 --dir ice2 --host 192.0.2.1 > far.txt 2>&1)
+check "start-icestorm refuses a non-loopback host without certificates" test $? -eq 2
+mkdir -p no-certs-secret && chmod 700 no-certs-secret && cp -p keys/keyring keys/ui.secret keys/supervisor.secret no-certs-secret/
+SAFECASS_KEYS="$scratch/no-certs-secret" "$bin" run "$system" --coordinator ui --ice 192.0.2.1:4061 --duration 1 \
+  > far-run.txt 2>&1
 status=$?
-check "run refuses a non-loopback IceStorm without --tls" test $status -eq 2
-check "and says to use --tls" grep -q -- "--tls" far-run.txt
-"$bin" supervisor "$system" --ice 192.0.2.1:4061 --duration 1 > far-sup.txt 2>&1
+check "run refuses a non-loopback IceStorm without TLS" test $status -eq 2
+check "and says how to get it" grep -q -- "safecass keys" far-run.txt
+SAFECASS_KEYS="$scratch/no-certs-secret" "$bin" supervisor "$system" --ice 192.0.2.1:4061 --duration 1 > far-sup.txt 2>&1
 check "the supervisor refuses it too" test $? -eq 2
-console --coordinator ui --ice 192.0.2.1:4061 -c "state list" > far-console.txt 2>&1
+SAFECASS_KEYS="$scratch/no-certs" console --coordinator ui --ice 192.0.2.1:4061 -c "state list" > far-console.txt 2>&1
 check "the console refuses it too" test $? -ne 0
 
 if [ $failures -ne 0 ]; then
   echo "--- robot.log"; tail -20 robot.log; echo "--- ui.log"; tail -20 ui.log
-  echo "--- plain.txt"; cat plain.txt; echo "--- wrong.txt"; cat wrong.txt; echo "--- far-run.txt"; cat far-run.txt
+  echo "--- plain.txt"; cat plain.txt; echo "--- wrong.txt"; cat wrong.txt; echo "--- admin.txt"; cat admin.txt
+  echo "--- far-run.txt"; cat far-run.txt
   exit 1
 fi

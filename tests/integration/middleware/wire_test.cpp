@@ -22,6 +22,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -34,6 +35,7 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "fixture.hpp"
 #include "receiver.hpp"
 #include "safecass.h"
 #include "safecass/filters/monitor.hpp"
@@ -138,7 +140,7 @@ struct Bus {
   std::unique_ptr<middleware::CoordinatorNode> node;
   std::mutex mutex;
   std::vector<std::string> log;
-  Ice::CommunicatorHolder ice{Ice::initialize()};
+  Ice::CommunicatorHolder ice;  ///< presents wire-p's certificate (made with the keys, below)
   std::shared_ptr<wire::StateTopicPrx> state_pub;
   std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
   std::optional<Signer> provider, other, supervisor, attacker;
@@ -159,8 +161,11 @@ struct Bus {
     register_builtin_filters(registry);
     load = spec::load_system_from_text(kSystem, "wire.json", registry);
     EXPECT_TRUE(load.ok());
-    EXPECT_TRUE(middleware::create_bus_keys(*load.system, keys, true));
-    EXPECT_TRUE(middleware::create_bus_keys(*load.system, attacker_keys, true));
+    // The attacker's keys are not the system's, but its certificate is of the system's CA: an
+    // insider at the broker (a reader), whose messages every receiver must still refuse.
+    EXPECT_TRUE(fixture::make_keys(*load.system, keys));
+    EXPECT_TRUE(fixture::make_keys(*load.system, attacker_keys));
+    ice = Ice::CommunicatorHolder(fixture::communicator(keys, "wire-p"));
     provider = load_signer(keys, "wire-p");
     other = load_signer(keys, "wire-c");
     supervisor = load_signer(keys, "supervisor");
@@ -170,7 +175,7 @@ struct Bus {
     EXPECT_TRUE(middleware::connect_remote_providers(*load.system, "wire-c", co));
     for (const char* d : {"P.D0", "P.D1", "P.D2", "P.D3"}) last_sent[d] = 0;
 
-    adapter = ice->createObjectAdapterWithEndpoints("ProviderAlive", "tcp -h 127.0.0.1");
+    adapter = ice->createObjectAdapterWithEndpoints("ProviderAlive", fixture::kAdapterEndpoint);
     alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "wire-p"))->ice_toString();
     supervisor_alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "supervisor"))->ice_toString();
     adapter->activate();
@@ -219,8 +224,7 @@ struct Bus {
 
   /// The IceStorm topic `name` of the fixture (created when it does not exist yet).
   std::shared_ptr<IceStorm::TopicPrx> topic(const std::string& name) const {
-    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-        ice->stringToProxy("SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + port));
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ice->stringToProxy(fixture::topic_manager(port)));
     try {
       return manager->retrieve(name);
     } catch (const IceStorm::NoSuchTopic&) {
@@ -636,6 +640,54 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; })) << bus.all_log();
   EXPECT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
   supervisor->stop();
+}
+
+// Members only at the broker (docs/security.md): IceStorm serves mutual TLS only, and admits a
+// process only with a certificate of the system's CA. Without one (plain TCP, or a certificate of
+// another CA) nobody lists, unsubscribes, creates or publishes; the victim keeps its
+// subscriptions and sees the provider's next fault at once, without having to make one again.
+TEST(Wire, ANonMemberCanNeitherListNorUnsubscribeNorCreateATopicAtTheBrokerAndTheVictimsViewStaysTrue) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  const std::size_t held = bus.topic("safecass.state.wire-p")->getSubscribers().size();
+  ASSERT_GE(held, 1u) << "the node subscribes to the provider's state topic";
+  const std::uint64_t resubscribed = bus.node->stats().resubscriptions;
+
+  const std::string outsider_keys = bus.scratch + "/wire-outsider-keys";
+  std::filesystem::remove_all(outsider_keys);
+  ASSERT_TRUE(middleware::create_bus_keys(*bus.load.system, outsider_keys, middleware::KeyOptions::replacing()))
+      << "a CA of its own";
+  struct Outsider {
+    const char* who;
+    Ice::CommunicatorHolder ice;
+    std::string manager;
+  };
+  std::vector<Outsider> outsiders;
+  outsiders.push_back({"plain TCP", Ice::CommunicatorHolder(Ice::initialize()),
+                       "SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port + " -t 1000"});
+  outsiders.push_back({"a certificate of another CA",
+                       Ice::CommunicatorHolder(fixture::communicator(outsider_keys, "reader")),
+                       fixture::topic_manager(bus.port) + " -t 1000"});
+  for (Outsider& o : outsiders) {
+    auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(o.ice->stringToProxy(o.manager));
+    EXPECT_THROW(manager->retrieveAll(), Ice::LocalException) << o.who << ": lists no topic";
+    EXPECT_THROW(manager->create("safecass.outsider"), Ice::LocalException) << o.who << ": creates no topic";
+    EXPECT_THROW(
+        {
+          auto t = manager->retrieve("safecass.state.wire-p");
+          for (const Ice::Identity& victim : t->getSubscribers()) {
+            t->unsubscribe(o.ice->stringToProxy(Ice::identityToString(victim)));
+          }
+        },
+        Ice::LocalException)
+        << o.who << ": unsubscribes nobody";
+  }
+  EXPECT_EQ(bus.topic("safecass.state.wire-p")->getSubscribers().size(), held);
+
+  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }, 2000ms)) << bus.all_log();
+  EXPECT_EQ(bus.node->stats().resubscriptions, resubscribed) << "no subscription was lost to make again";
 }
 
 // A coordinator of the system file that never sends a heartbeat the supervisor can believe (not
@@ -1076,7 +1128,7 @@ struct Impostor {
     const Ice::ByteSeq old_nonce(middleware::detail::kNonceBytes, 7);
     alive = std::make_shared<ReplayingAlive>(middleware::detail::make_proof(
         *bus.provider, bus.ice.communicator(), old_nonce, bus.provider_heartbeat(kIncarnation, bus.beat_seq)));
-    adapter = bus.ice->createObjectAdapterWithEndpoints("", "tcp -h 127.0.0.1");
+    adapter = bus.ice->createObjectAdapterWithEndpoints("", fixture::kAdapterEndpoint);
     proxy = adapter->add(alive, Ice::stringToIdentity("safecass/control-wire-p"))->ice_toString();
     adapter->activate();
   }

@@ -167,12 +167,13 @@ async function waitStatus(page, coordinator, status, timeout) {
 
 async function test() {
   fs.mkdirSync(scratch, { recursive: true });
-  const ice = await startIceStorm();
-  // The bus is authenticated: the system's keys, inherited by every process started here.
+  // The bus is authenticated and IceStorm admits only the system's certificates: the system's
+  // keys, inherited by IceStorm and every process started here.
   const keys = path.join(scratch, 'keys');
   const made = await run(safecass, ['keys', kSystem, '--out', keys, '--replace']);
   if (made.code !== 0) throw new Error(`safecass keys failed (${made.code}): ${made.stderr}`);
   process.env.SAFECASS_KEYS = keys;
+  const ice = await startIceStorm();
   const robotToken = path.join(scratch, 'robot.token');
   await startCoordinator('robot', ice, robotToken);
   const { viewer, url, token, text } = await startViewer(ice, robotToken);

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <random>
 
+#include "certificates.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/keys.hpp"
@@ -99,12 +100,16 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   ASSERT_FALSE(no_keys) << "the bus is authenticated: no keys, no node";
   EXPECT_NE(no_keys.error().message.find("safecass keys"), std::string::npos) << no_keys.error().message;
 
-  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, true));
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
   options.keys_dir = keys;
   options.ice.host = "192.0.2.7";
+  EXPECT_TRUE(CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options))
+      << "keys with the system's certificates: mutual TLS, so another host is allowed";
+  ASSERT_EQ(::rename((keys + "/ca.pem").c_str(), (keys + "/ca.pem.away").c_str()), 0);
   auto far = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
-  ASSERT_FALSE(far) << "a non-loopback IceStorm without --insecure";
+  ASSERT_FALSE(far) << "a non-loopback IceStorm without TLS and without --insecure";
   EXPECT_EQ(far.error().code, ErrorCode::InvalidArgument);
+  ASSERT_EQ(::rename((keys + "/ca.pem.away").c_str(), (keys + "/ca.pem").c_str()), 0);
   options.ice.host = "127.0.0.1";
 
   ASSERT_EQ(::chmod((keys + "/robot.secret").c_str(), 0640), 0);
@@ -121,7 +126,7 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
 TEST(BusKeys, AreCreatedPrivateOncePerSignerAndNeverOverwriteAForeignFile) {
   Robodoc r;
   const std::string keys = ::testing::TempDir() + "safecass-keys-" + std::to_string(::getpid());
-  auto names = create_bus_keys(*r.load.system, keys, true);
+  auto names = create_bus_keys(*r.load.system, keys, KeyOptions::replacing());
   ASSERT_TRUE(names) << names.error().message;
   EXPECT_EQ(*names, (std::vector<std::string>{"robot", "ui", "supervisor"}));
   struct stat st {};
@@ -129,18 +134,99 @@ TEST(BusKeys, AreCreatedPrivateOncePerSignerAndNeverOverwriteAForeignFile) {
   EXPECT_EQ(st.st_mode & 0777, 0700u);
   ASSERT_EQ(::stat((keys + "/robot.secret").c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u);
-  auto again = create_bus_keys(*r.load.system, keys, false);
+  auto again = create_bus_keys(*r.load.system, keys);
   ASSERT_FALSE(again) << "existing keys are kept unless replaced";
   EXPECT_EQ(again.error().code, ErrorCode::Duplicate);
   // A file that is not a key is never overwritten, even with replace.
   ::unlink((keys + "/ui.secret").c_str());
   { std::ofstream(keys + "/ui.secret") << "my notes\n"; }
-  auto foreign = create_bus_keys(*r.load.system, keys, true);
+  auto foreign = create_bus_keys(*r.load.system, keys, KeyOptions::replacing());
   ASSERT_FALSE(foreign);
   std::ifstream in(keys + "/ui.secret");
   std::string line;
   std::getline(in, line);
   EXPECT_EQ(line, "my notes");
+}
+
+std::string file_text(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+KeyOptions with_addresses(std::vector<std::string> addresses) {
+  KeyOptions o = KeyOptions::replacing();
+  o.addresses = std::move(addresses);
+  return o;
+}
+
+KeyOptions with_ca(const std::string& dir) {
+  KeyOptions o = KeyOptions::replacing();
+  o.ca_dir = dir;
+  return o;
+}
+
+mode_t file_mode(const std::string& path) {
+  struct stat st {};
+  return ::stat(path.c_str(), &st) == 0 ? (st.st_mode & 0777) : 0;
+}
+
+// Members only at the broker (docs/security.md): the one key set-up makes the system's CA and a
+// certificate signed by it for every member, IceStorm and the tools' reader; private keys 0600.
+TEST(BusKeys, MakeTheSystemsCaAndACertificateSignedByItForEveryMemberIceStormAndTheReader) {
+  Robodoc r;
+  const std::string keys = ::testing::TempDir() + "safecass-certs-" + std::to_string(::getpid());
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, with_addresses({"IP:10.0.0.5", "DNS:robot.local"})));
+  const std::string ca = file_text(keys + "/ca.pem");
+  ASSERT_EQ(ca.rfind("-----BEGIN CERTIFICATE-----", 0), 0u);
+  EXPECT_EQ(file_mode(keys + "/ca.key"), 0600u);
+  for (const char* name : {"robot", "ui", "supervisor", "icestorm", "reader"}) {
+    const std::string path = keys + "/" + name;
+    EXPECT_TRUE(detail::signed_by(file_text(path + ".pem"), ca)) << name;
+    EXPECT_EQ(file_mode(path + ".pem"), 0644u) << name;
+    EXPECT_EQ(file_mode(path + ".key"), 0600u) << name;
+  }
+  // Made again (--replace), the keys are new and the CA is kept: IceStorm, started with the first
+  // certificates, still admits the members' new ones.
+  const std::string first_robot = file_text(keys + "/robot.pem");
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
+  EXPECT_EQ(file_text(keys + "/ca.pem"), ca);
+  EXPECT_NE(file_text(keys + "/robot.pem"), first_robot);
+  EXPECT_TRUE(detail::signed_by(file_text(keys + "/robot.pem"), ca));
+
+  // Another system's CA does not vouch for these certificates.
+  const std::string other = keys + "-other";
+  ASSERT_TRUE(create_bus_keys(*r.load.system, other, KeyOptions::replacing()));
+  EXPECT_FALSE(detail::signed_by(file_text(keys + "/robot.pem"), file_text(other + "/ca.pem")));
+
+  // A system that shares the broker signs with its CA (--ca DIR): the CA's key is not copied.
+  const std::string shared = keys + "-shared";
+  ASSERT_TRUE(create_bus_keys(*r.load.system, shared, with_ca(keys)));
+  EXPECT_EQ(file_text(shared + "/ca.pem"), ca);
+  EXPECT_TRUE(detail::signed_by(file_text(shared + "/robot.pem"), ca));
+  EXPECT_EQ(file_mode(shared + "/ca.key"), 0u) << "the CA's key stays where it is";
+}
+
+TEST(BusKeys, AreRefusedWithAClearErrorForAReservedNameABadAddressOrACaWithoutItsKey) {
+  Robodoc r;
+  const std::string keys = ::testing::TempDir() + "safecass-certs-bad-" + std::to_string(::getpid());
+  auto address = create_bus_keys(*r.load.system, keys, with_addresses({"10.0.0.5"}));
+  ASSERT_FALSE(address);
+  EXPECT_EQ(address.error().code, ErrorCode::InvalidArgument);
+  EXPECT_NE(address.error().message.find("IP:ADDRESS or DNS:NAME"), std::string::npos) << address.error().message;
+  struct stat st {};
+  EXPECT_NE(::stat(keys.c_str(), &st), 0) << "a refused address writes nothing";
+
+  spec::SystemSpec reserved = *r.load.system;
+  reserved.coordinators.emplace_back("icestorm", std::vector<std::string>{});
+  auto name = create_bus_keys(reserved, keys, KeyOptions::replacing());
+  ASSERT_FALSE(name);
+  EXPECT_NE(name.error().message.find("'icestorm' is reserved"), std::string::npos) << name.error().message;
+
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
+  ASSERT_EQ(::unlink((keys + "/ca.key").c_str()), 0);
+  auto half = create_bus_keys(*r.load.system, keys, KeyOptions::replacing());
+  ASSERT_FALSE(half) << "ca.pem without ca.key cannot sign";
+  EXPECT_NE(half.error().message.find("ca.pem and ca.key go together"), std::string::npos) << half.error().message;
 }
 
 TEST(BusKeys, LoopbackHostsAreRecognised) {

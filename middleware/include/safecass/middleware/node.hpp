@@ -50,14 +50,21 @@ struct IceEndpoint {
 [[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
 
 /// Mutual TLS (IceSSL) on every connection of a process: to IceStorm, from IceStorm to its
-/// subscribers, and to and from Control endpoints (docs/security.md). `dir` holds the system's
-/// `ca.pem` and this process's `NAME.pem` / `NAME.key` (scripts/setup-tls); every peer must present
-/// a certificate signed by that CA. Empty `dir`: plain TCP, loopback only unless --insecure.
+/// subscribers, and to and from Control and Alive endpoints (docs/security.md). `dir` holds the
+/// system's `ca.pem` and this process's `NAME.pem` / `NAME.key` (`safecass keys` makes them in the
+/// key directory); every peer must present a certificate signed by that CA. Empty `dir`: plain TCP,
+/// loopback only unless --insecure.
 struct TlsOptions {
   std::string dir;
   std::string name;  ///< the certificate to present (NAME.pem, NAME.key)
   bool enabled() const noexcept { return !dir.empty(); }
 };
+
+/// The transport of the process that presents certificate `name`: `given` when it names a
+/// directory (--tls DIR), else the key directory `keys_dir` when it holds the system's CA
+/// (`ca.pem`): members only at the broker by default. Else plain TCP (keys made without
+/// certificates, by an earlier `safecass keys`).
+[[nodiscard]] TlsOptions tls_from_keys(const std::string& keys_dir, TlsOptions given, std::string_view name);
 
 /// Checks the TLS files of `tls` (when enabled) and that `hosts` are loopback unless TLS or
 /// `insecure`. `who` names the caller in the message. Errors: InvalidArgument, NotFound.

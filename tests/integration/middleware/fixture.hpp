@@ -1,0 +1,77 @@
+#pragma once
+// The ctest fixture's IceStorm as the middleware integration tests reach it: its port, and the
+// system's CA it admits (scripts/start-icestorm --keys, written to SAFECASS_ICESTORM_ENV as
+// ICESTORM_TLS). IceStorm admits only certificates of that CA (docs/security.md), so a test that
+// makes keys of its own makes them with that CA.
+
+#include <Ice/Ice.h>
+#include <IceSSL/IceSSL.h>
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "safecass/middleware/keys.hpp"
+
+namespace safecass::fixture {
+
+/// The value of KEY in the fixture's environment file, empty when it is not there.
+inline std::string icestorm_env(const std::string& key) {
+  const char* file = std::getenv("SAFECASS_ICESTORM_ENV");
+  std::ifstream in(file != nullptr ? file : "");
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(key + "=", 0) == 0) return line.substr(key.size() + 1);
+  }
+  return "";
+}
+
+/// The directory of the CA the fixture's IceStorm admits.
+inline std::string ca_dir() { return icestorm_env("ICESTORM_TLS"); }
+
+/// The bus keys of `system` in `dir`, their certificates signed by the fixture's CA.
+[[nodiscard]] inline bool make_keys(const spec::SystemSpec& system, const std::string& dir) {
+  const std::string ca = ca_dir();
+  if (ca.empty()) {
+    ADD_FAILURE() << "the fixture's IceStorm runs without the system's CA (no ICESTORM_TLS)";
+    return false;
+  }
+  middleware::KeyOptions options = middleware::KeyOptions::replacing();
+  options.ca_dir = ca;
+  auto made = middleware::create_bus_keys(system, dir, options);
+  EXPECT_TRUE(made) << (made ? "" : made.error().message);
+  return made.has_value();
+}
+
+/// A communicator that presents the certificate `name` of the key directory `dir` (mutual TLS, as
+/// every SAFECASS process does), with Ice's defaults otherwise and the given extra properties.
+inline std::shared_ptr<Ice::Communicator> communicator(
+    const std::string& dir, const std::string& name,
+    const std::vector<std::pair<std::string, std::string>>& extra = {}) {
+  static const bool registered = [] {
+    Ice::registerIceSSL(false);
+    return true;
+  }();
+  (void)registered;
+  Ice::InitializationData init;
+  init.properties = Ice::createProperties();
+  init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
+  init.properties->setProperty("IceSSL.DefaultDir", dir);
+  init.properties->setProperty("IceSSL.CAs", "ca.pem");
+  init.properties->setProperty("IceSSL.CertFile", name + ".pem");
+  init.properties->setProperty("IceSSL.KeyFile", name + ".key");
+  init.properties->setProperty("IceSSL.VerifyPeer", "2");
+  for (const auto& [key, value] : extra) init.properties->setProperty(key, value);
+  return Ice::initialize(init);
+}
+
+/// The endpoint of a test's own object adapter, and of IceStorm's TopicManager on `port`.
+inline const char* const kAdapterEndpoint = "ssl -h 127.0.0.1";
+inline std::string topic_manager(const std::string& port) {
+  return "SafecassIceStorm/TopicManager:ssl -h 127.0.0.1 -p " + port;
+}
+
+}  // namespace safecass::fixture
