@@ -56,6 +56,12 @@ public:
     std::lock_guard lock(mutex_);
     return refused_;
   }
+  /// Lets `control` be tried again when a later heartbeat names it: it did not answer (a TLS
+  /// handshake or a busy process that outlasted the connect timeout), which says nothing of it.
+  void retry(const std::string& control) {
+    std::lock_guard lock(mutex_);
+    std::erase(tried_, control);
+  }
   /// The next endpoint named by an authenticated heartbeat that was not tried yet (empty: none
   /// came until `until`).
   std::string next(std::chrono::steady_clock::time_point until) {
@@ -165,6 +171,7 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
       auto beat = prove_now(impl->ic, *keys, o.coordinator, candidate);
       if (!beat) {
         unproven = beat.error().message;
+        if (beat.error().code == ErrorCode::Io) finder->retry(control);  // no answer: ask again, not a bad proof
         continue;
       }
       impl->incarnation = beat->incarnation;

@@ -1,6 +1,7 @@
 // CoordinatorNode: one coordinator process on IceStorm (see node.hpp for the design).
 
 #include "safecass/middleware/node.hpp"
+#include "safecass/core/address.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -81,13 +82,13 @@ bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
         runs_provider == coordinator_name)
       continue;
     State propagate = State::Error;
+    const std::string iface = k.provided.substr(k.provided.find('.') + 1);
     if (const spec::ComponentSpec* spec = find_spec(system, provider)) {
-      const std::string iface = k.provided.substr(k.provided.find('.') + 1);
       for (const spec::ServiceSpec& s : spec->services) {
         if (s.provided == iface) propagate = s.dependency.propagate;
       }
     }
-    if (!coordinator.find_machine(provider + ".s_P." + k.provided.substr(k.provided.find('.') + 1))) {
+    if (!coordinator.find_machine(address::provided(provider, iface))) {
       if (auto r = coordinator.add_remote_provided(k.provided, propagate); !r) return tl::unexpected(r.error());
     }
     if (auto r = coordinator.connect(k.required, k.provided); !r) return tl::unexpected(r.error());
@@ -793,11 +794,11 @@ struct CoordinatorNode::Impl {
       if (hb.incarnation == incarnation) {
         last_own_heartbeat.store(now);
       } else {
-        duplicates_seen.fetch_add(1);
         drops->drop(name + "/duplicate", "middleware: " + name + ": another process runs coordinator '" + name +
                                              "' (incarnation " + std::to_string(hb.incarnation) + ", ours " +
                                              std::to_string(incarnation) + "): two processes with one name; " +
                                              "receivers follow the newer one");
+        duplicates_seen.fetch_add(1);  // after the line: a reader of the count finds it logged
       }
       return;
     }
@@ -882,6 +883,9 @@ struct CoordinatorNode::Impl {
   }
 
   void on_resync(const wire::Signed& m) {
+    // This process's own requests come back on the topic: nothing to republish for them (and a
+    // message naming this process as its sender cannot be opened by it: it holds no tag for itself).
+    if (m.signer == name) return;
     wire::ResyncRequest r;
     if (const std::string why = open_sealed(*signer, ic, m, kKindResync, r); !why.empty()) {
       refuse(m.signer, "a resync request signed '" + printable(m.signer) + "': " + why);

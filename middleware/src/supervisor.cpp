@@ -1,6 +1,7 @@
 // The supervisor: the system-wide view and lost-coordinator detection (see supervisor.hpp).
 
 #include "safecass/middleware/supervisor.hpp"
+#include "safecass/core/address.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -441,7 +442,8 @@ struct Supervisor::Impl {
       return;
     }
     std::string& address = address_scratch;
-    address.assign(u.iface, 0, dot).append(".s_S.").append(u.iface, dot + 1);
+    address::assign_service(address, std::string_view(u.iface).substr(0, dot),
+                            std::string_view(u.iface).substr(dot + 1));
     // The note printed with the state: "roots a:b, c:d"; the view keeps the causes after "roots ".
     constexpr std::string_view kRoots = "roots ";
     std::string& note = note_scratch;
@@ -603,23 +605,28 @@ struct Supervisor::Impl {
   void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
     if (recovered.empty()) return;
     print("supervisor: coordinator '" + who + "' recovered");
-    for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", c + ".s_F");
+    for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", address::framework(c));
   }
 
   /// After records of a coordinator were missed, its rows in the view may be stale: read its
   /// state list (the read model's rows, from its Control object found in its authenticated
   /// heartbeat) and print every row that differs from the view. Never on the dispatch thread.
   void refresh_missed() {
-    std::vector<std::pair<std::string, std::string>> due;  // coordinator, Control proxy
+    struct Due {
+      std::string name;
+      std::string control;  ///< its Control proxy
+      std::int64_t seq;     ///< the last record received when the read began
+    };
+    std::vector<Due> due;
     {
       std::lock_guard lock(mutex);
       for (auto& [name, peer] : peers) {
         if (!peer.refresh || peer.control.empty()) continue;
         peer.refresh = false;
-        due.emplace_back(name, peer.control);
+        due.push_back(Due{name, peer.control, peer.last_event_seq});
       }
     }
-    for (const auto& [name, control] : due) {
+    for (const auto& [name, control, seq_before] : due) {
       const std::string who = printable(name);
       std::vector<introspect::StateRow> rows;
       std::map<std::string, std::string> causes;
@@ -652,13 +659,18 @@ struct Supervisor::Impl {
       std::vector<Changed> lines;
       {
         std::lock_guard lock(mutex);
-        const std::int64_t record_seq = peers.at(name).last_event_seq;  // the rows are as of this record
+        // The rows are at least as new as every record received when the read began: they are
+        // stamped with that record's number, so that an older record arriving late does not take
+        // them back. A row a newer record set while the read was on its way is newer than the
+        // read's answer may be, and is kept (the read takes several requests; the coordinator
+        // goes on).
         for (const introspect::StateRow& r : rows) {
           const auto it = view.find(r.address);
           if (it == view.end() && r.state == State::Normal) continue;  // never reported, still Normal
+          if (it != view.end() && it->second.coordinator == name && it->second.record_seq > seq_before) continue;
           const std::string cause = r.state == State::Normal ? std::string() : causes[r.address];
           if (it != view.end() && it->second.state == r.state) continue;
-          view[r.address] = ViewRow{name, r.address, r.state, cause, record_seq};
+          view[r.address] = ViewRow{name, r.address, r.state, cause, seq_before};
           lines.push_back(
               Changed{r.address, r.state, "refreshed after missed records" + (cause.empty() ? "" : "; root " + cause)});
         }
@@ -705,7 +717,7 @@ struct Supervisor::Impl {
       }
       for (const auto& [name, components, why] : lost_now) {
         print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
-        for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", c + ".s_F");
+        for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", address::framework(c));
       }
     }
   }
