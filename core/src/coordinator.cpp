@@ -1,4 +1,5 @@
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/address.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -244,8 +245,8 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
   cd.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   size_history();
   component_index_.emplace(std::string(name), id);
-  cd.framework = add_machine(id, MachineKind::Framework, kNone, cd.name + ".s_F");
-  cd.application = add_machine(id, MachineKind::Application, kNone, cd.name + ".s_A");
+  cd.framework = add_machine(id, MachineKind::Framework, kNone, address::framework(cd.name));
+  cd.application = add_machine(id, MachineKind::Application, kNone, address::application(cd.name));
   cd.machine_state_count[index(State::Normal)] = 2;
   return id;
 }
@@ -282,13 +283,13 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
                                                 "' must be non-empty, without dots or spaces");
   }
   for (MachineId m : c.provided) {
-    if (machines_[m].address == c.name + ".s_P." + std::string(name)) {
+    if (machines_[m].address == address::provided(c.name, name)) {
       return fail(ErrorCode::Duplicate,
                   "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
   const auto iface = static_cast<std::uint32_t>(c.provided.size());
-  const MachineId id = add_machine(component, MachineKind::Provided, iface, c.name + ".s_P." + std::string(name));
+  const MachineId id = add_machine(component, MachineKind::Provided, iface, address::provided(c.name, name));
   c.provided.push_back(id);
   c.services.push_back(ServiceData{});
   ++c.machine_state_count[index(State::Normal)];
@@ -305,13 +306,13 @@ Expected<MachineId> Coordinator::add_required(ComponentId component, std::string
                                                 "' must be non-empty, without dots or spaces");
   }
   for (MachineId m : c.required) {
-    if (machines_[m].address == c.name + ".s_R." + std::string(name)) {
+    if (machines_[m].address == address::required(c.name, name)) {
       return fail(ErrorCode::Duplicate,
                   "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
   const auto iface = static_cast<std::uint32_t>(c.required.size());
-  const MachineId id = add_machine(component, MachineKind::Required, iface, c.name + ".s_R." + std::string(name));
+  const MachineId id = add_machine(component, MachineKind::Required, iface, address::required(c.name, name));
   c.required.push_back(id);
   c.required_connection.push_back(kNoConnection);
   ++c.machine_state_count[index(State::Normal)];

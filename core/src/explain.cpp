@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "safecass/core/address.hpp"
 #include "safecass/core/coordinator.hpp"
 
 namespace safecass {
@@ -75,7 +76,7 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
     const auto [from, edge] = edges[parent_edge[to_index(at)]];
     const Connection& conn = connections_[to_index(edge->via)];
     const ComponentData& provider = components_[conn.provider];
-    reversed.push_back(provider.name + ".s_S." + std::string(interface_name(provider.provided[conn.provided])));
+    reversed.push_back(address::service(provider.name, interface_name(provider.provided[conn.provided])));
     reversed.push_back(machines_[from].address);
     at = from;
   }

@@ -1,4 +1,5 @@
 #include "safecass/filters/monitor.hpp"
+#include "safecass/core/address.hpp"
 
 #include <cmath>
 
@@ -71,10 +72,10 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
     case MachineKind::Application: init.target = coordinator_.application_machine(*component); break;
     case MachineKind::Provided:
     case MachineKind::Required: {
-      const bool provided = config.target.kind == MachineKind::Provided;
-      const std::string address = config.target.component + (provided ? ".s_P." : ".s_R.") + config.target.interface;
-      auto m = coordinator_.find_machine(address);
-      if (!m) return fail(ErrorCode::NotFound, where + ": target " + address + " does not exist");
+      const std::string machine =
+          address::machine(config.target.kind, config.target.component, config.target.interface);
+      auto m = coordinator_.find_machine(machine);
+      if (!m) return fail(ErrorCode::NotFound, where + ": target " + machine + " does not exist");
       init.target = *m;
       break;
     }

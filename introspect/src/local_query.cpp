@@ -1,4 +1,5 @@
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/core/address.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -89,10 +90,8 @@ std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
   for (const MachineId m : co_.required_machines(id)) machine(m);
   const auto& provided = co_.provided_machines(id);
   for (std::uint32_t p = 0; p < provided.size(); ++p) {
-    out.push_back({name + ".s_S." + std::string(co_.interface_name(provided[p])),
-                   RowKind::Service,
-                   co_.service_state(id, p),
-                   {}});
+    out.push_back(
+        {address::service(name, co_.interface_name(provided[p])), RowKind::Service, co_.service_state(id, p), {}});
   }
   return out;
 }
@@ -245,7 +244,7 @@ Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
       const std::string p(co_.interface_name(provided[i]));
       const ServiceDependency& d = co_.service(id, i);
       ServiceRow r;
-      r.address = std::string(co_.component_name(id)) + ".s_S." + p;
+      r.address = address::service(co_.component_name(id), p);
       r.state = co_.service_state(id, i);
       r.propagate = d.propagate;
       r.depends_on.push_back("s_P." + p);
@@ -291,7 +290,7 @@ Expected<Names> LocalQuery::names() {
     n.components.emplace_back(co_.component_name(i));
     n.addresses.emplace_back(co_.component_name(i));
     for (const MachineId p : co_.provided_machines(i)) {
-      n.addresses.push_back(std::string(co_.component_name(i)) + ".s_S." + std::string(co_.interface_name(p)));
+      n.addresses.push_back(address::service(co_.component_name(i), co_.interface_name(p)));
     }
   }
   for (MachineId m : id_range<MachineId>(co_.machine_count())) {

@@ -32,15 +32,7 @@ std::pair<std::string, std::string> filter_events(const FilterConfig& config, co
   return {names[0], names[1]};
 }
 
-std::string machine_of(const FilterTarget& t) {
-  switch (t.kind) {
-    case MachineKind::Framework: return t.component + ".s_F";
-    case MachineKind::Application: return t.component + ".s_A";
-    case MachineKind::Provided: return t.component + ".s_P." + t.interface;
-    case MachineKind::Required: return t.component + ".s_R." + t.interface;
-  }
-  return t.component + ".s_A";
-}
+std::string machine_of(const FilterTarget& t) { return address::machine(t.kind, t.component, t.interface); }
 
 }  // namespace
 

@@ -406,9 +406,7 @@ std::vector<std::string> addresses_of(const Coordinator& co) {
     out.push_back(co.address_of(co.application_machine(c)));
     for (MachineId m : co.provided_machines(c)) {
       out.push_back(co.address_of(m));
-      std::string service = co.address_of(m);
-      if (const auto at = service.rfind(".s_P."); at != std::string::npos) service.replace(at, 5, ".s_S.");
-      out.push_back(service);
+      out.push_back(address::service(co.component_name(c), co.interface_name(m)));
     }
     for (MachineId m : co.required_machines(c)) out.push_back(co.address_of(m));
   }

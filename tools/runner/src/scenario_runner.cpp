@@ -1,4 +1,5 @@
 #include "safecass/runner/scenario_runner.hpp"
+#include "safecass/core/address.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -33,13 +34,13 @@ std::vector<std::string> ScenarioRunner::addresses() const {
   for (const auto& [coordinator, components] : system.coordinators) out.push_back(coordinator);
   for (const spec::ComponentSpec& c : system.components) {
     out.push_back(c.name);
-    out.push_back(c.name + ".s_F");
-    out.push_back(c.name + ".s_A");
+    out.push_back(address::framework(c.name));
+    out.push_back(address::application(c.name));
     for (const std::string& p : c.provided) {
-      out.push_back(c.name + ".s_P." + p);
-      out.push_back(c.name + ".s_S." + p);
+      out.push_back(address::provided(c.name, p));
+      out.push_back(address::service(c.name, p));
     }
-    for (const std::string& r : c.required) out.push_back(c.name + ".s_R." + r);
+    for (const std::string& r : c.required) out.push_back(address::required(c.name, r));
   }
   return out;
 }

@@ -39,6 +39,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "safecass/core/address.hpp"
 #include "safecass/core/clock.hpp"
 #include "safecass/core/condition.hpp"
 #include "safecass/core/condition_set.hpp"
@@ -49,9 +50,6 @@
 #include "safecass/core/state.hpp"
 
 namespace safecass {
-
-/// The four kinds of state machine a component owns (DESIGN §2.2).
-enum class MachineKind : std::uint8_t { Framework, Application, Provided, Required };
 
 /// What the service state of a provided interface depends on (DESIGN §2.2):
 /// s_S.p = s_P.p ⊗ [s_F] ⊗ [s_A] ⊗ (⊗ over the listed required interfaces).
