@@ -34,34 +34,32 @@ port=$(sed -n 's/^ICESTORM_PORT=//p' ice.env)
 grep -q "ssl -h 127.0.0.1 -p $port" ice/icebox.config
 check "IceStorm's endpoints are TLS, from the keys alone" test $? -eq 0
 
-"$bin" run "$system" --coordinator robot --ice "127.0.0.1:$port" --duration 30 \
+"$bin" run "$system" --coordinator robot --ice "127.0.0.1:$port" --duration 120 \
   --scenario "$src/tests/integration/middleware/robot_feed.json" --allow-write --token-file "$scratch/robot.token" \
   > robot.log 2>&1 & pids+=($!)
-"$bin" run "$system" --coordinator ui --ice "127.0.0.1:$port" --duration 30 > ui.log 2>&1 & pids+=($!)
+"$bin" run "$system" --coordinator ui --ice "127.0.0.1:$port" --duration 120 > ui.log 2>&1 & pids+=($!)
 
 console() { "$bin" console --ice "127.0.0.1:$port" --timeout 3000 "$@"; }
-for _ in $(seq 1 50); do
-  console --coordinator ui -c "state list PENDANT" > state.txt 2>/dev/null && break
-  sleep 0.2
-done
-check "the ui answers a console over TLS" grep -q "PENDANT.s_R.Status  Normal" state.txt
-for _ in $(seq 1 10); do  # a loaded machine may need a second try for a TLS handshake
-  console --coordinator robot --token-file "$scratch/robot.token" --allow-write \
-    -c "event generate EVT_FORCE_ERROR JR3.s_A" > generate.txt 2>&1 && break
-  sleep 0.3
-done
+# retry SECONDS COMMAND...: runs COMMAND until it succeeds, for at most SECONDS (a loaded machine
+# may need more than one try for the processes to start or for a TLS handshake).
+retry() {
+  local until=$((SECONDS + $1))
+  shift
+  until "$@"; do
+    [ $SECONDS -ge $until ] && return 1
+    sleep 0.2
+  done
+}
+ui_shows() { console --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  $1"; }
+retry 20 ui_shows Normal
+check "the ui answers a console over TLS" test $? -eq 0
+retry 20 sh -c '"$0" console --ice "127.0.0.1:$1" --timeout 3000 --coordinator robot --token-file "$2" --allow-write \
+  -c "event generate EVT_FORCE_ERROR JR3.s_A" > generate.txt 2>&1' "$bin" "$port" "$scratch/robot.token"
 check "a write over TLS is accepted with the token" grep -q "generated EVT_FORCE_ERROR on JR3.s_A" generate.txt
-seen=1
-for _ in $(seq 1 50); do
-  console --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  Error" && { seen=0; break; }
-  sleep 0.1
-done
-check "the fault crossed from robot to ui over TLS" test $seen -eq 0
+retry 20 ui_shows Error
+check "the fault crossed from robot to ui over TLS" test $? -eq 0
 
-for _ in $(seq 1 10); do
-  "$bin" timeline --ice "127.0.0.1:$port" --coordinator ui --html timeline.html > timeline.txt 2>&1 && break
-  sleep 0.3
-done
+retry 20 "$bin" timeline --ice "127.0.0.1:$port" --coordinator ui --html timeline.html > timeline.txt 2>&1
 check "timeline --ice draws a live history over TLS" test -s timeline.html
 
 # Without certificates (a key directory holding only the keyring), or with another CA's.
@@ -70,21 +68,14 @@ SAFECASS_KEYS="$scratch/no-certs" console --coordinator ui -c "state list PENDAN
 check "a console without a certificate is refused" test $? -ne 0
 SAFECASS_KEYS="$scratch/other-system" console --coordinator ui -c "state list PENDANT" > wrong.txt 2>&1
 check "a console with another CA's certificate is refused" test $? -ne 0
-timeout 20 icestormadmin --Ice.Default.Timeout=2000 \
+timeout 20 icestormadmin --Ice.Default.Timeout=2000 --Ice.Override.ConnectTimeout=1000 --Ice.RetryIntervals=-1 \
   --IceStormAdmin.TopicManager.Default="SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p $port" \
   -e "topics; destroy safecass.heartbeat" > admin.txt 2>&1
 check "icestormadmin without a certificate can neither list nor destroy a topic" test $? -ne 0
-seen=1
-for _ in $(seq 1 30); do
-  console --coordinator robot --token-file "$scratch/robot.token" --allow-write \
-    -c "event generate /EVT_FORCE_ERROR JR3.s_A" > clear.txt 2>&1 || { sleep 0.3; continue; }
-  break
-done
-for _ in $(seq 1 50); do
-  console --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -q "PENDANT.s_R.Status  Normal" && { seen=0; break; }
-  sleep 0.1
-done
-check "and the ui still follows the robot" test $seen -eq 0
+retry 20 sh -c '"$0" console --ice "127.0.0.1:$1" --timeout 3000 --coordinator robot --token-file "$2" --allow-write \
+  -c "event generate /EVT_FORCE_ERROR JR3.s_A" > clear.txt 2>&1' "$bin" "$port" "$scratch/robot.token"
+retry 20 ui_shows Normal
+check "and the ui still follows the robot" test $? -eq 0
 
 (unset SAFECASS_KEYS; "$src/scripts/start-icestorm" --port 0 --dir ice2 --host 192.0.2.1 > far.txt 2>&1)
 check "start-icestorm refuses a non-loopback host without certificates" test $? -eq 2
