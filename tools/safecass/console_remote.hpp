@@ -6,7 +6,7 @@
 // The remote console shares the in-process console's parser, completion, usage lines and `help`
 // (console_shell.hpp) and prints the same shapes where the coordinator's answers carry the same
 // data. Differences, all documented in docs/tools.md ("Console against a live coordinator"):
-// `time` is in-process only; `watch SECONDS` polls the coordinator's states and prints each change;
+// `time` is in-process only; `watch SECONDS` prints the coordinator's records as the bus pushes them;
 // history lines carry no severity and no root sample; `filter info` shows no ranges or signal sizes.
 
 #include <memory>

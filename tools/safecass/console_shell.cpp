@@ -270,7 +270,7 @@ const std::vector<CommandSpec>& commands() {
        "watch",
        "watch [SECONDS]",
        "advance simulated time by SECONDS (default 1), running the scenario and the system and printing each "
-       "transition as it happens (against a live coordinator: poll its states for SECONDS, printing each change)",
+       "transition as it happens (against a live coordinator: print its records for SECONDS, as the bus pushes them)",
        false,
        0,
        1,

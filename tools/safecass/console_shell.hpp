@@ -3,7 +3,7 @@
 // the parser of command lines, TAB completion, usage and error lines, `help`, and the text and
 // JSON helpers every printer uses. One console::Backend runs the parsed commands (console.cpp),
 // over a SystemQuery: a system in this process in simulated time (LocalQuery) or a live
-// coordinator through the middleware (RemoteQuery, console_remote.cpp). Internal to tools/safecass.
+// coordinator through the middleware (RemoteClient, console_remote.cpp). Internal to tools/safecass.
 
 #include <cstddef>
 #include <functional>

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "safecass/filters/registry.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/introspect/json.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/verify/verify.hpp"
 
@@ -15,8 +15,12 @@ namespace safecass::tools {
 
 namespace {
 
-/// The one JSON escaper (spec::json_quote, introspect::json_string).
-std::string json_string(std::string_view s) { return spec::json_quote(s); }
+/// Three decimals: the figures' precision in --json (megabytes, seconds).
+std::string fixed3(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3f", v);
+  return buf;
+}
 
 std::string where_text(const spec::Position& p) {
   if (p.file.empty()) return {};
@@ -89,24 +93,25 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
       ++undecided;
     }
     if (json) {
-      std::string line = "{\"kind\":" + json_string(verify::to_string(p.kind)) + ",\"name\":" + json_string(p.name) +
-                         ",\"result\":" + json_string(checked(p) ? verify::to_string(p.verdict) : "warning") +
-                         ",\"checks\":" + json_string(p.text);
+      introspect::JsonObject line;
+      line.str("kind", verify::to_string(p.kind))
+          .str("name", p.name)
+          .str("result", checked(p) ? verify::to_string(p.verdict) : "warning")
+          .str("checks", p.text);
       if (!p.where.file.empty()) {
-        line += ",\"file\":" + json_string(p.where.file) + ",\"line\":" + std::to_string(p.where.line) +
-                ",\"column\":" + std::to_string(p.where.column);
+        line.str("file", p.where.file).integer("line", p.where.line).integer("column", p.where.column);
       }
       if (!p.structural) {
-        char buf[200];
-        std::snprintf(buf, sizeof buf,
-                      ",\"states\":%llu,\"memory_mb\":%.3f,\"seconds\":%.3f,\"onsets\":%zu,\"onsets_total\":%zu",
-                      static_cast<unsigned long long>(p.states), p.memory_mb, p.seconds, p.onsets, p.onsets_total);
-        line += buf;
+        line.integer("states", static_cast<long long>(p.states))
+            .raw("memory_mb", fixed3(p.memory_mb))
+            .raw("seconds", fixed3(p.seconds))
+            .integer("onsets", static_cast<long long>(p.onsets))
+            .integer("onsets_total", static_cast<long long>(p.onsets_total));
       }
-      if (!p.message.empty()) line += ",\"message\":" + json_string(p.message);
-      if (!p.scenario.empty()) line += ",\"scenario\":" + json_string(p.scenario);
-      if (!p.advice.empty()) line += ",\"advice\":" + json_string(p.advice);
-      std::printf("%s}\n", line.c_str());
+      if (!p.message.empty()) line.str("message", p.message);
+      if (!p.scenario.empty()) line.str("scenario", p.scenario);
+      if (!p.advice.empty()) line.str("advice", p.advice);
+      std::printf("%s\n", line.text().c_str());
       continue;
     }
     if (!checked(p)) {
@@ -134,10 +139,17 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
   }
   const int exit = report->exit_code();
   if (json) {
-    std::printf(
-        "{\"kind\":\"summary\",\"system\":%s,\"holds\":%zu,\"violated\":%zu,\"undecided\":%zu,\"warnings\":%zu,"
-        "\"seconds\":%.3f,\"exit\":%d}\n",
-        json_string(report->system).c_str(), holds, violated, undecided, findings, report->seconds, exit);
+    const std::string line = introspect::JsonObject()
+                                 .str("kind", "summary")
+                                 .str("system", report->system)
+                                 .integer("holds", static_cast<long long>(holds))
+                                 .integer("violated", static_cast<long long>(violated))
+                                 .integer("undecided", static_cast<long long>(undecided))
+                                 .integer("warnings", static_cast<long long>(findings))
+                                 .raw("seconds", fixed3(report->seconds))
+                                 .integer("exit", exit)
+                                 .text();
+    std::printf("%s\n", line.c_str());
   } else {
     std::printf(
         "%s: %zu propert%s hold%s, %zu violated, %zu undecided, %zu warning%s about the specification (%.2f s)\n",

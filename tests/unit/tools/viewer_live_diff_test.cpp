@@ -1,4 +1,4 @@
-// The network-free part of `safecass viewer --ice` (tools/viewer/live_diff.hpp): the rows of a
+// The network-free part of `safecass viewer --ice` (safecass/viewer/live_diff.hpp): the rows of a
 // coordinator's state list (the read model's), the picture built from them, and how the protocol
 // pushes a live coordinator's status. The live system itself is
 // tested in tests/integration/viewer_ice/.

@@ -1,4 +1,4 @@
-// `safecass viewer --ice` (tools/viewer/middleware_source.hpp) without a running system: what
+// `safecass viewer --ice` (safecass/viewer/middleware_source.hpp) without a running system: what
 // open() refuses, and how a system none of whose coordinators answers is shown and handled (no
 // IceStorm listens on the port). The live system is tested in tests/integration/viewer_ice/.
 

@@ -1,4 +1,4 @@
-// `safecass viewer`, its message handling (tools/viewer/protocol.hpp) on the robodoc example run
+// `safecass viewer`, its message handling (safecass/viewer/protocol.hpp) on the robodoc example run
 // in-process: the JSON picture of the system, explain, pushed updates, refused bad requests and
 // refused writes. No network here (viewer_server_test.cpp does the sockets).
 

@@ -1,4 +1,4 @@
-// `safecass viewer --replay` (tools/viewer/replay_source.hpp): a recording of the robodoc story fed
+// `safecass viewer --replay` (safecass/viewer/replay_source.hpp): a recording of the robodoc story fed
 // through robodoc by the replay module; the states shown at any time the page seeks to are the
 // recorded run's states at that time (from its history file), forwards and backwards; bad logs are
 // refused with file:line; a replay is read-only; the protocol's replay controls.

@@ -1,4 +1,4 @@
-// `safecass viewer`, its server (tools/viewer/server.hpp) through real sockets on 127.0.0.1 with a
+// `safecass viewer`, its server (safecass/viewer/server.hpp) through real sockets on 127.0.0.1 with a
 // port picked by the system: the embedded page, the JSON view, refused hosts, methods and
 // origins, the WebSocket protocol with its push of updates, and the backoff after a failed accept.
 

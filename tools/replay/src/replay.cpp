@@ -12,6 +12,7 @@
 #include <unordered_map>
 
 #include "safecass/introspect/format.hpp"
+#include "safecass/introspect/json.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/replay/source.hpp"
 #include "safecass/runner/scenario_runner.hpp"
@@ -450,15 +451,6 @@ std::string cause_text(const Cause& c) {
   return out;
 }
 
-std::string quoted(std::string_view s) {
-  std::string out = "\"";
-  for (char ch : s) {
-    if (ch == '"' || ch == '\\') out += '\\';
-    out += ch;
-  }
-  return out + "\"";
-}
-
 struct Interval {
   Time from{}, to{};
   bool open = true;
@@ -584,21 +576,29 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
       const std::string until = i.open ? secs(a->now()) : secs(i.to);
       if (o.json) {
         const Cause& c = i.cause;
-        std::string cause = "{\"system\":" + quoted(i.side == 'B' ? "B" : "A") + ",\"origin\":" + quoted(c.origin) +
-                            ",\"event\":" + quoted(c.event);
-        if (!c.filter.empty()) cause += ",\"filter\":" + quoted(c.filter);
+        introspect::JsonObject cause;
+        cause.str("system", i.side == 'B' ? "B" : "A").str("origin", c.origin).str("event", c.event);
+        if (!c.filter.empty()) cause.str("filter", c.filter);
         if (!c.signal.empty()) {
-          char v[40];
-          std::snprintf(v, sizeof v, "%.9g", c.value);
-          cause +=
-              ",\"signal\":" + quoted(c.signal) + ",\"value\":" + (std::isfinite(c.value) ? std::string(v) : quoted(v));
+          cause.str("signal", c.signal);
+          // JSON has no NaN or infinity: a non-finite value is written as its text ("nan", "inf").
+          if (std::isfinite(c.value)) {
+            cause.num("value", c.value);
+          } else {
+            cause.str("value", introspect::number_text(c.value));
+          }
         }
-        cause += "}";
-        std::fprintf(o.out,
-                     "{\"kind\":\"difference\",\"address\":%s,\"from\":%s,\"to\":%s,\"until_end\":%s,\"b\":\"%s\","
-                     "\"a\":\"%s\",\"cause\":%s}\n",
-                     quoted(t.name).c_str(), secs(i.from).c_str(), until.c_str(), i.open ? "true" : "false",
-                     std::string(to_string(i.b)).c_str(), std::string(to_string(i.a)).c_str(), cause.c_str());
+        const std::string line = introspect::JsonObject()
+                                     .str("kind", "difference")
+                                     .str("address", t.name)
+                                     .raw("from", secs(i.from))
+                                     .raw("to", until)
+                                     .boolean("until_end", i.open)
+                                     .str("b", to_string(i.b))
+                                     .str("a", to_string(i.a))
+                                     .raw("cause", cause.text())
+                                     .text();
+        std::fprintf(o.out, "%s\n", line.c_str());
       } else {
         std::fprintf(o.out, "  %s .. %s s%s  B %s, A %s  first cause (%c): %s\n", secs(i.from).c_str(), until.c_str(),
                      i.open ? " (to the end)" : "", std::string(to_string(i.b)).c_str(),
@@ -608,9 +608,15 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   }
   for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
   if (o.json) {
-    std::fprintf(o.out, "{\"kind\":\"diff\",\"b\":%s,\"a\":%s,\"addresses\":%zu,\"intervals\":%zu,\"differ\":%s}\n",
-                 quoted(system_b).c_str(), quoted(o.system).c_str(), addresses, intervals,
-                 addresses ? "true" : "false");
+    const std::string line = introspect::JsonObject()
+                                 .str("kind", "diff")
+                                 .str("b", system_b)
+                                 .str("a", o.system)
+                                 .integer("addresses", static_cast<long long>(addresses))
+                                 .integer("intervals", static_cast<long long>(intervals))
+                                 .boolean("differ", addresses != 0)
+                                 .text();
+    std::fprintf(o.out, "%s\n", line.c_str());
   } else if (addresses == 0) {
     std::fprintf(o.out, "B (%s) and A (%s) never differ on %s\n", system_b.c_str(), o.system.c_str(), o.input.c_str());
   } else {

@@ -3,7 +3,7 @@
 /// SystemQuery: the one interface through which every tool reads (and, with write access,
 /// changes) a running system. Two implementations: LocalQuery (local_query.hpp) over a
 /// Coordinator, its Monitor and the FilterRegistry of this process, and the middleware's
-/// RemoteQuery (safecass/middleware/remote_query.hpp) over a live coordinator process. The
+/// RemoteClient (safecass/middleware/client.hpp) over a live coordinator process. The
 /// middleware's Control servant answers with a LocalQuery, so both give the same answers.
 ///
 /// Every answer is a value type of model.hpp with names resolved. Errors are the system's own:
