@@ -92,7 +92,7 @@ bench: deps
 # (about a minute) that checks the harness and that the JSON has every figure.
 PEERS := $(BUILD)/peers
 PEER_TARGETS := bench_peers_core peer_detection peer_icestorm_raw peer_supervisor_load peer_ros_visibility \
-  peer_ros_watch bench_middleware safecass_bench safecass
+  peer_ros_watch bench_middleware safecass_bench
 CCACHE_LAUNCHER := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 bench-peers: deps
 	@./scripts/install-deps.sh --bench-peers

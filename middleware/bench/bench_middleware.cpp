@@ -6,6 +6,9 @@
 //
 // --ca DIR: the key directory whose CA the IceStorm admits (scripts/start-icestorm --keys DIR);
 // the run's own keys are signed by it, and the bus runs over mutual TLS as deployed.
+//   bench_middleware --make-keys DIR   makes such a directory (the benchmark system's keys, a CA
+//                                      and IceStorm's certificate) and exits: what the scripts
+//                                      start IceStorm with.
 //
 // Two processes: this one forks a provider ("sensor": JR3 provides ForceData) and runs the client
 // ("robot": CONTROL requires JR3.ForceData through a remote provided interface). Both use the
@@ -207,6 +210,15 @@ double percentile(std::vector<double> v, double q) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 3 && std::string(argv[1]) == "--make-keys") {
+    FilterRegistry registry;
+    register_builtin_filters(registry);
+    auto load = spec::load_system_from_text(system_text(1), "bench.json", registry);
+    auto made = load.ok() ? middleware::create_bus_keys(*load.system, argv[2], middleware::KeyOptions::replacing())
+                          : Expected<std::vector<std::string>>(fail(ErrorCode::Parse, "the system does not load"));
+    if (!made) std::fprintf(stderr, "bench_middleware: %s\n", made.error().message.c_str());
+    return made ? 0 : 2;
+  }
   std::string ice_text, out_path = "bench-middleware.json";
   int samples = 2000;
   double seconds = 2.0;
