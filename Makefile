@@ -110,7 +110,7 @@ bench-verify: build
 # are built (their `<folder>/all` targets: the test programs and the libraries they link) and run,
 # folder by folder; docs/contributing.md, "Continuous integration", says which and why. No test of
 # these folders starts the `safecass` command; a folder whose tests do adds it to the targets.
-ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/spec tests/unit/record tests/unit/replay
+ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/json tests/unit/spec tests/unit/record tests/unit/replay
 TSAN_CI_DIRS := tests/unit/core
 # Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
 # invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.

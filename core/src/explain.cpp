@@ -10,7 +10,7 @@
 namespace safecass {
 
 namespace {
-// The formats of the read model's introspect::json_seconds and short_number (introspect sits above
+// The formats of the JSON writer's json::json_seconds and the read model's number text (json and introspect sit above
 // core, so they cannot be called from here).
 std::string seconds_text(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
 std::string number_text(double v) { return fmt::format("{:g}", v); }

@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 #include <variant>
 
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 
 namespace safecass::introspect {
 
@@ -22,7 +22,7 @@ std::string short_number(double v) { return fmt::format("{:g}", v); }
 std::string sample_json(double v) {
   if (std::isnan(v)) return "\"nan\"";
   if (std::isinf(v)) return v > 0 ? "\"inf\"" : "\"-inf\"";
-  return json_number(v);
+  return json::json_number(v);
 }
 
 std::string joined(const std::vector<std::string>& items, std::string_view separator) {
@@ -80,7 +80,7 @@ std::string iso8601_local(std::int64_t unix_ns) {
                      (off % 3600) / 60);
 }
 
-std::string seconds_text(Time t) { return json_seconds(t); }
+std::string seconds_text(Time t) { return json::json_seconds(t); }
 
 std::string number_text(double v) { return fmt::format("{:.9g}", v); }
 
@@ -145,15 +145,15 @@ std::string param_json(const ParamValue& v) {
       [](const auto& x) -> std::string {
         using T = std::decay_t<decltype(x)>;
         if constexpr (std::is_same_v<T, double>) {
-          return json_number(x);
+          return json::json_number(x);
         } else if constexpr (std::is_same_v<T, bool>) {
           return x ? "true" : "false";
         } else if constexpr (std::is_same_v<T, std::string>) {
-          return json_string(x);
+          return json::json_string(x);
         } else if constexpr (std::is_same_v<T, std::vector<std::string>>) {
-          return json_string_array(x);
+          return json::json_string_array(x);
         } else {
-          return json_number_array(x);
+          return json::json_number_array(x);
         }
       },
       v);
@@ -189,7 +189,7 @@ std::string history_text(const HistoryEntry& e, const TimeFormat& time) {
 }
 
 std::string history_json(const HistoryEntry& e) {
-  JsonObject j;
+  json::JsonObject j;
   j.integer("seq", static_cast<long long>(e.seq)).seconds("t", e.time).str("kind", to_string(e.kind));
   if (e.outcome != Outcome::None) j.str("outcome", to_string(e.outcome));
   if (!e.component.empty()) j.str("component", e.component);
@@ -200,7 +200,7 @@ std::string history_json(const HistoryEntry& e) {
   if (e.mirror) j.boolean("mirror", true);
   if (e.root) {
     const RootEntry& r = *e.root;
-    JsonObject root;
+    json::JsonObject root;
     root.str("event", r.event).str("origin", r.origin).seconds("t", r.time);
     if (!r.filter.empty()) root.str("filter", r.filter);
     if (!r.signal.empty())
@@ -268,7 +268,7 @@ std::string explanation_text(const Explanation& e, const TimeFormat& time) {
 }
 
 std::string explanation_json(const std::string& address, const Explanation& e) {
-  JsonObject j;
+  json::JsonObject j;
   j.str("address", address)
       .str("machine", e.machine)
       .str("event", e.event)
@@ -316,7 +316,7 @@ std::string state_list_text(const std::vector<StateRow>& rows) {
 std::string state_list_json(const std::vector<StateRow>& rows) {
   std::string out;
   for (const StateRow& r : rows) {
-    out += JsonObject()
+    out += json::JsonObject()
                .str("address", r.address)
                .str("kind", to_string(r.kind))
                .str("state", to_string(r.state))
@@ -343,7 +343,7 @@ std::string filter_list_text(const std::vector<FilterRow>& rows) {
 std::string filter_list_json(const std::vector<FilterRow>& rows) {
   std::string out;
   for (const FilterRow& f : rows) {
-    out += JsonObject()
+    out += json::JsonObject()
                .str("filter", f.name)
                .str("type", f.type)
                .str("target", f.target.empty() ? "-" : f.target)
@@ -398,7 +398,7 @@ std::string filter_info_text(const FilterInfo& info) {
 }
 
 std::string filter_info_json(const FilterInfo& info) {
-  JsonObject head;
+  json::JsonObject head;
   head.opt("filter", info.filter ? info.filter->name : std::string())
       .str("type", info.type)
       .str("doc", info.doc)
@@ -418,14 +418,14 @@ std::string filter_info_json(const FilterInfo& info) {
   }
   std::string out = head.text() + "\n";
   for (const ParamRow& p : info.params) {
-    JsonObject j;
+    json::JsonObject j;
     j.str("param", p.name)
         .str("type", to_string(p.type))
         .raw("default", p.default_value ? param_json(*p.default_value) : "null")
         .boolean("required", !p.default_value && !p.optional);
     if (p.type == ParamType::Number || p.type == ParamType::Integer) {
-      j.raw("min", p.min > -1e299 ? json_number(p.min) : "null")
-          .raw("max", p.max < 1e299 ? json_number(p.max) : "null");
+      j.raw("min", p.min > -1e299 ? json::json_number(p.min) : "null")
+          .raw("max", p.max < 1e299 ? json::json_number(p.max) : "null");
     }
     if (p.type == ParamType::Choice) j.strings("choices", p.choices);
     if (info.filter) j.raw("value", p.value ? param_json(*p.value) : "null");
@@ -451,7 +451,7 @@ std::string event_list_text(const std::vector<EventRow>& rows) {
 std::string event_list_json(const std::vector<EventRow>& rows) {
   std::string out;
   for (const EventRow& e : rows) {
-    out += JsonObject()
+    out += json::JsonObject()
                .str("event", e.name)
                .integer("severity", e.severity)
                .str("kind", event_kind(e))
@@ -482,7 +482,7 @@ std::string connection_list_text(const std::vector<ConnectionRow>& rows) {
 std::string connection_list_json(const std::vector<ConnectionRow>& rows) {
   std::string out;
   for (const ConnectionRow& k : rows) {
-    JsonObject j;
+    json::JsonObject j;
     j.str("required", k.required).str("provided", k.provided);
     if (k.required_state)
       j.str("required_state", to_string(*k.required_state));
@@ -514,7 +514,7 @@ std::string service_list_text(const std::vector<ServiceRow>& rows) {
 std::string service_list_json(const std::vector<ServiceRow>& rows) {
   std::string out;
   for (const ServiceRow& s : rows) {
-    out += JsonObject()
+    out += json::JsonObject()
                .str("service", s.address)
                .str("state", to_string(s.state))
                .strings("depends_on", s.depends_on)

@@ -75,7 +75,7 @@ Cert new_certificate(EVP_PKEY* key, const std::string& common_name, long days) {
   return cert;
 }
 
-Expected<Pem> to_pem(X509* cert, EVP_PKEY* key) {
+[[nodiscard]] Expected<Pem> to_pem(X509* cert, EVP_PKEY* key) {
   Bio cert_out(BIO_new(BIO_s_mem()));
   Bio key_out(BIO_new(BIO_s_mem()));
   if (!cert_out || !key_out || PEM_write_bio_X509(cert_out.get(), cert) != 1 ||
@@ -87,7 +87,7 @@ Expected<Pem> to_pem(X509* cert, EVP_PKEY* key) {
 
 }  // namespace
 
-Expected<Pem> make_ca(std::string_view system_name) {
+[[nodiscard]] Expected<Pem> make_ca(std::string_view system_name) {
   Key key(EVP_EC_gen("P-256"));
   if (!key) return fail_openssl("making the CA's key");
   Cert cert = new_certificate(key.get(), "SAFECASS CA of system " + std::string(system_name), kCaDays);
@@ -101,7 +101,8 @@ Expected<Pem> make_ca(std::string_view system_name) {
   return to_pem(cert.get(), key.get());
 }
 
-Expected<Pem> make_certificate(const Pem& ca, const std::string& name, const std::vector<std::string>& addresses) {
+[[nodiscard]] Expected<Pem> make_certificate(const Pem& ca, const std::string& name,
+                                             const std::vector<std::string>& addresses) {
   Bio ca_cert_in = memory_of(ca.certificate);
   Bio ca_key_in = memory_of(ca.key);
   Cert ca_cert(ca_cert_in ? PEM_read_bio_X509(ca_cert_in.get(), nullptr, nullptr, nullptr) : nullptr);

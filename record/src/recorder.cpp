@@ -1,7 +1,7 @@
 #include "safecass/record/recorder.hpp"
 
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 #include "segmented_file.hpp"
 
 #include <fcntl.h>
@@ -39,7 +39,7 @@ std::vector<std::string> describe_losses(const RecordStatus& s) {
 }
 
 std::string record_status_json(const RecordStatus& s) {
-  introspect::JsonObject j;
+  json::JsonObject j;
   j.str("kind", "recorder")
       .str("path", s.path)
       .integer("written", static_cast<long long>(s.written))
@@ -101,7 +101,7 @@ void Recorder::writer() {
       std::string line;
       bool record = false;
       if (dropped_ != dropped_reported_) {
-        line = introspect::JsonObject()
+        line = json::JsonObject()
                    .str("kind", "overflow")
                    .integer("dropped", static_cast<long long>(dropped_ - dropped_reported_))
                    .text();

@@ -1,7 +1,7 @@
 #include "safecass/spec/diagnostics.hpp"
 
-#include "safecass/introspect/json.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 
 #include "text.hpp"
 
@@ -24,7 +24,7 @@ std::string to_json(const Diagnostic& d) {
   const char* severity = d.severity == Diagnostic::Severity::Error     ? "error"
                          : d.severity == Diagnostic::Severity::Warning ? "warning"
                                                                        : "note";
-  return introspect::JsonObject()
+  return json::JsonObject()
       .str("file", d.where.file)
       .integer("line", d.where.line)
       .integer("column", d.where.column)

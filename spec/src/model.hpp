@@ -13,8 +13,8 @@
 #include "safecass/core/event.hpp"
 #include "safecass/filters/filter.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/spec/diagnostics.hpp"
-#include "safecass/spec/json.hpp"
 #include "safecass/spec/system.hpp"
 
 namespace safecass::spec::detail {
@@ -22,7 +22,7 @@ namespace safecass::spec::detail {
 /// Where a value is: index of its file, position, JSON pointer in that file.
 struct Site {
   int file = -1;
-  TextPosition position;
+  json::TextPosition position;
   std::string pointer;
 };
 
@@ -32,7 +32,7 @@ struct Document {
   std::string path;
   std::string canonical;
   std::string text;
-  std::optional<JsonValue> root;
+  std::optional<json::JsonValue> root;
 };
 
 /// Collects diagnostics and turns sites into positions.
@@ -89,8 +89,8 @@ struct ParamItem {
   std::string name;
   Site key_site;
   Site value_site;
-  const JsonValue* value = nullptr;  ///< null: synthesized by a pipeline (see `synthetic`)
-  std::string synthetic;             ///< a signal name filled in by a pipeline
+  const json::JsonValue* value = nullptr;  ///< null: synthesized by a pipeline (see `synthetic`)
+  std::string synthetic;                   ///< a signal name filled in by a pipeline
 };
 
 struct FilterItem {
@@ -110,9 +110,9 @@ struct FilterItem {
   bool has_class = false;
   bool has_target_interface = false;
   bool target_component_given = false;
-  bool argument_misspelled = false;                ///< an unknown key of the filter is a typo of 'argument' (reported)
-  const JsonValue* misspelled_argument = nullptr;  ///< its value: the events it names count as generated
-  bool from_template = false;                      ///< instantiated from a framework filter template for `owner`
+  bool argument_misspelled = false;  ///< an unknown key of the filter is a typo of 'argument' (reported)
+  const json::JsonValue* misspelled_argument = nullptr;  ///< its value: the events it names count as generated
+  bool from_template = false;                            ///< instantiated from a framework filter template for `owner`
   std::vector<ParamItem> params;
 };
 

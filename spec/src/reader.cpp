@@ -24,14 +24,14 @@ constexpr std::size_t kMaxIncludeDepth = 16;
 constexpr std::size_t kMaxFiles = 100000;
 constexpr int kMaxJsonDepth = 64;
 
-std::string a_type(JsonValue::Type t) {
+std::string a_type(json::JsonValue::Type t) {
   switch (t) {
-    case JsonValue::Type::Null: return "null";
-    case JsonValue::Type::Bool: return "a boolean";
-    case JsonValue::Type::Number: return "a number";
-    case JsonValue::Type::String: return "a string";
-    case JsonValue::Type::Array: return "an array";
-    case JsonValue::Type::Object: return "an object";
+    case json::JsonValue::Type::Null: return "null";
+    case json::JsonValue::Type::Bool: return "a boolean";
+    case json::JsonValue::Type::Number: return "a number";
+    case json::JsonValue::Type::String: return "a string";
+    case json::JsonValue::Type::Array: return "an array";
+    case json::JsonValue::Type::Object: return "an object";
   }
   return "a value";
 }
@@ -45,7 +45,7 @@ bool whole(double d) noexcept { return std::isfinite(d) && std::floor(d) == d; }
 /// get() then returns only members that are present and of the right shape.
 class Fields {
 public:
-  Fields(Sink& sink, int file, const JsonValue& object, std::string pointer, const ObjectKind& kind,
+  Fields(Sink& sink, int file, const json::JsonValue& object, std::string pointer, const ObjectKind& kind,
          std::string context)
       : sink_(sink),
         file_(file),
@@ -54,10 +54,10 @@ public:
         kind_(kind),
         context_(std::move(context)) {
     std::set<std::string_view> seen;
-    for (const JsonMember& m : object.object) {
+    for (const json::JsonMember& m : object.object) {
       const Site key_site{file_, m.key_position, pointer_join(pointer_, m.key)};
       if (!seen.insert(m.key).second) {
-        const JsonMember* first = object.find_member(m.key);
+        const json::JsonMember* first = object.find_member(m.key);
         sink_.error(key_site, context_ + ": duplicate key " + quote_name(m.key) + " (first at line " +
                                   std::to_string(first->key_position.line) + ", column " +
                                   std::to_string(first->key_position.column) + ")");
@@ -100,22 +100,22 @@ public:
     }
   }
 
-  const JsonValue* get(std::string_view key) const noexcept {
-    for (const JsonMember* m : good_) {
+  const json::JsonValue* get(std::string_view key) const noexcept {
+    for (const json::JsonMember* m : good_) {
       if (m->key == key) return &m->value;
     }
     return nullptr;
   }
   /// A Choice member as its canonical choice ("active" and "INTERNAL" are "ACTIVE"), or "".
   std::string_view choice(std::string_view key) const noexcept {
-    const JsonValue* v = get(key);
+    const json::JsonValue* v = get(key);
     const Key* k = kind_.find(key);
     return v == nullptr || k == nullptr ? std::string_view() : canonical_choice(*k, v->string);
   }
-  const JsonMember* member(std::string_view key) const noexcept { return object_.find_member(key); }
+  const json::JsonMember* member(std::string_view key) const noexcept { return object_.find_member(key); }
   bool has(std::string_view key) const noexcept { return member(key) != nullptr; }
   Site site(std::string_view key) const {
-    const JsonMember* m = member(key);
+    const json::JsonMember* m = member(key);
     if (m == nullptr) return object_site();
     return Site{file_, m->value.position, pointer(key)};
   }
@@ -126,18 +126,18 @@ public:
   /// The string items of a StringList member, with their sites.
   std::vector<Name> names(std::string_view key) const {
     std::vector<Name> out;
-    const JsonValue* v = get(key);
+    const json::JsonValue* v = get(key);
     if (v == nullptr) return out;
     for (std::size_t i = 0; i < v->array.size(); ++i) {
-      const JsonValue& item = v->array[i];
+      const json::JsonValue& item = v->array[i];
       if (item.is_string()) out.push_back(Name{item.string, Site{file_, item.position, pointer_join(pointer(key), i)}});
     }
     return out;
   }
 
 private:
-  bool check(const Key& key, const JsonMember& m) {
-    const JsonValue& v = m.value;
+  bool check(const Key& key, const json::JsonMember& m) {
+    const json::JsonValue& v = m.value;
     const Site site{file_, v.position, pointer(m.key)};
     const std::string what = context_ + ": " + quote_name(m.key);
     const auto wrong = [&](const std::string& expected) {
@@ -184,7 +184,7 @@ private:
           return wrong(key.shape == Shape::StringList ? "an array of strings"
                                                       : "an array of " + join_or(to_strings(key.choices)));
         for (std::size_t i = 0; i < v.array.size(); ++i) {
-          const JsonValue& item = v.array[i];
+          const json::JsonValue& item = v.array[i];
           const Site item_site{file_, item.position, pointer_join(site.pointer, i)};
           if (!item.is_string()) {
             sink_.error(item_site, what + " items must be strings, not " + a_type(item.type));
@@ -200,7 +200,7 @@ private:
     return false;
   }
 
-  bool check_choice(const Key& key, const JsonValue& v, const Site& site, const std::string& what) {
+  bool check_choice(const Key& key, const json::JsonValue& v, const Site& site, const std::string& what) {
     if (!canonical_choice(key, v.string).empty()) return true;
     sink_.error(site, what + " must be " + join_or(to_strings(key.choices)) + ", not " + quote_name(v.string) +
                           did_you_mean(v.string, to_strings(key.choices)));
@@ -209,15 +209,15 @@ private:
 
   Sink& sink_;
   int file_;
-  const JsonValue& object_;
+  const json::JsonValue& object_;
   std::string pointer_;
   const ObjectKind& kind_;
   std::string context_;
-  std::vector<const JsonMember*> good_;
+  std::vector<const json::JsonMember*> good_;
 };
 
-std::string named(std::string_view kind, const JsonValue& object, std::string_view name_key) {
-  const JsonValue* n = object.find(name_key);
+std::string named(std::string_view kind, const json::JsonValue& object, std::string_view name_key) {
+  const json::JsonValue* n = object.find(name_key);
   if (n != nullptr && n->is_string()) return std::string(kind) + " " + quote_name(n->string);
   return std::string(kind);
 }
@@ -239,7 +239,7 @@ public:
     model_.path = path;
     const int doc = open(path, text, nullptr);
     if (doc < 0) return;
-    const JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
+    const json::JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
     switch (kind_of(doc, root)) {
       case FileKind::Component: {
         ComponentItem c;
@@ -261,15 +261,15 @@ private:
   enum class FileKind { System, Component, Invalid };
 
   /// What a file holds; reports files that are neither or both.
-  FileKind kind_of(int doc, const JsonValue& root) {
+  FileKind kind_of(int doc, const json::JsonValue& root) {
     const bool system = root.find_member("system") != nullptr || root.find_member("components") != nullptr;
     const bool component = root.find_member("component") != nullptr;
     const Site site{doc, root.position, ""};
-    if (const JsonMember* monitor = root.find_member("monitor"); monitor != nullptr && !system && !component) {
+    if (const json::JsonMember* monitor = root.find_member("monitor"); monitor != nullptr && !system && !component) {
       refuse_monitor_targets(doc, *monitor);
       return FileKind::Invalid;
     }
-    if (const JsonMember* old = root.find_member("component_name"); old != nullptr && !system && !component) {
+    if (const json::JsonMember* old = root.find_member("component_name"); old != nullptr && !system && !component) {
       sink_.error(Site{doc, old->key_position, "/component_name"},
                   "'component_name' is the original's key for the component's name: write \"component\"");
       return FileKind::Invalid;
@@ -298,7 +298,7 @@ private:
   /// framework to stream a measurement (a thread's period or duty cycle) at a sampling rate,
   /// without any limit, so nothing in it says what is a fault. Each target gets one error that
   /// names the filter that detects that fault once the limits are written down.
-  void refuse_monitor_targets(int doc, const JsonMember& monitor) {
+  void refuse_monitor_targets(int doc, const json::JsonMember& monitor) {
     const std::string base = "/monitor";
     const std::string intro =
         "the 2016 monitor-target file is not loaded (a target streams a measurement and sets no limit): ";
@@ -308,14 +308,14 @@ private:
       return;
     }
     for (std::size_t i = 0; i < monitor.value.array.size(); ++i) {
-      const JsonValue& target = monitor.value.array[i];
+      const json::JsonValue& target = monitor.value.array[i];
       const std::string p = pointer_join(base, i);
       std::string type;
       std::string component = "the component";
       if (target.is_object()) {
-        if (const JsonValue* t = target.find("type"); t != nullptr && t->is_string()) type = t->string;
-        if (const JsonValue* loc = target.find("location"); loc != nullptr && loc->is_object()) {
-          if (const JsonValue* c = loc->find("component"); c != nullptr && c->is_string() && !c->string.empty()) {
+        if (const json::JsonValue* t = target.find("type"); t != nullptr && t->is_string()) type = t->string;
+        if (const json::JsonValue* loc = target.find("location"); loc != nullptr && loc->is_object()) {
+          if (const json::JsonValue* c = loc->find("component"); c != nullptr && c->is_string() && !c->string.empty()) {
             component = "component " + quote_name(c->string);
           }
         }
@@ -334,9 +334,9 @@ private:
         advice = "for " + (type.empty() ? std::string("this target") : "target " + quote_name(type)) + " of " +
                  component + ", write a filter on the signal it measures (Threshold, Range, Frequency, DutyCycle...)";
       }
-      const TextPosition at = target.is_object() && target.find_member("type") != nullptr
-                                  ? target.find_member("type")->key_position
-                                  : target.position;
+      const json::TextPosition at = target.is_object() && target.find_member("type") != nullptr
+                                        ? target.find_member("type")->key_position
+                                        : target.position;
       sink_.error(
           Site{doc, at, target.is_object() && target.find_member("type") != nullptr ? pointer_join(p, "type") : p},
           intro + advice);
@@ -408,7 +408,7 @@ private:
     Document& d = sink_.documents.back();
     std::string_view body = d.text;
     if (body.empty()) {
-      sink_.error(Site{doc, TextPosition{1, 1}, ""}, "empty file: expected a JSON object");
+      sink_.error(Site{doc, json::TextPosition{1, 1}, ""}, "empty file: expected a JSON object");
       return -1;
     }
     if (body.substr(0, 3) == "\xEF\xBB\xBF") body.remove_prefix(3);  // a byte-order mark
@@ -419,7 +419,7 @@ private:
                   std::string("invalid UTF-8 (byte ") + hex + "): a specification is UTF-8 text");
       return -1;
     }
-    JsonParse parsed = parse_json(body, kMaxJsonDepth);
+    json::JsonParse parsed = json::parse_json(body, kMaxJsonDepth);
     if (parsed.error) {
       sink_.error(Site{doc, parsed.error->position, ""}, parsed.error->message);
       return -1;
@@ -434,9 +434,9 @@ private:
     return doc;
   }
 
-  void include(int from, const JsonValue& entry, const std::string& pointer) {
+  void include(int from, const json::JsonValue& entry, const std::string& pointer) {
     Fields f(sink_, from, entry, pointer, include_kind(), "include");
-    const JsonValue* path = f.get("include");
+    const json::JsonValue* path = f.get("include");
     if (path == nullptr) return;
     const Site site = f.site("include");
     if (path->string.empty()) {
@@ -455,7 +455,7 @@ private:
     if (resolved.empty()) resolved = ".";
     const int doc = open(resolved, nullptr, &site);
     if (doc < 0) return;
-    const JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
+    const json::JsonValue& root = *sink_.documents[static_cast<std::size_t>(doc)].root;
     switch (kind_of(doc, root)) {
       case FileKind::Component: {
         ComponentItem c;
@@ -469,18 +469,18 @@ private:
     stack_.pop_back();
   }
 
-  void read_system(int doc, const JsonValue& root, const std::string& pointer, bool top) {
+  void read_system(int doc, const json::JsonValue& root, const std::string& pointer, bool top) {
     Fields f(sink_, doc, root, pointer, system_kind(), named("system", root, "system"));
     if (top) {
-      if (const JsonValue* n = f.get("system")) model_.name = n->string;
+      if (const json::JsonValue* n = f.get("system")) model_.name = n->string;
     }
-    if (const JsonValue* list = f.get("components")) {
+    if (const json::JsonValue* list = f.get("components")) {
       if (top) {
         model_.component_entries = list->array.size();
         model_.has_components_key = true;
       }
       for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const JsonValue& entry = list->array[i];
+        const json::JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("components"), i);
         const Site site{doc, entry.position, p};
         if (!entry.is_object()) {
@@ -500,9 +500,9 @@ private:
         }
       }
     }
-    if (const JsonValue* list = f.get("connections")) {
+    if (const json::JsonValue* list = f.get("connections")) {
       for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const JsonValue& entry = list->array[i];
+        const json::JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("connections"), i);
         if (!entry.is_object()) {
           sink_.error(Site{doc, entry.position, p},
@@ -515,18 +515,18 @@ private:
         item.site = c.object_site();
         item.required_site = c.site("required");
         item.provided_site = c.site("provided");
-        const JsonValue* r = c.get("required");
-        const JsonValue* pr = c.get("provided");
+        const json::JsonValue* r = c.get("required");
+        const json::JsonValue* pr = c.get("provided");
         if (r != nullptr) item.required = r->string;
         if (pr != nullptr) item.provided = pr->string;
         item.complete = r != nullptr && pr != nullptr;
         model_.connections.push_back(std::move(item));
       }
     }
-    if (const JsonValue* list = f.get("hazards")) {
+    if (const json::JsonValue* list = f.get("hazards")) {
       model_.has_hazards = true;
       for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const JsonValue& entry = list->array[i];
+        const json::JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("hazards"), i);
         if (!entry.is_object()) {
           sink_.error(Site{doc, entry.position, p},
@@ -536,9 +536,9 @@ private:
         model_.hazards.push_back(read_hazard(doc, entry, p));
       }
     }
-    if (const JsonValue* list = f.get("invariants")) {
+    if (const json::JsonValue* list = f.get("invariants")) {
       for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const JsonValue& entry = list->array[i];
+        const json::JsonValue& entry = list->array[i];
         const std::string p = pointer_join(f.pointer("invariants"), i);
         if (!entry.is_object()) {
           sink_.error(Site{doc, entry.position, p},
@@ -550,22 +550,22 @@ private:
         item.site = fi.object_site();
         item.name_site = fi.site("name");
         item.formula_site = fi.site("formula");
-        if (const JsonValue* n = fi.get("name")) {
+        if (const json::JsonValue* n = fi.get("name")) {
           item.name = n->string;
           item.has_name = true;
         }
-        if (const JsonValue* t = fi.get("formula")) {
+        if (const json::JsonValue* t = fi.get("formula")) {
           item.formula = t->string;
           item.has_formula = true;
         }
-        if (const JsonValue* d = fi.get("description")) item.description = d->string;
+        if (const json::JsonValue* d = fi.get("description")) item.description = d->string;
         model_.invariants.push_back(std::move(item));
       }
     }
-    if (const JsonValue* coordinators = f.get("coordinators")) {
+    if (const json::JsonValue* coordinators = f.get("coordinators")) {
       const std::string base = f.pointer("coordinators");
       std::set<std::string_view> seen;
-      for (const JsonMember& m : coordinators->object) {
+      for (const json::JsonMember& m : coordinators->object) {
         const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
         if (!seen.insert(m.key).second) {
           sink_.error(key_site, "coordinators: duplicate key " + quote_name(m.key));
@@ -580,7 +580,7 @@ private:
           continue;
         }
         for (std::size_t i = 0; i < m.value.array.size(); ++i) {
-          const JsonValue& c = m.value.array[i];
+          const json::JsonValue& c = m.value.array[i];
           const Site item_site{doc, c.position, pointer_join(key_site.pointer, i)};
           if (!c.is_string()) {
             sink_.error(item_site, "coordinator " + quote_name(m.key) + ": components are named by strings, not " +
@@ -595,25 +595,25 @@ private:
     }
   }
 
-  void read_component(int doc, const JsonValue& value, const std::string& pointer, ComponentItem& c) {
+  void read_component(int doc, const json::JsonValue& value, const std::string& pointer, ComponentItem& c) {
     Fields f(sink_, doc, value, pointer, component_kind(), named("component", value, "component"));
     c.site = f.object_site();
     c.name_site = f.site("component");
-    if (const JsonValue* n = f.get("component")) {
+    if (const json::JsonValue* n = f.get("component")) {
       c.name = n->string;
       c.has_name = true;
     }
     const std::string& ctx = f.context();
-    if (const JsonValue* interfaces = f.get("interfaces")) {
+    if (const json::JsonValue* interfaces = f.get("interfaces")) {
       c.has_interfaces = true;
       Fields fi(sink_, doc, *interfaces, f.pointer("interfaces"), interfaces_kind(), ctx);
       c.provided = fi.names("provided");
       c.required = fi.names("required");
     }
-    if (const JsonValue* signals = f.get("signals")) {
+    if (const json::JsonValue* signals = f.get("signals")) {
       c.has_signals = true;
       for (std::size_t i = 0; i < signals->array.size(); ++i) {
-        const JsonValue& s = signals->array[i];
+        const json::JsonValue& s = signals->array[i];
         const std::string p = pointer_join(f.pointer("signals"), i);
         if (!s.is_object()) {
           sink_.error(Site{doc, s.position, p},
@@ -621,18 +621,18 @@ private:
           continue;
         }
         Fields fs(sink_, doc, s, p, signal_kind(), named("signal", s, "name"));
-        const JsonValue* name = fs.get("name");
+        const json::JsonValue* name = fs.get("name");
         if (name == nullptr) continue;
         SignalItem item;
         item.name = name->string.find('.') == std::string::npos ? c.name + "." + name->string : name->string;
         item.site = fs.site("name");
-        if (const JsonValue* size = fs.get("size")) item.size = static_cast<std::size_t>(size->number);
+        if (const json::JsonValue* size = fs.get("size")) item.size = static_cast<std::size_t>(size->number);
         c.signals.push_back(std::move(item));
       }
     }
-    if (const JsonValue* events = f.get("event")) {
+    if (const json::JsonValue* events = f.get("event")) {
       for (std::size_t i = 0; i < events->array.size(); ++i) {
-        const JsonValue& e = events->array[i];
+        const json::JsonValue& e = events->array[i];
         const std::string p = pointer_join(f.pointer("event"), i);
         if (!e.is_object()) {
           sink_.error(Site{doc, e.position, p}, ctx + ": an event must be an object, not " + a_type(e.type));
@@ -641,9 +641,9 @@ private:
         c.events.push_back(read_event(doc, e, p, c.name));
       }
     }
-    if (const JsonValue* filters = f.get("filter")) {
+    if (const json::JsonValue* filters = f.get("filter")) {
       for (std::size_t i = 0; i < filters->array.size(); ++i) {
-        const JsonValue& e = filters->array[i];
+        const json::JsonValue& e = filters->array[i];
         const std::string p = pointer_join(f.pointer("filter"), i);
         if (!e.is_object()) {
           sink_.error(Site{doc, e.position, p}, ctx + ": a filter must be an object, not " + a_type(e.type));
@@ -654,16 +654,16 @@ private:
         if (e.find_member("pipeline") != nullptr) {
           Fields fp(sink_, doc, e, p, pipeline_kind(), named("pipeline", e, "name"));
           entry.name_site = fp.site("name");
-          if (const JsonValue* n = fp.get("name"))
+          if (const json::JsonValue* n = fp.get("name"))
             entry.pipeline = n->string;
           else
             entry.pipeline = "?";
           TargetDefault target;
-          if (const JsonValue* t = fp.get("target"))
+          if (const json::JsonValue* t = fp.get("target"))
             target = read_target(doc, *t, fp.pointer("target"), fp.context(), c.name);
-          if (const JsonValue* stages = fp.get("pipeline")) {
+          if (const json::JsonValue* stages = fp.get("pipeline")) {
             for (std::size_t k = 0; k < stages->array.size(); ++k) {
-              const JsonValue& s = stages->array[k];
+              const json::JsonValue& s = stages->array[k];
               const std::string sp = pointer_join(fp.pointer("pipeline"), k);
               if (!s.is_object()) {
                 sink_.error(Site{doc, s.position, sp},
@@ -682,9 +682,9 @@ private:
         c.filters.push_back(std::move(entry));
       }
     }
-    if (const JsonValue* services = f.get("service")) {
+    if (const json::JsonValue* services = f.get("service")) {
       for (std::size_t i = 0; i < services->array.size(); ++i) {
-        const JsonValue& s = services->array[i];
+        const json::JsonValue& s = services->array[i];
         const std::string p = pointer_join(f.pointer("service"), i);
         if (!s.is_object()) {
           sink_.error(Site{doc, s.position, p}, ctx + ": a service must be an object, not " + a_type(s.type));
@@ -694,42 +694,42 @@ private:
         ServiceItem item;
         item.site = fs.object_site();
         item.name_site = fs.site("name");
-        if (const JsonValue* n = fs.get("name")) {
+        if (const json::JsonValue* n = fs.get("name")) {
           item.provided = n->string;
           item.has_name = true;
         }
-        if (const JsonValue* d = fs.get("dependency")) {
+        if (const json::JsonValue* d = fs.get("dependency")) {
           Fields fd(sink_, doc, *d, fs.pointer("dependency"), dependency_kind(), fs.context() + " dependency");
           ServiceDependency dep = ServiceDependency::provided_only();
-          if (const JsonValue* b = fd.get("s_F")) dep.framework = b->boolean;
-          if (const JsonValue* b = fd.get("s_A")) dep.application = b->boolean;
+          if (const json::JsonValue* b = fd.get("s_F")) dep.framework = b->boolean;
+          if (const json::JsonValue* b = fd.get("s_A")) dep.application = b->boolean;
           item.required = fd.names("s_R");
           for (const Name& r : item.required) dep.required.push_back(r.text);
           item.dependency = std::move(dep);
         }
-        if (const JsonValue* pr = fs.get("propagate")) {
+        if (const json::JsonValue* pr = fs.get("propagate")) {
           item.dependency.propagate = pr->string == "warning" ? State::Warning : State::Error;
         }
         c.services.push_back(std::move(item));
       }
     }
-    if (const JsonValue* period = f.get("period")) c.period = period->number;
+    if (const json::JsonValue* period = f.get("period")) c.period = period->number;
   }
 
-  HazardItem read_hazard(int doc, const JsonValue& e, const std::string& pointer) {
+  HazardItem read_hazard(int doc, const json::JsonValue& e, const std::string& pointer) {
     Fields f(sink_, doc, e, pointer, hazard_kind(), named("hazard", e, "id"));
     HazardItem item;
     item.site = f.object_site();
     item.id_site = f.site("id");
-    if (const JsonValue* n = f.get("id")) {
+    if (const json::JsonValue* n = f.get("id")) {
       item.id = n->string;
       item.has_id = true;
     }
-    if (const JsonValue* d = f.get("description")) item.description = d->string;
-    if (const JsonValue* r = f.get("reaction")) {
+    if (const json::JsonValue* d = f.get("description")) item.description = d->string;
+    if (const json::JsonValue* r = f.get("reaction")) {
       const std::string base = f.pointer("reaction");
       std::set<std::string_view> seen;
-      for (const JsonMember& m : r->object) {
+      for (const json::JsonMember& m : r->object) {
         const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
         if (!seen.insert(m.key).second) {
           sink_.error(key_site, f.context() + ": reaction: duplicate address " + quote_name(m.key));
@@ -747,7 +747,7 @@ private:
     return item;
   }
 
-  EventItem read_event(int doc, const JsonValue& e, const std::string& pointer, const std::string& component) {
+  EventItem read_event(int doc, const json::JsonValue& e, const std::string& pointer, const std::string& component) {
     Fields f(sink_, doc, e, pointer, event_kind(), named("event", e, "name"));
     EventItem item;
     item.component = component;
@@ -758,17 +758,17 @@ private:
     item.completes_site = f.site("completes");
     item.latched_site = f.site("latched");
     item.hazard_site = f.site("hazard");
-    if (const JsonValue* n = f.get("name")) {
+    if (const json::JsonValue* n = f.get("name")) {
       item.def.name = n->string;
       item.has_name = true;
     }
-    if (const JsonValue* s = f.get("severity")) {
+    if (const json::JsonValue* s = f.get("severity")) {
       item.def.severity = static_cast<int>(s->number);  // range checked: 1-255
       item.has_severity = true;
     }
-    if (const JsonValue* t = f.get("state_transition")) {
+    if (const json::JsonValue* t = f.get("state_transition")) {
       item.has_transitions = true;
-      for (const JsonValue& x : t->array) {
+      for (const json::JsonValue& x : t->array) {
         const auto tr = x.is_string() ? parse_transition(x.string) : std::nullopt;
         if (tr)
           item.def.transitions.insert(*tr);
@@ -778,14 +778,14 @@ private:
     } else if (f.has("state_transition")) {
       item.transitions_valid = false;
     }
-    if (const JsonValue* c = f.get("completes")) item.def.completes = c->string;
-    if (const JsonValue* l = f.get("latched")) item.def.latched = l->boolean;
-    if (const JsonValue* h = f.get("hazard")) item.def.hazard = h->string;
-    if (const JsonValue* d = f.get("description")) item.def.description = d->string;
+    if (const json::JsonValue* c = f.get("completes")) item.def.completes = c->string;
+    if (const json::JsonValue* l = f.get("latched")) item.def.latched = l->boolean;
+    if (const json::JsonValue* h = f.get("hazard")) item.def.hazard = h->string;
+    if (const json::JsonValue* d = f.get("description")) item.def.description = d->string;
     return item;
   }
 
-  TargetDefault read_target(int doc, const JsonValue& t, const std::string& pointer, const std::string& context,
+  TargetDefault read_target(int doc, const json::JsonValue& t, const std::string& pointer, const std::string& context,
                             const std::string& owner) {
     Fields f(sink_, doc, t, pointer, target_kind(), context + " target");
     TargetDefault out;
@@ -795,25 +795,25 @@ private:
     out.component_site = f.site("component");
     out.interface_site = f.site("interface");
     out.target.component = owner;
-    if (const JsonValue* type = f.get("type")) {
+    if (const json::JsonValue* type = f.get("type")) {
       const std::string& s = type->string;
       out.target.kind = s == "s_F"   ? MachineKind::Framework
                         : s == "s_P" ? MachineKind::Provided
                         : s == "s_R" ? MachineKind::Required
                                      : MachineKind::Application;
     }
-    if (const JsonValue* c = f.get("component")) {
+    if (const json::JsonValue* c = f.get("component")) {
       out.target.component = c->string;
       out.component_given = true;
     }
-    if (const JsonValue* i = f.get("interface")) {
+    if (const json::JsonValue* i = f.get("interface")) {
       out.target.interface = i->string;
       out.has_interface = true;
     }
     return out;
   }
 
-  FilterItem read_filter(int doc, const JsonValue& e, const std::string& pointer, const std::string& owner,
+  FilterItem read_filter(int doc, const json::JsonValue& e, const std::string& pointer, const std::string& owner,
                          const TargetDefault& inherited) {
     Fields f(sink_, doc, e, pointer, filter_kind(), named("filter", e, "name"));
     FilterItem item;
@@ -821,11 +821,11 @@ private:
     item.site = f.object_site();
     item.name_site = f.site("name");
     item.class_site = f.site("class_name");
-    if (const JsonValue* n = f.get("name")) {
+    if (const json::JsonValue* n = f.get("name")) {
       item.config.name = n->string;
       item.named = true;
     }
-    if (const JsonValue* c = f.get("class_name")) {
+    if (const json::JsonValue* c = f.get("class_name")) {
       item.config.type = c->string;
       item.has_class = true;
     }
@@ -837,16 +837,17 @@ private:
     }
     // A misspelled "argument" is reported once, as the unknown key: the parameters it holds are
     // then not reported missing as well.
-    for (const JsonMember& m : e.object) {
+    for (const json::JsonMember& m : e.object) {
       if (filter_kind().find(m.key) != nullptr) continue;
       if (m.key == "Arguments" || nearest(m.key, {"argument"}).has_value()) {
         item.argument_misspelled = true;
         item.misspelled_argument = &m.value;
       }
     }
-    if (const JsonValue* b = f.get("enabled")) item.config.enabled = b->boolean;
+    if (const json::JsonValue* b = f.get("enabled")) item.config.enabled = b->boolean;
     TargetDefault target = inherited;
-    if (const JsonValue* t = f.get("target")) target = read_target(doc, *t, f.pointer("target"), f.context(), owner);
+    if (const json::JsonValue* t = f.get("target"))
+      target = read_target(doc, *t, f.pointer("target"), f.context(), owner);
     if (target.given) {
       item.config.target = target.target;
       item.target_site = target.site;
@@ -861,10 +862,10 @@ private:
       item.target_site = item.target_type_site = item.target_component_site = item.target_interface_site = item.site;
     }
     item.argument_site = f.site("argument");
-    if (const JsonValue* a = f.get("argument")) {
+    if (const json::JsonValue* a = f.get("argument")) {
       std::set<std::string_view> seen;
       const std::string base = f.pointer("argument");
-      for (const JsonMember& m : a->object) {
+      for (const json::JsonMember& m : a->object) {
         const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
         if (!seen.insert(m.key).second) {
           sink_.error(key_site, f.context() + ": duplicate parameter " + quote_name(m.key));

@@ -8,8 +8,8 @@
 #include <limits>
 
 #include "safecass/core/state.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/spec/file.hpp"
-#include "safecass/spec/json.hpp"
 
 #include "text.hpp"
 
@@ -147,20 +147,20 @@ class Reader {
 public:
   Reader(std::string file, std::vector<Diagnostic>& out) : file_(std::move(file)), out_(out) {}
 
-  void error(const TextPosition& p, const std::string& pointer, std::string message) {
+  void error(const json::TextPosition& p, const std::string& pointer, std::string message) {
     out_.push_back(
         Diagnostic{Diagnostic::Severity::Error, Position{file_, p.line, p.column}, std::move(message), pointer});
   }
 
-  bool number(const JsonValue& v, const std::string& pointer, const char* what, double& out) {
+  bool number(const json::JsonValue& v, const std::string& pointer, const char* what, double& out) {
     if (!v.is_number()) {
-      error(v.position, pointer, std::string(what) + " must be a number, not " + std::string(type_name(v.type)));
+      error(v.position, pointer, std::string(what) + " must be a number, not " + std::string(json::type_name(v.type)));
       return false;
     }
     out = v.number;
     return true;
   }
-  bool text(const JsonValue& v, const std::string& pointer, const char* what, std::string& out) {
+  bool text(const json::JsonValue& v, const std::string& pointer, const char* what, std::string& out) {
     if (!v.is_string() || v.string.empty()) {
       error(v.position, pointer, std::string(what) + " must be a non-empty string");
       return false;
@@ -169,7 +169,7 @@ public:
     return true;
   }
   /// A number or a list of numbers.
-  bool values(const JsonValue& v, const std::string& pointer, std::vector<double>& out) {
+  bool values(const json::JsonValue& v, const std::string& pointer, std::vector<double>& out) {
     if (v.is_number()) {
       out = {v.number};
       return true;
@@ -189,10 +189,10 @@ public:
   }
   /// Reports the keys of `obj` that are not `known`, with the nearest known one; returns the
   /// known keys suggested, so that a typo of a required key is not also reported missing.
-  std::vector<std::string> unknown_keys(const JsonValue& obj, const std::string& pointer,
+  std::vector<std::string> unknown_keys(const json::JsonValue& obj, const std::string& pointer,
                                         std::initializer_list<std::string_view> known) {
     std::vector<std::string> suggested;
-    for (const JsonMember& m : obj.object) {
+    for (const json::JsonMember& m : obj.object) {
       if (std::find(known.begin(), known.end(), m.key) == known.end()) {
         std::string list;
         std::vector<std::string> candidates;
@@ -233,7 +233,7 @@ std::string escape_pointer(const std::string& key) {
   return out;
 }
 
-void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<ScenarioStep>& steps) {
+void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::deque<ScenarioStep>& steps) {
   const std::string base = "/steps/" + std::to_string(index);
   if (!step.is_object()) {
     r.error(step.position, base, "a step must be an object with \"at\" and one action");
@@ -241,11 +241,11 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
   }
   static constexpr std::string_view kActions[] = {"sample", "ramp",   "generate",           "inject",
                                                   "reset",  "expect", "expect_outstanding", "expect_cause"};
-  const JsonValue* at = step.find("at");
+  const json::JsonValue* at = step.find("at");
   double when = 0.0;
   if (at == nullptr) {
     // A misspelled "at" is one error, the unknown key with its suggestion.
-    for (const JsonMember& m : step.object) {
+    for (const json::JsonMember& m : step.object) {
       if (std::find(std::begin(kActions), std::end(kActions), m.key) != std::end(kActions)) continue;
       if (detail::nearest(m.key, {"at"})) {
         r.error(m.key_position, base + "/" + escape_pointer(m.key),
@@ -263,7 +263,7 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
   }
   int actions = 0;
   bool unknown_action = false;
-  for (const JsonMember& m : step.object) {
+  for (const json::JsonMember& m : step.object) {
     if (m.key == "at") continue;
     const auto it = std::find(std::begin(kActions), std::end(kActions), m.key);
     if (it == std::end(kActions)) {
@@ -279,7 +279,7 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
     }
     ++actions;
     const std::string p = base + "/" + m.key;
-    const JsonValue& v = m.value;
+    const json::JsonValue& v = m.value;
     ScenarioStep s;
     s.at = when;
     s.index = static_cast<std::uint32_t>(index);
@@ -298,7 +298,7 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
         {
           std::vector<std::pair<std::string_view, std::vector<double>>> samples;
           samples.reserve(v.object.size());
-          for (const JsonMember& sm : v.object) {
+          for (const json::JsonMember& sm : v.object) {
             std::vector<double> vals;
             ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
             samples.emplace_back(sm.key, std::move(vals));
@@ -313,10 +313,10 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           break;
         }
         const auto typos = r.unknown_keys(v, p, {"signal", "from", "to", "until"});
-        const JsonValue* sig = v.find("signal");
-        const JsonValue* from = v.find("from");
-        const JsonValue* to = v.find("to");
-        const JsonValue* until = v.find("until");
+        const json::JsonValue* sig = v.find("signal");
+        const json::JsonValue* from = v.find("from");
+        const json::JsonValue* to = v.find("to");
+        const json::JsonValue* until = v.find("until");
         if (sig == nullptr || from == nullptr || to == nullptr || until == nullptr) {
           const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
           const bool all_typos = (sig != nullptr || typo("signal")) && (from != nullptr || typo("from")) &&
@@ -342,8 +342,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           break;
         }
         const auto typos = r.unknown_keys(v, p, {"event", "target"});
-        const JsonValue* e = v.find("event");
-        const JsonValue* t = v.find("target");
+        const json::JsonValue* e = v.find("event");
+        const json::JsonValue* t = v.find("target");
         if (e == nullptr) {
           if (std::find(typos.begin(), typos.end(), "event") == typos.end())
             r.error(v.position, p, "\"generate\" needs \"event\"");
@@ -362,10 +362,10 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
         }
         const auto typos = r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
         const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
-        const JsonValue* f = v.find("filter");
-        const JsonValue* sig = v.find("signal");
-        const JsonValue* deep = v.find("deep");
-        const JsonValue* vals = v.find("values");
+        const json::JsonValue* f = v.find("filter");
+        const json::JsonValue* sig = v.find("signal");
+        const json::JsonValue* deep = v.find("deep");
+        const json::JsonValue* vals = v.find("values");
         if ((f == nullptr) == (sig == nullptr)) {
           if (f != nullptr || !(typo("filter") || typo("signal"))) {
             r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
@@ -410,8 +410,8 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           break;
         }
         const auto typos = r.unknown_keys(v, p, {"target", "reason"});
-        const JsonValue* t = v.find("target");
-        const JsonValue* why = v.find("reason");
+        const json::JsonValue* t = v.find("target");
+        const json::JsonValue* why = v.find("reason");
         if (t == nullptr) {
           if (std::find(typos.begin(), typos.end(), "target") == typos.end())
             r.error(v.position, p, "\"reset\" needs \"target\"");
@@ -431,7 +431,7 @@ void read_step(Reader& r, const JsonValue& step, std::size_t index, std::deque<S
           ok = false;
           break;
         }
-        for (const JsonMember& em : v.object) {
+        for (const json::JsonMember& em : v.object) {
           std::string expected;
           if (!r.text(em.value, p + "/" + escape_pointer(em.key), "an expectation", expected)) {
             ok = false;
@@ -480,21 +480,21 @@ ScenarioLoad load_scenario(const std::string& path) {
   sc.path = path;
   std::vector<Diagnostic> step_diagnostics;
   Reader step_reader(path, step_diagnostics);
-  const JsonParse parsed = parse_json_streaming(
-      text, "steps", [&](std::size_t index, JsonValue&& step) { read_step(step_reader, step, index, sc.steps); });
+  const json::JsonParse parsed = json::parse_json_streaming(
+      text, "steps", [&](std::size_t index, json::JsonValue&& step) { read_step(step_reader, step, index, sc.steps); });
   std::string().swap(text);
   if (parsed.error) {  // the syntax error alone, as for any file that is not JSON
     r.error(parsed.error->position, "", parsed.error->message);
     return out;
   }
-  const JsonValue& root = *parsed.value;
+  const json::JsonValue& root = *parsed.value;
   if (!root.is_object()) {
     r.error(root.position, "", "a scenario must be a JSON object");
     return out;
   }
   const auto typos = r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
   const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
-  const JsonValue* system = root.find("system");
+  const json::JsonValue* system = root.find("system");
   if (system == nullptr) {
     if (!typo("system"))
       r.error(root.position, "", "scenario needs \"system\" (the system file, relative to the scenario)");
@@ -502,12 +502,12 @@ ScenarioLoad load_scenario(const std::string& path) {
     const std::filesystem::path base = std::filesystem::path(path).parent_path();
     sc.system = (base / s).lexically_normal().string();
   }
-  if (const JsonValue* period = root.find("period")) {
+  if (const json::JsonValue* period = root.find("period")) {
     if (r.number(*period, "/period", "\"period\"", sc.period) && !(sc.period > 0 && sc.period <= 10)) {
       r.error(period->position, "/period", "\"period\" must be in (0, 10] seconds");
     }
   }
-  const JsonValue* duration = root.find("duration");
+  const json::JsonValue* duration = root.find("duration");
   if (duration == nullptr) {
     if (!typo("duration")) r.error(root.position, "", "scenario needs \"duration\" (seconds)");
   } else if (r.number(*duration, "/duration", "\"duration\"", sc.duration) &&
@@ -517,7 +517,7 @@ ScenarioLoad load_scenario(const std::string& path) {
   if (sc.period > 0 && sc.duration / sc.period > 1e8) {
     r.error(root.position, "", "duration / period is more than 1e8 ticks");
   }
-  const JsonValue* steps = root.find("steps");
+  const json::JsonValue* steps = root.find("steps");
   if (steps != nullptr && !steps->is_array()) r.error(steps->position, "/steps", "\"steps\" must be a list");
   if (duration != nullptr && duration->is_number() && sc.duration >= 0 && sc.duration <= 1e6) {
     // An expectation after the end would never be checked: say so now, with its position.

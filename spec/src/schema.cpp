@@ -5,7 +5,8 @@
 #include <map>
 
 #include "keys.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 #include "text.hpp"
 
 namespace safecass::spec {
@@ -27,7 +28,7 @@ struct Node {
   static Node text(std::string_view s) {
     Node n;
     n.kind = Kind::Scalar;
-    n.scalar = json_quote(s);
+    n.scalar = json::json_string(s);
     return n;
   }
   static Node raw(std::string s) {
@@ -102,7 +103,7 @@ struct Node {
         }
         out += "{\n";
         for (std::size_t i = 0; i < keys.size(); ++i) {
-          out += pad + json_quote(keys[i]) + ": ";
+          out += pad + json::json_string(keys[i]) + ": ";
           values[i].write(out, indent + 2);
           out += i + 1 < keys.size() ? ",\n" : "\n";
         }

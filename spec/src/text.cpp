@@ -98,7 +98,7 @@ std::optional<Utf8Error> check_utf8(std::string_view text) {
       if (c == 0xF4) hi = 0x8F;  // above U+10FFFF
     }
     const auto fail_at = [&](std::size_t k) {
-      return Utf8Error{TextPosition{line, static_cast<int>(k - line_start) + 1}, byte(k)};
+      return Utf8Error{json::TextPosition{line, static_cast<int>(k - line_start) + 1}, byte(k)};
     };
     if (length == 0) return fail_at(i);
     for (std::size_t k = 1; k < length; ++k) {

@@ -6,7 +6,7 @@
 #include <string_view>
 #include <vector>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 
 namespace safecass::spec::detail {
 
@@ -26,7 +26,7 @@ std::string pointer_join(const std::string& pointer, std::size_t index);
 /// Position of the first byte that is not valid UTF-8 (overlong forms, surrogates and code
 /// points above U+10FFFF are invalid), and that byte.
 struct Utf8Error {
-  TextPosition position;
+  json::TextPosition position;
   unsigned char byte = 0;
 };
 std::optional<Utf8Error> check_utf8(std::string_view text);

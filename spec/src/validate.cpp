@@ -16,14 +16,14 @@ namespace safecass::spec::detail {
 
 namespace {
 
-std::string a_type(JsonValue::Type t) {
+std::string a_type(json::JsonValue::Type t) {
   switch (t) {
-    case JsonValue::Type::Null: return "null";
-    case JsonValue::Type::Bool: return "a boolean";
-    case JsonValue::Type::Number: return "a number";
-    case JsonValue::Type::String: return "a string";
-    case JsonValue::Type::Array: return "an array";
-    case JsonValue::Type::Object: return "an object";
+    case json::JsonValue::Type::Null: return "null";
+    case json::JsonValue::Type::Bool: return "a boolean";
+    case json::JsonValue::Type::Number: return "a number";
+    case json::JsonValue::Type::String: return "a string";
+    case json::JsonValue::Type::Array: return "an array";
+    case json::JsonValue::Type::Object: return "an object";
   }
   return "a value";
 }
@@ -44,34 +44,34 @@ std::string qualify(std::string_view signal, std::string_view component) {
 }
 
 /// A parameter as written, converted to the type its manifest expects.
-std::optional<ParamValue> convert(const JsonValue& v, ParamType type) {
+std::optional<ParamValue> convert(const json::JsonValue& v, ParamType type) {
   switch (v.type) {
-    case JsonValue::Type::Number: return ParamValue(v.number);
-    case JsonValue::Type::Bool: return ParamValue(v.boolean);
-    case JsonValue::Type::String: return ParamValue(v.string);
-    case JsonValue::Type::Array: {
+    case json::JsonValue::Type::Number: return ParamValue(v.number);
+    case json::JsonValue::Type::Bool: return ParamValue(v.boolean);
+    case json::JsonValue::Type::String: return ParamValue(v.string);
+    case json::JsonValue::Type::Array: {
       const bool strings =
-          std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_string(); });
+          std::all_of(v.array.begin(), v.array.end(), [](const json::JsonValue& x) { return x.is_string(); });
       const bool numbers =
-          std::all_of(v.array.begin(), v.array.end(), [](const JsonValue& x) { return x.is_number(); });
+          std::all_of(v.array.begin(), v.array.end(), [](const json::JsonValue& x) { return x.is_number(); });
       if (v.array.empty()) {
         return type == ParamType::NumberList ? ParamValue(std::vector<double>{})
                                              : ParamValue(std::vector<std::string>{});
       }
       if (strings) {
         std::vector<std::string> out;
-        for (const JsonValue& x : v.array) out.push_back(x.string);
+        for (const json::JsonValue& x : v.array) out.push_back(x.string);
         return ParamValue(std::move(out));
       }
       if (numbers) {
         std::vector<double> out;
-        for (const JsonValue& x : v.array) out.push_back(x.number);
+        for (const json::JsonValue& x : v.array) out.push_back(x.number);
         return ParamValue(std::move(out));
       }
       return std::nullopt;
     }
-    case JsonValue::Type::Null:
-    case JsonValue::Type::Object: break;
+    case json::JsonValue::Type::Null:
+    case json::JsonValue::Type::Object: break;
   }
   return std::nullopt;
 }
@@ -214,11 +214,11 @@ private:
       }
     }
     if (m_.system_file && m_.has_components_key && m_.component_entries == 0) {
-      sink_.warning(
-          Site{0,
-               sink_.documents.empty() || !sink_.documents[0].root ? TextPosition{} : sink_.documents[0].root->position,
-               ""},
-          "system " + quote_name(m_.name) + " has no components");
+      sink_.warning(Site{0,
+                         sink_.documents.empty() || !sink_.documents[0].root ? json::TextPosition{}
+                                                                             : sink_.documents[0].root->position,
+                         ""},
+                    "system " + quote_name(m_.name) + " has no components");
     }
   }
 
@@ -712,13 +712,13 @@ private:
     if (f.misspelled_argument != nullptr && f.misspelled_argument->is_object()) {
       // The parameters are under a misspelled key (reported): the events they name still count
       // as generated, so that the one mistake is not reported again as "not generated".
-      for (const JsonMember& m : f.misspelled_argument->object) {
-        const auto mark = [&](const JsonValue& v) {
+      for (const json::JsonMember& m : f.misspelled_argument->object) {
+        const auto mark = [&](const json::JsonValue& v) {
           if (!v.is_string()) return;
           if (const auto e = events_.find(v.string); e != events_.end()) e->second.generated = true;
         };
         mark(m.value);
-        for (const JsonValue& item : m.value.array) mark(item);
+        for (const json::JsonValue& item : m.value.array) mark(item);
       }
     }
     // Aliases of parameters (ChangeDetection's 2016 `event`) are checked as the parameter.
@@ -1037,12 +1037,12 @@ private:
   void mark_named_events(const FilterItem& f) {
     for (const ParamItem& p : f.params) {
       if (p.value == nullptr) continue;
-      const auto mark = [&](const JsonValue& v) {
+      const auto mark = [&](const json::JsonValue& v) {
         if (!v.is_string()) return;
         if (const auto e = events_.find(v.string); e != events_.end()) e->second.generated = true;
       };
       mark(*p.value);
-      for (const JsonValue& item : p.value->array) mark(item);
+      for (const json::JsonValue& item : p.value->array) mark(item);
     }
   }
 

@@ -63,7 +63,7 @@ cmake_minimum_required(VERSION 3.25)
 project(probe LANGUAGES CXX)
 find_package(safecass REQUIRED $want)
 set(loaded)
-foreach(m core filters introspect spec record native middleware_token middleware ros1 runner)
+foreach(m core filters json introspect spec record native middleware_token middleware ros1 runner)
   if(TARGET safecass::\${m})
     list(APPEND loaded \${m})
   endif()
@@ -123,10 +123,10 @@ case $case_name in
     grep -q -- "-- loaded: core$" "$tmp/core/log" || fail "core: $(grep loaded "$tmp/core/log")"
     grep -q -- "-- Ice found: \[\]" "$tmp/core/log" || fail "core needed Ice: $(grep Ice "$tmp/core/log")"
     probe_components "COMPONENTS spec" "$prefix" "$tmp/spec" || fail "spec: $(cat "$tmp/spec/log")"
-    grep -q -- "-- loaded: core;filters;introspect;spec$" "$tmp/spec/log" || fail "spec: $(grep loaded "$tmp/spec/log")"
+    grep -q -- "-- loaded: core;filters;json;spec$" "$tmp/spec/log" || fail "spec: $(grep loaded "$tmp/spec/log")"
     if installed_modules "$prefix" | grep -qx middleware; then
       probe_components "COMPONENTS middleware" "$prefix" "$tmp/mw" || fail "middleware: $(cat "$tmp/mw/log")"
-      grep -q -- "-- loaded: core;filters;introspect;spec;middleware_token;middleware$" "$tmp/mw/log" \
+      grep -q -- "-- loaded: core;filters;json;introspect;spec;middleware_token;middleware$" "$tmp/mw/log" \
         || fail "middleware: $(grep loaded "$tmp/mw/log")"
       grep -q -- "-- Ice found: \[\(1\|TRUE\|ON\)\]" "$tmp/mw/log" || fail "middleware without Ice: $(grep Ice "$tmp/mw/log")"
     fi

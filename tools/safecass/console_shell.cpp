@@ -3,7 +3,7 @@
 
 #include "console_shell.hpp"
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -17,8 +17,8 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
 #include "safecass/introspect/query.hpp"
+#include "safecass/json/write.hpp"
 
 namespace safecass::tools::console {
 
@@ -29,9 +29,9 @@ std::string_view trim(std::string_view s);
 using introspect::columns;
 using introspect::number_text;
 using introspect::seconds_text;
-using Json = introspect::JsonObject;
-inline std::string json_string(std::string_view s) { return introspect::json_string(s); }
-inline std::string json_list(const std::vector<std::string>& items) { return introspect::json_string_array(items); }
+using Json = json::JsonObject;
+inline std::string json_string(std::string_view s) { return json::json_string(s); }
+inline std::string json_list(const std::vector<std::string>& items) { return json::json_string_array(items); }
 
 // ---- words, numbers and samples ------------------------------------------------------------------
 

@@ -2,10 +2,10 @@
 
 #include "timeline.hpp"
 
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 
+#include "safecass/json/read.hpp"
 #include "safecass/spec/file.hpp"
-#include "safecass/spec/json.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -24,7 +24,7 @@ namespace safecass::tools {
 namespace {
 
 using Kind = HistoryRecord::Kind;
-using spec::JsonValue;
+using json::JsonValue;
 
 // ---------------------------------------------------------------------------------------------
 // Text helpers (all deterministic: no locale, no pointers, no clocks).
@@ -86,14 +86,14 @@ std::string canonical(const JsonValue& v) {
     case JsonValue::Type::Null: return "null";
     case JsonValue::Type::Bool: return v.boolean ? "true" : "false";
     case JsonValue::Type::Number: return num(v.number);
-    case JsonValue::Type::String: return introspect::json_string(v.string);
+    case JsonValue::Type::String: return json::json_string(v.string);
     case JsonValue::Type::Array: {
-      introspect::JsonArray a;
+      json::JsonArray a;
       for (const JsonValue& item : v.array) a.raw(canonical(item));
       return a.text();
     }
     case JsonValue::Type::Object: {
-      introspect::JsonObject o;
+      json::JsonObject o;
       for (const auto& member : v.object) o.raw(member.key, canonical(member.value));
       return o.text();
     }
@@ -134,7 +134,7 @@ public:
       return {};
     }
     if (!v->is_string()) {
-      fail("\"" + std::string(key) + "\" must be a string, not " + std::string(spec::type_name(v->type)));
+      fail("\"" + std::string(key) + "\" must be a string, not " + std::string(json::type_name(v->type)));
       return {};
     }
     return v->string;
@@ -147,7 +147,7 @@ public:
       return std::nullopt;
     }
     if (!v->is_number()) {
-      fail("\"" + std::string(key) + "\" must be a number, not " + std::string(spec::type_name(v->type)));
+      fail("\"" + std::string(key) + "\" must be a number, not " + std::string(json::type_name(v->type)));
       return std::nullopt;
     }
     return v->number;
@@ -157,7 +157,7 @@ public:
     const JsonValue* v = object_.find(key);
     if (v == nullptr) return false;
     if (!v->is_bool()) {
-      fail("\"" + std::string(key) + "\" must be true or false, not " + std::string(spec::type_name(v->type)));
+      fail("\"" + std::string(key) + "\" must be true or false, not " + std::string(json::type_name(v->type)));
       return false;
     }
     return v->boolean;
@@ -182,7 +182,7 @@ private:
 /// Checks and types one parsed line. Returns an error message, or nothing when the record is good.
 std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
   if (!v.is_object())
-    return "expected a JSON object (one record per line), not " + std::string(spec::type_name(v.type));
+    return "expected a JSON object (one record per line), not " + std::string(json::type_name(v.type));
   FieldReader f(v);
   const std::string kind_text = f.string("kind", true);
   if (f.error()) return f.error();
@@ -221,7 +221,7 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
   }
   if (const JsonValue* root = v.find("root")) {
     if (!root->is_object()) {
-      f.fail("\"root\" must be an object, not " + std::string(spec::type_name(root->type)));
+      f.fail("\"root\" must be an object, not " + std::string(json::type_name(root->type)));
     } else {
       FieldReader rf(*root);
       r.has_root = true;
@@ -391,8 +391,8 @@ std::string marker_tip(const Lane& lane, const Marker& m) {
 /// One lane of the model as JSON (the JSON writer), one bar or marker a line so that golden diffs
 /// read well. Not yet safe inside <script>: model_json() makes the whole text so.
 std::string lane_json(const Lane& l) {
-  using introspect::JsonArray;
-  using introspect::JsonObject;
+  using json::JsonArray;
+  using json::JsonObject;
   JsonArray bars(JsonArray::Layout::OnePerLine);
   for (const Bar& b : l.bars) {
     JsonObject bar;
@@ -438,7 +438,7 @@ HistoryParse parse_history(std::string_view text) {
       out.errors.push_back({line_no, "empty line: expected a JSON object (one record per line)"});
       continue;
     }
-    spec::JsonParse parsed = spec::parse_json(line, 16);
+    json::JsonParse parsed = json::parse_json(line, 16);
     if (parsed.error) {
       HistoryError e{line_no, "invalid JSON at column " + std::to_string(parsed.error->position.column) + ": " +
                                   parsed.error->message};
@@ -593,8 +593,8 @@ std::vector<const Lane*> ordered_machines(const Group& g) {
 }
 
 std::string model_json(const Model& m, std::size_t record_count) {
-  using introspect::JsonArray;
-  using introspect::JsonObject;
+  using json::JsonArray;
+  using json::JsonObject;
   JsonArray overflows(JsonArray::Layout::OnePerLine);
   for (const auto& band : m.overflows) {
     const std::string tip = "The recorder dropped " + std::to_string(band.record->dropped) +
@@ -627,7 +627,7 @@ std::string model_json(const Model& m, std::size_t record_count) {
 }
 
 std::string history_json(const std::vector<HistoryRecord>& records) {
-  introspect::JsonArray lines(introspect::JsonArray::Layout::OnePerLine);
+  json::JsonArray lines(json::JsonArray::Layout::OnePerLine);
   for (const HistoryRecord& r : records) lines.raw(canonical(r.json));
   return script_safe(lines.text());
 }

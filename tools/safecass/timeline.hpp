@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 
 namespace safecass::tools {
 
@@ -44,7 +44,7 @@ struct HistoryRecord {
   } root;
   std::string text;           ///< reason (ignored, reset "who: why") or injection description
   std::uint64_t dropped = 0;  ///< Overflow: how many records the recorder dropped
-  spec::JsonValue json;       ///< the line as read, re-emitted into the page
+  json::JsonValue json;       ///< the line as read, re-emitted into the page
 };
 
 struct HistoryError {

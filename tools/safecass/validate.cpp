@@ -9,7 +9,7 @@
 #include <map>
 
 #include "safecass/filters/registry.hpp"
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/spec/spec.hpp"
 #include "spec_commands.hpp"
 
@@ -66,7 +66,7 @@ int run_validate(const std::vector<std::string>& files, bool json_output, bool v
     }
   }
   if (json_output) {
-    const std::string summary = introspect::JsonObject()
+    const std::string summary = json::JsonObject()
                                     .strings("files", files)
                                     .integer("errors", static_cast<long long>(errors))
                                     .integer("warnings", static_cast<long long>(warnings))

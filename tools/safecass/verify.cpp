@@ -7,7 +7,7 @@
 #include <string>
 
 #include "safecass/filters/registry.hpp"
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/verify/verify.hpp"
 
@@ -93,7 +93,7 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
       ++undecided;
     }
     if (json) {
-      introspect::JsonObject line;
+      json::JsonObject line;
       line.str("kind", verify::to_string(p.kind))
           .str("name", p.name)
           .str("result", checked(p) ? verify::to_string(p.verdict) : "warning")
@@ -139,7 +139,7 @@ int run_verify(const std::string& system_path, const verify::Options& options, b
   }
   const int exit = report->exit_code();
   if (json) {
-    const std::string line = introspect::JsonObject()
+    const std::string line = json::JsonObject()
                                  .str("kind", "summary")
                                  .str("system", report->system)
                                  .integer("holds", static_cast<long long>(holds))

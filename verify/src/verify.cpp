@@ -15,7 +15,8 @@
 
 #include "model.hpp"
 #include "promela.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 #include "spin.hpp"
 
 namespace safecass::verify {
@@ -71,9 +72,6 @@ std::string file_name(const std::string& name) {
   if (out.empty() || out[0] == '.') out = "_" + out;
   return out;
 }
-
-/// The one JSON escaper (spec::json_quote, introspect::json_string).
-std::string json_string(std::string_view s) { return spec::json_quote(s); }
 
 /// What an atom must tell apart: Error or not (false), or all three levels (true).
 bool needs_warning(spec::Formula::Compare c, State level) {
@@ -392,27 +390,26 @@ private:
     std::string text =
         "// Counterexample of " + std::string(to_string(r.kind)) + " " + r.name + " found by `safecass verify`\n";
     text += "// (SPIN's shortest trail). `safecass run` replays it and fails at the last step.\n";
-    text += "{\n  \"system\": " + json_string(system_path) + ",\n";
-    text +=
-        "  \"description\": " + json_string(std::string(to_string(r.kind)) + " " + r.name + " violated: " + r.message) +
-        ",\n";
+    text += "{\n  \"system\": " + json::json_string(system_path) + ",\n";
+    text += "  \"description\": " +
+            json::json_string(std::string(to_string(r.kind)) + " " + r.name + " violated: " + r.message) + ",\n";
     text += "  \"period\": 0.001,\n  \"duration\": 0.0,\n  \"steps\": [\n";
     std::vector<std::string> lines;
     for (const Step& s : steps) {
       if (s.kind == Step::Kind::Reset) {
-        lines.push_back("    { \"at\": 0.0, \"reset\": { \"target\": " + json_string(s.target) +
+        lines.push_back("    { \"at\": 0.0, \"reset\": { \"target\": " + json::json_string(s.target) +
                         ", \"reason\": \"counterexample step\" } }");
       } else if (s.target.empty()) {
-        lines.push_back("    { \"at\": 0.0, \"generate\": { \"event\": " + json_string(s.event) + " } }");
+        lines.push_back("    { \"at\": 0.0, \"generate\": { \"event\": " + json::json_string(s.event) + " } }");
       } else {
-        lines.push_back("    { \"at\": 0.0, \"generate\": { \"event\": " + json_string(s.event) +
-                        ", \"target\": " + json_string(s.target) + " } }");
+        lines.push_back("    { \"at\": 0.0, \"generate\": { \"event\": " + json::json_string(s.event) +
+                        ", \"target\": " + json::json_string(s.target) + " } }");
       }
     }
     if (!expect.empty()) {
       std::string e;
       for (const auto& [address, level] : expect) {
-        e += (e.empty() ? "" : ", ") + json_string(address) + ": " + json_string(level_name(level));
+        e += (e.empty() ? "" : ", ") + json::json_string(address) + ": " + json::json_string(level_name(level));
       }
       lines.push_back("    { \"at\": 0.0, \"expect\": { " + e + " } }");
     }

@@ -2,7 +2,7 @@
 
 #include <set>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/spec/scenario.hpp"
 
 namespace safecass::ros1 {
@@ -45,8 +45,8 @@ std::vector<EventDef> default_ros_events() {
 
 namespace {
 
+using json::JsonValue;
 using spec::Diagnostic;
-using spec::JsonValue;
 
 class Reader {
 public:
@@ -59,13 +59,13 @@ public:
   bool expect(const JsonValue& v, JsonValue::Type type, const std::string& pointer, const char* what) {
     if (v.type == type) return true;
     error(v, pointer,
-          std::string(what) + " must be a " + std::string(spec::type_name(type)) + ", not a " +
-              std::string(spec::type_name(v.type)));
+          std::string(what) + " must be a " + std::string(json::type_name(type)) + ", not a " +
+              std::string(json::type_name(v.type)));
     return false;
   }
   /// Reports every key of `object` that is not in `known`.
   void known_keys(const JsonValue& object, const std::string& pointer, std::initializer_list<const char*> known) {
-    for (const spec::JsonMember& m : object.object) {
+    for (const json::JsonMember& m : object.object) {
       bool ok = false;
       for (const char* k : known) ok = ok || m.key == k;
       if (!ok) {
@@ -200,7 +200,7 @@ void read_topic(Reader& r, const JsonValue& v, const std::string& pointer, Mappi
   }
   if (const JsonValue* sig = v.find("signals")) {
     if (r.expect(*sig, JsonValue::Type::Object, pointer + "/signals", "'signals'")) {
-      for (const spec::JsonMember& member : sig->object) {
+      for (const json::JsonMember& member : sig->object) {
         const std::string p = pointer + "/signals/" + member.key;
         FieldBinding b;
         b.signal = member.key;
@@ -332,9 +332,9 @@ MappingLoad load_mapping(const std::string& path) {
 
 MappingLoad load_mapping_from_text(std::string_view text, const std::string& name) {
   MappingLoad out;
-  spec::JsonParse parsed = spec::parse_json(text);
+  json::JsonParse parsed = json::parse_json(text);
   if (!parsed.value) {
-    const spec::JsonError& e = *parsed.error;
+    const json::JsonError& e = *parsed.error;
     out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error,
                                          spec::Position{name, e.position.line, e.position.column}, e.message, ""});
     return out;
@@ -356,7 +356,7 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
   if (const JsonValue* nodes = root.find("nodes")) {
     if (r.expect(*nodes, JsonValue::Type::Object, "/nodes", "'nodes'")) {
       std::set<std::string> seen;
-      for (const spec::JsonMember& n : nodes->object) {
+      for (const json::JsonMember& n : nodes->object) {
         const std::string p = "/nodes/" + n.key;
         if (!r.expect(n.value, JsonValue::Type::String, p, "a node name")) continue;
         if (n.value.string.empty() || n.value.string.front() != '/') {

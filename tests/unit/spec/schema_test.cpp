@@ -6,7 +6,7 @@
 
 #include <cstdlib>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "spec_test_support.hpp"
 
 namespace safecass::spec::test {
@@ -28,10 +28,10 @@ TEST(SpecSchema, CheckedInFileEqualsTheGeneratedSchema) {
 TEST(SpecSchema, IsDeterministicJsonOfDraft2020_12) {
   const std::string schema = json_schema(builtin_registry());
   EXPECT_EQ(schema, json_schema(builtin_registry()));
-  const JsonParse p = parse_json(schema);
+  const json::JsonParse p = json::parse_json(schema);
   ASSERT_TRUE(p.value) << p.error->message;
   EXPECT_EQ(p.value->find("$schema")->string, "https://json-schema.org/draft/2020-12/schema");
-  const JsonValue* defs = p.value->find("$defs");
+  const json::JsonValue* defs = p.value->find("$defs");
   ASSERT_NE(defs, nullptr);
   for (const char* def :
        {"system", "component", "include", "interfaces", "signal", "event", "filter", "pipeline", "target", "service",
@@ -41,11 +41,11 @@ TEST(SpecSchema, IsDeterministicJsonOfDraft2020_12) {
 }
 
 TEST(SpecSchema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
-  const JsonParse p = parse_json(json_schema(builtin_registry()));
+  const json::JsonParse p = json::parse_json(json_schema(builtin_registry()));
   ASSERT_TRUE(p.value);
-  const JsonValue* defs = p.value->find("$defs");
+  const json::JsonValue* defs = p.value->find("$defs");
   for (const FilterManifest* m : builtin_registry().manifests()) {
-    const JsonValue* argument = defs->find("argument_" + m->type);
+    const json::JsonValue* argument = defs->find("argument_" + m->type);
     ASSERT_NE(argument, nullptr) << m->type;
     EXPECT_EQ(argument->find("additionalProperties")->boolean, false);
     // Every parameter, and every other name of one (ChangeDetection's 2016 `event`).
@@ -53,15 +53,15 @@ TEST(SpecSchema, HasAnArgumentSchemaForEveryFilterTypeAndEveryNameOfIt) {
     for (const auto& [alias, param] : m->aliases)
       EXPECT_NE(argument->find("properties")->find(alias), nullptr) << alias;
   }
-  const JsonValue* names = defs->find("filter")->find("properties")->find("class_name")->find("enum");
+  const json::JsonValue* names = defs->find("filter")->find("properties")->find("class_name")->find("enum");
   ASSERT_NE(names, nullptr);
   std::vector<std::string> all;
-  for (const JsonValue& n : names->array) all.push_back(n.string);
+  for (const json::JsonValue& n : names->array) all.push_back(n.string);
   EXPECT_THAT(all, ::testing::IsSupersetOf({"Threshold", "FilterThreshold", "Persistence", "Heartbeat", "Period",
                                             "TrendVel", "FilterTrendVel"}));
-  const JsonValue* threshold = defs->find("argument_Threshold")->find("properties")->find("direction");
+  const json::JsonValue* threshold = defs->find("argument_Threshold")->find("properties")->find("direction");
   EXPECT_EQ(threshold->find("default")->string, "above");
-  const JsonValue* severity = defs->find("event")->find("properties")->find("severity");
+  const json::JsonValue* severity = defs->find("event")->find("properties")->find("severity");
   EXPECT_EQ(severity->find("minimum")->number, 1);
   EXPECT_EQ(severity->find("maximum")->number, 255);
 }

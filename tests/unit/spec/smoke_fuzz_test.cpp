@@ -9,7 +9,8 @@
 #include <map>
 #include <random>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 #include "spec_test_support.hpp"
 
 namespace safecass::spec::test {
@@ -154,14 +155,14 @@ TEST(SpecSmokeFuzz, MutatedGoodSpecsNeverCrashAndAlwaysPointInsideTheText) {
   EXPECT_GT(checker.loaded(), 0);  // some mutants are still valid specs
 }
 
-/// Writes a JsonValue back as text (for the type-substitution run).
-void write(const JsonValue& v, std::string& out) {
+/// Writes a json::JsonValue back as text (for the type-substitution run).
+void write(const json::JsonValue& v, std::string& out) {
   switch (v.type) {
-    case JsonValue::Type::Null: out += "null"; return;
-    case JsonValue::Type::Bool: out += v.boolean ? "true" : "false"; return;
-    case JsonValue::Type::Number: out += std::to_string(v.number); return;
-    case JsonValue::Type::String: out += json_quote(v.string); return;
-    case JsonValue::Type::Array:
+    case json::JsonValue::Type::Null: out += "null"; return;
+    case json::JsonValue::Type::Bool: out += v.boolean ? "true" : "false"; return;
+    case json::JsonValue::Type::Number: out += std::to_string(v.number); return;
+    case json::JsonValue::Type::String: out += json::json_string(v.string); return;
+    case json::JsonValue::Type::Array:
       out += "[";
       for (std::size_t i = 0; i < v.array.size(); ++i) {
         if (i) out += ", ";
@@ -169,11 +170,11 @@ void write(const JsonValue& v, std::string& out) {
       }
       out += "]";
       return;
-    case JsonValue::Type::Object:
+    case json::JsonValue::Type::Object:
       out += "{";
       for (std::size_t i = 0; i < v.object.size(); ++i) {
         if (i) out += ", ";
-        out += json_quote(v.object[i].key) + ": ";
+        out += json::json_string(v.object[i].key) + ": ";
         write(v.object[i].value, out);
       }
       out += "}";
@@ -181,10 +182,10 @@ void write(const JsonValue& v, std::string& out) {
   }
 }
 
-void collect(JsonValue& v, std::vector<JsonValue*>& out) {
+void collect(json::JsonValue& v, std::vector<json::JsonValue*>& out) {
   out.push_back(&v);
-  for (JsonValue& item : v.array) collect(item, out);
-  for (JsonMember& m : v.object) collect(m.value, out);
+  for (json::JsonValue& item : v.array) collect(item, out);
+  for (json::JsonMember& m : v.object) collect(m.value, out);
 }
 
 TEST(SpecSmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
@@ -193,17 +194,17 @@ TEST(SpecSmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
   Checker checker;
   for (const std::string& seed :
        {std::string("tests/data/good_specs/jr3.json"), std::string("tests/data/good_specs/robodoc.json")}) {
-    const JsonParse parsed = parse_json(read_text(seed));
+    const json::JsonParse parsed = json::parse_json(read_text(seed));
     ASSERT_TRUE(parsed.value);
-    std::vector<JsonValue*> nodes;
-    JsonValue copy = *parsed.value;
+    std::vector<json::JsonValue*> nodes;
+    json::JsonValue copy = *parsed.value;
     collect(copy, nodes);
     for (std::size_t n = 1; n < nodes.size(); ++n) {
       for (const std::string& replacement : replacements) {
-        JsonValue doc = *parsed.value;
-        std::vector<JsonValue*> targets;
+        json::JsonValue doc = *parsed.value;
+        std::vector<json::JsonValue*> targets;
         collect(doc, targets);
-        *targets[n] = *parse_json(replacement).value;
+        *targets[n] = *json::parse_json(replacement).value;
         std::string text;
         write(doc, text);
         checker.check(text, seed);

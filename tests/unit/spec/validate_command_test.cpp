@@ -3,7 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "spec_commands.hpp"
 #include "spec_test_support.hpp"
 
@@ -57,7 +57,7 @@ TEST(SpecValidateCommand, JsonOutputIsOneObjectPerLineThenASummary) {
   for (std::size_t nl; (nl = out.find('\n', start)) != std::string::npos; start = nl + 1)
     lines.push_back(out.substr(start, nl - start));
   ASSERT_EQ(lines.size(), 2u);
-  const JsonParse first = parse_json(lines[0]);
+  const json::JsonParse first = json::parse_json(lines[0]);
   ASSERT_TRUE(first.value);
   EXPECT_EQ(first.value->find("line")->number, 4);
   EXPECT_EQ(first.value->find("severity")->string, "error");

@@ -16,7 +16,7 @@
 #include <sstream>
 #include <string>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "timeline.hpp"
 
 namespace safecass::tools {
@@ -76,9 +76,9 @@ TEST(Timeline, GoldenHistoryGivesTheExpectedLanesBarsAndMarkers) {
 }
 
 TEST(Timeline, ModelIsValidJsonWithOneLanePerMachineAndOnePerComponent) {
-  const auto parsed = spec::parse_json(timeline_model_json(parse_ok(read_text(kSmall))));
+  const auto parsed = json::parse_json(timeline_model_json(parse_ok(read_text(kSmall))));
   ASSERT_TRUE(parsed.value) << parsed.error->message;
-  const spec::JsonValue& groups = *parsed.value->find("groups");
+  const json::JsonValue& groups = *parsed.value->find("groups");
   ASSERT_EQ(groups.array.size(), 2u);
   // Components in order of first appearance; inside one, the extended state first, then s_F, s_A, s_P, s_R.
   EXPECT_EQ(groups.array[0].find("component")->string, "JR3");
@@ -122,7 +122,7 @@ TEST(Timeline, PageEmbedsTheModelAndEveryHistoryLineAsAJsonArray) {
   const auto records = parse_ok(read_text(kSmall));
   const std::string page = render_timeline_page(records, "small.jsonl");
   EXPECT_EQ(script_data(page, "timeline-model"), timeline_model_json(records));
-  const auto history = spec::parse_json(script_data(page, "timeline-history"));
+  const auto history = json::parse_json(script_data(page, "timeline-history"));
   ASSERT_TRUE(history.value) << history.error->message;
   ASSERT_TRUE(history.value->is_array());
   ASSERT_EQ(history.value->array.size(), 27u);
@@ -290,7 +290,7 @@ TEST(Timeline, EmptyHistoryGivesAValidPageSayingNoTransitions) {
   EXPECT_THAT(page, HasSubstr("</html>"));
   EXPECT_THAT(page, HasSubstr("The history is empty: no transitions."));
   EXPECT_EQ(script_data(page, "timeline-history"), "[]");
-  const auto model = spec::parse_json(script_data(page, "timeline-model"));
+  const auto model = json::parse_json(script_data(page, "timeline-model"));
   ASSERT_TRUE(model.value) << model.error->message;
   EXPECT_EQ(model.value->find("transitions")->number, 0.0);
   EXPECT_TRUE(model.value->find("groups")->array.empty());

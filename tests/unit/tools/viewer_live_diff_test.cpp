@@ -13,7 +13,7 @@
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/local_query.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/live_diff.hpp"
@@ -44,14 +44,14 @@ struct LocalCoordinator {
   Monitor monitor;
 };
 
-spec::JsonValue parse(const std::string& text) {
-  spec::JsonParse p = spec::parse_json(text, 64);
+json::JsonValue parse(const std::string& text) {
+  json::JsonParse p = json::parse_json(text, 64);
   EXPECT_TRUE(p.value.has_value()) << text;
-  return p.value ? *p.value : spec::JsonValue{};
+  return p.value ? *p.value : json::JsonValue{};
 }
 
-std::string str(const spec::JsonValue& object, std::string_view key) {
-  const spec::JsonValue* v = object.find(key);
+std::string str(const json::JsonValue& object, std::string_view key) {
+  const json::JsonValue* v = object.find(key);
   return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
 }
 
@@ -135,7 +135,7 @@ TEST(ViewerLiveDiff, PictureTakesTheWorstComponentStateAndSkipsRowsItCannotPlace
 
 TEST(ViewerLiveDiff, CoordinatorRecordNamesTheCoordinatorAndIsListed) {
   const std::string r = coordinator_record("ui", "lost: coordinator 'ui' did not answer", 3.25);
-  const spec::JsonValue v = parse(r);
+  const json::JsonValue v = parse(r);
   EXPECT_EQ(str(v, "kind"), "coordinator");
   EXPECT_EQ(str(v, "coordinator"), "ui");
   EXPECT_EQ(str(v, "text"), "lost: coordinator 'ui' did not answer");
@@ -181,7 +181,7 @@ TEST(ViewerLiveDiff, ProtocolShowsALiveCoordinatorsStatusInTheViewAndPushesItsCh
       coordinator_view("ui", {{"PENDANT", introspect::RowKind::Component, State::Normal, ""}}));
   source.v.coordinators.back().status = "unreachable";
   Protocol protocol(source, {});
-  const spec::JsonValue view = parse(protocol.view_json());
+  const json::JsonValue view = parse(protocol.view_json());
   EXPECT_EQ(str(view.find("coordinators")->array.at(0), "status"), "unreachable");
 
   source.v.coordinators.back().status = "";

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/protocol.hpp"
 
@@ -32,31 +32,31 @@ std::unique_ptr<InProcessSource> open_story() {
   return source ? std::move(*source) : nullptr;
 }
 
-spec::JsonValue parse(const std::string& text) {
-  spec::JsonParse p = spec::parse_json(text, 64);
+json::JsonValue parse(const std::string& text) {
+  json::JsonParse p = json::parse_json(text, 64);
   EXPECT_TRUE(p.value.has_value()) << text;
-  return p.value ? *p.value : spec::JsonValue{};
+  return p.value ? *p.value : json::JsonValue{};
 }
 
-std::string str(const spec::JsonValue& object, std::string_view key) {
-  const spec::JsonValue* v = object.find(key);
+std::string str(const json::JsonValue& object, std::string_view key) {
+  const json::JsonValue* v = object.find(key);
   return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
 }
 
 /// The component `name` of the view, or nullptr.
-const spec::JsonValue* component(const spec::JsonValue& view, std::string_view name) {
-  for (const spec::JsonValue& co : view.find("coordinators")->array) {
-    for (const spec::JsonValue& c : co.find("components")->array) {
+const json::JsonValue* component(const json::JsonValue& view, std::string_view name) {
+  for (const json::JsonValue& co : view.find("coordinators")->array) {
+    for (const json::JsonValue& c : co.find("components")->array) {
       if (str(c, "name") == name) return &c;
     }
   }
   return nullptr;
 }
 
-const spec::JsonValue* machine(const spec::JsonValue& view, std::string_view component_name, std::string_view address) {
-  const spec::JsonValue* c = component(view, component_name);
+const json::JsonValue* machine(const json::JsonValue& view, std::string_view component_name, std::string_view address) {
+  const json::JsonValue* c = component(view, component_name);
   if (c == nullptr) return nullptr;
-  for (const spec::JsonValue& m : c->find("machines")->array) {
+  for (const json::JsonValue& m : c->find("machines")->array) {
     if (str(m, "address") == address) return &m;
   }
   return nullptr;
@@ -73,7 +73,7 @@ TEST(ViewerProtocol, ViewListsCoordinatorsComponentsAndEveryMachineWithItsState)
   auto source = open_story();
   ASSERT_NE(source, nullptr);
   Protocol protocol(*source, {});
-  spec::JsonValue view = parse(protocol.view_json());
+  json::JsonValue view = parse(protocol.view_json());
   EXPECT_EQ(str(view, "system"), "robodoc");
   EXPECT_EQ(str(view, "state"), "Normal");
   const auto& coordinators = view.find("coordinators")->array;
@@ -85,11 +85,11 @@ TEST(ViewerProtocol, ViewListsCoordinatorsComponentsAndEveryMachineWithItsState)
   EXPECT_EQ(str(coordinators[1].find("components")->array[0], "name"), "PENDANT");
 
   // CONTROL: framework, application, two provided, two required, two services, in that order.
-  const spec::JsonValue* control = component(view, "CONTROL");
+  const json::JsonValue* control = component(view, "CONTROL");
   ASSERT_NE(control, nullptr);
   std::vector<std::string> addresses;
   std::vector<std::string> kinds;
-  for (const spec::JsonValue& m : control->find("machines")->array) {
+  for (const json::JsonValue& m : control->find("machines")->array) {
     addresses.push_back(str(m, "address"));
     kinds.push_back(str(m, "kind"));
   }
@@ -117,7 +117,7 @@ TEST(ViewerProtocol, ViewListsCoordinatorsComponentsAndEveryMachineWithItsState)
 TEST(ViewerProtocol, HelloSaysWhetherWritesAreAllowedAndCarriesTheView) {
   auto source = open_story();
   ASSERT_NE(source, nullptr);
-  const spec::JsonValue read_only = parse(Protocol(*source, {}).hello());
+  const json::JsonValue read_only = parse(Protocol(*source, {}).hello());
   EXPECT_EQ(str(read_only, "type"), "hello");
   EXPECT_FALSE(read_only.find("write")->boolean);
   EXPECT_EQ(str(*read_only.find("view"), "system"), "robodoc");
@@ -129,13 +129,13 @@ TEST(ViewerProtocol, ExplainGivesEachConditionWithRootCauseFilterSignalAndHopPat
   ASSERT_NE(source, nullptr);
   Protocol protocol(*source, {});
   source->advance_to(0.5);
-  const spec::JsonValue reply = parse(protocol.handle(R"({"id":7,"op":"explain","address":"CONTROL"})"));
+  const json::JsonValue reply = parse(protocol.handle(R"({"id":7,"op":"explain","address":"CONTROL"})"));
   EXPECT_EQ(str(reply, "type"), "reply");
   EXPECT_EQ(reply.find("id")->number, 7);
   EXPECT_EQ(str(reply, "state"), "Error");
   const auto& conditions = reply.find("conditions")->array;
   ASSERT_EQ(conditions.size(), 1u);
-  const spec::JsonValue& c = conditions[0];
+  const json::JsonValue& c = conditions[0];
   EXPECT_EQ(str(c, "machine"), "CONTROL.s_R.ForceData");
   EXPECT_EQ(str(c, "event"), "EVT_SERVICE_FAILURE");
   EXPECT_TRUE(c.find("mirror")->boolean);
@@ -146,15 +146,15 @@ TEST(ViewerProtocol, ExplainGivesEachConditionWithRootCauseFilterSignalAndHopPat
   EXPECT_GT(c.find("value")->number, 30.0);
   EXPECT_EQ(str(c, "hazard"), "H-3");
   std::vector<std::string> path;
-  for (const spec::JsonValue& hop : c.find("path")->array) path.push_back(hop.string);
+  for (const json::JsonValue& hop : c.find("path")->array) path.push_back(hop.string);
   ASSERT_GE(path.size(), 2u);
   EXPECT_EQ(path.front(), "JR3.s_A");
   EXPECT_EQ(path.back(), "CONTROL.s_R.ForceData");
 
   // A coordinator explains every condition of its components; a Normal state has none.
-  const spec::JsonValue robot = parse(protocol.handle(R"({"op":"explain","address":"coordinator:robot"})"));
+  const json::JsonValue robot = parse(protocol.handle(R"({"op":"explain","address":"coordinator:robot"})"));
   EXPECT_GE(robot.find("conditions")->array.size(), 4u);  // JR3, CONTROL, SERVO (and services)
-  const spec::JsonValue bmm = parse(protocol.handle(R"({"op":"explain","address":"BMM"})"));
+  const json::JsonValue bmm = parse(protocol.handle(R"({"op":"explain","address":"BMM"})"));
   EXPECT_EQ(str(bmm, "state"), "Normal");
   EXPECT_TRUE(bmm.find("conditions")->array.empty());
 }
@@ -164,9 +164,9 @@ TEST(ViewerProtocol, UpdatePushesOnlyChangedStatesAndTheListedRecords) {
   ASSERT_NE(source, nullptr);
   Protocol protocol(*source, {});
   source->advance_to(0.5);
-  const spec::JsonValue update = parse(protocol.update(0));
+  const json::JsonValue update = parse(protocol.update(0));
   EXPECT_EQ(str(update, "type"), "update");
-  const spec::JsonValue& states = *update.find("states");
+  const json::JsonValue& states = *update.find("states");
   ASSERT_NE(states.find("CONTROL"), nullptr);
   EXPECT_EQ(states.find("CONTROL")->array[0].string, "Error");
   EXPECT_EQ(states.find("CONTROL")->array[1].string, "EVT_SERVICE_FAILURE");
@@ -175,7 +175,7 @@ TEST(ViewerProtocol, UpdatePushesOnlyChangedStatesAndTheListedRecords) {
   EXPECT_EQ(states.find("BMM"), nullptr) << "unchanged states are not sent";
   EXPECT_EQ(states.find("JR3.s_F"), nullptr);
   bool saw_jr3 = false;
-  for (const spec::JsonValue& r : update.find("records")->array) {
+  for (const json::JsonValue& r : update.find("records")->array) {
     EXPECT_NE(str(r, "kind"), "event") << "plain events are not listed";
     saw_jr3 = saw_jr3 || (str(r, "machine") == "JR3.s_A" && str(r, "to") == "Error");
   }
@@ -233,7 +233,7 @@ TEST(ViewerProtocol, MalformedMessagesGetAnErrorThatSaysWhatIsWrongAndChangeNoth
       {R"({"op":"broadcast","event":"EVT_FORCE_ERROR","token":"s3cret"})", ""},
   };
   for (const auto& [message, expected] : cases) {
-    const spec::JsonValue reply = parse(protocol.handle(message));
+    const json::JsonValue reply = parse(protocol.handle(message));
     EXPECT_EQ(str(reply, "type"), "error") << message;
     EXPECT_THAT(str(reply, "error"), HasSubstr(expected)) << message;
   }
@@ -275,7 +275,7 @@ TEST(ViewerProtocol, WritesAreRefusedWhenTheViewerIsReadOnly) {
         R"({"op":"broadcast","event":"EVT_CONTROL_FORCE_FREEZE","token":"x"})",
         R"({"op":"inject","filter":"force_limit","samples":[50],"token":"x"})",
         R"({"op":"reset","target":"SYSTEM"})"}) {
-    const spec::JsonValue reply = parse(protocol.handle(message));
+    const json::JsonValue reply = parse(protocol.handle(message));
     EXPECT_EQ(str(reply, "type"), "error") << message;
     EXPECT_THAT(str(reply, "error"), HasSubstr("refused: this viewer is read-only")) << message;
   }
@@ -299,14 +299,14 @@ TEST(ViewerProtocol, WritesWithoutTheRightTokenAreRefusedAndWithItApplied) {
   EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Normal);
   EXPECT_TRUE(source->take_records().empty());
 
-  const spec::JsonValue ok = parse(protocol.handle(generate + R"(,"token":"s3cret","id":3})"));
+  const json::JsonValue ok = parse(protocol.handle(generate + R"(,"token":"s3cret","id":3})"));
   EXPECT_EQ(str(ok, "type"), "reply");
   EXPECT_EQ(str(ok, "op"), "generate");
   EXPECT_THAT(str(ok, "text"), HasSubstr("generated EVT_CONTROL_FORCE_FREEZE on CONTROL.s_A"));
   EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Error);
   EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Error);
 
-  const spec::JsonValue reset =
+  const json::JsonValue reset =
       parse(protocol.handle(R"({"op":"reset","target":"CONTROL","reason":"test","token":"s3cret"})"));
   EXPECT_THAT(str(reset, "text"), HasSubstr("reset CONTROL"));
   EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Normal);
@@ -318,7 +318,7 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   Protocol protocol(*source, writable("k"));
   source->advance_to(0.1);
   // Deep: a 1.5 mm bone displacement written into BMM.Displacement is seen on the next run.
-  const spec::JsonValue deep =
+  const json::JsonValue deep =
       parse(protocol.handle(R"({"op":"inject","signal":"BMM.Displacement","samples":[1.5],"token":"k"})"));
   EXPECT_THAT(str(deep, "text"), HasSubstr("wrote 1 sample into signal BMM.Displacement"));
   source->advance_to(0.102);
@@ -327,7 +327,7 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   EXPECT_EQ(why[0].root_event, "EVT_BONE_MOTION");
   EXPECT_TRUE(why[0].injected);
   // Shallow: queued into one filter.
-  const spec::JsonValue shallow =
+  const json::JsonValue shallow =
       parse(protocol.handle(R"({"op":"inject","filter":"force_limit","samples":[[50],[50]],"token":"k"})"));
   EXPECT_THAT(str(shallow, "text"), HasSubstr("queued 2 samples into filter force_limit"));
 }
@@ -336,8 +336,8 @@ TEST(ViewerProtocol, ViewCarriesTheConnectionsForTheGraphAndScenarioSecondsAsIts
   auto source = open_story();
   ASSERT_NE(source, nullptr);
   Protocol protocol(*source, ProtocolOptions{});
-  const spec::JsonValue view = parse(protocol.view_json());
-  const spec::JsonValue* connections = view.find("connections");
+  const json::JsonValue view = parse(protocol.view_json());
+  const json::JsonValue* connections = view.find("connections");
   ASSERT_NE(connections, nullptr);
   ASSERT_EQ(connections->array.size(), 4u);  // as robodoc.json lists them
   EXPECT_EQ(str(connections->array[2], "required"), "SERVO.Command");

@@ -18,10 +18,10 @@
 #include <vector>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/spec/json.hpp"
 #include "safecass/viewer/protocol.hpp"
 #include "safecass/viewer/replay_source.hpp"
 
@@ -71,12 +71,12 @@ protected:
     std::ifstream in(history_);
     std::string line;
     while (std::getline(in, line)) {
-      const spec::JsonParse p = spec::parse_json(line, 16);
+      const json::JsonParse p = json::parse_json(line, 16);
       if (!p.value) continue;
-      const spec::JsonValue& r = *p.value;
-      const spec::JsonValue* kind = r.find("kind");
-      const spec::JsonValue* time = r.find("t");
-      const spec::JsonValue* to = r.find("to");
+      const json::JsonValue& r = *p.value;
+      const json::JsonValue* kind = r.find("kind");
+      const json::JsonValue* time = r.find("t");
+      const json::JsonValue* to = r.find("to");
       if (kind == nullptr || time == nullptr || to == nullptr || time->number > t + 1e-9) continue;
       if (kind->string == "transition") states[r.find("machine")->string] = to->string;
       if (kind->string == "component-transition") states[r.find("component")->string] = to->string;
@@ -90,9 +90,9 @@ protected:
     std::ifstream in(history_);
     std::string line;
     while (std::getline(in, line)) {
-      const spec::JsonParse p = spec::parse_json(line, 16);
+      const json::JsonParse p = json::parse_json(line, 16);
       if (!p.value) continue;
-      const spec::JsonValue* kind = p.value->find("kind");
+      const json::JsonValue* kind = p.value->find("kind");
       if (kind != nullptr && (kind->string == "transition" || kind->string == "component-transition")) {
         const double t = p.value->find("t")->number;
         if (out.empty() || out.back() != t) out.push_back(t);
@@ -255,10 +255,10 @@ TEST(ViewerReplaySource, ACsvLogShowsAtEveryTickTheStatesSafecassReplayPrintsFor
   std::vector<std::pair<double, std::string>> transitions;  // ARM.s_A's
   char line[4096];
   while (std::fgets(line, sizeof line, out) != nullptr) {
-    const spec::JsonParse p = spec::parse_json(line, 16);
+    const json::JsonParse p = json::parse_json(line, 16);
     if (!p.value || !p.value->is_object()) continue;
-    const spec::JsonValue* kind = p.value->find("kind");
-    const spec::JsonValue* machine = p.value->find("machine");
+    const json::JsonValue* kind = p.value->find("kind");
+    const json::JsonValue* machine = p.value->find("machine");
     if (kind != nullptr && kind->string == "transition" && machine != nullptr && machine->string == "ARM.s_A")
       transitions.emplace_back(p.value->find("t")->number, p.value->find("to")->string);
   }

@@ -21,7 +21,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/server.hpp"
 
@@ -197,15 +197,15 @@ TEST(ViewerServer, PushesTheTransitionsOfTheScenarioAsTheyHappen) {
   while (!seen && std::chrono::steady_clock::now() - start < std::chrono::seconds(8)) {
     const std::string m = client.read();
     if (m.find(R"("type":"update")") == std::string::npos) continue;
-    const spec::JsonParse p = spec::parse_json(m);
+    const json::JsonParse p = json::parse_json(m);
     ASSERT_TRUE(p.value.has_value()) << m;
-    const spec::JsonValue* control = p.value->find("states")->find("CONTROL");
+    const json::JsonValue* control = p.value->find("states")->find("CONTROL");
     if (control == nullptr || control->array[0].string != "Error") continue;
     seen = true;
     // Pushed within one poll of the transition: the update's clock is at most 100 ms later.
     double transition_t = -1;
-    for (const spec::JsonValue& r : p.value->find("records")->array) {
-      const spec::JsonValue* c = r.find("component");
+    for (const json::JsonValue& r : p.value->find("records")->array) {
+      const json::JsonValue* c = r.find("component");
       if (r.find("kind")->string == "component-transition" && c != nullptr && c->string == "CONTROL")
         transition_t = r.find("t")->number;
     }

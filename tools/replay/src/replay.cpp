@@ -12,7 +12,7 @@
 #include <unordered_map>
 
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/replay/source.hpp"
 #include "safecass/runner/scenario_runner.hpp"
@@ -576,7 +576,7 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
       const std::string until = i.open ? secs(a->now()) : secs(i.to);
       if (o.json) {
         const Cause& c = i.cause;
-        introspect::JsonObject cause;
+        json::JsonObject cause;
         cause.str("system", i.side == 'B' ? "B" : "A").str("origin", c.origin).str("event", c.event);
         if (!c.filter.empty()) cause.str("filter", c.filter);
         if (!c.signal.empty()) {
@@ -588,7 +588,7 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
             cause.str("value", introspect::number_text(c.value));
           }
         }
-        const std::string line = introspect::JsonObject()
+        const std::string line = json::JsonObject()
                                      .str("kind", "difference")
                                      .str("address", t.name)
                                      .raw("from", secs(i.from))
@@ -608,7 +608,7 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   }
   for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
   if (o.json) {
-    const std::string line = introspect::JsonObject()
+    const std::string line = json::JsonObject()
                                  .str("kind", "diff")
                                  .str("b", system_b)
                                  .str("a", o.system)

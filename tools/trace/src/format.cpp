@@ -2,8 +2,8 @@
 
 #include <string>
 
-#include "safecass/introspect/json.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/trace/trace.hpp"
 
 namespace safecass::trace {
@@ -38,8 +38,8 @@ std::string filter_text(const FilterLink& f) {
   return out;
 }
 
-using introspect::JsonArray;
-using introspect::JsonObject;
+using json::JsonArray;
+using json::JsonObject;
 
 std::string json_where(const spec::Position& p) {
   return JsonObject()

@@ -10,11 +10,11 @@
 #include <set>
 
 #include "safecass/filters/monitor.hpp"
+#include "safecass/json/read.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/runner/system.hpp"
 #include "safecass/spec/file.hpp"
-#include "safecass/spec/json.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::trace {
@@ -119,23 +119,23 @@ std::optional<Time> cleared_at(const RunFacts& run, const Coordinator& co, Event
     start = end + 1;
     ++line;
     if (row.find_first_not_of(" \t\r") == std::string_view::npos) continue;
-    const spec::JsonParse parsed = spec::parse_json(row);
+    const json::JsonParse parsed = json::parse_json(row);
     if (parsed.error || !parsed.value || !parsed.value->is_object()) {
       errors.push_back(error_at(spec::Position{path, line, parsed.error ? parsed.error->position.column : 1},
                                 "not a `safecass verify --json` line: " +
                                     (parsed.error ? parsed.error->message : std::string("a JSON object is expected"))));
       continue;
     }
-    const spec::JsonValue& object = *parsed.value;
-    const spec::JsonValue* kind = object.find("kind");
+    const json::JsonValue& object = *parsed.value;
+    const json::JsonValue* kind = object.find("kind");
     if (kind == nullptr || !kind->is_string()) {
       errors.push_back(error_at(spec::Position{path, line, 1}, "not a `safecass verify --json` line: no \"kind\""));
       continue;
     }
     any = true;
     if (kind->string != "hazard") continue;
-    const spec::JsonValue* name = object.find("name");
-    const spec::JsonValue* result = object.find("result");
+    const json::JsonValue* name = object.find("name");
+    const json::JsonValue* result = object.find("result");
     if (name == nullptr || result == nullptr || !name->is_string() || !result->is_string()) {
       errors.push_back(error_at(spec::Position{path, line, 1}, "a hazard line needs \"name\" and \"result\" strings"));
       continue;

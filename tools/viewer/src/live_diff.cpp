@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 
 namespace safecass::viewer {
 
@@ -61,8 +61,8 @@ CoordinatorView coordinator_view(std::string name, const std::vector<introspect:
 }
 
 std::string coordinator_record(std::string_view coordinator, std::string_view text, double t) {
-  return introspect::JsonObject()
-      .raw("t", introspect::json_seconds(seconds_to_time(t)))
+  return json::JsonObject()
+      .raw("t", json::json_seconds(seconds_to_time(t)))
       .str("kind", "coordinator")
       .str("coordinator", coordinator)
       .str("text", text)

@@ -4,7 +4,7 @@
 #include <iterator>
 
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer::detail {
@@ -87,7 +87,7 @@ std::vector<std::string> PendingRecords::take() {
   out.swap(records_);
   if (dropped_ != 0) {
     out.push_back(
-        introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(dropped_)).text());
+        json::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(dropped_)).text());
     dropped_ = 0;
   }
   return out;

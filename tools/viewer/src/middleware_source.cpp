@@ -14,8 +14,8 @@
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
@@ -378,7 +378,7 @@ void MiddlewareSource::poll() {
   }
   if (m.dropped != 0) {
     m.taken.push_back(
-        introspect::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(m.dropped)).text());
+        json::JsonObject().str("kind", "overflow").integer("dropped", static_cast<long long>(m.dropped)).text());
     m.dropped = 0;
   }
   if (m.version == m.shown_version) return;

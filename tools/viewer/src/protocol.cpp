@@ -10,8 +10,8 @@
 
 #include <fmt/format.h>
 
-#include "safecass/introspect/json.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 
 namespace safecass::viewer {
 
@@ -22,17 +22,17 @@ constexpr std::size_t kMaxSamples = 1000;   ///< samples in one injection
 constexpr std::size_t kMaxSampleSize = 64;  ///< doubles in one sample
 constexpr long long kTimeIntervalMs = 250;  ///< clock-only messages at most this often
 
-std::string quote(std::string_view s) { return introspect::json_string(s); }
+std::string quote(std::string_view s) { return json::json_string(s); }
 
-std::string number(double v) { return introspect::json_number(v); }
+std::string number(double v) { return json::json_number(v); }
 
 /// Seconds with six decimals (the history-file format of times).
-std::string seconds(double v) { return introspect::json_seconds(seconds_to_time(v)); }
+std::string seconds(double v) { return json::json_seconds(seconds_to_time(v)); }
 
 std::string state_text(State s) { return quote(to_string(s)); }
 
-/// The one JSON writer's object (introspect/json.hpp).
-using Object = introspect::JsonObject;
+/// The one JSON writer's object (json/write.hpp).
+using Object = json::JsonObject;
 
 template <class Range, class F>
 std::string array(const Range& items, F&& each) {
@@ -149,7 +149,7 @@ std::string explanation_to_json(const Explanation& e) {
 
 /// A request being checked: the parsed object, its echoed id and op, and the first error found.
 struct Request {
-  const spec::JsonValue* object = nullptr;
+  const json::JsonValue* object = nullptr;
   std::string id;  ///< the id as JSON, or empty
   std::string op;
 };
@@ -171,9 +171,9 @@ Object reply(const Request& r) {
 }
 
 /// Checks that every key of the request is one of `allowed` (and appears once).
-std::string check_keys(const spec::JsonValue& object, std::initializer_list<std::string_view> allowed) {
+std::string check_keys(const json::JsonValue& object, std::initializer_list<std::string_view> allowed) {
   std::set<std::string_view> seen;
-  for (const spec::JsonMember& m : object.object) {
+  for (const json::JsonMember& m : object.object) {
     bool ok = false;
     for (const std::string_view a : allowed) ok = ok || m.key == a;
     if (!ok) {
@@ -187,11 +187,11 @@ std::string check_keys(const spec::JsonValue& object, std::initializer_list<std:
 }
 
 /// A required (or optional, when `required` is false) non-empty string member.
-std::string get_string(const spec::JsonValue& object, std::string_view key, std::string& out, bool required = true) {
-  const spec::JsonValue* v = object.find(key);
+std::string get_string(const json::JsonValue& object, std::string_view key, std::string& out, bool required = true) {
+  const json::JsonValue* v = object.find(key);
   if (v == nullptr) return required ? "missing key '" + std::string(key) + "'" : std::string();
   if (!v->is_string())
-    return "'" + std::string(key) + "' must be a string, not " + std::string(spec::type_name(v->type));
+    return "'" + std::string(key) + "' must be a string, not " + std::string(json::type_name(v->type));
   if (v->string.empty()) return "'" + std::string(key) + "' must not be empty";
   if (v->string.size() > kMaxString)
     return "'" + std::string(key) + "' is longer than " + std::to_string(kMaxString) + " characters";
@@ -199,19 +199,19 @@ std::string get_string(const spec::JsonValue& object, std::string_view key, std:
   return {};
 }
 
-std::string get_samples(const spec::JsonValue& object, std::vector<std::vector<double>>& out) {
-  const spec::JsonValue* v = object.find("samples");
+std::string get_samples(const json::JsonValue& object, std::vector<std::vector<double>>& out) {
+  const json::JsonValue* v = object.find("samples");
   if (v == nullptr) return "missing key 'samples' (an array of samples, each a number or an array of numbers)";
   if (!v->is_array() || v->array.empty()) return "'samples' must be a non-empty array of samples";
   if (v->array.size() > kMaxSamples) return "'samples' holds more than " + std::to_string(kMaxSamples) + " samples";
   for (std::size_t i = 0; i < v->array.size(); ++i) {
-    const spec::JsonValue& s = v->array[i];
+    const json::JsonValue& s = v->array[i];
     const std::string where = "samples[" + std::to_string(i) + "]";
     std::vector<double> sample;
     if (s.is_number()) {
       sample.push_back(s.number);
     } else if (s.is_array() && !s.array.empty() && s.array.size() <= kMaxSampleSize) {
-      for (const spec::JsonValue& x : s.array) {
+      for (const json::JsonValue& x : s.array) {
         if (!x.is_number()) return where + " must hold numbers only";
         sample.push_back(x.number);
       }
@@ -229,12 +229,12 @@ std::string get_samples(const spec::JsonValue& object, std::vector<std::vector<d
 }  // namespace
 
 bool listed_record(std::string_view record_json) {
-  const spec::JsonParse p = spec::parse_json(record_json, 8);
+  const json::JsonParse p = json::parse_json(record_json, 8);
   if (!p.value || !p.value->is_object()) return false;
-  const spec::JsonValue* kind = p.value->find("kind");
+  const json::JsonValue* kind = p.value->find("kind");
   if (kind == nullptr || !kind->is_string()) return false;
   if (kind->string == "event") {
-    const spec::JsonValue* outcome = p.value->find("outcome");
+    const json::JsonValue* outcome = p.value->find("outcome");
     return outcome != nullptr && outcome->is_string() && (outcome->string == "masked" || outcome->string == "ignored");
   }
   return true;  // transitions, component transitions, resets, injections, overflow
@@ -345,19 +345,19 @@ std::string Protocol::handle(std::string_view message) {
                        "message too long (" + std::to_string(message.size()) + " bytes; at most " +
                            std::to_string(options_.max_message) + ")");
   }
-  const spec::JsonParse parsed = spec::parse_json(message, 8);
+  const json::JsonParse parsed = json::parse_json(message, 8);
   if (!parsed.value) {
-    const spec::JsonError& e = *parsed.error;
+    const json::JsonError& e = *parsed.error;
     return error_reply(
         {}, {},
         "not JSON: " + std::to_string(e.position.line) + ":" + std::to_string(e.position.column) + ": " + e.message);
   }
-  const spec::JsonValue& object = *parsed.value;
+  const json::JsonValue& object = *parsed.value;
   if (!object.is_object())
-    return error_reply({}, {}, "a message must be a JSON object, not " + std::string(spec::type_name(object.type)));
+    return error_reply({}, {}, "a message must be a JSON object, not " + std::string(json::type_name(object.type)));
   Request r;
   r.object = &object;
-  if (const spec::JsonValue* id = object.find("id")) {
+  if (const json::JsonValue* id = object.find("id")) {
     if (id->is_number() && std::isfinite(id->number)) {
       r.id = number(id->number);
     } else if (id->is_string() && id->string.size() <= 64) {
@@ -366,7 +366,7 @@ std::string Protocol::handle(std::string_view message) {
       return error_reply({}, {}, "'id' must be a number or a string of at most 64 characters");
     }
   }
-  const spec::JsonValue* op = object.find("op");
+  const json::JsonValue* op = object.find("op");
   if (op == nullptr)
     return error_reply(r.id, {}, "missing key 'op' (view, explain, generate, broadcast, inject, reset, replay)");
   if (!op->is_string()) return error_reply(r.id, {}, "'op' must be a string");
@@ -374,7 +374,7 @@ std::string Protocol::handle(std::string_view message) {
   std::string problem;
   std::string token;
   auto token_of = [&]() -> std::string {
-    const spec::JsonValue* t = object.find("token");
+    const json::JsonValue* t = object.find("token");
     if (t == nullptr) return {};
     if (!t->is_string()) {
       problem = "'token' must be a string";
@@ -458,8 +458,8 @@ std::string Protocol::handle(std::string_view message) {
     if (problem.empty()) problem = get_string(object, "action", action);
     ReplayControl control;
     if (problem.empty()) {
-      const spec::JsonValue* t = object.find("t");
-      const spec::JsonValue* speed = object.find("speed");
+      const json::JsonValue* t = object.find("t");
+      const json::JsonValue* speed = object.find("speed");
       if (action == "play" || action == "pause" || action == "next") {
         control.op = action == "play"    ? ReplayControl::Op::Play
                      : action == "pause" ? ReplayControl::Op::Pause

@@ -9,8 +9,8 @@
 #include "local_view.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/json/write.hpp"
 #include "safecass/replay/replay.hpp"
 
 namespace safecass::viewer {

@@ -1,12 +1,10 @@
-#include "safecass/spec/json.hpp"
-
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/read.hpp"
 
 #include <charconv>
 #include <cmath>
 #include <cstdio>
 
-namespace safecass::spec {
+namespace safecass::json {
 
 const JsonMember* JsonValue::find_member(std::string_view key) const noexcept {
   if (type != Type::Object) return nullptr;
@@ -395,6 +393,4 @@ JsonParse parse_json_streaming(std::string_view text, std::string_view key, cons
   return Parser(text, max_depth, key, element).run();
 }
 
-std::string json_quote(std::string_view text) { return introspect::json_string(text); }
-
-}  // namespace safecass::spec
+}  // namespace safecass::json

@@ -6,9 +6,9 @@
 #include <utility>
 #include <vector>
 
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
 
-namespace safecass::spec {
+namespace safecass::json {
 namespace {
 
 JsonValue parse_ok(std::string_view text) {
@@ -140,9 +140,9 @@ TEST(JsonReader, ReportsBadLiteralsAndControlBytes) {
   EXPECT_EQ(parse_error(std::string("[\0]", 3)).message, "unexpected character '\\x00': expected a value");
 }
 
-TEST(JsonReader, QuotesStringsForOutput) {
-  EXPECT_EQ(json_quote("a\"b\\c\n\x01"), "\"a\\\"b\\\\c\\n\\u0001\"");
+TEST(JsonReader, NamesTheTypeOfAValueAsJsonDoes) {
   EXPECT_EQ(type_name(JsonValue::Type::Object), "object");
+  EXPECT_EQ(type_name(JsonValue::Type::Bool), "boolean");
 }
 
 TEST(JsonReader, StreamsTheElementsOfOneListOfTheRootObjectAndKeepsTheRestAsATree) {
@@ -184,4 +184,4 @@ TEST(JsonReader, StreamsTheElementsOfOneListOfTheRootObjectAndKeepsTheRestAsATre
 }
 
 }  // namespace
-}  // namespace safecass::spec
+}  // namespace safecass::json

@@ -1,5 +1,5 @@
-// The one JSON writer of SAFECASS (introspect/json.hpp) and the read model's number and time text
-// (format.hpp): what every tool writes goes through them, so their rules are checked here once.
+// The one JSON writer of SAFECASS (json/write.hpp): what every tool writes goes through it, so its
+// rules are checked here once.
 
 #include <gtest/gtest.h>
 
@@ -7,11 +7,10 @@
 #include <limits>
 #include <string>
 
-#include "safecass/introspect/format.hpp"
-#include "safecass/introspect/json.hpp"
-#include "safecass/spec/json.hpp"
+#include "safecass/json/read.hpp"
+#include "safecass/json/write.hpp"
 
-namespace safecass::introspect {
+namespace safecass::json {
 namespace {
 
 TEST(JsonWriter, AStringEscapesQuotesBackslashesAndEveryControlCharacter) {
@@ -26,7 +25,7 @@ TEST(JsonWriter, AStringEscapesQuotesBackslashesAndEveryControlCharacter) {
 TEST(JsonWriter, EveryStringItWritesReadsBackAsTheSameText) {
   std::string all;
   for (int c = 1; c < 128; ++c) all += static_cast<char>(c);
-  const spec::JsonParse parsed = spec::parse_json(json_string(all));
+  const JsonParse parsed = parse_json(json_string(all));
   ASSERT_TRUE(parsed.value) << parsed.error->message;
   ASSERT_TRUE(parsed.value->is_string());
   EXPECT_EQ(parsed.value->string, all);
@@ -46,7 +45,6 @@ TEST(JsonWriter, ANumberIsItsShortestTextAndNullWhenNotFinite) {
 TEST(JsonWriter, SecondsHaveSixDecimalsAsInTheHistoryFile) {
   EXPECT_EQ(json_seconds(Time{std::chrono::microseconds(301000)}), "0.301000");
   EXPECT_EQ(json_seconds(Time{}), "0.000000");
-  EXPECT_EQ(seconds_text(Time{std::chrono::seconds(12)}), "12.000000");
 }
 
 TEST(JsonWriter, AnObjectKeepsItsMembersInOrderAndEscapesItsKeys) {
@@ -75,12 +73,5 @@ TEST(JsonWriter, AnArrayIsCompactOrOneItemALine) {
   EXPECT_EQ(json_string_array({}), "[]");
 }
 
-TEST(NumberText, HasAtMostNineSignificantDigitsAndNamesNonFiniteValues) {
-  EXPECT_EQ(number_text(30.0), "30");
-  EXPECT_EQ(number_text(1.0 / 3.0), "0.333333333");
-  EXPECT_EQ(number_text(std::numeric_limits<double>::quiet_NaN()), "nan");
-  EXPECT_EQ(number_text(-std::numeric_limits<double>::infinity()), "-inf");
-}
-
 }  // namespace
-}  // namespace safecass::introspect
+}  // namespace safecass::json

@@ -1,10 +1,10 @@
-#include "safecass/introspect/json.hpp"
+#include "safecass/json/write.hpp"
 
 #include <cmath>
 
 #include <fmt/format.h>
 
-namespace safecass::introspect {
+namespace safecass::json {
 
 void append_json_string(std::string& out, std::string_view text) {
   static constexpr char kHex[] = "0123456789abcdef";
@@ -96,4 +96,4 @@ JsonArray& JsonArray::str(std::string_view value) {
   return *this;
 }
 
-}  // namespace safecass::introspect
+}  // namespace safecass::json

@@ -1,5 +1,5 @@
 #pragma once
-/// @file json.hpp
+/// @file write.hpp
 /// The one JSON writer of SAFECASS: one string escaper and an object/array builder. Every tool and
 /// module that writes JSON (history lines, console --json, the viewer's messages, diagnostics, the
 /// schema) writes it through these functions; nothing concatenates JSON by hand.
@@ -15,7 +15,7 @@
 
 #include "safecass/core/clock.hpp"
 
-namespace safecass::introspect {
+namespace safecass::json {
 
 /// Appends `text` to `out` as a JSON string (quotes included): `"` `\` and control characters
 /// are escaped (\n, \r, \t by name, the others as \u00XX); every other byte is copied.
@@ -79,4 +79,4 @@ private:
   Layout layout_ = Layout::Compact;
 };
 
-}  // namespace safecass::introspect
+}  // namespace safecass::json

@@ -1,6 +1,7 @@
 #pragma once
-/// @file json.hpp
-/// A JSON reader that keeps the line and column of every value and key, accepts `//` and `/* */`
+/// @file read.hpp
+/// The one JSON reader of SAFECASS (the writer is write.hpp; both form the json module, below spec
+/// and introspect). It keeps the line and column of every value and key, accepts `//` and `/* */`
 /// comments (as the 2016 specifications do), and never crashes on any input: malformed text,
 /// deep nesting, huge numbers and invalid UTF-8 escapes all give an error with a position.
 
@@ -13,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-namespace safecass::spec {
+namespace safecass::json {
 
 /// 1-based line and column (columns count bytes).
 struct TextPosition {
@@ -79,7 +80,4 @@ using JsonElementHandler = std::function<void(std::size_t index, JsonValue&& ele
 JsonParse parse_json_streaming(std::string_view text, std::string_view key, const JsonElementHandler& element,
                                int max_depth = 64);
 
-/// Escapes a string for a JSON document (quotes included): introspect::json_string, the one escaper.
-std::string json_quote(std::string_view text);
-
-}  // namespace safecass::spec
+}  // namespace safecass::json

@@ -1,0 +1,26 @@
+// The read model's text of numbers and times (introspect/format.hpp), which every tool prints.
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "safecass/introspect/format.hpp"
+
+namespace safecass::introspect {
+namespace {
+
+TEST(SecondsText, HasSixDecimalsAsInTheHistoryFile) {
+  EXPECT_EQ(seconds_text(Time{std::chrono::seconds(12)}), "12.000000");
+  EXPECT_EQ(seconds_text(Time{std::chrono::microseconds(301000)}), "0.301000");
+}
+
+TEST(NumberText, HasAtMostNineSignificantDigitsAndNamesNonFiniteValues) {
+  EXPECT_EQ(number_text(30.0), "30");
+  EXPECT_EQ(number_text(1.0 / 3.0), "0.333333333");
+  EXPECT_EQ(number_text(std::numeric_limits<double>::quiet_NaN()), "nan");
+  EXPECT_EQ(number_text(-std::numeric_limits<double>::infinity()), "-inf");
+}
+
+}  // namespace
+}  // namespace safecass::introspect
