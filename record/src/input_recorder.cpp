@@ -3,27 +3,12 @@
 #include <algorithm>
 #include <set>
 
+#include "safecass/json/write.hpp"
 #include "segmented_file.hpp"
 
 namespace safecass {
 
 namespace {
-void append_quoted(std::string& out, std::string_view s) {
-  out += '"';
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", static_cast<unsigned char>(c));
-      out += buf;
-    } else {
-      out += c;
-    }
-  }
-  out += '"';
-}
 std::string plural(std::uint64_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
@@ -52,19 +37,19 @@ std::vector<std::string> describe_losses(const InputRecordStatus& s) {
 }
 
 std::string record_status_json(const InputRecordStatus& s) {
-  std::string out = "{\"kind\":\"input_recorder\",\"path\":";
-  append_quoted(out, s.path);
-  out += ",\"samples\":" + std::to_string(s.samples) + ",\"actions\":" + std::to_string(s.actions) +
-         ",\"lost\":" + std::to_string(s.lost) + ",\"dropped\":" + std::to_string(s.dropped) +
-         ",\"unwritten\":" + std::to_string(s.unwritten) +
-         ",\"write_error\":" + (s.write_error.empty() ? "false" : "true");
-  if (!s.write_error.empty()) {
-    out += ",\"error\":";
-    append_quoted(out, s.write_error);
-  }
-  out += ",\"rotations\":" + std::to_string(s.rotations) + std::string(",\"complete\":") +
-         (s.complete() ? "true" : "false") + "}";
-  return out;
+  const auto count = [](std::uint64_t n) { return static_cast<long long>(n); };
+  json::JsonObject out;
+  out.str("kind", "input_recorder")
+      .str("path", s.path)
+      .integer("samples", count(s.samples))
+      .integer("actions", count(s.actions))
+      .integer("lost", count(s.lost))
+      .integer("dropped", count(s.dropped))
+      .integer("unwritten", count(s.unwritten))
+      .boolean("write_error", !s.write_error.empty());
+  if (!s.write_error.empty()) out.str("error", s.write_error);
+  out.integer("rotations", count(s.rotations)).boolean("complete", s.complete());
+  return out.text();
 }
 
 std::string InputRecorder::path_for_history(const std::string& history) {

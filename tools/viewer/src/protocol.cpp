@@ -36,12 +36,9 @@ using Object = json::JsonObject;
 
 template <class Range, class F>
 std::string array(const Range& items, F&& each) {
-  std::string out = "[";
-  for (const auto& item : items) {
-    if (out.size() > 1) out += ',';
-    out += each(item);
-  }
-  return out + "]";
+  json::JsonArray out;
+  for (const auto& item : items) out.raw(each(item));
+  return out.text();
 }
 
 using StateMap = std::map<std::string, std::pair<State, std::string>>;
@@ -274,16 +271,15 @@ std::string Protocol::update(long long now_ms) {
     last_time_ms_ = now_ms;
     return hello();
   }
-  std::string listed = "[";
+  json::JsonArray listed;
   for (std::string& r : records) {
     if (!listed_record(r)) continue;
-    if (listed.size() > 1) listed += ',';
-    listed += r;
+    listed.raw(r);
     recent_.push_back(std::move(r));
     if (recent_.size() > options_.recent) recent_.pop_front();
   }
-  listed += ']';
-  std::string changed = "{";
+  json::JsonObject changed;
+  std::size_t changes = 0;
   // A change of state comes with a record, or (a live system's state list, fetched after the
   // records that announced it) with a new view_version(): a state list that arrives in a later
   // poll than its records must still reach the page.
@@ -293,21 +289,20 @@ std::string Protocol::update(long long now_ms) {
     for (const auto& [address, state] : now) {
       const auto it = sent_.find(address);
       if (it != sent_.end() && it->second == state) continue;
-      if (changed.size() > 1) changed += ',';
-      changed += quote(address) + ":[" + state_text(state.first) + "," + quote(state.second) + "]";
+      changed.raw(address, json::JsonArray().raw(state_text(state.first)).str(state.second).text());
+      ++changes;
     }
     sent_ = std::move(now);
   }
-  changed += '}';
-  if (changed.size() > 2 || listed.size() > 2) {
+  if (changes > 0 || !listed.empty()) {
     last_time_ms_ = now_ms;
     last_replay_ = replay ? replay_json(*replay) : std::string();
     Object o;
     o.str("type", "update")
         .raw("t", seconds(source_.now()))
         .boolean("running", source_.running())
-        .raw("states", changed)
-        .raw("records", listed);
+        .raw("states", changed.text())
+        .raw("records", listed.text());
     if (replay) o.raw("replay", last_replay_);
     return o.text();
   }
