@@ -31,6 +31,18 @@ std::string_view type_name(JsonValue::Type t) noexcept {
   return "?";
 }
 
+std::string_view a_type_name(JsonValue::Type t) noexcept {
+  switch (t) {
+    case JsonValue::Type::Null: return "null";
+    case JsonValue::Type::Bool: return "a boolean";
+    case JsonValue::Type::Number: return "a number";
+    case JsonValue::Type::String: return "a string";
+    case JsonValue::Type::Array: return "an array";
+    case JsonValue::Type::Object: return "an object";
+  }
+  return "a value";
+}
+
 namespace {
 
 class Parser {

@@ -53,7 +53,6 @@ using namespace safecass;
 
 namespace {
 std::string g_keys;  ///< the bus keys of the benchmark's system (a private temporary directory)
-std::string g_ca;    ///< --ca DIR: the key directory whose CA signs them (empty: a CA of their own)
 }  // namespace
 using namespace std::chrono_literals;
 
@@ -207,23 +206,33 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(i, v.size() - 1)];
 }
 
+/// The bus keys of the benchmark's system with `interfaces` interfaces in `dir`, signed by the CA
+/// of `ca_dir` (empty: a CA of their own). Says why not on stderr.
+bool make_keys(const std::string& dir, int interfaces, const std::string& ca_dir) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
+  middleware::KeyOptions options = middleware::KeyOptions::replacing();
+  options.ca_dir = ca_dir;
+  auto made = load.ok() ? middleware::create_bus_keys(*load.system, dir, options)
+                        : Expected<std::vector<std::string>>(fail(ErrorCode::Parse, "the system does not load"));
+  if (!made) {
+    std::fprintf(stderr, "bench_middleware: cannot create bus keys in %s: %s\n", dir.c_str(),
+                 made.error().message.c_str());
+  }
+  return made.has_value();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 3 && std::string(argv[1]) == "--make-keys") {
-    FilterRegistry registry;
-    register_builtin_filters(registry);
-    auto load = spec::load_system_from_text(system_text(1), "bench.json", registry);
-    auto made = load.ok() ? middleware::create_bus_keys(*load.system, argv[2], middleware::KeyOptions::replacing())
-                          : Expected<std::vector<std::string>>(fail(ErrorCode::Parse, "the system does not load"));
-    if (!made) std::fprintf(stderr, "bench_middleware: %s\n", made.error().message.c_str());
-    return made ? 0 : 2;
-  }
+  if (argc == 3 && std::string(argv[1]) == "--make-keys") return make_keys(argv[2], 1, {}) ? 0 : 2;
   std::string ice_text, out_path = "bench-middleware.json";
   int samples = 2000;
   double seconds = 2.0;
   int interfaces = 16;
   std::chrono::microseconds pause{50};
+  std::string ca_dir;  // --ca DIR: the key directory whose CA signs the run's keys
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice")
@@ -237,7 +246,7 @@ int main(int argc, char** argv) {
     else if (key == "--interfaces")
       interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
     else if (key == "--ca")
-      g_ca = argv[i + 1];
+      ca_dir = argv[i + 1];
     else if (key == "--pause-us")
       pause = std::chrono::microseconds(std::clamp(std::atoi(argv[i + 1]), 0, 1000000));
     else {
@@ -254,20 +263,7 @@ int main(int argc, char** argv) {
   char keys_template[] = "/tmp/safecass-bench-keys.XXXXXX";
   if (::mkdtemp(keys_template) == nullptr) return 2;
   g_keys = keys_template;
-  {
-    FilterRegistry registry;
-    register_builtin_filters(registry);
-    auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
-    middleware::KeyOptions options = middleware::KeyOptions::replacing();
-    options.ca_dir = g_ca;
-    auto made = load.ok() ? middleware::create_bus_keys(*load.system, g_keys, options)
-                          : Expected<std::vector<std::string>>(fail(ErrorCode::Parse, "the system does not load"));
-    if (!made) {
-      std::fprintf(stderr, "bench_middleware: cannot create bus keys in %s: %s\n", g_keys.c_str(),
-                   made.error().message.c_str());
-      return 2;
-    }
-  }
+  if (!make_keys(g_keys, interfaces, ca_dir)) return 2;
   struct RemoveKeys {
     ~RemoveKeys() { std::filesystem::remove_all(g_keys); }
   } remove_keys;

@@ -54,23 +54,25 @@ std::string plain_tcp_warning(const std::string& keys_dir) {
          "with `safecass keys SYSTEM --out DIR --replace` and start IceStorm with --keys DIR (docs/security.md)";
 }
 
+void set_tls_properties(const Ice::PropertiesPtr& properties, const TlsOptions& tls) {
+  static const bool registered = [] {
+    Ice::registerIceSSL(false);  // linked in; loaded only by the property below
+    return true;
+  }();
+  (void)registered;
+  properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
+  properties->setProperty("IceSSL.DefaultDir", tls.dir);
+  properties->setProperty("IceSSL.CAs", "ca.pem");
+  properties->setProperty("IceSSL.CertFile", tls.name + ".pem");
+  properties->setProperty("IceSSL.KeyFile", tls.name + ".key");
+  properties->setProperty("IceSSL.VerifyPeer", "2");  // mutual: every peer shows a CA-signed certificate
+  properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
+}
+
 std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
-  if (tls.enabled()) {
-    static const bool registered = [] {
-      Ice::registerIceSSL(false);  // linked in; loaded only by the property below
-      return true;
-    }();
-    (void)registered;
-    init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
-    init.properties->setProperty("IceSSL.DefaultDir", tls.dir);
-    init.properties->setProperty("IceSSL.CAs", "ca.pem");
-    init.properties->setProperty("IceSSL.CertFile", tls.name + ".pem");
-    init.properties->setProperty("IceSSL.KeyFile", tls.name + ".key");
-    init.properties->setProperty("IceSSL.VerifyPeer", "2");  // mutual: every peer shows a CA-signed certificate
-    init.properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
-  }
+  if (tls.enabled()) set_tls_properties(init.properties, tls);
   init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
   // A TLS handshake costs a few round trips and some CPU: give it longer on a loaded machine.
   init.properties->setProperty("Ice.Override.ConnectTimeout", tls.enabled() ? "2000" : "500");

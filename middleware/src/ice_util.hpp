@@ -38,6 +38,9 @@ std::string resubscribed_line(const std::vector<std::string>& topics);
 /// With `tls` enabled, IceSSL is loaded with the CA and the process's certificate, and every peer
 /// must present a certificate signed by that CA (IceSSL.VerifyPeer=2).
 std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls = {});
+/// The IceSSL properties of mutual TLS with `tls` (enabled): the CA, this process's certificate,
+/// every peer verified. make_communicator sets them; a test's own communicator too.
+void set_tls_properties(const Ice::PropertiesPtr& properties, const TlsOptions& tls);
 /// "ssl" with TLS, else "tcp": the protocol of every endpoint the process creates or names.
 inline std::string protocol(const TlsOptions& tls) { return tls.enabled() ? "ssl" : "tcp"; }
 /// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS).

@@ -16,17 +16,8 @@ namespace safecass::spec::detail {
 
 namespace {
 
-std::string a_type(json::JsonValue::Type t) {
-  switch (t) {
-    case json::JsonValue::Type::Null: return "null";
-    case json::JsonValue::Type::Bool: return "a boolean";
-    case json::JsonValue::Type::Number: return "a number";
-    case json::JsonValue::Type::String: return "a string";
-    case json::JsonValue::Type::Array: return "an array";
-    case json::JsonValue::Type::Object: return "an object";
-  }
-  return "a value";
-}
+/// "a number", "an object": the type of a value in a message.
+std::string a_type(json::JsonValue::Type t) { return std::string(json::a_type_name(t)); }
 
 std::vector<std::string> names_of(const std::vector<Name>& names) {
   std::vector<std::string> out;

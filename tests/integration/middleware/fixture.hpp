@@ -5,7 +5,6 @@
 // makes keys of its own makes them with that CA.
 
 #include <Ice/Ice.h>
-#include <IceSSL/IceSSL.h>
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "ice_util.hpp"  // middleware/src: the product's TLS properties
 #include "safecass/middleware/keys.hpp"
 
 namespace safecass::fixture {
@@ -51,19 +51,9 @@ inline std::string ca_dir() { return icestorm_env("ICESTORM_TLS"); }
 inline std::shared_ptr<Ice::Communicator> communicator(
     const std::string& dir, const std::string& name,
     const std::vector<std::pair<std::string, std::string>>& extra = {}) {
-  static const bool registered = [] {
-    Ice::registerIceSSL(false);
-    return true;
-  }();
-  (void)registered;
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
-  init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
-  init.properties->setProperty("IceSSL.DefaultDir", dir);
-  init.properties->setProperty("IceSSL.CAs", "ca.pem");
-  init.properties->setProperty("IceSSL.CertFile", name + ".pem");
-  init.properties->setProperty("IceSSL.KeyFile", name + ".key");
-  init.properties->setProperty("IceSSL.VerifyPeer", "2");
+  middleware::detail::set_tls_properties(init.properties, middleware::TlsOptions{dir, name});
   for (const auto& [key, value] : extra) init.properties->setProperty(key, value);
   return Ice::initialize(init);
 }

@@ -54,6 +54,9 @@ struct JsonMember {
 
 /// "object", "array", "string", "number", "boolean", "null".
 std::string_view type_name(JsonValue::Type t) noexcept;
+/// The same with its article, for messages: "null", "a boolean", "a number", "a string", "an
+/// array", "an object".
+std::string_view a_type_name(JsonValue::Type t) noexcept;
 
 struct JsonError {
   TextPosition position;
