@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test stress-test known-defects fuzz-smoke bench bench-peers bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-verify asan tsan package lint clean
 
 all: build
 
@@ -77,14 +77,21 @@ fuzz-smoke: deps
 	  || { tail -40 $(FUZZ)/smoke.log; echo "fuzz-smoke: the spec loader fuzzer found a failure"; exit 1; }
 	@echo "fuzz-smoke: no failure in 20 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/smoke.log | tail -1))"
 
-# Benchmarks are built in Release in their own tree; results land in build/bench.json.
+# Benchmarks are built in Release in their own tree; results land in build/bench.json (every
+# repetition and the aggregates), run on one core (the last) when taskset is there.
+PIN := $(shell command -v taskset >/dev/null 2>&1 && echo "taskset -c $$(($$(nproc) - 1))")
 bench: deps
 	@test -f $(BUILD)/release/build.ninja || cmake --preset release >/dev/null
 	@cmake --build $(BUILD)/release -j $(JOBS)
-	@./$(BUILD)/release/bin/safecass_bench --benchmark_repetitions=5 \
-	  --benchmark_report_aggregates_only=true \
+	@$(PIN) ./$(BUILD)/release/bin/safecass_bench --benchmark_repetitions=5 \
+	  --benchmark_display_aggregates_only=true \
 	  --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	@./scripts/bench-middleware $(BUILD)/release/bin/bench_middleware $(BUILD)/bench-middleware.json
+
+# The hot paths against the committed baseline (benchmarks/baseline.json): each ratio, and a
+# failure beyond its tolerance (docs/benchmarks.md, "bench-check"). Reads build/bench.json; not in CI.
+bench-check:
+	@./scripts/bench-check $(BUILD)/bench.json benchmarks/baseline.json
 
 # SAFECASS side by side with its peers (raw IceStorm, roscpp, ROS diagnostics, Boost.MSM and
 # Boost.Statechart) in one run: its own Release tree with ROS 1 (build/peers), results in

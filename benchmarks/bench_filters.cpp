@@ -115,7 +115,7 @@ void BM_DetectionCycle(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * n * 3);
   if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
 }
-BENCHMARK(BM_DetectionCycle)->Arg(10)->Arg(100)->Arg(1000)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_DetectionCycle)->Arg(10)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace safecass

@@ -33,7 +33,7 @@ Filter::~Filter() = default;
 std::uint64_t Filter::missed_samples() const noexcept {
   std::uint64_t n = 0;
   for (std::size_t i = 0; i < cold_->inputs.size(); ++i) n += cursor(i).missed();
-  return n;
+  return n + cold_->banked_missed.load(std::memory_order_relaxed);
 }
 
 void Filter::run_general(Time now) noexcept {
@@ -137,6 +137,7 @@ Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
   std::lock_guard lock(cold_->injection_mutex);
   cold_->injections.insert(cold_->injections.end(), samples.begin(), samples.end());
   if (!cold_->injections.empty()) detour_.fetch_or(kInjection, std::memory_order_acq_rel);
+  tell_bank();
   return {};
 }
 

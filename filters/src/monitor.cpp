@@ -1,6 +1,8 @@
 #include "safecass/filters/monitor.hpp"
 #include "safecass/core/address.hpp"
 
+#include "banks.hpp"
+
 #include <cmath>
 
 #include <algorithm>
@@ -8,8 +10,12 @@
 
 namespace safecass {
 
-Monitor::Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history)
-    : coordinator_(coordinator), registry_(registry), signals_(signal_history) {}
+Monitor::Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history, bool banks)
+    : coordinator_(coordinator),
+      registry_(registry),
+      signals_(signal_history),
+      banks_(banks),
+      passive_(std::make_unique<detail::Banks>(banks)) {}
 
 Monitor::~Monitor() { stop(); }
 
@@ -182,19 +188,39 @@ Expected<Filter*> Monitor::add_filter(FilterConfig config) {
     if (!s) return tl::unexpected(s.error());  // cannot happen: checked in prepare()
     init->outputs[o] = *s;
   }
-  const ComponentId component = init->component;
-  const ExecutionMode execution = init->config.execution;
   auto filter = registry_.find(init->config.type)->factory(std::move(*init));
   Filter* raw = filter.get();
   filters_.push_back(std::move(filter));
-  if (execution == ExecutionMode::Passive) {
-    passive_.push_back(raw);
-  } else {
-    if (active_.size() <= to_index(component)) active_.resize(to_index(component) + std::size_t{1});
-    active_[to_index(component)].push_back(raw);
-  }
+  group(*raw).add(raw);
   return raw;
 }
+
+detail::Banks& Monitor::group(const Filter& filter) {
+  if (filter.execution() == ExecutionMode::Passive) return *passive_;
+  const std::size_t c = to_index(filter.component());
+  while (active_.size() <= c) active_.push_back(std::make_unique<detail::Banks>(banks_));
+  return *active_[c];
+}
+
+void Monitor::regroup(std::size_t count) {
+  // The new groups adopt the filters' states and positions from the old ones, which must live
+  // until then.
+  passive_->settle();
+  for (auto& g : active_) g->settle();
+  auto old_active = std::move(active_);
+  auto old_passive = std::move(passive_);
+  active_.clear();
+  passive_ = std::make_unique<detail::Banks>(banks_);
+  for (std::size_t i = 0; i < count && i < filters_.size(); ++i) group(*filters_[i]).add(filters_[i].get());
+}
+
+std::size_t Monitor::banked_count() const noexcept {
+  std::size_t n = passive_->banked();
+  for (const auto& g : active_) n += g->banked();
+  return n;
+}
+
+std::size_t Monitor::passive_count() const noexcept { return passive_->size(); }
 
 Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std::vector<FilterConfig> stages) {
   const std::size_t filters_before = filters_.size();
@@ -224,12 +250,8 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
     auto f = add_filter(stage);
     if (!f) {
       // All or nothing: undo the stages already created.
-      while (filters_.size() > filters_before) {
-        Filter* last = filters_.back().get();
-        std::erase(passive_, last);
-        for (auto& list : active_) std::erase(list, last);
-        filters_.pop_back();
-      }
+      regroup(filters_before);
+      filters_.resize(filters_before);
       signals_.truncate(signals_before);
       return fail(f.error().code,
                   "pipeline '" + std::string(name) + "', stage " + std::to_string(i + 1) + ": " + f.error().message);
@@ -241,12 +263,10 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
 
 void Monitor::run_active(ComponentId component, Time now) noexcept {
   if (to_index(component) >= active_.size()) return;
-  for (Filter* f : active_[to_index(component)]) f->run(now);
+  active_[to_index(component)]->run(now);
 }
 
-void Monitor::tick(Time now) noexcept {
-  for (Filter* f : passive_) f->run(now);
-}
+void Monitor::tick(Time now) noexcept { passive_->run(now); }
 
 void Monitor::start(std::chrono::nanoseconds period) {
   if (thread_.joinable()) return;

@@ -2,72 +2,44 @@
 
 #include <cmath>
 
-#include "common.hpp"
+#include "banked.hpp"
 
 namespace safecass::builtin {
 
+namespace {}  // namespace
+
+Threshold::Threshold(FilterInit init) : Filter(std::move(init)) {
+  ThresholdState& s = state_.own();
+  s.above = text("direction") == "above";
+  s.onset_level = s.above ? number("threshold") + number("tolerance") : number("threshold") - number("tolerance");
+  s.clear_level = s.above ? s.onset_level - number("hysteresis") : s.onset_level + number("hysteresis");
+  s.persistence = Persistence(number("persistence"), text("persistence_unit") == "seconds");
+  s.out_above = number("output_above");
+  s.out_below = number("output_below");
+  s.output = outputs().empty() ? nullptr : outputs()[0];
+}
+
+FilterManifest Threshold::manifest() {
+  FilterManifest m;
+  m.doc = "event when a scalar crosses a threshold (with tolerance, hysteresis and persistence)";
+  m.params = {
+      ParamSpec::signal("input_signal", "scalar signal to check"),
+      ParamSpec::number("threshold", "the limit"),
+      ParamSpec::number("tolerance", "margin added to the limit before an onset", 0.0, 0, 1e300),
+      ParamSpec::number("hysteresis", "how far back past the limit the value must return to clear", 0.0, 0, 1e300),
+      ParamSpec::choice("direction", "which side of the limit is the fault", {"above", "below"}, "above"),
+      persistence_param(),
+      persistence_unit_param(),
+      ParamSpec::signal("output_signal", "written every sample: output_above while detected, else output_below", true),
+      ParamSpec::number("output_above", "output value while detected", 1.0),
+      ParamSpec::number("output_below", "output value otherwise", 0.0)};
+  add_event_params(m);
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  return m;
+}
+
 namespace {
-
-/// x > threshold + tolerance for `persistence` → onset; x ≤ threshold + tolerance − hysteresis →
-/// completion; `direction: below` mirrors both.
-class Threshold final : public Filter {
-public:
-  explicit Threshold(FilterInit init)
-      : Filter(std::move(init)),
-        above_(text("direction") == "above"),
-        onset_level_(above_ ? number("threshold") + number("tolerance") : number("threshold") - number("tolerance")),
-        clear_level_(above_ ? onset_level_ - number("hysteresis") : onset_level_ + number("hysteresis")),
-        persistence_(number("persistence"), text("persistence_unit") == "seconds"),
-        out_above_(number("output_above")),
-        out_below_(number("output_below")) {}
-
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "event when a scalar crosses a threshold (with tolerance, hysteresis and persistence)";
-    m.params = {
-        ParamSpec::signal("input_signal", "scalar signal to check"),
-        ParamSpec::number("threshold", "the limit"),
-        ParamSpec::number("tolerance", "margin added to the limit before an onset", 0.0, 0, 1e300),
-        ParamSpec::number("hysteresis", "how far back past the limit the value must return to clear", 0.0, 0, 1e300),
-        ParamSpec::choice("direction", "which side of the limit is the fault", {"above", "below"}, "above"),
-        persistence_param(),
-        persistence_unit_param(),
-        ParamSpec::signal("output_signal", "written every sample: output_above while detected, else output_below",
-                          true),
-        ParamSpec::number("output_above", "output value while detected", 1.0),
-        ParamSpec::number("output_below", "output value otherwise", 0.0)};
-    add_event_params(m);
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    return m;
-  }
-
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    const double x = s.scalar();
-    const bool beyond = above_ ? x > onset_level_ : x < onset_level_;
-    const bool held = persistence_.update(beyond, s.time);
-    bool now = detected_;
-    if (!detected_ && held) now = true;
-    if (detected_ && (above_ ? x <= clear_level_ : x >= clear_level_)) now = false;
-    detected_ = now;
-    report(detected_, x, s.time);
-    write(0, s.time, detected_ ? out_above_ : out_below_);
-  }
-  void on_reset() noexcept override {
-    detected_ = false;
-    persistence_.reset();
-  }
-
-private:
-  bool above_;
-  double onset_level_;
-  double clear_level_;
-  Persistence persistence_;
-  double out_above_;
-  double out_below_;
-  bool detected_ = false;
-};
 
 /// Outside [min, max] → onset; back inside [min + hysteresis, max − hysteresis] → completion.
 class Range final : public Filter {

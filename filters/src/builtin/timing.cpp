@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "common.hpp"
+#include "banked.hpp"
 
 namespace safecass::builtin {
 
@@ -70,49 +70,27 @@ private:
   bool was_on_ = false;
 };
 
-/// No new sample for `timeout` seconds (counted from start-up, i.e. the first run) → onset; a new
-/// sample → completion. Defaults to EVT_STALE / /EVT_STALE.
-class Watchdog final : public Filter {
-public:
-  explicit Watchdog(FilterInit init) : Filter(std::move(init)), timeout_(seconds_to_time(number("timeout"))) {}
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "event when the input has no new sample for timeout seconds (heartbeat, staleness)";
-    m.params = {
-        ParamSpec::signal("input_signal", "any signal (a heartbeat)"),
-        ParamSpec::number("timeout", "seconds without a new sample that make it stale", std::nullopt, 1e-9, 1e9),
-        ParamSpec::signal("output_signal", "age of the newest sample in seconds, every run", true),
-        ParamSpec::event("event_onset", "event when stale", std::string("EVT_STALE")),
-        ParamSpec::event("event_completion", "event when fresh again", std::string("/EVT_STALE"))};
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    return m;
-  }
-  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
-    return any_input_no_output(s);
-  }
+}  // namespace
 
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    if (!started_ || s.time > last_) last_ = s.time;
-    started_ = true;
-  }
-  void on_tick(Time now) noexcept override {
-    if (!started_) {
-      last_ = now;  // start-up counts as the last sign of life
-      started_ = true;
-    }
-    const Time age = now - last_;
-    report(age > timeout_, to_seconds(age), last_);
-    write(0, now, to_seconds(age));
-  }
-  void on_reset() noexcept override { started_ = false; }
+Watchdog::Watchdog(FilterInit init) : Filter(std::move(init)) {
+  state_.own().timeout = seconds_to_time(number("timeout"));
+  state_.own().output = outputs().empty() ? nullptr : outputs()[0];
+}
 
-private:
-  Time timeout_;
-  Time last_{};
-  bool started_ = false;
-};
+FilterManifest Watchdog::manifest() {
+  FilterManifest m;
+  m.doc = "event when the input has no new sample for timeout seconds (heartbeat, staleness)";
+  m.params = {ParamSpec::signal("input_signal", "any signal (a heartbeat)"),
+              ParamSpec::number("timeout", "seconds without a new sample that make it stale", std::nullopt, 1e-9, 1e9),
+              ParamSpec::signal("output_signal", "age of the newest sample in seconds, every run", true),
+              ParamSpec::event("event_onset", "event when stale", std::string("EVT_STALE")),
+              ParamSpec::event("event_completion", "event when fresh again", std::string("/EVT_STALE"))};
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  return m;
+}
+
+namespace {
 
 /// Rate and jitter of a signal's samples over the last `window` intervals.
 class Frequency final : public Filter {

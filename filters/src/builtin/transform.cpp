@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "common.hpp"
+#include "banked.hpp"
 
 namespace safecass::builtin {
 
@@ -83,95 +83,73 @@ private:
   bool has_previous_ = false;
 };
 
-/// Mean of the last `window` samples (fewer at start-up), element-wise.
-class MovingAverage final : public Filter {
-public:
-  static constexpr const char* kType = "MovingAverage";
-  explicit MovingAverage(FilterInit init)
-      : Filter(std::move(init)), window_(static_cast<std::size_t>(number("window"))), size_(inputs()[0]->size()) {
-    const std::size_t values = (window_ + 2) * size_;  // the ring, the running sum, the output
-    if (values > kInline) heap_.assign(values, 0.0);
-    ring_ = values > kInline ? heap_.data() : inline_;
-    sum_ = ring_ + window_ * size_;
-    out_ = sum_ + size_;
-  }
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "moving average over the last window samples (element-wise)";
-    m.params = {
-        ParamSpec::signal("input_signal", "scalar or vector signal"),
-        ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
-        ParamSpec::signal("output_signal",
-                          "the average, same size as the input (default: the signal named after the filter)", true)};
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    m.generates_events = false;
-    m.default_output = true;
-    return m;
-  }
-  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
-    return same_size<MovingAverage>(s);
-  }
+}  // namespace
 
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    if (size_ == 1) {
-      on_scalar(s);
-      return;
-    }
-    double* slot = &ring_[next_ * size_];
-    for (std::size_t i = 0; i < size_; ++i) {
-      if (count_ == window_) sum_[i] -= slot[i];
-      slot[i] = s[i];
-      sum_[i] += s[i];
-    }
-    if (++next_ == window_) next_ = 0;  // not %: a division costs more than the rest of the update
-    if (count_ < window_) ++count_;
-    // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
-    if (next_ == 0) {
-      std::fill(sum_, sum_ + size_, 0.0);
-      for (std::size_t k = 0; k < count_; ++k)
-        for (std::size_t i = 0; i < size_; ++i) sum_[i] += ring_[k * size_ + i];
-    }
-    for (std::size_t i = 0; i < size_; ++i) out_[i] = sum_[i] / static_cast<double>(count_);
-    write(0, s.time, out_);
+MovingAverage::MovingAverage(FilterInit init)
+    : Filter(std::move(init)), window_(static_cast<std::size_t>(number("window"))), size_(inputs()[0]->size()) {
+  if (size_ == 1) {
+    if (window_ > kInline) heap_.assign(window_, 0.0);
+    ring_ = window_ > kInline ? heap_.data() : inline_;
+    AverageState& s = scalar_.own();
+    s.ring = ring_;
+    s.window = static_cast<std::uint32_t>(window_);
+    s.output = outputs().empty() ? nullptr : outputs()[0];
+    return;
   }
-  void on_reset() noexcept override {
-    count_ = next_ = 0;
+  heap_.assign((window_ + 2) * size_, 0.0);  // the ring, the running sum, the output
+  ring_ = heap_.data();
+  sum_ = ring_ + window_ * size_;
+  out_ = sum_ + size_;
+}
+
+FilterManifest MovingAverage::manifest() {
+  FilterManifest m;
+  m.doc = "moving average over the last window samples (element-wise)";
+  m.params = {
+      ParamSpec::signal("input_signal", "scalar or vector signal"),
+      ParamSpec::integer("window", "number of samples averaged", 10.0, 1, 1e6),
+      ParamSpec::signal("output_signal",
+                        "the average, same size as the input (default: the signal named after the filter)", true)};
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  m.generates_events = false;
+  m.default_output = true;
+  return m;
+}
+
+Expected<std::vector<std::size_t>> MovingAverage::output_sizes(const FilterShape& s) {
+  return same_size<MovingAverage>(s);
+}
+
+void MovingAverage::on_vector(const SampleView& s) noexcept {
+  double* slot = &ring_[next_ * size_];
+  for (std::size_t i = 0; i < size_; ++i) {
+    if (count_ == window_) sum_[i] -= slot[i];
+    slot[i] = s[i];
+    sum_[i] += s[i];
+  }
+  if (++next_ == window_) next_ = 0;
+  if (count_ < window_) ++count_;
+  // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
+  if (next_ == 0) {
     std::fill(sum_, sum_ + size_, 0.0);
+    for (std::size_t k = 0; k < count_; ++k)
+      for (std::size_t i = 0; i < size_; ++i) sum_[i] += ring_[k * size_ + i];
   }
+  for (std::size_t i = 0; i < size_; ++i) out_[i] = sum_[i] / static_cast<double>(count_);
+  write(0, s.time, out_);
+}
 
-private:
-  /// on_sample() for a scalar input: the same arithmetic, without the element loops.
-  void on_scalar(const SampleView& s) noexcept {
-    const double x = s[0];
-    if (count_ == window_) sum_[0] -= ring_[next_];
-    ring_[next_] = x;
-    sum_[0] += x;
-    if (++next_ == window_) next_ = 0;
-    if (count_ < window_) ++count_;
-    if (next_ == 0) {
-      double sum = 0.0;
-      for (std::size_t k = 0; k < count_; ++k) sum += ring_[k];
-      sum_[0] = sum;
-    }
-    write(0, s.time, sum_[0] / static_cast<double>(count_));
+void MovingAverage::on_reset() noexcept {
+  if (size_ == 1) {
+    scalar_->reset();
+    return;
   }
+  count_ = next_ = 0;
+  std::fill(sum_, sum_ + size_, 0.0);
+}
 
-  // A small average (a scalar's window of up to 14 samples) keeps its ring, sum and output inside
-  // the object, next to the filter's hot fields (docs/filters.md, "Memory layout"); a larger one
-  // in heap_.
-  static constexpr std::size_t kInline = 16;
-  std::size_t window_;
-  std::size_t size_;
-  std::size_t next_ = 0;
-  std::size_t count_ = 0;
-  double* ring_ = nullptr;  ///< window_ samples of size_ values
-  double* sum_ = nullptr;   ///< size_ values: the running sum
-  double* out_ = nullptr;   ///< size_ values: the average written
-  double inline_[kInline] = {};
-  std::vector<double> heap_;
-};
+namespace {
 
 /// L2 (default), L1 or L∞ norm of a vector.
 class Norm final : public Filter {

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdlib>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "safecass/filters/monitor.hpp"
 
@@ -164,6 +166,46 @@ TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
             }),
             0);
   EXPECT_EQ(s.co.coordinator_state(), State::Error);
+}
+
+TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsAndDetours) {
+  // Banks (docs/filters.md): a Threshold, a Watchdog and a MovingAverage per signal, in banks;
+  // several samples per run, a NaN now and then, a deep injection, a filter disabled and enabled
+  // again: none of it allocates after the warm-up (the deep injection's ring is made by the
+  // first injection, in the warm-up).
+  Rig s;
+  std::vector<Signal*> signals;
+  for (int k = 0; k < 50; ++k) {
+    const std::string x = "x" + std::to_string(k);
+    signals.push_back(*s.monitor.add_signal("C." + x));
+    s.add("Threshold", {{"input_signal", x}, {"threshold", 10.0}, {"event_onset", std::string("EVT_X")}});
+    s.add("Watchdog", {{"input_signal", x}, {"timeout", 1.0}});
+    s.add("MovingAverage", {{"input_signal", x}, {"window", 10.0}});
+  }
+  ASSERT_EQ(s.monitor.banked_count(), 150U);
+  Filter* toggled = s.monitor.filters()[1].get();
+  auto cycle = [&](int i) {
+    for (Signal* x : signals) {
+      x->push(Time{10 * i}, i % 97 == 0 ? std::nan("") : 1.0);
+      x->push(Time{10 * i + 5}, 2.0);
+    }
+    if (i % 50 == 0) (void)s.monitor.inject_deep("C.x3", {{3.0}}, Time{10 * i + 6});
+    if (i % 30 == 0) toggled->set_enabled(i % 60 != 0);
+    s.monitor.run_active(s.component, Time{10 * i + 9});
+  };
+  for (int i = 0; i < 200; ++i) cycle(i);
+  // Without the deep injection, whose argument is a vector made by the caller.
+  EXPECT_EQ(allocations_in([&] {
+              for (int i = 201; i < 1000; ++i) {
+                for (Signal* x : signals) {
+                  x->push(Time{10 * i}, i % 97 == 0 ? std::nan("") : 1.0);
+                  x->push(Time{10 * i + 5}, 2.0);
+                }
+                if (i % 30 == 0) toggled->set_enabled(i % 60 != 0);
+                s.monitor.run_active(s.component, Time{10 * i + 9});
+              }
+            }),
+            0);
 }
 
 }  // namespace

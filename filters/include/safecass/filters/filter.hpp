@@ -72,6 +72,10 @@ struct FilterInit {
   NameId name_id = kNoName;
 };
 
+namespace detail {
+class Banks;
+}
+
 class Filter {
 public:
   Filter(const Filter&) = delete;
@@ -96,6 +100,7 @@ public:
     } else {
       detour_.fetch_or(kDisabled, std::memory_order_acq_rel);
     }
+    tell_bank();
   }
   /// True while the filter's detection is active (an onset sent, its completion not yet).
   bool detected() const noexcept { return detected_.load(std::memory_order_acquire); }
@@ -154,6 +159,8 @@ protected:
   bool flag(std::string_view param) const;
 
 private:
+  friend class detail::Banks;  // runs a banked filter's samples without run() (docs/filters.md)
+
   /// Once per run, after the new samples: for filters that watch time (Watchdog, Deadline).
   /// The default does nothing and tells run() to stop calling it. It is private so that an
   /// override, which may be protected, cannot call it.
@@ -184,6 +191,10 @@ private:
     if (invalid_count_ != 0 && cold_->invalid[input] != 0) invalid_sample(input, sample, false);
     cursor(input).keep();
     on_sample(input, sample);
+  }
+  /// A bank that runs this filter learns that it must look at detour_ again.
+  void tell_bank() noexcept {
+    if (cold_->bank_changes != nullptr) cold_->bank_changes->fetch_add(1, std::memory_order_acq_rel);
   }
   SignalCursor& cursor(std::size_t input) noexcept { return input == 0 ? first_ : cold_->more_cursors[input - 1]; }
   const SignalCursor& cursor(std::size_t input) const noexcept {
@@ -237,6 +248,8 @@ private:
     std::vector<char> has_pending;
     std::mutex injection_mutex;  ///< guards injections and kInjection
     std::deque<std::vector<double>> injections;
+    std::atomic<std::uint32_t>* bank_changes = nullptr;  ///< the bank's change count, when banked
+    std::atomic<std::uint64_t> banked_missed{0};         ///< samples its bank's reader missed
   };
   std::unique_ptr<Cold> cold_;
 };

@@ -23,12 +23,18 @@
 
 namespace safecass {
 
+namespace detail {
+class Banks;
+}
+
 class Monitor {
 public:
   static constexpr std::chrono::nanoseconds kDefaultPeriod = std::chrono::milliseconds(5);
 
-  /// `coordinator` and `registry` must outlive the monitor.
-  Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history = 1024);
+  /// `coordinator` and `registry` must outlive the monitor. `banks` false runs every filter as an
+  /// object (docs/filters.md, "Filter banks": the reference the banks are tested against).
+  Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history = 1024,
+          bool banks = true);
   ~Monitor();
   Monitor(const Monitor&) = delete;
   Monitor& operator=(const Monitor&) = delete;
@@ -51,12 +57,15 @@ public:
   Filter* find_filter(std::string_view name) const noexcept;
   const std::vector<std::unique_ptr<Filter>>& filters() const noexcept { return filters_; }
 
+  /// Filters whose state is in a bank (docs/filters.md, "Filter banks").
+  std::size_t banked_count() const noexcept;
+
   /// Runs the ACTIVE filters of `component`, in creation order. Lock-free unless an event fires.
   void run_active(ComponentId component, Time now) noexcept;
   /// Runs every PASSIVE filter once, in creation order (one monitor tick).
   void tick(Time now) noexcept;
   /// The number of PASSIVE filters (a runtime need not start the monitor thread without any).
-  std::size_t passive_count() const noexcept { return passive_.size(); }
+  std::size_t passive_count() const noexcept;
 
   /// Starts the monitor thread: tick(clock.now()) every `period` of real time.
   void start(std::chrono::nanoseconds period = kDefaultPeriod);
@@ -80,13 +89,18 @@ private:
   [[nodiscard]] Expected<FilterInit> prepare(FilterConfig config,
                                              std::vector<std::pair<std::string, std::size_t>>& new_outputs);
   void record_injection(MachineId machine, std::string text);
+  /// The run group of a filter: its component's ACTIVE filters, or the PASSIVE ones.
+  detail::Banks& group(const Filter& filter);
+  /// Makes the run groups again from the first `count` filters (a failed pipeline is undone).
+  void regroup(std::size_t count);
 
   Coordinator& coordinator_;
   const FilterRegistry& registry_;
   SignalRegistry signals_;
   std::vector<std::unique_ptr<Filter>> filters_;
-  std::vector<std::vector<Filter*>> active_;  ///< per component
-  std::vector<Filter*> passive_;
+  bool banks_;
+  std::vector<std::unique_ptr<detail::Banks>> active_;  ///< per component
+  std::unique_ptr<detail::Banks> passive_;
   std::thread thread_;
   std::atomic<bool> stop_{false};
 };

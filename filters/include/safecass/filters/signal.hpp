@@ -75,6 +75,11 @@ public:
       for (std::size_t i = 0; i < width_; ++i) store(w[kHeader + i], values[i]);
     }
     head_.store(index + 1, std::memory_order_release);
+    // The next push writes the next slot, usually in a line no cache holds any more (a ring of
+    // capacity() samples per signal, one push per cycle): fetch it now, while the loop goes on.
+    const auto* next = reinterpret_cast<const char*>(slot(index + 1));
+    __builtin_prefetch(next, 1);
+    __builtin_prefetch(next + (stride_ * sizeof(std::uint64_t)) - 1, 1);
   }
 
   /// Index the next push will take: samples [end() - capacity(), end()) are readable.
@@ -256,6 +261,17 @@ public:
   bool stage_latest(SampleView& out) noexcept;
   std::uint64_t missed() const noexcept { return missed_; }
   const Signal* signal() const noexcept { return signal_; }
+  /// Moves this cursor to where `other`, a cursor of the same signal, stands: the next sample it
+  /// reads is the one `other` reads next. The kept sample is forgotten.
+  void follow(const SignalCursor& other) noexcept {
+    next_ = other.next_;
+    injected_next_ = other.injected_next_;
+    kept_ = -1;
+  }
+  /// Whether this cursor and `other`, of the same signal, read the same sample next.
+  bool level_with(const SignalCursor& other) const noexcept {
+    return next_ == other.next_ && injected_next_ == other.injected_next_;
+  }
 
 private:
   bool next_written(SampleView& out) noexcept {

@@ -1,0 +1,104 @@
+#pragma once
+// The filters of one run group (a component's ACTIVE filters, or the monitor's PASSIVE ones) and
+// how they run: filter banks (DESIGN §3, docs/filters.md "Filter banks"). Internal to the filters
+// module: the monitor owns one per group.
+//
+// A group runs its filters in creation order, as steps. A step is either one filter run as an
+// object (Filter::run), or a *reader*: consecutive built-in filters of a bankable type that read
+// one scalar signal. A reader reads each new sample of its signal once and hands it to each of its
+// filters in turn; their state lives in one array per type (the banks), and they are run by a
+// switch over their type, not a virtual call. A filter object is touched only when it has an event
+// to raise, a non-finite or injected sample to judge, or a detour (disabled, shallow injection):
+// then that filter runs its samples through the object path until it is level with the reader
+// again. Same filters, same order, same samples: the events, values and times are those of the
+// filters run one by one.
+
+#include <atomic>
+#include <cstdint>
+#include <vector>
+
+#include "builtin/banked.hpp"
+#include "safecass/filters/filter.hpp"
+
+namespace safecass::detail {
+
+class Banks {
+public:
+  /// `banking` false: every filter runs as an object (the reference the differential test
+  /// compares the banks with).
+  explicit Banks(bool banking) : banking_(banking) {}
+  Banks(const Banks&) = delete;
+  Banks& operator=(const Banks&) = delete;
+
+  /// Appends a filter to the group, after those added before (configuration time; allocates). A
+  /// bankable filter's state moves into its bank.
+  void add(Filter* filter);
+  /// Runs every filter of the group once, in creation order. Lock-free and allocation-free unless
+  /// an event fires; call from one thread.
+  void run(Time now) noexcept;
+  /// Makes every banked filter's own cursor read on from where its reader stands (before the
+  /// filters join another group).
+  void settle() noexcept;
+  std::size_t size() const noexcept { return size_; }
+  /// Filters whose state is in a bank (for tests and docs).
+  std::size_t banked() const noexcept { return members_.size(); }
+
+private:
+  enum class Kind : std::uint8_t { Threshold, Watchdog, Average };
+  struct Member {
+    Filter* filter = nullptr;
+    std::uint32_t index = 0;   ///< its state in the array of its kind
+    std::uint32_t reader = 0;  ///< the reader of its signal
+    Kind kind = Kind::Threshold;
+    bool out = false;       ///< runs as an object until level with its reader and without a detour
+    bool slow = false;      ///< its input is marked invalid: samples go through Filter::deliver
+    bool reported = false;  ///< Filter::detected() as of its last report
+  };
+  struct Reader {
+    SignalCursor cursor;
+    std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
+    std::uint32_t end = 0;
+  };
+  struct Step {
+    Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader]
+    std::uint32_t reader = 0;
+  };
+
+  bool bankable(Filter& filter, Kind& kind) const noexcept;
+  void adopt(Member& member);
+  void refresh() noexcept;
+  void run_reader(Reader& reader, Time now) noexcept;
+  void run_out(Member& m, const Reader& reader, Time now) noexcept;
+  void run_threshold(Member& m, std::size_t samples) noexcept;
+  void run_watchdog(Member& m, std::size_t samples, Time now) noexcept;
+  void run_average(Member& m, std::size_t samples) noexcept;
+  /// Sample `j` of this read through the object path (non-finite, injected, or the input marked).
+  void deliver(Member& m, std::size_t j) noexcept;
+  void report(Member& m, bool detected, double value, Time time) noexcept {
+    m.filter->report(detected, value, time);
+    m.reported = m.filter->detected();
+  }
+  bool judged_here(const Member& m, std::size_t j) const noexcept {
+    return !m.slow && (plain_ || (injected_[j] == 0 && std::isfinite(values_[j])));
+  }
+
+  bool banking_;
+  std::size_t size_ = 0;
+  std::vector<Step> steps_;
+  std::vector<Reader> readers_;
+  std::vector<Member> members_;
+  std::vector<builtin::ThresholdState> thresholds_;
+  std::vector<builtin::WatchdogState> watchdogs_;
+  std::vector<builtin::AverageState> averages_;
+  std::vector<double> rings_;                ///< the averages' rings, one after the other
+  std::vector<std::uint32_t> ring_offsets_;  ///< per average: where its ring starts in rings_
+  // The samples of the current read, for every filter of the reader in turn.
+  std::vector<Time> times_;
+  std::vector<double> values_;
+  std::vector<char> injected_;
+  bool plain_ = true;                      ///< every sample of the current read is finite and not injected
+  std::atomic<std::uint32_t> changes_{0};  ///< bumped by a member's set_enabled() and inject()
+  std::uint32_t seen_ = 0;
+};
+
+}  // namespace safecass::detail

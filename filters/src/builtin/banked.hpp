@@ -1,0 +1,205 @@
+#pragma once
+// The built-in filters that can run in a bank (docs/filters.md, "Filter banks"): Threshold,
+// Watchdog and MovingAverage. Each keeps the state it judges with in a small struct with the step
+// function that updates it. The filter object points at that struct: at first its own copy, and
+// once a bank adopts it, the bank's element in an array of such structs. Run as an object or in a
+// bank, the filter goes through the same step function on the same state, so the two cannot
+// disagree on the arithmetic; what the bank does differently (one read of each sample for every
+// filter of its signal, no virtual call, no object touched unless an event is due) is what the
+// differential test checks (tests/unit/filters/bank_test.cpp).
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "common.hpp"
+
+namespace safecass::builtin {
+
+/// Threshold's state: onset when x is beyond the onset level for `persistence`, completion when it
+/// is back past the clear level.
+struct ThresholdState {
+  double onset_level = 0.0;
+  double clear_level = 0.0;
+  double out_above = 1.0;
+  double out_below = 0.0;
+  Persistence persistence;
+  Signal* output = nullptr;
+  bool above = true;
+  bool detected = false;
+
+  /// One finite sample; returns whether the condition is detected after it.
+  bool step(double x, Time t) noexcept {
+    const bool beyond = above ? x > onset_level : x < onset_level;
+    const bool held = persistence.update(beyond, t);
+    bool now = detected;
+    if (!detected && held) now = true;
+    if (detected && (above ? x <= clear_level : x >= clear_level)) now = false;
+    detected = now;
+    return detected;
+  }
+  double output_value() const noexcept { return detected ? out_above : out_below; }
+  void reset() noexcept {
+    detected = false;
+    persistence.reset();
+  }
+};
+
+/// Watchdog's state: the newest sample's time, or start-up (the first run) before any.
+struct WatchdogState {
+  Time timeout{};
+  Time last{};
+  Signal* output = nullptr;
+  bool started = false;
+
+  void on_sample(Time t) noexcept {
+    if (!started || t > last) last = t;
+    started = true;
+  }
+  /// Once per run, after the samples: the age of the newest sample at `now`.
+  Time age(Time now) noexcept {
+    if (!started) {
+      last = now;  // start-up counts as the last sign of life
+      started = true;
+    }
+    return now - last;
+  }
+  void reset() noexcept { started = false; }
+};
+
+/// A scalar MovingAverage's state: the ring of the last `window` samples and its running sum.
+struct AverageState {
+  double* ring = nullptr;  ///< window values: the filter object's, or its bank's
+  double sum = 0.0;
+  std::uint32_t window = 1;
+  std::uint32_t next = 0;
+  std::uint32_t count = 0;
+  Signal* output = nullptr;
+
+  /// One finite sample; returns the mean of the last `window` samples.
+  double step(double x) noexcept {
+    if (count == window) sum -= ring[next];
+    ring[next] = x;
+    sum += x;
+    if (++next == window) next = 0;  // not %: a division costs more than the rest of the update
+    if (count < window) ++count;
+    // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
+    if (next == 0) {
+      double exact = 0.0;
+      for (std::uint32_t k = 0; k < count; ++k) exact += ring[k];
+      sum = exact;
+    }
+    return sum / static_cast<double>(count);
+  }
+  void reset() noexcept {
+    count = next = 0;
+    sum = 0.0;
+  }
+};
+
+/// The state a banked filter judges with: its own until a bank adopts it (Banks::add), then the
+/// bank's element, which adopt() fills with a copy of the filter's state so far.
+template <class State>
+class BankedState {
+public:
+  State& operator*() noexcept { return *state_; }
+  State* operator->() noexcept { return state_; }
+  const State* operator->() const noexcept { return state_; }
+  State& own() noexcept { return own_; }
+  void adopt(State* element) noexcept {
+    *element = *state_;
+    state_ = element;
+  }
+  /// The bank's array moved: the element is the same, at a new address.
+  void rebind(State* element) noexcept { state_ = element; }
+
+private:
+  State own_;
+  State* state_ = &own_;
+};
+
+/// x > threshold + tolerance for `persistence` → onset; x ≤ threshold + tolerance − hysteresis →
+/// completion; `direction: below` mirrors both.
+class Threshold final : public Filter {
+public:
+  explicit Threshold(FilterInit init);
+  static FilterManifest manifest();
+  BankedState<ThresholdState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const double x = s.scalar();
+    const bool detected = state_->step(x, s.time);
+    report(detected, x, s.time);
+    write(0, s.time, state_->output_value());
+  }
+  void on_reset() noexcept override { state_->reset(); }
+
+private:
+  BankedState<ThresholdState> state_;
+};
+
+/// No new sample for `timeout` seconds (counted from start-up, i.e. the first run) → onset; a new
+/// sample → completion. Defaults to EVT_STALE / /EVT_STALE.
+class Watchdog final : public Filter {
+public:
+  explicit Watchdog(FilterInit init);
+  static FilterManifest manifest();
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>(1, 1);
+  }
+  BankedState<WatchdogState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override { state_->on_sample(s.time); }
+  void on_reset() noexcept override { state_->reset(); }
+
+private:
+  void on_tick(Time now) noexcept override {
+    const Time age = state_->age(now);
+    report(age > state_->timeout, to_seconds(age), state_->last);
+    write(0, now, to_seconds(age));
+  }
+  BankedState<WatchdogState> state_;
+};
+
+/// Mean of the last `window` samples (fewer at start-up), element-wise. A scalar's state can be
+/// banked; a vector's stays in the object.
+class MovingAverage final : public Filter {
+public:
+  static constexpr const char* kType = "MovingAverage";
+  explicit MovingAverage(FilterInit init);
+  static FilterManifest manifest();
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s);
+  bool scalar() const noexcept { return size_ == 1; }
+  BankedState<AverageState>& state() noexcept { return scalar_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    if (size_ == 1) {
+      write(0, s.time, scalar_->step(s[0]));
+      return;
+    }
+    on_vector(s);
+  }
+  void on_reset() noexcept override;
+
+private:
+  void on_vector(const SampleView& s) noexcept;
+
+  // A scalar's window of up to kInline samples is kept inside the object (docs/filters.md,
+  // "Memory layout"); a larger window, and a vector's ring, running sum and output, in heap_.
+  static constexpr std::size_t kInline = 16;
+  std::size_t window_;
+  std::size_t size_;
+  BankedState<AverageState> scalar_;
+  std::size_t next_ = 0;    ///< a vector's
+  std::size_t count_ = 0;   ///< a vector's
+  double* ring_ = nullptr;  ///< window_ samples of size_ values
+  double* sum_ = nullptr;   ///< a vector's running sum (size_ values)
+  double* out_ = nullptr;   ///< a vector's average written (size_ values)
+  double inline_[kInline] = {};
+  std::vector<double> heap_;
+};
+
+}  // namespace safecass::builtin

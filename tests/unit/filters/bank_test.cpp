@@ -1,0 +1,301 @@
+// Filter banks (DESIGN §3, docs/filters.md "Filter banks"): a bank is an implementation of the
+// same filters, not new semantics. The differential test runs one random system twice, its
+// filters run as objects (Monitor(..., banks = false)) and in banks, and requires byte-equal
+// observer streams, outputs, detections and missed-sample counts after every cycle. The systems
+// mix every banked type with an object filter (Range) in between, ACTIVE and PASSIVE, pipelines
+// (a Threshold on a MovingAverage's output), EDGE and LEVEL, persistence in samples and seconds;
+// the signals mix noise around the limits, steps, ramps, NaN and ±inf; the runs mix several
+// samples per cycle, none, deep and shallow injection, and enabling and disabling filters.
+//
+// SAFECASS_BANK_SEEDS=N runs N seeds (the long run in docs/filters.md); `make test` runs 2,000.
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "safecass/core/coordinator.hpp"
+#include "safecass/filters/monitor.hpp"
+#include "safecass/filters/registry.hpp"
+
+namespace safecass {
+namespace {
+
+constexpr int kEvents = 3;
+
+/// One system, as the program below builds it: objects or banks.
+class World {
+public:
+  explicit World(bool banks) : monitor_(co_, registry_, 32, banks) {
+    register_builtin_filters(registry_);
+    (void)co_.add_component("C");
+    for (int e = 0; e < kEvents; ++e) {
+      const std::string name = "EVT_" + std::to_string(e);
+      (void)co_.add_event(
+          EventDef{name, 10 + e, {Transition::N2W, Transition::N2E, Transition::W2E}, "", false, "", ""});
+      (void)co_.add_event(
+          EventDef{"/" + name, 10 + e, {Transition::W2N, Transition::E2N, Transition::E2W}, "", false, "", ""});
+    }
+    co_.subscribe([this](const Record& r) { log_ += line(r); });
+  }
+  Monitor& monitor() { return monitor_; }
+  SimulatedClock& clock() { return clock_; }
+  const std::string& log() const { return log_; }
+
+  /// Everything a user can see after a cycle: outputs, detections, missed samples.
+  std::string view() const {
+    std::string v;
+    for (const auto& s : monitor_.signals().all()) {
+      Time t{};
+      double x = 0.0;
+      bool injected = false;
+      const bool any = s->latest(t, &x, &injected);
+      v += s->name() + "=" + (any ? std::to_string(t.count()) + ":" + bits(x) + (injected ? "i" : "") : "-") + ";";
+    }
+    for (const auto& f : monitor_.filters()) {
+      v += f->name() + (f->detected() ? "!" : ".") + std::to_string(f->missed_samples()) + ";";
+    }
+    return v;
+  }
+
+private:
+  static std::string bits(double x) { return std::to_string(std::bit_cast<std::uint64_t>(x)); }
+  std::string line(const Record& r) const {
+    std::string s = std::string(to_string(r.kind)) + " " + std::string(to_string(r.outcome)) +
+                    " t=" + std::to_string(r.time.count()) + " m=" + std::to_string(static_cast<int>(r.machine)) + " ";
+    if (r.event != kNoEvent) s += co_.event(r.event).name;
+    s += " " + std::string(to_string(r.from)) + ">" + std::string(to_string(r.to));
+    const SampleCause& c = r.root.sample;
+    if (c.present()) {
+      s += " by " + std::string(co_.name_of(c.filter)) + " on " + std::string(co_.name_of(c.signal)) +
+           " v=" + bits(c.value) + " at " + std::to_string(c.sample_time.count()) + (c.injected ? " injected" : "");
+    }
+    return s + "\n";
+  }
+
+  SimulatedClock clock_;
+  Coordinator co_{"bank", &clock_};
+  FilterRegistry registry_;
+  Monitor monitor_;
+  std::string log_;
+};
+
+/// A seeded random system and run, applied identically to both worlds.
+class Program {
+public:
+  explicit Program(unsigned seed) : rng_(seed) {}
+
+  void build(World& a, World& b) {
+    const int signals = pick(1, 3);
+    for (int i = 0; i < signals; ++i) names_.push_back("s" + std::to_string(i));
+    for (const std::string& s : names_) both(a, b, [&](World& w) { (void)w.monitor().add_signal("C." + s); });
+    const int filters = pick(1, 8);
+    for (int i = 0; i < filters; ++i) {
+      FilterConfig c = next_filter(i);
+      both(a, b, [&](World& w) {
+        auto f = w.monitor().add_filter(c);
+        ASSERT_TRUE(f) << f.error().message;
+      });
+      filter_names_.push_back(c.name);
+    }
+  }
+
+  /// One cycle: samples, faults and changes, then the run at the cycle's time.
+  void cycle(World& a, World& b, int k) {
+    const std::int64_t now = (k + 1) * 1'000'000;  // 1 ms
+    for (std::size_t s = 0; s < names_.size(); ++s) {
+      const int samples = pick(0, 6) < 4 ? 1 : pick(0, 3);
+      for (int j = 0; j < samples; ++j) {
+        const double x = value(s, k);
+        const Time t{now - (samples - j) * 100'000};
+        both(a, b, [&](World& w) { w.monitor().signals().find("C." + names_[s])->push(t, x); });
+      }
+    }
+    if (pick(0, 19) == 0) {  // deep injection
+      const std::string s = "C." + names_[static_cast<std::size_t>(pick(0, static_cast<int>(names_.size()) - 1))];
+      const std::vector<std::vector<double>> v{{injected()}, {injected()}};
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_deep(s, v, Time{now - 50'000})); });
+    }
+    if (pick(0, 19) == 0) {  // shallow injection
+      const std::string& f =
+          filter_names_[static_cast<std::size_t>(pick(0, static_cast<int>(filter_names_.size()) - 1))];
+      std::vector<std::vector<double>> v(static_cast<std::size_t>(pick(1, 3)));
+      for (auto& x : v) x = {injected()};
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_shallow(f, v)); });
+    }
+    if (k == 30 && pick(0, 1) == 0) {  // a pipeline that fails at its second stage: undone whole
+      FilterConfig first;
+      first.type = "MovingAverage";
+      first.target.component = "C";
+      first.params = {{"input_signal", names_[0]}};
+      FilterConfig second = first;
+      second.type = "NoSuchType";
+      both(a, b, [&](World& w) { ASSERT_FALSE(w.monitor().add_pipeline("undone", {first, second})); });
+    }
+    if (pick(0, 14) == 0) {  // enable or disable a filter
+      const std::string& f =
+          filter_names_[static_cast<std::size_t>(pick(0, static_cast<int>(filter_names_.size()) - 1))];
+      const bool on = pick(0, 1) == 0;
+      both(a, b, [&](World& w) { w.monitor().find_filter(f)->set_enabled(on); });
+    }
+    both(a, b, [&](World& w) {
+      w.clock().set(Time{now});
+      w.monitor().run_active(ComponentId{0}, Time{now});
+      w.monitor().tick(Time{now});
+    });
+  }
+
+private:
+  template <class F>
+  static void both(World& a, World& b, F&& f) {
+    f(a);
+    f(b);
+  }
+  int pick(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
+  double real(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+
+  /// Values around 10 (every threshold is near it): noise, steps, ramps, and now and then NaN or ±inf.
+  double value(std::size_t signal, int k) {
+    switch (pick(0, 24)) {
+      case 0: return std::numeric_limits<double>::quiet_NaN();
+      case 1: return std::numeric_limits<double>::infinity();
+      case 2: return -std::numeric_limits<double>::infinity();
+      case 3:
+      case 4: return pick(0, 1) == 0 ? 0.0 : 20.0;  // a step
+      case 5:
+      case 6: return 5.0 + 0.25 * ((k + static_cast<int>(signal) * 7) % 40);  // a ramp
+      default: return 10.0 + real(-2.0, 2.0);                                 // noise around the limits
+    }
+  }
+
+  /// An injected value: finite (injection refuses others), on either side of the limits.
+  double injected() { return pick(0, 1) == 0 ? 20.0 : 10.0 + real(-2.0, 2.0); }
+
+  FilterConfig next_filter(int i) {
+    FilterConfig c;
+    c.name = "f" + std::to_string(i);
+    c.target.component = "C";
+    c.execution = pick(0, 3) == 0 ? ExecutionMode::Passive : ExecutionMode::Active;
+    c.detection = pick(0, 2) == 0 ? DetectionMode::Level : DetectionMode::Edge;
+    c.enabled = pick(0, 9) != 0;
+    // Mostly the signals; sometimes the output of an earlier average (a pipeline).
+    std::string input = names_[static_cast<std::size_t>(pick(0, static_cast<int>(names_.size()) - 1))];
+    if (!averages_.empty() && pick(0, 3) == 0)
+      input = averages_[static_cast<std::size_t>(pick(0, static_cast<int>(averages_.size()) - 1))];
+    const std::string event = "EVT_" + std::to_string(pick(0, kEvents - 1));
+    switch (pick(0, 3)) {
+      case 0: {
+        c.type = "Threshold";
+        c.params = {{"input_signal", input},
+                    {"threshold", 10.0 + real(-1.0, 1.0)},
+                    {"tolerance", pick(0, 1) == 0 ? 0.0 : real(0.0, 0.5)},
+                    {"hysteresis", pick(0, 1) == 0 ? 0.0 : real(0.0, 1.5)},
+                    {"direction", std::string(pick(0, 2) == 0 ? "below" : "above")},
+                    {"event_onset", event}};
+        if (pick(0, 1) == 0) {
+          const bool seconds = pick(0, 1) == 0;
+          c.params["persistence"] = seconds ? real(0.0, 0.004) : static_cast<double>(pick(0, 3));
+          c.params["persistence_unit"] = std::string(seconds ? "seconds" : "samples");
+        }
+        if (pick(0, 1) == 0) c.params["output_signal"] = "out" + std::to_string(i);
+        break;
+      }
+      case 1:
+        c.type = "Watchdog";
+        c.params = {{"input_signal", input},
+                    {"timeout", pick(5, 40) * 1e-4},
+                    {"event_onset", event},
+                    {"event_completion", "/" + event}};
+        if (pick(0, 1) == 0) c.params["output_signal"] = "age" + std::to_string(i);
+        break;
+      case 2:
+        c.type = "MovingAverage";
+        c.params = {{"input_signal", input}, {"window", static_cast<double>(pick(1, 5))}};
+        averages_.push_back("MovingAverage_" + std::to_string(i + 1));  // the default output's name
+        c.name = "MovingAverage_" + std::to_string(i + 1);
+        c.params["output_signal"] = averages_.back();
+        break;
+      default:
+        c.type = "Range";  // not banked: runs as an object between banked filters
+        c.params = {{"input_signal", input}, {"min", 9.0}, {"max", 11.0}, {"event_onset", event}};
+        break;
+    }
+    return c;
+  }
+
+  std::mt19937 rng_;
+  std::vector<std::string> names_;
+  std::vector<std::string> averages_;
+  std::vector<std::string> filter_names_;
+};
+
+/// The first line where `a` and `b` differ, with the line before it.
+std::string first_difference(const std::string& a, const std::string& b) {
+  std::size_t line = 0, start = 0, previous = 0;
+  for (std::size_t i = 0; i < a.size() && i < b.size() && a[i] == b[i]; ++i) {
+    if (a[i] == '\n') {
+      ++line;
+      previous = start;
+      start = i + 1;
+    }
+  }
+  auto tail = [&](const std::string& s) { return s.substr(previous, s.find('\n', start) - previous); };
+  return "line " + std::to_string(line + 1) + "\n--- objects\n" + tail(a) + "\n--- banks\n" + tail(b);
+}
+
+/// Runs seed `seed` in both worlds; the first difference, or "".
+std::string difference(unsigned seed, std::size_t* banked = nullptr) {
+  World objects(false);
+  World banks(true);
+  Program program(seed);
+  program.build(objects, banks);
+  if (banked != nullptr) *banked += banks.monitor().banked_count();
+  EXPECT_EQ(objects.monitor().banked_count(), 0U);
+  for (int k = 0; k < 60; ++k) {
+    program.cycle(objects, banks, k);
+    if (objects.log() != banks.log()) {
+      return "cycle " + std::to_string(k) + ", observer stream, " + first_difference(objects.log(), banks.log());
+    }
+    if (objects.view() != banks.view()) {
+      return "cycle " + std::to_string(k) + ", view, " + first_difference(objects.view(), banks.view());
+    }
+  }
+  return "";
+}
+
+TEST(FilterBank, ABankRaisesTheSameEventsValuesTimesAndOrderAsTheFiltersRunOneByOne) {
+  const char* env = std::getenv("SAFECASS_BANK_SEEDS");
+  const unsigned seeds = env != nullptr ? static_cast<unsigned>(std::strtoul(env, nullptr, 10)) : 2000U;
+  std::size_t banked = 0;
+  for (unsigned seed = 1; seed <= seeds; ++seed) {
+    const std::string d = difference(seed, &banked);
+    ASSERT_EQ(d, "") << "seed " << seed << ": " << d;
+  }
+  EXPECT_GT(banked, seeds) << "the random systems must put filters in banks";
+}
+
+TEST(FilterBank, BuiltInFiltersOfOneSignalShareOneBankReaderAndCustomTypesStayObjects) {
+  World w(true);
+  ASSERT_TRUE(w.monitor().add_signal("C.x"));
+  auto add = [&](const std::string& type, Params p) {
+    FilterConfig c;
+    c.type = type;
+    c.target.component = "C";
+    c.params = std::move(p);
+    ASSERT_TRUE(w.monitor().add_filter(c));
+  };
+  add("Threshold", {{"input_signal", std::string("x")}, {"threshold", 1.0}, {"event_onset", std::string("EVT_0")}});
+  add("Watchdog", {{"input_signal", std::string("x")}, {"timeout", 1.0}});
+  add("MovingAverage", {{"input_signal", std::string("x")}});
+  add("Range", {{"input_signal", std::string("x")}, {"min", 0.0}, {"max", 1.0}, {"event_onset", std::string("EVT_1")}});
+  EXPECT_EQ(w.monitor().banked_count(), 3U);
+  EXPECT_EQ(w.monitor().filters().size(), 4U);  // the console and the read model list all four
+}
+
+}  // namespace
+}  // namespace safecass
