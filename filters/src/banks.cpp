@@ -24,6 +24,12 @@ bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
 
 void Banks::add(Filter* filter) {
   ++size_;
+  // A signal this filter writes cannot be read ahead of the run: it changes during it.
+  for (const Signal* output : filter->outputs()) {
+    if (output == nullptr) continue;
+    written_.push_back(output);
+    for (Reader& r : readers_) r.source = r.source && r.cursor.signal() != output;
+  }
   Kind kind{};
   if (!bankable(*filter, kind)) {
     steps_.push_back(Step{filter, 0});
@@ -39,6 +45,7 @@ void Banks::add(Filter* filter) {
     reader.cursor = SignalCursor(input);
     reader.cursor.follow(filter->first_);
     reader.begin = reader.end = static_cast<std::uint32_t>(members_.size());
+    reader.source = std::find(written_.begin(), written_.end(), input) == written_.end();
     readers_.push_back(std::move(reader));
     steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1)});
     const std::size_t samples = 2 * (input->buffer().capacity() + 1);  // written and injected
@@ -104,6 +111,11 @@ void Banks::run(Time now) noexcept {
     seen_ = changes;
     refresh();
   }
+  // First the signals no filter of the group writes, one sample each in the common case: their
+  // reads do not wait for one another (the run below would do them one filter after another,
+  // each a chain of dependent loads). The rest, and any run with more than one new sample, are
+  // read in turn below.
+  for (Reader& r : readers_) r.taken = r.source && r.cursor.take_single(r.time, r.value);
   for (const Step& step : steps_) {
     if (step.object != nullptr) {
       step.object->run(now);
@@ -131,21 +143,29 @@ void Banks::refresh() noexcept {
 
 void Banks::run_reader(Reader& reader, Time now) noexcept {
   std::size_t samples = 0;
-  const std::uint64_t missed = reader.cursor.missed();
   bool plain = true;  // every sample finite and written, not injected: the common case
-  reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
-    times_[samples] = s.time;
-    values_[samples] = s.data[0];
-    injected_[samples] = s.injected ? 1 : 0;
-    plain = plain && !s.injected && std::isfinite(s.data[0]);
-    ++samples;
-  });
-  plain_ = plain;
-  if (const std::uint64_t lost = reader.cursor.missed() - missed; lost != 0) {
-    for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
-      if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
+  if (reader.taken) {
+    times_[0] = reader.time;
+    values_[0] = reader.value;
+    injected_[0] = 0;
+    plain = std::isfinite(reader.value);
+    samples = 1;
+  } else {
+    const std::uint64_t missed = reader.cursor.missed();
+    reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
+      times_[samples] = s.time;
+      values_[samples] = s.data[0];
+      injected_[samples] = s.injected ? 1 : 0;
+      plain = plain && !s.injected && std::isfinite(s.data[0]);
+      ++samples;
+    });
+    if (const std::uint64_t lost = reader.cursor.missed() - missed; lost != 0) {
+      for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
+        if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
+      }
     }
   }
+  plain_ = plain;
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {

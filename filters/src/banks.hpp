@@ -58,6 +58,10 @@ private:
     SignalCursor cursor;
     std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
     std::uint32_t end = 0;
+    bool source = true;  ///< no filter of the group writes its signal: it can be read ahead
+    bool taken = false;  ///< read ahead: this run's one sample is `time`, `value`
+    Time time{};
+    double value = 0.0;
   };
   struct Step {
     Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader]
@@ -85,6 +89,7 @@ private:
   bool banking_;
   std::size_t size_ = 0;
   std::vector<Step> steps_;
+  std::vector<const Signal*> written_;  ///< the outputs of the group's filters
   std::vector<Reader> readers_;
   std::vector<Member> members_;
   std::vector<builtin::ThresholdState> thresholds_;

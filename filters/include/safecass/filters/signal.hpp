@@ -236,6 +236,18 @@ public:
       }
     }
   }
+  /// Reads the next sample of a scalar signal when it is the only unread one and was written, not
+  /// injected: true, and the cursor moves past it. Otherwise false, and nothing changes (read
+  /// with next() or read_new()). Lock-free, allocation-free.
+  bool take_single(Time& time, double& value) noexcept {
+    if (signal_ == nullptr) return false;
+    if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) return false;
+    const HistoryBuffer& b = signal_->buffer();
+    std::uint64_t end = b.end();
+    if (end != next_ + 1 || !b.read_published(next_, time, &value, end)) return false;
+    ++next_;
+    return true;
+  }
   /// Skips every sample written so far.
   void skip_to_end() noexcept;
 
