@@ -4,22 +4,32 @@
 
 namespace safecass::detail {
 
+using builtin::Debounce;
+using builtin::Frequency;
 using builtin::MovingAverage;
+using builtin::Norm;
 using builtin::Threshold;
 using builtin::Watchdog;
 
 bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
-  if (!banking_ || filter.inputs().size() != 1 || filter.inputs()[0]->size() != 1) return false;
+  if (!banking_ || filter.inputs().size() != 1) return false;
+  const bool scalar = filter.inputs()[0]->size() == 1;
   if (dynamic_cast<Threshold*>(&filter) != nullptr) {
     kind = Kind::Threshold;
   } else if (dynamic_cast<Watchdog*>(&filter) != nullptr) {
     kind = Kind::Watchdog;
   } else if (auto* average = dynamic_cast<MovingAverage*>(&filter); average != nullptr && average->scalar()) {
     kind = Kind::Average;
+  } else if (dynamic_cast<Debounce*>(&filter) != nullptr) {
+    kind = Kind::Debounce;
+  } else if (dynamic_cast<Frequency*>(&filter) != nullptr) {
+    kind = Kind::Frequency;
+  } else if (dynamic_cast<Norm*>(&filter) != nullptr) {
+    kind = Kind::Norm;
   } else {
     return false;
   }
-  return true;
+  return scalar || kind == Kind::Watchdog || kind == Kind::Frequency || kind == Kind::Norm;
 }
 
 void Banks::add(Filter* filter) {
@@ -46,14 +56,23 @@ void Banks::add(Filter* filter) {
     reader.cursor.follow(filter->first_);
     reader.begin = reader.end = static_cast<std::uint32_t>(members_.size());
     reader.source = std::find(written_.begin(), written_.end(), input) == written_.end();
+    reader.first = static_cast<std::uint32_t>(readers_.size());
+    for (std::size_t r = 0; r < readers_.size(); ++r) {
+      if (readers_[r].cursor.signal() == input) {
+        reader.first = static_cast<std::uint32_t>(r);
+        break;
+      }
+    }
     readers_.push_back(std::move(reader));
     steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1)});
     const std::size_t samples = 2 * (input->buffer().capacity() + 1);  // written and injected
     if (times_.size() < samples) {
       times_.resize(samples);
-      values_.resize(samples);
       injected_.resize(samples);
+      finite_.resize(samples);
     }
+    readers_.back().width = static_cast<std::uint32_t>(input->size());
+    values_.resize(std::max(values_.size(), samples * input->size()));
   }
   Member m;
   m.filter = filter;
@@ -71,15 +90,17 @@ void Banks::add(Filter* filter) {
 void Banks::adopt(Member& member) {
   // Moves the filter's state into its bank; when the bank's array grows, every member of that
   // kind is pointed at its element's new address.
-  auto place = [&](auto& bank, auto state_of) {
+  auto place = [&](auto& bank, auto state_of) -> auto& {
     const auto* before = bank.data();
     bank.emplace_back();
     member.index = static_cast<std::uint32_t>(bank.size() - 1);
     state_of(member.filter).adopt(&bank.back());
-    if (bank.data() == before) return;
-    for (Member& m : members_) {
-      if (m.kind == member.kind && &m != &member) state_of(m.filter).rebind(&bank[m.index]);
+    if (bank.data() != before) {
+      for (Member& m : members_) {
+        if (m.kind == member.kind && &m != &member) state_of(m.filter).rebind(&bank[m.index]);
+      }
     }
+    return bank.back();
   };
   switch (member.kind) {
     case Kind::Threshold:
@@ -91,19 +112,43 @@ void Banks::adopt(Member& member) {
           watchdogs_, [](Filter * f) -> auto& { return static_cast<Watchdog*>(f)->state(); });
       break;
     case Kind::Average: {
-      place(
+      auto& s = place(
           averages_, [](Filter * f) -> auto& { return static_cast<MovingAverage*>(f)->state(); });
-      // Its ring too, next to the rings of the averages before it.
-      builtin::AverageState& s = averages_.back();
-      const double* before = rings_.data();
-      ring_offsets_.push_back(static_cast<std::uint32_t>(rings_.size()));
-      rings_.insert(rings_.end(), s.ring, s.ring + s.window);
-      s.ring = rings_.data() + ring_offsets_.back();
-      if (rings_.data() == before) break;
-      for (std::size_t i = 0; i < averages_.size(); ++i) averages_[i].ring = rings_.data() + ring_offsets_[i];
+      keep_ring(member, s.ring, s.window);
       break;
     }
+    case Kind::Debounce:
+      place(
+          debounces_, [](Filter * f) -> auto& { return static_cast<Debounce*>(f)->state(); });
+      break;
+    case Kind::Frequency: {
+      auto& s = place(
+          frequencies_, [](Filter * f) -> auto& { return static_cast<Frequency*>(f)->state(); });
+      keep_ring(member, s.ring, s.window);
+      break;
+    }
+    case Kind::Norm:
+      place(
+          norms_, [](Filter * f) -> auto& { return static_cast<Norm*>(f)->state(); });
+      break;
   }
+}
+
+void Banks::keep_ring(const Member& member, double* ring, std::uint32_t window) {
+  // The ring goes next to the rings of the filters before it; when rings_ grows, every state is
+  // pointed at its ring's new address.
+  const double* before = rings_.data();
+  ring_list_.push_back(Ring{member.kind, member.index, static_cast<std::uint32_t>(rings_.size())});
+  rings_.insert(rings_.end(), ring, ring + window);
+  if (rings_.data() != before) {
+    for (const Ring& r : ring_list_) ring_of(r) = rings_.data() + r.offset;
+  } else {
+    ring_of(ring_list_.back()) = rings_.data() + ring_list_.back().offset;
+  }
+}
+
+double*& Banks::ring_of(const Ring& ring) noexcept {
+  return ring.kind == Kind::Average ? averages_[ring.index].ring : frequencies_[ring.index].ring;
 }
 
 void Banks::run(Time now) noexcept {
@@ -115,7 +160,21 @@ void Banks::run(Time now) noexcept {
   // reads do not wait for one another (the run below would do them one filter after another,
   // each a chain of dependent loads). The rest, and any run with more than one new sample, are
   // read in turn below.
-  for (Reader& r : readers_) r.taken = r.source && r.cursor.take_single(r.time, r.value);
+  // A signal that several readers follow (filters of one signal with others in between) is read
+  // once: a reader one sample behind the first reader of its signal takes the same sample.
+  for (Reader& r : readers_) {
+    r.taken = false;
+    if (!r.source || r.width != 1) continue;
+    const Reader& first = readers_[r.first];
+    if (&first != &r && first.taken && r.cursor.one_behind(first.cursor)) {
+      r.cursor.follow(first.cursor);
+      r.time = first.time;
+      r.value = first.value;
+      r.taken = true;
+    } else {
+      r.taken = r.cursor.take_single(r.time, &r.value);
+    }
+  }
   for (const Step& step : steps_) {
     if (step.object != nullptr) {
       step.object->run(now);
@@ -141,31 +200,50 @@ void Banks::refresh() noexcept {
   }
 }
 
-void Banks::run_reader(Reader& reader, Time now) noexcept {
-  std::size_t samples = 0;
-  bool plain = true;  // every sample finite and written, not injected: the common case
+std::size_t Banks::read(Reader& reader) noexcept {
+  width_ = reader.width;
   if (reader.taken) {
     times_[0] = reader.time;
     values_[0] = reader.value;
     injected_[0] = 0;
-    plain = std::isfinite(reader.value);
-    samples = 1;
-  } else {
-    const std::uint64_t missed = reader.cursor.missed();
-    reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
-      times_[samples] = s.time;
-      values_[samples] = s.data[0];
-      injected_[samples] = s.injected ? 1 : 0;
-      plain = plain && !s.injected && std::isfinite(s.data[0]);
-      ++samples;
-    });
-    if (const std::uint64_t lost = reader.cursor.missed() - missed; lost != 0) {
-      for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
-        if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
-      }
+    finite_[0] = std::isfinite(reader.value) ? 1 : 0;
+    plain_ = finite_[0] != 0;
+    return 1;
+  }
+  if (reader.cursor.take_single(times_[0], values_.data())) {  // one new sample: the common case
+    bool finite = true;
+    for (std::size_t i = 0; i < width_; ++i) finite = finite && std::isfinite(values_[i]);
+    injected_[0] = 0;
+    finite_[0] = finite ? 1 : 0;
+    plain_ = finite;
+    return 1;
+  }
+  std::size_t samples = 0;
+  bool plain = true;  // every sample finite and written, not injected
+  const std::uint64_t missed = reader.cursor.missed();
+  reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
+    times_[samples] = s.time;
+    bool finite = true;
+    for (std::size_t i = 0; i < s.size; ++i) {
+      values_[samples * s.size + i] = s.data[i];
+      finite = finite && std::isfinite(s.data[i]);
+    }
+    injected_[samples] = s.injected ? 1 : 0;
+    finite_[samples] = finite ? 1 : 0;
+    plain = plain && !s.injected && finite;
+    ++samples;
+  });
+  if (const std::uint64_t lost = reader.cursor.missed() - missed; lost != 0) {
+    for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
+      if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
     }
   }
   plain_ = plain;
+  return samples;
+}
+
+void Banks::run_reader(Reader& reader, Time now) noexcept {
+  const std::size_t samples = read(reader);
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
@@ -176,6 +254,9 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
       case Kind::Threshold: run_threshold(m, samples); break;
       case Kind::Watchdog: run_watchdog(m, samples, now); break;
       case Kind::Average: run_average(m, samples); break;
+      case Kind::Debounce: run_debounce(m, samples); break;
+      case Kind::Frequency: run_frequency(m, samples); break;
+      case Kind::Norm: run_norm(m, samples); break;
     }
   }
 }
@@ -191,7 +272,7 @@ void Banks::run_out(Member& m, const Reader& reader, Time now) noexcept {
 
 void Banks::deliver(Member& m, std::size_t j) noexcept {
   Filter& f = *m.filter;
-  f.deliver(0, SampleView{times_[j], &values_[j], 1, injected_[j] != 0});
+  f.deliver(0, SampleView{times_[j], sample(j), width_, injected_[j] != 0});
   f.current_injected_ = false;
   m.slow = f.invalid_count_ != 0;
   m.reported = f.detected();
@@ -204,7 +285,7 @@ void Banks::run_threshold(Member& m, std::size_t samples) noexcept {
       deliver(m, j);
       continue;
     }
-    const double x = values_[j];
+    const double x = *sample(j);
     const bool detected = s.step(x, times_[j]);
     if (detected || m.reported) report(m, detected, x, times_[j]);
     if (s.output != nullptr) s.output->push(times_[j], s.output_value());
@@ -233,8 +314,48 @@ void Banks::run_average(Member& m, std::size_t samples) noexcept {
       deliver(m, j);
       continue;
     }
-    const double mean = s.step(values_[j]);
+    const double mean = s.step(*sample(j));
     if (s.output != nullptr) s.output->push(times_[j], mean);
+  }
+}
+
+void Banks::run_debounce(Member& m, std::size_t samples) noexcept {
+  builtin::DebounceState& s = debounces_[m.index];
+  for (std::size_t j = 0; j < samples; ++j) {
+    if (!judged_here(m, j)) {
+      deliver(m, j);
+      continue;
+    }
+    const double x = *sample(j);
+    const bool detected = s.step(x, times_[j]);
+    if (detected || m.reported) report(m, detected, x, times_[j]);
+    if (s.output != nullptr) s.output->push(times_[j], detected ? 1.0 : 0.0);
+  }
+}
+
+void Banks::run_frequency(Member& m, std::size_t samples) noexcept {
+  builtin::FrequencyState& s = frequencies_[m.index];
+  for (std::size_t j = 0; j < samples; ++j) {
+    if (!judged_here(m, j)) {
+      deliver(m, j);
+      continue;
+    }
+    bool detected = false;
+    double rate = 0.0;
+    if (!s.step(times_[j], detected, rate)) continue;
+    if (detected || m.reported) report(m, detected, rate, times_[j]);
+    if (s.output != nullptr) s.output->push(times_[j], rate);
+  }
+}
+
+void Banks::run_norm(Member& m, std::size_t samples) noexcept {
+  const builtin::NormState& s = norms_[m.index];
+  for (std::size_t j = 0; j < samples; ++j) {
+    if (!judged_here(m, j)) {
+      deliver(m, j);
+      continue;
+    }
+    if (s.output != nullptr) s.output->push(times_[j], s.step(sample(j), width_));
   }
 }
 

@@ -5,7 +5,7 @@
 //
 // A group runs its filters in creation order, as steps. A step is either one filter run as an
 // object (Filter::run), or a *reader*: consecutive built-in filters of a bankable type that read
-// one scalar signal. A reader reads each new sample of its signal once and hands it to each of its
+// one signal. A reader reads each new sample of its signal once and hands it to each of its
 // filters in turn; their state lives in one array per type (the banks), and they are run by a
 // switch over their type, not a virtual call. A filter object is touched only when it has an event
 // to raise, a non-finite or injected sample to judge, or a detour (disabled, shallow injection):
@@ -44,7 +44,7 @@ public:
   std::size_t banked() const noexcept { return members_.size(); }
 
 private:
-  enum class Kind : std::uint8_t { Threshold, Watchdog, Average };
+  enum class Kind : std::uint8_t { Threshold, Watchdog, Average, Debounce, Frequency, Norm };
   struct Member {
     Filter* filter = nullptr;
     std::uint32_t index = 0;   ///< its state in the array of its kind
@@ -58,8 +58,10 @@ private:
     SignalCursor cursor;
     std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
     std::uint32_t end = 0;
-    bool source = true;  ///< no filter of the group writes its signal: it can be read ahead
-    bool taken = false;  ///< read ahead: this run's one sample is `time`, `value`
+    std::uint32_t width = 1;  ///< doubles per sample
+    bool source = true;       ///< no filter of the group writes its signal: it can be read ahead
+    std::uint32_t first = 0;  ///< the first reader of the same signal (itself if none before)
+    bool taken = false;       ///< read ahead (a scalar): this run's one sample is `time`, `value`
     Time time{};
     double value = 0.0;
   };
@@ -67,24 +69,39 @@ private:
     Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader]
     std::uint32_t reader = 0;
   };
+  /// The ring of a banked filter's state (MovingAverage's samples, Frequency's intervals), kept in
+  /// rings_ after the others'.
+  struct Ring {
+    Kind kind;
+    std::uint32_t index;
+    std::uint32_t offset;
+  };
 
   bool bankable(Filter& filter, Kind& kind) const noexcept;
   void adopt(Member& member);
-  void refresh() noexcept;
-  void run_reader(Reader& reader, Time now) noexcept;
-  void run_out(Member& m, const Reader& reader, Time now) noexcept;
-  void run_threshold(Member& m, std::size_t samples) noexcept;
-  void run_watchdog(Member& m, std::size_t samples, Time now) noexcept;
-  void run_average(Member& m, std::size_t samples) noexcept;
+  void keep_ring(const Member& member, double* ring, std::uint32_t window);
+  double*& ring_of(const Ring& ring) noexcept;
+  [[gnu::cold]] void refresh() noexcept;
+  /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_.
+  [[gnu::always_inline]] inline std::size_t read(Reader& reader) noexcept;
+  [[gnu::always_inline]] inline void run_reader(Reader& reader, Time now) noexcept;
+  [[gnu::cold]] void run_out(Member& m, const Reader& reader, Time now) noexcept;
+  [[gnu::always_inline]] inline void run_threshold(Member& m, std::size_t samples) noexcept;
+  [[gnu::always_inline]] inline void run_watchdog(Member& m, std::size_t samples, Time now) noexcept;
+  [[gnu::always_inline]] inline void run_average(Member& m, std::size_t samples) noexcept;
+  [[gnu::always_inline]] inline void run_debounce(Member& m, std::size_t samples) noexcept;
+  [[gnu::always_inline]] inline void run_frequency(Member& m, std::size_t samples) noexcept;
+  [[gnu::always_inline]] inline void run_norm(Member& m, std::size_t samples) noexcept;
   /// Sample `j` of this read through the object path (non-finite, injected, or the input marked).
-  void deliver(Member& m, std::size_t j) noexcept;
-  void report(Member& m, bool detected, double value, Time time) noexcept {
+  [[gnu::cold]] void deliver(Member& m, std::size_t j) noexcept;
+  [[gnu::cold]] void report(Member& m, bool detected, double value, Time time) noexcept {
     m.filter->report(detected, value, time);
     m.reported = m.filter->detected();
   }
   bool judged_here(const Member& m, std::size_t j) const noexcept {
-    return !m.slow && (plain_ || (injected_[j] == 0 && std::isfinite(values_[j])));
+    return !m.slow && (plain_ || (injected_[j] == 0 && finite_[j] != 0));
   }
+  const double* sample(std::size_t j) const noexcept { return &values_[j * width_]; }
 
   bool banking_;
   std::size_t size_ = 0;
@@ -95,12 +112,17 @@ private:
   std::vector<builtin::ThresholdState> thresholds_;
   std::vector<builtin::WatchdogState> watchdogs_;
   std::vector<builtin::AverageState> averages_;
-  std::vector<double> rings_;                ///< the averages' rings, one after the other
-  std::vector<std::uint32_t> ring_offsets_;  ///< per average: where its ring starts in rings_
+  std::vector<builtin::DebounceState> debounces_;
+  std::vector<builtin::FrequencyState> frequencies_;
+  std::vector<builtin::NormState> norms_;
+  std::vector<double> rings_;
+  std::vector<Ring> ring_list_;
   // The samples of the current read, for every filter of the reader in turn.
   std::vector<Time> times_;
-  std::vector<double> values_;
+  std::vector<double> values_;  ///< width_ doubles per sample
   std::vector<char> injected_;
+  std::vector<char> finite_;
+  std::size_t width_ = 1;
   bool plain_ = true;                      ///< every sample of the current read is finite and not injected
   std::atomic<std::uint32_t> changes_{0};  ///< bumped by a member's set_enabled() and inject()
   std::uint32_t seen_ = 0;

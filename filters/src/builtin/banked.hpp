@@ -8,6 +8,7 @@
 // filter of its signal, no virtual call, no object touched unless an event is due) is what the
 // differential test checks (tests/unit/filters/bank_test.cpp).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -95,6 +96,94 @@ struct AverageState {
     count = next = 0;
     sum = 0.0;
   }
+};
+
+/// Debounce's state: on must persist before the onset, off before the completion.
+struct DebounceState {
+  Persistence on;
+  Persistence off;
+  Signal* output = nullptr;
+  bool detected = false;
+
+  /// One finite sample; returns whether the debounced input is on after it.
+  bool step(double x, Time t) noexcept {
+    const bool is_on = x != 0.0;
+    if (on.update(is_on, t)) detected = true;
+    if (off.update(!is_on, t)) detected = false;
+    return detected;
+  }
+  void reset() noexcept {
+    detected = false;
+    on.reset();
+    off.reset();
+  }
+};
+
+/// Frequency's state: the last `window` intervals between samples and their running sum.
+struct FrequencyState {
+  double* ring = nullptr;  ///< window intervals in seconds: the filter object's, or its bank's
+  double sum = 0.0;
+  double min_rate = 0.0;
+  double max_rate = 0.0;
+  double max_jitter = 0.0;
+  Time previous{};
+  Signal* output = nullptr;
+  std::uint32_t window = 1;
+  std::uint32_t next = 0;
+  std::uint32_t filled = 0;
+  bool has_previous = false;
+
+  /// One finite sample at `t`. Returns true once the window is full, with the verdict in
+  /// `detected` and the mean rate in `rate`; false while it fills.
+  bool step(Time t, bool& detected, double& rate) noexcept {
+    bool judged = false;
+    if (has_previous) {
+      const double dt = to_seconds(t - previous);
+      if (filled == window) sum -= ring[next];
+      ring[next] = dt;
+      sum += dt;
+      next = (next + 1) % window;
+      if (filled < window) ++filled;
+      if (filled == window && sum > 0) {
+        const double mean = sum / static_cast<double>(window);
+        rate = 1.0 / mean;
+        const bool slow = min_rate > 0 && rate < min_rate;
+        const bool fast = max_rate > 0 && rate > max_rate;
+        const bool jitter = max_jitter > 0 && std::fabs(dt - mean) > max_jitter;
+        detected = slow || fast || jitter;
+        judged = true;
+      }
+    }
+    previous = t;
+    has_previous = true;
+    return judged;
+  }
+  void reset() noexcept {
+    has_previous = false;
+    filled = next = 0;
+    sum = 0;
+  }
+};
+
+/// Norm's state: which norm, and where it goes.
+struct NormState {
+  int kind = 0;  ///< 0: L2, 1: L1, 2: L∞
+  Signal* output = nullptr;
+
+  double step(const double* v, std::size_t n) const noexcept {
+    double x = 0.0;
+    if (kind == 0) {
+      for (std::size_t i = 0; i < n; ++i) x += v[i] * v[i];
+      return std::sqrt(x);
+    }
+    if (kind == 1) {
+      for (std::size_t i = 0; i < n; ++i) x += std::fabs(v[i]);
+      return x;
+    }
+    for (std::size_t i = 0; i < n; ++i) x = std::max(x, std::fabs(v[i]));
+    return x;
+  }
+  void reset() noexcept {}
 };
 
 /// The state a banked filter judges with: its own until a bank adopts it (Banks::add), then the
@@ -200,6 +289,67 @@ private:
   double* out_ = nullptr;   ///< a vector's average written (size_ values)
   double inline_[kInline] = {};
   std::vector<double> heap_;
+};
+
+/// A non-zero input that holds for `persistence` → onset; zero for `release` samples → completion.
+class Debounce final : public Filter {
+public:
+  explicit Debounce(FilterInit init);
+  static FilterManifest manifest();
+  BankedState<DebounceState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    const bool detected = state_->step(s.scalar(), s.time);
+    report(detected, s.scalar(), s.time);
+    write(0, s.time, detected ? 1.0 : 0.0);
+  }
+  void on_reset() noexcept override { state_->reset(); }
+
+private:
+  BankedState<DebounceState> state_;
+};
+
+/// Rate and jitter of a signal's samples over the last `window` intervals.
+class Frequency final : public Filter {
+public:
+  explicit Frequency(FilterInit init);
+  static FilterManifest manifest();
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>(1, 1);
+  }
+  BankedState<FrequencyState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override {
+    bool detected = false;
+    double rate = 0.0;
+    if (!state_->step(s.time, detected, rate)) return;
+    report(detected, rate, s.time);
+    write(0, s.time, rate);
+  }
+  void on_reset() noexcept override { state_->reset(); }
+
+private:
+  BankedState<FrequencyState> state_;
+  std::vector<double> intervals_;  ///< the ring, until a bank adopts it
+};
+
+/// L2 (default), L1 or L∞ norm of a vector.
+class Norm final : public Filter {
+public:
+  explicit Norm(FilterInit init);
+  static FilterManifest manifest();
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
+    return std::vector<std::size_t>{1};
+  }
+  BankedState<NormState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t, const SampleView& s) noexcept override { write(0, s.time, state_->step(s.data, s.size)); }
+
+private:
+  BankedState<NormState> state_;
 };
 
 }  // namespace safecass::builtin

@@ -6,8 +6,6 @@
 
 namespace safecass::builtin {
 
-namespace {}  // namespace
-
 Threshold::Threshold(FilterInit init) : Filter(std::move(init)) {
   ThresholdState& s = state_.own();
   s.above = text("direction") == "above";
@@ -172,47 +170,27 @@ private:
   bool has_previous_ = false;
 };
 
-/// A non-zero input that holds for `persistence` → onset; zero for `release` samples → completion.
-class Debounce final : public Filter {
-public:
-  explicit Debounce(FilterInit init)
-      : Filter(std::move(init)),
-        on_(number("persistence"), text("persistence_unit") == "seconds"),
-        off_(number("release"), false) {}
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "debounces an on/off input: on must persist before the onset, off must persist before the completion";
-    m.params = {ParamSpec::signal("input_signal", "scalar signal, 0 = off"), persistence_param(3),
-                persistence_unit_param(),
-                ParamSpec::integer("release", "consecutive off samples before the completion", 1.0, 1, 1e9),
-                ParamSpec::signal("output_signal", "the debounced value, 1 or 0", true)};
-    add_event_params(m, true);
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    return m;
-  }
-
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    const bool on = s.scalar() != 0.0;
-    if (on_.update(on, s.time)) detected_ = true;
-    if (off_.update(!on, s.time)) detected_ = false;
-    report(detected_, s.scalar(), s.time);
-    write(0, s.time, detected_ ? 1.0 : 0.0);
-  }
-  void on_reset() noexcept override {
-    detected_ = false;
-    on_.reset();
-    off_.reset();
-  }
-
-private:
-  Persistence on_;
-  Persistence off_;
-  bool detected_ = false;
-};
-
 }  // namespace
+
+Debounce::Debounce(FilterInit init) : Filter(std::move(init)) {
+  DebounceState& s = state_.own();
+  s.on = Persistence(number("persistence"), text("persistence_unit") == "seconds");
+  s.off = Persistence(number("release"), false);
+  s.output = outputs().empty() ? nullptr : outputs()[0];
+}
+
+FilterManifest Debounce::manifest() {
+  FilterManifest m;
+  m.doc = "debounces an on/off input: on must persist before the onset, off must persist before the completion";
+  m.params = {ParamSpec::signal("input_signal", "scalar signal, 0 = off"), persistence_param(3),
+              persistence_unit_param(),
+              ParamSpec::integer("release", "consecutive off samples before the completion", 1.0, 1, 1e9),
+              ParamSpec::signal("output_signal", "the debounced value, 1 or 0", true)};
+  add_event_params(m, true);
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  return m;
+}
 
 void register_detection(FilterRegistry& r) {
   (void)r.add<Threshold>("Threshold");

@@ -90,77 +90,36 @@ FilterManifest Watchdog::manifest() {
   return m;
 }
 
+Frequency::Frequency(FilterInit init)
+    : Filter(std::move(init)), intervals_(static_cast<std::size_t>(number("window")), 0.0) {
+  FrequencyState& s = state_.own();
+  s.ring = intervals_.data();
+  s.window = static_cast<std::uint32_t>(intervals_.size());
+  s.min_rate = number("min_rate");
+  s.max_rate = number("max_rate");
+  s.max_jitter = number("max_jitter");
+  s.output = outputs().empty() ? nullptr : outputs()[0];
+}
+
+FilterManifest Frequency::manifest() {
+  FilterManifest m;
+  m.doc =
+      "event when the sample rate leaves [min_rate, max_rate] or an interval deviates from the mean by more than "
+      "max_jitter";
+  m.params = {ParamSpec::signal("input_signal", "any signal whose sample times are judged"),
+              ParamSpec::number("min_rate", "lowest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
+              ParamSpec::number("max_rate", "highest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
+              ParamSpec::number("max_jitter", "largest allowed |interval - mean interval| in seconds (0: no bound)",
+                                0.0, 0, 1e9),
+              ParamSpec::integer("window", "intervals averaged; judged once the window is full", 10.0, 1, 1e6),
+              ParamSpec::signal("output_signal", "the mean rate in Hz", true)};
+  add_event_params(m, true);
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  return m;
+}
+
 namespace {
-
-/// Rate and jitter of a signal's samples over the last `window` intervals.
-class Frequency final : public Filter {
-public:
-  explicit Frequency(FilterInit init)
-      : Filter(std::move(init)),
-        min_rate_(number("min_rate")),
-        max_rate_(number("max_rate")),
-        max_jitter_(number("max_jitter")),
-        window_(static_cast<std::size_t>(number("window"))),
-        intervals_(window_, 0.0) {}
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc =
-        "event when the sample rate leaves [min_rate, max_rate] or an interval deviates from the mean by more than "
-        "max_jitter";
-    m.params = {ParamSpec::signal("input_signal", "any signal whose sample times are judged"),
-                ParamSpec::number("min_rate", "lowest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
-                ParamSpec::number("max_rate", "highest allowed rate in Hz (0: no bound)", 0.0, 0, 1e12),
-                ParamSpec::number("max_jitter", "largest allowed |interval - mean interval| in seconds (0: no bound)",
-                                  0.0, 0, 1e9),
-                ParamSpec::integer("window", "intervals averaged; judged once the window is full", 10.0, 1, 1e6),
-                ParamSpec::signal("output_signal", "the mean rate in Hz", true)};
-    add_event_params(m, true);
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    return m;
-  }
-  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
-    return any_input_no_output(s);
-  }
-
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    if (has_previous_) {
-      const double dt = to_seconds(s.time - previous_);
-      if (filled_ == window_) sum_ -= intervals_[next_];
-      intervals_[next_] = dt;
-      sum_ += dt;
-      next_ = (next_ + 1) % window_;
-      if (filled_ < window_) ++filled_;
-      if (filled_ == window_ && sum_ > 0) {
-        const double mean = sum_ / static_cast<double>(window_);
-        const double rate = 1.0 / mean;
-        const bool slow = min_rate_ > 0 && rate < min_rate_;
-        const bool fast = max_rate_ > 0 && rate > max_rate_;
-        const bool jitter = max_jitter_ > 0 && std::fabs(dt - mean) > max_jitter_;
-        report(slow || fast || jitter, rate, s.time);
-        write(0, s.time, rate);
-      }
-    }
-    previous_ = s.time;
-    has_previous_ = true;
-  }
-  void on_reset() noexcept override {
-    has_previous_ = false;
-    filled_ = next_ = 0;
-    sum_ = 0;
-  }
-
-private:
-  double min_rate_, max_rate_, max_jitter_;
-  std::size_t window_;
-  std::vector<double> intervals_;
-  std::size_t next_ = 0;
-  std::size_t filled_ = 0;
-  double sum_ = 0;
-  Time previous_{};
-  bool has_previous_ = false;
-};
 
 /// Execution time / period above `max_duty` → onset.
 class DutyCycle final : public Filter {

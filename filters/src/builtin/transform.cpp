@@ -149,50 +149,27 @@ void MovingAverage::on_reset() noexcept {
   std::fill(sum_, sum_ + size_, 0.0);
 }
 
+Norm::Norm(FilterInit init) : Filter(std::move(init)) {
+  const std::string& norm = text("norm");
+  state_.own().kind = norm == "L1" ? 1 : norm == "Linf" ? 2 : 0;
+  state_.own().output = outputs().empty() ? nullptr : outputs()[0];
+}
+
+FilterManifest Norm::manifest() {
+  FilterManifest m;
+  m.doc = "norm of a vector signal";
+  m.params = {
+      ParamSpec::signal("input_signal", "vector (or scalar) signal"),
+      ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
+      ParamSpec::signal("output_signal", "the norm (scalar; default: the signal named after the filter)", true)};
+  m.inputs = {"input_signal"};
+  m.outputs = {"output_signal"};
+  m.generates_events = false;
+  m.default_output = true;
+  return m;
+}
+
 namespace {
-
-/// L2 (default), L1 or L∞ norm of a vector.
-class Norm final : public Filter {
-public:
-  explicit Norm(FilterInit init)
-      : Filter(std::move(init)),
-        kind_(text("norm") == "L1"     ? 1
-              : text("norm") == "Linf" ? 2
-                                       : 0) {}
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "norm of a vector signal";
-    m.params = {
-        ParamSpec::signal("input_signal", "vector (or scalar) signal"),
-        ParamSpec::choice("norm", "which norm", {"L2", "L1", "Linf"}, "L2"),
-        ParamSpec::signal("output_signal", "the norm (scalar; default: the signal named after the filter)", true)};
-    m.inputs = {"input_signal"};
-    m.outputs = {"output_signal"};
-    m.generates_events = false;
-    m.default_output = true;
-    return m;
-  }
-  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape&) {
-    return std::vector<std::size_t>{1};
-  }
-
-protected:
-  void on_sample(std::size_t, const SampleView& s) noexcept override {
-    double n = 0.0;
-    if (kind_ == 0) {
-      for (std::size_t i = 0; i < s.size; ++i) n += s[i] * s[i];
-      n = std::sqrt(n);
-    } else if (kind_ == 1) {
-      for (std::size_t i = 0; i < s.size; ++i) n += std::fabs(s[i]);
-    } else {
-      for (std::size_t i = 0; i < s.size; ++i) n = std::max(n, std::fabs(s[i]));
-    }
-    write(0, s.time, n);
-  }
-
-private:
-  int kind_;
-};
 
 /// Element-wise a (op) b, where b is a second signal or the constant `operand`.
 class Arithmetic final : public Filter {

@@ -169,7 +169,8 @@ TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
 }
 
 TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsAndDetours) {
-  // Banks (docs/filters.md): a Threshold, a Watchdog and a MovingAverage per signal, in banks;
+  // Banks (docs/filters.md): a Threshold, a Watchdog and a MovingAverage per signal, a vector's
+  // Norm → MovingAverage → Threshold, a Debounce and a Frequency, in banks;
   // several samples per run, a NaN now and then, a deep injection, a filter disabled and enabled
   // again: none of it allocates after the warm-up (the deep injection's ring is made by the
   // first injection, in the warm-up).
@@ -182,13 +183,23 @@ TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsA
     s.add("Watchdog", {{"input_signal", x}, {"timeout", 1.0}});
     s.add("MovingAverage", {{"input_signal", x}, {"window", 10.0}});
   }
-  ASSERT_EQ(s.monitor.banked_count(), 150U);
+  // A vector through a banked pipeline, and the other banked types.
+  Signal* force = *s.monitor.add_signal("C.force", 3);
+  s.add("Norm", {{"input_signal", std::string("force")}, {"output_signal", std::string("norm")}});
+  s.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}});
+  s.add("Threshold",
+        {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  s.add("Debounce", {{"input_signal", std::string("x0")}, {"event_onset", std::string("EVT_X")}});
+  s.add("Frequency", {{"input_signal", std::string("x1")}, {"min_rate", 1.0}, {"event_onset", std::string("EVT_X")}});
+  ASSERT_EQ(s.monitor.banked_count(), 155U);
   Filter* toggled = s.monitor.filters()[1].get();
+  const double f[] = {1, 2, 3};
   auto cycle = [&](int i) {
     for (Signal* x : signals) {
       x->push(Time{10 * i}, i % 97 == 0 ? std::nan("") : 1.0);
       x->push(Time{10 * i + 5}, 2.0);
     }
+    force->push(Time{10 * i}, f);
     if (i % 50 == 0) (void)s.monitor.inject_deep("C.x3", {{3.0}}, Time{10 * i + 6});
     if (i % 30 == 0) toggled->set_enabled(i % 60 != 0);
     s.monitor.run_active(s.component, Time{10 * i + 9});
@@ -201,6 +212,7 @@ TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsA
                   x->push(Time{10 * i}, i % 97 == 0 ? std::nan("") : 1.0);
                   x->push(Time{10 * i + 5}, 2.0);
                 }
+                force->push(Time{10 * i}, f);
                 if (i % 30 == 0) toggled->set_enabled(i % 60 != 0);
                 s.monitor.run_active(s.component, Time{10 * i + 9});
               }

@@ -2,10 +2,12 @@
 // same filters, not new semantics. The differential test runs one random system twice, its
 // filters run as objects (Monitor(..., banks = false)) and in banks, and requires byte-equal
 // observer streams, outputs, detections and missed-sample counts after every cycle. The systems
-// mix every banked type with an object filter (Range) in between, ACTIVE and PASSIVE, pipelines
-// (a Threshold on a MovingAverage's output), EDGE and LEVEL, persistence in samples and seconds;
-// the signals mix noise around the limits, steps, ramps, NaN and ±inf; the runs mix several
-// samples per cycle, none, deep and shallow injection, and enabling and disabling filters.
+// mix every banked type (Threshold, Watchdog, MovingAverage, Debounce, Frequency, Norm) with an
+// object filter (Range) in between, ACTIVE and PASSIVE, scalar and vector signals, pipelines (a
+// filter on an earlier filter's output), EDGE and LEVEL, persistence in samples and seconds; the
+// signals mix noise around the limits, steps, ramps, zeros, NaN and ±inf; the runs mix several
+// samples per cycle, none, deep and shallow injection, enabling and disabling filters, and a
+// pipeline that fails half-built and is undone.
 //
 // SAFECASS_BANK_SEEDS=N runs N seeds (the long run in docs/filters.md); `make test` runs 2,000.
 
@@ -92,8 +94,12 @@ public:
 
   void build(World& a, World& b) {
     const int signals = pick(1, 3);
-    for (int i = 0; i < signals; ++i) names_.push_back("s" + std::to_string(i));
-    for (const std::string& s : names_) both(a, b, [&](World& w) { (void)w.monitor().add_signal("C." + s); });
+    for (int i = 0; i < signals; ++i) inputs_.push_back({"s" + std::to_string(i), 1});
+    if (pick(0, 1) == 0) inputs_.push_back({"v", 3});  // a vector (a force)
+    signals_ = inputs_;
+    for (const auto& [name, size] : signals_) {
+      both(a, b, [&](World& w) { (void)w.monitor().add_signal("C." + name, size); });
+    }
     const int filters = pick(1, 8);
     for (int i = 0; i < filters; ++i) {
       FilterConfig c = next_filter(i);
@@ -101,45 +107,44 @@ public:
         auto f = w.monitor().add_filter(c);
         ASSERT_TRUE(f) << f.error().message;
       });
-      filter_names_.push_back(c.name);
+      filters_.push_back({c.name, width_of(std::get<std::string>(c.params.at("input_signal")))});
     }
   }
 
   /// One cycle: samples, faults and changes, then the run at the cycle's time.
   void cycle(World& a, World& b, int k) {
     const std::int64_t now = (k + 1) * 1'000'000;  // 1 ms
-    for (std::size_t s = 0; s < names_.size(); ++s) {
+    for (std::size_t s = 0; s < signals_.size(); ++s) {
       const int samples = pick(0, 6) < 4 ? 1 : pick(0, 3);
       for (int j = 0; j < samples; ++j) {
-        const double x = value(s, k);
+        std::vector<double> x(signals_[s].second);
+        for (double& e : x) e = value(s, k);
         const Time t{now - (samples - j) * 100'000};
-        both(a, b, [&](World& w) { w.monitor().signals().find("C." + names_[s])->push(t, x); });
+        both(a, b, [&](World& w) { w.monitor().signals().find("C." + signals_[s].first)->push(t, x.data()); });
       }
     }
     if (pick(0, 19) == 0) {  // deep injection
-      const std::string s = "C." + names_[static_cast<std::size_t>(pick(0, static_cast<int>(names_.size()) - 1))];
-      const std::vector<std::vector<double>> v{{injected()}, {injected()}};
-      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_deep(s, v, Time{now - 50'000})); });
+      const auto& [name, size] = signals_[index(signals_.size())];
+      const std::vector<std::vector<double>> v{injected(size), injected(size)};
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_deep("C." + name, v, Time{now - 50'000})); });
     }
     if (pick(0, 19) == 0) {  // shallow injection
-      const std::string& f =
-          filter_names_[static_cast<std::size_t>(pick(0, static_cast<int>(filter_names_.size()) - 1))];
+      const auto& [name, size] = filters_[index(filters_.size())];
       std::vector<std::vector<double>> v(static_cast<std::size_t>(pick(1, 3)));
-      for (auto& x : v) x = {injected()};
-      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_shallow(f, v)); });
+      for (auto& x : v) x = injected(size);
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_shallow(name, v)); });
     }
     if (k == 30 && pick(0, 1) == 0) {  // a pipeline that fails at its second stage: undone whole
       FilterConfig first;
       first.type = "MovingAverage";
       first.target.component = "C";
-      first.params = {{"input_signal", names_[0]}};
+      first.params = {{"input_signal", signals_[0].first}};
       FilterConfig second = first;
       second.type = "NoSuchType";
       both(a, b, [&](World& w) { ASSERT_FALSE(w.monitor().add_pipeline("undone", {first, second})); });
     }
     if (pick(0, 14) == 0) {  // enable or disable a filter
-      const std::string& f =
-          filter_names_[static_cast<std::size_t>(pick(0, static_cast<int>(filter_names_.size()) - 1))];
+      const std::string& f = filters_[index(filters_.size())].first;
       const bool on = pick(0, 1) == 0;
       both(a, b, [&](World& w) { w.monitor().find_filter(f)->set_enabled(on); });
     }
@@ -151,13 +156,22 @@ public:
   }
 
 private:
+  using Named = std::pair<std::string, std::size_t>;  // a name and a width
+
   template <class F>
   static void both(World& a, World& b, F&& f) {
     f(a);
     f(b);
   }
   int pick(int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(rng_); }
+  std::size_t index(std::size_t n) { return static_cast<std::size_t>(pick(0, static_cast<int>(n) - 1)); }
   double real(double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng_); }
+  std::size_t width_of(const std::string& signal) const {
+    for (const auto& [name, size] : signals_) {
+      if (name == signal) return size;
+    }
+    return 1;
+  }
 
   /// Values around 10 (every threshold is near it): noise, steps, ramps, and now and then NaN or ±inf.
   double value(std::size_t signal, int k) {
@@ -172,9 +186,29 @@ private:
       default: return 10.0 + real(-2.0, 2.0);                                 // noise around the limits
     }
   }
+  /// An injected sample: finite (injection refuses others), on either side of the limits.
+  std::vector<double> injected(std::size_t size) {
+    std::vector<double> v(size);
+    for (double& x : v) x = pick(0, 2) == 0 ? 20.0 : pick(0, 3) == 0 ? 0.0 : 10.0 + real(-2.0, 2.0);
+    return v;
+  }
 
-  /// An injected value: finite (injection refuses others), on either side of the limits.
-  double injected() { return pick(0, 1) == 0 ? 20.0 : 10.0 + real(-2.0, 2.0); }
+  /// A scalar input: a signal, or sometimes the output of an earlier filter (a pipeline).
+  std::string scalar_input() {
+    std::vector<std::string> scalars;
+    for (const auto& [name, size] : inputs_) {
+      if (size == 1) scalars.push_back(name);
+    }
+    if (!outputs_.empty() && pick(0, 2) == 0) return outputs_[index(outputs_.size())];
+    return scalars[index(scalars.size())];
+  }
+  std::string any_input() { return pick(0, 2) == 0 ? inputs_[index(inputs_.size())].first : scalar_input(); }
+  /// Names an output `name`, readable by the filters after this one.
+  void output(FilterConfig& c, const std::string& name) {
+    c.params["output_signal"] = name;
+    outputs_.push_back(name);
+    signals_.push_back({name, 1});
+  }
 
   FilterConfig next_filter(int i) {
     FilterConfig c;
@@ -183,55 +217,79 @@ private:
     c.execution = pick(0, 3) == 0 ? ExecutionMode::Passive : ExecutionMode::Active;
     c.detection = pick(0, 2) == 0 ? DetectionMode::Level : DetectionMode::Edge;
     c.enabled = pick(0, 9) != 0;
-    // Mostly the signals; sometimes the output of an earlier average (a pipeline).
-    std::string input = names_[static_cast<std::size_t>(pick(0, static_cast<int>(names_.size()) - 1))];
-    if (!averages_.empty() && pick(0, 3) == 0)
-      input = averages_[static_cast<std::size_t>(pick(0, static_cast<int>(averages_.size()) - 1))];
     const std::string event = "EVT_" + std::to_string(pick(0, kEvents - 1));
-    switch (pick(0, 3)) {
-      case 0: {
+    auto events = [&] {
+      c.params["event_onset"] = event;
+      c.params["event_completion"] = "/" + event;
+    };
+    auto persistence = [&](const char* unit_param) {
+      const bool seconds = pick(0, 1) == 0;
+      c.params["persistence"] = seconds ? real(0.0, 0.004) : static_cast<double>(pick(0, 3));
+      if (unit_param != nullptr) c.params[unit_param] = std::string(seconds ? "seconds" : "samples");
+    };
+    switch (pick(0, 6)) {
+      case 0:
         c.type = "Threshold";
-        c.params = {{"input_signal", input},
+        c.params = {{"input_signal", scalar_input()},
                     {"threshold", 10.0 + real(-1.0, 1.0)},
                     {"tolerance", pick(0, 1) == 0 ? 0.0 : real(0.0, 0.5)},
                     {"hysteresis", pick(0, 1) == 0 ? 0.0 : real(0.0, 1.5)},
-                    {"direction", std::string(pick(0, 2) == 0 ? "below" : "above")},
-                    {"event_onset", event}};
-        if (pick(0, 1) == 0) {
-          const bool seconds = pick(0, 1) == 0;
-          c.params["persistence"] = seconds ? real(0.0, 0.004) : static_cast<double>(pick(0, 3));
-          c.params["persistence_unit"] = std::string(seconds ? "seconds" : "samples");
-        }
-        if (pick(0, 1) == 0) c.params["output_signal"] = "out" + std::to_string(i);
+                    {"direction", std::string(pick(0, 2) == 0 ? "below" : "above")}};
+        events();
+        if (pick(0, 1) == 0) persistence("persistence_unit");
+        if (pick(0, 1) == 0) output(c, "out" + std::to_string(i));
         break;
-      }
       case 1:
         c.type = "Watchdog";
-        c.params = {{"input_signal", input},
-                    {"timeout", pick(5, 40) * 1e-4},
-                    {"event_onset", event},
-                    {"event_completion", "/" + event}};
-        if (pick(0, 1) == 0) c.params["output_signal"] = "age" + std::to_string(i);
+        c.params = {{"input_signal", any_input()}, {"timeout", pick(5, 40) * 1e-4}};
+        events();
+        if (pick(0, 1) == 0) output(c, "age" + std::to_string(i));
         break;
       case 2:
         c.type = "MovingAverage";
-        c.params = {{"input_signal", input}, {"window", static_cast<double>(pick(1, 5))}};
-        averages_.push_back("MovingAverage_" + std::to_string(i + 1));  // the default output's name
-        c.name = "MovingAverage_" + std::to_string(i + 1);
-        c.params["output_signal"] = averages_.back();
+        c.params = {{"input_signal", scalar_input()}, {"window", static_cast<double>(pick(1, 5))}};
+        output(c, "mean" + std::to_string(i));
         break;
+      case 3:
+        c.type = "Debounce";
+        c.params = {{"input_signal", scalar_input()}, {"release", static_cast<double>(pick(1, 3))}};
+        events();
+        if (pick(0, 1) == 0) persistence("persistence_unit");
+        if (pick(0, 1) == 0) output(c, "debounced" + std::to_string(i));
+        break;
+      case 4:
+        c.type = "Frequency";
+        c.params = {{"input_signal", any_input()},
+                    {"min_rate", pick(0, 1) == 0 ? 0.0 : real(500.0, 1500.0)},
+                    {"max_rate", pick(0, 1) == 0 ? 0.0 : real(1000.0, 5000.0)},
+                    {"max_jitter", pick(0, 1) == 0 ? 0.0 : real(0.0, 0.0005)},
+                    {"window", static_cast<double>(pick(1, 4))}};
+        events();
+        if (pick(0, 1) == 0) output(c, "rate" + std::to_string(i));
+        break;
+      case 5: {
+        c.type = "Norm";
+        std::vector<std::string> all;
+        for (const auto& [name, size] : inputs_) all.push_back(name);
+        const char* norms[] = {"L2", "L1", "Linf"};
+        c.params = {{"input_signal", all[index(all.size())]}, {"norm", std::string(norms[pick(0, 2)])}};
+        output(c, "norm" + std::to_string(i));
+        break;
+      }
       default:
         c.type = "Range";  // not banked: runs as an object between banked filters
-        c.params = {{"input_signal", input}, {"min", 9.0}, {"max", 11.0}, {"event_onset", event}};
+        c.params = {{"input_signal", scalar_input()}, {"min", 9.0}, {"max", 11.0}};
+        events();
         break;
     }
     return c;
   }
 
   std::mt19937 rng_;
-  std::vector<std::string> names_;
-  std::vector<std::string> averages_;
-  std::vector<std::string> filter_names_;
+  std::vector<Named> inputs_;         ///< the signals the cycle writes
+  std::vector<Named> signals_;        ///< every signal: the inputs, then the filters' outputs
+  std::vector<std::string> outputs_;  ///< the scalar outputs, in the order made
+  std::vector<Named> filters_;        ///< each filter and its input's width
 };
 
 /// The first line where `a` and `b` differ, with the line before it.

@@ -236,15 +236,15 @@ public:
       }
     }
   }
-  /// Reads the next sample of a scalar signal when it is the only unread one and was written, not
-  /// injected: true, and the cursor moves past it. Otherwise false, and nothing changes (read
-  /// with next() or read_new()). Lock-free, allocation-free.
-  bool take_single(Time& time, double& value) noexcept {
+  /// Reads the next sample into `out` (size() doubles) when it is the only unread one and was
+  /// written, not injected: true, and the cursor moves past it. Otherwise false, and nothing
+  /// changes (read with next() or read_new()). Lock-free, allocation-free.
+  bool take_single(Time& time, double* out) noexcept {
     if (signal_ == nullptr) return false;
     if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) return false;
     const HistoryBuffer& b = signal_->buffer();
     std::uint64_t end = b.end();
-    if (end != next_ + 1 || !b.read_published(next_, time, &value, end)) return false;
+    if (end != next_ + 1 || !b.read_published(next_, time, out, end)) return false;
     ++next_;
     return true;
   }
@@ -279,6 +279,10 @@ public:
     next_ = other.next_;
     injected_next_ = other.injected_next_;
     kept_ = -1;
+  }
+  /// Whether `other`, a cursor of the same signal, stands one written sample after this one.
+  bool one_behind(const SignalCursor& other) const noexcept {
+    return next_ + 1 == other.next_ && injected_next_ == other.injected_next_;
   }
   /// Whether this cursor and `other`, of the same signal, read the same sample next.
   bool level_with(const SignalCursor& other) const noexcept {
