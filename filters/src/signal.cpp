@@ -12,11 +12,12 @@ std::size_t round_up_pow2(std::size_t n) {
 }
 }  // namespace
 
-HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity)
+HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity, bool keyed)
     : width_(width),
-      stride_(width + kHeader),
+      header_(keyed ? 2 : 1),
+      stride_(width + header_),
       mask_(round_up_pow2(capacity < 2 ? 2 : capacity) - 1),
-      words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * (width + kHeader))) {}
+      words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * stride_)) {}
 
 Signal::Signal(std::string name, ComponentId component, std::size_t size, std::size_t history)
     : buffer_(size, history), name_(std::move(name)), component_(component) {}
@@ -24,7 +25,7 @@ Signal::Signal(std::string name, ComponentId component, std::size_t size, std::s
 void Signal::inject(Time time, const double* values) {
   std::lock_guard lock(inject_mutex_);
   if (!injection_ring_) {
-    injection_ring_ = std::make_unique<HistoryBuffer>(size(), buffer_.capacity() + 1);
+    injection_ring_ = std::make_unique<HistoryBuffer>(size(), buffer_.capacity() + 1, true);
     injections_.store(injection_ring_.get(), std::memory_order_release);
   }
   // The key places the sample after every sample written so far (see SignalCursor).

@@ -44,13 +44,14 @@ struct SampleView {
 };
 
 /// A ring of timestamped samples with one writer at a time and any number of lock-free readers.
-/// Each slot holds the time, an order key (see Signal) and width() doubles, stored as bit
+/// Each slot holds the time, in a keyed ring an order key (see Signal), and width() doubles, stored as bit
 /// patterns in relaxed atomics so that a reader racing the writer is well defined (the head check
 /// discards such a copy).
 class HistoryBuffer {
 public:
   /// `width` doubles per sample; the ring has `capacity` rounded up to a power of two slots.
-  HistoryBuffer(std::size_t width, std::size_t capacity);
+  /// `keyed`: each slot also keeps an order key (the injection ring; see Signal).
+  HistoryBuffer(std::size_t width, std::size_t capacity, bool keyed = false);
   HistoryBuffer(const HistoryBuffer&) = delete;
   HistoryBuffer& operator=(const HistoryBuffer&) = delete;
 
@@ -68,11 +69,11 @@ public:
     std::atomic_thread_fence(std::memory_order_release);
     std::atomic<std::uint64_t>* w = slot(index);
     w[0].store(static_cast<std::uint64_t>(time.count()), std::memory_order_relaxed);
-    w[1].store(key, std::memory_order_relaxed);
+    if (header_ == 2) w[1].store(key, std::memory_order_relaxed);
     if (width_ == 1) {
-      store(w[kHeader], values[0]);  // scalars: no loop
+      store(w[header_], values[0]);  // scalars: no loop
     } else {
-      for (std::size_t i = 0; i < width_; ++i) store(w[kHeader + i], values[i]);
+      for (std::size_t i = 0; i < width_; ++i) store(w[header_ + i], values[i]);
     }
     head_.store(index + 1, std::memory_order_release);
     // The next push writes the next slot, usually in a line no cache holds any more (a ring of
@@ -92,8 +93,8 @@ public:
     if (index >= head || head - index > mask_) return false;
     const std::atomic<std::uint64_t>* w = slot(index);
     time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
-    if (key != nullptr) *key = w[1].load(std::memory_order_relaxed);
-    for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[kHeader + i]);
+    if (key != nullptr) *key = header_ == 2 ? w[1].load(std::memory_order_relaxed) : 0;
+    for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[header_ + i]);
     std::atomic_thread_fence(std::memory_order_acquire);
     // The slot is rewritten by sample index + mask_ + 1, whose stores start after the head
     // reached index + mask_ + 1: while the head is below that, the copy is intact.
@@ -106,9 +107,9 @@ public:
     const std::atomic<std::uint64_t>* w = slot(index);
     time = Time{static_cast<Time::rep>(w[0].load(std::memory_order_relaxed))};
     if (width_ == 1) {
-      out[0] = load(w[kHeader]);
+      out[0] = load(w[header_]);
     } else {
-      for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[kHeader + i]);
+      for (std::size_t i = 0; i < width_; ++i) out[i] = load(w[header_ + i]);
     }
     std::atomic_thread_fence(std::memory_order_acquire);
     head = head_.load(std::memory_order_relaxed);
@@ -116,7 +117,6 @@ public:
   }
 
 private:
-  static constexpr std::size_t kHeader = 2;  // time, order key
   std::atomic<std::uint64_t>* slot(std::uint64_t index) const noexcept { return &words_[(index & mask_) * stride_]; }
   // A double as the bits of a relaxed atomic word (std::bit_cast, in C++17).
   static void store(std::atomic<std::uint64_t>& word, double value) noexcept {
@@ -132,7 +132,10 @@ private:
   }
   // Every reader loads the head along with these fields (they never change after construction),
   // so the head shares their cache line: a reader of a signal touches one line besides the slot.
+  // A slot is the time, the order key in a keyed ring, then width_ values: 16 bytes for a scalar
+  // of the writer's ring, four to a cache line (docs/filters.md, "Memory layout").
   std::size_t width_;
+  std::size_t header_;  ///< words before the values: 1 (time) or 2 (time, key)
   std::size_t stride_;  ///< words per slot
   std::size_t mask_;
   std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
