@@ -54,10 +54,16 @@ public:
     std::string v;
     for (const auto& s : monitor_.signals().all()) {
       Time t{};
-      double x = 0.0;
+      std::vector<double> x(s->size());
       bool injected = false;
-      const bool any = s->latest(t, &x, &injected);
-      v += s->name() + "=" + (any ? std::to_string(t.count()) + ":" + bits(x) + (injected ? "i" : "") : "-") + ";";
+      v += s->name() + "=";
+      if (!s->latest(t, x.data(), &injected)) {
+        v += "-;";
+        continue;
+      }
+      v += std::to_string(t.count()) + (injected ? "i" : "");
+      for (const double e : x) v += ":" + bits(e);
+      v += ";";
     }
     for (const auto& f : monitor_.filters()) {
       v += f->name() + (f->detected() ? "!" : ".") + std::to_string(f->missed_samples()) + ";";
