@@ -13,12 +13,14 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
@@ -359,6 +361,48 @@ TEST(FilterBank, BuiltInFiltersOfOneSignalShareOneBankReaderAndCustomTypesStayOb
   add("Range", {{"input_signal", std::string("x")}, {"min", 0.0}, {"max", 1.0}, {"event_onset", std::string("EVT_1")}});
   EXPECT_EQ(w.monitor().banked_count(), 3U);
   EXPECT_EQ(w.monitor().filters().size(), 4U);  // the console and the read model list all four
+}
+
+TEST(FilterBank, AFilterDisabledAndInjectedFromAnotherThreadWhileItsBankRunsStaysExactAfterward) {
+  // set_enabled() and inject() come from tool threads while the component's loop runs the bank;
+  // a change is seen at the bank's next run. Afterwards the filter judges as before.
+  World w(true);
+  Signal* x = *w.monitor().add_signal("C.x");
+  FilterConfig c;
+  c.name = "limit";
+  c.type = "Threshold";
+  c.target.component = "C";
+  c.params = {{"input_signal", std::string("x")}, {"threshold", 10.0}, {"event_onset", std::string("EVT_0")}};
+  Filter* limit = *w.monitor().add_filter(c);
+  c.name = "other";
+  Filter* other = *w.monitor().add_filter(c);
+  ASSERT_EQ(w.monitor().banked_count(), 2U);
+  std::atomic<bool> done{false};
+  std::thread tool([&] {
+    for (int i = 0; !done.load(); ++i) {
+      limit->set_enabled(i % 2 == 0);
+      if (i % 5 == 0) (void)w.monitor().inject_shallow("limit", {{1.0}});
+      std::this_thread::yield();
+    }
+  });
+  std::int64_t t = 0;
+  for (int i = 0; i < 20000; ++i) {
+    x->push(Time{++t}, 1.0);
+    w.monitor().run_active(ComponentId{0}, Time{t});
+  }
+  done = true;
+  tool.join();
+  limit->set_enabled(true);
+  for (int i = 0; i < 5; ++i) {  // the detour ends (queued injections, re-enabling): back in the bank
+    x->push(Time{++t}, 1.0);
+    w.monitor().run_active(ComponentId{0}, Time{t});
+  }
+  EXPECT_FALSE(limit->detected());
+  x->push(Time{++t}, 20.0);
+  w.monitor().run_active(ComponentId{0}, Time{t});
+  EXPECT_TRUE(limit->detected());
+  EXPECT_TRUE(other->detected());
+  EXPECT_EQ(limit->missed_samples(), 0U);
 }
 
 }  // namespace
