@@ -87,50 +87,38 @@ void Banks::add(Filter* filter) {
   filter->cold_->bank_changes = &changes_;
 }
 
-void Banks::adopt(Member& member) {
+template <class F, class State>
+State& Banks::place(Member& member, std::vector<State>& bank) {
   // Moves the filter's state into its bank; when the bank's array grows, every member of that
   // kind is pointed at its element's new address.
-  auto place = [&](auto& bank, auto state_of) -> auto& {
-    const auto* before = bank.data();
-    bank.emplace_back();
-    member.index = static_cast<std::uint32_t>(bank.size() - 1);
-    state_of(member.filter).adopt(&bank.back());
-    if (bank.data() != before) {
-      for (Member& m : members_) {
-        if (m.kind == member.kind && &m != &member) state_of(m.filter).rebind(&bank[m.index]);
-      }
+  const State* before = bank.data();
+  bank.emplace_back();
+  member.index = static_cast<std::uint32_t>(bank.size() - 1);
+  static_cast<F*>(member.filter)->state().adopt(&bank.back());
+  if (bank.data() != before) {
+    for (Member& m : members_) {
+      if (m.kind == member.kind && &m != &member) static_cast<F*>(m.filter)->state().rebind(&bank[m.index]);
     }
-    return bank.back();
-  };
+  }
+  return bank.back();
+}
+
+void Banks::adopt(Member& member) {
   switch (member.kind) {
-    case Kind::Threshold:
-      place(
-          thresholds_, [](Filter * f) -> auto& { return static_cast<Threshold*>(f)->state(); });
-      break;
-    case Kind::Watchdog:
-      place(
-          watchdogs_, [](Filter * f) -> auto& { return static_cast<Watchdog*>(f)->state(); });
-      break;
+    case Kind::Threshold: place<Threshold>(member, thresholds_); break;
+    case Kind::Watchdog: place<Watchdog>(member, watchdogs_); break;
     case Kind::Average: {
-      auto& s = place(
-          averages_, [](Filter * f) -> auto& { return static_cast<MovingAverage*>(f)->state(); });
+      builtin::AverageState& s = place<MovingAverage>(member, averages_);
       keep_ring(member, s.ring, s.window);
       break;
     }
-    case Kind::Debounce:
-      place(
-          debounces_, [](Filter * f) -> auto& { return static_cast<Debounce*>(f)->state(); });
-      break;
+    case Kind::Debounce: place<Debounce>(member, debounces_); break;
     case Kind::Frequency: {
-      auto& s = place(
-          frequencies_, [](Filter * f) -> auto& { return static_cast<Frequency*>(f)->state(); });
+      builtin::FrequencyState& s = place<Frequency>(member, frequencies_);
       keep_ring(member, s.ring, s.window);
       break;
     }
-    case Kind::Norm:
-      place(
-          norms_, [](Filter * f) -> auto& { return static_cast<Norm*>(f)->state(); });
-      break;
+    case Kind::Norm: place<Norm>(member, norms_); break;
   }
 }
 
@@ -250,13 +238,63 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
       run_out(m, reader, now);
       continue;
     }
+    // Each kind: the step its object's on_sample() takes, then the report and the output write.
     switch (m.kind) {
-      case Kind::Threshold: run_threshold(m, samples); break;
-      case Kind::Watchdog: run_watchdog(m, samples, now); break;
-      case Kind::Average: run_average(m, samples); break;
-      case Kind::Debounce: run_debounce(m, samples); break;
-      case Kind::Frequency: run_frequency(m, samples); break;
-      case Kind::Norm: run_norm(m, samples); break;
+      case Kind::Threshold: {
+        builtin::ThresholdState& s = thresholds_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          const double x = *sample(j);
+          const bool detected = s.step(x, times_[j]);
+          if (detected || m.reported) report(m, detected, x, times_[j]);
+          if (s.output != nullptr) s.output->push(times_[j], s.output_value());
+        });
+        break;
+      }
+      case Kind::Watchdog: {
+        builtin::WatchdogState& s = watchdogs_[m.index];
+        each_sample(m, samples, [&](std::size_t j) { s.on_sample(times_[j]); });
+        const Time age = s.age(now);  // its on_tick()
+        const bool stale = age > s.timeout;
+        if (stale || m.reported) report(m, stale, to_seconds(age), s.last);
+        if (s.output != nullptr) s.output->push(now, to_seconds(age));
+        break;
+      }
+      case Kind::Average: {
+        builtin::AverageState& s = averages_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          const double mean = s.step(*sample(j));
+          if (s.output != nullptr) s.output->push(times_[j], mean);
+        });
+        break;
+      }
+      case Kind::Debounce: {
+        builtin::DebounceState& s = debounces_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          const double x = *sample(j);
+          const bool detected = s.step(x, times_[j]);
+          if (detected || m.reported) report(m, detected, x, times_[j]);
+          if (s.output != nullptr) s.output->push(times_[j], detected ? 1.0 : 0.0);
+        });
+        break;
+      }
+      case Kind::Frequency: {
+        builtin::FrequencyState& s = frequencies_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          bool detected = false;
+          double rate = 0.0;
+          if (!s.step(times_[j], detected, rate)) return;
+          if (detected || m.reported) report(m, detected, rate, times_[j]);
+          if (s.output != nullptr) s.output->push(times_[j], rate);
+        });
+        break;
+      }
+      case Kind::Norm: {
+        const builtin::NormState& s = norms_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          if (s.output != nullptr) s.output->push(times_[j], s.step(sample(j), width_));
+        });
+        break;
+      }
     }
   }
 }
@@ -276,87 +314,6 @@ void Banks::deliver(Member& m, std::size_t j) noexcept {
   f.current_injected_ = false;
   m.slow = f.invalid_count_ != 0;
   m.reported = f.detected();
-}
-
-void Banks::run_threshold(Member& m, std::size_t samples) noexcept {
-  builtin::ThresholdState& s = thresholds_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (!judged_here(m, j)) {
-      deliver(m, j);
-      continue;
-    }
-    const double x = *sample(j);
-    const bool detected = s.step(x, times_[j]);
-    if (detected || m.reported) report(m, detected, x, times_[j]);
-    if (s.output != nullptr) s.output->push(times_[j], s.output_value());
-  }
-}
-
-void Banks::run_watchdog(Member& m, std::size_t samples, Time now) noexcept {
-  builtin::WatchdogState& s = watchdogs_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (judged_here(m, j)) {
-      s.on_sample(times_[j]);
-    } else {
-      deliver(m, j);
-    }
-  }
-  const Time age = s.age(now);
-  const bool stale = age > s.timeout;
-  if (stale || m.reported) report(m, stale, to_seconds(age), s.last);
-  if (s.output != nullptr) s.output->push(now, to_seconds(age));
-}
-
-void Banks::run_average(Member& m, std::size_t samples) noexcept {
-  builtin::AverageState& s = averages_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (!judged_here(m, j)) {
-      deliver(m, j);
-      continue;
-    }
-    const double mean = s.step(*sample(j));
-    if (s.output != nullptr) s.output->push(times_[j], mean);
-  }
-}
-
-void Banks::run_debounce(Member& m, std::size_t samples) noexcept {
-  builtin::DebounceState& s = debounces_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (!judged_here(m, j)) {
-      deliver(m, j);
-      continue;
-    }
-    const double x = *sample(j);
-    const bool detected = s.step(x, times_[j]);
-    if (detected || m.reported) report(m, detected, x, times_[j]);
-    if (s.output != nullptr) s.output->push(times_[j], detected ? 1.0 : 0.0);
-  }
-}
-
-void Banks::run_frequency(Member& m, std::size_t samples) noexcept {
-  builtin::FrequencyState& s = frequencies_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (!judged_here(m, j)) {
-      deliver(m, j);
-      continue;
-    }
-    bool detected = false;
-    double rate = 0.0;
-    if (!s.step(times_[j], detected, rate)) continue;
-    if (detected || m.reported) report(m, detected, rate, times_[j]);
-    if (s.output != nullptr) s.output->push(times_[j], rate);
-  }
-}
-
-void Banks::run_norm(Member& m, std::size_t samples) noexcept {
-  const builtin::NormState& s = norms_[m.index];
-  for (std::size_t j = 0; j < samples; ++j) {
-    if (!judged_here(m, j)) {
-      deliver(m, j);
-      continue;
-    }
-    if (s.output != nullptr) s.output->push(times_[j], s.step(sample(j), width_));
-  }
 }
 
 }  // namespace safecass::detail

@@ -79,6 +79,8 @@ private:
 
   bool bankable(Filter& filter, Kind& kind) const noexcept;
   void adopt(Member& member);
+  template <class F, class State>
+  State& place(Member& member, std::vector<State>& bank);
   void keep_ring(const Member& member, double* ring, std::uint32_t window);
   double*& ring_of(const Ring& ring) noexcept;
   [[gnu::cold]] void refresh() noexcept;
@@ -86,12 +88,17 @@ private:
   [[gnu::always_inline]] inline std::size_t read(Reader& reader) noexcept;
   [[gnu::always_inline]] inline void run_reader(Reader& reader, Time now) noexcept;
   [[gnu::cold]] void run_out(Member& m, const Reader& reader, Time now) noexcept;
-  [[gnu::always_inline]] inline void run_threshold(Member& m, std::size_t samples) noexcept;
-  [[gnu::always_inline]] inline void run_watchdog(Member& m, std::size_t samples, Time now) noexcept;
-  [[gnu::always_inline]] inline void run_average(Member& m, std::size_t samples) noexcept;
-  [[gnu::always_inline]] inline void run_debounce(Member& m, std::size_t samples) noexcept;
-  [[gnu::always_inline]] inline void run_frequency(Member& m, std::size_t samples) noexcept;
-  [[gnu::always_inline]] inline void run_norm(Member& m, std::size_t samples) noexcept;
+  /// Hands each sample of this read that the bank judges to `judge(j)`, the others to the object.
+  template <class Judge>
+  [[gnu::always_inline]] void each_sample(Member& m, std::size_t samples, Judge&& judge) noexcept {
+    for (std::size_t j = 0; j < samples; ++j) {
+      if (judged_here(m, j)) {
+        judge(j);
+      } else {
+        deliver(m, j);
+      }
+    }
+  }
   /// Sample `j` of this read through the object path (non-finite, injected, or the input marked).
   [[gnu::cold]] void deliver(Member& m, std::size_t j) noexcept;
   [[gnu::cold]] void report(Member& m, bool detected, double value, Time time) noexcept {
