@@ -102,11 +102,11 @@ public:
 
   void build(World& a, World& b) {
     const int signals = pick(1, 3);
-    for (int i = 0; i < signals; ++i) inputs_.push_back({"s" + std::to_string(i), 1});
-    if (pick(0, 1) == 0) inputs_.push_back({"v", 3});  // a vector (a force)
+    for (int i = 0; i < signals; ++i) inputs_.emplace_back("s" + std::to_string(i), 1);
+    if (pick(0, 1) == 0) inputs_.emplace_back("v", 3);  // a vector (a force)
     signals_ = inputs_;
-    for (const auto& [name, size] : signals_) {
-      both(a, b, [&](World& w) { (void)w.monitor().add_signal("C." + name, size); });
+    for (const Named& s : signals_) {
+      both(a, b, [&](World& w) { (void)w.monitor().add_signal("C." + s.first, s.second); });
     }
     const int filters = pick(1, 8);
     for (int i = 0; i < filters; ++i) {
@@ -115,32 +115,32 @@ public:
         auto f = w.monitor().add_filter(c);
         ASSERT_TRUE(f) << f.error().message;
       });
-      filters_.push_back({c.name, width_of(std::get<std::string>(c.params.at("input_signal")))});
+      filters_.emplace_back(c.name, width_of(std::get<std::string>(c.params.at("input_signal"))));
     }
   }
 
   /// One cycle: samples, faults and changes, then the run at the cycle's time.
   void cycle(World& a, World& b, int k) {
-    const std::int64_t now = (k + 1) * 1'000'000;  // 1 ms
+    const std::int64_t now = std::int64_t{k + 1} * 1'000'000;  // 1 ms
     for (std::size_t s = 0; s < signals_.size(); ++s) {
       const int samples = pick(0, 6) < 4 ? 1 : pick(0, 3);
       for (int j = 0; j < samples; ++j) {
         std::vector<double> x(signals_[s].second);
         for (double& e : x) e = value(s, k);
-        const Time t{now - (samples - j) * 100'000};
+        const Time t{now - std::int64_t{samples - j} * 100'000};
         both(a, b, [&](World& w) { w.monitor().signals().find("C." + signals_[s].first)->push(t, x.data()); });
       }
     }
     if (pick(0, 19) == 0) {  // deep injection
-      const auto& [name, size] = signals_[index(signals_.size())];
-      const std::vector<std::vector<double>> v{injected(size), injected(size)};
-      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_deep("C." + name, v, Time{now - 50'000})); });
+      const Named& s = signals_[index(signals_.size())];
+      const std::vector<std::vector<double>> v{injected(s.second), injected(s.second)};
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_deep("C." + s.first, v, Time{now - 50'000})); });
     }
     if (pick(0, 19) == 0) {  // shallow injection
-      const auto& [name, size] = filters_[index(filters_.size())];
+      const Named& f = filters_[index(filters_.size())];
       std::vector<std::vector<double>> v(static_cast<std::size_t>(pick(1, 3)));
-      for (auto& x : v) x = injected(size);
-      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_shallow(name, v)); });
+      for (auto& x : v) x = injected(f.second);
+      both(a, b, [&](World& w) { ASSERT_TRUE(w.monitor().inject_shallow(f.first, v)); });
     }
     if (k == 30 && pick(0, 1) == 0) {  // a pipeline that fails at its second stage: undone whole
       FilterConfig first;
@@ -215,7 +215,7 @@ private:
   void output(FilterConfig& c, const std::string& name) {
     c.params["output_signal"] = name;
     outputs_.push_back(name);
-    signals_.push_back({name, 1});
+    signals_.emplace_back(name, 1);
   }
 
   FilterConfig next_filter(int i) {
