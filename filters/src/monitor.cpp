@@ -40,10 +40,8 @@ Expected<Signal*> Monitor::add_signal(std::string_view name, std::size_t size) {
 }
 
 Filter* Monitor::find_filter(std::string_view name) const noexcept {
-  for (const auto& f : filters_) {
-    if (f->name() == name) return f.get();
-  }
-  return nullptr;
+  const auto it = by_name_.find(name);
+  return it == by_name_.end() ? nullptr : it->second;
 }
 
 Expected<FilterInit> Monitor::prepare(FilterConfig config,
@@ -191,6 +189,7 @@ Expected<Filter*> Monitor::add_filter(FilterConfig config) {
   auto filter = registry_.find(init->config.type)->factory(std::move(*init));
   Filter* raw = filter.get();
   filters_.push_back(std::move(filter));
+  by_name_.emplace(raw->name(), raw);
   group(*raw).add(raw);
   return raw;
 }
@@ -251,6 +250,7 @@ Expected<std::vector<Filter*>> Monitor::add_pipeline(std::string_view name, std:
     if (!f) {
       // All or nothing: undo the stages already created.
       regroup(filters_before);
+      for (std::size_t k = filters_before; k < filters_.size(); ++k) by_name_.erase(filters_[k]->name());
       filters_.resize(filters_before);
       signals_.truncate(signals_before);
       return fail(f.error().code,

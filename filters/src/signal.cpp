@@ -132,14 +132,20 @@ Expected<Signal*> SignalRegistry::add(std::string_view name, ComponentId compone
     return s;
   }
   signals_.push_back(std::make_unique<Signal>(std::string(name), component, size, default_history_));
+  by_name_.emplace(signals_.back()->name(), signals_.back().get());
   return signals_.back().get();
 }
 
 Signal* SignalRegistry::find(std::string_view name) const noexcept {
-  for (const auto& s : signals_) {
-    if (s->name() == name) return s.get();
+  const auto it = by_name_.find(name);
+  return it == by_name_.end() ? nullptr : it->second;
+}
+
+void SignalRegistry::truncate(std::size_t count) {
+  while (signals_.size() > count) {
+    by_name_.erase(signals_.back()->name());
+    signals_.pop_back();
   }
-  return nullptr;
 }
 
 }  // namespace safecass

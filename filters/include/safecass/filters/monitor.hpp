@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <unordered_map>
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
@@ -98,6 +99,7 @@ private:
   const FilterRegistry& registry_;
   SignalRegistry signals_;
   std::vector<std::unique_ptr<Filter>> filters_;
+  std::unordered_map<std::string_view, Filter*> by_name_;  ///< keys: the filters' own names
   bool banks_;
   std::vector<std::unique_ptr<detail::Banks>> active_;  ///< per component
   std::unique_ptr<detail::Banks> passive_;

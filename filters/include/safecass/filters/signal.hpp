@@ -24,6 +24,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -344,13 +345,12 @@ public:
   Signal* find(std::string_view name) const noexcept;
   const std::vector<std::unique_ptr<Signal>>& all() const noexcept { return signals_; }
   /// Removes the signals created after the first `count` (undoing a failed configuration step).
-  void truncate(std::size_t count) {
-    if (count < signals_.size()) signals_.resize(count);
-  }
+  void truncate(std::size_t count);
 
 private:
   std::size_t default_history_;
   std::vector<std::unique_ptr<Signal>> signals_;
+  std::unordered_map<std::string_view, Signal*> by_name_;  ///< keys: the signals' own names
 };
 
 }  // namespace safecass
