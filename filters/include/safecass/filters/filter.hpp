@@ -107,7 +107,9 @@ public:
   /// Samples lost to history-buffer overflow since creation.
   std::uint64_t missed_samples() const noexcept;
 
-  /// Processes the new samples of every input, then on_tick(now). Call from one thread only.
+  /// Processes the new samples of every input, then on_tick(now). Call from one thread only. A
+  /// filter of a monitor is run by it (Monitor::run_active, Monitor::tick), which may run it in a
+  /// bank without calling run(): do not also run it yourself.
   void run(Time now) noexcept {
     // The hot path, inlined into the caller: enabled, no shallow injection queued, one input.
     if (detour_.load(std::memory_order_acquire) != 0) {
