@@ -190,15 +190,22 @@ void Banks::refresh() noexcept {
 
 std::size_t Banks::read(Reader& reader) noexcept {
   width_ = reader.width;
+  std::size_t samples = 0;
+  bool plain = true;  // every sample finite and written, not injected
   if (reader.taken) {
     times_[0] = reader.time;
     values_[0] = reader.value;
     injected_[0] = 0;
     finite_[0] = std::isfinite(reader.value) ? 1 : 0;
-    plain_ = finite_[0] != 0;
-    return 1;
-  }
-  if (reader.cursor.take_single(times_[0], values_.data())) {  // one new sample: the common case
+    plain = finite_[0] != 0;
+    samples = 1;
+    // A sample written since the read ahead, during this run (an application's observer of an
+    // earlier filter's event), is read now, as the filters one by one would read it.
+    if (!reader.cursor.unread()) {
+      plain_ = plain;
+      return 1;
+    }
+  } else if (reader.cursor.take_single(times_[0], values_.data())) {  // one new sample: the common case
     bool finite = true;
     for (std::size_t i = 0; i < width_; ++i) finite = finite && std::isfinite(values_[i]);
     injected_[0] = 0;
@@ -206,8 +213,6 @@ std::size_t Banks::read(Reader& reader) noexcept {
     plain_ = finite;
     return 1;
   }
-  std::size_t samples = 0;
-  bool plain = true;  // every sample finite and written, not injected
   const std::uint64_t missed = reader.cursor.missed();
   reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
     times_[samples] = s.time;

@@ -284,6 +284,12 @@ public:
     injected_next_ = other.injected_next_;
     kept_ = -1;
   }
+  /// Whether a sample, written or injected, waits to be read. Lock-free.
+  bool unread() const noexcept {
+    if (signal_ == nullptr) return false;
+    if (const HistoryBuffer* inj = signal_->injections(); inj != nullptr && injected_next_ < inj->end()) return true;
+    return next_ < signal_->buffer().end();
+  }
   /// Whether `other`, a cursor of the same signal, stands one written sample after this one.
   bool one_behind(const SignalCursor& other) const noexcept {
     return next_ + 1 == other.next_ && injected_next_ == other.injected_next_;
