@@ -319,20 +319,9 @@ private:
       JsonValue item;
       if (!value(item, depth + 1)) return false;
       sink(index, std::move(item));
-      skip_space();
-      if (failed_) return false;
-      if (peek() == ',') {
-        advance();
-        skip_space();
-        if (failed_) return false;
-        if (peek() == ']') return fail_here("trailing comma before ']'");
-        continue;
-      }
-      if (peek() == ']') {
-        advance();
-        return true;
-      }
-      return fail_here(at_end() ? "unexpected end of file: expected ',' or ']'" : "expected ',' or ']'");
+      bool more = false;
+      if (!separator(']', more)) return false;
+      if (!more) return true;
     }
   }
 
@@ -367,21 +356,32 @@ private:
         return false;
       }
       v.object.push_back(std::move(m));
+      bool more = false;
+      if (!separator('}', more)) return false;
+      if (!more) return true;
+    }
+  }
+
+  /// After an element of an array or a member of an object: a ',' and another one (`more`), or
+  /// `close`, the end. A trailing comma is an error.
+  bool separator(char close, bool& more) {
+    auto closing = [close] { return std::string("'") + close + "'"; };  // for a message only
+    skip_space();
+    if (failed_) return false;
+    if (peek() == ',') {
+      advance();
       skip_space();
       if (failed_) return false;
-      if (peek() == ',') {
-        advance();
-        skip_space();
-        if (failed_) return false;
-        if (peek() == '}') return fail_here("trailing comma before '}'");
-        continue;
-      }
-      if (peek() == '}') {
-        advance();
-        return true;
-      }
-      return fail_here(at_end() ? "unexpected end of file: expected ',' or '}'" : "expected ',' or '}'");
+      if (peek() == close) return fail_here("trailing comma before " + closing());
+      more = true;
+      return true;
     }
+    if (peek() == close) {
+      advance();
+      more = false;
+      return true;
+    }
+    return fail_here((at_end() ? "unexpected end of file: expected ',' or " : "expected ',' or ") + closing());
   }
 
   std::string_view text_;
