@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo ros2-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-verify asan tsan package lint clean
 
 all: build
 
@@ -93,13 +93,20 @@ bench: deps
 bench-check:
 	@./scripts/bench-check $(BUILD)/bench.json benchmarks/baseline.json
 
+# ROBODOC on ROS 2 over DDS (examples/dds_robodoc): safecass_dds_node, a simulated JR3 driver and a
+# /diagnostics reader, all plain Cyclone DDS participants.
+ros2-demo: configure
+	@cmake -S . -B $(BUILD) -DSAFECASS_WITH_DDS=ON >/dev/null
+	@cmake --build $(BUILD) -j $(JOBS) --target safecass_dds_node dds_robodoc_jr3 dds_diagnostics_echo
+	@./scripts/ros2-demo.sh $(BUILD)
+
 # SAFECASS side by side with its peers (raw IceStorm, roscpp, ROS diagnostics, Boost.MSM and
 # Boost.Statechart) in one run: its own Release tree with ROS 1 (build/peers), results in
 # build/bench-peers.json and a table (docs/benchmarks.md). BENCH_PEERS_ARGS=--quick: a short run
 # (about a minute) that checks the harness and that the JSON has every figure.
 PEERS := $(BUILD)/peers
 PEER_TARGETS := bench_peers_core peer_detection peer_icestorm_raw peer_supervisor_load peer_ros_visibility \
-  peer_ros_watch bench_middleware safecass_bench
+  peer_ros_watch peer_dds_visibility bench_middleware safecass_bench
 CCACHE_LAUNCHER := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 bench-peers: deps
 	@./scripts/install-deps.sh --bench-peers
@@ -117,7 +124,8 @@ bench-verify: build
 # are built (their `<folder>/all` targets: the test programs and the libraries they link) and run,
 # folder by folder; docs/contributing.md, "Continuous integration", says which and why. No test of
 # these folders starts the `safecass` command; a folder whose tests do adds it to the targets.
-ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/json tests/unit/spec tests/unit/record tests/unit/replay
+ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/json tests/unit/spec tests/unit/record tests/unit/replay \
+  tests/unit/dds
 TSAN_CI_DIRS := tests/unit/core
 # Under UBSan's vptr check a process with no free descriptor reports its own valid objects as
 # invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.

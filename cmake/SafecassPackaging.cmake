@@ -37,7 +37,7 @@ set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
 set(CPACK_COMPONENT_DEV_DESCRIPTION
   "SAFECASS libraries, headers and CMake package config\n"
   "Static libraries of every SAFECASS module (safecass::core, ::filters, ::spec, ::record, ::native,\n"
-  "::middleware, ::ros1, ::runner as built), their headers, find_package(safecass) and pkg-config files.")
+  "::middleware, ::ros_common, ::ros1, ::dds, ::runner as built), their headers, find_package(safecass) and pkg-config files.")
 get_property(SAFECASS_DEBIAN_DEPENDS GLOBAL PROPERTY SAFECASS_DEBIAN_DEPENDS)
 list(REMOVE_DUPLICATES SAFECASS_DEBIAN_DEPENDS)
 list(JOIN SAFECASS_DEBIAN_DEPENDS ", " CPACK_DEBIAN_DEV_PACKAGE_DEPENDS)

@@ -70,6 +70,7 @@ def main():
         "roscpp_raw": load(work, "ros_visibility"),
         "ros_diagnostics_default": load(work, "diag_default_visibility"),
         "ros_diagnostics_fastest": load(work, "diag_fastest_visibility"),
+        "safecass_dds_node": load(work, "dds_visibility"),
     }
     watch = {"safecass_supervisor": load(work, "safecass_watch"),
              "safecass_supervisor_states_only": load(work, "safecass_watch_states"),
@@ -101,6 +102,7 @@ def main():
     sc, ice, ros = vis["safecass_over_icestorm"], vis["icestorm_raw_tls"], vis["roscpp_raw"]
     ice_plain = vis["icestorm_raw"]
     dd, df = vis["ros_diagnostics_default"], vis["ros_diagnostics_fastest"]
+    dds = vis["safecass_dds_node"]
     sup, agg = watch["safecass_supervisor"], watch["ros_diagnostic_aggregator"]
     sup_states = watch["safecass_supervisor_states_only"]
     result = {
@@ -122,6 +124,9 @@ def main():
                                                                 get(agg, "cpu_s_per_10k_updates")),
         "event_ns_ratio_vs_statechart": ratio(machines["safecass_ns_per_event"], machines["boost_statechart_ns_per_event"]),
         "scale_events_per_s": scale["events_per_s"],
+        # SAFECASS on ROS 2 (safecass_dds_node's bridge): a driver's sample → a /diagnostics reader.
+        "dds_node_visibility_p50_us": get(dds, "p50_us"),
+        "dds_node_visibility_p99_us": get(dds, "p99_us"),
         "memory_ratio_vs_aggregator_item": scale["memory_ratio_vs_aggregator_item"],
         "visibility": vis,
         "watching": watch,
@@ -172,6 +177,7 @@ def main():
         ("visibility raw roscpp", lat(ros)),
         ("visibility ROS diagnostics, defaults", lat(dd)),
         ("visibility ROS diagnostics, fastest", lat(df)),
+        ("visibility SAFECASS on ROS 2 (DDS): sample → /diagnostics", lat(dds)),
         ("supervisor CPU s / 10k updates, RSS", "—" if sup is None else
          f"{fmt(sup.get('cpu_s_per_10k_updates'), '', 4)} s, {fmt(sup.get('rss_bytes', 0) / 1e6)} MB"),
         ("supervisor --states-only CPU s / 10k updates, RSS", "—" if sup_states is None else

@@ -31,6 +31,11 @@ ALLOWED = {
     "tests/scenarios", "robots/robodoc.json", "robots/jr3.json", "args.ice",
     # Prose: "filters/pipelines" is "filters and pipelines"; English words in CamelCase.
     "filters/pipelines", "PascalCase", "CamelCase",
+    # Other projects' files, cited as the sources of ROS 2's conventions (extensions/dds).
+    "rmw_cyclonedds_cpp/src/namespace_prefix.hpp", "rmw_cyclonedds_cpp/src/MessageTypeSupport_impl.hpp",
+    "rmw_cyclonedds_cpp/src/rmw_node.cpp", "rmw/include/rmw/qos_profiles.h",
+    "diagnostic_updater/include/diagnostic_updater/diagnostic_updater.hpp",
+    "diagnostic_aggregator/src/aggregator.cpp", "rcl/src/rcl/domain_id.c",
     # Other projects' names: CMake, ROS, Ice.
     "FetchContent", "GenericAnalyzer", "DiagnosticStatus", "DiagnosticArray",
 }

@@ -18,46 +18,15 @@
 #include <ros/ros.h>
 #include <std_msgs/Float64.h>
 
-namespace {
+#include "force_profile.hpp"
 
-constexpr double kSaturationWarning = 38.0;
+namespace {
 
 struct Options {
   double rate = 200.0;
   double fz = 5.0;
-  std::vector<std::pair<double, double>> profile;
+  robodoc::ForceProfile profile;
 };
-
-bool parse_profile(const std::string& text, std::vector<std::pair<double, double>>& out) {
-  std::size_t start = 0;
-  while (start < text.size()) {
-    const std::size_t comma = text.find(',', start);
-    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    const std::size_t colon = item.find(':');
-    if (colon == std::string::npos) return false;
-    char* end = nullptr;
-    const double t = std::strtod(item.c_str(), &end);
-    if (end != item.c_str() + colon) return false;
-    const double v = std::strtod(item.c_str() + colon + 1, &end);
-    if (*end != '\0' || (!out.empty() && t < out.back().first)) return false;
-    out.emplace_back(t, v);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return !out.empty();
-}
-
-double profile_at(const std::vector<std::pair<double, double>>& p, double t) {
-  if (t <= p.front().first) return p.front().second;
-  for (std::size_t i = 1; i < p.size(); ++i) {
-    if (t <= p[i].first) {
-      const double span = p[i].first - p[i - 1].first;
-      const double a = span > 0 ? (t - p[i - 1].first) / span : 1.0;
-      return p[i - 1].second + a * (p[i].second - p[i - 1].second);
-    }
-  }
-  return p.back().second;
-}
 
 }  // namespace
 
@@ -72,7 +41,7 @@ int main(int argc, char** argv) {
     } else if (a == "--fz" && has_value) {
       o.fz = std::atof(argv[++i]);
     } else if (a == "--profile" && has_value) {
-      if (!parse_profile(argv[++i], o.profile)) {
+      if (!robodoc::parse_force_profile(argv[++i], o.profile)) {
         std::fprintf(stderr, "ros_robodoc_jr3: --profile wants T:FZ,T:FZ,... with increasing times\n");
         return 2;
       }
@@ -105,7 +74,7 @@ int main(int argc, char** argv) {
   while (ros::ok()) {
     ros::spinOnce();
     const double t = (ros::WallTime::now() - start).toSec();
-    if (!overridden && !o.profile.empty()) fz = profile_at(o.profile, t);
+    if (!overridden && !o.profile.empty()) fz = robodoc::force_at(o.profile, t);
     geometry_msgs::WrenchStamped m;
     m.header.seq = seq++;
     m.header.stamp = ros::Time::now();
@@ -125,9 +94,9 @@ int main(int argc, char** argv) {
       s.hardware_id = "jr3";
       const double norm =
           std::sqrt(m.wrench.force.x * m.wrench.force.x + m.wrench.force.y * m.wrench.force.y + fz * fz);
-      s.level =
-          norm > kSaturationWarning ? diagnostic_msgs::DiagnosticStatus::WARN : diagnostic_msgs::DiagnosticStatus::OK;
-      s.message = norm > kSaturationWarning ? "force near the end of the measuring range" : "within range";
+      s.level = norm > robodoc::kSaturationWarning ? diagnostic_msgs::DiagnosticStatus::WARN
+                                                   : diagnostic_msgs::DiagnosticStatus::OK;
+      s.message = norm > robodoc::kSaturationWarning ? "force near the end of the measuring range" : "within range";
       diagnostic_msgs::KeyValue kv;
       kv.key = "force norm";
       kv.value = std::to_string(norm);

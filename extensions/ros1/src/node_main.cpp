@@ -16,10 +16,8 @@
 #include <ros/ros.h>
 
 #include "safecass/filters/registry.hpp"
-#include "safecass/record/input_recorder.hpp"
-#include "safecass/record/recorder.hpp"
 #include "safecass/ros1/bridge.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/ros_common/recording.hpp"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "safecass");
@@ -47,33 +45,15 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s\n", bridge.error().message.c_str());
     return 2;
   }
-  // The history and the inputs, opened before anything runs. The inputs are the signals of the
-  // spec (not the bridge's own topic rates and ages), so the spec alone replays them.
-  std::unique_ptr<safecass::Recorder> history;
-  std::unique_ptr<safecass::InputRecorder> inputs;
+  // The history and the inputs, opened before anything runs.
+  std::unique_ptr<safecass::ros_common::NodeRecording> recording;
   if (!record.empty()) {
-    auto h = safecass::Recorder::open((*bridge)->coordinator(), record, 65536, limits);
-    if (!h) {
-      std::fprintf(stderr, "safecass_ros1_node: %s\n", h.error().message.c_str());
+    auto r = safecass::ros_common::NodeRecording::open((*bridge)->shadow(), registry, record, limits);
+    if (!r) {
+      std::fprintf(stderr, "safecass_ros1_node: %s\n", r.error().message.c_str());
       return 2;
     }
-    history = std::move(*h);
-    safecass::InputRecorderOptions o;
-    o.limits = limits;
-    o.clock = "steady";
-    const safecass::spec::LoadResult system = safecass::spec::load_system((*bridge)->mapping().system, registry);
-    if (system.system) {
-      for (const auto& c : system.system->components) {
-        for (const auto& sig : c.signals) o.signals.push_back(sig.name);
-      }
-    }
-    auto in = safecass::InputRecorder::open((*bridge)->monitor(), safecass::InputRecorder::path_for_history(record), o);
-    if (!in) {
-      std::fprintf(stderr, "safecass_ros1_node: %s\n", in.error().message.c_str());
-      return 2;
-    }
-    inputs = std::move(*in);
-    inputs->start_polling();
+    recording = std::move(*r);
   }
   if (auto r = (*bridge)->start(); !r) {
     std::fprintf(stderr, "safecass_ros1_node: %s\n", r.error().message.c_str());
@@ -84,17 +64,11 @@ int main(int argc, char** argv) {
   ros::spin();
   (*bridge)->stop();
   int code = 0;
-  if (inputs) {
-    inputs->close();
-    for (const std::string& loss : safecass::describe_losses(inputs->status()))
+  if (recording) {
+    for (const std::string& loss : recording->close()) {
       std::fprintf(stderr, "%s\n", loss.c_str());
-    if (!inputs->status().complete()) code = 2;
-  }
-  if (history) {
-    history->close();
-    for (const std::string& loss : safecass::describe_losses(history->status()))
-      std::fprintf(stderr, "%s\n", loss.c_str());
-    if (!history->status().complete()) code = 2;
+      code = 2;
+    }
   }
   return code;
 }

@@ -5,10 +5,11 @@
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
 #include "extract.hpp"
-#include "safecass/ros1/fields.hpp"
+#include "safecass/ros_common/fields.hpp"
 
 using namespace safecass;
 using namespace safecass::ros1;
+using namespace safecass::ros_common;
 
 namespace {
 

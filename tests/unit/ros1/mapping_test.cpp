@@ -2,10 +2,11 @@
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/ros1/bridge.hpp"
-#include "safecass/ros1/mapping.hpp"
+#include "safecass/ros_common/mapping.hpp"
 
 using namespace safecass;
 using namespace safecass::ros1;
+using namespace safecass::ros_common;
 
 namespace {
 

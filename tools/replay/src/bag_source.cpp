@@ -9,7 +9,7 @@
 #include <set>
 
 #include "extract.hpp"
-#include "safecass/ros1/mapping.hpp"
+#include "safecass/ros_common/mapping.hpp"
 
 namespace safecass::replay {
 
@@ -17,18 +17,18 @@ namespace {
 
 struct Binding {
   Signal* signal;
-  ros1::FieldPath path;
+  ros_common::FieldPath path;
   std::size_t width;
 };
 
 struct Topic {
-  ros1::TopicMapping mapping;
+  ros_common::TopicMapping mapping;
   std::vector<Binding> bindings;
 };
 
 class BagSource final : public InputSource {
 public:
-  BagSource(std::string path, ros1::Mapping mapping) : path_(std::move(path)), mapping_(std::move(mapping)) {}
+  BagSource(std::string path, ros_common::Mapping mapping) : path_(std::move(path)), mapping_(std::move(mapping)) {}
 
   [[nodiscard]] Expected<void> open() {
     try {
@@ -43,9 +43,9 @@ public:
 
   [[nodiscard]] Expected<void> bind(Monitor& monitor) override {
     std::vector<std::string> topics;
-    for (const ros1::TopicMapping& t : mapping_.topics) {
+    for (const ros_common::TopicMapping& t : mapping_.topics) {
       Topic topic{t, {}};
-      for (const ros1::FieldBinding& b : t.signals) {
+      for (const ros_common::FieldBinding& b : t.signals) {
         Signal* s = monitor.signals().find(b.signal);
         if (s == nullptr) {
           skipped_.insert(b.signal + " (" + t.topic + " " + b.path.text + ")");
@@ -162,16 +162,17 @@ private:
     if (t == nullptr) return true;
     const ros::Duration since = m.getTime() - begin_;
     const Time time{since.toNSec()};
-    const std::string expected(ros1::to_string(t->mapping.type));
+    const std::string expected(ros_common::to_string(t->mapping.type));
     if (m.getDataType() != expected) {
       return fail_message(t->mapping.topic, "a " + m.getDataType() + " message; the mapping says " + expected);
     }
     try {
       switch (t->mapping.type) {
-        case ros1::MessageType::Float64: return extract_all(*t, *m.instantiate<std_msgs::Float64>(), time);
-        case ros1::MessageType::WrenchStamped:
+        case ros_common::MessageType::Float64: return extract_all(*t, *m.instantiate<std_msgs::Float64>(), time);
+        case ros_common::MessageType::WrenchStamped:
           return extract_all(*t, *m.instantiate<geometry_msgs::WrenchStamped>(), time);
-        case ros1::MessageType::JointState: return extract_all(*t, *m.instantiate<sensor_msgs::JointState>(), time);
+        case ros_common::MessageType::JointState:
+          return extract_all(*t, *m.instantiate<sensor_msgs::JointState>(), time);
       }
     } catch (const std::exception& e) {
       return fail_message(t->mapping.topic, "cannot be read as " + expected + " (rosbag: " + e.what() + ")");
@@ -180,7 +181,7 @@ private:
   }
 
   std::string path_;
-  ros1::Mapping mapping_;
+  ros_common::Mapping mapping_;
   rosbag::Bag bag_;
   ros::Time begin_;
   std::unique_ptr<rosbag::View> view_;
@@ -199,7 +200,7 @@ private:
 }  // namespace
 
 [[nodiscard]] Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping) {
-  ros1::MappingLoad m = ros1::load_mapping(mapping);
+  ros_common::MappingLoad m = ros_common::load_mapping(mapping);
   if (!m.mapping) {
     std::string all;
     for (const auto& d : m.diagnostics) all += (all.empty() ? "" : "\n") + spec::format(d);

@@ -13,6 +13,8 @@
 ///   and per state machine), periodically and at once after a change.
 /// - Statuses of other nodes on /diagnostics become events (OK/WARN/ERROR/STALE).
 ///
+/// The model and everything that does not depend on roscpp is the shared ros_common::Shadow
+/// (extensions/ros_common); this class moves messages between roscpp and it.
 /// Lifecycle: create() (loads the mapping and the system, builds the model; no ROS call) →
 /// add_loop() for components whose code runs in this node → start() (ros::init() done: subscribes,
 /// advertises, starts timers, the monitor thread and the graph-check thread) → the application
@@ -21,34 +23,20 @@
 /// Bad messages (wrong array length, unknown diagnostic level) are counted, warned about
 /// (throttled) and change nothing; NaN/Inf samples raise EVT_INVALID_SAMPLE through the filters.
 
-#include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
-#include <vector>
 
-#include "safecass/core/coordinator.hpp"
-#include "safecass/filters/monitor.hpp"
-#include "safecass/filters/registry.hpp"
-#include "safecass/ros1/mapping.hpp"
+#include "safecass/ros_common/shadow.hpp"
 
 namespace safecass::ros1 {
 
-/// Counters, readable at any time (approximate while running).
-struct BridgeStats {
-  std::uint64_t messages = 0;      ///< topic messages that fed signals
-  std::uint64_t bad_messages = 0;  ///< topic messages rejected (shape did not match the path)
-  std::uint64_t diagnostics_published = 0;
-  std::uint64_t statuses_ingested = 0;  ///< statuses of other nodes that matched a rule
-  std::uint64_t bad_statuses = 0;       ///< statuses with a level that is not one
-  std::uint64_t graph_checks = 0;
-  std::uint64_t graph_problems = 0;  ///< missing items found by the last check
-};
+using ros_common::BridgeStats;
+using ros_common::Mapping;
 
 class Bridge {
 public:
-  using Body = std::function<void(Time now)>;
+  using Body = ros_common::Shadow::Body;
 
   /// Loads `mapping_path` and the system it names, checks one against the other and builds the
   /// coordinator (named after the mapping's coordinator, or the system) and monitor. `clock` must
@@ -64,6 +52,7 @@ public:
   Coordinator& coordinator() noexcept;
   Monitor& monitor() noexcept;
   const Mapping& mapping() const noexcept;
+  ros_common::Shadow& shadow() noexcept;
 
   /// Runs `body` every `period` on the spinning thread, after `component`'s ACTIVE filters (the
   /// component's own loop; use dispatch() inside). A body that throws raises

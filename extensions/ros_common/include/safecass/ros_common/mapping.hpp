@@ -1,9 +1,10 @@
 #pragma once
 /// @file mapping.hpp
-/// The ROS mapping file: how a SAFECASS system specification meets a ROS 1 graph. The system
-/// file stays framework-free; this small file says which ROS node each component is, which topic
-/// carries which connection, which message fields feed which signals, and how diagnostics flow.
-/// The format is documented in docs/frameworks.md ("ROS 1"). Plain C++17, no ROS header.
+/// The ROS mapping file: how a SAFECASS system specification meets a ROS graph, ROS 1 or ROS 2.
+/// The system file stays framework-free; this small file says which ROS node each component is,
+/// which topic carries which connection, which message fields feed which signals, and how
+/// diagnostics flow. One format for both frameworks (a ROS 1 mapping runs unchanged on ROS 2): it
+/// is documented in docs/frameworks.md ("The ROS mapping file"). Plain C++17, no ROS header.
 
 #include <optional>
 #include <string>
@@ -12,10 +13,10 @@
 
 #include "safecass/core/event.hpp"
 #include "safecass/core/expected.hpp"
-#include "safecass/ros1/fields.hpp"
+#include "safecass/ros_common/fields.hpp"
 #include "safecass/spec/diagnostics.hpp"
 
-namespace safecass::ros1 {
+namespace safecass::ros_common {
 
 /// One signal fed by a topic: `"JR3.Fx": "wrench.force.x"`.
 struct FieldBinding {
@@ -63,6 +64,7 @@ struct IngestRule {
 };
 
 struct Mapping {
+  int ros_version = 1;                                     ///< the header: "safecass_ros1": 1 or "safecass_ros2": 1
   std::string path;                                        ///< the mapping file as given
   std::string system;                                      ///< the system file, resolved relative to the mapping file
   std::string coordinator;                                 ///< only this coordinator's components (empty: all)
@@ -101,4 +103,4 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
 /// with its completion.
 std::vector<EventDef> default_ros_events();
 
-}  // namespace safecass::ros1
+}  // namespace safecass::ros_common

@@ -1,11 +1,11 @@
-#include "safecass/ros1/mapping.hpp"
+#include "safecass/ros_common/mapping.hpp"
 
 #include <set>
 
 #include "safecass/json/read.hpp"
 #include "safecass/spec/scenario.hpp"
 
-namespace safecass::ros1 {
+namespace safecass::ros_common {
 
 bool IngestRule::matches(std::string_view status_name) const noexcept {
   if (!name.empty() && name.back() == '*') {
@@ -342,14 +342,22 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
   const JsonValue& root = *parsed.value;
   Reader r(name, out.diagnostics);
   if (!r.expect(root, JsonValue::Type::Object, "", "a ROS mapping")) return out;
-  r.known_keys(root, "",
-               {"safecass_ros1", "system", "coordinator", "nodes", "events", "topics", "diagnostics", "graph"});
+  r.known_keys(
+      root, "",
+      {"safecass_ros1", "safecass_ros2", "system", "coordinator", "nodes", "events", "topics", "diagnostics", "graph"});
   Mapping m;
   m.path = name;
-  const JsonValue* version = root.find("safecass_ros1");
-  if (version == nullptr || !version->is_number() || version->number != 1) {
-    r.error(version ? *version : root, version ? "/safecass_ros1" : "",
-            "a ROS mapping starts with \"safecass_ros1\": 1");
+  // One format for both frameworks; the header says which graph it was written for.
+  const JsonValue* v1 = root.find("safecass_ros1");
+  const JsonValue* v2 = root.find("safecass_ros2");
+  const JsonValue* version = v1 != nullptr ? v1 : v2;
+  if (v1 != nullptr && v2 != nullptr) {
+    r.error(*v2, "/safecass_ros2", "a ROS mapping has one header, \"safecass_ros1\": 1 or \"safecass_ros2\": 1");
+  } else if (version == nullptr || !version->is_number() || version->number != 1) {
+    r.error(version ? *version : root, version ? (v1 ? "/safecass_ros1" : "/safecass_ros2") : "",
+            "a ROS mapping starts with \"safecass_ros1\": 1 or \"safecass_ros2\": 1");
+  } else {
+    m.ros_version = v1 != nullptr ? 1 : 2;
   }
   if (r.string(root, "system", "", m.system, true) && m.system.front() != '/') m.system = directory_of(name) + m.system;
   r.string(root, "coordinator", "", m.coordinator, false);
@@ -403,4 +411,4 @@ MappingLoad load_mapping_from_text(std::string_view text, const std::string& nam
   return out;
 }
 
-}  // namespace safecass::ros1
+}  // namespace safecass::ros_common

@@ -24,14 +24,15 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/core/state.hpp"
 
-namespace safecass::ros1 {
+namespace safecass::ros_common {
 
 /// The message types the bridge can read numbers from.
 enum class MessageType : std::uint8_t { Float64, WrenchStamped, JointState };
 
 /// "std_msgs/Float64", "geometry_msgs/WrenchStamped", "sensor_msgs/JointState".
 std::string_view to_string(MessageType type) noexcept;
-/// Parses a ROS message type name. Errors: NotFound (names the supported types).
+/// Parses a ROS message type name, as ROS 1 writes it ("std_msgs/Float64") or ROS 2
+/// ("std_msgs/msg/Float64"). Errors: NotFound (names the supported types).
 [[nodiscard]] Expected<MessageType> parse_message_type(std::string_view name);
 
 /// A parsed field path: which part of a message, and which element of it.
@@ -50,6 +51,24 @@ struct FieldPath {
 /// Parses `path` for messages of `type`. Errors: InvalidArgument, with a message that names the
 /// path, the part that is wrong and what would be accepted.
 [[nodiscard]] Expected<FieldPath> parse_field_path(MessageType type, std::string_view path);
+
+/// The numbers of one message as field paths see them, whatever the framework's message type:
+/// each framework fills it from its own message (no copy of the arrays) and extract() does the rest.
+struct MessageNumbers {
+  double data = 0.0;                      ///< std_msgs/Float64
+  double wrench[6] = {0, 0, 0, 0, 0, 0};  ///< force x y z, torque x y z
+  const double* position = nullptr;       ///< sensor_msgs/JointState arrays
+  std::size_t position_size = 0;
+  const double* velocity = nullptr;
+  std::size_t velocity_size = 0;
+  const double* effort = nullptr;
+  std::size_t effort_size = 0;
+};
+
+/// Writes `width` doubles of `msg` at `path` into `out`. False, with `error` set, when the message
+/// does not have them (a JointState array shorter than needed). Never throws; allocates only to
+/// write the error.
+bool extract(const FieldPath& path, const MessageNumbers& msg, double* out, std::size_t width, std::string& error);
 
 /// The four levels of `diagnostic_msgs/DiagnosticStatus`, with the same byte values.
 enum class DiagnosticLevel : std::uint8_t { Ok = 0, Warn = 1, Error = 2, Stale = 3 };
@@ -73,4 +92,4 @@ constexpr std::optional<DiagnosticLevel> diagnostic_level_from_byte(int byte) no
 /// "OK", "WARN", "ERROR", "STALE".
 std::string_view to_string(DiagnosticLevel level) noexcept;
 
-}  // namespace safecass::ros1
+}  // namespace safecass::ros_common

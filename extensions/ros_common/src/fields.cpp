@@ -1,9 +1,9 @@
-#include "safecass/ros1/fields.hpp"
+#include "safecass/ros_common/fields.hpp"
 
 #include <cctype>
 #include <vector>
 
-namespace safecass::ros1 {
+namespace safecass::ros_common {
 
 std::string_view to_string(MessageType type) noexcept {
   switch (type) {
@@ -15,8 +15,11 @@ std::string_view to_string(MessageType type) noexcept {
 }
 
 [[nodiscard]] Expected<MessageType> parse_message_type(std::string_view name) {
+  // ROS 2 names the same message "pkg/msg/Type".
+  std::string plain(name);
+  if (const std::size_t at = plain.find("/msg/"); at != std::string::npos) plain.erase(at, 4);
   for (MessageType t : {MessageType::Float64, MessageType::WrenchStamped, MessageType::JointState}) {
-    if (name == to_string(t)) return t;
+    if (plain == to_string(t)) return t;
   }
   return fail(ErrorCode::NotFound, "unsupported message type '" + std::string(name) +
                                        "' (supported: std_msgs/Float64, geometry_msgs/WrenchStamped, "
@@ -35,6 +38,55 @@ std::size_t FieldPath::width() const noexcept {
     case Field::Effort: break;
   }
   return 0;
+}
+
+bool extract(const FieldPath& path, const MessageNumbers& msg, double* out, std::size_t width, std::string& error) {
+  switch (path.type) {
+    case MessageType::Float64:
+      if (width != 1) break;
+      out[0] = msg.data;
+      return true;
+    case MessageType::WrenchStamped: {
+      if (width != path.width()) break;
+      std::size_t first = path.field == FieldPath::Field::Torque ? 3 : 0;
+      if (path.index >= 0) first += static_cast<std::size_t>(path.index);
+      for (std::size_t i = 0; i < width; ++i) out[i] = msg.wrench[first + i];
+      return true;
+    }
+    case MessageType::JointState: {
+      const double* array = msg.position;
+      std::size_t size = msg.position_size;
+      const char* name = "position";
+      if (path.field == FieldPath::Field::Velocity) {
+        array = msg.velocity;
+        size = msg.velocity_size;
+        name = "velocity";
+      } else if (path.field == FieldPath::Field::Effort) {
+        array = msg.effort;
+        size = msg.effort_size;
+        name = "effort";
+      }
+      if (path.index >= 0) {
+        if (width != 1 || static_cast<std::size_t>(path.index) >= size) {
+          error =
+              std::string(name) + " has " + std::to_string(size) + " elements, no [" + std::to_string(path.index) + "]";
+          return false;
+        }
+        out[0] = array[static_cast<std::size_t>(path.index)];
+        return true;
+      }
+      if (size != width) {
+        error = std::string(name) + " has " + std::to_string(size) + " elements, the signal expects " +
+                std::to_string(width);
+        return false;
+      }
+      for (std::size_t i = 0; i < width; ++i) out[i] = array[i];
+      return true;
+    }
+  }
+  error = "path '" + path.text + "' does not read " + std::to_string(width) + " doubles of a " +
+          std::string(to_string(path.type));
+  return false;
 }
 
 std::string_view to_string(DiagnosticLevel level) noexcept {
@@ -155,4 +207,4 @@ bool split_index(std::string_view part, std::string_view& name, int& index) {
   return bad("unsupported message type");
 }
 
-}  // namespace safecass::ros1
+}  // namespace safecass::ros_common

@@ -1,0 +1,40 @@
+#include "safecass/ros_common/recording.hpp"
+
+#include "safecass/spec/load.hpp"
+
+namespace safecass::ros_common {
+
+Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow, const FilterRegistry& registry,
+                                                             const std::string& history_path, FileLimits limits) {
+  std::unique_ptr<NodeRecording> r(new NodeRecording());
+  auto h = Recorder::open(shadow.coordinator(), history_path, 65536, limits);
+  if (!h) return tl::unexpected(h.error());
+  r->history_ = std::move(*h);
+  InputRecorderOptions o;
+  o.limits = limits;
+  o.clock = "steady";
+  const spec::LoadResult system = spec::load_system(shadow.mapping().system, registry);
+  if (system.system) {
+    for (const auto& c : system.system->components) {
+      for (const auto& sig : c.signals) o.signals.push_back(sig.name);
+    }
+  }
+  auto in = InputRecorder::open(shadow.monitor(), InputRecorder::path_for_history(history_path), o);
+  if (!in) return tl::unexpected(in.error());
+  r->inputs_ = std::move(*in);
+  r->inputs_->start_polling();
+  return r;
+}
+
+std::vector<std::string> NodeRecording::close() {
+  std::vector<std::string> losses;
+  inputs_->close();
+  for (std::string& loss : describe_losses(inputs_->status())) losses.push_back(std::move(loss));
+  if (!inputs_->status().complete() && losses.empty()) losses.emplace_back("the input recording is incomplete");
+  history_->close();
+  for (std::string& loss : describe_losses(history_->status())) losses.push_back(std::move(loss));
+  if (!history_->status().complete() && losses.empty()) losses.emplace_back("the history recording is incomplete");
+  return losses;
+}
+
+}  // namespace safecass::ros_common
