@@ -36,6 +36,7 @@ struct Bridge::Impl {
   void on_message(std::size_t topic, const M& msg);
   void on_diagnostics(const ros::MessageEvent<diagnostic_msgs::DiagnosticArray const>& event);
   void on_tick();
+  void publish();
   void graph_loop();
   void check_graph();
 };
@@ -151,10 +152,14 @@ void Bridge::Impl::on_message(std::size_t topic, const M& msg) {
     out += b.width;
   }
   shadow->deliver(topic, now);
+  if (shadow->take_change()) publish();  // a change made by this message's filters, at once
 }
 
 void Bridge::Impl::on_tick() {
-  if (!shadow->tick(shadow->coordinator().clock().now())) return;
+  if (shadow->tick(shadow->coordinator().clock().now())) publish();
+}
+
+void Bridge::Impl::publish() {
   diagnostic_msgs::DiagnosticArray array;
   array.header.stamp = ros::Time::now();
   for (ros_common::Status& s : shadow->statuses()) {
@@ -182,6 +187,7 @@ void Bridge::Impl::on_diagnostics(const ros::MessageEvent<diagnostic_msgs::Diagn
   for (const diagnostic_msgs::DiagnosticStatus& s : array.status)
     statuses.push_back(ros_common::ReceivedStatus{s.name, static_cast<int>(s.level)});
   shadow->ingest(statuses, event.getPublisherName());
+  if (shadow->take_change()) publish();
 }
 
 // ---- graph check ---------------------------------------------------------------------------------
