@@ -62,7 +62,8 @@ stress-test: build
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
-# A short libFuzzer run of the spec loader (clang, ASan + UBSan); the long run is in docs/spec-format.md.
+# Short libFuzzer runs of the spec loader and of the ROS inputs (clang, ASan + UBSan); the long
+# runs are in docs/spec-format.md.
 FUZZ := $(BUILD)/fuzz
 fuzz-smoke: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
@@ -76,6 +77,14 @@ fuzz-smoke: deps
 	  -artifact_prefix=$(FUZZ)/ $(FUZZ)/corpus >$(FUZZ)/smoke.log 2>&1 \
 	  || { tail -40 $(FUZZ)/smoke.log; echo "fuzz-smoke: the spec loader fuzzer found a failure"; exit 1; }
 	@echo "fuzz-smoke: no failure in 20 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/smoke.log | tail -1))"
+	@cmake --build $(FUZZ) -j $(JOBS) --target ros_input_fuzz >/dev/null
+	@mkdir -p $(FUZZ)/ros-corpus
+	@for f in examples/ros_robodoc/mapping.json examples/dds_robodoc/mapping.json tests/unit/dds/data/*.json; do \
+	  { printf '\003'; cat "$$f"; } >"$(FUZZ)/ros-corpus/$$(echo "$$f" | tr / _)"; done
+	@$(FUZZ)/bin/ros_input_fuzz -max_len=4096 -max_total_time=10 -print_final_stats=1 \
+	  -artifact_prefix=$(FUZZ)/ros- $(FUZZ)/ros-corpus >$(FUZZ)/ros-smoke.log 2>&1 \
+	  || { tail -40 $(FUZZ)/ros-smoke.log; echo "fuzz-smoke: the ROS input fuzzer found a failure"; exit 1; }
+	@echo "fuzz-smoke: ROS inputs (CDR, mapping files): no failure in 10 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/ros-smoke.log | tail -1))"
 
 # Benchmarks are built in Release in their own tree; results land in build/bench.json (every
 # repetition and the aggregates), run on one core (the last) when taskset is there.

@@ -22,6 +22,8 @@ packages+=(clang-format clang-tidy)
 # ROS 2 over DDS (extensions/dds, examples/dds_robodoc, `make ros2-demo`): Eclipse Cyclone DDS's C
 # library and its IDL compiler (idlc) and tools (ddsperf).
 packages+=(cyclonedds-dev cyclonedds-tools libcycloneddsidl0)
+# `safecass replay` of a ROS 2 bag (rosbag2's sqlite3 store).
+packages+=(libsqlite3-dev)
 # ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (`safecass
 # replay` of a bag), the messages,
 # diagnostic_aggregator and rosdiagnostic; unshare/ip for the loopback-only test namespace.

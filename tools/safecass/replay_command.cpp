@@ -41,10 +41,11 @@ void add_replay_command(CLI::App& app, int& code) {
                   "record the replay's inputs to this file (\"-\": do not)");
   cmd->add_option("--max-bytes", args->max_bytes, "rotate the replay's recordings at this many bytes")
       ->check(CLI::Range(std::uint64_t{4096}, std::uint64_t{1} << 62));
-  cmd->add_option("--format", args->options.format, "recording, csv or bag (default: from the file's first bytes)")
-      ->check(CLI::IsMember({"recording", "csv", "bag"}));
+  cmd->add_option("--format", args->options.format,
+                  "recording, csv, bag (ROS 1) or rosbag2 (ROS 2) (default: from the file's first bytes)")
+      ->check(CLI::IsMember({"recording", "csv", "bag", "rosbag2"}));
   cmd->add_option("--mapping", args->options.mapping,
-                  "a ROS bag: the ROS extension's mapping file (topics and field paths to signals)");
+                  "a ROS 1 or ROS 2 bag: the ROS extensions' mapping file (topics and field paths to signals)");
   cmd->callback([args, from, to, period, &code] {
     replay::ReplayOptions o = args->options;
     if (from->count() != 0) o.from = args->from;

@@ -248,8 +248,8 @@ void add_viewer_command(CLI::App& app, int& code) {
                   "a recorded input log (SAFECASS recording, CSV or ROS 1 bag) fed through --system in simulated "
                   "time; the page gets a time slider (play, pause, speed, seek, next transition); read-only");
   cmd->add_option("--format", args->format,
-                  "with --replay: recording, csv or bag (default: from the file's first bytes)")
-      ->check(CLI::IsMember({"recording", "csv", "bag"}));
+                  "with --replay: recording, csv, bag or rosbag2 (default: from the file's first bytes)")
+      ->check(CLI::IsMember({"recording", "csv", "bag", "rosbag2"}));
   cmd->add_option("--mapping", args->mapping, "with --replay of a ROS bag: the ROS extension's mapping file");
   cmd->add_flag("--allow-write", args->allow_write, "accept generate, inject and reset requests that carry the token");
   cmd->add_flag("--open", args->open, "open the page in the desktop's browser (xdg-open)");

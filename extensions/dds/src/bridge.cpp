@@ -238,8 +238,8 @@ void Bridge::Impl::spin() {
   constexpr auto kTick = std::chrono::milliseconds(20);
   const auto begin = Steady::now();
   auto next_tick = begin;
-  auto next_graph =
-      begin + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(shadow->mapping().graph_grace));
+  auto next_graph = begin + std::chrono::duration_cast<Steady::duration>(
+                                std::chrono::duration<double>(shadow->mapping().graph_grace));
   const auto graph_period =
       std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(shadow->mapping().graph_period));
   std::vector<Steady::time_point> next_loop(shadow->loop_count(), begin);

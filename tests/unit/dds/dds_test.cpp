@@ -13,10 +13,13 @@
 #include <thread>
 #include <vector>
 
+#include <dds/ddsi/ddsi_serdata.h>
+
 #include "ros2_msgs.h"
 #include "safecass/dds/bridge.hpp"
 #include "safecass/dds/ros2.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/ros_common/cdr.hpp"
 
 using namespace safecass;
 namespace ros2 = safecass::dds::ros2;
@@ -392,4 +395,98 @@ TEST(Ros2BridgeCreate, ASecondHeaderOrNoneIsRefused) {
     ASSERT_FALSE(load.diagnostics.empty());
     EXPECT_NE(load.diagnostics[0].message.find("safecass_ros2"), std::string::npos) << load.diagnostics[0].message;
   }
+}
+
+// ---- CDR: the numbers of a message from its bytes (ROS 2 bags) ---------------------------------------
+
+namespace {
+
+/// The CDR bytes Cyclone DDS puts on the wire for `sample`.
+std::vector<std::uint8_t> wire_bytes(const dds_topic_descriptor_t& type, const char* name, const void* sample) {
+  const dds_entity_t pp = dds_create_participant(kDomain, nullptr, nullptr);
+  const dds_entity_t topic = dds_create_topic(pp, &type, name, nullptr, nullptr);
+  dds_qos_t* q = ros2::qos();
+  const dds_entity_t w = dds_create_writer(pp, topic, q, nullptr);
+  const dds_entity_t r = dds_create_reader(pp, topic, q, nullptr);
+  dds_delete_qos(q);
+  dds_write(w, sample);
+  ddsi_serdata* data = nullptr;
+  dds_sample_info_t info;
+  std::vector<std::uint8_t> bytes;
+  if (wait_for([&] { return dds_takecdr(r, &data, 1, &info, DDS_ANY_STATE) == 1; })) {
+    bytes.resize(ddsi_serdata_size(data));
+    ddsi_serdata_to_ser(data, 0, bytes.size(), bytes.data());
+    ddsi_serdata_unref(data);
+  }
+  dds_delete(pp);
+  return bytes;
+}
+
+}  // namespace
+
+TEST(Ros2Cdr, EveryMappedTypeDecodesFromTheBytesCycloneDdsWrites) {
+  ASSERT_GT(local_domain(), 0);
+  using ros_common::MessageType;
+  ros_common::DecodedMessage m;
+  std::string error;
+
+  const std_msgs_msg_dds__Float64_ f{-273.15};
+  auto bytes = wire_bytes(std_msgs_msg_dds__Float64__desc, "cdr_f", &f);
+  ASSERT_TRUE(ros_common::decode_cdr(MessageType::Float64, bytes.data(), bytes.size(), m, error)) << error;
+  EXPECT_EQ(m.numbers.data, -273.15);
+
+  // An odd-length frame id puts the doubles after padding.
+  char frame[] = "sensor_frame_1";
+  geometry_msgs_msg_dds__WrenchStamped_ w{};
+  w.header_.stamp_ = {1700000000, 123};
+  w.header_.frame_id_ = frame;
+  w.wrench_.force_ = {1.0, 2.0, 3.0};
+  w.wrench_.torque_ = {4.0, 5.0, 6.0};
+  bytes = wire_bytes(geometry_msgs_msg_dds__WrenchStamped__desc, "cdr_w", &w);
+  ASSERT_TRUE(ros_common::decode_cdr(MessageType::WrenchStamped, bytes.data(), bytes.size(), m, error)) << error;
+  EXPECT_EQ(std::vector<double>(m.numbers.wrench, m.numbers.wrench + 6), (std::vector<double>{1, 2, 3, 4, 5, 6}));
+
+  char a[] = "shoulder", b[] = "elbow_joint";
+  char* names[] = {a, b};
+  double position[2] = {0.5, -0.25}, effort[1] = {7.0};
+  sensor_msgs_msg_dds__JointState_ js{};
+  js.header_.frame_id_ = frame;
+  js.name_ = {2, 2, names, false};
+  js.position_ = {2, 2, position, false};  // velocity: empty
+  js.effort_ = {1, 1, effort, false};
+  bytes = wire_bytes(sensor_msgs_msg_dds__JointState__desc, "cdr_j", &js);
+  ASSERT_TRUE(ros_common::decode_cdr(MessageType::JointState, bytes.data(), bytes.size(), m, error)) << error;
+  EXPECT_EQ(m.position, (std::vector<double>{0.5, -0.25}));
+  EXPECT_TRUE(m.velocity.empty());
+  EXPECT_EQ(m.effort, (std::vector<double>{7.0}));
+  EXPECT_EQ(m.numbers.position_size, 2u);
+}
+
+TEST(Ros2Cdr, BigEndianCdrDecodesToo) {
+  // 00 00 (CDR big endian), then 1.5 as a big-endian double.
+  const std::uint8_t bytes[] = {0, 0, 0, 0, 0x3f, 0xf8, 0, 0, 0, 0, 0, 0};
+  ros_common::DecodedMessage m;
+  std::string error;
+  ASSERT_TRUE(ros_common::decode_cdr(ros_common::MessageType::Float64, bytes, sizeof bytes, m, error)) << error;
+  EXPECT_EQ(m.numbers.data, 1.5);
+}
+
+TEST(Ros2Cdr, BytesThatAreNotTheMessageAreRefusedWithWhereAndWhat) {
+  ros_common::DecodedMessage m;
+  std::string error;
+  using ros_common::MessageType;
+  const std::uint8_t short_header[] = {0, 1};
+  EXPECT_FALSE(ros_common::decode_cdr(MessageType::Float64, short_header, sizeof short_header, m, error));
+  EXPECT_EQ(error, "byte 0: fewer than the 4 bytes of the CDR encapsulation header");
+  const std::uint8_t xcdr2[] = {0, 7, 0, 0, 1, 2, 3, 4, 5, 6, 7, 8};
+  EXPECT_FALSE(ros_common::decode_cdr(MessageType::Float64, xcdr2, sizeof xcdr2, m, error));
+  EXPECT_EQ(error, "byte 0: encapsulation 00 07 is not plain CDR (00 00 or 00 01)");
+  // A WrenchStamped whose frame id claims 4 GB.
+  const std::uint8_t huge_string[] = {0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 0xff, 0xff, 0xff, 0xff, 'a'};
+  EXPECT_FALSE(ros_common::decode_cdr(MessageType::WrenchStamped, huge_string, sizeof huge_string, m, error));
+  EXPECT_EQ(error, "byte 12: a string of 4294967295 bytes runs past the end (17 bytes)");
+  // A JointState whose names claim 1,000,000 strings in a few bytes.
+  const std::uint8_t many[] = {0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0x40, 0x42, 0x0f, 0x00};
+  EXPECT_FALSE(ros_common::decode_cdr(MessageType::JointState, many, sizeof many, m, error));
+  EXPECT_EQ(error, "byte 20: a sequence of 1000000 strings runs past the end (24 bytes)");
 }

@@ -9,6 +9,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <unordered_map>
 
 #include "safecass/introspect/format.hpp"
@@ -21,6 +22,9 @@
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG
 #include "safecass/replay/bag_source.hpp"
 #endif
+#ifdef SAFECASS_REPLAY_WITH_ROSBAG2
+#include "safecass/replay/rosbag2_source.hpp"
+#endif
 
 namespace safecass::replay {
 
@@ -30,8 +34,11 @@ using runner::ScenarioRunner;
 
 std::string secs(Time t) { return introspect::seconds_text(t); }
 
-/// The format of a log from its first bytes: a recording's header, a bag's "#ROSBAG", else CSV.
+/// The format of a log from its first bytes: a recording's header, a bag's "#ROSBAG", SQLite's
+/// header or a directory (a ROS 2 bag), else CSV.
 std::string sniff(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) return "rosbag2";
   char head[16] = {};
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd < 0) return "";  // open_input() says why it cannot be read
@@ -40,6 +47,7 @@ std::string sniff(const std::string& path) {
   const std::string_view h(head, n > 0 ? static_cast<std::size_t>(n) : 0);
   if (h.substr(0, input_log::kMagic.size()) == input_log::kMagic) return "recording";
   if (h.substr(0, 7) == "#ROSBAG") return "bag";
+  if (h.substr(0, 16) == std::string_view("SQLite format 3\0", 16)) return "rosbag2";
   return "csv";
 }
 
@@ -69,7 +77,19 @@ std::string sniff(const std::string& path) {
         o.input + ": a ROS bag needs the ROS 1 extension, and this safecass was built without it (SAFECASS_WITH_ROS1)");
 #endif
   }
-  return fail(ErrorCode::InvalidArgument, "unknown log format '" + format + "' (recording, csv or bag)");
+  if (format == "rosbag2") {
+#ifdef SAFECASS_REPLAY_WITH_ROSBAG2
+    if (o.mapping.empty()) {
+      return fail(ErrorCode::InvalidArgument,
+                  o.input + ": a ROS 2 bag needs the ROS extensions' mapping file (--mapping FILE)");
+    }
+    return open_rosbag2(o.input, o.mapping);
+#else
+    return fail(ErrorCode::InvalidArgument,
+                o.input + ": a ROS 2 bag needs SQLite, and this safecass was built without it (libsqlite3-dev)");
+#endif
+  }
+  return fail(ErrorCode::InvalidArgument, "unknown log format '" + format + "' (recording, csv, bag or rosbag2)");
 }
 
 /// The system, composed as `safecass run` composes it, with no scenario steps.

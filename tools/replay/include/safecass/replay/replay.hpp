@@ -27,7 +27,7 @@ namespace safecass::replay {
 struct ReplayOptions {
   std::string system;          ///< the system file replayed (with --diff: SYSTEM_A, the reference)
   std::string input;           ///< the log
-  std::string format;          ///< "recording", "csv", "bag"; empty: from the file's first bytes
+  std::string format;          ///< "recording", "csv", "bag", "rosbag2"; empty: from the file's first bytes
   std::string mapping;         ///< a bag: the ROS extension's mapping file
   std::optional<double> from;  ///< seconds: inputs before are not fed; the replay starts there
   std::optional<double> to;    ///< seconds: inputs after are not fed; the replay ends there

@@ -25,7 +25,7 @@ namespace safecass::viewer {
 struct ReplaySourceOptions {
   std::string system;   ///< the system file the log is fed through
   std::string input;    ///< the log: a SAFECASS input recording, a CSV file or a ROS 1 bag
-  std::string format;   ///< "recording", "csv", "bag"; empty: from the file's first bytes
+  std::string format;   ///< "recording", "csv", "bag", "rosbag2"; empty: from the file's first bytes
   std::string mapping;  ///< a bag: the ROS extension's mapping file
   double speed = 1.0;   ///< recording seconds per wall-clock second while playing, in (0, 1000]
 };
