@@ -115,8 +115,12 @@ int main(int argc, char** argv) {
   const pid_t node = ::fork();
   if (node == 0) return run_node(domain);
 
-  dds_create_domain(static_cast<dds_domainid_t>(domain), ros2::loopback_config().c_str());
-  const dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
+  auto joined = ros2::join(domain);
+  if (!joined) {
+    std::fprintf(stderr, "peer_dds_visibility: %s\n", joined.error().message.c_str());
+    return 3;
+  }
+  const dds_entity_t pp = joined->participant;
   dds_qos_t* q = ros2::qos();
   const dds_entity_t wt = dds_create_topic(pp, &geometry_msgs_msg_dds__WrenchStamped__desc,
                                            ros2::dds_topic("/jr3/wrench").c_str(), nullptr, nullptr);

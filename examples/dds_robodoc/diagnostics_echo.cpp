@@ -59,14 +59,12 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  const char* uri = std::getenv("CYCLONEDDS_URI");
-  if (uri == nullptr || *uri == '\0')
-    dds_create_domain(static_cast<dds_domainid_t>(*id), ros2::loopback_config().c_str());
-  const dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(*id), nullptr, nullptr);
-  if (pp < 0) {
-    std::fprintf(stderr, "dds_diagnostics_echo: DDS participant: %s\n", dds_strretcode(pp));
+  auto joined = ros2::join(domain);
+  if (!joined) {
+    std::fprintf(stderr, "%s: %s\n", "dds_diagnostics_echo", joined.error().message.c_str());
     return 3;
   }
+  const dds_entity_t pp = joined->participant;
   const std::string name = ros2::dds_topic("/diagnostics");
   const dds_entity_t topic =
       dds_create_topic(pp, &diagnostic_msgs_msg_dds__DiagnosticArray__desc, name.c_str(), nullptr, nullptr);

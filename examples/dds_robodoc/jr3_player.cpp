@@ -77,14 +77,12 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
-  const char* uri = std::getenv("CYCLONEDDS_URI");
-  if (uri == nullptr || *uri == '\0')
-    dds_create_domain(static_cast<dds_domainid_t>(*id), ros2::loopback_config().c_str());
-  const dds_entity_t pp = dds_create_participant(static_cast<dds_domainid_t>(*id), nullptr, nullptr);
-  if (pp < 0) {
-    std::fprintf(stderr, "dds_robodoc_jr3: DDS participant: %s\n", dds_strretcode(pp));
+  auto joined = ros2::join(domain);
+  if (!joined) {
+    std::fprintf(stderr, "%s: %s\n", "dds_robodoc_jr3", joined.error().message.c_str());
     return 3;
   }
+  const dds_entity_t pp = joined->participant;
   dds_qos_t* qos = ros2::qos();
   const std::string wrench_name = ros2::dds_topic("/jr3/wrench");
   const dds_entity_t wrench_topic =

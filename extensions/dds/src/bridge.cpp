@@ -4,7 +4,6 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <thread>
 #include <vector>
 
@@ -122,23 +121,11 @@ Expected<void> Bridge::add_loop(std::string_view component, Time period, Body bo
 }
 
 Expected<void> Bridge::Impl::join() {
-  auto id = ros2::domain_id(options.domain);
-  if (!id) return tl::unexpected(id.error());
-  domain = *id;
-  const char* uri = std::getenv("CYCLONEDDS_URI");
-  if (options.loopback && (uri == nullptr || *uri == '\0')) {
-    const std::string config = ros2::loopback_config();
-    const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(domain), config.c_str());
-    // PRECONDITION_NOT_MET: this process already has the domain (another bridge), configured.
-    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET) return fail(ErrorCode::Io, dds_error("DDS domain", d));
-    if (d > 0) domain_entity = Entity(d);
-  }
-  participant = Entity(dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr));
-  if (participant.handle < 0) {
-    const dds_return_t rc = participant.handle;
-    participant.handle = 0;
-    return fail(ErrorCode::Io, dds_error("DDS participant", rc));
-  }
+  auto joined = ros2::join(options.domain, options.loopback);
+  if (!joined) return tl::unexpected(joined.error());
+  domain = *ros2::domain_id(options.domain);
+  domain_entity = Entity(joined->domain);
+  participant = Entity(joined->participant);
   const dds_entity_t pp = participant.handle;
   dds_qos_t* qos = ros2::qos();
   const Mapping& m = shadow->mapping();

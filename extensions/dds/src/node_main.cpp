@@ -98,12 +98,5 @@ int main(int argc, char** argv) {
   int signal = 0;
   sigwait(&stop_signals, &signal);
   (*bridge)->stop();
-  int code = 0;
-  if (recording) {
-    for (const std::string& loss : recording->close()) {
-      std::fprintf(stderr, "%s\n", loss.c_str());
-      code = 2;
-    }
-  }
-  return code;
+  return safecass::ros_common::NodeRecording::finish(recording);
 }

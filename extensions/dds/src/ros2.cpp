@@ -68,6 +68,27 @@ dds_qos_t* qos(int depth) {
   return static_cast<int>(id);
 }
 
+[[nodiscard]] Expected<Participant> join(int domain, bool loopback) {
+  auto id = domain_id(domain);
+  if (!id) return tl::unexpected(id.error());
+  Participant out;
+  const char* uri = std::getenv("CYCLONEDDS_URI");
+  if (loopback && (uri == nullptr || *uri == '\0')) {
+    const dds_entity_t d = dds_create_domain(static_cast<dds_domainid_t>(*id), loopback_config().c_str());
+    // PRECONDITION_NOT_MET: this process already has the domain, configured.
+    if (d < 0 && d != DDS_RETCODE_PRECONDITION_NOT_MET)
+      return fail(ErrorCode::Io, std::string("DDS domain: ") + dds_strretcode(d));
+    if (d > 0) out.domain = d;
+  }
+  out.participant = dds_create_participant(static_cast<dds_domainid_t>(*id), nullptr, nullptr);
+  if (out.participant < 0) {
+    const dds_return_t rc = out.participant;
+    if (out.domain > 0) dds_delete(out.domain);
+    return fail(ErrorCode::Io, std::string("DDS participant: ") + dds_strretcode(rc));
+  }
+  return out;
+}
+
 std::string loopback_config() {
   return "<CycloneDDS><Domain Id=\"any\">"
          "<General><Interfaces><NetworkInterface address=\"127.0.0.1\"/></Interfaces>"

@@ -63,12 +63,5 @@ int main(int argc, char** argv) {
            std::string((*bridge)->coordinator().name()).c_str());
   ros::spin();
   (*bridge)->stop();
-  int code = 0;
-  if (recording) {
-    for (const std::string& loss : recording->close()) {
-      std::fprintf(stderr, "%s\n", loss.c_str());
-      code = 2;
-    }
-  }
-  return code;
+  return safecass::ros_common::NodeRecording::finish(recording);
 }

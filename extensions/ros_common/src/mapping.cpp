@@ -186,9 +186,7 @@ void read_topic(Reader& r, const JsonValue& v, const std::string& pointer, Mappi
       for (std::size_t i = 0; i < req->array.size(); ++i) {
         const JsonValue& e = req->array[i];
         const std::string p = pointer + "/required/" + std::to_string(i);
-        if (!r.expect(e, JsonValue::Type::String, p, "an interface")) {
-          ok = false;
-        } else if (r.dotted(e, p, e.string, "interface")) {
+        if (r.expect(e, JsonValue::Type::String, p, "an interface") && r.dotted(e, p, e.string, "interface")) {
           t.required.push_back(e.string);
         } else {
           ok = false;

@@ -1,5 +1,7 @@
 #include "safecass/ros_common/recording.hpp"
 
+#include <cstdio>
+
 #include "safecass/spec/load.hpp"
 
 namespace safecass::ros_common {
@@ -35,6 +37,17 @@ std::vector<std::string> NodeRecording::close() {
   for (std::string& loss : describe_losses(history_->status())) losses.push_back(std::move(loss));
   if (!history_->status().complete() && losses.empty()) losses.emplace_back("the history recording is incomplete");
   return losses;
+}
+
+int NodeRecording::finish(std::unique_ptr<NodeRecording>& recording) {
+  if (!recording) return 0;
+  int code = 0;
+  for (const std::string& loss : recording->close()) {
+    std::fprintf(stderr, "%s\n", loss.c_str());
+    code = 2;
+  }
+  recording.reset();
+  return code;
 }
 
 }  // namespace safecass::ros_common

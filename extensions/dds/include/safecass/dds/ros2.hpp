@@ -65,6 +65,17 @@ dds_qos_t* qos(int depth = kDefaultDepth);
 /// ROS_DOMAIN_ID that is not an integer in [0, 232].
 [[nodiscard]] Expected<int> domain_id(int explicit_id);
 
+/// A participant of ROS 2's DDS world, and the domain entity when this call configured the domain.
+struct Participant {
+  dds_entity_t domain = 0;       ///< > 0: created here (loopback_config()); delete it after the participant
+  dds_entity_t participant = 0;  ///< > 0
+};
+/// Joins `domain` (see domain_id()): on 127.0.0.1 only (loopback_config()) when `loopback` and
+/// CYCLONEDDS_URI does not configure Cyclone DDS (a domain this process already has keeps its
+/// configuration); else as CYCLONEDDS_URI or Cyclone's defaults say. Errors: InvalidArgument (the
+/// domain), Io (DDS refused, with its reason).
+[[nodiscard]] Expected<Participant> join(int domain, bool loopback = true);
+
 /// A Cyclone DDS configuration that keeps a participant on 127.0.0.1: unicast discovery of peers
 /// on the loopback address, no multicast, a 2 s participant lease (a vanished participant's
 /// endpoints go within ~2 s). Used when CYCLONEDDS_URI is not set.

@@ -24,6 +24,9 @@ public:
                                                                      FileLimits limits = {});
   /// Closes both files; the losses, one line each (empty: the recording is complete).
   std::vector<std::string> close();
+  /// Closes `recording`, when there is one, and prints its losses on stderr: the node's exit status
+  /// (0, or 2 for an incomplete recording).
+  static int finish(std::unique_ptr<NodeRecording>& recording);
 
 private:
   NodeRecording() = default;
