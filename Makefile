@@ -79,7 +79,7 @@ fuzz-smoke: deps
 	@echo "fuzz-smoke: no failure in 20 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/smoke.log | tail -1))"
 	@cmake --build $(FUZZ) -j $(JOBS) --target ros_input_fuzz >/dev/null
 	@mkdir -p $(FUZZ)/ros-corpus
-	@for f in examples/ros_robodoc/mapping.json examples/dds_robodoc/mapping.json tests/unit/dds/data/*.json; do \
+	@for f in examples/ros_robodoc/mapping.json examples/dds_robodoc/mapping.json tests/unit/dds/data/*.json tests/integration/dds/*.json; do \
 	  { printf '\003'; cat "$$f"; } >"$(FUZZ)/ros-corpus/$$(echo "$$f" | tr / _)"; done
 	@$(FUZZ)/bin/ros_input_fuzz -max_len=4096 -max_total_time=10 -print_final_stats=1 \
 	  -artifact_prefix=$(FUZZ)/ros- $(FUZZ)/ros-corpus >$(FUZZ)/ros-smoke.log 2>&1 \

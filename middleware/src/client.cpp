@@ -135,7 +135,9 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
   }
   try {
     impl->ic = make_communicator(o.tls);
-    auto adapter = impl->ic->createObjectAdapterWithEndpoints("SafecassClient", protocol(o.tls) + " -h 127.0.0.1");
+    if (impl->options.listen_host.empty()) impl->options.listen_host = listen_host_towards(o.ice);
+    auto adapter =
+        impl->ic->createObjectAdapterWithEndpoints("SafecassClient", protocol(o.tls) + " -h " + o.listen_host);
     auto finder = std::make_shared<Finder>(o.coordinator, *keys, impl->ic);
     auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
         impl->ic, "beat", [finder](const wire::Signed& m) { finder->on_beat(m); }, impl->undecodable, "console"));
@@ -438,7 +440,7 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
   try {
     const ClientOptions& o = impl_->options;
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
-                                                               protocol(o.tls) + " -h 127.0.0.1");
+                                                               protocol(o.tls) + " -h " + o.listen_host);
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
     auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
         impl_->ic, "records", [follower](const wire::Signed& m) { follower->on_records(m); }, impl_->undecodable,

@@ -1,7 +1,11 @@
 #include "ice_util.hpp"
 
 #include <IceSSL/IceSSL.h>
+#include <arpa/inet.h>
+#include <netdb.h>
+#include <sys/socket.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <chrono>
 
@@ -47,6 +51,30 @@ TlsOptions tls_from_keys(const std::string& keys_dir, TlsOptions given, std::str
 }  // namespace safecass::middleware
 
 namespace safecass::middleware::detail {
+
+std::string listen_host_towards(const IceEndpoint& ice) {
+  if (is_loopback_host(ice.host)) return "127.0.0.1";
+  addrinfo hints{};
+  hints.ai_family = AF_INET;
+  hints.ai_socktype = SOCK_DGRAM;
+  addrinfo* found = nullptr;
+  if (::getaddrinfo(ice.host.c_str(), std::to_string(ice.port).c_str(), &hints, &found) != 0 || found == nullptr)
+    return "127.0.0.1";
+  std::string out = "127.0.0.1";
+  // A UDP socket "connected" to the broker sends nothing; the kernel picks the route and so the
+  // local address.
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  sockaddr_in local{};
+  socklen_t size = sizeof local;
+  char text[INET_ADDRSTRLEN] = {};
+  if (fd >= 0 && ::connect(fd, found->ai_addr, found->ai_addrlen) == 0 &&
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&local), &size) == 0 &&
+      ::inet_ntop(AF_INET, &local.sin_addr, text, sizeof text) != nullptr)
+    out = text;
+  if (fd >= 0) ::close(fd);
+  ::freeaddrinfo(found);
+  return out;
+}
 
 std::string plain_tcp_warning(const std::string& keys_dir) {
   return "no TLS certificates in " + keys_dir +
@@ -148,15 +176,24 @@ std::int64_t steady_ns() noexcept {
 namespace safecass::middleware::detail {
 
 void Link::connect(const std::vector<std::string>& publish_on) {
-  manager_ = topic_manager(ic_, ice_, tls_);
+  // Every attempt on connections of its own: after a partition the old ones may look open while
+  // their packets wait out TCP's retransmission backoff (minutes), and Ice would keep using them.
+  if (manager_ != nullptr) {
+    if (auto old = manager_->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
+    for (const auto& [name, p] : publishers_) {
+      if (auto old = p->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
+    }
+  }
+  const std::string id = "link-" + std::to_string(++generation_);
+  manager_ = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(topic_manager(ic_, ice_, tls_)->ice_connectionId(id));
   manager_->ice_ping();
   for (Subscription& s : subscriptions_) {
-    s.proxy = topic(manager_, s.topic);
+    s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, s.topic)->ice_connectionId(id));
     (void)subscribe(s.proxy, s.subscriber);
   }
   publishers_.clear();
   for (const std::string& name : publish_on) {
-    publishers_.emplace_back(name, topic(manager_, name)->getPublisher()->ice_oneway());
+    publishers_.emplace_back(name, topic(manager_, name)->getPublisher()->ice_oneway()->ice_connectionId(id));
   }
 }
 
@@ -187,7 +224,9 @@ std::vector<std::string> Link::check() {
   if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
   std::vector<std::string> made;
   for (Subscription& s : subscriptions_) {
-    if (s.proxy == nullptr) s.proxy = topic(manager_, s.topic);
+    if (s.proxy == nullptr)
+      s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(
+          topic(manager_, s.topic)->ice_connectionId(manager_->ice_getConnectionId()));
     if (subscribe(s.proxy, s.subscriber)) made.push_back(s.topic);
   }
   return made;

@@ -41,6 +41,12 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls = {})
 /// The IceSSL properties of mutual TLS with `tls` (enabled): the CA, this process's certificate,
 /// every peer verified. make_communicator sets them; a test's own communicator too.
 void set_tls_properties(const Ice::PropertiesPtr& properties, const TlsOptions& tls);
+/// Where a process that did not choose an address listens for what IceStorm pushes to it: the
+/// address of this host that reaches `ice` (the interface facing the broker, never every
+/// interface), or 127.0.0.1 when the broker is local or cannot be routed to (connecting then
+/// fails with its own clear error).
+std::string listen_host_towards(const IceEndpoint& ice);
+
 /// "ssl" with TLS, else "tcp": the protocol of every endpoint the process creates or names.
 inline std::string protocol(const TlsOptions& tls) { return tls.enabled() ? "ssl" : "tcp"; }
 /// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS).
@@ -72,7 +78,8 @@ std::int64_t steady_ns() noexcept;
 namespace safecass::middleware::detail {
 
 /// A connection to IceStorm: the topics a process subscribes to and publishes on. connect() may
-/// be called again after a failure (IceStorm restarted): it resubscribes and refreshes publishers.
+/// be called again after a failure (IceStorm restarted, a partition healed): it closes the old
+/// connections, opens new ones, resubscribes and refreshes publishers.
 class Link {
 public:
   Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice, TlsOptions tls = {})
@@ -109,6 +116,7 @@ private:
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
   std::uint64_t checks_ = 0;
+  std::uint64_t generation_ = 0;  ///< connect() attempts: each on connections of its own
 };
 
 }  // namespace safecass::middleware::detail

@@ -49,6 +49,10 @@ struct ClientOptions {
   /// Accept IceStorm or a coordinator that is not on this host without TLS.
   bool insecure = false;
   std::chrono::milliseconds timeout{2000};
+  /// Where the client listens for the heartbeats and records IceStorm pushes to it. Empty: the
+  /// address of this host that reaches IceStorm (127.0.0.1 when IceStorm is local), so that a
+  /// console on another host than the broker works without one more option.
+  std::string listen_host;
 };
 
 /// The SystemQuery of one live coordinator process (the read model's remote implementation):

@@ -12,7 +12,7 @@ write=$3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
-replay() { "$safecass" replay examples/robodoc/robodoc.json --mapping tests/unit/dds/data/replay_mapping.json --input "$@"; }
+replay() { "$safecass" replay examples/robodoc/robodoc.json --mapping tests/integration/dds/replay_mapping.json --input "$@"; }
 refused() {  # refused BAG REGEX: exit 2, the message, nothing ran
   replay "$1" >"$tmp/out" 2>"$tmp/err"; local code=$?
   [ $code = 2 ] || fail "$1: exit code $code: $(cat "$tmp/err")"

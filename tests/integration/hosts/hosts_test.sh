@@ -1,0 +1,145 @@
+#!/usr/bin/env bash
+# SAFECASS across hosts: three network namespaces joined by veth links to a switch on 10.77.0.0/24:
+# the robot's coordinator on host a (10.77.0.1), the ui on host b (10.77.0.2), IceStorm and the
+# supervisor on host c (10.77.0.3). Every link is mutual TLS with the system's keys (`safecass
+# keys`); every process listens on its host's address. Each case makes and removes its own hosts
+# and stops its processes by PID. Exit 77 (skipped) where namespaces cannot be made (not root).
+#   hosts_test.sh CASE BIN_DIR SOURCE_DIR
+set -uo pipefail
+case_name=$1
+bin=$(realpath "$2")
+src=$(realpath "$3")
+source "$src/scripts/hosts-lib.sh"
+if ! hosts_available; then
+  echo "SKIPPED: network namespaces cannot be made here (needs root and iproute2: ip netns add)"
+  exit 77
+fi
+HOSTS_DIR="$bin/../hosts-test/$case_name"
+rm -rf "$HOSTS_DIR"; mkdir -p "$HOSTS_DIR"; HOSTS_DIR=$(realpath "$HOSTS_DIR"); cd "$HOSTS_DIR"
+system="$src/examples/robodoc/robodoc.json"
+failures=0
+finish() {
+  hosts_down
+  if [ $failures -ne 0 ]; then
+    for f in "$HOSTS_DIR"/*.log; do echo "---- $f"; tail -15 "$f"; done
+    exit 1
+  fi
+  echo "PASS $case_name"
+}
+trap finish EXIT
+check() {  # check DESCRIPTION COMMAND...
+  local what="$1"; shift
+  if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
+}
+# retry SECONDS COMMAND...: until COMMAND succeeds, for at most SECONDS.
+retry() {
+  local until=$((SECONDS + $1))
+  shift
+  until "$@"; do
+    [ $SECONDS -ge $until ] && return 1
+    sleep 0.1
+  done
+}
+now_ms() { date +%s%3N; }
+
+"$bin/safecass" keys "$system" --out keys --replace >/dev/null 2>&1 || { echo "keys failed"; exit 1; }
+export SAFECASS_KEYS="$HOSTS_DIR/keys"
+hosts_up "sc$$" a b c
+ice="10.77.0.3:4061"
+
+# The broker and the supervisor on c, the robot on a, the ui on b.
+on c "$src/scripts/start-icestorm" --host 10.77.0.3 --port 4061 --publish-port 4062 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" \
+  >/dev/null 2>"$HOSTS_DIR/icestorm-start.log" || { echo "start-icestorm on c failed: $(cat icestorm-start.log)"; exit 1; }
+hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' ice.env)")
+feed="$src/tests/integration/hosts/quiet_feed.json"
+[ "$case_name" = across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_healing ] &&
+  feed="$src/tests/integration/hosts/late_fault_feed.json"
+robot_started=$SECONDS
+hosts_start robot a "$bin/safecass" run "$system" --coordinator robot --ice "$ice" --listen 10.77.0.1 --duration 280 \
+  --scenario "$feed" --allow-write --token-file "$HOSTS_DIR/robot.token"
+hosts_start ui b "$bin/safecass" run "$system" --coordinator ui --ice "$ice" --listen 10.77.0.2 --duration 280
+hosts_start supervisor c "$bin/safecass" supervisor "$system" --ice "$ice" --listen 10.77.0.3 --duration 280
+
+console() {  # console HOST ARGS...: the console, on HOST
+  local host=$1
+  shift
+  on "$host" "$bin/safecass" console --ice "$ice" --timeout 3000 "$@"
+}
+ui_shows() { console b --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -Eq "PENDANT.s_R.Status  $1"; }
+generate() {  # generate EVENT: on the robot's JR3.s_A, from host c, with the robot's token
+  console c --coordinator robot --token-file "$HOSTS_DIR/robot.token" --allow-write -c "event generate $1 JR3.s_A" \
+    >>generate.log 2>&1
+}
+retry 40 ui_shows Normal
+check "the ui on b follows the robot on a through IceStorm on c, over TLS" test $? -eq 0
+
+case $case_name in
+across_hosts_a_fault_propagates_and_clears)
+  retry 20 generate EVT_FORCE_ERROR
+  check "a console on c writes to the robot on a with its token" test $? -eq 0
+  retry 20 ui_shows "Error +EVT_SERVICE_FAILURE"
+  check "the fault on a reaches the ui on b" test $? -eq 0
+  retry 20 grep -q "\[robot\] .*JR3.s_A Normal -> Error EVT_FORCE_ERROR" supervisor.log
+  check "and the supervisor on c" test $? -eq 0
+  retry 20 generate /EVT_FORCE_ERROR
+  retry 20 ui_shows Normal
+  check "its clearing reaches the ui on b" test $? -eq 0
+  ;;
+across_hosts_a_killed_provider_fails_the_view_safe_within_the_bound)
+  start=$(now_ms)
+  kill -KILL "$pid_robot"
+  retry 10 ui_shows "Error +EVT_COORDINATOR_LOST"
+  check "the ui on b shows the robot on a lost (Error, not stale Normal)" test $? -eq 0
+  echo "   robot killed -> the ui's console shows Error: $(($(now_ms) - start)) ms (loss bound: 3 heartbeats, 300 ms, plus the console's own round trip)"
+  retry 10 grep -q "EVT_COORDINATOR_LOST" supervisor.log
+  check "the supervisor on c reports EVT_COORDINATOR_LOST" test $? -eq 0
+  hosts_start robot2 a "$bin/safecass" run "$system" --coordinator robot --ice "$ice" --listen 10.77.0.1 --duration 60 \
+    --scenario "$src/tests/integration/hosts/quiet_feed.json"
+  retry 30 ui_shows Normal
+  check "a restarted robot clears it" test $? -eq 0
+  ;;
+across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_healing)
+  grep -Eq "\[robot\] JR3.s_A .*-> Error" robot.log && { echo "the robot faulted before the partition (a very slow start)"; failures=1; exit 1; }
+  echo "   the link is cut $((SECONDS - robot_started)) s after the robot started (its fault comes at 20 s)"
+  start=$(now_ms)
+  hosts_cut a
+  retry 10 ui_shows "Error +EVT_COORDINATOR_LOST"
+  check "with a's link down, the ui on b shows the robot lost" test $? -eq 0
+  echo "   link down -> the ui's console shows Error: $(($(now_ms) - start)) ms"
+  # t = 20 s on the robot: its force crosses the limit on a, unseen by the others.
+  retry 60 grep -Eq "\[robot\] JR3.s_A .*-> Error EVT_FORCE_ERROR" robot.log
+  check "the robot raised its force fault while cut off" test $? -eq 0
+  hosts_heal a
+  start=$(now_ms)
+  retry 30 ui_shows "Error +EVT_SERVICE_FAILURE"
+  check "after healing, the ui on b holds the fault raised during the partition" test $? -eq 0
+  echo "   link up -> the ui's console shows the robot's fault: $(($(now_ms) - start)) ms"
+  retry 10 grep -q "\[ui\] CONTROL.s_P.Status .*-> Error EVT_SERVICE_FAILURE (root JR3.s_A:EVT_FORCE_ERROR)" ui.log
+  check "with its root on a" test $? -eq 0
+  retry 20 grep -q "EVT_COORDINATOR_LOST" supervisor.log
+  check "the supervisor reported the loss" test $? -eq 0
+  retry 20 grep -Eq "\[robot\] .*JR3.s_A .*-> Error EVT_FORCE_ERROR" supervisor.log
+  check "and, after healing, the fault itself" test $? -eq 0
+  ;;
+across_hosts_no_certificate_another_ca_and_non_members_are_refused)
+  mkdir -p no-certs && chmod 700 no-certs && cp keys/keyring no-certs/
+  SAFECASS_KEYS="$HOSTS_DIR/no-certs" console b --coordinator ui -c "state list PENDANT" >plain.txt 2>&1
+  check "a console on b without a certificate is refused" test $? -ne 0
+  "$bin/safecass" keys "$system" --out other-ca --replace >/dev/null 2>&1
+  SAFECASS_KEYS="$HOSTS_DIR/other-ca" console b --coordinator ui -c "state list PENDANT" >other.txt 2>&1
+  check "a console on b with another CA's certificate is refused" test $? -ne 0
+  on b timeout 20 icestormadmin --Ice.Default.Timeout=2000 --Ice.Override.ConnectTimeout=1000 --Ice.RetryIntervals=-1 \
+    --IceStormAdmin.TopicManager.Default="SafecassIceStorm/TopicManager:tcp -h 10.77.0.3 -p 4061" \
+    -e "topics; destroy safecass.heartbeat" >admin.txt 2>&1
+  check "a non-member on b (plain TCP) can neither list nor destroy a topic at the broker on c" test $? -ne 0
+  SAFECASS_KEYS="$HOSTS_DIR/no-certs" on b "$bin/safecass" run "$system" --coordinator ui --ice "$ice" \
+    --listen 10.77.0.2 --duration 1 >run-plain.txt 2>&1
+  check "a coordinator without a certificate refuses to join across hosts" test $? -eq 2
+  retry 10 ui_shows Normal
+  check "and the ui's view stayed true" test $? -eq 0
+  ;;
+*)
+  echo "unknown case $case_name" >&2
+  failures=1
+  ;;
+esac
