@@ -10,7 +10,7 @@
 #include <ros/ros.h>
 #include <xmlrpcpp/XmlRpcException.h>
 
-#include "extract.hpp"
+#include "safecass/ros1/messages.hpp"
 
 namespace safecass::ros1 {
 
@@ -145,7 +145,7 @@ void Bridge::Impl::on_message(std::size_t topic, const M& msg) {
   std::string error;
   double* out = shadow->scratch(topic);
   for (const Shadow::Bound& b : shadow->bound(topic)) {
-    if (!detail::extract(b.path, msg, out, b.width, error)) {
+    if (!extract(b.path, msg, out, b.width, error)) {
       shadow->reject(topic, error);
       return;
     }

@@ -4,7 +4,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
-#include "extract.hpp"
+#include "safecass/ros1/messages.hpp"
 #include "safecass/ros_common/fields.hpp"
 
 using namespace safecass;
@@ -83,14 +83,14 @@ TEST(Ros1Fields, WrenchPathsExtractTheNamedNumbers) {
   const auto m = wrench();
   std::string error;
   double out[6] = {};
-  ASSERT_TRUE(detail::extract(path(MessageType::WrenchStamped, "wrench"), m, out, 6, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::WrenchStamped, "wrench"), m, out, 6, error));
   for (int i = 0; i < 6; ++i) EXPECT_EQ(out[i], i + 1);
-  ASSERT_TRUE(detail::extract(path(MessageType::WrenchStamped, "wrench.torque"), m, out, 3, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::WrenchStamped, "wrench.torque"), m, out, 3, error));
   EXPECT_EQ(out[0], 4);
   EXPECT_EQ(out[2], 6);
-  ASSERT_TRUE(detail::extract(path(MessageType::WrenchStamped, "wrench.force.y"), m, out, 1, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::WrenchStamped, "wrench.force.y"), m, out, 1, error));
   EXPECT_EQ(out[0], 2);
-  ASSERT_TRUE(detail::extract(path(MessageType::WrenchStamped, "wrench.torque[2]"), m, out, 1, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::WrenchStamped, "wrench.torque[2]"), m, out, 1, error));
   EXPECT_EQ(out[0], 6);
 }
 
@@ -99,7 +99,7 @@ TEST(Ros1Fields, Float64DataIsExtractedEvenWhenNotFiniteSoTheFiltersCanFlagIt) {
   m.data = std::nan("");
   std::string error;
   double out = 0;
-  ASSERT_TRUE(detail::extract(path(MessageType::Float64, "data"), m, &out, 1, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::Float64, "data"), m, &out, 1, error));
   EXPECT_TRUE(std::isnan(out));
 }
 
@@ -109,15 +109,15 @@ TEST(Ros1Fields, JointStateArraysMustHaveTheSignalsLengthAndIndicesMustExist) {
   m.effort = {7, 8, 9};
   std::string error;
   double out[3] = {};
-  ASSERT_TRUE(detail::extract(path(MessageType::JointState, "position"), m, out, 3, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::JointState, "position"), m, out, 3, error));
   EXPECT_EQ(out[1], 0.2);
-  ASSERT_TRUE(detail::extract(path(MessageType::JointState, "effort[2]"), m, out, 1, error));
+  ASSERT_TRUE(ros1::extract(path(MessageType::JointState, "effort[2]"), m, out, 1, error));
   EXPECT_EQ(out[0], 9);
 
   out[0] = -1;
-  EXPECT_FALSE(detail::extract(path(MessageType::JointState, "position"), m, out, 6, error));
+  EXPECT_FALSE(ros1::extract(path(MessageType::JointState, "position"), m, out, 6, error));
   EXPECT_NE(error.find("has 3 elements, the signal expects 6"), std::string::npos) << error;
-  EXPECT_FALSE(detail::extract(path(MessageType::JointState, "velocity[0]"), m, out, 1, error));
+  EXPECT_FALSE(ros1::extract(path(MessageType::JointState, "velocity[0]"), m, out, 1, error));
   EXPECT_NE(error.find("velocity has 0 elements"), std::string::npos) << error;
   EXPECT_EQ(out[0], -1);  // nothing written on failure
 }
@@ -125,8 +125,8 @@ TEST(Ros1Fields, JointStateArraysMustHaveTheSignalsLengthAndIndicesMustExist) {
 TEST(Ros1Fields, APathOfAnotherMessageTypeIsRefused) {
   std::string error;
   double out[3] = {};
-  EXPECT_FALSE(detail::extract(path(MessageType::JointState, "position[0]"), wrench(), out, 1, error));
-  EXPECT_FALSE(detail::extract(path(MessageType::WrenchStamped, "wrench.force"), std_msgs::Float64(), out, 1, error));
+  EXPECT_FALSE(ros1::extract(path(MessageType::JointState, "position[0]"), wrench(), out, 1, error));
+  EXPECT_FALSE(ros1::extract(path(MessageType::WrenchStamped, "wrench.force"), std_msgs::Float64(), out, 1, error));
 }
 
 TEST(Ros1Levels, GcmStatesMapToTheDiagnosticStatusLevelBytes) {

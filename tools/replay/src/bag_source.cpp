@@ -8,8 +8,8 @@
 #include <deque>
 #include <set>
 
-#include "extract.hpp"
 #include "message_source.hpp"
+#include "safecass/ros1/messages.hpp"
 #include "safecass/ros_common/mapping.hpp"
 
 namespace safecass::replay {
@@ -68,11 +68,11 @@ private:
     try {
       switch (t->mapping.type) {
         case ros_common::MessageType::Float64:
-          return feed(*t, ros1::detail::numbers_of(*m.instantiate<std_msgs::Float64>()), time);
+          return feed(*t, ros1::numbers_of(*m.instantiate<std_msgs::Float64>()), time);
         case ros_common::MessageType::WrenchStamped:
-          return feed(*t, ros1::detail::numbers_of(*m.instantiate<geometry_msgs::WrenchStamped>()), time);
+          return feed(*t, ros1::numbers_of(*m.instantiate<geometry_msgs::WrenchStamped>()), time);
         case ros_common::MessageType::JointState:
-          return feed(*t, ros1::detail::numbers_of(*m.instantiate<sensor_msgs::JointState>()), time);
+          return feed(*t, ros1::numbers_of(*m.instantiate<sensor_msgs::JointState>()), time);
       }
     } catch (const std::exception& e) {
       return fail_message(t->mapping.topic, "cannot be read as " + expected + " (rosbag: " + e.what() + ")");

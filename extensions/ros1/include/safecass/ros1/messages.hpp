@@ -1,7 +1,8 @@
 #pragma once
-/// @file extract.hpp
-/// The numbers of a ROS 1 message as field paths see them (private: includes ROS headers). The
-/// reading itself is ros_common::extract(), shared with every framework.
+/// @file messages.hpp
+/// The numbers of a ROS 1 message as field paths see them, for the bridge and for readers of ROS 1
+/// bags (includes the ROS message headers: C++17). The reading itself is ros_common::extract(),
+/// shared with every framework.
 
 #include <geometry_msgs/WrenchStamped.h>
 #include <sensor_msgs/JointState.h>
@@ -9,7 +10,7 @@
 
 #include "safecass/ros_common/fields.hpp"
 
-namespace safecass::ros1::detail {
+namespace safecass::ros1 {
 
 inline ros_common::MessageNumbers numbers_of(const std_msgs::Float64& msg) {
   ros_common::MessageNumbers n;
@@ -49,4 +50,4 @@ bool extract(const ros_common::FieldPath& path, const Message& msg, double* out,
   return ros_common::extract(path, numbers_of(msg), out, width, error);
 }
 
-}  // namespace safecass::ros1::detail
+}  // namespace safecass::ros1
