@@ -18,6 +18,8 @@ using ros_common::Shadow;
 
 namespace {
 
+constexpr int kReaderDepth = 100;
+
 std::string dds_error(const char* what, dds_return_t rc) { return std::string(what) + ": " + dds_strretcode(rc); }
 
 MessageNumbers numbers_of(MessageType type, const void* sample) {
@@ -127,7 +129,10 @@ Expected<void> Bridge::Impl::join() {
   domain_entity = Entity(joined->domain);
   participant = Entity(joined->participant);
   const dds_entity_t pp = participant.handle;
-  dds_qos_t* qos = ros2::qos();
+  // The topics' readers keep more than ROS 2's default 10 samples (history depth is not matched
+  // against the writer's): a burst while the spinning thread is busy must not overwrite a sample
+  // before its filters judge it (the ROS 1 bridge queues 100 as well).
+  dds_qos_t* qos = ros2::qos(kReaderDepth);
   const Mapping& m = shadow->mapping();
   auto check = [](dds_entity_t e, const std::string& what) -> Expected<void> {
     if (e < 0) return fail(ErrorCode::Io, dds_error(what.c_str(), e));

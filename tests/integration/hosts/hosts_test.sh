@@ -27,6 +27,7 @@ finish() {
   echo "PASS $case_name"
 }
 trap finish EXIT
+trap 'exit 143' INT TERM  # a timeout's SIGTERM too: the EXIT trap removes the hosts
 check() {  # check DESCRIPTION COMMAND...
   local what="$1"; shift
   if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
