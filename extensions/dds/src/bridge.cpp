@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <thread>
 #include <vector>
 
@@ -74,7 +75,6 @@ struct Bridge::Impl {
   std::unique_ptr<Shadow> shadow;
   BridgeOptions options;
   int domain = -1;
-  Entity domain_entity;  ///< only when the bridge configured the domain itself
   Entity participant;
   std::vector<dds_entity_t> readers;  ///< per shadow topic (children of the participant)
   dds_entity_t writer = 0;
@@ -92,6 +92,20 @@ struct Bridge::Impl {
   void take_diagnostics();
   void publish(std::vector<ros_common::Status> statuses);
   void check_graph();
+  /// When the spinning thread does what next (that thread only).
+  using Steady = std::chrono::steady_clock;
+  struct Schedule {
+    Steady::time_point next_tick, next_graph;
+    Steady::duration graph_period{};
+    std::vector<Steady::time_point> next_loop;
+    std::vector<Steady::duration> loop_period;
+  };
+  Schedule schedule;
+  /// One pass of the spinning thread: messages, loops, the graph check, the tick.
+  void step();
+  /// A fault of the bridge itself: said, and EVT_THREAD_EXCEPTION on every component's s_F, so that
+  /// no view stays Normal on a bridge that no longer reads.
+  void fail_safe(const std::string& why);
   void warn(const std::string& text) const { options.warn(text); }
 };
 
@@ -126,7 +140,8 @@ Expected<void> Bridge::Impl::join() {
   auto joined = ros2::join(options.domain, options.loopback);
   if (!joined) return tl::unexpected(joined.error());
   domain = *ros2::domain_id(options.domain);
-  domain_entity = Entity(joined->domain);
+  // The domain is left to the process: deleting it would delete every participant in it, other
+  // bridges' and the application's too.
   participant = Entity(joined->participant);
   const dds_entity_t pp = participant.handle;
   // The topics' readers keep more than ROS 2's default 10 samples (history depth is not matched
@@ -197,7 +212,6 @@ Expected<void> Bridge::start() {
   if (auto r = d.join(); !r) {
     d.waitset.reset();
     d.participant.reset();
-    d.domain_entity.reset();
     d.readers.clear();
     return r;
   }
@@ -217,7 +231,6 @@ void Bridge::stop() noexcept {
   d.shadow->stop();
   d.waitset.reset();
   d.participant.reset();  // deletes the readers, writer and topics
-  d.domain_entity.reset();
   d.readers.clear();
   d.writer = d.ingest_reader = d.publications = d.subscriptions = 0;
   d.started = false;
@@ -226,46 +239,67 @@ void Bridge::stop() noexcept {
 // ---- the spinning thread -------------------------------------------------------------------------
 
 void Bridge::Impl::spin() {
-  using Steady = std::chrono::steady_clock;
-  constexpr auto kTick = std::chrono::milliseconds(20);
   const auto begin = Steady::now();
-  auto next_tick = begin;
-  auto next_graph = begin + std::chrono::duration_cast<Steady::duration>(
-                                std::chrono::duration<double>(shadow->mapping().graph_grace));
-  const auto graph_period =
+  Schedule& at = schedule;
+  at.next_tick = begin;
+  at.next_graph = begin + std::chrono::duration_cast<Steady::duration>(
+                              std::chrono::duration<double>(shadow->mapping().graph_grace));
+  at.graph_period =
       std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(shadow->mapping().graph_period));
-  std::vector<Steady::time_point> next_loop(shadow->loop_count(), begin);
-  std::vector<Steady::duration> loop_period;
+  at.next_loop.assign(shadow->loop_count(), begin);
+  at.loop_period.clear();
   for (std::size_t i = 0; i < shadow->loop_count(); ++i)
-    loop_period.push_back(std::chrono::duration_cast<Steady::duration>(shadow->loop_period(i)));
+    at.loop_period.push_back(std::chrono::duration_cast<Steady::duration>(shadow->loop_period(i)));
 
   while (!stopping.load(std::memory_order_acquire)) {
-    auto wake = next_tick;
-    for (const auto& t : next_loop) wake = std::min(wake, t);
-    if (publications > 0) wake = std::min(wake, next_graph);
+    auto wake = at.next_tick;
+    for (const auto& t : at.next_loop) wake = std::min(wake, t);
+    if (publications > 0) wake = std::min(wake, at.next_graph);
     const auto wait = std::max(Steady::duration::zero(), wake - Steady::now());
-    dds_waitset_wait(waitset.handle, nullptr, 0, std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count());
+    const dds_return_t rc = dds_waitset_wait(waitset.handle, nullptr, 0,
+                                             std::chrono::duration_cast<std::chrono::nanoseconds>(wait).count());
     if (stopping.load(std::memory_order_acquire)) break;
-    for (std::size_t i = 0; i < readers.size(); ++i) take_topic(i);
-    if (ingest_reader > 0) take_diagnostics();
-    // A change made by a message (its ACTIVE filters, an ingested status) is published at once.
-    if (shadow->take_change()) publish(shadow->statuses());
-    const auto now = Steady::now();
-    for (std::size_t i = 0; i < next_loop.size(); ++i) {
-      if (now < next_loop[i]) continue;
-      shadow->run_loop(i);
-      next_loop[i] += loop_period[i];
-      if (next_loop[i] < now) next_loop[i] = now + loop_period[i];  // overran: no burst of catch-up cycles
+    if (rc < 0) {  // the DDS entities are gone (deleted from elsewhere): nothing more can be read
+      fail_safe(dds_error("DDS waitset", rc) + "; the bridge stops reading");
+      return;
     }
-    if (publications > 0 && now >= next_graph) {
-      check_graph();
-      next_graph = now + graph_period;
+    try {
+      step();
+    } catch (const std::exception& e) {
+      fail_safe(std::string("the bridge's thread: ") + e.what());
     }
-    if (now >= next_tick) {
-      if (shadow->tick(shadow->coordinator().clock().now())) publish(shadow->statuses());
-      next_tick += kTick;
-      if (next_tick < now) next_tick = now + kTick;
-    }
+  }
+}
+
+void Bridge::Impl::fail_safe(const std::string& why) {
+  warn(why);
+  Coordinator& co = shadow->coordinator();
+  for (ComponentId c : id_range<ComponentId>(co.component_count()))
+    co.generate(framework_event::kThreadException, co.framework_machine(c));
+}
+
+void Bridge::Impl::step() {
+  constexpr auto kTick = std::chrono::milliseconds(20);
+  Schedule& at = schedule;
+  for (std::size_t i = 0; i < readers.size(); ++i) take_topic(i);
+  if (ingest_reader > 0) take_diagnostics();
+  // A change made by a message (its ACTIVE filters, an ingested status) is published at once.
+  if (shadow->take_change()) publish(shadow->statuses());
+  const auto now = Steady::now();
+  for (std::size_t i = 0; i < at.next_loop.size(); ++i) {
+    if (now < at.next_loop[i]) continue;
+    shadow->run_loop(i);
+    at.next_loop[i] += at.loop_period[i];
+    if (at.next_loop[i] < now) at.next_loop[i] = now + at.loop_period[i];  // overran: no burst of catch-up cycles
+  }
+  if (publications > 0 && now >= at.next_graph) {
+    check_graph();
+    at.next_graph = now + at.graph_period;
+  }
+  if (now >= at.next_tick) {
+    if (shadow->tick(shadow->coordinator().clock().now())) publish(shadow->statuses());
+    at.next_tick += kTick;
+    if (at.next_tick < now) at.next_tick = now + kTick;
   }
 }
 
@@ -358,6 +392,8 @@ void Bridge::Impl::publish(std::vector<ros_common::Status> statuses) {
 void Bridge::Impl::check_graph() {
   ros_common::GraphView live;
   live.nodes_known = false;
+  dds_guid_t self{};
+  dds_get_guid(participant.handle, &self);
   constexpr std::size_t kMax = 1024;
   std::vector<void*> samples(kMax);
   std::vector<dds_sample_info_t> infos(kMax);
@@ -366,7 +402,9 @@ void Bridge::Impl::check_graph() {
     const dds_return_t n = dds_read_mask(reader, samples.data(), infos.data(), kMax, kMax,
                                          DDS_ANY_SAMPLE_STATE | DDS_ANY_VIEW_STATE | DDS_ALIVE_INSTANCE_STATE);
     if (n < 0) {
-      warn(dds_error("DDS discovery not read; graph not checked", n));
+      // Not knowing the graph is not a complete graph: every mapped interface is reported missing.
+      warn(dds_error("DDS discovery not read; every mapped endpoint counts as missing", n));
+      shadow->check_graph(ros_common::GraphView{false, {}, {}, {}, {}});
       return;
     }
     auto& endpoints = reader == publications ? live.publishers : live.subscribers;
@@ -379,7 +417,10 @@ void Bridge::Impl::check_graph() {
       for (std::size_t i = 0; i < shadow->topic_count(); ++i) {
         if (shadow->topic(i).topic != *topic) continue;
         if (e->type_name == ros2::dds_type(shadow->topic(i).type)) {
-          endpoints[*topic].insert("");
+          // The bridge's own readers are not a ROS node's subscription (GraphView::kSelf).
+          endpoints[*topic].insert(std::memcmp(&e->participant_key, &self, sizeof self) == 0
+                                       ? std::string(ros_common::GraphView::kSelf)
+                                       : std::string());
         } else if (reader == publications) {
           live.mistyped[*topic].insert(e->type_name);
         }

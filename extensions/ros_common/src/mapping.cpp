@@ -304,7 +304,7 @@ void read_diagnostics(Reader& r, const JsonValue& v, Mapping& m) {
     const JsonValue& e = in->array[i];
     const std::string p = pointer + "/ingest/" + std::to_string(i);
     if (!r.expect(e, JsonValue::Type::Object, p, "an ingest rule")) continue;
-    r.known_keys(e, p, {"name", "target", "warn", "error", "stale"});
+    r.known_keys(e, p, {"name", "target", "warn", "error", "stale", "stale_after"});
     IngestRule rule;
     rule.where = r.at(e);
     bool ok = r.string(e, "name", p, rule.name, true);
@@ -312,6 +312,7 @@ void read_diagnostics(Reader& r, const JsonValue& v, Mapping& m) {
     r.string(e, "warn", p, rule.warn, false);
     r.string(e, "error", p, rule.error, false);
     r.string(e, "stale", p, rule.stale, false);
+    r.number(e, "stale_after", p, rule.stale_after, 0, 3600);
     if (ok) m.ingest.push_back(std::move(rule));
   }
 }

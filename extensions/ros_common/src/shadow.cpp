@@ -52,11 +52,16 @@ struct Shadow::Loop {
 };
 
 struct Shadow::Ingest {
+  struct Seen {
+    DiagnosticLevel level = DiagnosticLevel::Ok;
+    Time last{};  ///< when it was last received
+  };
   const IngestRule* rule = nullptr;
   MachineId target = kNoMachine;
-  std::array<EventId, 3> onset{};                              ///< WARN, ERROR, STALE
-  std::map<std::string, DiagnosticLevel, std::less<>> levels;  ///< per status name
+  std::array<EventId, 3> onset{};                 ///< WARN, ERROR, STALE
+  std::map<std::string, Seen, std::less<>> seen;  ///< per status name
   std::array<bool, 3> active{};
+  std::string cause;  ///< the status name of the newest non-OK level
 };
 
 // ---- construction --------------------------------------------------------------------------------
@@ -370,6 +375,7 @@ void Shadow::run_loop(std::size_t i) {
 }
 
 bool Shadow::tick(Time now) {
+  age_ingested(now);
   for (auto& t : topics_) {
     if (t->age == nullptr) continue;
     const Time::rep last = t->last_arrival.load(std::memory_order_acquire);
@@ -474,9 +480,9 @@ std::vector<Status> Shadow::statuses() {
 // ---- diagnostics in ------------------------------------------------------------------------------
 
 void Shadow::ingest(const std::vector<ReceivedStatus>& statuses, std::string_view sender) {
+  const Time now = coordinator_->clock().now();
   for (Ingest& in : ingests_) {
     bool touched = false;
-    std::string cause_name = in.rule->name;
     for (const ReceivedStatus& s : statuses) {
       if (!in.rule->matches(s.name)) continue;
       const auto level = diagnostic_level_from_byte(s.level);
@@ -487,30 +493,48 @@ void Shadow::ingest(const std::vector<ReceivedStatus>& statuses, std::string_vie
         continue;
       }
       ingested_.fetch_add(1, std::memory_order_relaxed);
-      in.levels[std::string(s.name)] = *level;
-      if (*level != DiagnosticLevel::Ok) cause_name = std::string(s.name);
+      in.seen[std::string(s.name)] = Ingest::Seen{*level, now};
+      if (*level != DiagnosticLevel::Ok) in.cause = std::string(s.name);
       touched = true;
     }
-    if (!touched) continue;
-    std::array<bool, 3> want{};
-    for (const auto& l : in.levels) {
-      if (l.second != DiagnosticLevel::Ok) want[static_cast<std::size_t>(l.second) - 1] = true;
-    }
-    SampleCause cause;
-    cause.filter = diagnostics_name_;
-    cause.signal = coordinator_->intern(cause_name);
-    // Onsets first, then completions: WARN → ERROR never passes through Normal.
-    for (std::size_t i = 0; i < 3; ++i) {
-      if (want[i] && !in.active[i]) {
-        cause.value = static_cast<double>(i + 1);
-        coordinator_->generate(in.onset[i], in.target, cause);
-      }
-    }
-    for (std::size_t i = 0; i < 3; ++i) {
-      if (!want[i] && in.active[i]) coordinator_->generate(coordinator_->event(in.onset[i]).counterpart, in.target);
-    }
-    in.active = want;
+    if (touched) apply(in);
   }
+}
+
+void Shadow::age_ingested(Time now) {
+  for (Ingest& in : ingests_) {
+    if (in.rule->stale_after <= 0) continue;
+    const Time limit = seconds_to_time(in.rule->stale_after);
+    bool aged = false;
+    for (auto& [name, seen] : in.seen) {
+      if (seen.level == DiagnosticLevel::Stale || now - seen.last < limit) continue;
+      seen.level = DiagnosticLevel::Stale;  // silence is not OK
+      in.cause = name;
+      aged = true;
+    }
+    if (aged) apply(in);
+  }
+}
+
+void Shadow::apply(Ingest& in) {
+  std::array<bool, 3> want{};
+  for (const auto& [name, seen] : in.seen) {
+    if (seen.level != DiagnosticLevel::Ok) want[static_cast<std::size_t>(seen.level) - 1] = true;
+  }
+  SampleCause cause;
+  cause.filter = diagnostics_name_;
+  cause.signal = coordinator_->intern(in.cause.empty() ? in.rule->name : in.cause);
+  // Onsets first, then completions: WARN → ERROR never passes through Normal.
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (want[i] && !in.active[i]) {
+      cause.value = static_cast<double>(i + 1);
+      coordinator_->generate(in.onset[i], in.target, cause);
+    }
+  }
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!want[i] && in.active[i]) coordinator_->generate(coordinator_->event(in.onset[i]).counterpart, in.target);
+  }
+  in.active = want;
 }
 
 // ---- graph check ---------------------------------------------------------------------------------
@@ -533,6 +557,18 @@ void Shadow::check_graph(const GraphView& live) {
     if (it == m.end()) return false;
     return node == nullptr || it->second.count(*node) != 0;
   };
+  // Where nodes are unknown: another participant's endpoint, or the bridge's own for a component
+  // whose loop runs here.
+  auto anybody = [&](const std::map<std::string, std::set<std::string>>& m, const std::string& topic,
+                     const std::string& iface) {
+    const auto it = m.find(topic);
+    if (it == m.end()) return false;
+    for (const std::string& node : it->second) {
+      if (node != GraphView::kSelf) return true;
+    }
+    const auto c = co.find_component(iface.substr(0, iface.find('.')));
+    return c && std::any_of(loops_.begin(), loops_.end(), [&](const auto& l) { return l->component == *c; });
+  };
   auto component_of = [](const std::string& iface) { return iface.substr(0, iface.find('.')); };
   if (live.nodes_known) {
     for (const auto& n : mapping_.nodes) {
@@ -552,21 +588,22 @@ void Shadow::check_graph(const GraphView& live) {
     }
     // An interface is checked when the mapping names its component's node: that node (or, where
     // the framework cannot name nodes, somebody) must publish or subscribe to the topic.
-    auto absent = [&](const std::string* node, const std::map<std::string, std::set<std::string>>& endpoints) {
+    auto absent = [&](const std::string* node, const std::map<std::string, std::set<std::string>>& endpoints,
+                      const std::string& iface) {
       if (node == nullptr) return false;
-      if (!live.nodes_known) return !has(endpoints, m.topic, nullptr);
+      if (!live.nodes_known) return !anybody(endpoints, m.topic, iface);
       return live.nodes.count(*node) != 0 && !has(endpoints, m.topic, node);
     };
     auto who = [&](const std::string* node) { return live.nodes_known ? "node " + *node : std::string("nobody"); };
     if (!m.provided.empty()) {
       const std::string* node = mapping_.node_of(component_of(m.provided));
-      if (wrong == live.mistyped.end() && absent(node, live.publishers))  // a wrong type says more
+      if (wrong == live.mistyped.end() && absent(node, live.publishers, m.provided))  // a wrong type says more
         report(t->provided, who(node) + (live.nodes_known ? " does not publish " : " publishes ") + m.topic + " (" +
                                 m.provided + ")");
     }
     for (std::size_t i = 0; i < m.required.size(); ++i) {
       const std::string* node = mapping_.node_of(component_of(m.required[i]));
-      if (absent(node, live.subscribers))
+      if (absent(node, live.subscribers, m.required[i]))
         report(t->required[i], who(node) + (live.nodes_known ? " does not subscribe to " : " subscribes to ") +
                                    m.topic + " (" + m.required[i] + ")");
     }

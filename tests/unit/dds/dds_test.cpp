@@ -328,6 +328,41 @@ TEST_F(Ros2Bridge, AnotherNodesDiagnosticsBecomeEventsAndClear) {
   EXPECT_EQ(state("JR3.s_F"), State::Normal);
 }
 
+TEST_F(Ros2Bridge, AnIngestedStatusThatFallsSilentIsStaleNotOk) {
+  Peer peer;
+  const dds_entity_t w = peer.writer(diagnostic_msgs_msg_dds__DiagnosticArray__desc, "/diagnostics", 1);
+  char name[] = "jr3_sim: saturation", empty[] = "";
+  diagnostic_msgs_msg_dds__DiagnosticStatus_ s{};
+  s.name_ = name;
+  s.message_ = s.hardware_id_ = empty;
+  s.level_ = 0;  // OK
+  diagnostic_msgs_msg_dds__DiagnosticArray_ a{};
+  a.header_.frame_id_ = empty;
+  a.status_ = {1, 1, &s, false};
+  const auto m = wrench(0.0, 0.0, 5.0);  // keeps JR3's own force checks quiet
+  const dds_entity_t force = peer.writer(geometry_msgs_msg_dds__WrenchStamped__desc, "/jr3/wrench");
+  ASSERT_TRUE(wait_for([&] {
+    dds_write(w, &a);
+    dds_write(force, &m);
+    return bridge_->stats().statuses_ingested > 0 && state("JR3.s_F") == State::Normal;
+  }));
+  // The node falls silent (its status was OK): after the rule's 0.5 s it is STALE, an Error.
+  const auto silent = std::chrono::steady_clock::now();
+  ASSERT_TRUE(wait_for([&] {
+    dds_write(force, &m);
+    return state("JR3.s_F") == State::Error;
+  }));
+  EXPECT_GE(std::chrono::steady_clock::now() - silent, std::chrono::milliseconds(450));
+  auto machine = bridge_->coordinator().find_machine("JR3.s_F");
+  EXPECT_EQ(bridge_->coordinator().event(bridge_->coordinator().snapshot(*machine).outstanding).name, "EVT_STALE");
+  // It speaks again: OK again.
+  EXPECT_TRUE(wait_for([&] {
+    dds_write(w, &a);
+    dds_write(force, &m);
+    return state("JR3.s_F") == State::Normal;
+  }));
+}
+
 // ---- the graph ----------------------------------------------------------------------------------
 
 TEST_F(Ros2Bridge, ATopicPublishedWithAnotherTypeRaisesTheGraphEventOnItsInterface) {
@@ -489,4 +524,45 @@ TEST(Ros2Cdr, BytesThatAreNotTheMessageAreRefusedWithWhereAndWhat) {
   const std::uint8_t many[] = {0, 1, 0, 0, 1, 0, 0, 0, 2, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0x40, 0x42, 0x0f, 0x00};
   EXPECT_FALSE(ros_common::decode_cdr(MessageType::JointState, many, sizeof many, m, error));
   EXPECT_EQ(error, "byte 20: a sequence of 1000000 strings runs past the end (24 bytes)");
+}
+
+TEST(Ros2Graph, ARequiredInterfaceNeedsAnotherNodesSubscriptionNotTheBridgesOwnReader) {
+  ASSERT_GT(local_domain(), 0);
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  dds::BridgeOptions o;
+  o.domain = kDomain;
+  o.warn = [](const std::string&) {};
+  auto b = dds::Bridge::create("tests/unit/dds/data/required_mapping.json", registry, nullptr, o);
+  ASSERT_TRUE(b) << b.error().message;
+  dds::Bridge& bridge = **b;
+  ASSERT_TRUE(bridge.start());
+  Coordinator& co = bridge.coordinator();
+  const MachineId required = *co.find_machine("CONTROL.s_R.ForceData");
+  // The force flows (JR3 stays Normal), so only the graph can fail CONTROL's required interface.
+  Peer driver;
+  const dds_entity_t w = driver.writer(geometry_msgs_msg_dds__WrenchStamped__desc, "/jr3/wrench");
+  const auto m = wrench(0.0, 0.0, 5.0);
+  auto state = [&] {
+    dds_write(w, &m);
+    return co.snapshot(required).state;
+  };
+  const MachineId jr3 = *co.find_machine("JR3.s_F");
+  ASSERT_TRUE(wait_for([&] { return state() != State::Normal && co.snapshot(jr3).state == State::Normal; }))
+      << "CONTROL.s_R.ForceData " << to_string(state()) << ", JR3.s_F " << to_string(co.snapshot(jr3).state);
+  // Only the bridge reads /jr3/wrench: CONTROL's subscription is missing, and that is the cause.
+  auto cause = [&] {
+    const auto why = co.outstanding(required);
+    return why ? std::string(co.name_of(why->root.sample.signal)) : std::string();
+  };
+  EXPECT_TRUE(wait_for([&] {
+    return state() == State::Error && cause() == "nobody subscribes to /jr3/wrench (CONTROL.ForceData)";
+  })) << cause();
+  // A ROS 2 node (another participant) subscribes: the interface is complete again.
+  Peer control;
+  dds_qos_t* q = ros2::qos();
+  const dds_entity_t reader = control.reader(geometry_msgs_msg_dds__WrenchStamped__desc, "/jr3/wrench", q);
+  ASSERT_GT(reader, 0);
+  EXPECT_TRUE(wait_for([&] { return state() == State::Normal; }));
+  bridge.stop();
 }

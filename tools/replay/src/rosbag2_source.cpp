@@ -32,11 +32,22 @@ public:
     } else {
       files_.push_back(path());
     }
-    // Each file must be a rosbag2 store now, not half-way through the replay.
+    // Each file must be a rosbag2 store now, not half-way through the replay; the split files of a
+    // bag are read in the order of their first message (their names need not sort: bag_10 < bag_2).
+    std::vector<std::pair<std::int64_t, std::string>> firsts;
     for (const std::string& f : files_) {
       if (auto r = open_file(f, {}); !r) return r;
+      sqlite3_stmt* first = nullptr;
+      std::int64_t stamp = 0;
+      if (sqlite3_prepare_v2(db_, "SELECT MIN(timestamp) FROM messages", -1, &first, nullptr) == SQLITE_OK &&
+          sqlite3_step(first) == SQLITE_ROW)
+        stamp = sqlite3_column_int64(first, 0);
+      sqlite3_finalize(first);
+      firsts.emplace_back(stamp, f);
       close();
     }
+    std::stable_sort(firsts.begin(), firsts.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t i = 0; i < firsts.size(); ++i) files_[i] = firsts[i].second;
     return {};
   }
 
@@ -126,7 +137,10 @@ private:
     std::string why;
     if (!ros_common::decode_cdr(t->mapping.type, data, size, decoded_, why))
       return fail_message(name, "not a " + type + " in CDR: " + why);
-    return feed(*t, decoded_.numbers, Time{stamp - *first_});
+    std::int64_t since = 0;
+    if (__builtin_sub_overflow(stamp, *first_, &since) || since < 0)
+      return fail_message(name, "its time stamp " + std::to_string(stamp) + " ns is before the bag's first message");
+    return feed(*t, decoded_.numbers, Time{since});
   }
 
   std::vector<std::string> files_;

@@ -58,6 +58,9 @@ struct IngestRule {
   std::string warn = "EVT_ROS_DIAG_WARN";
   std::string error = "EVT_ROS_DIAG_ERROR";
   std::string stale = "EVT_STALE";
+  /// Seconds without news of a status after which it counts as STALE (a node that crashed after
+  /// saying OK is not OK); 0: never. diagnostic_aggregator's analyzers default to 5 s.
+  double stale_after = 5.0;
   spec::Position where;
 
   bool matches(std::string_view status_name) const noexcept;

@@ -65,6 +65,9 @@ struct ReceivedStatus {
 
 /// The live graph as the framework sees it.
 struct GraphView {
+  /// The node name of the bridge's own endpoints where nodes are not known: they count for a
+  /// component whose loop runs in the bridge (its code is here), for no other.
+  static constexpr std::string_view kSelf = "(this bridge)";
   /// False when the framework cannot name the nodes behind endpoints (then only topics are checked:
   /// a provided interface needs a publisher of its topic, a required one a subscriber).
   bool nodes_known = true;
@@ -133,8 +136,8 @@ public:
   void stop() noexcept;
   bool started() const noexcept { return started_; }
 
-  /// Every tick (the extensions tick at 50 Hz): samples the topics' ages; true when the diagnostics
-  /// are due (a state changed, or the publish period passed).
+  /// Every tick (the extensions tick at 50 Hz): samples the topics' ages and ages the ingested
+  /// statuses; true when the diagnostics are due (a state changed, or the publish period passed).
   bool tick(Time now);
   /// True once after a state changed (tick() includes this): an extension that checks after each
   /// message publishes a change at once instead of at its next tick.
@@ -145,7 +148,8 @@ public:
   std::string status_name(std::string_view address) const { return mapping_.prefix + ": " + std::string(address); }
 
   /// Statuses received from another node (not this one): those that match an ingest rule raise or
-  /// clear the rule's events. A level that is not a level is counted, warned about and ignored.
+  /// clear the rule's events. A level that is not a level is counted, warned about and ignored. A
+  /// status not received again within its rule's `stale_after` counts as STALE (tick() ages them).
   void ingest(const std::vector<ReceivedStatus>& statuses, std::string_view sender);
   bool ingests() const noexcept { return !ingests_.empty(); }
 
@@ -163,6 +167,10 @@ private:
   struct Ingest;
   Shadow() = default;
   [[nodiscard]] Expected<void> bind();
+  /// Ingested statuses not heard of within their rule's stale_after become STALE.
+  void age_ingested(Time now);
+  /// Raises and clears a rule's events after its statuses changed.
+  void apply(Ingest& in);
   /// Warnings of bad input, at most one per 5 s (the counters in stats() keep the number).
   void warn_throttled(const std::string& text);
   void fill_status(Status& s, const std::string& address, StateSnapshot snap,
