@@ -38,7 +38,20 @@ on() {
   ip netns exec "$(hosts_ns "$host")" "$@"
 }
 
+# Namespaces an earlier run left behind (killed before it could remove them) whose process is
+# gone: their prefix is "sc" or "scd" and the PID of the run that made them.
+hosts_sweep() {
+  local ns pid
+  for ns in $(ip netns list 2>/dev/null | awk '{print $1}' | grep -E '^scd?[0-9]+(sw|[a-z])$'); do
+    pid=$(echo "$ns" | sed -E 's/^scd?([0-9]+).*/\1/')
+    kill -0 "$pid" 2>/dev/null && continue
+    ip netns pids "$ns" 2>/dev/null | xargs -r kill -KILL 2>/dev/null
+    ip netns del "$ns" 2>/dev/null || true
+  done
+}
+
 hosts_up() {
+  hosts_sweep
   hosts_prefix=$1
   shift
   local sw="${hosts_prefix}sw" host i=0

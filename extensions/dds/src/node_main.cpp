@@ -53,12 +53,16 @@ int main(int argc, char** argv) {
     } else if (flag == "--record") {
       record = argv[++i];
     } else if (flag == "--domain") {
+      const char* text = argv[++i];
       char* end = nullptr;
-      const long d = std::strtol(argv[++i], &end, 10);
-      if (*end != '\0' || d < 0 || d > 232) return usage("--domain takes an integer in [0, 232]");
+      const long d = std::strtol(text, &end, 10);
+      if (*text == '\0' || *end != '\0' || d < 0 || d > 232) return usage("--domain takes an integer in [0, 232]");
       options.domain = static_cast<int>(d);
     } else if (flag == "--max-bytes") {
-      limits.max_bytes = std::strtoull(argv[++i], nullptr, 10);
+      const std::string text = argv[++i];
+      if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+        return usage("--max-bytes takes a number of bytes");
+      limits.max_bytes = std::strtoull(text.c_str(), nullptr, 10);
     } else {
       return usage(("unknown option '" + flag + "'").c_str());
     }

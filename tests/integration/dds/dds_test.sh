@@ -99,6 +99,9 @@ node_refuses_bad_arguments_and_mappings_with_where_and_what)
   [ $? -eq 2 ] && grep -q -- "--mapping FILE is required" "$dir/a.txt" || { cat "$dir/a.txt"; exit 1; }
   "$bin/safecass_dds_node" examples/robodoc/robodoc.json --mapping examples/dds_robodoc/mapping.json --domain 300 >"$dir/b.txt" 2>&1
   [ $? -eq 2 ] && grep -q "domain takes an integer in \[0, 232\]" "$dir/b.txt" || { cat "$dir/b.txt"; exit 1; }
+  "$bin/safecass_dds_node" examples/robodoc/robodoc.json --mapping examples/dds_robodoc/mapping.json --record "$dir/h.jsonl" \
+    --max-bytes 10M >"$dir/e.txt" 2>&1
+  [ $? -eq 2 ] && grep -q -- "--max-bytes takes a number of bytes" "$dir/e.txt" || { cat "$dir/e.txt"; exit 1; }
   sed 's/"wrench.force.z"/"wrench.force.q"/' examples/dds_robodoc/mapping.json >"$dir/bad.json"
   "$bin/safecass_dds_node" examples/robodoc/robodoc.json --mapping "$dir/bad.json" >"$dir/c.txt" 2>&1
   [ $? -eq 2 ] && grep -Eq "bad.json:[0-9]+:[0-9]+: error: field path 'wrench.force.q'" "$dir/c.txt" || { cat "$dir/c.txt"; exit 1; }

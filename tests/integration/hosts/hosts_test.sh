@@ -61,17 +61,20 @@ hosts_start robot a "$bin/safecass" run "$system" --coordinator robot --ice "$ic
 hosts_start ui b "$bin/safecass" run "$system" --coordinator ui --ice "$ice" --listen 10.77.0.2 --duration 280
 hosts_start supervisor c "$bin/safecass" supervisor "$system" --ice "$ice" --listen 10.77.0.3 --duration 280
 
-console() {  # console HOST ARGS...: the console, on HOST
+console() {  # console HOST ARGS...: the console, on HOST (never longer than 20 s, also on a loaded machine)
   local host=$1
   shift
-  on "$host" "$bin/safecass" console --ice "$ice" --timeout 3000 "$@"
+  on "$host" timeout 20 "$bin/safecass" console --ice "$ice" --timeout 3000 "$@"
 }
 ui_shows() { console b --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -Eq "PENDANT.s_R.Status  $1"; }
 generate() {  # generate EVENT: on the robot's JR3.s_A, from host c, with the robot's token
   console c --coordinator robot --token-file "$HOSTS_DIR/robot.token" --allow-write -c "event generate $1 JR3.s_A" \
     >>generate.log 2>&1
 }
-retry 40 ui_shows Normal
+# The ui has heard the robot itself (a ui that never did shows its required interface lost anyway,
+# but a case must start from a robot that is known alive everywhere).
+retry 60 grep -q "coordinator 'robot' proved alive" ui.log && retry 60 grep -q "coordinator 'robot' is up" supervisor.log &&
+  retry 40 ui_shows Normal
 check "the ui on b follows the robot on a through IceStorm on c, over TLS" test $? -eq 0
 
 case $case_name in
