@@ -26,10 +26,11 @@ echo "   Fz: 5 N for 3 s, up to 40 N at 5 s (JR3's limit is 30 N), held until 9 
 echo "   each line: a status on rt/diagnostics (diagnostic_msgs/msg/DiagnosticArray) whose level or message changed"
 echo
 ros_start node "$build/bin/safecass_dds_node" examples/robodoc/robodoc.json --mapping examples/dds_robodoc/mapping.json
+: >"$work/echo.log"  # before the reader starts, so that tail finds it at once
 ros_start echo "$build/bin/dds_diagnostics_echo" --prefix "safecass: "
 ros_start jr3 "$build/bin/dds_robodoc_jr3" --profile 0:5,3:5,5:40,9:40,11:5 --seconds 14
 # Component-level statuses ("safecass: JR3: ..."), as they come.
-tail -n +1 -f "$work/echo.log" | grep --line-buffered -E 'safecass: [A-Z0-9]+: ' &
+tail -n +1 -F "$work/echo.log" 2>/dev/null | grep --line-buffered -E 'safecass: [A-Z0-9]+: ' &
 tail_pid=$!
 for _ in $(seq 150); do kill -0 "$pid_jr3" 2>/dev/null || break; sleep 0.1; done
 sleep 1
