@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
 
 all: build
 
@@ -128,6 +128,12 @@ bench-peers: deps
 	@test -f $(PEERS)/build.ninja || cmake --preset peers $(CCACHE_LAUNCHER) >/dev/null
 	@cmake --build $(PEERS) -j $(JOBS) --target $(PEER_TARGETS)
 	@./scripts/bench-peers $(PEERS) $(BUILD)/bench-peers.json $(BENCH_PEERS_ARGS)
+
+# How far one system scales: 1, 10, 25 and 50 coordinator processes of 20 components at 10 state
+# changes a second each, through IceStorm replicated under IceGrid (docs/scaling.md); written to
+# build/bench-scale-out.json. BENCH_SCALE_OUT_ARGS=--quick: 5 s per run.
+bench-scale-out: build
+	@./scripts/bench-scale-out $(BUILD) $(BUILD)/bench-scale-out.json $(BENCH_SCALE_OUT_ARGS)
 
 # `safecass verify` on robodoc and on a generated 50-component tree with hazards: wall-clock time
 # (SPIN and the C compiler included) and memory, written to build/bench-verify.json.

@@ -104,7 +104,12 @@ hosts_down() {
   local i host
   for ((i = ${#hosts_pids[@]} - 1; i >= 0; i--)); do hosts_stop "${hosts_pids[i]}"; done
   hosts_pids=()
-  for host in "${hosts_names[@]}"; do ip netns del "$(hosts_ns "$host")" 2>/dev/null || true; done
+  # What those left running (an IceGrid node's replicas when the node had to be killed) dies
+  # with its host: a namespace's processes would outlive its removal.
+  for host in "${hosts_names[@]}"; do
+    ip netns pids "$(hosts_ns "$host")" 2>/dev/null | xargs -r kill -KILL 2>/dev/null
+    ip netns del "$(hosts_ns "$host")" 2>/dev/null || true
+  done
   [ -n "$hosts_prefix" ] && ip netns del "${hosts_prefix}sw" 2>/dev/null || true
   hosts_names=()
 }

@@ -38,8 +38,9 @@ packages+=(
 packages+=(libboost-dev libboost-system-dev chromium)
 command -v node >/dev/null 2>&1 || packages+=(nodejs npm)
 # The middleware (middleware/, `safecass run --ice`, `safecass supervisor`, scripts/start-icestorm):
-# ZeroC Ice 3.7 with slice2cpp, and IceBox hosting the IceStorm service.
-packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils)
+# ZeroC Ice 3.7 with slice2cpp, and IceBox hosting the IceStorm service; IceGrid for a replicated
+# IceStorm (`scripts/start-icestorm --replicas`, `make cluster-demo`).
+packages+=(zeroc-ice-compilers libzeroc-ice-dev zeroc-icebox libzeroc-icestorm3.7 zeroc-ice-utils zeroc-icegrid)
 # Every bus message is signed (Ed25519, libsodium); `safecass trace` hashes the spec files with it.
 packages+=(libsodium-dev)
 # `safecass keys` makes the system's CA and the members' TLS certificates with OpenSSL's library.

@@ -134,7 +134,7 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     return fail(ErrorCode::NotFound, "coordinator '" + o.coordinator + "' has no key in " + *dir + "/keyring");
   }
   try {
-    impl->ic = make_communicator(o.tls);
+    impl->ic = make_communicator(o.tls, o.ice);
     if (impl->options.listen_host.empty()) impl->options.listen_host = listen_host_towards(o.ice);
     auto adapter =
         impl->ic->createObjectAdapterWithEndpoints("SafecassClient", protocol(o.tls) + " -h " + o.listen_host);
@@ -188,8 +188,8 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     if (found == nullptr) {
       const std::uint64_t refused = finder->refused();
       return fail(ErrorCode::Io,
-                  "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " + o.ice.host +
-                      ":" + std::to_string(o.ice.port) + " within " + std::to_string(o.timeout.count()) + " ms" +
+                  "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " +
+                      to_string(o.ice) + " within " + std::to_string(o.timeout.count()) + " ms" +
                       (unproven.empty() ? "" : " from a process that proved itself alive (" + unproven + ")") +
                       (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
     }

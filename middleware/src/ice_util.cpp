@@ -97,13 +97,25 @@ void set_tls_properties(const Ice::PropertiesPtr& properties, const TlsOptions& 
   properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
 }
 
-std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
+std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls, const IceEndpoint& ice) {
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
   if (tls.enabled()) set_tls_properties(init.properties, tls);
+  if (ice.locator) {
+    // IceStorm's proxies (topics, publishers) name replica groups; the registry resolves them.
+    // Every process takes the replicas in the registry's priority order, so all publish to the
+    // same one while it lives and move to the next together; endpoints are asked again every
+    // 2 s, so a replica restarted on another port is found.
+    init.properties->setProperty("Ice.Default.Locator", "IceGrid/Locator:" + protocol(tls) + " -h " + ice.host +
+                                                            " -p " + std::to_string(ice.port) + " -t 2000");
+    init.properties->setProperty("Ice.Default.EndpointSelection", "Ordered");
+    init.properties->setProperty("Ice.Default.LocatorCacheTimeout", "2");
+  }
   init.properties->setProperty("Ice.Default.Host", "127.0.0.1");
-  // A TLS handshake costs a few round trips and some CPU: give it longer on a loaded machine.
-  init.properties->setProperty("Ice.Override.ConnectTimeout", tls.enabled() ? "2000" : "500");
+  // A TLS handshake costs a few round trips and some CPU: give it longer on a loaded machine. With
+  // replicas, a connection attempt to one on a host cut off must give up well within a call's
+  // 2 s, so that the same call still reaches the next replica.
+  init.properties->setProperty("Ice.Override.ConnectTimeout", ice.locator ? "700" : tls.enabled() ? "2000" : "500");
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
   init.properties->setProperty("Ice.RetryIntervals", "-1");
   init.properties->setProperty("Ice.Warn.Connections", "0");
@@ -119,8 +131,10 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls) {
 
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls) {
-  const std::string text = std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " + ice.host +
-                           " -p " + std::to_string(ice.port) + " -t 2000";
+  // Replicated: the topic manager's well-known object, found through the communicator's locator.
+  const std::string text = ice.locator ? std::string(kIceStormInstance) + "/TopicManager"
+                                       : std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " +
+                                             ice.host + " -p " + std::to_string(ice.port) + " -t 2000";
   return Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(text));
 }
 
@@ -188,6 +202,7 @@ void Link::connect(const std::vector<std::string>& publish_on) {
   manager_ = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(topic_manager(ic_, ice_, tls_)->ice_connectionId(id));
   manager_->ice_ping();
   for (Subscription& s : subscriptions_) {
+    s.check = {};  // a check of the old connection
     s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, s.topic)->ice_connectionId(id));
     (void)subscribe(s.proxy, s.subscriber);
   }
@@ -217,17 +232,32 @@ std::string resubscribed_line(const std::vector<std::string>& topics) {
 }
 
 std::vector<std::string> Link::check() {
-  if (++checks_ % kResubscribeCheckEvery != 0) {
-    ping();
-    return {};
-  }
   if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
+  manager_->ice_ping();
   std::vector<std::string> made;
+  bool pending = false;
   for (Subscription& s : subscriptions_) {
-    if (s.proxy == nullptr)
-      s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(
-          topic(manager_, s.topic)->ice_connectionId(manager_->ice_getConnectionId()));
-    if (subscribe(s.proxy, s.subscriber)) made.push_back(s.topic);
+    if (!s.check.valid()) continue;
+    if (s.check.wait_for(std::chrono::seconds(0)) != std::future_status::ready) {
+      pending = true;
+      continue;
+    }
+    try {
+      s.check.get();
+      made.push_back(s.topic);  // IceStorm did not hold it: made again now
+    } catch (const IceStorm::AlreadySubscribed&) {
+    } catch (const Ice::TimeoutException&) {
+      // No answer in time: a replicated IceStorm electing a master answers no subscription until
+      // it has one. The ping above answered; the next round asks again.
+    }
+  }
+  if (!pending && ++checks_ % kResubscribeCheckEvery == 0) {
+    for (Subscription& s : subscriptions_) {
+      if (s.proxy == nullptr)
+        s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(
+            topic(manager_, s.topic)->ice_connectionId(manager_->ice_getConnectionId()));
+      s.check = s.proxy->subscribeAndGetPublisherAsync(IceStorm::QoS{}, s.subscriber->ice_oneway());
+    }
   }
   return made;
 }

@@ -6,6 +6,7 @@
 #include <IceStorm/IceStorm.h>
 
 #include <cstdint>
+#include <future>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -37,7 +38,8 @@ std::string resubscribed_line(const std::vector<std::string>& topics);
 /// dead IceStorm is noticed quickly; one dispatch thread keeps updates in order.
 /// With `tls` enabled, IceSSL is loaded with the CA and the process's certificate, and every peer
 /// must present a certificate signed by that CA (IceSSL.VerifyPeer=2).
-std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls = {});
+/// With `ice` naming an IceGrid registry (a replicated IceStorm), its locator is the default one.
+std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls = {}, const IceEndpoint& ice = {});
 /// The IceSSL properties of mutual TLS with `tls` (enabled): the CA, this process's certificate,
 /// every peer verified. make_communicator sets them; a test's own communicator too.
 void set_tls_properties(const Ice::PropertiesPtr& properties, const TlsOptions& tls);
@@ -49,7 +51,7 @@ std::string listen_host_towards(const IceEndpoint& ice);
 
 /// "ssl" with TLS, else "tcp": the protocol of every endpoint the process creates or names.
 inline std::string protocol(const TlsOptions& tls) { return tls.enabled() ? "ssl" : "tcp"; }
-/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS).
+/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS), or through the locator.
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls = {});
 /// Retrieves a topic, creating it when it does not exist yet.
@@ -95,12 +97,15 @@ public:
   /// Throws when IceStorm does not answer.
   void ping() const;
   /// Called once a heartbeat period: pings IceStorm, and every kResubscribeCheckEvery-th call
-  /// instead makes again each subscription IceStorm no longer holds, returning their topics (empty:
-  /// all were there; the caller resynchronises otherwise). IceStorm drops a twoway subscriber whose
-  /// delivery failed or timed out (a process starved or stopped for longer than IceStorm's send
-  /// timeout), and a subscription can be removed from outside; without this check such a process
-  /// would go on unaware that nothing reaches it. Throws Ice exceptions when IceStorm cannot be
-  /// reached.
+  /// also asks IceStorm to make again each subscription it no longer holds. The asking is
+  /// asynchronous (a replicated IceStorm answers it only once its replicas have a master, which
+  /// after the master's death takes seconds, and the caller's heartbeats must not wait for that);
+  /// a later call returns the topics whose subscription was made again (empty: all were there;
+  /// the caller resynchronises otherwise). IceStorm drops a subscriber whose delivery failed or
+  /// timed out (a process starved or stopped for longer than IceStorm's send timeout), and a
+  /// subscription can be removed from outside; without this check such a process would go on
+  /// unaware that nothing reaches it. Throws Ice exceptions when IceStorm cannot be reached or
+  /// refuses the subscription.
   std::vector<std::string> check();
 
 private:
@@ -111,7 +116,8 @@ private:
   struct Subscription {
     std::string topic;
     std::shared_ptr<Ice::ObjectPrx> subscriber;
-    std::shared_ptr<IceStorm::TopicPrx> proxy;  ///< set by connect()
+    std::shared_ptr<IceStorm::TopicPrx> proxy;           ///< set by connect()
+    std::future<std::shared_ptr<Ice::ObjectPrx>> check;  ///< check()'s pending subscription, if any
   };
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;

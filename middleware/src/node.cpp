@@ -25,24 +25,36 @@ namespace safecass::middleware {
 
 using namespace detail;
 
-[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text) {
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view whole) {
   IceEndpoint e;
+  std::string_view text = whole;
+  if (text.starts_with(kLocatorPrefix)) {
+    e.locator = true;
+    text.remove_prefix(kLocatorPrefix.size());
+    if (text.find(':') == std::string_view::npos)
+      return fail(ErrorCode::Parse,
+                  "--ice '" + std::string(whole) + "': write locator:HOST:PORT (the IceGrid registry)");
+  }
   std::string_view port = text;
   if (const auto colon = text.rfind(':'); colon != std::string_view::npos) {
     e.host = std::string(text.substr(0, colon));
     port = text.substr(colon + 1);
     if (e.host.empty())
-      return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': empty host (write HOST:PORT)");
+      return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': empty host (write HOST:PORT)");
   }
   int value = 0;
   if (port.empty() || port.size() > 5 || port.find_first_not_of("0123456789") != std::string_view::npos) {
-    return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': the port must be a number (write HOST:PORT)");
+    return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': the port must be a number (write HOST:PORT)");
   }
   for (char c : port) value = value * 10 + (c - '0');
   if (value < 1 || value > 65535)
-    return fail(ErrorCode::Parse, "--ice '" + std::string(text) + "': port outside 1-65535");
+    return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': port outside 1-65535");
   e.port = value;
   return e;
+}
+
+std::string to_string(const IceEndpoint& ice) {
+  return (ice.locator ? std::string(kLocatorPrefix) : std::string()) + ice.host + ":" + std::to_string(ice.port);
 }
 
 namespace {
@@ -600,8 +612,7 @@ struct CoordinatorNode::Impl {
           last_own_heartbeat.store(connected_at);
           connected.store(true);
           connects.fetch_add(1);
-          log("middleware: " + name + ": connected to IceStorm at " + options.ice.host + ":" +
-              std::to_string(options.ice.port) + "; resynchronising");
+          log("middleware: " + name + ": connected to IceStorm at " + to_string(options.ice) + "; resynchronising");
           reported_down = false;
           failed_connects = 0;
           mark_all(true);
@@ -612,8 +623,8 @@ struct CoordinatorNode::Impl {
           const std::int64_t now = steady_ns();
           ++failed_connects;
           if (!reported_down || now - last_down_report > std::chrono::nanoseconds(std::chrono::seconds(5)).count()) {
-            log("middleware: " + name + ": IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port) +
-                " unreachable (" + std::string(e.ice_id()) +
+            log("middleware: " + name + ": IceStorm at " + to_string(options.ice) + " unreachable (" +
+                std::string(e.ice_id()) +
                 (reported_down ? ", " + std::to_string(failed_connects) + " attempts so far" : std::string()) +
                 "); running locally, retrying");
             reported_down = true;
@@ -1097,7 +1108,7 @@ Expected<void> CoordinatorNode::start() {
   Impl& d = *impl_;
   if (d.running.load()) return {};
   try {
-    d.ic = make_communicator(d.options.tls);
+    d.ic = make_communicator(d.options.tls, d.options.ice);
     const std::string endpoint = protocol(d.options.tls) + " -h " + d.options.listen_host +
                                  (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);

@@ -748,7 +748,7 @@ struct Supervisor::Impl {
           request_resync("");
           connected = true;
           reported = false;
-          print("supervisor: connected to IceStorm at " + options.ice.host + ":" + std::to_string(options.ice.port));
+          print("supervisor: connected to IceStorm at " + to_string(options.ice));
           // From now on every coordinator of the system file is watched, heard from or not.
           std::int64_t unset = 0;
           (void)watching_since.compare_exchange_strong(unset, steady_ns());
@@ -869,7 +869,7 @@ Expected<void> Supervisor::start() {
   Impl& d = *impl_;
   if (d.running.load()) return {};
   try {
-    d.ic = make_communicator(d.options.tls);
+    d.ic = make_communicator(d.options.tls, d.options.ice);
     auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor",
                                                           protocol(d.options.tls) + " -h " + d.options.listen_host);
     d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);

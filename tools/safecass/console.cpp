@@ -587,7 +587,9 @@ void add_console_command(CLI::App& app, int& code) {
       ->excludes(commands);
   cmd->add_flag("--json", args->json, "print one JSON object per result line");
   cmd->add_flag("--allow-write", args->allow_write, "accept write commands (inject, generate, broadcast, reset)");
-  cmd->add_option("--ice", args->ice, "work on a live coordinator: IceStorm at HOST:PORT (with --coordinator)");
+  cmd->add_option("--ice", args->ice,
+                  "work on a live coordinator: IceStorm at HOST:PORT, or locator:HOST:PORT for a replicated one (with "
+                  "--coordinator)");
   cmd->add_option("--coordinator", args->coordinator, "with --ice: the coordinator's name");
   cmd->add_option("--keys", args->keys,
                   "with --ice: the system's bus keys (only the keyring is read; default $SAFECASS_KEYS)");

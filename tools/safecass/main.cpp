@@ -102,7 +102,9 @@ int main(int argc, char** argv) {
   timeline->add_option("HISTORY", timeline_history,
                        "history file (JSON lines, from `safecass run --record`); not with --ice");
   timeline->add_option("--html", timeline_html, "write the page to this file")->required();
-  timeline->add_option("--ice", timeline_ice, "draw the live history of a coordinator instead: IceStorm at HOST:PORT");
+  timeline->add_option(
+      "--ice", timeline_ice,
+      "draw the live history of a coordinator instead: IceStorm at HOST:PORT (locator:HOST:PORT: replicated)");
   timeline->add_option("--coordinator", timeline_coordinator, "with --ice: the coordinator's name");
   timeline->add_option("--keys", timeline_keys, "with --ice: the system's bus keys (default $SAFECASS_KEYS)");
   timeline->add_option("--tls", timeline_tls, "with --ice: mutual TLS; DIR holds ca.pem and console.pem/.key");

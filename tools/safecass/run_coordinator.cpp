@@ -181,7 +181,9 @@ struct Driver {
 void add_middleware_options(CLI::App& run, RunArgs& args) {
   run.add_option("--coordinator", args.coordinator,
                  "run only this coordinator's components, in real time (a process of a multi-process system)");
-  run.add_option("--ice", args.ice, "with --coordinator: join the system through IceStorm at HOST:PORT");
+  run.add_option("--ice", args.ice,
+                 "with --coordinator: join the system through IceStorm at HOST:PORT (locator:HOST:PORT: a replicated "
+                 "IceStorm's IceGrid registry)");
   run.add_option("--duration", args.duration,
                  "with --coordinator: stop after SECONDS (default: the scenario's, else until SIGINT/SIGTERM)");
   run.add_flag("--allow-write", args.allow_write,

@@ -102,7 +102,9 @@ void add_supervisor_command(CLI::App& app, int& code) {
   auto* cmd = app.add_subcommand(
       "supervisor", "Watch a multi-process system through IceStorm: transitions, lost coordinators, system view");
   cmd->add_option("SYSTEM", args.system, "the system file its coordinators run")->required();
-  cmd->add_option("--ice", args.ice, "IceStorm at HOST:PORT")->required();
+  cmd->add_option("--ice", args.ice,
+                  "IceStorm at HOST:PORT (locator:HOST:PORT: a replicated IceStorm's IceGrid registry)")
+      ->required();
   cmd->add_option("--lost-after", args.lost_after_ms,
                   "milliseconds without a heartbeat before a coordinator is lost (default 600)");
   cmd->add_option("--duration", args.duration, "stop after SECONDS (default: until SIGINT/SIGTERM)");

@@ -238,9 +238,10 @@ void add_viewer_command(CLI::App& app, int& code) {
                   "is used when it holds ca.pem");
   cmd->add_option("--read-token-file", args->read_token_files,
                   "with --ice: COORDINATOR=FILE, a coordinator's read credential (repeatable)");
-  cmd->add_option("--ice", args->ice,
-                  "IceStorm HOST:PORT: watch the live system whose coordinators run as processes "
-                  "(`safecass run SYSTEM --coordinator NAME --ice ...`); needs --system");
+  cmd->add_option(
+      "--ice", args->ice,
+      "IceStorm HOST:PORT (locator:HOST:PORT: replicated): watch the live system whose coordinators run as processes "
+      "(`safecass run SYSTEM --coordinator NAME --ice ...`); needs --system");
   cmd->add_option("--token-file", args->token_files,
                   "COORDINATOR=FILE (repeatable, with --ice): the token file of a coordinator started with "
                   "--allow-write; writes to it carry its token");

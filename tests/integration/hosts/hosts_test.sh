@@ -49,8 +49,25 @@ hosts_up "sc$$" a b c
 ice="10.77.0.3:4061"
 
 # The broker and the supervisor on c, the robot on a, the ui on b.
-on c "$src/scripts/start-icestorm" --host 10.77.0.3 --port 4061 --publish-port 4062 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" \
-  >/dev/null 2>"$HOSTS_DIR/icestorm-start.log" || { echo "start-icestorm on c failed: $(cat icestorm-start.log)"; exit 1; }
+if [ "$case_name" = across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another_hosts_replica_dies ]; then
+  # IceStorm replicated under IceGrid: the registry on c, a node and a replica on each host
+  # (replica i on the i-th host: 1 on a, 2 on b, 3 on c). The registry's host waits for the
+  # master's election, which needs the nodes of a and b.
+  on c "$src/scripts/start-icestorm" --replicas 3 --nodes a=10.77.0.1,b=10.77.0.2,c=10.77.0.3 --host 10.77.0.3 \
+    --port 4061 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" >/dev/null 2>"$HOSTS_DIR/icestorm-start.log" &
+  registry_started=$!
+  for h in a b; do
+    on "$h" "$src/scripts/start-icestorm" --join "$h" --registry 10.77.0.3:4061 --host "$(hosts_ip "$h")" \
+      --dir "$HOSTS_DIR/ice-$h" --env "$HOSTS_DIR/ice-$h.env" --no-wait >/dev/null 2>>"$HOSTS_DIR/icestorm-start.log" ||
+      { echo "start-icestorm --join on $h failed: $(cat icestorm-start.log)"; exit 1; }
+    hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' "ice-$h.env")")
+  done
+  wait $registry_started || { echo "start-icestorm --replicas on c failed: $(cat icestorm-start.log)"; exit 1; }
+  ice="locator:10.77.0.3:4061"
+else
+  on c "$src/scripts/start-icestorm" --host 10.77.0.3 --port 4061 --publish-port 4062 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" \
+    >/dev/null 2>"$HOSTS_DIR/icestorm-start.log" || { echo "start-icestorm on c failed: $(cat icestorm-start.log)"; exit 1; }
+fi
 hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' ice.env)")
 feed="$src/tests/integration/hosts/quiet_feed.json"
 [ "$case_name" = across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_healing ] &&
@@ -124,6 +141,55 @@ across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_hea
   check "the supervisor reported the loss" test $? -eq 0
   retry 20 grep -Eq "\[robot\] .*JR3.s_A .*-> Error EVT_FORCE_ERROR" supervisor.log
   check "and, after healing, the fault itself" test $? -eq 0
+  ;;
+across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another_hosts_replica_dies)
+  master() {  # the master replica's id, once the three agree on it and are all in the normal state
+    on c icestormadmin --Ice.Config="$HOSTS_DIR/ice/admin.config" -e replica 2>/dev/null |
+      awk '/coord:/ {m[$3]++} /state:/ && $3 == "normal" {n++} END {for (k in m) if (m[k] == 3 && n == 3) print k}'
+  }
+  has_master() { [ -n "$(master)" ]; }
+  replica_host() { case $1 in 1) echo a ;; 2) echo b ;; 3) echo c ;; esac; }
+  kill_replica() {  # kill_replica ID: kill -9 of that replica, on its host (its node starts it again)
+    local h
+    h=$(replica_host "$1")
+    on "$h" pkill -KILL -f "$HOSTS_DIR/ice[-a-z]*/node-$h/data/servers/SafecassIceStorm$1[/]"
+  }
+  fault=EVT_FORCE_ERROR
+  for victim in master 1; do
+    retry 30 has_master
+    m=$(master)
+    check "the three replicas agree on a master ($m) before the kill" test -n "$m"
+    [ "$victim" = master ] && id=$m || id=1
+    start=$(now_ms)
+    kill_replica "$id"
+    check "replica $id (on host $(replica_host "$id")) killed" test $? -eq 0
+    retry 20 generate "$fault"
+    if [ "$fault" = EVT_FORCE_ERROR ]; then retry 20 ui_shows "Error +EVT_SERVICE_FAILURE"; else retry 20 ui_shows Normal; fi
+    check "after replica $id's death a fault's change on a ($fault) reaches the ui on b" test $? -eq 0
+    echo "   replica $id killed -> the ui's console shows the change: $(($(now_ms) - start)) ms (the console's own connection included)"
+    retry 30 has_master
+    check "the replicas agree on a master again (replica $id restarted by its node)" test $? -eq 0
+    [ "$fault" = EVT_FORCE_ERROR ] && fault=/EVT_FORCE_ERROR || fault=EVT_FORCE_ERROR
+  done
+  retry 20 ui_shows Normal
+  check "the ui's view converges to the robot's (Normal, no loss left)" test $? -eq 0
+  retry 20 grep -q "\[robot\] .*JR3.s_A Error -> Normal /EVT_FORCE_ERROR" supervisor.log
+  check "the supervisor on c saw the fault clear" test $? -eq 0
+  # Host a cut off with the robot and replica 1, which carries every process's messages: the
+  # robot is lost (fail-safe), and b and c go on through the other replicas.
+  sup_hears_ui() { ! grep -E "coordinator 'ui' (lost|recovered)" supervisor.log | tail -1 | grep -q lost; }
+  retry 30 has_master
+  start=$(now_ms)
+  hosts_cut a
+  retry 10 ui_shows "Error +EVT_COORDINATOR_LOST"
+  check "with host a and its replica cut off, the ui on b shows the robot lost" test $? -eq 0
+  sleep 1
+  retry 15 sup_hears_ui
+  check "the supervisor on c hears the ui on b through the replicas left" test $? -eq 0
+  echo "   host a cut -> the supervisor hears the ui again after $(($(now_ms) - start)) ms (at most)"
+  hosts_heal a
+  retry 30 ui_shows Normal
+  check "after healing the ui's view is Normal again" test $? -eq 0
   ;;
 across_hosts_no_certificate_another_ca_and_non_members_are_refused)
   mkdir -p no-certs && chmod 700 no-certs && cp keys/keyring no-certs/

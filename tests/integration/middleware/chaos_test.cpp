@@ -213,14 +213,18 @@ private:
 };
 
 /// The test's own IceStorm (scripts/start-icestorm), killed and restarted on the same port and
-/// database directory. A reaper child kills it by PID if the test dies before its destructor
-/// runs (the IceStorm runs in its own session, so nothing else would stop it).
+/// database directory; or, with `replicas`, its own replicated IceStorm under IceGrid (one node
+/// with the registry, `replicas` IceBoxes), whose replicas are killed one at a time and restarted
+/// by the node. A reaper child kills it by PID (and the replicas by their data directory) if the
+/// test dies before its destructor runs (the IceStorm runs in its own session, so nothing else
+/// would stop it).
 class IceStorm {
 public:
-  IceStorm(std::string source, const std::string& scratch)
+  IceStorm(std::string source, const std::string& scratch, int replicas = 0)
       : script_(std::move(source) + "/scripts/start-icestorm"),
-        dir_(scratch + "/chaos-icestorm"),
-        env_file_(scratch + "/chaos-icestorm.env") {
+        dir_(scratch + (replicas > 0 ? "/chaos-icegrid" : "/chaos-icestorm")),
+        env_file_(dir_ + ".env"),
+        replicas_(replicas) {
     std::remove(env_file_.c_str());
     const pid_t parent = ::getpid();
     reaper_ = ::fork();
@@ -237,6 +241,7 @@ public:
           if (pid > 1) ::kill(static_cast<pid_t>(pid), SIGKILL);
         }
       }
+      if (replicas_ > 0) std::system(("pkill -KILL -f '" + dir_ + "[/]node-'").c_str());
       std::_Exit(0);
     }
   }
@@ -255,8 +260,9 @@ public:
   /// port of a killed IceStorm can stay in use for a moment after it: up to five attempts, half a
   /// second apart.
   bool start() {
-    const std::string command =
-        script_ + " --port " + (port_.empty() ? "0" : port_) + " --dir " + dir_ + " --env " + env_file_ + " >/dev/null";
+    const std::string command = script_ + (replicas_ > 0 ? " --replicas " + std::to_string(replicas_) : "") +
+                                " --port " + (port_.empty() ? "0" : port_) + " --dir " + dir_ + " --env " + env_file_ +
+                                " >/dev/null";
     bool started = false;
     for (int attempt = 0; attempt < 5 && !started; ++attempt) {
       if (attempt > 0) std::this_thread::sleep_for(500ms);
@@ -264,6 +270,7 @@ public:
     }
     if (!started) return false;
     port_ = env_file_value(env_file_, "ICESTORM_PORT");
+    endpoint_ = env_file_value(env_file_, "ICESTORM_ICE");
     pid_ = static_cast<pid_t>(std::stol(env_file_value(env_file_, "ICESTORM_PID")));
     return pid_ > 0;
   }
@@ -272,18 +279,61 @@ public:
   void signal(int sig) const {
     if (pid_ > 0) ::kill(pid_, sig);
   }
-  /// kill -9, and waits until the process is gone (its port is free again).
+  /// kill -9, and waits until the process is gone (its port is free again). Replicated: the
+  /// node, then every replica it ran.
   void kill() {
     if (pid_ <= 0) return;
     ::kill(pid_, SIGKILL);
     for (int i = 0; i < 300 && ::kill(pid_, 0) == 0; ++i) std::this_thread::sleep_for(10ms);
     pid_ = -1;
+    if (replicas_ > 0) std::system(("pkill -KILL -f '" + dir_ + "[/]node-'").c_str());
   }
-  std::string endpoint() const { return "127.0.0.1:" + port_; }
-  std::string log() const { return dir_ + "/icebox.log"; }
+  /// What processes give to --ice: "127.0.0.1:PORT", or "locator:127.0.0.1:PORT" when replicated.
+  std::string endpoint() const { return endpoint_; }
+  std::string log() const { return replicas_ > 0 ? dir_ + "/node-local.log" : dir_ + "/icebox.log"; }
+
+  // -- replicated only --
+
+  /// The replicas' own report (`icestormadmin ... replica`): per replica "ID: coord: N" and
+  /// "ID: state: S" lines, or an error.
+  std::string replica_report() const {
+    std::string out;
+    FILE* p = ::popen(("icestormadmin --Ice.Config=" + dir_ + "/admin.config -e replica 2>&1").c_str(), "r");
+    if (p == nullptr) return out;
+    char line[256];
+    while (std::fgets(line, sizeof line, p) != nullptr) out += line;
+    ::pclose(p);
+    return out;
+  }
+  /// The master replica's id, 0 when the replicas do not agree on one or some replica is not in
+  /// the normal state (an election, or a replica restarting).
+  int settled_master() const {
+    const std::string report = replica_report();
+    int master = 0, normal = 0;
+    std::istringstream lines(report);
+    std::string line;
+    while (std::getline(lines, line)) {
+      int id = 0, value = 0;
+      char word[16] = {};
+      if (std::sscanf(line.c_str(), "%d: coord: %d", &id, &value) == 2) {
+        if (master != 0 && master != value) return 0;
+        master = value;
+      } else if (std::sscanf(line.c_str(), "%d: state: %15s", &id, word) == 2 && std::string(word) == "normal") {
+        ++normal;
+      }
+    }
+    return normal == replicas_ ? master : 0;
+  }
+  /// kill -9 of replica `id` (its node starts it again at once); false when it is not running.
+  bool kill_replica(int id) const {
+    // "[/]": the pattern does not match the shell that runs pkill with it.
+    const std::string pattern = dir_ + "/node-local/data/servers/SafecassIceStorm" + std::to_string(id) + "[/]";
+    return std::system(("pkill -KILL -f '" + pattern + "'").c_str()) == 0;
+  }
 
 private:
-  std::string script_, dir_, env_file_, port_;
+  std::string script_, dir_, env_file_, port_, endpoint_;
+  int replicas_ = 0;
   pid_t pid_ = -1;
   pid_t reaper_ = -1;
 };
@@ -399,6 +449,10 @@ struct SupervisorLog {
   std::map<std::string, std::pair<std::string, std::string>> view;  ///< address -> (coordinator, state)
   std::map<std::string, bool> lost;
   std::map<std::string, std::vector<std::string>> received;
+  /// Records printed late (" (late: seq N arrived after newer records)"): reported missed first,
+  /// then received out of order, which a replicated IceStorm can do when a publisher moves from
+  /// one replica to another. Not in `received` (which is in order), and they take no row back.
+  std::map<std::string, std::vector<std::string>> late;
   std::map<std::string, std::uint64_t> missed;
   std::uint64_t missed_total = 0;  ///< over every incarnation
   std::uint64_t refused = 0;
@@ -436,6 +490,10 @@ struct SupervisorLog {
         std::string address, first, arrow, to;
         words >> address >> first >> arrow >> to;
         if (address == "reset") continue;  // a reset record: not a transition
+        if (const auto at = line.find(" (late: seq "); at != std::string::npos) {
+          late[who].push_back(line.substr(0, at));
+          continue;
+        }
         if (arrow == "->") {
           view[address] = {who, to};
           received[who].push_back(line);
@@ -541,13 +599,14 @@ const std::vector<Operation>& operations() {
 
 class Chaos {
 public:
-  Chaos()
+  /// `replicas` > 0: a replicated IceStorm of that many replicas instead of one IceStorm.
+  explicit Chaos(int replicas = 0)
       : bin_(env("SAFECASS_BIN")),
         source_(env("SAFECASS_SOURCE_DIR")),
         scratch_(env("SAFECASS_SCRATCH", "/tmp")),
         system_(source_ + "/examples/robodoc/robodoc.json"),
         feed_(source_ + "/tests/integration/middleware/chaos_robot_feed.json"),
-        icestorm_(source_, scratch_),
+        icestorm_(source_, scratch_, replicas),
         reference_(system_) {
     if (reference_.load.ok()) {
       for (const auto& [coordinator, components] : reference_.load.system->coordinators) {
@@ -728,10 +787,15 @@ public:
     std::string out;
     for (const auto* p : {&robot_, &ui_}) {
       const std::string who = p == &robot_ ? "robot" : "ui";
-      const Delivery d = delivered(transitions_printed((*p)->log(), who, components_[who]), anchor_[who],
-                                   s.received.count(who) ? s.received.at(who) : std::vector<std::string>{},
-                                   s.missed.count(who) ? s.missed.at(who) : 0);
+      const auto printed = transitions_printed((*p)->log(), who, components_[who]);
+      const Delivery d =
+          delivered(printed, anchor_[who], s.received.count(who) ? s.received.at(who) : std::vector<std::string>{},
+                    s.missed.count(who) ? s.missed.at(who) : 0);
       if (!d.ok()) out += "records: " + d.text(who) + "\n";
+      for (const std::string& line : s.late.count(who) ? s.late.at(who) : std::vector<std::string>{}) {
+        if (std::find(printed.begin(), printed.end(), line) == printed.end())
+          out += "records: the supervisor printed late a transition the process did not make: " + line + "\n";
+      }
     }
     return out;
   }
@@ -1023,6 +1087,129 @@ void lose_a_fault_in_an_icestorm_crash(Chaos& chaos) {
   std::this_thread::sleep_for(300ms);  // the robot publishes its records (5 ms) into the frozen IceStorm
   chaos.icestorm().kill();
   ASSERT_TRUE(chaos.icestorm().start());
+}
+// A replicated IceStorm (scripts/start-icestorm --replicas 3: IceGrid, one node, three IceBoxes)
+// under the same four processes. Rounds alternate: kill -9 the master replica, kill -9 the replica
+// every process publishes to (the first in priority order; not the master, which IceStorm elects
+// from the highest id), and bursts. For 3 s after a kill the robot raises and clears a fault that
+// reaches the ui's PENDANT.s_R.Status, the next one as soon as the ui shows the last, then more
+// faults follow; the round measures the failover (the longest of those faults' ways: how long
+// updates stopped flowing) and then requires, as every chaos round does, that every
+// process converges to the in-process states and that no record is lost unreported. A loss the
+// processes raise during the failover (it outlasts the 300 ms loss bound when the master dies: the
+// replicas elect again, which takes IceStorm about a second) must clear. Before the next kill the
+// killed replica is back (its node restarts it) and the replicas agree on a master again.
+TEST(Chaos, WithAReplicatedBrokerEveryProcessConvergesAfterItsMasterOrAnotherReplicaIsKilledWhileFaultsAreRaised) {
+  const auto started = Steady::now();
+  const unsigned seed = static_cast<unsigned>(std::stoul(env("SAFECASS_CHAOS_SEED", "20261127")));
+  const int rounds = std::stoi(env("SAFECASS_CHAOS_ROUNDS", "8"));
+  const Millis bound(std::stoi(env("SAFECASS_CHAOS_BOUND_MS", "2000")));
+  std::printf("[chaos] replicated broker: seed %u, %d rounds, convergence bound %lld ms\n", seed, rounds,
+              static_cast<long long>(bound.count()));
+  std::fflush(stdout);
+  std::mt19937 random(seed);
+  auto uniform = [&](int lo, int hi) { return std::uniform_int_distribution<int>(lo, hi)(random); };
+
+  Chaos chaos(3);
+  ASSERT_TRUE(chaos.reference().co != nullptr);
+  ASSERT_TRUE(chaos.start()) << chaos.logs();
+  std::string problem;
+  ASSERT_TRUE(chaos.converges(10000ms, problem)) << "start-up\n" << problem << chaos.logs();
+
+  // The marker fault: JR3's force error reaches the ui through CONTROL (PENDANT.s_R.Status).
+  const Operation raise{false, "EVT_FORCE_ERROR", "JR3.s_A"}, clear{false, "/EVT_FORCE_ERROR", "JR3.s_A"};
+  std::vector<double> failover_ms[2];
+  for (int round = 0; round < rounds; ++round) {
+    const int kind = round % 3;  // 0: the master, 1: the publishers' replica, 2: a burst
+    std::string what = kind == 0   ? "kill -9 the master replica"
+                       : kind == 1 ? "kill -9 the publishers' replica"
+                                   : "a burst of faults";
+    std::string failure;
+    auto burst = [&](int n) {
+      for (int i = 0; i < n && failure.empty(); ++i) {
+        const Operation& op =
+            operations()[static_cast<std::size_t>(uniform(0, static_cast<int>(operations().size()) - 1))];
+        failure = chaos.apply(op);
+      }
+    };
+    const auto round_started = Steady::now();
+    if (kind == 2) {
+      burst(uniform(5, 20));
+    } else {
+      int master = 0;
+      if (!eventually([&] { return (master = chaos.icestorm().settled_master()) != 0; }, 15000ms)) {
+        failure = "the replicas do not agree on a master before the kill:\n" + chaos.icestorm().replica_report();
+      }
+      const int victim = kind == 0 ? master : (master == 1 ? 2 : 1);
+      what += " (" + std::to_string(victim) + ")";
+      const auto killed = Steady::now();
+      if (failure.empty() && !chaos.icestorm().kill_replica(victim))
+        failure = "replica " + std::to_string(victim) + " was not running";
+      // For 3 s after the kill the robot raises and clears the marker fault, each time as soon
+      // as the ui shows the last one: the longest of those waits is how long updates stopped.
+      auto in_process = [&] {
+        auto why = chaos.reference().co->explain("PENDANT.s_R.Status");
+        return why && std::any_of(why->begin(), why->end(),
+                                  [](const Explanation& e) { return e.root_event == "EVT_FORCE_ERROR"; });
+      };
+      double longest = 0;
+      int toggles = 0;
+      while (failure.empty() && seconds_since(killed) < 3.0) {
+        const bool before = in_process();
+        const auto sent = Steady::now();
+        failure = chaos.apply(before ? clear : raise);
+        const bool after = in_process();
+        if (!failure.empty() || after == before) break;  // another fault hides the marker: no figure
+        if (!eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_FORCE_ERROR") == after; },
+                        10000ms)) {
+          failure = "the ui does not show the fault raised " +
+                    std::to_string(static_cast<int>(seconds_since(killed) * 1000)) + " ms after the kill within 10 s";
+        }
+        longest = std::max(longest, seconds_since(sent) * 1000);
+        ++toggles;
+      }
+      if (toggles > 0) {
+        failover_ms[kind].push_back(longest);
+        what += ": " + std::to_string(toggles) + " faults, the slowest seen by the ui after " +
+                std::to_string(static_cast<int>(longest)) + " ms";
+      } else {
+        what += ": another fault hid the marker fault (no figure)";
+      }
+      burst(uniform(0, 5));
+      if (failure.empty() && !eventually([&] { return chaos.icestorm().settled_master() != 0; }, 15000ms)) {
+        failure = "the replicas do not agree on a master again within 15 s:\n" + chaos.icestorm().replica_report();
+      }
+    }
+    if (!failure.empty()) {
+      ADD_FAILURE() << "round " << round << " (" << what << "): " << failure << "\n" << chaos.logs();
+      break;
+    }
+    const auto over = Steady::now();
+    const bool converged = chaos.converges(bound, problem);
+    std::printf("[chaos] round %2d: %-90s converged in %4.0f ms (round %.1f s)\n", round, what.c_str(),
+                seconds_since(over) * 1000, seconds_since(round_started));
+    std::fflush(stdout);
+    if (!converged) {
+      ADD_FAILURE() << "round " << round << " (" << what << "): not converged " << bound.count()
+                    << " ms after the disruption was over\n"
+                    << problem << chaos.logs();
+      break;
+    }
+  }
+  for (int kind = 0; kind < 2; ++kind) {
+    auto& v = failover_ms[kind];
+    if (v.empty()) continue;
+    std::sort(v.begin(), v.end());
+    std::printf("[chaos] failover, %s killed: %zu rounds, %.0f–%.0f ms (median %.0f)\n",
+                kind == 0 ? "the master replica" : "the publishers' replica", v.size(), v.front(), v.back(),
+                v[v.size() / 2]);
+  }
+  const bool rounds_passed = !HasFailure();
+  const std::string exit_problems = chaos.stop_all();
+  if (rounds_passed) {
+    EXPECT_EQ(exit_problems, "") << chaos.logs();
+  }
+  std::printf("[chaos] %s; total %.1f s\n", chaos.totals().c_str(), seconds_since(started));
 }
 
 // Nothing lost silently (DESIGN §7, STYLE "say what was lost"): the supervisor detects a gap in a

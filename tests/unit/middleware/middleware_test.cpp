@@ -30,8 +30,22 @@ TEST(IceEndpoint, HostAndPortAreParsed) {
   EXPECT_EQ(p->host, "127.0.0.1") << "loopback by default";
 }
 
+TEST(IceEndpoint, ALocatorPrefixNamesTheIceGridRegistryOfAReplicatedIceStormAndPrintsBackAsWritten) {
+  auto e = parse_ice_endpoint("locator:10.77.0.3:4061");
+  ASSERT_TRUE(e);
+  EXPECT_TRUE(e->locator);
+  EXPECT_EQ(e->host, "10.77.0.3");
+  EXPECT_EQ(e->port, 4061);
+  EXPECT_EQ(to_string(*e), "locator:10.77.0.3:4061");
+  auto direct = parse_ice_endpoint("127.0.0.1:4061");
+  ASSERT_TRUE(direct);
+  EXPECT_FALSE(direct->locator);
+  EXPECT_EQ(to_string(*direct), "127.0.0.1:4061");
+}
+
 TEST(IceEndpoint, MalformedEndpointsAreParseErrorsThatSayWhy) {
-  for (const char* bad : {"", "host:", ":4061", "host:port", "host:70000", "host:0", "host:-1", "host:123456"}) {
+  for (const char* bad : {"", "host:", ":4061", "host:port", "host:70000", "host:0", "host:-1", "host:123456",
+                          "locator:", "locator:4061", "locator::4061", "locator:host:port"}) {
     auto e = parse_ice_endpoint(bad);
     ASSERT_FALSE(e) << bad;
     EXPECT_EQ(e.error().code, ErrorCode::Parse);

@@ -348,8 +348,8 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
       return fail(token.error().code, "--read-token-file " + name + "=" + path + ": " + token.error().message);
     l->read_token = *token;
   }
-  impl->description = "live: " + file_name(options.system) + " through IceStorm " + impl->ice.host + ":" +
-                      std::to_string(impl->ice.port) + ", coordinators " + names;
+  impl->description = "live: " + file_name(options.system) + " through IceStorm " + middleware::to_string(impl->ice) +
+                      ", coordinators " + names;
 
   Impl* self = impl.get();
   for (auto& l : impl->links) {

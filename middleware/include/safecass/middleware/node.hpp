@@ -41,13 +41,19 @@
 
 namespace safecass::middleware {
 
-/// Where IceStorm listens: "HOST:PORT" (its TopicManager endpoint). Host defaults to 127.0.0.1.
+/// Where a process finds IceStorm: "HOST:PORT", the TopicManager endpoint of one IceStorm, or
+/// "locator:HOST:PORT", the locator of the IceGrid registry of a replicated IceStorm
+/// (`scripts/start-icestorm --replicas N`, docs/deployment.md "A replicated broker"). Host
+/// defaults to 127.0.0.1.
 struct IceEndpoint {
   std::string host = "127.0.0.1";
   int port = 0;
+  bool locator = false;  ///< host:port is an IceGrid registry, not an IceStorm
 };
-/// Parses "HOST:PORT" or "PORT". Errors: Parse (with what was wrong).
+/// Parses "HOST:PORT", "PORT" or "locator:HOST:PORT". Errors: Parse (with what was wrong).
 [[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
+/// The text parse_ice_endpoint reads: "HOST:PORT" or "locator:HOST:PORT".
+std::string to_string(const IceEndpoint& ice);
 
 /// Mutual TLS (IceSSL) on every connection of a process: to IceStorm, from IceStorm to its
 /// subscribers, and to and from Control and Alive endpoints (docs/security.md). `dir` holds the
@@ -82,6 +88,8 @@ public:
 
 /// The IceStorm instance name scripts/start-icestorm configures.
 inline constexpr std::string_view kIceStormInstance = "SafecassIceStorm";
+/// What --ice starts with when it names an IceGrid registry: "locator:HOST:PORT".
+inline constexpr std::string_view kLocatorPrefix = "locator:";
 
 /// The default NodeOptions::max_message_bytes: Ice.MessageSizeMax (4096 KiB, set in every
 /// SAFECASS process and in scripts/start-icestorm's IceStorm) less 64 KiB for what is added to a
