@@ -88,7 +88,7 @@ public:
       : ic_(std::move(ic)), ice_(std::move(ice)), tls_(std::move(tls)) {}
   /// Registers a subscriber of `topic` (used by every connect()).
   void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber) {
-    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), nullptr});
+    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), nullptr, {}});
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.
   void connect(const std::vector<std::string>& publish_on);

@@ -741,6 +741,7 @@ struct CoordinatorNode::Impl {
     state_stream(stream_scratch, u.iface);
     switch (peer.fresh.stream(stream_scratch, u.incarnation, u.seq, missed, why)) {
       case PeerFreshness::Verdict::Accept: break;
+      case PeerFreshness::Verdict::Covered:  // (heartbeats only)
       case PeerFreshness::Verdict::Unproven:
         // A process not proven alive yet (a restart, or a replay of an earlier run): its state is
         // taken once its heartbeat is proven, from a republish.
@@ -826,6 +827,7 @@ struct CoordinatorNode::Impl {
         // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
         prover->ask(hb.coordinator, hb.control);
         return;
+      case PeerFreshness::Verdict::Covered: return;  // the proof was fresher
       case PeerFreshness::Verdict::Refuse:
         refuse(m.signer, "a heartbeat of '" + printable(hb.coordinator) + "': " + why);
         return;

@@ -56,10 +56,14 @@ PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::str
 PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
   if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
   if (seq <= heartbeat_seq_) {
+    // The proof carried the heartbeat it was sent with: that one (and older ones still on their
+    // way) arrive after it, and are no replay.
+    if (heartbeat_from_proof_) return Verdict::Covered;
     why = "seq " + std::to_string(seq) + " not above " + std::to_string(heartbeat_seq_) + " (replayed)";
     return Verdict::Refuse;
   }
   heartbeat_seq_ = seq;
+  heartbeat_from_proof_ = false;
   return Verdict::Accept;
 }
 
@@ -95,10 +99,14 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why) {
     return false;
   }
   if (beat.incarnation == incarnation_) {
-    heartbeat_seq_ = std::max<std::int64_t>(heartbeat_seq_, beat.seq);
+    if (beat.seq >= heartbeat_seq_) {
+      heartbeat_seq_ = beat.seq;
+      heartbeat_from_proof_ = true;
+    }
   } else {
     incarnation_ = beat.incarnation;
     heartbeat_seq_ = beat.seq;
+    heartbeat_from_proof_ = true;
     streams_.clear();
   }
   // What the process had sent when it answered: anything at or below it that arrives later is

@@ -83,6 +83,9 @@ public:
     Refuse,    ///< a replay, an older process, a jump: `why` says which
     Unproven,  ///< a process this receiver has not proven alive yet (ask it: Prover), or a
                ///< message it sent before it proved itself alive: dropped, without blame
+    Covered,   ///< a heartbeat numbered at or below the proof just taken, before any newer one:
+               ///< sent before or with the proof and still on its way; dropped, without blame
+               ///< and without asking again (its number is no news: the proof was fresher)
   };
   /// The incarnation rule alone, for a message of `incarnation`: older than the believed one
   /// refused, another one not proven, the believed one accepted.
@@ -110,6 +113,7 @@ private:
   };
   std::int64_t incarnation_ = 0;
   std::int64_t heartbeat_seq_ = 0;
+  bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
   std::map<std::string, Stream, std::less<>> streams_;
 };
 

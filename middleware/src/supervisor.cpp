@@ -474,6 +474,7 @@ struct Supervisor::Impl {
       std::string why;
       switch (p->second.fresh.stream(stream, u.incarnation, u.seq, missed, why)) {
         case PeerFreshness::Verdict::Accept: break;
+        case PeerFreshness::Verdict::Covered:           // (heartbeats only)
         case PeerFreshness::Verdict::Unproven: return;  // taken from its republish once proven
         case PeerFreshness::Verdict::Refuse:
           refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": " + why);
@@ -531,6 +532,7 @@ struct Supervisor::Impl {
           prover->ask(h.coordinator, h.control);
           return;
         }
+        case PeerFreshness::Verdict::Covered: return;  // the proof was fresher
         case PeerFreshness::Verdict::Refuse:
           // An older incarnation still beating while a newer one runs: two processes, one name.
           if (h.incarnation < known &&

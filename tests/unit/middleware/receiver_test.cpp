@@ -51,6 +51,19 @@ TEST(PeerFreshness, AfterAProofOnlyThatProcessIsTakenAnOlderOneIsRefusedANewerOn
   EXPECT_EQ(peer.incarnation(), kRun);
 }
 
+TEST(PeerFreshness, AHeartbeatNumberedAsTheProofSaysArrivingAfterItIsDroppedWithoutBlameUntilANewerIsTaken) {
+  PeerFreshness peer;
+  std::string why;
+  ASSERT_TRUE(peer.proven(proof(kRun, 7, 0), why)) << why;
+  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Covered) << "the heartbeat sent with the proof, arriving after it";
+  EXPECT_EQ(peer.heartbeat(kRun, 6, why), Verdict::Covered) << "an older one still on its way";
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Refuse) << "once a newer one is taken, an older one is a replay";
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse);
+  ASSERT_TRUE(peer.proven(proof(kRun, 5, 0), why)) << "a slower proof of the same process";
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse) << "a proof older than what was taken covers nothing";
+}
+
 TEST(PeerFreshness, AStreamMessageAtOrBelowTheProofsCountIsDroppedWithoutBlameAndTheNextIsTaken) {
   PeerFreshness peer;
   std::string why;
