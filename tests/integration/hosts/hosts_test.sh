@@ -184,7 +184,10 @@ across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another
   retry 10 ui_shows "Error +EVT_COORDINATOR_LOST"
   check "with host a and its replica cut off, the ui on b shows the robot lost" test $? -eq 0
   sleep 1
-  retry 15 sup_hears_ui
+  # A liveness check, not a timing target: each process finds the replicas left once its calls to
+  # replica 1 time out (2 s a call, 0.7 s a connection attempt); 3.7 s on an idle machine, 6-16 s
+  # beside two busy loops (docs/deployment.md).
+  retry 40 sup_hears_ui
   check "the supervisor on c hears the ui on b through the replicas left" test $? -eq 0
   echo "   host a cut -> the supervisor hears the ui again after $(($(now_ms) - start)) ms (at most)"
   hosts_heal a
