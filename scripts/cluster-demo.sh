@@ -58,11 +58,7 @@ for h in a b; do
 done
 wait $registry || exit 1
 hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' "$HOSTS_DIR/ice.env")")
-# The master replica's id, once the three agree on it.
-master() {
-  on c icestormadmin --Ice.Config="$HOSTS_DIR/ice/admin.config" -e replica 2>/dev/null |
-    awk '/coord:/ {m[$3]++} /state:/ && $3 == "normal" {n++} END {for (k in m) if (m[k] == 3 && n == 3) print k}'
-}
+master() { hosts_broker_master c "$HOSTS_DIR/ice"; }
 hosts_start supervisor c "$bin/safecass" supervisor "$system" --ice $ice --listen 10.77.0.3
 hosts_start ui b "$bin/safecass" run "$system" --coordinator ui --ice $ice --listen 10.77.0.2
 start=$SECONDS

@@ -10,6 +10,9 @@
 #   hosts_start NAME HOST CMD...     starts CMD on HOST in the background, output in $HOSTS_DIR/NAME.log,
 #                                    PID in pid_NAME (stopped by hosts_down)
 #   hosts_down                       stops what hosts_start started (by PID), removes the namespaces
+#   hosts_broker_master HOST DIR     the master replica's id of the replicated IceStorm whose registry
+#                                    runs on HOST with data directory DIR, once its three replicas
+#                                    agree on it and are all in the normal state (else nothing)
 
 hosts_prefix=
 hosts_names=()
@@ -98,6 +101,11 @@ hosts_stop() {
   for _ in $(seq 30); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
   kill -KILL "$pid" 2>/dev/null || true
   wait "$pid" 2>/dev/null || true
+}
+
+hosts_broker_master() {
+  on "$1" icestormadmin --Ice.Config="$2/admin.config" -e replica 2>/dev/null |
+    awk '/coord:/ {m[$3]++} /state:/ && $3 == "normal" {n++} END {for (k in m) if (m[k] == 3 && n == 3) print k}'
 }
 
 hosts_down() {

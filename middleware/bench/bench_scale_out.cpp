@@ -222,39 +222,90 @@ double broker_rss(const std::vector<int>& pids) {
   return sum;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Options {
   std::string ice_text, out_path = "bench-scale-out.json", ca_dir;
   int n = 10, k = 20;
   double rate = 10.0, seconds = 10.0;
   std::vector<int> broker;
+};
+
+/// The command line (see the file comment); false, said on stderr, for an unknown option.
+bool parse_options(int argc, char** argv, Options& o) {
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     const std::string value = argv[i + 1];
     if (key == "--ice") {
-      ice_text = value;
+      o.ice_text = value;
     } else if (key == "--out") {
-      out_path = value;
+      o.out_path = value;
     } else if (key == "--ca") {
-      ca_dir = value;
+      o.ca_dir = value;
     } else if (key == "--coordinators") {
-      n = std::clamp(std::atoi(value.c_str()), 1, 500);
+      o.n = std::clamp(std::atoi(value.c_str()), 1, 500);
     } else if (key == "--components") {
-      k = std::clamp(std::atoi(value.c_str()), 1, 1000);
+      o.k = std::clamp(std::atoi(value.c_str()), 1, 1000);
     } else if (key == "--rate") {
-      rate = std::clamp(std::atof(value.c_str()), 0.1, 1000.0);
+      o.rate = std::clamp(std::atof(value.c_str()), 0.1, 1000.0);
     } else if (key == "--seconds") {
-      seconds = std::max(1.0, std::atof(value.c_str()));
+      o.seconds = std::max(1.0, std::atof(value.c_str()));
     } else if (key == "--broker") {
       std::istringstream list(value);
-      for (std::string pid; std::getline(list, pid, ',');) broker.push_back(std::atoi(pid.c_str()));
+      for (std::string pid; std::getline(list, pid, ',');) o.broker.push_back(std::atoi(pid.c_str()));
     } else {
       std::fprintf(stderr, "bench_scale_out: unknown option %s\n", key.c_str());
-      return 2;
+      return false;
     }
   }
-  auto ice = middleware::parse_ice_endpoint(ice_text);
+  return true;
+}
+
+/// The watcher's latencies: a provider's raise (a remote root entering Error on W's required
+/// interface) → now, each raise counted once (a provider declared lost and back shows its active
+/// roots again).
+class Latencies {
+public:
+  void watch(Member& watcher, int n, int k) {
+    for (int p = 0; p < n; ++p) {
+      for (int c = 0; c < k; ++c) {
+        watcher.co->on_machine(
+            *watcher.co->find_machine("W.s_R." + component(p, c)),
+            StateCallbacks{nullptr,
+                           [this, &watcher](const TransitionInfo& info) {
+                             // A loss the watcher raises itself has a local root.
+                             if (!measuring.load() || info.transition != Transition::N2E || info.root == nullptr ||
+                                 info.root->remote == kNone)
+                               return;
+                             const double us =
+                                 static_cast<double>((watcher.clock.now() - info.root->time).count()) / 1000.0;
+                             std::lock_guard lock(mutex_);
+                             if (seen_.emplace(info.root->remote_origin, info.root->time.count()).second)
+                               us_.push_back(us);
+                           },
+                           nullptr});
+      }
+    }
+  }
+  std::vector<double> taken() const {
+    std::lock_guard lock(mutex_);
+    return us_;
+  }
+  std::atomic<bool> measuring{false};
+
+private:
+  mutable std::mutex mutex_;
+  std::vector<double> us_;
+  std::set<std::pair<NameId, std::int64_t>> seen_;  ///< (origin, onset) of the raises seen
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (!parse_options(argc, argv, o)) return 2;
+  const int n = o.n, k = o.k;
+  const double rate = o.rate, seconds = o.seconds;
+  const std::vector<int>& broker = o.broker;
+  auto ice = middleware::parse_ice_endpoint(o.ice_text);
   if (!ice) {
     std::fprintf(stderr, "bench_scale_out: %s\n", ice.error().message.c_str());
     return 2;
@@ -275,7 +326,7 @@ int main(int argc, char** argv) {
     ~RemoveKeys() { std::filesystem::remove_all(dir); }
   } remove_keys{keys};
   middleware::KeyOptions key_options = middleware::KeyOptions::replacing();
-  key_options.ca_dir = ca_dir;
+  key_options.ca_dir = o.ca_dir;
   if (auto made = middleware::create_bus_keys(system, keys, key_options); !made) {
     std::fprintf(stderr, "bench_scale_out: %s\n", made.error().message.c_str());
     return 2;
@@ -308,30 +359,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "bench_scale_out: the watcher did not join the bus\n");
     return 1;
   }
-  std::mutex mutex;
-  std::vector<double> latencies;
-  // A raise is counted once: a provider declared lost and back shows its active roots again.
-  std::set<std::pair<NameId, std::int64_t>> seen;  ///< (origin, onset) of the raises seen
-  std::atomic<bool> measuring{false};
-  for (int p = 0; p < n; ++p) {
-    for (int c = 0; c < k; ++c) {
-      watcher.co->on_machine(
-          *watcher.co->find_machine("W.s_R." + component(p, c)),
-          StateCallbacks{nullptr,
-                         [&](const TransitionInfo& info) {
-                           // A provider's raise: a remote root (a loss the watcher raises itself is local).
-                           if (!measuring.load() || info.transition != Transition::N2E || info.root == nullptr ||
-                               info.root->remote == kNone)
-                             return;
-                           const double us =
-                               static_cast<double>((watcher.clock.now() - info.root->time).count()) / 1000.0;
-                           std::lock_guard lock(mutex);
-                           if (seen.emplace(info.root->remote_origin, info.root->time.count()).second)
-                             latencies.push_back(us);
-                         },
-                         nullptr});
-    }
-  }
+  Latencies latencies;
+  latencies.watch(watcher, n, k);
   // The measurement starts from a settled system: the watcher holds every provider proven alive.
   const MachineId w = *watcher.co->find_machine("W");
   for (int i = 0; i < 3000 && watcher.co->state(w) != State::Normal; ++i) std::this_thread::sleep_for(10ms);
@@ -343,7 +372,7 @@ int main(int argc, char** argv) {
   const double sup_cpu0 = peers::cpu_seconds(supervisor_pid), broker_cpu0 = broker_cpu(broker);
   const auto watch_before = watcher.node->stats();
   const std::int64_t t0 = peers::now_ns();
-  measuring.store(true);
+  latencies.measuring.store(true);
   for (std::size_t i = 1; i < children.size(); ++i) write_text(children[i].in, "g");
   std::uint64_t changes = 0, raises = 0, state_messages = 0, event_messages = 0;
   for (std::size_t i = 1; i < children.size(); ++i) {
@@ -356,7 +385,7 @@ int main(int argc, char** argv) {
     event_messages += e;
   }
   const double elapsed = static_cast<double>(peers::now_ns() - t0) / 1e9;
-  measuring.store(false);
+  latencies.measuring.store(false);
   const double sup_cpu = peers::cpu_seconds(supervisor_pid) - sup_cpu0;
   const double brk_cpu = broker_cpu(broker) - broker_cpu0;
   const double sup_rss = peers::status_bytes(supervisor_pid, "VmRSS");
@@ -369,11 +398,7 @@ int main(int argc, char** argv) {
   std::uint64_t refused = 0, notices = 0;
   sup_report >> rows >> refused >> notices;
 
-  std::vector<double> copy;
-  {
-    std::lock_guard lock(mutex);
-    copy = latencies;
-  }
+  const std::vector<double> copy = latencies.taken();
   const double heartbeats_per_s = (n + 2) * 10.0;  // every member and the supervisor, every 100 ms
   const double published_per_s = static_cast<double>(state_messages + event_messages) / elapsed + heartbeats_per_s;
   char json[2048];
@@ -392,7 +417,7 @@ int main(int argc, char** argv) {
       100.0 * sup_cpu / elapsed, sup_rss, rows, static_cast<unsigned long long>(refused),
       static_cast<unsigned long long>(notices), 100.0 * brk_cpu / elapsed, brk_rss, broker.size(),
       settled ? "true" : "false");
-  std::ofstream(out_path) << json;
+  std::ofstream(o.out_path) << json;
   std::printf("%s", json);
   watcher.node->stop();
   // Every raise should reach the watcher; a shortfall (the processes could not keep up and raised

@@ -232,8 +232,7 @@ std::string resubscribed_line(const std::vector<std::string>& topics) {
 }
 
 std::vector<std::string> Link::check() {
-  if (manager_ == nullptr) throw Ice::ConnectionRefusedException(__FILE__, __LINE__);
-  manager_->ice_ping();
+  ping();
   std::vector<std::string> made;
   bool pending = false;
   for (Subscription& s : subscriptions_) {

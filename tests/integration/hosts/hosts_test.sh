@@ -143,10 +143,7 @@ across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_hea
   check "and, after healing, the fault itself" test $? -eq 0
   ;;
 across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another_hosts_replica_dies)
-  master() {  # the master replica's id, once the three agree on it and are all in the normal state
-    on c icestormadmin --Ice.Config="$HOSTS_DIR/ice/admin.config" -e replica 2>/dev/null |
-      awk '/coord:/ {m[$3]++} /state:/ && $3 == "normal" {n++} END {for (k in m) if (m[k] == 3 && n == 3) print k}'
-  }
+  master() { hosts_broker_master c "$HOSTS_DIR/ice"; }
   has_master() { [ -n "$(master)" ]; }
   replica_host() { case $1 in 1) echo a ;; 2) echo b ;; 3) echo c ;; esac; }
   kill_replica() {  # kill_replica ID: kill -9 of that replica, on its host (its node starts it again)
