@@ -142,7 +142,7 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
         impl->ic, "beat", [finder](const wire::Signed& m) { finder->on_beat(m); }, impl->undecodable, "console"));
     adapter->activate();
-    auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), kHeartbeatTopic);
+    auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), heartbeat_topic(o.coordinator));
     subscribe(heartbeat, proxy);
     // Each endpoint an authentic heartbeat names is asked for a proof of life before anything
     // else is sent to it; one that cannot give one (a replayed heartbeat of a dead process, an

@@ -25,7 +25,15 @@ inline std::string state_topic(std::string_view coordinator) {
   return std::string(kStateTopic) + "." + std::string(coordinator);
 }
 inline constexpr const char* kEventTopic = "safecass.events";
+/// Heartbeats go to one topic per signer too, "safecass.heartbeat.<signer>" (a coordinator, or
+/// the supervisor): a coordinator hears only itself (its own heartbeat coming back proves its
+/// subscriptions work), the providers it holds and the supervisor; the supervisor hears every
+/// coordinator of the system file. Deliveries grow with the connections, not with the square of
+/// the members (docs/scaling.md).
 inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
+inline std::string heartbeat_topic(std::string_view signer) {
+  return std::string(kHeartbeatTopic) + "." + std::string(signer);
+}
 inline constexpr const char* kResyncTopic = "safecass.resync";
 
 /// Every this many heartbeat periods a process's link checks that IceStorm still holds each of

@@ -600,12 +600,12 @@ struct CoordinatorNode::Impl {
     while (running.load()) {
       if (!connected.load()) {
         try {
-          link->connect({state_topic(name), kEventTopic, kHeartbeatTopic, kResyncTopic});
+          link->connect({state_topic(name), kEventTopic, heartbeat_topic(name), kResyncTopic});
           {
             std::lock_guard lock(link_mutex);
             state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(state_topic(name)));
             event_pub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kEventTopic));
-            heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(kHeartbeatTopic));
+            heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(heartbeat_topic(name)));
             resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
           }
           connected_at = steady_ns();
@@ -1152,8 +1152,12 @@ Expected<void> CoordinatorNode::start() {
         providers.push_back(h.provider);
       }
     }
-    for (const std::string& provider : providers) d.link->subscribe_to(state_topic(provider), state);
-    d.link->subscribe_to(kHeartbeatTopic, heartbeat);
+    for (const std::string& provider : providers) {
+      d.link->subscribe_to(state_topic(provider), state);
+      d.link->subscribe_to(heartbeat_topic(provider), heartbeat);
+    }
+    d.link->subscribe_to(heartbeat_topic(d.name), heartbeat);
+    d.link->subscribe_to(heartbeat_topic(kSupervisorSigner), heartbeat);
     d.link->subscribe_to(kResyncTopic, resync);
     d.adapter->activate();
   } catch (const Ice::Exception& e) {

@@ -741,8 +741,9 @@ struct Supervisor::Impl {
     while (running.load()) {
       try {
         if (!connected) {
-          link->connect({kResyncTopic, kHeartbeatTopic});
-          heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(kHeartbeatTopic));
+          link->connect({kResyncTopic, heartbeat_topic(kSupervisorSigner)});
+          heartbeat_pub =
+              Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(heartbeat_topic(kSupervisorSigner)));
           {
             std::lock_guard lock(link_mutex);
             resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
@@ -890,8 +891,12 @@ Expected<void> Supervisor::start() {
     };
     if (d.options.records) d.link->subscribe_to(kEventTopic, subscriber("records", &Impl::on_events));
     auto state = subscriber("updates", &Impl::on_updates);
-    for (const auto& [name, _] : d.peers) d.link->subscribe_to(state_topic(name), state);
-    d.link->subscribe_to(kHeartbeatTopic, subscriber("beat", &Impl::on_beat));
+    auto beat = subscriber("beat", &Impl::on_beat);
+    for (const auto& [name, _] : d.peers) {
+      d.link->subscribe_to(state_topic(name), state);
+      d.link->subscribe_to(heartbeat_topic(name), beat);
+    }
+    d.link->subscribe_to(heartbeat_topic(kSupervisorSigner), beat);  // another supervisor is said
     d.alive = guarded(std::make_shared<AliveServant>(d))->ice_toString();
     adapter->activate();
   } catch (const Ice::Exception& e) {

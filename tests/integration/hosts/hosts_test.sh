@@ -200,7 +200,7 @@ across_hosts_no_certificate_another_ca_and_non_members_are_refused)
   check "a console on b with another CA's certificate is refused" test $? -ne 0
   on b timeout 20 icestormadmin --Ice.Default.Timeout=2000 --Ice.Override.ConnectTimeout=1000 --Ice.RetryIntervals=-1 \
     --IceStormAdmin.TopicManager.Default="SafecassIceStorm/TopicManager:tcp -h 10.77.0.3 -p 4061" \
-    -e "topics; destroy safecass.heartbeat" >admin.txt 2>&1
+    -e "topics; destroy safecass.heartbeat.robot" >admin.txt 2>&1
   check "a non-member on b (plain TCP) can neither list nor destroy a topic at the broker on c" test $? -ne 0
   SAFECASS_KEYS="$HOSTS_DIR/no-certs" on b "$bin/safecass" run "$system" --coordinator ui --ice "$ice" \
     --listen 10.77.0.2 --duration 1 >run-plain.txt 2>&1

@@ -70,7 +70,7 @@ SAFECASS_KEYS="$scratch/other-system" console --coordinator ui -c "state list PE
 check "a console with another CA's certificate is refused" test $? -ne 0
 timeout 20 icestormadmin --Ice.Default.Timeout=2000 --Ice.Override.ConnectTimeout=1000 --Ice.RetryIntervals=-1 \
   --IceStormAdmin.TopicManager.Default="SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p $port" \
-  -e "topics; destroy safecass.heartbeat" > admin.txt 2>&1
+  -e "topics; destroy safecass.heartbeat.robot" > admin.txt 2>&1
 check "icestormadmin without a certificate can neither list nor destroy a topic" test $? -ne 0
 retry 20 sh -c '"$0" console --ice "127.0.0.1:$1" --timeout 3000 --coordinator robot --token-file "$2" --allow-write \
   -c "event generate /EVT_FORCE_ERROR JR3.s_A" > clear.txt 2>&1' "$bin" "$port" "$scratch/robot.token"

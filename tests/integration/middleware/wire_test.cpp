@@ -142,7 +142,10 @@ struct Bus {
   std::vector<std::string> log;
   Ice::CommunicatorHolder ice;  ///< presents wire-p's certificate (made with the keys, below)
   std::shared_ptr<wire::StateTopicPrx> state_pub;
-  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
+  /// The publisher of `name`'s heartbeat topic ("safecass.heartbeat.<name>").
+  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub(const std::string& name) {
+    return Ice::uncheckedCast<wire::HeartbeatTopicPrx>(topic("safecass.heartbeat." + name)->getPublisher());
+  }
   std::optional<Signer> provider, other, supervisor, attacker;
   // The provider's heartbeat, sent by a thread while `beating`: the last seq of each stream.
   std::map<std::string, std::int64_t> last_sent;
@@ -180,7 +183,6 @@ struct Bus {
     supervisor_alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "supervisor"))->ice_toString();
     adapter->activate();
     state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(topic("safecass.state.wire-p")->getPublisher()->ice_oneway());
-    heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(topic("safecass.heartbeat")->getPublisher());
     beat_thread = std::thread([this] {
       while (running.load()) {
         if (beating.load()) beat(*provider, "wire-p", kIncarnation);
@@ -204,7 +206,7 @@ struct Bus {
     // The node's subscriptions are in place: IceStorm lists a subscriber on each of its topics.
     EXPECT_TRUE(eventually(
         [&] {
-          for (const char* t : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+          for (const char* t : {"safecass.state.wire-p", "safecass.heartbeat.wire-p", "safecass.resync"}) {
             if (topic(t)->getSubscribers().empty()) return false;
           }
           return true;
@@ -263,7 +265,7 @@ struct Bus {
         if (events_sent) h.lastSeq["events"] = *events_sent;
       }
     }
-    heartbeat_pub->beat(key.sign(middleware::detail::kKindHeartbeat, encode(ice.communicator(), h)));
+    heartbeat_pub(name)->beat(key.sign(middleware::detail::kKindHeartbeat, encode(ice.communicator(), h)));
   }
   /// Publishes `batch` signed by `key`; a genuine batch also advances what the heartbeat lists.
   void send(const Signer& key, const wire::StateUpdateSeq& batch) {
@@ -607,6 +609,32 @@ std::unique_ptr<middleware::Supervisor> start_supervisor(Bus& bus, SupervisorOut
   return std::move(*supervisor);
 }
 
+// Heartbeats go to one topic per signer: a coordinator hears itself (its heartbeat coming back
+// proves its subscriptions work), the providers it holds and the supervisor; the supervisor hears
+// every coordinator of the system file (and itself, to notice a second supervisor). Nobody hears
+// the heartbeats of members it does not watch, so deliveries grow with the connections, not with
+// the square of the members (docs/scaling.md).
+TEST(Wire, ACoordinatorHearsTheHeartbeatsOfItselfItsProvidersAndTheSupervisorAndTheSupervisorThoseOfEveryCoordinator) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const auto node_hears = [&](const std::string& topic) {
+    for (const Ice::Identity& id : bus.topic(topic)->getSubscribers()) {
+      if (id.name == "heartbeat" && id.category.rfind("safecass-wire-c-", 0) == 0) return true;
+    }
+    return false;
+  };
+  for (const char* signer : {"wire-c", "wire-p", "supervisor"}) {
+    const std::string topic = std::string("safecass.heartbeat.") + signer;
+    EXPECT_TRUE(eventually([&] { return node_hears(topic); })) << topic;
+    // The node and the supervisor: nobody else.
+    EXPECT_TRUE(eventually([&] { return bus.topic(topic)->getSubscribers().size() == 2; })) << topic;
+  }
+}
+
 // IceStorm drops a twoway subscriber whose delivery fails or times out (a process starved, or a
 // message it cannot decode), and anyone who reaches IceStorm can unsubscribe anybody: a process
 // that did not notice would go on with nothing reaching it. Here every subscription of the
@@ -621,7 +649,7 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   const middleware::Supervisor& sup = *supervisor;
 
   std::size_t removed = 0;
-  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat"}) {
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat.wire-p"}) {
     auto t = bus.topic(name);
     for (const Ice::Identity& subscriber : t->getSubscribers()) {
       t->unsubscribe(bus.ice->stringToProxy(Ice::identityToString(subscriber)));
@@ -1224,17 +1252,17 @@ TEST(Wire, UndecodableMessagesDropNoSubscriptionAndAreLoggedAtMostOnceASecond) {
     encoded.endEncapsulation();
     encoded.finished(garbage);
   }
-  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat.wire-p", "safecass.resync"}) {
     auto pub = bus.topic(name)->getPublisher()->ice_oneway();
-    const char* op = std::string(name) == "safecass.heartbeat" ? "beat"
-                     : std::string(name) == "safecass.resync"  ? "resync"
-                                                               : "updates";
+    const char* op = std::string(name) == "safecass.heartbeat.wire-p" ? "beat"
+                     : std::string(name) == "safecass.resync"         ? "resync"
+                                                                      : "updates";
     Ice::ByteSeq ignored;
     for (int i = 0; i < 500; ++i) pub->ice_invoke(op, Ice::OperationMode::Normal, garbage, ignored);
   }
   ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused - refused_before >= 1000; })) << bus.all_log();
   std::this_thread::sleep_for(300ms);
-  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat", "safecass.resync"}) {
+  for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat.wire-p", "safecass.resync"}) {
     EXPECT_FALSE(bus.topic(name)->getSubscribers().empty()) << name;
   }
   EXPECT_EQ(bus.node->stats().resubscriptions, 0u) << "nobody was dropped\n" << bus.all_log();
@@ -1337,7 +1365,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   };
   const std::vector<Topic> topics{{"safecass.state.wire-p", "updates"},
                                   {"safecass.events", "records"},
-                                  {"safecass.heartbeat", "beat"},
+                                  {"safecass.heartbeat.wire-p", "beat"},
                                   {"safecass.resync", "resync"}};
   const std::size_t log_before = bus.all_log().size();
   const std::size_t out_before = out.all().size();
