@@ -124,6 +124,13 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls, cons
   init.properties->setProperty("Ice.Warn.Dispatch", "0");
   init.properties->setProperty("Ice.ThreadPool.Server.Size", "1");
   init.properties->setProperty("Ice.ThreadPool.Server.SizeMax", "1");
+  // Answers to asynchronous calls (a proof of life, a subscription check) run their callbacks on
+  // the client pool, and a callback may itself send (a proof taken asks the peer to republish).
+  // That send can need the pool (a connection to establish, the locator to ask): with one thread,
+  // which the callback holds, it waited out its timeout while nothing else was read — a stall of
+  // every delivery for 1-2 s. The pool grows instead (docs/scaling.md).
+  init.properties->setProperty("Ice.ThreadPool.Client.Size", "1");
+  init.properties->setProperty("Ice.ThreadPool.Client.SizeMax", "4");
   init.properties->setProperty("Ice.ACM.Client.Timeout", "0");
   init.properties->setProperty("Ice.MessageSizeMax", "4096");
   return Ice::initialize(init);

@@ -36,9 +36,13 @@ inline std::string heartbeat_topic(std::string_view signer) {
 }
 inline constexpr const char* kResyncTopic = "safecass.resync";
 
-/// Every this many heartbeat periods a process's link checks that IceStorm still holds each of
-/// its subscriptions (Link::check); in between it only pings IceStorm.
-inline constexpr std::uint64_t kResubscribeCheckEvery = 3;
+/// Every this many heartbeat periods (1 s at the default 100 ms) a process's link checks that
+/// IceStorm still holds each of its subscriptions (Link::check); in between it only pings IceStorm.
+/// A check is an update at IceStorm (a replicated one forwards it to its master): every 3 periods
+/// it cost the broker half of its CPU at 50 coordinators (docs/scaling.md). A lost subscription
+/// fails toward safe without it (a silent heartbeat or a stream behind counts as lost within the
+/// loss bound); the check only bounds how long until the view recovers.
+inline constexpr std::uint64_t kResubscribeCheckEvery = 10;
 /// The log line (without the process's prefix) for subscriptions Link::check made again.
 std::string resubscribed_line(const std::vector<std::string>& topics);
 
