@@ -1371,6 +1371,11 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   const std::size_t out_before = out.all().size();
   const long rss_before = rss_kib();
   constexpr int kPerTopic = 20000;
+  // The flood of the issue: 20,000 per topic in a few seconds (2 s: 40,000 messages a second in
+  // all). SAFECASS_FLOOD_UNPACED=1 sends as fast as this process can instead, to see the queues.
+  constexpr auto kFloodTime = std::chrono::milliseconds(2000);
+  const bool paced = std::getenv("SAFECASS_FLOOD_UNPACED") == nullptr;
+  std::chrono::steady_clock::duration flood_took{};
   std::atomic<bool> flooding{true};
   std::thread flood([&] {
     std::vector<std::shared_ptr<Ice::ObjectPrx>> pubs;
@@ -1388,6 +1393,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
       encoded.finished(forged_bytes);
     }
     Ice::ByteSeq ignored;
+    const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < kPerTopic; ++i) {
       for (std::size_t t = 0; t < topics.size(); ++t) {
         pubs[t]->ice_invoke(topics[t].operation, Ice::OperationMode::Normal, i % 2 == 0 ? garbage : forged_bytes,
@@ -1395,9 +1401,11 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
       }
       if (i % 200 == 199) {
         for (auto& p : pubs) p->ice_flushBatchRequests();
+        if (paced) std::this_thread::sleep_until(start + kFloodTime * (i + 1) / kPerTopic);
       }
     }
     for (auto& p : pubs) p->ice_flushBatchRequests();
+    flood_took = std::chrono::steady_clock::now() - start;
     flooding.store(false);
   });
   // In the middle of the flood, wire-p raises a genuine fault.
@@ -1422,13 +1430,16 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   auto ms = [](std::chrono::steady_clock::duration d) {
     return static_cast<double>(std::chrono::duration_cast<std::chrono::microseconds>(d).count()) / 1000.0;
   };
-  std::printf("[flood] fault seen by the coordinator after %.1f ms, by the supervisor after %.1f ms%s\n",
-              ms(node_after), ms(supervisor_after), mid_flood ? " (during the flood)" : "");
+  std::printf(
+      "[flood] %d messages on each of %zu topics in %.0f ms (%s); fault seen by the coordinator after %.1f ms, by "
+      "the supervisor after %.1f ms%s\n",
+      kPerTopic, topics.size(), ms(flood_took), paced ? "paced" : "unpaced", ms(node_after), ms(supervisor_after),
+      mid_flood ? " (during the flood)" : "");
   EXPECT_TRUE(node_saw) << bus.all_log();
   EXPECT_TRUE(supervisor_saw) << out.all();
-  // The fault waits in IceStorm's and the receivers' queues behind the flood on its own topic
-  // (40-90 ms on an idle machine, docs/security.md); it is seen, within 2 s even beside two busy
-  // loops.
+  // Paced, the receivers keep up and the fault is seen within a few milliseconds; unpaced it waits
+  // in IceStorm's and the receivers' queues behind the flood on its own topic (docs/security.md).
+  // The bound is loose so that a loaded machine passes: the figure is what the line above prints.
   EXPECT_LT(ms(node_after), 2000.0);
   EXPECT_LT(ms(supervisor_after), 2000.0);
 
