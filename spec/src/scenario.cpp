@@ -233,16 +233,172 @@ std::string escape_pointer(const std::string& key) {
   return out;
 }
 
-void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::deque<ScenarioStep>& steps) {
-  const std::string base = "/steps/" + std::to_string(index);
-  if (!step.is_object()) {
-    r.error(step.position, base, "a step must be an object with \"at\" and one action");
-    return;
+bool read_sample(Reader& r, const json::JsonValue& v, const std::string& p, ScenarioStep& s) {
+  if (!v.is_object() || v.object.empty()) {
+    r.error(v.position, p, "\"sample\" must be an object of signal: value");
+    return false;
   }
-  static constexpr std::string_view kActions[] = {"sample", "ramp",   "generate",           "inject",
-                                                  "reset",  "expect", "expect_outstanding", "expect_cause"};
+  bool ok = true;
+  std::vector<std::pair<std::string_view, std::vector<double>>> samples;
+  samples.reserve(v.object.size());
+  for (const json::JsonMember& sm : v.object) {
+    std::vector<double> vals;
+    ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
+    samples.emplace_back(sm.key, std::move(vals));
+  }
+  if (ok) s.samples = SampleList(samples);
+  return ok;
+}
+
+bool read_ramp(Reader& r, const json::JsonValue& v, const std::string& p, double when, StepAction& a) {
+  if (!v.is_object()) {
+    r.error(v.position, p, "\"ramp\" must be an object {signal, from, to, until}");
+    return false;
+  }
+  const auto typos = r.unknown_keys(v, p, {"signal", "from", "to", "until"});
+  const json::JsonValue* sig = v.find("signal");
+  const json::JsonValue* from = v.find("from");
+  const json::JsonValue* to = v.find("to");
+  const json::JsonValue* until = v.find("until");
+  if (sig == nullptr || from == nullptr || to == nullptr || until == nullptr) {
+    const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
+    const bool all_typos = (sig != nullptr || typo("signal")) && (from != nullptr || typo("from")) &&
+                           (to != nullptr || typo("to")) && (until != nullptr || typo("until"));
+    if (!all_typos) r.error(v.position, p, "\"ramp\" needs signal, from, to and until");
+    return false;
+  }
+  bool ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal);
+  ok = r.number(*from, p + "/from", "\"from\"", a.from) && ok;
+  ok = r.number(*to, p + "/to", "\"to\"", a.to) && ok;
+  ok = r.number(*until, p + "/until", "\"until\"", a.until) && ok;
+  if (ok && a.until < when) {
+    r.error(until->position, p + "/until", "\"until\" must not be before \"at\"");
+    return false;
+  }
+  return ok;
+}
+
+bool read_generate(Reader& r, const json::JsonValue& v, const std::string& p, StepAction& a) {
+  if (!v.is_object()) {
+    r.error(v.position, p, "\"generate\" must be an object {event, target}");
+    return false;
+  }
+  const auto typos = r.unknown_keys(v, p, {"event", "target"});
+  const json::JsonValue* e = v.find("event");
+  const json::JsonValue* t = v.find("target");
+  if (e == nullptr) {
+    if (std::find(typos.begin(), typos.end(), "event") == typos.end())
+      r.error(v.position, p, "\"generate\" needs \"event\"");
+    return false;
+  }
+  bool ok = r.text(*e, p + "/event", "\"event\"", a.event);
+  if (t != nullptr) ok = r.text(*t, p + "/target", "\"target\"", a.target) && ok;
+  return ok;
+}
+
+bool read_inject(Reader& r, const json::JsonValue& v, const std::string& p, StepAction& a) {
+  if (!v.is_object()) {
+    r.error(v.position, p, "\"inject\" must be an object {filter|signal, deep, values}");
+    return false;
+  }
+  const auto typos = r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
+  const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
+  const json::JsonValue* f = v.find("filter");
+  const json::JsonValue* sig = v.find("signal");
+  const json::JsonValue* deep = v.find("deep");
+  const json::JsonValue* vals = v.find("values");
+  if ((f == nullptr) == (sig == nullptr)) {
+    if (f != nullptr || !(typo("filter") || typo("signal"))) {
+      r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
+    }
+    return false;
+  }
+  bool ok = true;
+  if (f != nullptr) ok = r.text(*f, p + "/filter", "\"filter\"", a.filter) && ok;
+  if (sig != nullptr) ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal) && ok;
+  if (deep != nullptr) {
+    if (!deep->is_bool()) {
+      r.error(deep->position, p + "/deep", "\"deep\" must be true or false");
+      ok = false;
+    } else {
+      a.deep = deep->boolean;
+    }
+  }
+  if (sig != nullptr && !a.deep) {
+    r.error(sig->position, p + "/signal", "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
+    ok = false;
+  }
+  if (vals == nullptr || !vals->is_array() || vals->array.empty()) {
+    if (vals != nullptr || !typo("values")) {
+      r.error(vals == nullptr ? v.position : vals->position, p + "/values",
+              "\"values\" must be a non-empty list of samples");
+    }
+    return false;
+  }
+  for (std::size_t i = 0; i < vals->array.size(); ++i) {
+    std::vector<double> sample;
+    ok = r.values(vals->array[i], p + "/values/" + std::to_string(i), sample) && ok;
+    a.values.push_back(std::move(sample));
+  }
+  return ok;
+}
+
+bool read_reset(Reader& r, const json::JsonValue& v, const std::string& p, StepAction& a) {
+  if (!v.is_object()) {
+    r.error(v.position, p, "\"reset\" must be an object {target, reason}");
+    return false;
+  }
+  const auto typos = r.unknown_keys(v, p, {"target", "reason"});
+  const json::JsonValue* t = v.find("target");
+  const json::JsonValue* why = v.find("reason");
+  if (t == nullptr) {
+    if (std::find(typos.begin(), typos.end(), "target") == typos.end())
+      r.error(v.position, p, "\"reset\" needs \"target\"");
+    return false;
+  }
+  bool ok = r.text(*t, p + "/target", "\"target\"", a.target);
+  a.reason = "scenario";
+  if (why != nullptr) ok = r.text(*why, p + "/reason", "\"reason\"", a.reason) && ok;
+  return ok;
+}
+
+/// "expect", "expect_outstanding" (`key`) or "expect_cause": an object of address: expected value.
+bool read_expectations(Reader& r, const json::JsonValue& v, const std::string& p, const std::string& key,
+                       ScenarioStep::Kind kind, StepAction& a) {
+  if (!v.is_object() || v.object.empty()) {
+    r.error(v.position, p, "\"" + key + "\" must be an object of address: expected value");
+    return false;
+  }
+  bool ok = true;
+  for (const json::JsonMember& em : v.object) {
+    std::string expected;
+    if (!r.text(em.value, p + "/" + escape_pointer(em.key), "an expectation", expected)) {
+      ok = false;
+      continue;
+    }
+    if (kind == ScenarioStep::Kind::Expect && !parse_state(expected)) {
+      r.error(em.value.position, p + "/" + escape_pointer(em.key),
+              "expected state must be Normal, Warning or Error, not \"" + expected + "\"");
+      ok = false;
+      continue;
+    }
+    if (kind == ScenarioStep::Kind::ExpectCause && expected.find(':') == std::string::npos) {
+      r.error(em.value.position, p + "/" + escape_pointer(em.key),
+              "a cause is written \"Component.s_X:EVENT\", not \"" + expected + "\"");
+      ok = false;
+      continue;
+    }
+    a.expectations.emplace_back(em.key, expected);
+  }
+  return ok;
+}
+
+constexpr std::string_view kActions[] = {"sample", "ramp",   "generate",           "inject",
+                                         "reset",  "expect", "expect_outstanding", "expect_cause"};
+
+/// The step's "at" (seconds, not negative) into `when`; false (reported) when it has none.
+bool read_at(Reader& r, const json::JsonValue& step, const std::string& base, double& when) {
   const json::JsonValue* at = step.find("at");
-  double when = 0.0;
   if (at == nullptr) {
     // A misspelled "at" is one error, the unknown key with its suggestion.
     for (const json::JsonMember& m : step.object) {
@@ -250,17 +406,28 @@ void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::d
       if (detail::nearest(m.key, {"at"})) {
         r.error(m.key_position, base + "/" + escape_pointer(m.key),
                 "unknown key \"" + m.key + "\"; did you mean 'at'?");
-        return;
+        return false;
       }
     }
     r.error(step.position, base, "step needs \"at\" (seconds)");
-    return;
+    return false;
   }
-  if (!r.number(*at, base + "/at", "\"at\"", when)) return;
+  if (!r.number(*at, base + "/at", "\"at\"", when)) return false;
   if (when < 0) {
     r.error(at->position, base + "/at", "\"at\" must not be negative");
+    return false;
+  }
+  return true;
+}
+
+void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::deque<ScenarioStep>& steps) {
+  const std::string base = "/steps/" + std::to_string(index);
+  if (!step.is_object()) {
+    r.error(step.position, base, "a step must be an object with \"at\" and one action");
     return;
   }
+  double when = 0.0;
+  if (!read_at(r, step, base, when)) return;
   int actions = 0;
   bool unknown_action = false;
   for (const json::JsonMember& m : step.object) {
@@ -289,169 +456,14 @@ void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::d
     StepAction a;
     bool ok = true;
     switch (s.kind) {
-      case ScenarioStep::Kind::Sample:
-        if (!v.is_object() || v.object.empty()) {
-          r.error(v.position, p, "\"sample\" must be an object of signal: value");
-          ok = false;
-          break;
-        }
-        {
-          std::vector<std::pair<std::string_view, std::vector<double>>> samples;
-          samples.reserve(v.object.size());
-          for (const json::JsonMember& sm : v.object) {
-            std::vector<double> vals;
-            ok = r.values(sm.value, p + "/" + escape_pointer(sm.key), vals) && ok;
-            samples.emplace_back(sm.key, std::move(vals));
-          }
-          if (ok) s.samples = SampleList(samples);
-        }
-        break;
-      case ScenarioStep::Kind::Ramp: {
-        if (!v.is_object()) {
-          r.error(v.position, p, "\"ramp\" must be an object {signal, from, to, until}");
-          ok = false;
-          break;
-        }
-        const auto typos = r.unknown_keys(v, p, {"signal", "from", "to", "until"});
-        const json::JsonValue* sig = v.find("signal");
-        const json::JsonValue* from = v.find("from");
-        const json::JsonValue* to = v.find("to");
-        const json::JsonValue* until = v.find("until");
-        if (sig == nullptr || from == nullptr || to == nullptr || until == nullptr) {
-          const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
-          const bool all_typos = (sig != nullptr || typo("signal")) && (from != nullptr || typo("from")) &&
-                                 (to != nullptr || typo("to")) && (until != nullptr || typo("until"));
-          if (!all_typos) r.error(v.position, p, "\"ramp\" needs signal, from, to and until");
-          ok = false;
-          break;
-        }
-        ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal) && ok;
-        ok = r.number(*from, p + "/from", "\"from\"", a.from) && ok;
-        ok = r.number(*to, p + "/to", "\"to\"", a.to) && ok;
-        ok = r.number(*until, p + "/until", "\"until\"", a.until) && ok;
-        if (ok && a.until < when) {
-          r.error(until->position, p + "/until", "\"until\" must not be before \"at\"");
-          ok = false;
-        }
-        break;
-      }
-      case ScenarioStep::Kind::Generate: {
-        if (!v.is_object()) {
-          r.error(v.position, p, "\"generate\" must be an object {event, target}");
-          ok = false;
-          break;
-        }
-        const auto typos = r.unknown_keys(v, p, {"event", "target"});
-        const json::JsonValue* e = v.find("event");
-        const json::JsonValue* t = v.find("target");
-        if (e == nullptr) {
-          if (std::find(typos.begin(), typos.end(), "event") == typos.end())
-            r.error(v.position, p, "\"generate\" needs \"event\"");
-          ok = false;
-          break;
-        }
-        ok = r.text(*e, p + "/event", "\"event\"", a.event) && ok;
-        if (t != nullptr) ok = r.text(*t, p + "/target", "\"target\"", a.target) && ok;
-        break;
-      }
-      case ScenarioStep::Kind::Inject: {
-        if (!v.is_object()) {
-          r.error(v.position, p, "\"inject\" must be an object {filter|signal, deep, values}");
-          ok = false;
-          break;
-        }
-        const auto typos = r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
-        const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
-        const json::JsonValue* f = v.find("filter");
-        const json::JsonValue* sig = v.find("signal");
-        const json::JsonValue* deep = v.find("deep");
-        const json::JsonValue* vals = v.find("values");
-        if ((f == nullptr) == (sig == nullptr)) {
-          if (f != nullptr || !(typo("filter") || typo("signal"))) {
-            r.error(v.position, p, "\"inject\" needs exactly one of \"filter\" or \"signal\"");
-          }
-          ok = false;
-          break;
-        }
-        if (f != nullptr) ok = r.text(*f, p + "/filter", "\"filter\"", a.filter) && ok;
-        if (sig != nullptr) ok = r.text(*sig, p + "/signal", "\"signal\"", a.signal) && ok;
-        if (deep != nullptr) {
-          if (!deep->is_bool()) {
-            r.error(deep->position, p + "/deep", "\"deep\" must be true or false");
-            ok = false;
-          } else {
-            a.deep = deep->boolean;
-          }
-        }
-        if (sig != nullptr && !a.deep) {
-          r.error(sig->position, p + "/signal",
-                  "a shallow injection goes into a filter: use \"filter\", or \"deep\": true");
-          ok = false;
-        }
-        if (vals == nullptr || !vals->is_array() || vals->array.empty()) {
-          if (vals != nullptr || !typo("values")) {
-            r.error(vals == nullptr ? v.position : vals->position, p + "/values",
-                    "\"values\" must be a non-empty list of samples");
-          }
-          ok = false;
-          break;
-        }
-        for (std::size_t i = 0; i < vals->array.size(); ++i) {
-          std::vector<double> sample;
-          ok = r.values(vals->array[i], p + "/values/" + std::to_string(i), sample) && ok;
-          a.values.push_back(std::move(sample));
-        }
-        break;
-      }
-      case ScenarioStep::Kind::Reset: {
-        if (!v.is_object()) {
-          r.error(v.position, p, "\"reset\" must be an object {target, reason}");
-          ok = false;
-          break;
-        }
-        const auto typos = r.unknown_keys(v, p, {"target", "reason"});
-        const json::JsonValue* t = v.find("target");
-        const json::JsonValue* why = v.find("reason");
-        if (t == nullptr) {
-          if (std::find(typos.begin(), typos.end(), "target") == typos.end())
-            r.error(v.position, p, "\"reset\" needs \"target\"");
-          ok = false;
-          break;
-        }
-        ok = r.text(*t, p + "/target", "\"target\"", a.target) && ok;
-        a.reason = "scenario";
-        if (why != nullptr) ok = r.text(*why, p + "/reason", "\"reason\"", a.reason) && ok;
-        break;
-      }
+      case ScenarioStep::Kind::Sample: ok = read_sample(r, v, p, s); break;
+      case ScenarioStep::Kind::Ramp: ok = read_ramp(r, v, p, when, a); break;
+      case ScenarioStep::Kind::Generate: ok = read_generate(r, v, p, a); break;
+      case ScenarioStep::Kind::Inject: ok = read_inject(r, v, p, a); break;
+      case ScenarioStep::Kind::Reset: ok = read_reset(r, v, p, a); break;
       case ScenarioStep::Kind::Expect:
       case ScenarioStep::Kind::ExpectOutstanding:
-      case ScenarioStep::Kind::ExpectCause:
-        if (!v.is_object() || v.object.empty()) {
-          r.error(v.position, p, "\"" + m.key + "\" must be an object of address: expected value");
-          ok = false;
-          break;
-        }
-        for (const json::JsonMember& em : v.object) {
-          std::string expected;
-          if (!r.text(em.value, p + "/" + escape_pointer(em.key), "an expectation", expected)) {
-            ok = false;
-            continue;
-          }
-          if (s.kind == ScenarioStep::Kind::Expect && !parse_state(expected)) {
-            r.error(em.value.position, p + "/" + escape_pointer(em.key),
-                    "expected state must be Normal, Warning or Error, not \"" + expected + "\"");
-            ok = false;
-            continue;
-          }
-          if (s.kind == ScenarioStep::Kind::ExpectCause && expected.find(':') == std::string::npos) {
-            r.error(em.value.position, p + "/" + escape_pointer(em.key),
-                    "a cause is written \"Component.s_X:EVENT\", not \"" + expected + "\"");
-            ok = false;
-            continue;
-          }
-          a.expectations.emplace_back(em.key, expected);
-        }
-        break;
+      case ScenarioStep::Kind::ExpectCause: ok = read_expectations(r, v, p, m.key, s.kind, a); break;
     }
     if (!ok) continue;
     if (s.kind != ScenarioStep::Kind::Sample) s.action = std::make_shared<const StepAction>(std::move(a));

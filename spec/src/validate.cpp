@@ -672,8 +672,44 @@ private:
     }
   }
 
+  /// What check_filter's steps share about one filter.
+  struct FilterCheck {
+    std::string ctx;  ///< "filter 'NAME' (Type)", the prefix of every message
+    const FilterRegistry::Entry* entry = nullptr;
+    const ComponentItem* target = nullptr;                       ///< null when the target component does not exist
+    std::string coordinator;                                     ///< of the target component
+    Params given;                                                ///< the parameters that convert and check one by one
+    std::map<std::string, const ParamItem*, std::less<>> items;  ///< where each given one is written
+    bool params_ok = true;
+    Params checked;  ///< all parameters checked together (with defaults), when params_ok
+  };
+
   void check_filter(FilterItem& f, bool skip_duplicate_name) {
-    std::string ctx = "filter " + quote_name(f.config.name);
+    FilterCheck c;
+    c.ctx = "filter " + quote_name(f.config.name);
+    check_filter_name(f, skip_duplicate_name);
+    if (!f.has_class) return;  // reported as a missing key
+    c.entry = filter_class(f, c.ctx);
+    if (c.entry == nullptr) return;
+    const FilterManifest& manifest = c.entry->manifest;
+    f.config.type = manifest.type;
+    c.ctx += " (" + manifest.type + ")";
+    normalize_filter_params(f, c.ctx, manifest);
+    c.target = check_filter_target(f, c.ctx);
+    c.coordinator = coordinator_of(f.config.target.component);
+    check_filter_params(f, manifest, c);
+    f.config.params = c.given;
+
+    // Events first: whatever else is wrong, the events a filter names count as generated, so
+    // that one mistake is not reported twice.
+    check_filter_events(f, c.ctx, manifest, c.given, c.items);
+    if (c.target == nullptr) return;  // signals are resolved against the target component
+    const std::optional<std::vector<std::size_t>> sizes = check_filter_inputs(f, c);
+    check_filter_outputs(f, c, sizes);
+  }
+
+  /// A filter's name: a token, and unique (unless its pipeline's name was reported duplicate).
+  void check_filter_name(const FilterItem& f, bool skip_duplicate_name) {
     if (f.named && !token_name(f.config.name)) {
       sink_.error(f.name_site, "filter name " + quote_name(f.config.name) + " must be non-empty, without spaces");
     } else if (!skip_duplicate_name) {
@@ -683,23 +719,28 @@ private:
                     "duplicate filter " + quote_name(f.config.name) + " (first at " + sink_.at(it->second) + ")");
       }
     }
-    if (!f.has_class) return;  // reported as a missing key
+  }
+
+  /// The registry's entry of the filter's class, or null (reported, with the nearest known name;
+  /// the events the filter names still count as generated).
+  const FilterRegistry::Entry* filter_class(const FilterItem& f, const std::string& ctx) {
     const FilterRegistry::Entry* entry = registry_.find(f.config.type);
-    if (entry == nullptr) {
-      std::vector<std::string> known;
-      for (const FilterManifest* m : registry_.manifests()) known.push_back(m->type);
-      std::string suggestion = did_you_mean(f.config.type, known);
-      if (suggestion.empty() && f.config.type.rfind("Filter", 0) == 0) {
-        suggestion = did_you_mean(f.config.type.substr(6), known);
-      }
-      if (suggestion.empty()) suggestion = " (known: " + join_list(known) + ")";
-      sink_.error(f.class_site, ctx + ": unknown filter class " + quote_name(f.config.type) + suggestion);
-      mark_named_events(f);
-      return;
+    if (entry != nullptr) return entry;
+    std::vector<std::string> known;
+    for (const FilterManifest* m : registry_.manifests()) known.push_back(m->type);
+    std::string suggestion = did_you_mean(f.config.type, known);
+    if (suggestion.empty() && f.config.type.rfind("Filter", 0) == 0) {
+      suggestion = did_you_mean(f.config.type.substr(6), known);
     }
-    const FilterManifest& manifest = entry->manifest;
-    f.config.type = manifest.type;
-    ctx += " (" + manifest.type + ")";
+    if (suggestion.empty()) suggestion = " (known: " + join_list(known) + ")";
+    sink_.error(f.class_site, ctx + ": unknown filter class " + quote_name(f.config.type) + suggestion);
+    mark_named_events(f);
+    return nullptr;
+  }
+
+  /// Events named under a misspelled parameters key count as generated; aliases become their
+  /// parameter; a type that names its own output gets the default output parameter.
+  void normalize_filter_params(FilterItem& f, const std::string& ctx, const FilterManifest& manifest) {
     if (f.misspelled_argument != nullptr && f.misspelled_argument->is_object()) {
       // The parameters are under a misspelled key (reported): the events they name still count
       // as generated, so that the one mistake is not reported again as "not generated".
@@ -733,8 +774,11 @@ private:
       f.params.push_back(ParamItem{manifest.outputs.front(), f.argument_site, f.argument_site, nullptr,
                                    default_output_name(f.config.name, f.config.target.component)});
     }
+  }
 
-    // Target.
+  /// The target: its component exists, and so does the interface it names. Returns the target
+  /// component, or null.
+  const ComponentItem* check_filter_target(const FilterItem& f, const std::string& ctx) {
     const std::string& tc = f.config.target.component;
     const ComponentItem* target = component(tc);
     if (target == nullptr && invalid_components_.count(tc) > 0) {
@@ -757,12 +801,15 @@ private:
       sink_.warning(f.target_interface_site, ctx + ": 'interface' is ignored for target type " +
                                                  (f.config.target.kind == MachineKind::Framework ? "s_F" : "s_A"));
     }
-    const std::string coordinator = coordinator_of(tc);
+    return target;
+  }
 
-    // Parameters, one by one so that every problem is reported.
-    Params given;
-    std::map<std::string, const ParamItem*, std::less<>> items;
-    bool params_ok = true;
+  /// The parameters, one by one so that every problem is reported, then all together.
+  void check_filter_params(const FilterItem& f, const FilterManifest& manifest, FilterCheck& c) {
+    const std::string& ctx = c.ctx;
+    Params& given = c.given;
+    std::map<std::string, const ParamItem*, std::less<>>& items = c.items;
+    bool& params_ok = c.params_ok;
     std::vector<std::string> param_names;
     for (const ParamSpec& p : manifest.params) param_names.push_back(p.name);
     std::set<std::string, std::less<>> misspelled;  // known names that an unknown parameter is a typo of
@@ -847,21 +894,23 @@ private:
         params_ok = false;
       }
     }
-    f.config.params = given;
+    c.checked = std::move(checked);
+  }
 
-    // Events first: whatever else is wrong, the events a filter names count as generated, so
-    // that one mistake is not reported twice.
-    check_filter_events(f, ctx, manifest, given, items);
-    if (target == nullptr) return;  // signals are resolved against the target component
-
-    // Input signals, in manifest order (lists expanded), as the monitor resolves them.
+  /// Input signals, in manifest order (lists expanded), as the monitor resolves them; then the
+  /// filter type's own size check on stand-in signals of the declared sizes. Returns the sizes
+  /// of its outputs, when known.
+  std::optional<std::vector<std::size_t>> check_filter_inputs(const FilterItem& f, const FilterCheck& c) {
+    const std::string& ctx = c.ctx;
+    const std::string& tc = f.config.target.component;
+    const FilterManifest& manifest = c.entry->manifest;
     std::vector<std::unique_ptr<Signal>> scratch;
     std::vector<std::pair<std::string, Site>> input_sites;
-    bool sizes_known = params_ok;
+    bool sizes_known = c.params_ok;
     for (const std::string& input : manifest.inputs) {
-      const auto it = given.find(input);
-      if (it == given.end()) continue;
-      const ParamItem* item = items.at(input);
+      const auto it = c.given.find(input);
+      if (it == c.given.end()) continue;
+      const ParamItem* item = c.items.at(input);
       std::vector<std::pair<std::string, Site>> names;
       if (const auto* one = std::get_if<std::string>(&it->second)) names.emplace_back(*one, item->value_site);
       if (const auto* many = std::get_if<std::vector<std::string>>(&it->second)) {
@@ -875,7 +924,7 @@ private:
         }
       }
       for (const auto& [name, site] : names) {
-        const std::size_t size = resolve_input(ctx, input, name, site, tc, coordinator, f.from_template);
+        const std::size_t size = resolve_input(ctx, input, name, site, tc, c.coordinator, f.from_template);
         if (size == 0) {
           sizes_known = false;
           continue;
@@ -885,37 +934,43 @@ private:
       }
     }
 
-    // Sizes: the filter type's own check, on stand-in signals of the declared sizes.
     std::optional<std::vector<std::size_t>> sizes;
-    if (sizes_known) {
-      std::vector<Signal*> inputs;
-      for (const auto& sig : scratch) inputs.push_back(sig.get());
-      try {
-        auto r = entry->shape(FilterShape{f.config.name, checked, inputs});
-        if (r) {
-          sizes = std::move(*r);
-        } else {
-          // Point at the input the message names, if it names one.
-          Site site = f.argument_site;
-          for (const auto& [name, input_site] : input_sites) {
-            if (r.error().message.find("'" + name + "'") != std::string::npos) {
-              site = input_site;
-              break;
-            }
+    if (!sizes_known) return sizes;
+    std::vector<Signal*> inputs;
+    for (const auto& sig : scratch) inputs.push_back(sig.get());
+    try {
+      auto r = c.entry->shape(FilterShape{f.config.name, c.checked, inputs});
+      if (r) {
+        sizes = std::move(*r);
+      } else {
+        // Point at the input the message names, if it names one.
+        Site site = f.argument_site;
+        for (const auto& [name, input_site] : input_sites) {
+          if (r.error().message.find("'" + name + "'") != std::string::npos) {
+            site = input_site;
+            break;
           }
-          sink_.error(site, r.error().message);
         }
-      } catch (const std::exception& e) {
-        sink_.error(f.argument_site, ctx + ": the size check failed: " + e.what());
+        sink_.error(site, r.error().message);
       }
+    } catch (const std::exception& e) {
+      sink_.error(f.argument_site, ctx + ": the size check failed: " + e.what());
     }
+    return sizes;
+  }
 
-    // Output signals: created by the filter unless they exist; an existing one must have the size written.
+  /// Output signals: created by the filter unless they exist; an existing one must have the size
+  /// written, and a second writer is warned of.
+  void check_filter_outputs(const FilterItem& f, const FilterCheck& c,
+                            const std::optional<std::vector<std::size_t>>& sizes) {
+    const std::string& ctx = c.ctx;
+    const std::string& tc = f.config.target.component;
+    const FilterManifest& manifest = c.entry->manifest;
     for (std::size_t k = 0; k < manifest.outputs.size(); ++k) {
       const std::string& output = manifest.outputs[k];
-      const auto it = given.find(output);
-      if (it == given.end() || !std::holds_alternative<std::string>(it->second)) continue;
-      const Site& site = items.at(output)->value_site;
+      const auto it = c.given.find(output);
+      if (it == c.given.end() || !std::holds_alternative<std::string>(it->second)) continue;
+      const Site& site = c.items.at(output)->value_site;
       const std::string full = qualify(std::get<std::string>(it->second), tc);
       const auto dot = full.find('.');
       if (dot == 0 || dot + 1 == full.size()) {
@@ -929,7 +984,7 @@ private:
                               " for signal " + quote_name(full) + did_you_mean(comp, component_names()));
         continue;
       }
-      check_same_coordinator(ctx, output, full, comp, coordinator, site);
+      check_same_coordinator(ctx, output, full, comp, c.coordinator, site);
       const std::size_t size = sizes && k < sizes->size() ? (*sizes)[k] : 0;
       const auto existing = signals_.find(full);
       if (existing == signals_.end()) {

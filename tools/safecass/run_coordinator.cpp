@@ -203,21 +203,23 @@ void add_middleware_options(CLI::App& run, RunArgs& args) {
                  "with --ice: reads (state, history, explain...) need the credential this file will hold (mode 0600)");
 }
 
-int run_coordinator(const RunArgs& args) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
-  std::optional<spec::Scenario> scenario;
+namespace {
+
+/// The scenario of `--scenario` (checked against the whole system before anything runs) and the
+/// system file to open (SYSTEM, or the scenario's). False (said) on an error.
+bool load_run_scenario(const RunArgs& args, const FilterRegistry& registry, std::optional<spec::Scenario>& scenario,
+                       std::string& system_path) {
   if (!args.scenario.empty()) {
     spec::ScenarioLoad loaded = spec::load_scenario(args.scenario);
     for (const auto& d : loaded.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-    if (!loaded.scenario) return 2;
+    if (!loaded.scenario) return false;
     scenario = std::move(loaded.scenario);
   }
-  std::string system_path = args.system;
+  system_path = args.system;
   if (system_path.empty() && scenario) system_path = scenario->system;
   if (system_path.empty()) {
     std::fprintf(stderr, "safecass run: --coordinator needs a SYSTEM file (or a scenario that names one)\n");
-    return 2;
+    return false;
   }
   if (scenario) {
     // Every name the scenario uses is checked against the whole system before anything runs, as
@@ -225,9 +227,152 @@ int run_coordinator(const RunArgs& args) {
     auto checked = runner::ScenarioRunner::open(runner::ScenarioSource{args.scenario, system_path}, registry);
     if (!checked) {
       runner::print(checked.error(), stderr);
-      return 2;
+      return false;
     }
   }
+  return true;
+}
+
+/// The durable history (--record), opened before anything runs so that it holds every record of
+/// the process, and the inputs next to it (samples of the local input signals and the scenario's
+/// actions, read from the signals' buffers every 10 ms by the recorder's own thread). False (said)
+/// on an error.
+bool open_histories(const RunArgs& args, Coordinator& co, Monitor& monitor, Time period,
+                    std::unique_ptr<Recorder>& recorder, std::unique_ptr<InputRecorder>& inputs) {
+  if (!args.record.empty()) {
+    auto history_file = Recorder::open(co, args.record, 65536, FileLimits{args.max_bytes});
+    if (!history_file) {
+      std::fprintf(stderr, "safecass run: %s\n", history_file.error().message.c_str());
+      return false;
+    }
+    recorder = std::move(*history_file);
+  }
+  const std::string inputs_path = !args.record_inputs.empty() ? args.record_inputs
+                                  : args.record.empty()       ? std::string()
+                                                              : InputRecorder::path_for_history(args.record);
+  if (inputs_path.empty() || inputs_path == "-") return true;
+  InputRecorderOptions o;
+  o.limits.max_bytes = args.max_bytes;
+  o.period = period;
+  o.clock = "steady";
+  auto input_recorder = InputRecorder::open(monitor, inputs_path, o);
+  if (!input_recorder) {
+    std::fprintf(stderr, "safecass run: %s\n", input_recorder.error().message.c_str());
+    return false;
+  }
+  inputs = std::move(*input_recorder);
+  inputs->start_polling();
+  return true;
+}
+
+/// A coordinator process on the bus (--ice): its token files and its node. Members are destroyed
+/// in reverse order: the node before the recorded writes it calls.
+struct BusPart {
+  std::string token_path;
+  std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
+  std::unique_ptr<middleware::TokenFile> read_token_file;
+  std::unique_ptr<RecordedActions> recorded_writes;  ///< the console's and viewer's writes, recorded
+  std::unique_ptr<middleware::CoordinatorNode> node;
+};
+
+/// Joins the bus when --ice is given: makes the token files, then creates and starts the node.
+/// False (said) on an error, or on --allow-write without --ice.
+bool join_bus(const RunArgs& args, runner::System& built, const FilterRegistry& registry, InputRecorder* inputs,
+              BusPart& bus) {
+  if (args.ice.empty()) {
+    if (!args.allow_write) return true;
+    std::fprintf(stderr, "safecass run: --allow-write needs --ice (write operations come through the middleware)\n");
+    return false;
+  }
+  auto endpoint = middleware::parse_ice_endpoint(args.ice);
+  if (!endpoint) {
+    std::fprintf(stderr, "safecass run: %s\n", endpoint.error().message.c_str());
+    return false;
+  }
+  std::string token;
+  if (args.allow_write) {
+    // Never over a file that is not ours, never shared with a running process (token.hpp).
+    auto t = args.token_file.empty() ? middleware::TokenFile::create_default(args.coordinator)
+                                     : middleware::TokenFile::create(args.token_file);
+    if (!t) {
+      std::fprintf(stderr, "safecass run: %s\n", t.error().message.c_str());
+      return false;
+    }
+    bus.token_file = std::move(*t);
+    token = bus.token_file->secret();
+    bus.token_path = bus.token_file->path();
+  }
+  if (!args.read_token_file.empty()) {
+    auto t = middleware::TokenFile::create(args.read_token_file);
+    if (!t) {
+      std::fprintf(stderr, "safecass run: --read-token-file: %s\n", t.error().message.c_str());
+      return false;
+    }
+    bus.read_token_file = std::move(*t);
+  }
+  middleware::NodeOptions options;
+  options.ice = *endpoint;
+  options.allow_write = args.allow_write;
+  options.token = token;
+  if (bus.read_token_file) options.read_token = bus.read_token_file->secret();
+  options.keys_dir = args.keys;
+  options.insecure = args.insecure;
+  options.tls.dir = args.tls;
+  if (!args.listen.empty()) options.listen_host = args.listen;
+  options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
+  options.log = [](const std::string& line) { say(line); };
+  if (inputs != nullptr) {
+    bus.recorded_writes = std::make_unique<RecordedActions>(*inputs);
+    options.clock.actions = bus.recorded_writes.get();
+  }
+  auto created = middleware::CoordinatorNode::create(built.coordinator(), built.monitor(), registry, built.spec(),
+                                                     args.coordinator, options);
+  if (!created) {
+    std::fprintf(stderr, "safecass run: %s\n", created.error().message.c_str());
+    return false;
+  }
+  bus.node = std::move(*created);
+  if (auto r = bus.node->start(); !r) {
+    std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
+    return false;
+  }
+  return true;
+}
+
+/// Closes the histories once every thread that makes records has stopped, and says every loss:
+/// nothing is lost silently, and a history that misses records fails the command (`code` 2).
+/// Returns whether both are complete; with --json, their status lines go to `status_json`.
+bool close_histories(const RunArgs& args, InputRecorder* inputs, Recorder* recorder, int& code,
+                     std::string& status_json) {
+  bool complete = true;
+  if (inputs != nullptr) {
+    inputs->close();
+    const InputRecordStatus status = inputs->status();
+    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
+    std::fflush(stderr);
+    complete = status.complete();
+    if (args.json) status_json = record_status_json(status);
+  }
+  if (recorder != nullptr) {
+    recorder->close();  // what is queued is the end of the history
+    const RecordStatus status = recorder->status();
+    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
+    std::fflush(stderr);
+    complete = complete && status.complete();
+    if (args.json) status_json += (status_json.empty() ? "" : "\n") + record_status_json(status);
+  }
+  if (!complete) code = 2;
+  return complete;
+}
+
+}  // namespace
+
+int run_coordinator(const RunArgs& args) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  std::optional<spec::Scenario> scenario;
+  std::string system_path;
+  if (!load_run_scenario(args, registry, scenario, system_path)) return 2;
   middleware::HostClock clock;
   runner::SystemOptions system_options;
   system_options.coordinator = args.coordinator;
@@ -255,99 +400,11 @@ int run_coordinator(const RunArgs& args) {
     // thread holds (it is recursive).
     say("[" + std::string(co.name()) + "] " + introspect::live_line(introspect::history_entry(r, co)));
   });
-
-  // The durable history: opened before anything runs, so it holds every record of the process.
   std::unique_ptr<Recorder> recorder;
-  if (!args.record.empty()) {
-    auto history_file = Recorder::open(co, args.record, 65536, FileLimits{args.max_bytes});
-    if (!history_file) {
-      std::fprintf(stderr, "safecass run: %s\n", history_file.error().message.c_str());
-      return 2;
-    }
-    recorder = std::move(*history_file);
-  }
-
-  // The inputs (samples of the local input signals, and the scenario's actions) next to the
-  // history: read from the signals' buffers every 10 ms by the recorder's own thread.
   std::unique_ptr<InputRecorder> inputs;
-  const std::string inputs_path = !args.record_inputs.empty() ? args.record_inputs
-                                  : args.record.empty()       ? std::string()
-                                                              : InputRecorder::path_for_history(args.record);
-  if (!inputs_path.empty() && inputs_path != "-") {
-    InputRecorderOptions o;
-    o.limits.max_bytes = args.max_bytes;
-    o.period = system_options.component_period;
-    o.clock = "steady";
-    auto input_recorder = InputRecorder::open(monitor, inputs_path, o);
-    if (!input_recorder) {
-      std::fprintf(stderr, "safecass run: %s\n", input_recorder.error().message.c_str());
-      return 2;
-    }
-    inputs = std::move(*input_recorder);
-    inputs->start_polling();
-  }
-
-  std::string token;
-  std::string token_path;
-  std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
-  std::unique_ptr<middleware::TokenFile> read_token_file;
-  std::unique_ptr<RecordedActions> recorded_writes;  // outlives the node that calls it
-  std::unique_ptr<middleware::CoordinatorNode> node;
-  if (!args.ice.empty()) {
-    auto endpoint = middleware::parse_ice_endpoint(args.ice);
-    if (!endpoint) {
-      std::fprintf(stderr, "safecass run: %s\n", endpoint.error().message.c_str());
-      return 2;
-    }
-    if (args.allow_write) {
-      // Never over a file that is not ours, never shared with a running process (token.hpp).
-      auto t = args.token_file.empty() ? middleware::TokenFile::create_default(args.coordinator)
-                                       : middleware::TokenFile::create(args.token_file);
-      if (!t) {
-        std::fprintf(stderr, "safecass run: %s\n", t.error().message.c_str());
-        return 2;
-      }
-      token_file = std::move(*t);
-      token = token_file->secret();
-      token_path = token_file->path();
-    }
-    if (!args.read_token_file.empty()) {
-      auto t = middleware::TokenFile::create(args.read_token_file);
-      if (!t) {
-        std::fprintf(stderr, "safecass run: --read-token-file: %s\n", t.error().message.c_str());
-        return 2;
-      }
-      read_token_file = std::move(*t);
-    }
-    middleware::NodeOptions options;
-    options.ice = *endpoint;
-    options.allow_write = args.allow_write;
-    options.token = token;
-    if (read_token_file) options.read_token = read_token_file->secret();
-    options.keys_dir = args.keys;
-    options.insecure = args.insecure;
-    options.tls.dir = args.tls;
-    if (!args.listen.empty()) options.listen_host = args.listen;
-    options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
-    options.log = [](const std::string& line) { say(line); };
-    if (inputs) {
-      recorded_writes = std::make_unique<RecordedActions>(*inputs);  // console/viewer writes
-      options.clock.actions = recorded_writes.get();
-    }
-    auto created = middleware::CoordinatorNode::create(co, monitor, registry, system, args.coordinator, options);
-    if (!created) {
-      std::fprintf(stderr, "safecass run: %s\n", created.error().message.c_str());
-      return 2;
-    }
-    node = std::move(*created);
-    if (auto r = node->start(); !r) {
-      std::fprintf(stderr, "safecass run: %s\n", r.error().message.c_str());
-      return 2;
-    }
-  } else if (args.allow_write) {
-    std::fprintf(stderr, "safecass run: --allow-write needs --ice (write operations come through the middleware)\n");
-    return 2;
-  }
+  if (!open_histories(args, co, monitor, system_options.component_period, recorder, inputs)) return 2;
+  BusPart bus;
+  if (!join_bus(args, built, registry, inputs.get(), bus)) return 2;
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
@@ -356,8 +413,8 @@ int run_coordinator(const RunArgs& args) {
   say("safecass run: coordinator '" + args.coordinator + "' of system '" + system.name + "', " + std::to_string(local) +
       " components, pid " + std::to_string(::getpid()) +
       (args.ice.empty() ? std::string(", no middleware") : ", IceStorm " + args.ice) +
-      (args.allow_write ? ", write access (token file " + token_path + ")" : ", read-only"));
-  if (node) say("safecass run: control " + node->control_proxy());
+      (args.allow_write ? ", write access (token file " + bus.token_path + ")" : ", read-only"));
+  if (bus.node) say("safecass run: control " + bus.node->control_proxy());
 
   runtime.start();
   const double duration = args.duration > 0 ? args.duration : (scenario ? scenario->duration : 0.0);
@@ -381,40 +438,18 @@ int run_coordinator(const RunArgs& args) {
     checks = d->checks;
   }
   runtime.stop();
-  if (node) {
-    const middleware::NodeStats s = node->stats();
-    node->stop();
+  if (bus.node) {
+    const middleware::NodeStats s = bus.node->stats();
+    bus.node->stop();
     say("safecass run: middleware: " + std::to_string(s.updates_published) + " updates published, " +
         std::to_string(s.updates_applied) + " applied, " + std::to_string(s.updates_rejected) + " rejected, " +
         std::to_string(s.updates_missed) + " missed, " + std::to_string(s.resyncs_requested) + " resyncs, " +
         std::to_string(s.connects) + " connections, " + std::to_string(s.events_dropped) + " event records dropped");
   }
-  if (token_file) token_file->remove();
+  if (bus.token_file) bus.token_file->remove();
   int code = failures == 0 ? 0 : 1;
-  bool history_complete = true;
   std::string recorder_status;
-  if (inputs) {
-    inputs->close();
-    const InputRecordStatus status = inputs->status();
-    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
-    std::fflush(stderr);
-    if (!status.complete()) {
-      history_complete = false;
-      code = 2;
-    }
-    if (args.json) recorder_status = record_status_json(status);
-  }
-  if (recorder) {
-    // Every thread that makes records has stopped: what is queued is the end of the history.
-    recorder->close();
-    const RecordStatus status = recorder->status();
-    // Nothing lost silently: a history that misses records is said, and fails the command.
-    for (const std::string& loss : describe_losses(status)) std::fprintf(stderr, "%s\n", loss.c_str());
-    std::fflush(stderr);
-    history_complete = history_complete && status.complete();
-    if (!history_complete) code = 2;
-    if (args.json) recorder_status += (recorder_status.empty() ? "" : "\n") + record_status_json(status);
-  }
+  const bool history_complete = close_histories(args, inputs.get(), recorder.get(), code, recorder_status);
   say("safecass run: coordinator '" + args.coordinator + "' stopped; system state " +
       std::string(to_string(co.coordinator_state())) +
       (scenario ? ", " + std::to_string(checks) + " expectations checked, " + std::to_string(failures) + " failed"

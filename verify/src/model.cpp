@@ -53,10 +53,17 @@ Expected<std::unique_ptr<Model>> Model::build(const spec::SystemSpec& system, co
 }
 
 Expected<void> Model::derive(const FilterRegistry& registry) {
-  Coordinator& co = *coordinator_;
-  const std::size_t machines = co.machine_count();
-  at_machine_.assign(machines, {});
+  at_machine_.assign(coordinator_->machine_count(), {});
+  derive_roots(registry);
+  derive_reach();
+  const RootsAt at = roots_at();
+  derive_addresses(at);
+  derive_levels(at);
+  return {};
+}
 
+void Model::derive_roots(const FilterRegistry& registry) {
+  Coordinator& co = *coordinator_;
   std::map<std::string, spec::Position, std::less<>> event_where;
   std::map<std::string, std::string, std::less<>> declared_by;
   for (const spec::ComponentSpec& c : system_->components) {
@@ -146,9 +153,13 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       r.level[static_cast<std::size_t>(s)] = onset_level(r.transitions, s);
     at_machine_[r.machine].push_back(i);
   }
+}
 
-  // Reachability, from the coordinator itself: a root of each level at each machine that holds
-  // roots, and where its mirrors land.
+void Model::derive_reach() {
+  // From the coordinator itself: a root of each level at each machine that holds roots, and
+  // where its mirrors land.
+  Coordinator& co = *coordinator_;
+  const std::size_t machines = co.machine_count();
   reach_error_.assign(machines, IdVector<bool, MachineId>(machines, false));
   reach_warning_.assign(machines, IdVector<bool, MachineId>(machines, false));
   for (MachineId origin : id_range<MachineId>(machines)) {
@@ -166,8 +177,10 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       (void)co.reset(std::string_view("SYSTEM"), "verify", "probe");
     }
   }
+}
 
-  // Addresses: SYSTEM, each component, its machines and services, with their root sets.
+Model::RootsAt Model::roots_at() const {
+  const std::size_t machines = coordinator_->machine_count();
   const auto machine_roots = [&](MachineId m, bool error) {
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < roots_.size(); ++i) {
@@ -176,19 +189,25 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
     }
     return out;
   };
-  IdVector<std::vector<std::size_t>, MachineId> machine_error(machines), machine_warning(machines);
+  RootsAt at{IdVector<std::vector<std::size_t>, MachineId>(machines),
+             IdVector<std::vector<std::size_t>, MachineId>(machines)};
   for (MachineId m : id_range<MachineId>(machines)) {
-    machine_error[m] = machine_roots(m, true);
-    machine_warning[m] = machine_roots(m, false);
+    at.error[m] = machine_roots(m, true);
+    at.warning[m] = machine_roots(m, false);
   }
+  return at;
+}
+
+void Model::derive_addresses(const RootsAt& at) {
+  const Coordinator& co = *coordinator_;
   const auto make = [&](std::string address, std::vector<MachineId> ms, spec::Position where) {
     AddressInfo a;
     a.address = std::move(address);
     a.where = std::move(where);
     std::set<std::size_t> e, w;
     for (MachineId m : ms) {
-      e.insert(machine_error[m].begin(), machine_error[m].end());
-      w.insert(machine_warning[m].begin(), machine_warning[m].end());
+      e.insert(at.error[m].begin(), at.error[m].end());
+      w.insert(at.warning[m].begin(), at.warning[m].end());
     }
     a.error_roots.assign(e.begin(), e.end());
     a.warning_roots.assign(w.begin(), w.end());
@@ -228,8 +247,10 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       make(name + ".s_S." + std::string(co.interface_name(co.provided_machines(c)[p])), deps, where);
     }
   }
+}
 
-  // Which levels each root can take: a fixpoint over the machines' possible states.
+void Model::derive_levels(const RootsAt& at) {
+  const std::size_t machines = coordinator_->machine_count();
   can_.assign(roots_.size(), {false, false, false});
   IdVector<std::array<bool, 3>, MachineId> possible(machines, {true, false, false});
   for (bool changed = true; changed;) {
@@ -246,15 +267,14 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
       }
     }
     for (MachineId m : id_range<MachineId>(machines)) {
-      for (std::size_t i : machine_error[m]) {
+      for (std::size_t i : at.error[m]) {
         if (can_[i][2] && !possible[m][2]) possible[m][2] = changed = true;
       }
-      for (std::size_t i : machine_warning[m]) {
+      for (std::size_t i : at.warning[m]) {
         if (can_[i][1] && !possible[m][1]) possible[m][1] = changed = true;
       }
     }
   }
-  return {};
 }
 
 int Model::address_index(std::string_view address) const {

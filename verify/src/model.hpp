@@ -104,6 +104,21 @@ public:
 private:
   Model() = default;
   [[nodiscard]] Expected<void> derive(const FilterRegistry& registry);
+  // derive()'s steps, in order.
+  /// The roots: onsets filters generate on their targets, onsets components raise on their s_A,
+  /// broadcasts on every s_A.
+  void derive_roots(const FilterRegistry& registry);
+  /// Where a root of each level at each machine that holds roots makes mirrors land.
+  void derive_reach();
+  /// The roots that can set each machine (its own and those that reach it), per level.
+  struct RootsAt {
+    IdVector<std::vector<std::size_t>, MachineId> error, warning;
+  };
+  RootsAt roots_at() const;
+  /// SYSTEM, each component, its machines and services, with their root sets.
+  void derive_addresses(const RootsAt& at);
+  /// Which levels each root can take: a fixpoint over the machines' possible states.
+  void derive_levels(const RootsAt& at);
 
   const spec::SystemSpec* system_ = nullptr;
   std::unique_ptr<Coordinator> coordinator_;

@@ -178,101 +178,130 @@ bool Trace::has_error_gap() const noexcept {
   return std::any_of(gaps.begin(), gaps.end(), [](const Gap& g) { return g.severity == Severity::Error; });
 }
 
-[[nodiscard]] tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
-                                                                             const FilterRegistry& registry) {
-  Trace trace;
-  trace.system_path = options.system;
+namespace {
 
-  // ---- the specification ----------------------------------------------------------------------
-  spec::LoadResult loaded = spec::load_system(options.system, registry);
-  Diagnostics errors;
-  for (spec::Diagnostic& d : loaded.diagnostics) {
-    (d.severity == spec::Diagnostic::Severity::Error ? errors : trace.notes).push_back(std::move(d));
-  }
-  if (!errors.empty() || !loaded.system) {
-    if (errors.empty()) errors.push_back(error_at(spec::Position{options.system, 0, 0}, "cannot load the system"));
-    return tl::unexpected(std::move(errors));
-  }
-  const spec::SystemSpec& sys = *loaded.system;
-  trace.system = sys.name;
+/// Builds one trace, step by step (build_trace below): the specification and its files, the
+/// built system's filters and events, the scenario runs, each hazard with its gaps, the gaps of
+/// what no hazard claims, the coverage summary.
+class Builder {
+public:
+  Builder(const TraceOptions& options, const FilterRegistry& registry) : options_(options), registry_(registry) {}
 
-  std::map<std::string, Verdict> verdicts;
-  if (!options.verify_json.empty()) {
-    auto v = read_verify(options.verify_json);
-    if (!v) return tl::unexpected(std::move(v.error()));
-    verdicts = std::move(*v);
-    trace.verify_source = options.verify_json;
+  [[nodiscard]] tl::expected<Trace, Diagnostics> build() {
+    if (Diagnostics errors = load(); !errors.empty()) return tl::unexpected(std::move(errors));
+    collect_sources();
+    collect_filters();
+    if (Diagnostics errors = run_scenarios(); !errors.empty()) return tl::unexpected(std::move(errors));
+    for (const spec::HazardSpec& h : sys().hazards) trace_.hazards.push_back(trace_hazard(h));
+    unclaimed_filters_and_failed_scenarios();
+    std::stable_sort(gaps_.begin(), gaps_.end(), [](const Gap& a, const Gap& b) { return a.severity < b.severity; });
+    trace_.gaps = std::move(gaps_);
+    summarize_coverage();
+    return std::move(trace_);
   }
 
-  // Every spec file with its SHA-256: the evidence names exactly what it was built from.
-  std::vector<std::string> paths{sys.path.empty() ? options.system : sys.path};
-  for (const spec::ComponentSpec& c : sys.components) {
-    if (!c.file.empty() && std::find(paths.begin(), paths.end(), c.file) == paths.end()) paths.push_back(c.file);
-  }
-  for (const std::string& p : paths) {
-    auto bytes = spec::read_regular_file(p, std::size_t{16} << 20);
-    if (!bytes) return tl::unexpected(Diagnostics{error_at(spec::Position{p, 0, 0}, bytes.error().message)});
-    trace.files.push_back(SpecFile{p, sha256_hex(*bytes)});
-  }
-
-  // The built system: events as the coordinator checked them, filters with their defaults.
-  auto built = runner::build_system(sys, registry);
-  if (!built) return tl::unexpected(std::move(built.error()));
-  const Coordinator& co = (*built)->coordinator();
-  const Monitor& monitor = (*built)->monitor();
-
+private:
   struct StageSource {
     std::string pipeline;
     std::vector<std::string> chain;
     spec::Position where;
     std::optional<double> period;
   };
-  std::map<std::string, StageSource, std::less<>> stage_source;
-  std::map<std::string, std::pair<std::string, spec::Position>, std::less<>> event_source;  // name → component, where
-  std::vector<std::string> event_order;
-  for (const spec::ComponentSpec& c : sys.components) {
-    for (const spec::FilterSpec& fs : c.filters) {
-      std::vector<std::string> chain;
-      if (!fs.pipeline.empty()) {
-        for (const FilterConfig& st : fs.stages) chain.push_back(st.name);
-      }
-      for (const FilterConfig& st : fs.stages)
-        stage_source[st.name] = StageSource{fs.pipeline, chain, fs.where, c.period};
+
+  const spec::SystemSpec& sys() const { return *loaded_.system; }
+  const Coordinator& co() const { return system_->coordinator(); }
+
+  // ---- the specification ----------------------------------------------------------------------
+  /// Loads the system, the verify verdicts and every spec file's hash, and builds the system.
+  [[nodiscard]] Diagnostics load() {
+    trace_.system_path = options_.system;
+    loaded_ = spec::load_system(options_.system, registry_);
+    Diagnostics errors;
+    for (spec::Diagnostic& d : loaded_.diagnostics) {
+      (d.severity == spec::Diagnostic::Severity::Error ? errors : trace_.notes).push_back(std::move(d));
     }
-    for (std::size_t k = 0; k < c.events.size(); ++k) {
-      const spec::Position where = k < c.event_where.size() ? c.event_where[k] : c.where;
-      event_source.emplace(c.events[k].name, std::make_pair(c.name, where));
-      event_order.push_back(c.events[k].name);
+    if (!errors.empty() || !loaded_.system) {
+      if (errors.empty()) errors.push_back(error_at(spec::Position{options_.system, 0, 0}, "cannot load the system"));
+      return errors;
+    }
+    trace_.system = sys().name;
+
+    if (!options_.verify_json.empty()) {
+      auto v = read_verify(options_.verify_json);
+      if (!v) return std::move(v.error());
+      verdicts_ = std::move(*v);
+      trace_.verify_source = options_.verify_json;
+    }
+
+    // Every spec file with its SHA-256: the evidence names exactly what it was built from.
+    std::vector<std::string> paths{sys().path.empty() ? options_.system : sys().path};
+    for (const spec::ComponentSpec& c : sys().components) {
+      if (!c.file.empty() && std::find(paths.begin(), paths.end(), c.file) == paths.end()) paths.push_back(c.file);
+    }
+    for (const std::string& p : paths) {
+      auto bytes = spec::read_regular_file(p, std::size_t{16} << 20);
+      if (!bytes) return Diagnostics{error_at(spec::Position{p, 0, 0}, bytes.error().message)};
+      trace_.files.push_back(SpecFile{p, sha256_hex(*bytes)});
+    }
+
+    // The built system: events as the coordinator checked them, filters with their defaults.
+    auto built = runner::build_system(sys(), registry_);
+    if (!built) return std::move(built.error());
+    system_ = std::move(*built);
+    return {};
+  }
+
+  /// Where each filter stage and each event is written in the specification.
+  void collect_sources() {
+    for (const spec::ComponentSpec& c : sys().components) {
+      for (const spec::FilterSpec& fs : c.filters) {
+        std::vector<std::string> chain;
+        if (!fs.pipeline.empty()) {
+          for (const FilterConfig& st : fs.stages) chain.push_back(st.name);
+        }
+        for (const FilterConfig& st : fs.stages)
+          stage_source_[st.name] = StageSource{fs.pipeline, chain, fs.where, c.period};
+      }
+      for (std::size_t k = 0; k < c.events.size(); ++k) {
+        const spec::Position where = k < c.event_where.size() ? c.event_where[k] : c.where;
+        event_source_.emplace(c.events[k].name, std::make_pair(c.name, where));
+        event_order_.push_back(c.events[k].name);
+      }
     }
   }
 
-  std::vector<FilterFacts> filters;
-  for (const auto& f : monitor.filters()) {
+  void collect_filters() {
+    for (const auto& f : system_->monitor().filters()) filters_.push_back(filter_facts(*f));
+  }
+
+  /// One built filter: where it is written, what it reads and targets, its period, the events it
+  /// generates and its other parameters.
+  FilterFacts filter_facts(const Filter& f) const {
     FilterFacts ff;
     FilterLink& l = ff.link;
-    const FilterConfig& cfg = f->config();
+    const FilterConfig& cfg = f.config();
     l.name = cfg.name;
     l.type = cfg.type;
-    l.component = std::string(co.component_name(f->component()));
-    l.target = f->target() == kNoMachine ? std::string() : co.address_of(f->target());
-    for (const Signal* s : f->inputs()) l.signals += (l.signals.empty() ? "" : ", ") + s->name();
+    l.component = std::string(co().component_name(f.component()));
+    l.target = f.target() == kNoMachine ? std::string() : co().address_of(f.target());
+    for (const Signal* s : f.inputs()) l.signals += (l.signals.empty() ? "" : ", ") + s->name();
     l.execution = cfg.execution == ExecutionMode::Active ? "ACTIVE" : "PASSIVE";
-    const auto src = stage_source.find(cfg.name);
-    if (src != stage_source.end()) {
+    const auto src = stage_source_.find(cfg.name);
+    if (src != stage_source_.end()) {
       l.pipeline = src->second.pipeline;
       l.chain = src->second.chain;
       l.where = src->second.where;
     }
     if (cfg.execution == ExecutionMode::Passive) {
       l.period = number(to_seconds(Monitor::kDefaultPeriod)) + " s (monitor)";
-    } else if (src != stage_source.end() && src->second.period) {
+    } else if (src != stage_source_.end() && src->second.period) {
       l.period = number(*src->second.period) + " s (" + l.component + "'s period)";
     } else {
       l.period = "the scenario's tick (" + l.component + " names no period)";
     }
     // Events: the manifest's first Event parameter is the onset, the second the completion.
     std::set<std::string> event_params;
-    if (const FilterRegistry::Entry* entry = registry.find(cfg.type)) {
+    if (const FilterRegistry::Entry* entry = registry_.find(cfg.type)) {
       int k = 0;
       for (const ParamSpec& p : entry->manifest.params) {
         if (p.type != ParamType::Event) continue;
@@ -280,13 +309,13 @@ bool Trace::has_error_gap() const noexcept {
         const auto it = cfg.params.find(p.name);
         if (it != cfg.params.end() && k < 2) {
           if (const std::string* name = std::get_if<std::string>(&it->second)) {
-            if (auto e = co.find_event(*name)) (k == 0 ? ff.onset : ff.completion) = *e;
+            if (auto e = co().find_event(*name)) (k == 0 ? ff.onset : ff.completion) = *e;
           }
         }
         ++k;
       }
     }
-    if (ff.onset != kNoEvent && ff.completion == kNoEvent) ff.completion = co.event(ff.onset).counterpart;
+    if (ff.onset != kNoEvent && ff.completion == kNoEvent) ff.completion = co().event(ff.onset).counterpart;
     for (const auto& [name, value] : cfg.params) {
       if (event_params.count(name) != 0) continue;
       if (name == "threshold") {
@@ -296,11 +325,12 @@ bool Trace::has_error_gap() const noexcept {
       if (name == "input_signal" || name == "input_signals") continue;  // the signals column
       l.parameters.push_back(name + "=" + param_text(value));
     }
-    filters.push_back(std::move(ff));
+    return ff;
   }
 
-  const auto event_link = [&](EventId id) {
-    const Event& e = co.event(id);
+  /// An event with where it is written, the filters that generate it and what they target.
+  EventLink event_link(EventId id) const {
+    const Event& e = co().event(id);
     EventLink l;
     l.name = e.name;
     l.onset = e.is_onset;
@@ -308,12 +338,12 @@ bool Trace::has_error_gap() const noexcept {
     l.transitions = transitions_text(e.transitions);
     l.level = e.is_onset ? std::string(to_string(onset_level(e.transitions, State::Normal))) : "Normal";
     l.latched = e.latched;
-    if (e.is_onset && e.counterpart != kNoEvent) l.completion = co.event(e.counterpart).name;
-    if (const auto src = event_source.find(e.name); src != event_source.end()) {
+    if (e.is_onset && e.counterpart != kNoEvent) l.completion = co().event(e.counterpart).name;
+    if (const auto src = event_source_.find(e.name); src != event_source_.end()) {
       l.component = src->second.first;
       l.where = src->second.second;
     }
-    for (const FilterFacts& f : filters) {
+    for (const FilterFacts& f : filters_) {
       if ((e.is_onset ? f.onset : f.completion) != id) continue;
       FilterLink fl = f.link;
       fl.role = e.is_onset ? "onset" : "completion";
@@ -325,22 +355,29 @@ bool Trace::has_error_gap() const noexcept {
       l.targets.push_back(l.component + ".s_A (generated by " + l.component + ")");
     if (e.is_broadcast()) l.targets.push_back("every s_A (broadcast)");
     return l;
-  };
+  }
 
   // ---- the scenarios --------------------------------------------------------------------------
-  std::vector<RunFacts> runs;
-  for (const std::string& path : options.scenarios) {
-    auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{path, options.system}, registry);
-    if (!opened) {
-      for (spec::Diagnostic& d : opened.error()) errors.push_back(std::move(d));
-      continue;
+  [[nodiscard]] Diagnostics run_scenarios() {
+    Diagnostics errors;
+    for (const std::string& path : options_.scenarios) {
+      auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{path, options_.system}, registry_);
+      if (!opened) {
+        for (spec::Diagnostic& d : opened.error()) errors.push_back(std::move(d));
+        continue;
+      }
+      run_scenario(path, **opened);
     }
-    runner::ScenarioRunner& runner = **opened;
+    return errors;
+  }
+
+  /// Runs one scenario, keeping what its records show (first onsets, completions, resets).
+  void run_scenario(const std::string& path, runner::ScenarioRunner& runner) {
     Coordinator& rc = runner.coordinator();
     RunFacts run;
     ScenarioResult sr;
     sr.path = path;
-    const bool keep_history = options.histories;
+    const bool keep_history = options_.histories;
     const auto id = rc.subscribe([&](const Record& r) {
       if (keep_history) {
         sr.history += record_to_json(r, rc);
@@ -374,140 +411,160 @@ bool Trace::has_error_gap() const noexcept {
     sr.checks = run.result.checks;
     sr.failures = run.result.failures;
     sr.duration = run.duration;
-    trace.scenarios.push_back(std::move(sr));
-    runs.push_back(std::move(run));
+    trace_.scenarios.push_back(std::move(sr));
+    runs_.push_back(std::move(run));
   }
-  if (!errors.empty()) return tl::unexpected(std::move(errors));
 
-  // Event ids agree between the trace's system and every run's: the same spec, built the same way.
-  const auto fired_in = [&](const RunFacts& run, const std::string& name) {
-    return run.result.coverage.events_fired.count(name) != 0;
-  };
-  const auto uses_of = [&](const std::string& name) {
+  /// The scenarios that fired event `name`, with the transitions it took in each. Event ids agree
+  /// between the trace's system and every run's: the same spec, built the same way.
+  std::vector<ScenarioUse> uses_of(const std::string& name) const {
     std::vector<ScenarioUse> out;
-    for (std::size_t k = 0; k < runs.size(); ++k) {
-      if (!fired_in(runs[k], name)) continue;
-      ScenarioUse u{trace.scenarios[k].path, {}};
+    for (std::size_t k = 0; k < runs_.size(); ++k) {
+      if (runs_[k].result.coverage.events_fired.count(name) == 0) continue;
+      ScenarioUse u{trace_.scenarios[k].path, {}};
       for (Transition t : kTransitionOrder) {
-        if (runs[k].result.coverage.taken.count({name, std::string(to_string(t))}) != 0)
+        if (runs_[k].result.coverage.taken.count({name, std::string(to_string(t))}) != 0)
           u.transitions.emplace_back(to_string(t));
       }
       out.push_back(std::move(u));
     }
     return out;
-  };
+  }
 
-  std::vector<Gap> gaps;
-  const auto gap = [&](Severity s, std::string kind, std::string hazard, std::string subject, std::string message,
-                       spec::Position where) {
-    gaps.push_back(
+  void gap(Severity s, std::string kind, std::string hazard, std::string subject, std::string message,
+           spec::Position where) {
+    gaps_.push_back(
         Gap{s, std::move(kind), std::move(hazard), std::move(subject), std::move(message), std::move(where)});
-  };
+  }
 
   // ---- the hazards ----------------------------------------------------------------------------
-  std::set<EventId> linked_onsets;
-  for (const spec::HazardSpec& h : sys.hazards) {
+  HazardTrace trace_hazard(const spec::HazardSpec& h) {
     HazardTrace ht;
     ht.id = h.id;
     ht.description = h.description;
     ht.where = h.where;
+    const std::vector<EventId> onsets = hazard_events(h, ht);
+    // The reaction, and which scenarios check it after a linked onset fired.
+    std::vector<std::optional<Time>> first_linked(runs_.size());
+    for (std::size_t k = 0; k < runs_.size(); ++k) {
+      for (EventId e : onsets) {
+        const auto it = runs_[k].first_onset.find(e);
+        if (it != runs_[k].first_onset.end() && (!first_linked[k] || it->second < *first_linked[k]))
+          first_linked[k] = it->second;
+      }
+    }
+    hazard_reaction(h, first_linked, ht);
+    hazard_excerpt(onsets, first_linked, ht);
+    const auto it = verdicts_.find(h.id);
+    if (it != verdicts_.end()) {
+      ht.verified = it->second;
+      ht.verify_detail = "hazard " + h.id + " in " + options_.verify_json;
+    } else {
+      ht.verify_detail = options_.verify_json.empty() ? "no verify result given: --verify FILE"
+                                                      : "no result for " + h.id + " in " + options_.verify_json;
+    }
+    hazard_gaps(h, ht);
+    return ht;
+  }
+
+  /// The onsets linked to hazard `h` (in the system's order) and their completions, into
+  /// `ht.events`, with the scenarios that fired and cleared them. Returns the onsets.
+  std::vector<EventId> hazard_events(const spec::HazardSpec& h, HazardTrace& ht) {
     std::vector<EventId> onsets;
-    for (const std::string& name : event_order) {
-      auto id = co.find_event(name);
-      if (!id || !co.event(*id).is_onset || co.event(*id).hazard != h.id) continue;
+    for (const std::string& name : event_order_) {
+      auto id = co().find_event(name);
+      if (!id || !co().event(*id).is_onset || co().event(*id).hazard != h.id) continue;
       onsets.push_back(*id);
-      linked_onsets.insert(*id);
+      linked_onsets_.insert(*id);
       EventLink onset = event_link(*id);
       onset.fired_by = uses_of(onset.name);
-      for (std::size_t k = 0; k < runs.size(); ++k) {
-        const auto first = runs[k].first_onset.find(*id);
-        if (first != runs[k].first_onset.end() && cleared_at(runs[k], co, *id, first->second)) {
-          onset.cleared_by.push_back(trace.scenarios[k].path);
+      for (std::size_t k = 0; k < runs_.size(); ++k) {
+        const auto first = runs_[k].first_onset.find(*id);
+        if (first != runs_[k].first_onset.end() && cleared_at(runs_[k], co(), *id, first->second)) {
+          onset.cleared_by.push_back(trace_.scenarios[k].path);
         }
       }
       ht.events.push_back(std::move(onset));
-      if (co.event(*id).counterpart != kNoEvent) {
-        EventLink completion = event_link(co.event(*id).counterpart);
+      if (co().event(*id).counterpart != kNoEvent) {
+        EventLink completion = event_link(co().event(*id).counterpart);
         completion.fired_by = uses_of(completion.name);
         ht.events.push_back(std::move(completion));
       }
     }
-    // The reaction, and which scenarios check it after a linked onset fired.
-    std::size_t best_checks = 0;
-    std::optional<std::size_t> chosen;
-    std::vector<std::optional<Time>> first_linked(runs.size());
-    for (std::size_t k = 0; k < runs.size(); ++k) {
-      for (EventId e : onsets) {
-        const auto it = runs[k].first_onset.find(e);
-        if (it != runs[k].first_onset.end() && (!first_linked[k] || it->second < *first_linked[k]))
-          first_linked[k] = it->second;
-      }
-    }
+    return onsets;
+  }
+
+  /// Each reaction of `h`, with the scenarios whose expectations check it at its level after a
+  /// linked onset first fired (`first_linked`, per run).
+  void hazard_reaction(const spec::HazardSpec& h, const std::vector<std::optional<Time>>& first_linked,
+                       HazardTrace& ht) const {
     for (std::size_t r = 0; r < h.reaction.size(); ++r) {
       ReactionLink rl;
       rl.address = h.reaction[r].first;
       rl.level = std::string(to_string(h.reaction[r].second));
       rl.where = r < h.reaction_where.size() ? h.reaction_where[r] : h.where;
-      for (std::size_t k = 0; k < runs.size(); ++k) {
+      for (std::size_t k = 0; k < runs_.size(); ++k) {
         if (!first_linked[k]) continue;
         const bool checked =
-            std::any_of(runs[k].result.coverage.states_checked.begin(), runs[k].result.coverage.states_checked.end(),
+            std::any_of(runs_[k].result.coverage.states_checked.begin(), runs_[k].result.coverage.states_checked.end(),
                         [&](const runner::StateCheck& c) {
                           return c.held && c.address == rl.address && c.expected >= h.reaction[r].second &&
                                  c.at >= *first_linked[k];
                         });
-        if (checked) rl.checked_by.push_back(trace.scenarios[k].path);
+        if (checked) rl.checked_by.push_back(trace_.scenarios[k].path);
       }
       ht.reaction.push_back(std::move(rl));
     }
-    for (std::size_t k = 0; k < runs.size(); ++k) {
+  }
+
+  /// The timeline excerpt of the hazard: the run whose expectations check most of its reaction,
+  /// from a linked onset's first firing to its clearing, over the components involved.
+  void hazard_excerpt(const std::vector<EventId>& onsets, const std::vector<std::optional<Time>>& first_linked,
+                      HazardTrace& ht) const {
+    std::size_t best_checks = 0;
+    std::optional<std::size_t> chosen;
+    for (std::size_t k = 0; k < runs_.size(); ++k) {
       if (!first_linked[k]) continue;
       std::size_t checks = 0;
       for (const ReactionLink& rl : ht.reaction) {
-        checks += std::count(rl.checked_by.begin(), rl.checked_by.end(), trace.scenarios[k].path) != 0 ? 1 : 0;
+        checks += std::count(rl.checked_by.begin(), rl.checked_by.end(), trace_.scenarios[k].path) != 0 ? 1 : 0;
       }
       if (!chosen || checks > best_checks) {
         chosen = k;
         best_checks = checks;
       }
     }
-    if (chosen) {
-      const RunFacts& run = runs[*chosen];
-      ht.excerpt_scenario = trace.scenarios[*chosen].path;
-      const Time from = *first_linked[*chosen];
-      Time to = seconds_to_time(run.duration);
-      std::set<std::string> components;
-      for (EventId e : onsets) {
-        const auto it = run.first_onset.find(e);
-        if (it == run.first_onset.end() || it->second != from) continue;
-        if (auto c = cleared_at(run, co, e, from)) to = *c;
-      }
-      for (EventId e : onsets) {
-        if (const auto it = run.onset_components.find(e); it != run.onset_components.end()) {
-          components.insert(it->second.begin(), it->second.end());
-        }
-      }
-      for (const ReactionLink& rl : ht.reaction) {
-        if (rl.address != "SYSTEM") components.insert(component_of(rl.address));
-      }
-      const double span = std::max(to_seconds(to - from), 0.01);
-      ht.excerpt_from = std::max(0.0, to_seconds(from) - span * 0.25);
-      ht.excerpt_to = std::min(run.duration, to_seconds(to) + span * 0.25);
-      // Keep the system's order of components.
-      for (const spec::ComponentSpec& c : sys.components) {
-        if (components.count(c.name) != 0) ht.excerpt_components.push_back(c.name);
+    if (!chosen) return;
+    const RunFacts& run = runs_[*chosen];
+    ht.excerpt_scenario = trace_.scenarios[*chosen].path;
+    const Time from = *first_linked[*chosen];
+    Time to = seconds_to_time(run.duration);
+    std::set<std::string> components;
+    for (EventId e : onsets) {
+      const auto it = run.first_onset.find(e);
+      if (it == run.first_onset.end() || it->second != from) continue;
+      if (auto c = cleared_at(run, co(), e, from)) to = *c;
+    }
+    for (EventId e : onsets) {
+      if (const auto it = run.onset_components.find(e); it != run.onset_components.end()) {
+        components.insert(it->second.begin(), it->second.end());
       }
     }
-    const auto it = verdicts.find(h.id);
-    if (it != verdicts.end()) {
-      ht.verified = it->second;
-      ht.verify_detail = "hazard " + h.id + " in " + options.verify_json;
-    } else {
-      ht.verify_detail = options.verify_json.empty() ? "no verify result given: --verify FILE"
-                                                     : "no result for " + h.id + " in " + options.verify_json;
+    for (const ReactionLink& rl : ht.reaction) {
+      if (rl.address != "SYSTEM") components.insert(component_of(rl.address));
     }
+    const double span = std::max(to_seconds(to - from), 0.01);
+    ht.excerpt_from = std::max(0.0, to_seconds(from) - span * 0.25);
+    ht.excerpt_to = std::min(run.duration, to_seconds(to) + span * 0.25);
+    // Keep the system's order of components.
+    for (const spec::ComponentSpec& c : sys().components) {
+      if (components.count(c.name) != 0) ht.excerpt_components.push_back(c.name);
+    }
+  }
 
-    // Gaps of this hazard.
+  /// The gaps of one hazard: undetected, reaction violated, events not fired or not cleared,
+  /// reactions unchecked.
+  void hazard_gaps(const spec::HazardSpec& h, const HazardTrace& ht) {
     const bool detected = std::any_of(ht.events.begin(), ht.events.end(),
                                       [](const EventLink& e) { return e.onset && !e.filters.empty(); });
     if (ht.events.empty()) {
@@ -524,7 +581,7 @@ bool Trace::has_error_gap() const noexcept {
     }
     if (ht.verified == Verdict::Violated) {
       gap(Severity::Error, "reaction-violated", h.id, h.id,
-          "`safecass verify` found the reaction of " + h.id + " violated (" + options.verify_json + ")", h.where);
+          "`safecass verify` found the reaction of " + h.id + " violated (" + options_.verify_json + ")", h.where);
     }
     for (const EventLink& e : ht.events) {
       const bool latched_completion =
@@ -550,67 +607,88 @@ bool Trace::has_error_gap() const noexcept {
             rl.where);
       }
     }
-    trace.hazards.push_back(std::move(ht));
   }
 
-  // Filters that generate an onset no hazard claims.
-  for (const FilterFacts& f : filters) {
-    if (f.onset == kNoEvent || linked_onsets.count(f.onset) != 0) continue;
-    const Event& e = co.event(f.onset);
-    if (to_index(e.id) < framework_event::kCount) continue;
-    gap(Severity::Info, "filter-without-hazard", "", f.link.name,
-        "filter " + f.link.name + " generates " + e.name + ", which is linked to no declared hazard", f.link.where);
-    if (std::none_of(trace.unlinked.begin(), trace.unlinked.end(),
-                     [&](const EventLink& l) { return l.name == e.name; })) {
-      EventLink l = event_link(f.onset);
-      l.fired_by = uses_of(l.name);
-      trace.unlinked.push_back(std::move(l));
+  /// Filters that generate an onset no hazard claims, and scenarios that fail.
+  void unclaimed_filters_and_failed_scenarios() {
+    for (const FilterFacts& f : filters_) {
+      if (f.onset == kNoEvent || linked_onsets_.count(f.onset) != 0) continue;
+      const Event& e = co().event(f.onset);
+      if (to_index(e.id) < framework_event::kCount) continue;
+      gap(Severity::Info, "filter-without-hazard", "", f.link.name,
+          "filter " + f.link.name + " generates " + e.name + ", which is linked to no declared hazard", f.link.where);
+      if (std::none_of(trace_.unlinked.begin(), trace_.unlinked.end(),
+                       [&](const EventLink& l) { return l.name == e.name; })) {
+        EventLink l = event_link(f.onset);
+        l.fired_by = uses_of(l.name);
+        trace_.unlinked.push_back(std::move(l));
+      }
+    }
+    for (const ScenarioResult& s : trace_.scenarios) {
+      if (s.passed) continue;
+      gap(Severity::Error, "scenario-failed", "", s.path,
+          "scenario " + s.path + " fails (" + std::to_string(s.failures.size()) + " expectation" +
+              (s.failures.size() == 1 ? "" : "s") +
+              "): its evidence does not count until it passes; first: " + s.failures.front(),
+          spec::Position{s.path, 0, 0});
     }
   }
-  for (std::size_t k = 0; k < trace.scenarios.size(); ++k) {
-    const ScenarioResult& s = trace.scenarios[k];
-    if (s.passed) continue;
-    gap(Severity::Error, "scenario-failed", "", s.path,
-        "scenario " + s.path + " fails (" + std::to_string(s.failures.size()) + " expectation" +
-            (s.failures.size() == 1 ? "" : "s") +
-            "): its evidence does not count until it passes; first: " + s.failures.front(),
-        spec::Position{s.path, 0, 0});
-  }
-  std::stable_sort(gaps.begin(), gaps.end(), [](const Gap& a, const Gap& b) { return a.severity < b.severity; });
-  trace.gaps = std::move(gaps);
 
   // ---- the coverage summary -------------------------------------------------------------------
-  Coverage& cv = trace.coverage;
-  std::set<std::string> fired;
-  std::set<std::pair<std::string, std::string>> taken;
-  for (const RunFacts& r : runs) {
-    fired.insert(r.result.coverage.events_fired.begin(), r.result.coverage.events_fired.end());
-    taken.insert(r.result.coverage.taken.begin(), r.result.coverage.taken.end());
-  }
-  for (EventId e : id_range(EventId{framework_event::kCount}, co.event_count())) {
-    const Event& ev = co.event(e);
-    ++cv.events_defined;
-    cv.events_fired += fired.count(ev.name) != 0 ? 1 : 0;
-    for (Transition t : kTransitionOrder) {
-      if (!ev.transitions.contains(t)) continue;
-      ++cv.transitions_defined;
-      cv.transitions_taken += taken.count({ev.name, std::string(to_string(t))}) != 0 ? 1 : 0;
+  void summarize_coverage() {
+    Coverage& cv = trace_.coverage;
+    std::set<std::string> fired;
+    std::set<std::pair<std::string, std::string>> taken;
+    for (const RunFacts& r : runs_) {
+      fired.insert(r.result.coverage.events_fired.begin(), r.result.coverage.events_fired.end());
+      taken.insert(r.result.coverage.taken.begin(), r.result.coverage.taken.end());
+    }
+    for (EventId e : id_range(EventId{framework_event::kCount}, co().event_count())) {
+      const Event& ev = co().event(e);
+      ++cv.events_defined;
+      cv.events_fired += fired.count(ev.name) != 0 ? 1 : 0;
+      for (Transition t : kTransitionOrder) {
+        if (!ev.transitions.contains(t)) continue;
+        ++cv.transitions_defined;
+        cv.transitions_taken += taken.count({ev.name, std::string(to_string(t))}) != 0 ? 1 : 0;
+      }
+    }
+    for (const HazardTrace& h : trace_.hazards) {
+      ++cv.hazards;
+      const bool detected = std::any_of(h.events.begin(), h.events.end(),
+                                        [](const EventLink& e) { return e.onset && !e.filters.empty(); });
+      const bool exercised = std::any_of(h.events.begin(), h.events.end(),
+                                         [](const EventLink& e) { return e.onset && !e.fired_by.empty(); });
+      cv.hazards_detected += detected ? 1 : 0;
+      cv.hazards_exercised += exercised ? 1 : 0;
+      for (const ReactionLink& r : h.reaction) {
+        ++cv.reactions;
+        cv.reactions_checked += r.checked_by.empty() ? 0 : 1;
+      }
     }
   }
-  for (const HazardTrace& h : trace.hazards) {
-    ++cv.hazards;
-    const bool detected =
-        std::any_of(h.events.begin(), h.events.end(), [](const EventLink& e) { return e.onset && !e.filters.empty(); });
-    const bool exercised = std::any_of(h.events.begin(), h.events.end(),
-                                       [](const EventLink& e) { return e.onset && !e.fired_by.empty(); });
-    cv.hazards_detected += detected ? 1 : 0;
-    cv.hazards_exercised += exercised ? 1 : 0;
-    for (const ReactionLink& r : h.reaction) {
-      ++cv.reactions;
-      cv.reactions_checked += r.checked_by.empty() ? 0 : 1;
-    }
-  }
-  return trace;
+
+  const TraceOptions& options_;
+  const FilterRegistry& registry_;
+  Trace trace_;
+  spec::LoadResult loaded_;
+  std::map<std::string, Verdict> verdicts_;
+  std::unique_ptr<runner::System> system_;
+  std::map<std::string, StageSource, std::less<>> stage_source_;
+  std::map<std::string, std::pair<std::string, spec::Position>, std::less<>>
+      event_source_;  ///< name → component, where
+  std::vector<std::string> event_order_;
+  std::vector<FilterFacts> filters_;
+  std::vector<RunFacts> runs_;
+  std::vector<Gap> gaps_;
+  std::set<EventId> linked_onsets_;  ///< onsets some hazard claims
+};
+
+}  // namespace
+
+[[nodiscard]] tl::expected<Trace, std::vector<spec::Diagnostic>> build_trace(const TraceOptions& options,
+                                                                             const FilterRegistry& registry) {
+  return Builder(options, registry).build();
 }
 
 }  // namespace safecass::trace
