@@ -504,16 +504,12 @@ private:
 
 }  // namespace
 
-[[nodiscard]] Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry,
-                                      const Options& options) {
-  const auto start = std::chrono::steady_clock::now();
-  auto built = Model::build(system, registry);
-  if (!built) return tl::unexpected(built.error());
-  Model& model = **built;
-  Report report;
-  report.system = system.name;
+namespace {
 
-  // The properties to check.
+/// The properties to search: each hazard's reaction while a linked onset is active, each
+/// invariant; only `options.property` when it is given.
+[[nodiscard]] Expected<std::vector<Check>> property_checks(const spec::SystemSpec& system, const Model& model,
+                                                           const Options& options) {
   std::vector<Check> checks;
   for (const spec::HazardSpec& h : system.hazards) {
     Check c;
@@ -571,6 +567,93 @@ private:
     }
   }
 
+  return checks;
+}
+
+/// Properties of the specification itself, decided on the model's structure: onsets that only a
+/// reset can clear, undetectable hazards, addresses that can never leave Normal.
+void structural_properties(const spec::SystemSpec& system, const Model& model, Report& report) {
+  const Coordinator& co = model.coordinator();
+  std::set<std::string> reported;
+  for (const detail::Root& r : model.roots()) {
+    if (r.clearable() || r.latched) continue;
+    const std::string subject = r.event + (r.broadcast >= 0 ? std::string() : "@" + co.address_of(r.machine));
+    if (!reported.insert(subject).second) continue;
+    PropertyResult p;
+    p.kind = PropertyResult::Kind::NeedsReset;
+    p.verdict = PropertyResult::Verdict::Violated;
+    p.structural = true;
+    p.name = subject;
+    p.where = r.where;
+    p.text = "every onset can be cleared";
+    p.message = "onset '" + r.event + "' on " +
+                (r.broadcast >= 0 ? std::string("every s_A") : co.address_of(r.machine)) + " (from " + r.source +
+                ") has no completion and is not latched: nothing but a reset can clear it";
+    report.properties.push_back(std::move(p));
+  }
+  for (const spec::HazardSpec& h : system.hazards) {
+    if (!model.linked(h.id).empty()) continue;
+    PropertyResult p;
+    p.kind = PropertyResult::Kind::Undetectable;
+    p.verdict = PropertyResult::Verdict::Violated;
+    p.structural = true;
+    p.name = h.id;
+    p.where = h.where;
+    p.text = "some onset of the model detects the hazard";
+    p.message = "hazard '" + h.id +
+                "' is undetectable: no onset in the model is linked to it, so its reaction holds "
+                "vacuously and nothing will ever raise it";
+    report.properties.push_back(std::move(p));
+  }
+  // Components, and every address a reaction or an invariant names.
+  std::vector<std::pair<std::string, spec::Position>> subjects;
+  for (const spec::ComponentSpec& c : system.components) subjects.emplace_back(c.name, c.where);
+  for (const spec::HazardSpec& h : system.hazards) {
+    for (std::size_t i = 0; i < h.reaction.size(); ++i) {
+      subjects.emplace_back(h.reaction[i].first, i < h.reaction_where.size() ? h.reaction_where[i] : h.where);
+    }
+  }
+  for (const spec::InvariantSpec& inv : system.invariants) {
+    auto f = spec::parse_formula(inv.formula);
+    if (!f) continue;
+    std::vector<const spec::Formula*> atoms;
+    f->atoms(atoms);
+    for (const spec::Formula* a : atoms) subjects.emplace_back(a->address, inv.where);
+  }
+  std::set<std::string> done;
+  for (const auto& [address, where] : subjects) {
+    if (!done.insert(address).second) continue;
+    const int a = model.address_index(address);
+    if (a < 0 || model.can_leave_normal(static_cast<std::size_t>(a))) continue;
+    PropertyResult p;
+    p.kind = PropertyResult::Kind::NeverLeavesNormal;
+    p.verdict = PropertyResult::Verdict::Violated;
+    p.structural = true;
+    p.name = address;
+    p.where = where;
+    p.text = "the address can leave Normal";
+    p.message = "address '" + address +
+                "' can never leave Normal: no onset of the model reaches it, so a reaction "
+                "that requires it at Warning or Error cannot be met";
+    report.properties.push_back(std::move(p));
+  }
+}
+
+}  // namespace
+
+[[nodiscard]] Expected<Report> verify(const spec::SystemSpec& system, const FilterRegistry& registry,
+                                      const Options& options) {
+  const auto start = std::chrono::steady_clock::now();
+  auto built = Model::build(system, registry);
+  if (!built) return tl::unexpected(built.error());
+  Model& model = **built;
+  Report report;
+  report.system = system.name;
+
+  auto property_list = property_checks(system, model, options);
+  if (!property_list) return tl::unexpected(property_list.error());
+  std::vector<Check>& checks = *property_list;
+
   auto dir = detail::WorkDir::create(options.work_dir);
   if (!dir) return tl::unexpected(dir.error());
   if (!checks.empty()) {
@@ -591,73 +674,7 @@ private:
   }
   for (PropertyResult& r : verifier.run_all(searched)) report.properties.push_back(std::move(r));
 
-  // Properties of the specification itself, decided on the model's structure.
-  if (options.property.empty()) {
-    const Coordinator& co = model.coordinator();
-    std::set<std::string> reported;
-    for (const detail::Root& r : model.roots()) {
-      if (r.clearable() || r.latched) continue;
-      const std::string subject = r.event + (r.broadcast >= 0 ? std::string() : "@" + co.address_of(r.machine));
-      if (!reported.insert(subject).second) continue;
-      PropertyResult p;
-      p.kind = PropertyResult::Kind::NeedsReset;
-      p.verdict = PropertyResult::Verdict::Violated;
-      p.structural = true;
-      p.name = subject;
-      p.where = r.where;
-      p.text = "every onset can be cleared";
-      p.message = "onset '" + r.event + "' on " +
-                  (r.broadcast >= 0 ? std::string("every s_A") : co.address_of(r.machine)) + " (from " + r.source +
-                  ") has no completion and is not latched: nothing but a reset can clear it";
-      report.properties.push_back(std::move(p));
-    }
-    for (const spec::HazardSpec& h : system.hazards) {
-      if (!model.linked(h.id).empty()) continue;
-      PropertyResult p;
-      p.kind = PropertyResult::Kind::Undetectable;
-      p.verdict = PropertyResult::Verdict::Violated;
-      p.structural = true;
-      p.name = h.id;
-      p.where = h.where;
-      p.text = "some onset of the model detects the hazard";
-      p.message = "hazard '" + h.id +
-                  "' is undetectable: no onset in the model is linked to it, so its reaction holds "
-                  "vacuously and nothing will ever raise it";
-      report.properties.push_back(std::move(p));
-    }
-    // Components, and every address a reaction or an invariant names.
-    std::vector<std::pair<std::string, spec::Position>> subjects;
-    for (const spec::ComponentSpec& c : system.components) subjects.emplace_back(c.name, c.where);
-    for (const spec::HazardSpec& h : system.hazards) {
-      for (std::size_t i = 0; i < h.reaction.size(); ++i) {
-        subjects.emplace_back(h.reaction[i].first, i < h.reaction_where.size() ? h.reaction_where[i] : h.where);
-      }
-    }
-    for (const spec::InvariantSpec& inv : system.invariants) {
-      auto f = spec::parse_formula(inv.formula);
-      if (!f) continue;
-      std::vector<const spec::Formula*> atoms;
-      f->atoms(atoms);
-      for (const spec::Formula* a : atoms) subjects.emplace_back(a->address, inv.where);
-    }
-    std::set<std::string> done;
-    for (const auto& [address, where] : subjects) {
-      if (!done.insert(address).second) continue;
-      const int a = model.address_index(address);
-      if (a < 0 || model.can_leave_normal(static_cast<std::size_t>(a))) continue;
-      PropertyResult p;
-      p.kind = PropertyResult::Kind::NeverLeavesNormal;
-      p.verdict = PropertyResult::Verdict::Violated;
-      p.structural = true;
-      p.name = address;
-      p.where = where;
-      p.text = "the address can leave Normal";
-      p.message = "address '" + address +
-                  "' can never leave Normal: no onset of the model reaches it, so a reaction "
-                  "that requires it at Warning or Error cannot be met";
-      report.properties.push_back(std::move(p));
-    }
-  }
+  if (options.property.empty()) structural_properties(system, model, report);
   report.seconds = seconds_since(start);
   return report;
 }

@@ -487,6 +487,82 @@ struct Tracked {
 
 }  // namespace
 
+namespace {
+
+/// One interval in which B and A differ at `address`, until `until`: a JSON line (--json) or a
+/// text line with its first cause.
+void print_interval(const Interval& i, const std::string& address, const std::string& until, const ReplayOptions& o) {
+  if (o.json) {
+    const Cause& c = i.cause;
+    json::JsonObject cause;
+    cause.str("system", i.side == 'B' ? "B" : "A").str("origin", c.origin).str("event", c.event);
+    if (!c.filter.empty()) cause.str("filter", c.filter);
+    if (!c.signal.empty()) {
+      cause.str("signal", c.signal);
+      // JSON has no NaN or infinity: a non-finite value is written as its text ("nan", "inf").
+      if (std::isfinite(c.value)) {
+        cause.num("value", c.value);
+      } else {
+        cause.str("value", introspect::number_text(c.value));
+      }
+    }
+    const std::string line = json::JsonObject()
+                                 .str("kind", "difference")
+                                 .str("address", address)
+                                 .raw("from", secs(i.from))
+                                 .raw("to", until)
+                                 .boolean("until_end", i.open)
+                                 .str("b", to_string(i.b))
+                                 .str("a", to_string(i.a))
+                                 .raw("cause", cause.text())
+                                 .text();
+    std::fprintf(o.out, "%s\n", line.c_str());
+  } else {
+    std::fprintf(o.out, "  %s .. %s s%s  B %s, A %s  first cause (%c): %s\n", secs(i.from).c_str(), until.c_str(),
+                 i.open ? " (to the end)" : "", std::string(to_string(i.b)).c_str(),
+                 std::string(to_string(i.a)).c_str(), i.side, cause_text(i.cause).c_str());
+  }
+}
+
+/// The differences, address by address, the addresses not compared, then the summary; `end`: the
+/// time the replay ended (the end of an interval still open). Returns 0 when B and A never
+/// differ, 1 when they do.
+int print_diff(const std::vector<Tracked>& tracked, const std::vector<std::string>& only, Time end,
+               const std::string& system_b, const ReplayOptions& o) {
+  std::size_t addresses = 0;
+  std::size_t intervals = 0;
+  for (const Tracked& t : tracked) {
+    if (t.intervals.empty()) continue;
+    ++addresses;
+    intervals += t.intervals.size();
+    if (!o.json) std::fprintf(o.out, "%s\n", t.name.c_str());
+    for (const Interval& i : t.intervals) {
+      print_interval(i, t.name, i.open ? secs(end) : secs(i.to), o);
+    }
+  }
+  for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
+  if (o.json) {
+    const std::string line = json::JsonObject()
+                                 .str("kind", "diff")
+                                 .str("b", system_b)
+                                 .str("a", o.system)
+                                 .integer("addresses", static_cast<long long>(addresses))
+                                 .integer("intervals", static_cast<long long>(intervals))
+                                 .boolean("differ", addresses != 0)
+                                 .text();
+    std::fprintf(o.out, "%s\n", line.c_str());
+  } else if (addresses == 0) {
+    std::fprintf(o.out, "B (%s) and A (%s) never differ on %s\n", system_b.c_str(), o.system.c_str(), o.input.c_str());
+  } else {
+    std::fprintf(o.out, "B (%s) and A (%s) differ at %zu address%s in %zu interval%s on %s\n", system_b.c_str(),
+                 o.system.c_str(), addresses, addresses == 1 ? "" : "es", intervals, intervals == 1 ? "" : "s",
+                 o.input.c_str());
+  }
+  return addresses == 0 ? 0 : 1;
+}
+
+}  // namespace
+
 int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const FilterRegistry& registry) {
   const std::string format = o.format.empty() ? sniff(o.input) : o.format;
   std::optional<Time> period;
@@ -585,66 +661,7 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   }
   print_notes(*src, o.err);
 
-  std::size_t addresses = 0;
-  std::size_t intervals = 0;
-  for (const Tracked& t : tracked) {
-    if (t.intervals.empty()) continue;
-    ++addresses;
-    intervals += t.intervals.size();
-    if (!o.json) std::fprintf(o.out, "%s\n", t.name.c_str());
-    for (const Interval& i : t.intervals) {
-      const std::string until = i.open ? secs(a->now()) : secs(i.to);
-      if (o.json) {
-        const Cause& c = i.cause;
-        json::JsonObject cause;
-        cause.str("system", i.side == 'B' ? "B" : "A").str("origin", c.origin).str("event", c.event);
-        if (!c.filter.empty()) cause.str("filter", c.filter);
-        if (!c.signal.empty()) {
-          cause.str("signal", c.signal);
-          // JSON has no NaN or infinity: a non-finite value is written as its text ("nan", "inf").
-          if (std::isfinite(c.value)) {
-            cause.num("value", c.value);
-          } else {
-            cause.str("value", introspect::number_text(c.value));
-          }
-        }
-        const std::string line = json::JsonObject()
-                                     .str("kind", "difference")
-                                     .str("address", t.name)
-                                     .raw("from", secs(i.from))
-                                     .raw("to", until)
-                                     .boolean("until_end", i.open)
-                                     .str("b", to_string(i.b))
-                                     .str("a", to_string(i.a))
-                                     .raw("cause", cause.text())
-                                     .text();
-        std::fprintf(o.out, "%s\n", line.c_str());
-      } else {
-        std::fprintf(o.out, "  %s .. %s s%s  B %s, A %s  first cause (%c): %s\n", secs(i.from).c_str(), until.c_str(),
-                     i.open ? " (to the end)" : "", std::string(to_string(i.b)).c_str(),
-                     std::string(to_string(i.a)).c_str(), i.side, cause_text(i.cause).c_str());
-      }
-    }
-  }
-  for (const std::string& n : only) std::fprintf(o.err, "note: address %s is not compared\n", n.c_str());
-  if (o.json) {
-    const std::string line = json::JsonObject()
-                                 .str("kind", "diff")
-                                 .str("b", system_b)
-                                 .str("a", o.system)
-                                 .integer("addresses", static_cast<long long>(addresses))
-                                 .integer("intervals", static_cast<long long>(intervals))
-                                 .boolean("differ", addresses != 0)
-                                 .text();
-    std::fprintf(o.out, "%s\n", line.c_str());
-  } else if (addresses == 0) {
-    std::fprintf(o.out, "B (%s) and A (%s) never differ on %s\n", system_b.c_str(), o.system.c_str(), o.input.c_str());
-  } else {
-    std::fprintf(o.out, "B (%s) and A (%s) differ at %zu address%s in %zu interval%s on %s\n", system_b.c_str(),
-                 o.system.c_str(), addresses, addresses == 1 ? "" : "es", intervals, intervals == 1 ? "" : "s",
-                 o.input.c_str());
-  }
-  return addresses == 0 ? 0 : 1;
+  return print_diff(tracked, only, a->now(), system_b, o);
 }
 
 // ---- ReplaySession ----------------------------------------------------------------------------

@@ -334,6 +334,47 @@ std::string Protocol::refuse_write(std::string_view id, std::string_view op, std
   return {};
 }
 
+namespace {
+
+/// A "replay" message's action ("play", "pause", "next"; "seek" with 't'; "speed" with 'speed')
+/// into `control`. Returns the problem, or empty.
+std::string replay_control(const json::JsonValue& object, ReplayControl& control) {
+  std::string problem = check_keys(object, {"id", "op", "action", "t", "speed"});
+  std::string action;
+  if (problem.empty()) problem = get_string(object, "action", action);
+  if (problem.empty()) {
+    const json::JsonValue* t = object.find("t");
+    const json::JsonValue* speed = object.find("speed");
+    if (action == "play" || action == "pause" || action == "next") {
+      control.op = action == "play"    ? ReplayControl::Op::Play
+                   : action == "pause" ? ReplayControl::Op::Pause
+                                       : ReplayControl::Op::Next;
+      if (t != nullptr || speed != nullptr) problem = "action '" + action + "' takes neither 't' nor 'speed'";
+    } else if (action == "seek") {
+      control.op = ReplayControl::Op::Seek;
+      if (speed != nullptr)
+        problem = "action 'seek' takes 't' (seconds), not 'speed'";
+      else if (t == nullptr || !t->is_number())
+        problem = "action 'seek' needs 't', a number of seconds";
+      else
+        control.t = t->number;
+    } else if (action == "speed") {
+      control.op = ReplayControl::Op::Speed;
+      if (t != nullptr)
+        problem = "action 'speed' takes 'speed', not 't'";
+      else if (speed == nullptr || !speed->is_number())
+        problem = "action 'speed' needs 'speed', a number";
+      else
+        control.speed = speed->number;
+    } else {
+      problem = "unknown action '" + action + "' (play, pause, speed, seek, next)";
+    }
+  }
+  return problem;
+}
+
+}  // namespace
+
 std::string Protocol::handle(std::string_view message) {
   if (message.size() > options_.max_message) {
     return error_reply({}, {},
@@ -448,38 +489,8 @@ std::string Protocol::handle(std::string_view message) {
   }
   if (r.op == "replay") {
     // Moving a replay in time changes what is shown, never the system or the log: no token.
-    problem = check_keys(object, {"id", "op", "action", "t", "speed"});
-    std::string action;
-    if (problem.empty()) problem = get_string(object, "action", action);
     ReplayControl control;
-    if (problem.empty()) {
-      const json::JsonValue* t = object.find("t");
-      const json::JsonValue* speed = object.find("speed");
-      if (action == "play" || action == "pause" || action == "next") {
-        control.op = action == "play"    ? ReplayControl::Op::Play
-                     : action == "pause" ? ReplayControl::Op::Pause
-                                         : ReplayControl::Op::Next;
-        if (t != nullptr || speed != nullptr) problem = "action '" + action + "' takes neither 't' nor 'speed'";
-      } else if (action == "seek") {
-        control.op = ReplayControl::Op::Seek;
-        if (speed != nullptr)
-          problem = "action 'seek' takes 't' (seconds), not 'speed'";
-        else if (t == nullptr || !t->is_number())
-          problem = "action 'seek' needs 't', a number of seconds";
-        else
-          control.t = t->number;
-      } else if (action == "speed") {
-        control.op = ReplayControl::Op::Speed;
-        if (t != nullptr)
-          problem = "action 'speed' takes 'speed', not 't'";
-        else if (speed == nullptr || !speed->is_number())
-          problem = "action 'speed' needs 'speed', a number";
-        else
-          control.speed = speed->number;
-      } else {
-        problem = "unknown action '" + action + "' (play, pause, speed, seek, next)";
-      }
-    }
+    problem = replay_control(object, control);
     if (!problem.empty()) return error_reply(r.id, r.op, problem);
     auto done = source_.control(control);
     if (!done) return error_reply(r.id, r.op, done.error().message);
