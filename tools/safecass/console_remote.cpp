@@ -9,7 +9,7 @@
 #include "safecass/introspect/format.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/token.hpp"
-#include "timeline.hpp"
+#include "safecass/timeline/timeline.hpp"
 
 namespace safecass::tools {
 
@@ -94,16 +94,16 @@ int run_timeline_ice(const std::string& ice, const std::string& coordinator, con
   }
   std::string text;
   for (const introspect::HistoryEntry& r : *records) text += introspect::history_json(r) + "\n";
-  const HistoryParse parsed = parse_history(text);
+  const timeline::HistoryParse parsed = timeline::parse_history(text);
   if (!parsed.errors.empty()) {  // a record the page cannot draw: say which, write nothing
-    for (const HistoryError& e : parsed.errors) {
+    for (const timeline::HistoryError& e : parsed.errors) {
       std::fprintf(stderr, "safecass timeline: coordinator '%s', record %d: %s\n", coordinator.c_str(), e.line,
                    e.message.c_str());
     }
     return 2;
   }
-  const int written =
-      write_timeline_page(parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
+  const int written = timeline::write_timeline_page(
+      parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
   if (written != 0) return written;
   std::fprintf(stderr, "safecass timeline: %zu records of coordinator '%s' drawn in %s\n", parsed.records.size(),
                coordinator.c_str(), html_out.c_str());

@@ -7,8 +7,8 @@
 
 #include "commands.hpp"
 #include "console.hpp"
+#include "safecass/timeline/timeline.hpp"
 #include "spec_commands.hpp"
-#include "timeline.hpp"
 #include "verify_command.hpp"
 #ifdef SAFECASS_WITH_ICE
 #include "console_remote.hpp"
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
         code = 2;
         return;
       }
-      code = safecass::tools::run_timeline(timeline_history, timeline_html);
+      code = safecass::timeline::run_timeline(timeline_history, timeline_html);
       return;
     }
     if (timeline_ice.empty() || timeline_coordinator.empty() || !timeline_history.empty()) {

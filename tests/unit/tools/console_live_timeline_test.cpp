@@ -6,7 +6,7 @@
 
 #include <string>
 
-#include "timeline.hpp"
+#include "safecass/timeline/timeline.hpp"
 
 namespace safecass::tools {
 namespace {
@@ -19,12 +19,12 @@ TEST(LiveTimeline, ARootCauseWithoutItsTimeIsShownWithoutAMadeUpTime) {
       "{\"seq\":1,\"t\":5000.25,\"kind\":\"transition\",\"component\":\"JR3\",\"machine\":\"JR3.s_A\",\"event\":"
       "\"EVT_FORCE_ERROR\",\"from\":\"Normal\",\"to\":\"Error\",\"root\":{\"event\":\"EVT_FORCE_ERROR\",\"origin\":"
       "\"JR3.s_A\"}}\n";
-  const HistoryParse parsed = parse_history(live);
+  const timeline::HistoryParse parsed = timeline::parse_history(live);
   ASSERT_TRUE(parsed.errors.empty()) << parsed.errors.front().message;
   ASSERT_EQ(parsed.records.size(), 1u);
   EXPECT_TRUE(parsed.records[0].has_root);
   EXPECT_FALSE(parsed.records[0].root.has_t);
-  const std::string model = timeline_model_json(parsed.records);
+  const std::string model = timeline::timeline_model_json(parsed.records);
   EXPECT_THAT(model, HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR"));
   EXPECT_THAT(model, Not(HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at ")));
 
@@ -32,10 +32,11 @@ TEST(LiveTimeline, ARootCauseWithoutItsTimeIsShownWithoutAMadeUpTime) {
       "{\"seq\":1,\"t\":0.25,\"kind\":\"transition\",\"component\":\"JR3\",\"machine\":\"JR3.s_A\",\"event\":"
       "\"EVT_FORCE_ERROR\",\"from\":\"Normal\",\"to\":\"Error\",\"root\":{\"event\":\"EVT_FORCE_ERROR\",\"origin\":"
       "\"JR3.s_A\",\"t\":0.25}}\n";
-  const HistoryParse with_time = parse_history(recorded);
+  const timeline::HistoryParse with_time = timeline::parse_history(recorded);
   ASSERT_TRUE(with_time.errors.empty());
   EXPECT_TRUE(with_time.records[0].root.has_t);
-  EXPECT_THAT(timeline_model_json(with_time.records), HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at 0.25 s"));
+  EXPECT_THAT(timeline::timeline_model_json(with_time.records),
+              HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at 0.25 s"));
 }
 
 }  // namespace

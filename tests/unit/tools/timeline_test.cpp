@@ -17,7 +17,7 @@
 #include <string>
 
 #include "safecass/json/read.hpp"
-#include "timeline.hpp"
+#include "safecass/timeline/timeline.hpp"
 
 namespace safecass::tools {
 namespace {
@@ -42,9 +42,9 @@ std::string read_text(const std::string& path) {
   return s.str();
 }
 
-std::vector<HistoryRecord> parse_ok(std::string_view text) {
-  HistoryParse p = parse_history(text);
-  for (const HistoryError& e : p.errors) ADD_FAILURE() << "line " << e.line << ": " << e.message;
+std::vector<timeline::HistoryRecord> parse_ok(std::string_view text) {
+  timeline::HistoryParse p = timeline::parse_history(text);
+  for (const timeline::HistoryError& e : p.errors) ADD_FAILURE() << "line " << e.line << ": " << e.message;
   return std::move(p.records);
 }
 
@@ -68,7 +68,7 @@ std::filesystem::path temp_dir() {
 }
 
 TEST(Timeline, GoldenHistoryGivesTheExpectedLanesBarsAndMarkers) {
-  const std::string model = timeline_model_json(parse_ok(read_text(kSmall)));
+  const std::string model = timeline::timeline_model_json(parse_ok(read_text(kSmall)));
   if (std::getenv("SAFECASS_UPDATE_GOLDEN") != nullptr) {
     std::ofstream(kSmallModel, std::ios::binary) << model << '\n';
   }
@@ -76,7 +76,7 @@ TEST(Timeline, GoldenHistoryGivesTheExpectedLanesBarsAndMarkers) {
 }
 
 TEST(Timeline, ModelIsValidJsonWithOneLanePerMachineAndOnePerComponent) {
-  const auto parsed = json::parse_json(timeline_model_json(parse_ok(read_text(kSmall))));
+  const auto parsed = json::parse_json(timeline::timeline_model_json(parse_ok(read_text(kSmall))));
   ASSERT_TRUE(parsed.value) << parsed.error->message;
   const json::JsonValue& groups = *parsed.value->find("groups");
   ASSERT_EQ(groups.array.size(), 2u);
@@ -96,7 +96,7 @@ TEST(Timeline, ModelIsValidJsonWithOneLanePerMachineAndOnePerComponent) {
 }
 
 TEST(Timeline, MarkerTooltipsGiveTheEventRootCauseSampleAndReason) {
-  const std::string model = timeline_model_json(parse_ok(read_text(kSmall)));
+  const std::string model = timeline::timeline_model_json(parse_ok(read_text(kSmall)));
   EXPECT_THAT(model, HasSubstr("Ignored completion /EVT_FORCE_ERROR\\nJR3.s_A, t = 0.35 s (history line 14)"));
   EXPECT_THAT(model, HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at 0.2 s\\n"
                                "filter force_limit, JR3.ForceNorm = 50 (sample at 0.2 s), injected sample"));
@@ -112,16 +112,16 @@ TEST(Timeline, MarkerTooltipsGiveTheEventRootCauseSampleAndReason) {
 
 TEST(Timeline, OverflowLineBecomesAWarningBandBetweenItsNeighbours) {
   const auto records = parse_ok(read_text(kSmall));
-  const std::string model = timeline_model_json(records);
+  const std::string model = timeline::timeline_model_json(records);
   EXPECT_THAT(model, HasSubstr("{\"line\":12,\"dropped\":3,\"from\":0.2,\"to\":0.3,"));
-  const std::string page = render_timeline_page(records, "small.jsonl");
+  const std::string page = timeline::render_timeline_page(records, "small.jsonl");
   EXPECT_THAT(page, HasSubstr("History line 12: the recorder dropped 3 records between 0.2 s and 0.3 s"));
 }
 
 TEST(Timeline, PageEmbedsTheModelAndEveryHistoryLineAsAJsonArray) {
   const auto records = parse_ok(read_text(kSmall));
-  const std::string page = render_timeline_page(records, "small.jsonl");
-  EXPECT_EQ(script_data(page, "timeline-model"), timeline_model_json(records));
+  const std::string page = timeline::render_timeline_page(records, "small.jsonl");
+  EXPECT_EQ(script_data(page, "timeline-model"), timeline::timeline_model_json(records));
   const auto history = json::parse_json(script_data(page, "timeline-history"));
   ASSERT_TRUE(history.value) << history.error->message;
   ASSERT_TRUE(history.value->is_array());
@@ -133,7 +133,7 @@ TEST(Timeline, PageEmbedsTheModelAndEveryHistoryLineAsAJsonArray) {
 }
 
 TEST(Timeline, PageIsOneSelfContainedFileWithInlineStyleAndScript) {
-  const std::string page = render_timeline_page(parse_ok(read_text(kSmall)), "small.jsonl");
+  const std::string page = timeline::render_timeline_page(parse_ok(read_text(kSmall)), "small.jsonl");
   EXPECT_EQ(page.rfind("<!DOCTYPE html>", 0), 0u);
   EXPECT_THAT(page, HasSubstr("</html>"));
   EXPECT_THAT(page, HasSubstr("<style>"));
@@ -150,7 +150,7 @@ TEST(Timeline, PageIsOneSelfContainedFileWithInlineStyleAndScript) {
 TEST(Timeline, TextFromTheHistoryCannotBreakOutOfThePage) {
   const std::string line =
       R"({"t":0.1,"kind":"injection","machine":"X.s_A","text":"</script><script>alert(1)</script>"})";
-  const std::string page = render_timeline_page(parse_ok(line), "<b>.jsonl");
+  const std::string page = timeline::render_timeline_page(parse_ok(line), "<b>.jsonl");
   EXPECT_THAT(page, Not(HasSubstr("<script>alert")));
   EXPECT_THAT(page, Not(HasSubstr("<b>.jsonl")));
   EXPECT_THAT(page, HasSubstr("&lt;b&gt;.jsonl"));
@@ -173,7 +173,7 @@ TEST(Timeline, MalformedLinesAreErrorsNamingTheirLineNumbers) {
       "{\"t\":0.6,\"kind\":\"transition\",\"from\":\"Error\",\"to\":\"Normal\"}\n"  // 11 no machine
       "{\"t\":0.7,\"kind\":\"event\",\"outcome\":\"masked\",\"machine\":\"A.s_A\",\"from\":\"Error\",\"to\":\"Error\","
       "\"root\":3}";
-  const HistoryParse p = parse_history(text);
+  const timeline::HistoryParse p = timeline::parse_history(text);
   ASSERT_EQ(p.errors.size(), 11u);
   const std::vector<std::pair<int, std::string>> expected{
       {2, "invalid JSON at column"},
@@ -198,18 +198,18 @@ TEST(Timeline, MalformedLinesAreErrorsNamingTheirLineNumbers) {
 
 TEST(Timeline, TornLastLineOfAKilledProcessIsSetAsideAndEveryCompleteRecordIsKept) {
   const std::string good = read_text(kSmall);
-  const HistoryParse complete = parse_history(good);
-  const HistoryParse p = parse_history(good + "{\"seq\":99,\"t\":0.6,\"ki");
+  const timeline::HistoryParse complete = timeline::parse_history(good);
+  const timeline::HistoryParse p = timeline::parse_history(good + "{\"seq\":99,\"t\":0.6,\"ki");
   EXPECT_TRUE(p.errors.empty());
   ASSERT_TRUE(p.torn.has_value());
   EXPECT_EQ(p.torn->line, 28);
   EXPECT_THAT(p.torn->message, HasSubstr("invalid JSON at column 19: unterminated string"));
   EXPECT_EQ(p.records.size(), complete.records.size());
-  EXPECT_EQ(timeline_model_json(p.records), timeline_model_json(complete.records));
+  EXPECT_EQ(timeline::timeline_model_json(p.records), timeline::timeline_model_json(complete.records));
 }
 
 TEST(Timeline, AMalformedLineThatIsNotTheLastIsStillAnErrorWhenTheLastIsTorn) {
-  const HistoryParse p = parse_history(
+  const timeline::HistoryParse p = timeline::parse_history(
       "{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
       "{\"t\":0.2,\"kind\":\"res\n"  // cut short, but a line follows: an error, not a torn line
       "{\"t\":0.3,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}\n"
@@ -222,12 +222,12 @@ TEST(Timeline, AMalformedLineThatIsNotTheLastIsStillAnErrorWhenTheLastIsTorn) {
 }
 
 TEST(Timeline, ALastLineWithoutNewlineThatIsCompleteIsARecordAndABadOneAnError) {
-  const HistoryParse good =
-      parse_history("{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}");
+  const timeline::HistoryParse good = timeline::parse_history(
+      "{\"t\":0.1,\"kind\":\"reset\",\"machine\":\"A.s_A\",\"from\":\"Normal\",\"to\":\"Normal\"}");
   EXPECT_TRUE(good.errors.empty());
   EXPECT_FALSE(good.torn.has_value());
   EXPECT_EQ(good.records.size(), 1u);
-  const HistoryParse bad = parse_history("{\"t\":0.1,\"kind\":\"heartbeat\"}");
+  const timeline::HistoryParse bad = timeline::parse_history("{\"t\":0.1,\"kind\":\"heartbeat\"}");
   ASSERT_EQ(bad.errors.size(), 1u) << "valid JSON is not torn: a wrong record stays an error";
   EXPECT_FALSE(bad.torn.has_value());
 }
@@ -239,7 +239,7 @@ TEST(Timeline, CommandDrawsAHistoryWithATornLastLineAndWarnsOnceNamingFileAndLin
   std::ofstream(history, std::ios::binary) << good << "{\"seq\":99,\"t\":0.6,\"kind\":\"trans";
   const auto page = dir / "killed.html";
   ::testing::internal::CaptureStderr();
-  const int code = run_timeline(history.string(), page.string());
+  const int code = timeline::run_timeline(history.string(), page.string());
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(code, 0);
   EXPECT_THAT(err, HasSubstr(history.string() + ":28: warning: the last line is torn"));
@@ -247,9 +247,9 @@ TEST(Timeline, CommandDrawsAHistoryWithATornLastLineAndWarnsOnceNamingFileAndLin
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   const std::string html = read_text(page.string());
   EXPECT_THAT(html, HasSubstr("History line 28 is torn"));
-  const HistoryParse complete = parse_history(good);
+  const timeline::HistoryParse complete = timeline::parse_history(good);
   EXPECT_EQ(script_data(html, "timeline-model"),
-            script_data(render_timeline_page(complete.records, "killed.jsonl"), "timeline-model"))
+            script_data(timeline::render_timeline_page(complete.records, "killed.jsonl"), "timeline-model"))
       << "every complete record is drawn";
   std::filesystem::remove_all(dir);
 }
@@ -262,7 +262,7 @@ TEST(Timeline, CommandExitsTwoWithFileAndLineForABadHistoryAndWritesNoPage) {
          "not json\n";
   const auto page = dir / "bad.html";
   ::testing::internal::CaptureStderr();
-  const int code = run_timeline(history.string(), page.string());
+  const int code = timeline::run_timeline(history.string(), page.string());
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_EQ(code, 2);
   EXPECT_THAT(err, HasSubstr(history.string() + ":2: error: invalid JSON at column 1"));
@@ -272,9 +272,9 @@ TEST(Timeline, CommandExitsTwoWithFileAndLineForABadHistoryAndWritesNoPage) {
 
 TEST(Timeline, CommandExitsTwoWhenTheHistoryCannotBeReadOrThePageCannotBeWritten) {
   ::testing::internal::CaptureStderr();
-  EXPECT_EQ(run_timeline("tests/data/timeline/no-such-history.jsonl", "/dev/null"), 2);
-  EXPECT_EQ(run_timeline(kSmall, "tests/data/timeline/no-such-dir/page.html"), 2);
-  EXPECT_EQ(run_timeline("/dev/zero", "/dev/null"), 2);
+  EXPECT_EQ(timeline::run_timeline("tests/data/timeline/no-such-history.jsonl", "/dev/null"), 2);
+  EXPECT_EQ(timeline::run_timeline(kSmall, "tests/data/timeline/no-such-dir/page.html"), 2);
+  EXPECT_EQ(timeline::run_timeline("/dev/zero", "/dev/null"), 2);
   const std::string err = ::testing::internal::GetCapturedStderr();
   EXPECT_THAT(err, HasSubstr("cannot read file '/dev/zero': not a regular file (a character device)"));
   EXPECT_THAT(err, HasSubstr("history: cannot read file 'tests/data/timeline/no-such-history.jsonl': no such file"));
@@ -282,10 +282,10 @@ TEST(Timeline, CommandExitsTwoWhenTheHistoryCannotBeReadOrThePageCannotBeWritten
 }
 
 TEST(Timeline, EmptyHistoryGivesAValidPageSayingNoTransitions) {
-  const HistoryParse p = parse_history("");
+  const timeline::HistoryParse p = timeline::parse_history("");
   EXPECT_TRUE(p.errors.empty());
   EXPECT_TRUE(p.records.empty());
-  const std::string page = render_timeline_page(p.records, "empty.jsonl");
+  const std::string page = timeline::render_timeline_page(p.records, "empty.jsonl");
   EXPECT_EQ(page.rfind("<!DOCTYPE html>", 0), 0u);
   EXPECT_THAT(page, HasSubstr("</html>"));
   EXPECT_THAT(page, HasSubstr("The history is empty: no transitions."));
@@ -299,19 +299,20 @@ TEST(Timeline, EmptyHistoryGivesAValidPageSayingNoTransitions) {
 TEST(Timeline, HistoryWithRecordsButNoTransitionSaysSo) {
   const auto records = parse_ok(
       R"({"t":1.5,"kind":"event","outcome":"ignored","machine":"A.s_A","event":"/E","from":"Normal","to":"Normal","text":"not active"})");
-  EXPECT_THAT(render_timeline_page(records, "h"), HasSubstr("1 record, no transitions, 2 lanes in 1 component"));
+  EXPECT_THAT(timeline::render_timeline_page(records, "h"),
+              HasSubstr("1 record, no transitions, 2 lanes in 1 component"));
 }
 
 TEST(Timeline, TwoRendersOfTheSameHistoryAreByteIdentical) {
   const auto dir = temp_dir();
   const auto a = dir / "a.html";
   const auto b = dir / "b.html";
-  ASSERT_EQ(run_timeline(kSmall, a.string()), 0);
-  ASSERT_EQ(run_timeline(kSmall, b.string()), 0);
+  ASSERT_EQ(timeline::run_timeline(kSmall, a.string()), 0);
+  ASSERT_EQ(timeline::run_timeline(kSmall, b.string()), 0);
   const std::string first = read_text(a.string());
   EXPECT_FALSE(first.empty());
   EXPECT_EQ(first, read_text(b.string()));
-  EXPECT_EQ(first, render_timeline_page(parse_ok(read_text(kSmall)), "small.jsonl"));
+  EXPECT_EQ(first, timeline::render_timeline_page(parse_ok(read_text(kSmall)), "small.jsonl"));
   std::filesystem::remove_all(dir);
 }
 

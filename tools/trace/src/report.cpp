@@ -7,8 +7,8 @@
 #include <map>
 #include <set>
 
+#include "safecass/timeline/timeline.hpp"
 #include "safecass/trace/trace.hpp"
-#include "timeline.hpp"
 #include "trace_assets.hpp"
 
 #ifndef SAFECASS_VERSION
@@ -252,7 +252,7 @@ std::string gap_table(const Trace& t) {
 }
 
 std::string excerpts(const Trace& t) {
-  std::map<std::string, std::vector<tools::HistoryRecord>> parsed;  // by scenario
+  std::map<std::string, std::vector<timeline::HistoryRecord>> parsed;  // by scenario
   std::string out;
   for (const HazardTrace& h : t.hazards) {
     out += "<h3>" + esc(h.id) + " <span class=\"desc\">" + esc(h.description) + "</span></h3>\n";
@@ -271,12 +271,12 @@ std::string excerpts(const Trace& t) {
       continue;
     }
     auto it = parsed.find(run->path);
-    if (it == parsed.end()) it = parsed.emplace(run->path, tools::parse_history(run->history).records).first;
+    if (it == parsed.end()) it = parsed.emplace(run->path, timeline::parse_history(run->history).records).first;
     const std::set<std::string> shown(h.excerpt_components.begin(), h.excerpt_components.end());
-    std::vector<tools::HistoryRecord> records;
-    for (const tools::HistoryRecord& r : it->second) {
+    std::vector<timeline::HistoryRecord> records;
+    for (const timeline::HistoryRecord& r : it->second) {
       const std::string component = !r.component.empty() ? r.component : r.machine.substr(0, r.machine.find('.'));
-      if (r.kind == tools::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
+      if (r.kind == timeline::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
     }
     out += "<figure class=\"excerpt\" data-hazard=\"" + esc(h.id) + "\" data-scenario=\"" + esc(run->path) +
            "\" data-from=\"" + number(h.excerpt_from) + "\" data-to=\"" + number(h.excerpt_to) + "\">\n<figcaption>" +
@@ -288,7 +288,7 @@ std::string excerpts(const Trace& t) {
            esc(h.id) +
            "\"></svg></div>\n"
            "<script type=\"application/json\" class=\"excerpt-model\">" +
-           tools::timeline_model_json(records) + "</script>\n</figure>\n";
+           timeline::timeline_model_json(records) + "</script>\n</figure>\n";
   }
   return out;
 }

@@ -1,6 +1,6 @@
 // `safecass timeline`: history (JSON lines) → model (lanes, bars, markers) → static HTML page.
 
-#include "timeline.hpp"
+#include "safecass/timeline/timeline.hpp"
 
 #include "safecass/json/write.hpp"
 
@@ -19,7 +19,7 @@
 
 #include "timeline_assets.hpp"  // generated from web/timeline/ at build time
 
-namespace safecass::tools {
+namespace safecass::timeline {
 
 namespace {
 
@@ -739,4 +739,4 @@ int write_timeline_page(const std::vector<HistoryRecord>& records, const std::st
   return 0;
 }
 
-}  // namespace safecass::tools
+}  // namespace safecass::timeline

@@ -16,7 +16,7 @@
 
 #include "safecass/json/read.hpp"
 
-namespace safecass::tools {
+namespace safecass::timeline {
 
 /// One line of a history file, checked and typed. Field names follow record_to_json()
 /// (record/src/recorder.cpp); a field absent from the line is empty (strings) or false/0.
@@ -92,4 +92,4 @@ int run_timeline(const std::string& history, const std::string& html_out);
 int write_timeline_page(const std::vector<HistoryRecord>& records, const std::string& title,
                         const std::string& html_out, const std::optional<HistoryError>& torn = std::nullopt);
 
-}  // namespace safecass::tools
+}  // namespace safecass::timeline
