@@ -84,6 +84,22 @@ std::string seconds_text(Time t) { return json::json_seconds(t); }
 
 std::string number_text(double v) { return fmt::format("{:.9g}", v); }
 
+std::string markup_text(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
 std::string TimeFormat::at(Time t) const {
   if (base_ == TimeBase::Simulated) return "t=" + seconds_text(t);
   return iso8601_local(t.count() + wall_offset_ns_);

@@ -9,25 +9,10 @@
 #include "middleware_commands.hpp"
 #endif
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 
 namespace safecass::tools {
-
-namespace {
-std::string xml_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-}  // namespace
 
 int run_run(const RunArgs& args) {
 #ifdef SAFECASS_WITH_ICE
@@ -109,9 +94,10 @@ int run_test(const TestArgs& args) {
     xml << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuite name=\"safecass\" tests=\"" << cases.size()
         << "\" failures=\"" << cases.size() - passed << "\">\n";
     for (const Case& c : cases) {
-      xml << "  <testcase name=\"" << xml_escape(c.name) << "\" classname=\"scenario\">\n";
+      xml << "  <testcase name=\"" << introspect::markup_text(c.name) << "\" classname=\"scenario\">\n";
       if (c.code == 2) xml << "    <error message=\"invalid scenario or system\"/>\n";
-      for (const std::string& f : c.result.failures) xml << "    <failure message=\"" << xml_escape(f) << "\"/>\n";
+      for (const std::string& f : c.result.failures)
+        xml << "    <failure message=\"" << introspect::markup_text(f) << "\"/>\n";
       xml << "  </testcase>\n";
     }
     xml << "</testsuite>\n";

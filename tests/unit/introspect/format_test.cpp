@@ -22,5 +22,11 @@ TEST(NumberText, HasAtMostNineSignificantDigitsAndNamesNonFiniteValues) {
   EXPECT_EQ(number_text(-std::numeric_limits<double>::infinity()), "-inf");
 }
 
+TEST(MarkupText, EscapesTheFiveMarkupCharactersAndCopiesEveryOtherByte) {
+  EXPECT_EQ(markup_text("a<b>&\"c'd"), "a&lt;b&gt;&amp;&quot;c&#39;d");
+  EXPECT_EQ(markup_text("JR3.s_A \xc2\xb0 \n"), "JR3.s_A \xc2\xb0 \n");
+  EXPECT_EQ(markup_text(""), "");
+}
+
 }  // namespace
 }  // namespace safecass::introspect

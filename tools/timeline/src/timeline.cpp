@@ -1,6 +1,7 @@
 // `safecass timeline`: history (JSON lines) → model (lanes, bars, markers) → static HTML page.
 
 #include "safecass/timeline/timeline.hpp"
+#include "safecass/introspect/format.hpp"
 
 #include "safecass/json/write.hpp"
 
@@ -58,21 +59,6 @@ std::string script_safe(std::string_view json) {
       case '<': out += "\\u003c"; break;
       case '>': out += "\\u003e"; break;
       case '&': out += "\\u0026"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
-std::string html_escape(std::string_view s) {
-  std::string out;
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
       default: out += c;
     }
   }
@@ -692,9 +678,9 @@ std::string render_timeline_page(const std::vector<HistoryRecord>& records, cons
                                  const std::optional<HistoryError>& torn) {
   const Model m = build_model(records);
   const std::map<std::string, std::string, std::less<>> values{
-      {"TITLE", html_escape(title)},         {"SUMMARY", html_escape(summary_text(m, records.size()))},
-      {"WARNINGS", warnings_html(m, torn)},  {"CSS", std::string(web::kTimelineCss)},
-      {"JS", std::string(web::kTimelineJs)}, {"MODEL", model_json(m, records.size())},
+      {"TITLE", introspect::markup_text(title)}, {"SUMMARY", introspect::markup_text(summary_text(m, records.size()))},
+      {"WARNINGS", warnings_html(m, torn)},      {"CSS", std::string(web::kTimelineCss)},
+      {"JS", std::string(web::kTimelineJs)},     {"MODEL", model_json(m, records.size())},
       {"HISTORY", history_json(records)},
   };
   return fill(web::kTimelineHtml, values);

@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/timeline/timeline.hpp"
 #include "safecass/trace/trace.hpp"
 #include "trace_assets.hpp"
@@ -18,22 +19,6 @@
 namespace safecass::trace {
 
 namespace {
-
-std::string esc(std::string_view s) {
-  std::string out;
-  out.reserve(s.size());
-  for (const char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
 
 std::string join(const std::vector<std::string>& items, const std::string& sep) {
   std::string out;
@@ -51,8 +36,8 @@ std::string marker(Severity s, const std::string& kind, const std::string& text)
   const std::string sev(to_string(s));
   std::string label = sev;
   for (char& c : label) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  return "<span class=\"marker-gap " + sev + "\" data-gap=\"" + esc(kind) + "\">" + label + ": " + esc(text) +
-         "</span>";
+  return "<span class=\"marker-gap " + sev + "\" data-gap=\"" + introspect::markup_text(kind) + "\">" + label + ": " +
+         introspect::markup_text(text) + "</span>";
 }
 
 /// The gaps about one subject of one hazard ("" hazard: gaps of no hazard).
@@ -92,23 +77,27 @@ Severity worst(const std::vector<const Gap*>& gaps, Severity none) {
 }
 
 std::string filter_cell(const FilterLink& f) {
-  std::string out = "<b>" + esc(f.name) + "</b> <span class=\"small\">(" + esc(f.role) + ")</span><br>" + esc(f.type) +
-                    ", " + esc(f.execution) + ", every " + esc(f.period) + "<br>on " + esc(f.target);
-  if (!f.signals.empty()) out += "<br>reads " + esc(f.signals);
-  if (!f.threshold.empty()) out += "<br>threshold <b>" + esc(f.threshold) + "</b>";
-  if (!f.parameters.empty()) out += "<br><span class=\"small\">" + esc(join(f.parameters, ", ")) + "</span>";
+  std::string out = "<b>" + introspect::markup_text(f.name) + "</b> <span class=\"small\">(" +
+                    introspect::markup_text(f.role) + ")</span><br>" + introspect::markup_text(f.type) + ", " +
+                    introspect::markup_text(f.execution) + ", every " + introspect::markup_text(f.period) + "<br>on " +
+                    introspect::markup_text(f.target);
+  if (!f.signals.empty()) out += "<br>reads " + introspect::markup_text(f.signals);
+  if (!f.threshold.empty()) out += "<br>threshold <b>" + introspect::markup_text(f.threshold) + "</b>";
+  if (!f.parameters.empty())
+    out += "<br><span class=\"small\">" + introspect::markup_text(join(f.parameters, ", ")) + "</span>";
   if (!f.pipeline.empty())
-    out += "<br><span class=\"small\">pipeline " + esc(f.pipeline) + ": " + esc(join(f.chain, " → ")) + "</span>";
+    out += "<br><span class=\"small\">pipeline " + introspect::markup_text(f.pipeline) + ": " +
+           introspect::markup_text(join(f.chain, " → ")) + "</span>";
   return out;
 }
 
 std::string event_cell(const EventLink& e) {
-  std::string out = "<b>" + esc(e.name) + "</b> <span class=\"small\">(" + (e.onset ? "onset" : "completion") +
-                    ")</span><br>" + esc(e.component) + ", severity " + std::to_string(e.severity) + "<br>" +
-                    esc(e.transitions);
-  if (e.onset) out += " → " + esc(e.level);
+  std::string out = "<b>" + introspect::markup_text(e.name) + "</b> <span class=\"small\">(" +
+                    (e.onset ? "onset" : "completion") + ")</span><br>" + introspect::markup_text(e.component) +
+                    ", severity " + std::to_string(e.severity) + "<br>" + introspect::markup_text(e.transitions);
+  if (e.onset) out += " → " + introspect::markup_text(e.level);
   if (e.latched) out += "<br><b>latched</b> (cleared by reset)";
-  out += "<br>to " + esc(join(e.targets, ", "));
+  out += "<br>to " + introspect::markup_text(join(e.targets, ", "));
   return out;
 }
 
@@ -116,14 +105,16 @@ std::string scenarios_cell(const EventLink& e) {
   if (e.fired_by.empty()) return "<span class=\"bad\">none</span>";
   std::string out = "<ul class=\"plain\">";
   for (const ScenarioUse& u : e.fired_by) {
-    out += "<li>" + esc(u.scenario) +
-           (u.transitions.empty() ? "" : " <span class=\"small\">(" + esc(join(u.transitions, " ")) + ")</span>") +
+    out += "<li>" + introspect::markup_text(u.scenario) +
+           (u.transitions.empty()
+                ? ""
+                : " <span class=\"small\">(" + introspect::markup_text(join(u.transitions, " ")) + ")</span>") +
            "</li>";
   }
   out += "</ul>";
   if (e.onset) {
     out += "<span class=\"small\">cleared by: " +
-           (e.cleared_by.empty() ? std::string("none") : esc(join(e.cleared_by, ", "))) + "</span>";
+           (e.cleared_by.empty() ? std::string("none") : introspect::markup_text(join(e.cleared_by, ", "))) + "</span>";
   }
   return out;
 }
@@ -132,9 +123,10 @@ std::string reaction_cell(const Trace& t, const HazardTrace& h) {
   if (h.reaction.empty()) return "<span class=\"small\">none declared</span>";
   std::string out = "<ul class=\"plain\">";
   for (const ReactionLink& r : h.reaction) {
-    out += "<li data-address=\"" + esc(r.address) + "\"><b>" + esc(r.address) + "</b> ≥ " + esc(r.level) +
-           "<br><span class=\"small\">" +
-           (r.checked_by.empty() ? std::string("checked by no expect") : "expect in " + esc(join(r.checked_by, ", "))) +
+    out += "<li data-address=\"" + introspect::markup_text(r.address) + "\"><b>" + introspect::markup_text(r.address) +
+           "</b> ≥ " + introspect::markup_text(r.level) + "<br><span class=\"small\">" +
+           (r.checked_by.empty() ? std::string("checked by no expect")
+                                 : "expect in " + introspect::markup_text(join(r.checked_by, ", "))) +
            "</span>" + markers(gaps_about(t, h.id, r.address)) + "</li>";
   }
   return out + "</ul>";
@@ -143,8 +135,8 @@ std::string reaction_cell(const Trace& t, const HazardTrace& h) {
 std::string verify_cell(const HazardTrace& h) {
   const std::string v(to_string(h.verified));
   const char* cls = h.verified == Verdict::Holds ? "ok" : h.verified == Verdict::Violated ? "bad" : "small";
-  return "<span class=\"" + std::string(cls) + "\" data-verify=\"" + v + "\">" + esc(v) +
-         "</span><br><span class=\"small\">" + esc(h.verify_detail) + "</span>";
+  return "<span class=\"" + std::string(cls) + "\" data-verify=\"" + v + "\">" + introspect::markup_text(v) +
+         "</span><br><span class=\"small\">" + introspect::markup_text(h.verify_detail) + "</span>";
 }
 
 std::string row_class(Severity s) {
@@ -176,7 +168,7 @@ std::string matrix(const Trace& t) {
     }
     if (rows.empty()) rows.push_back({nullptr, nullptr});
     const auto hazard_gaps = gaps_about(t, h.id, h.id);
-    out += "<tbody class=\"hazard\" data-hazard=\"" + esc(h.id) + "\">\n";
+    out += "<tbody class=\"hazard\" data-hazard=\"" + introspect::markup_text(h.id) + "\">\n";
     for (std::size_t k = 0; k < rows.size(); ++k) {
       const Row& r = rows[k];
       std::vector<const Gap*> row_gaps = k == 0 ? hazard_gaps : std::vector<const Gap*>{};
@@ -184,12 +176,13 @@ std::string matrix(const Trace& t) {
       if (r.event != nullptr) event_gaps = gaps_about(t, h.id, r.event->name);
       const bool first_of_event = r.event == nullptr || k == 0 || rows[k - 1].event != r.event;
       if (first_of_event) row_gaps.insert(row_gaps.end(), event_gaps.begin(), event_gaps.end());
-      out += "<tr data-event=\"" + esc(r.event != nullptr ? r.event->name : "") + "\" data-filter=\"" +
-             esc(r.filter != nullptr ? r.filter->name : "") + "\"" + row_class_or_none(worst(row_gaps, kNoGap)) + ">";
+      out += "<tr data-event=\"" + introspect::markup_text(r.event != nullptr ? r.event->name : "") +
+             "\" data-filter=\"" + introspect::markup_text(r.filter != nullptr ? r.filter->name : "") + "\"" +
+             row_class_or_none(worst(row_gaps, kNoGap)) + ">";
       if (k == 0) {
         const std::string span = " rowspan=\"" + std::to_string(rows.size()) + "\"";
-        out += "<td class=\"hazard-id\"" + span + ">" + esc(h.id) + "<br><span class=\"desc\">" + esc(h.description) +
-               "</span>" + markers(hazard_gaps) + "</td>";
+        out += "<td class=\"hazard-id\"" + span + ">" + introspect::markup_text(h.id) + "<br><span class=\"desc\">" +
+               introspect::markup_text(h.description) + "</span>" + markers(hazard_gaps) + "</td>";
         out += "<td" + span + ">" + reaction_cell(t, h) + "</td>";
       }
       if (r.event == nullptr) {
@@ -216,8 +209,8 @@ std::string matrix(const Trace& t) {
     for (const EventLink& e : t.unlinked) {
       for (const FilterLink& f : e.filters) {
         const auto g = gaps_about(t, "", f.name);
-        out += "<tr data-event=\"" + esc(e.name) + "\" data-filter=\"" + esc(f.name) + "\"" +
-               row_class_or_none(worst(g, kNoGap)) + ">";
+        out += "<tr data-event=\"" + introspect::markup_text(e.name) + "\" data-filter=\"" +
+               introspect::markup_text(f.name) + "\"" + row_class_or_none(worst(g, kNoGap)) + ">";
         if (first)
           out += "<td class=\"hazard-id\" rowspan=\"" + std::to_string(rows) +
                  "\">no hazard<br><span class=\"desc\">onsets generated by filters and linked to no declared "
@@ -243,10 +236,11 @@ std::string gap_table(const Trace& t) {
   for (const Gap& g : t.gaps) {
     std::string where = g.where.file;
     if (g.where.line > 0) where += ":" + std::to_string(g.where.line) + ":" + std::to_string(g.where.column);
-    out += "<tr class=\"gap gap-" + std::string(to_string(g.severity)) + "\" data-kind=\"" + esc(g.kind) +
-           "\" data-severity=\"" + std::string(to_string(g.severity)) + "\"><td>" + marker(g.severity, g.kind, g.kind) +
-           "</td><td>" + esc(g.kind) + "</td><td>" + esc(g.hazard) + "</td><td>" + esc(g.subject) + "</td><td>" +
-           esc(g.message) + "</td><td>" + esc(where) + "</td></tr>\n";
+    out += "<tr class=\"gap gap-" + std::string(to_string(g.severity)) + "\" data-kind=\"" +
+           introspect::markup_text(g.kind) + "\" data-severity=\"" + std::string(to_string(g.severity)) + "\"><td>" +
+           marker(g.severity, g.kind, g.kind) + "</td><td>" + introspect::markup_text(g.kind) + "</td><td>" +
+           introspect::markup_text(g.hazard) + "</td><td>" + introspect::markup_text(g.subject) + "</td><td>" +
+           introspect::markup_text(g.message) + "</td><td>" + introspect::markup_text(where) + "</td></tr>\n";
   }
   return out + "</tbody></table>\n";
 }
@@ -255,10 +249,11 @@ std::string excerpts(const Trace& t) {
   std::map<std::string, std::vector<timeline::HistoryRecord>> parsed;  // by scenario
   std::string out;
   for (const HazardTrace& h : t.hazards) {
-    out += "<h3>" + esc(h.id) + " <span class=\"desc\">" + esc(h.description) + "</span></h3>\n";
+    out += "<h3>" + introspect::markup_text(h.id) + " <span class=\"desc\">" + introspect::markup_text(h.description) +
+           "</span></h3>\n";
     if (h.excerpt_scenario.empty()) {
-      out +=
-          "<p class=\"bad\" data-excerpt-missing=\"" + esc(h.id) + "\">No scenario exercises " + esc(h.id) + ".</p>\n";
+      out += "<p class=\"bad\" data-excerpt-missing=\"" + introspect::markup_text(h.id) + "\">No scenario exercises " +
+             introspect::markup_text(h.id) + ".</p>\n";
       continue;
     }
     const ScenarioResult* run = nullptr;
@@ -266,8 +261,8 @@ std::string excerpts(const Trace& t) {
       if (s.path == h.excerpt_scenario) run = &s;
     }
     if (run == nullptr || run->history.empty()) {
-      out += "<p class=\"small\">" + esc(h.id) + " is exercised by " + esc(h.excerpt_scenario) +
-             " (no history kept).</p>\n";
+      out += "<p class=\"small\">" + introspect::markup_text(h.id) + " is exercised by " +
+             introspect::markup_text(h.excerpt_scenario) + " (no history kept).</p>\n";
       continue;
     }
     auto it = parsed.find(run->path);
@@ -278,14 +273,15 @@ std::string excerpts(const Trace& t) {
       const std::string component = !r.component.empty() ? r.component : r.machine.substr(0, r.machine.find('.'));
       if (r.kind == timeline::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
     }
-    out += "<figure class=\"excerpt\" data-hazard=\"" + esc(h.id) + "\" data-scenario=\"" + esc(run->path) +
-           "\" data-from=\"" + number(h.excerpt_from) + "\" data-to=\"" + number(h.excerpt_to) + "\">\n<figcaption>" +
-           esc(h.id) + " in " + esc(run->path) + ", t = " + number(h.excerpt_from) + " s to " + number(h.excerpt_to) +
-           " s; " + esc(join(h.excerpt_components, ", ")) +
+    out += "<figure class=\"excerpt\" data-hazard=\"" + introspect::markup_text(h.id) + "\" data-scenario=\"" +
+           introspect::markup_text(run->path) + "\" data-from=\"" + number(h.excerpt_from) + "\" data-to=\"" +
+           number(h.excerpt_to) + "\">\n<figcaption>" + introspect::markup_text(h.id) + " in " +
+           introspect::markup_text(run->path) + ", t = " + number(h.excerpt_from) + " s to " + number(h.excerpt_to) +
+           " s; " + introspect::markup_text(join(h.excerpt_components, ", ")) +
            "</figcaption>\n<div class=\"excerpt-box\"><svg class=\"timeline-axis\" role=\"img\" aria-label=\"Time axis "
            "in seconds\"></svg>"
            "<svg class=\"timeline-lanes\" role=\"img\" aria-label=\"States during " +
-           esc(h.id) +
+           introspect::markup_text(h.id) +
            "\"></svg></div>\n"
            "<script type=\"application/json\" class=\"excerpt-model\">" +
            timeline::timeline_model_json(records) + "</script>\n</figure>\n";
@@ -308,7 +304,7 @@ std::string coverage_table(const Trace& t) {
       "</tbody></table>\n<table "
       "id=\"scenario-table\"><thead><tr><th>Scenario</th><th>Result</th><th>Checks</th></tr></thead><tbody>\n";
   for (const ScenarioResult& s : t.scenarios) {
-    out += "<tr><td>" + esc(s.path) + "</td><td class=\"" + (s.passed ? "ok" : "bad") + "\">" +
+    out += "<tr><td>" + introspect::markup_text(s.path) + "</td><td class=\"" + (s.passed ? "ok" : "bad") + "\">" +
            (s.passed ? "passed" : "FAILED") + "</td><td>" + std::to_string(s.checks) + "</td></tr>\n";
   }
   return out + "</tbody></table>\n";
@@ -355,21 +351,22 @@ std::string render_trace_page(const Trace& t, const std::string& date) {
   for (const Gap& g : t.gaps) {
     (g.severity == Severity::Error ? errors : g.severity == Severity::Warning ? warnings : infos) += 1;
   }
-  std::string body = "<header class=\"report\">\n<h1>Hazard trace: <span id=\"system-name\">" + esc(t.system) +
-                     "</span></h1>\n<dl class=\"meta\">";
-  body += "<dt>System file</dt><dd>" + esc(t.system_path) + "</dd>";
-  body += "<dt>Tool</dt><dd id=\"tool-version\">safecass " + esc(tool_version()) + " (safecass trace)</dd>";
-  body += "<dt>Date</dt><dd id=\"report-date\">" + esc(date) + "</dd>";
+  std::string body = "<header class=\"report\">\n<h1>Hazard trace: <span id=\"system-name\">" +
+                     introspect::markup_text(t.system) + "</span></h1>\n<dl class=\"meta\">";
+  body += "<dt>System file</dt><dd>" + introspect::markup_text(t.system_path) + "</dd>";
+  body += "<dt>Tool</dt><dd id=\"tool-version\">safecass " + introspect::markup_text(tool_version()) +
+          " (safecass trace)</dd>";
+  body += "<dt>Date</dt><dd id=\"report-date\">" + introspect::markup_text(date) + "</dd>";
   body += "<dt>Scenarios</dt><dd>" + std::to_string(t.scenarios.size()) + "</dd>";
   body += "<dt>Verification</dt><dd>" +
           (t.verify_source.empty() ? std::string("not run (no `safecass verify --json` result given)")
-                                   : esc(t.verify_source)) +
+                                   : introspect::markup_text(t.verify_source)) +
           "</dd>";
   body +=
       "</dl>\n<table class=\"files\" id=\"file-table\"><thead><tr><th>Specification "
       "file</th><th>SHA-256</th></tr></thead><tbody>\n";
   for (const SpecFile& f : t.files)
-    body += "<tr><td>" + esc(f.path) + "</td><td class=\"hash\">" + f.sha256 + "</td></tr>\n";
+    body += "<tr><td>" + introspect::markup_text(f.path) + "</td><td class=\"hash\">" + f.sha256 + "</td></tr>\n";
   body += "</tbody></table>\n<p id=\"verdict\" class=\"verdict " + std::string(errors == 0 ? "pass" : "fail") + "\">" +
           (errors == 0 ? "No gap of error severity."
                        : std::to_string(errors) + " gap" + (errors == 1 ? "" : "s") + " of error severity.") +
@@ -383,8 +380,9 @@ std::string render_trace_page(const Trace& t, const std::string& date) {
       excerpts(t) + "</section>\n";
   body += "<section id=\"coverage\"><h2>Coverage</h2>\n" + coverage_table(t) + "</section>\n";
   const std::map<std::string, std::string, std::less<>> values{
-      {"TITLE", esc(t.system)}, {"TIMELINE_CSS", std::string(web::kTimelineCss)}, {"CSS", std::string(web::kTraceCss)},
-      {"BODY", body},           {"TIMELINE_JS", std::string(web::kTimelineJs)},   {"JS", std::string(web::kTraceJs)},
+      {"TITLE", introspect::markup_text(t.system)},   {"TIMELINE_CSS", std::string(web::kTimelineCss)},
+      {"CSS", std::string(web::kTraceCss)},           {"BODY", body},
+      {"TIMELINE_JS", std::string(web::kTimelineJs)}, {"JS", std::string(web::kTraceJs)},
   };
   return fill(web::kTraceHtml, values);
 }

@@ -39,6 +39,9 @@ std::string iso8601_local(std::int64_t unix_ns);
 std::string seconds_text(Time t);
 /// A number as people read it, at most 9 significant digits: "1.5", "30".
 std::string number_text(double v);
+/// Text for an HTML or XML document (the timeline and trace pages, `safecass run --junit`):
+/// & < > " ' become character references; every other byte is copied.
+std::string markup_text(std::string_view text);
 /// Left-aligned columns, two spaces apart; the last column is not padded. Each row ends in '\n'.
 std::string columns(const std::vector<std::vector<std::string>>& rows);
 /// "N2E,W2E".
