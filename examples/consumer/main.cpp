@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "safecass/native/runtime.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/spec/instance.hpp"
 
 using namespace safecass;
 
@@ -21,19 +21,19 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: gripper_consumer SPEC\n");
     return 2;
   }
-  FilterRegistry registry;
-  register_builtin_filters(registry);
-  spec::LoadResult loaded = spec::load_system(argv[1], registry);
-  for (const auto& d : loaded.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  if (!loaded.ok()) return 2;
-
   SimulatedClock clock;
-  Coordinator co("gripper_cell", &clock);
-  Monitor monitor(co, registry);
-  if (auto built = spec::instantiate(*loaded.system, co, monitor); !built) {
-    std::fprintf(stderr, "%s\n", built.error().message.c_str());
+  spec::InstanceOptions options;
+  options.name = "gripper_cell";
+  options.clock = &clock;
+  spec::Diagnostics notes;
+  auto opened = spec::open_instance(argv[1], builtin_filters(), options, &notes);
+  spec::print(notes, stderr);
+  if (!opened) {
+    spec::print(opened.error(), stderr);
     return 2;
   }
+  Coordinator& co = (*opened)->coordinator();
+  Monitor& monitor = (*opened)->monitor();
   const auto gripper = co.find_component("GRIPPER");
   Signal* force = monitor.signals().find("GRIPPER.Force");
   if (!gripper || force == nullptr) {

@@ -6,23 +6,22 @@
 
 #include <cstdio>
 
-#include "safecass/runner/system.hpp"
+#include "safecass/native/system.hpp"
 
 using namespace safecass;
 
 int main(int argc, char** argv) {
   const std::string path = argc > 1 ? argv[1] : "examples/force_sensor/force_sensor.json";
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   // One factory builds the system: coordinator, monitor, filters, and a 1 ms task per component.
-  runner::SystemOptions options;
+  native::SystemOptions options;
   options.component_period = std::chrono::milliseconds(1);
-  auto opened = runner::open_system(path, registry, options);
+  auto opened = native::open_system(path, registry, options);
   if (!opened) {
-    runner::print(opened.error(), stderr);
+    spec::print(opened.error(), stderr);
     return 2;
   }
-  runner::System& system = **opened;
+  native::System& system = **opened;
   SimulatedClock& clock = *system.simulated_clock();
   Coordinator& co = system.coordinator();
   native::Runtime& runtime = system.runtime();

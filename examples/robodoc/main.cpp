@@ -67,11 +67,10 @@ int main(int argc, char** argv) {
   const std::string scenario_path = argc > 1 ? argv[1] : "examples/robodoc/story.json";
   const std::string history_path = argc > 2 ? argv[2] : "";
 
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario_path, ""}, registry);
   if (!opened) {
-    runner::print(opened.error(), stderr);
+    spec::print(opened.error(), stderr);
     return 2;
   }
   runner::ScenarioRunner& run = **opened;

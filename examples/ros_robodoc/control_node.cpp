@@ -78,8 +78,7 @@ private:
 int main(int argc, char** argv) {
   ros::init(argc, argv, "robodoc_control");
   const std::string mapping = argc > 1 ? argv[1] : "examples/ros_robodoc/mapping.json";
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   auto bridge = ros1::Bridge::create(mapping, registry);
   if (!bridge) {
     std::fprintf(stderr, "%s\n", bridge.error().message.c_str());

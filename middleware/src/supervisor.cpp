@@ -17,12 +17,11 @@
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
 #include "receiver.hpp"
-#include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/model.hpp"
 #include "safecass/middleware/keys.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/spec/instance.hpp"
 
 namespace safecass::middleware {
 
@@ -42,9 +41,9 @@ using TextMap = std::unordered_map<std::string, V, TextHash, std::equal_to<>>;
 struct Supervisor::Impl {
   const spec::SystemSpec& system;
   SupervisorOptions options;
-  FilterRegistry registry;
-  Coordinator model{"supervisor"};
-  std::unique_ptr<Monitor> monitor;
+  FilterRegistry builtin;                    ///< the built-in filter types, when the options give no registry
+  std::unique_ptr<spec::Instance> instance;  ///< the view: every component of the system, named "supervisor"
+  Coordinator& model() noexcept { return instance->coordinator(); }
 
   /// Event records not received between two that were: IceStorm forwards a topic's messages
   /// without the "ordered" QoS, so a batch can arrive after the next one. A record of an open gap
@@ -607,7 +606,7 @@ struct Supervisor::Impl {
   void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
     if (recovered.empty()) return;
     print("supervisor: coordinator '" + who + "' recovered");
-    for (const std::string& c : recovered) (void)model.generate("/EVT_COORDINATOR_LOST", address::framework(c));
+    for (const std::string& c : recovered) (void)model().generate("/EVT_COORDINATOR_LOST", address::framework(c));
   }
 
   /// After records of a coordinator were missed, its rows in the view may be stale: read its
@@ -719,7 +718,7 @@ struct Supervisor::Impl {
       }
       for (const auto& [name, components, why] : lost_now) {
         print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
-        for (const std::string& c : components) (void)model.generate("EVT_COORDINATOR_LOST", address::framework(c));
+        for (const std::string& c : components) (void)model().generate("EVT_COORDINATOR_LOST", address::framework(c));
       }
     }
   }
@@ -808,15 +807,22 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
     Impl* d = impl.get();
     impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->print(line); });
   }
-  register_builtin_filters(impl->registry);
-  impl->monitor = std::make_unique<Monitor>(impl->model, impl->registry);
-  if (auto r = spec::instantiate(system, impl->model, *impl->monitor); !r) return tl::unexpected(r.error());
+  const FilterRegistry* registry = impl->options.registry;
+  if (registry == nullptr) {
+    register_builtin_filters(impl->builtin);
+    registry = &impl->builtin;
+  }
+  spec::InstanceOptions view;
+  view.name = "supervisor";
+  auto built = spec::build_instance(system, *registry, view);
+  if (!built) return fail(ErrorCode::InvalidArgument, "supervisor: " + spec::to_text(built.error()));
+  impl->instance = std::move(*built);
   for (const auto& [name, components] : system.coordinators) impl->peers[name].components = components;
   impl->members = std::make_unique<Members>(system);
   Impl* d = impl.get();
-  impl->model.subscribe([d](const Record& r) {
+  impl->model().subscribe([d](const Record& r) {
     if (r.kind != RecordKind::Transition) return;
-    const introspect::HistoryEntry entry = introspect::history_entry(r, d->model);
+    const introspect::HistoryEntry entry = introspect::history_entry(r, d->model());
     d->emit(SupervisorLine::of_record({}, entry));
   });
   return std::unique_ptr<Supervisor>(new Supervisor(std::move(impl)));
@@ -943,6 +949,6 @@ std::vector<std::string> Supervisor::lost() const {
 
 std::uint64_t Supervisor::messages_refused() const { return impl_->drops->count(); }
 
-const Coordinator& Supervisor::model() const { return impl_->model; }
+const Coordinator& Supervisor::model() const { return impl_->model(); }
 
 }  // namespace safecass::middleware

@@ -20,6 +20,27 @@ std::string format(const Diagnostic& d) {
   return out;
 }
 
+Diagnostics keep_errors(Diagnostics diagnostics, Diagnostics* notes) {
+  Diagnostics errors;
+  for (Diagnostic& d : diagnostics) {
+    if (d.severity == Diagnostic::Severity::Error)
+      errors.push_back(std::move(d));
+    else if (notes != nullptr)
+      notes->push_back(std::move(d));
+  }
+  return errors;
+}
+
+void print(const Diagnostics& diagnostics, std::FILE* out) {
+  for (const Diagnostic& d : diagnostics) std::fprintf(out, "%s\n", format(d).c_str());
+}
+
+std::string to_text(const Diagnostics& diagnostics) {
+  std::string text;
+  for (const Diagnostic& d : diagnostics) text += (text.empty() ? "" : "\n") + format(d);
+  return text;
+}
+
 std::string to_json(const Diagnostic& d) {
   const char* severity = d.severity == Diagnostic::Severity::Error     ? "error"
                          : d.severity == Diagnostic::Severity::Warning ? "warning"

@@ -388,7 +388,6 @@ private:
 
 /// A system built in this process, run in simulated time by a scenario runner.
 struct InProcessSystem {
-  FilterRegistry registry;  // outlives the runner's monitor
   std::unique_ptr<runner::ScenarioRunner> runner;
   runner::RunResult result;  // expectation failures of the scenario so far
   std::size_t failures_reported = 0;
@@ -407,9 +406,8 @@ Expected<std::unique_ptr<Backend>> console::make_backend(Target target, ConsoleO
 Expected<std::unique_ptr<Console>> Console::open(const std::string& system, const std::string& scenario,
                                                  ConsoleOptions options) {
   auto sys = std::make_shared<InProcessSystem>();
-  register_builtin_filters(sys->registry);
-  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario, system}, sys->registry);
-  if (!opened) return fail(ErrorCode::InvalidArgument, runner::to_text(opened.error()));
+  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario, system}, builtin_filters());
+  if (!opened) return fail(ErrorCode::InvalidArgument, spec::to_text(opened.error()));
   sys->runner = std::move(*opened);
   const spec::Scenario& sc = sys->runner->scenario();
   const std::string system_path = sc.system;
@@ -421,7 +419,7 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
   sys->runner->advance_to(Time{0}, sys->result);  // what happens at t = 0 is in the histories
   Coordinator& co = sys->runner->coordinator();
   Target target;
-  target.query = std::make_unique<in::LocalQuery>(co, sys->runner->monitor(), sys->registry, local);
+  target.query = std::make_unique<in::LocalQuery>(co, sys->runner->monitor(), builtin_filters(), local);
   target.subject = "system " + system_path + " (" + std::to_string(co.component_count()) + " components" +
                    (scenario.empty() ? "" : ", scenario " + scenario) + ")";
   InProcessSystem* raw = sys.get();

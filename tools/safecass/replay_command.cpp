@@ -57,8 +57,7 @@ void add_replay_command(CLI::App& app, int& code) {
       code = 2;
       return;
     }
-    FilterRegistry registry;
-    register_builtin_filters(registry);
+    const FilterRegistry& registry = builtin_filters();
     if (args->diff) {
       if (args->systems.size() != 2) {
         std::fprintf(stderr, "replay --diff: two systems are needed: SYSTEM_B SYSTEM_A\n");

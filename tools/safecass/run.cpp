@@ -23,8 +23,7 @@ int run_run(const RunArgs& args) {
                  "safecass run: --scenario is required (unless --coordinator runs one coordinator in real time)\n");
     return 2;
   }
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   runner::RunOptions options;
   options.json = args.json;
   options.record_path = args.record;
@@ -43,8 +42,7 @@ int run_run(const RunArgs& args) {
 }
 
 int run_test(const TestArgs& args) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   struct Case {
     std::string name;
     int code;

@@ -31,7 +31,7 @@
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/runner/system.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
 
@@ -226,7 +226,7 @@ bool load_run_scenario(const RunArgs& args, const FilterRegistry& registry, std:
     // `safecass run` does in simulated time; this process then applies the steps on its part.
     auto checked = runner::ScenarioRunner::open(runner::ScenarioSource{args.scenario, system_path}, registry);
     if (!checked) {
-      runner::print(checked.error(), stderr);
+      spec::print(checked.error(), stderr);
       return false;
     }
   }
@@ -277,7 +277,7 @@ struct BusPart {
 
 /// Joins the bus when --ice is given: makes the token files, then creates and starts the node.
 /// False (said) on an error, or on --allow-write without --ice.
-bool join_bus(const RunArgs& args, runner::System& built, const FilterRegistry& registry, InputRecorder* inputs,
+bool join_bus(const RunArgs& args, native::System& built, const FilterRegistry& registry, InputRecorder* inputs,
               BusPart& bus) {
   if (args.ice.empty()) {
     if (!args.allow_write) return true;
@@ -368,24 +368,23 @@ bool close_histories(const RunArgs& args, InputRecorder* inputs, Recorder* recor
 }  // namespace
 
 int run_coordinator(const RunArgs& args) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   std::optional<spec::Scenario> scenario;
   std::string system_path;
   if (!load_run_scenario(args, registry, scenario, system_path)) return 2;
   middleware::HostClock clock;
-  runner::SystemOptions system_options;
+  native::SystemOptions system_options;
   system_options.coordinator = args.coordinator;
   system_options.clock = &clock;
   if (scenario) system_options.component_period = seconds_to_time(scenario->period);
-  runner::Diagnostics notes;
-  auto opened = runner::open_system(system_path, registry, system_options, &notes);
-  runner::print(notes, stderr);
+  spec::Diagnostics notes;
+  auto opened = native::open_system(system_path, registry, system_options, &notes);
+  spec::print(notes, stderr);
   if (!opened) {
-    runner::print(opened.error(), stderr);
+    spec::print(opened.error(), stderr);
     return 2;
   }
-  runner::System& built = **opened;
+  native::System& built = **opened;
   const spec::SystemSpec& system = built.spec();
   Coordinator& co = built.coordinator();
   Monitor& monitor = built.monitor();

@@ -39,8 +39,7 @@ struct SupervisorArgs {
 };
 
 int run_supervisor(const SupervisorArgs& args) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   spec::LoadResult load = spec::load_system(args.system, registry);
   for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
   if (!load.ok()) return 2;
@@ -58,6 +57,7 @@ int run_supervisor(const SupervisorArgs& args) {
   options.ice = *endpoint;
   options.lost_after = std::chrono::milliseconds(args.lost_after_ms);
   options.keys_dir = args.keys;
+  options.registry = &registry;
   options.insecure = args.insecure;
   options.records = !args.states_only;
   options.tls.dir = args.tls;
@@ -142,8 +142,7 @@ void add_keys_command(CLI::App& app, int& code) {
                   "sign with the CA of this key directory (its ca.pem and ca.key): systems that share one "
                   "IceStorm share its CA (only ca.pem is copied)");
   cmd->callback([&code] {
-    FilterRegistry registry;
-    register_builtin_filters(registry);
+    const FilterRegistry& registry = builtin_filters();
     spec::LoadResult load = spec::load_system(system, registry);
     for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
     if (!load.ok()) {

@@ -43,8 +43,7 @@ std::string report_date() {
 }  // namespace
 
 int run_trace(const TraceArgs& args) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   trace::TraceOptions options;
   options.system = args.system;
   options.scenarios = args.scenarios;

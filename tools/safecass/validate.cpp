@@ -30,8 +30,7 @@ bool readable(const std::string& path) {
 }  // namespace
 
 int run_validate(const std::vector<std::string>& files, bool json_output, bool verbose) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   std::size_t errors = 0;
   std::size_t warnings = 0;
   bool unreadable = false;
@@ -81,8 +80,7 @@ int run_validate(const std::vector<std::string>& files, bool json_output, bool v
 }
 
 int run_schema() {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   const std::string schema = spec::json_schema(registry);
   std::fwrite(schema.data(), 1, schema.size(), stdout);
   std::fflush(stdout);

@@ -65,8 +65,7 @@ void add_verify_command(CLI::App& app, int& code) {
 }
 
 int run_verify(const std::string& system_path, const verify::Options& options, bool json) {
-  FilterRegistry registry;
-  register_builtin_filters(registry);
+  const FilterRegistry& registry = builtin_filters();
   const spec::LoadResult loaded = spec::load_system(system_path, registry);
   for (const spec::Diagnostic& d : loaded.diagnostics) {
     if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(stderr, "%s\n", spec::format(d).c_str());

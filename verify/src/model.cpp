@@ -38,22 +38,23 @@ std::string machine_of(const FilterTarget& t) { return address::machine(t.kind, 
 
 Expected<std::unique_ptr<Model>> Model::build(const spec::SystemSpec& system, const FilterRegistry& registry) {
   std::unique_ptr<Model> m(new Model());
-  m->system_ = &system;
-  CoordinatorOptions options;
-  options.history_records = 64;
-  options.history_per_address = 1;
-  m->coordinator_ = std::make_unique<Coordinator>(system.name.empty() ? "system" : system.name, nullptr, options);
-  m->monitor_ = std::make_unique<Monitor>(*m->coordinator_, registry, 2);
+  spec::InstanceOptions options;
+  options.coordinator_options.history_records = 64;
+  options.coordinator_options.history_per_address = 1;
+  options.signal_history = 2;
   // One process: every component, every connection (cross-process ones become synchronous).
-  if (auto r = spec::instantiate(system, *m->coordinator_, *m->monitor_); !r) {
-    return fail(ErrorCode::InvalidArgument, "cannot build system '" + system.name + "': " + r.error().message);
+  auto built = spec::build_instance(system, registry, options);
+  if (!built) {
+    return fail(ErrorCode::InvalidArgument, "cannot build system '" + system.name + "': " + spec::to_text(built.error()));
   }
+  m->instance_ = std::move(*built);
+  m->system_ = &m->instance_->spec();
   if (auto r = m->derive(registry); !r) return tl::unexpected(r.error());
   return m;
 }
 
 Expected<void> Model::derive(const FilterRegistry& registry) {
-  at_machine_.assign(coordinator_->machine_count(), {});
+  at_machine_.assign(instance_->coordinator().machine_count(), {});
   derive_roots(registry);
   derive_reach();
   const RootsAt at = roots_at();
@@ -63,7 +64,7 @@ Expected<void> Model::derive(const FilterRegistry& registry) {
 }
 
 void Model::derive_roots(const FilterRegistry& registry) {
-  Coordinator& co = *coordinator_;
+  Coordinator& co = instance_->coordinator();
   std::map<std::string, spec::Position, std::less<>> event_where;
   std::map<std::string, std::string, std::less<>> declared_by;
   for (const spec::ComponentSpec& c : system_->components) {
@@ -158,7 +159,7 @@ void Model::derive_roots(const FilterRegistry& registry) {
 void Model::derive_reach() {
   // From the coordinator itself: a root of each level at each machine that holds roots, and
   // where its mirrors land.
-  Coordinator& co = *coordinator_;
+  Coordinator& co = instance_->coordinator();
   const std::size_t machines = co.machine_count();
   reach_error_.assign(machines, IdVector<bool, MachineId>(machines, false));
   reach_warning_.assign(machines, IdVector<bool, MachineId>(machines, false));
@@ -180,7 +181,7 @@ void Model::derive_reach() {
 }
 
 Model::RootsAt Model::roots_at() const {
-  const std::size_t machines = coordinator_->machine_count();
+  const std::size_t machines = instance_->coordinator().machine_count();
   const auto machine_roots = [&](MachineId m, bool error) {
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < roots_.size(); ++i) {
@@ -199,7 +200,7 @@ Model::RootsAt Model::roots_at() const {
 }
 
 void Model::derive_addresses(const RootsAt& at) {
-  const Coordinator& co = *coordinator_;
+  const Coordinator& co = instance_->coordinator();
   const auto make = [&](std::string address, std::vector<MachineId> ms, spec::Position where) {
     AddressInfo a;
     a.address = std::move(address);
@@ -250,7 +251,7 @@ void Model::derive_addresses(const RootsAt& at) {
 }
 
 void Model::derive_levels(const RootsAt& at) {
-  const std::size_t machines = coordinator_->machine_count();
+  const std::size_t machines = instance_->coordinator().machine_count();
   can_.assign(roots_.size(), {false, false, false});
   IdVector<std::array<bool, 3>, MachineId> possible(machines, {true, false, false});
   for (bool changed = true; changed;) {

@@ -21,6 +21,7 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/id_vector.hpp"
 #include "safecass/filters/monitor.hpp"
+#include "safecass/spec/instance.hpp"
 #include "safecass/spec/formula.hpp"
 #include "safecass/verify/verify.hpp"
 
@@ -73,8 +74,8 @@ public:
                                                               const FilterRegistry& registry);
 
   const spec::SystemSpec& system() const { return *system_; }
-  Coordinator& coordinator() { return *coordinator_; }
-  const Coordinator& coordinator() const { return *coordinator_; }
+  Coordinator& coordinator() { return instance_->coordinator(); }
+  const Coordinator& coordinator() const { return instance_->coordinator(); }
   const std::vector<Root>& roots() const { return roots_; }
   const std::vector<Broadcast>& broadcasts() const { return broadcasts_; }
   const std::vector<AddressInfo>& addresses() const { return addresses_; }
@@ -89,7 +90,7 @@ public:
   /// Roots of a hazard.
   std::vector<std::size_t> linked(std::string_view hazard) const;
   /// The machine index of an address that is a machine, for resets.
-  const std::string& machine_address(MachineId m) const { return coordinator_->address_of(m); }
+  const std::string& machine_address(MachineId m) const { return instance_->coordinator().address_of(m); }
 
   /// The root classes among `roots` (sorted indices): each broadcast root alone; the others
   /// merged with their interchangeable peers when `merge`.
@@ -121,8 +122,7 @@ private:
   void derive_levels(const RootsAt& at);
 
   const spec::SystemSpec* system_ = nullptr;
-  std::unique_ptr<Coordinator> coordinator_;
-  std::unique_ptr<Monitor> monitor_;
+  std::unique_ptr<spec::Instance> instance_;  ///< the system, built by the one factory
   std::vector<Root> roots_;
   std::vector<Broadcast> broadcasts_;
   std::vector<AddressInfo> addresses_;

@@ -76,8 +76,7 @@ int main(int argc, char** argv) {
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
 
-  safecass::FilterRegistry registry;
-  safecass::register_builtin_filters(registry);
+  const safecass::FilterRegistry& registry = safecass::builtin_filters();
   auto bridge = safecass::dds::Bridge::create(mapping, registry, nullptr, options);
   if (!bridge) {
     std::fprintf(stderr, "%s\n", bridge.error().message.c_str());
@@ -85,7 +84,7 @@ int main(int argc, char** argv) {
   }
   std::unique_ptr<safecass::ros_common::NodeRecording> recording;
   if (!record.empty()) {
-    auto r = safecass::ros_common::NodeRecording::open((*bridge)->shadow(), registry, record, limits);
+    auto r = safecass::ros_common::NodeRecording::open((*bridge)->shadow(), record, limits);
     if (!r) {
       std::fprintf(stderr, "safecass_dds_node: %s\n", r.error().message.c_str());
       return 2;

@@ -25,8 +25,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: safecass_ros1_node MAPPING.json\n");
     return 2;
   }
-  safecass::FilterRegistry registry;
-  safecass::register_builtin_filters(registry);
+  const safecass::FilterRegistry& registry = safecass::builtin_filters();
   std::string record;
   safecass::FileLimits limits;
   for (int i = 2; i + 1 < argc; i += 2) {
@@ -48,7 +47,7 @@ int main(int argc, char** argv) {
   // The history and the inputs, opened before anything runs.
   std::unique_ptr<safecass::ros_common::NodeRecording> recording;
   if (!record.empty()) {
-    auto r = safecass::ros_common::NodeRecording::open((*bridge)->shadow(), registry, record, limits);
+    auto r = safecass::ros_common::NodeRecording::open((*bridge)->shadow(), record, limits);
     if (!r) {
       std::fprintf(stderr, "safecass_ros1_node: %s\n", r.error().message.c_str());
       return 2;

@@ -2,11 +2,9 @@
 
 #include <cstdio>
 
-#include "safecass/spec/load.hpp"
-
 namespace safecass::ros_common {
 
-Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow, const FilterRegistry& registry,
+Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow,
                                                              const std::string& history_path, FileLimits limits) {
   std::unique_ptr<NodeRecording> r(new NodeRecording());
   auto h = Recorder::open(shadow.coordinator(), history_path, 65536, limits);
@@ -15,11 +13,8 @@ Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow, con
   InputRecorderOptions o;
   o.limits = limits;
   o.clock = "steady";
-  const spec::LoadResult system = spec::load_system(shadow.mapping().system, registry);
-  if (system.system) {
-    for (const auto& c : system.system->components) {
-      for (const auto& sig : c.signals) o.signals.push_back(sig.name);
-    }
+  for (const auto& c : shadow.system().components) {
+    for (const auto& sig : c.signals) o.signals.push_back(sig.name);
   }
   auto in = InputRecorder::open(shadow.monitor(), InputRecorder::path_for_history(history_path), o);
   if (!in) return tl::unexpected(in.error());

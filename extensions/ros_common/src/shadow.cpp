@@ -6,20 +6,11 @@
 #include <cstdio>
 #include <optional>
 
-#include "safecass/spec/load.hpp"
+#include "safecass/spec/instance.hpp"
 
 namespace safecass::ros_common {
 
 namespace {
-
-std::string join_diagnostics(const std::vector<spec::Diagnostic>& diagnostics) {
-  std::string out;
-  for (const spec::Diagnostic& d : diagnostics) {
-    if (d.severity != spec::Diagnostic::Severity::Error) continue;
-    out += (out.empty() ? "" : "\n") + spec::format(d);
-  }
-  return out;
-}
 
 std::string fmt_double(double v) {
   char buf[40];
@@ -69,21 +60,22 @@ struct Shadow::Ingest {
 Expected<std::unique_ptr<Shadow>> Shadow::create(const std::string& mapping_path, const FilterRegistry& registry,
                                                  const Clock* clock, Warn warn, const std::string& system_path) {
   MappingLoad ml = load_mapping(mapping_path);
-  if (!ml.mapping) return fail(ErrorCode::Parse, join_diagnostics(ml.diagnostics));
+  if (!ml.mapping) return fail(ErrorCode::Parse, spec::to_text(spec::keep_errors(ml.diagnostics, nullptr)));
   if (!system_path.empty()) ml.mapping->system = system_path;
-  spec::LoadResult sys = spec::load_system(ml.mapping->system, registry);
-  if (!sys.ok()) return fail(ErrorCode::Parse, join_diagnostics(sys.diagnostics));
+  auto sys = spec::load_valid_system(ml.mapping->system, registry);
+  if (!sys) return fail(ErrorCode::Parse, spec::to_text(sys.error()));
 
   std::unique_ptr<Shadow> s(new Shadow());
   s->mapping_ = std::move(*ml.mapping);
   s->warn_ = warn ? std::move(warn) : Warn([](const std::string&) {});
-  const std::string name = s->mapping_.coordinator.empty() ? sys.system->name : s->mapping_.coordinator;
-  s->coordinator_ = std::make_unique<Coordinator>(name, clock);
-  s->monitor_ = std::make_unique<Monitor>(*s->coordinator_, registry);
-  if (auto r = spec::instantiate(*sys.system, *s->coordinator_, *s->monitor_, s->mapping_.coordinator); !r) {
-    return tl::unexpected(r.error());
-  }
-  Coordinator& co = *s->coordinator_;
+  spec::InstanceOptions options;
+  options.coordinator = s->mapping_.coordinator;
+  options.clock = clock;
+  auto built = spec::build_instance(std::move(*sys), registry, options);
+  if (!built) return fail(ErrorCode::InvalidArgument, spec::to_text(built.error()));
+  s->instance_ = std::move(*built);
+  const spec::SystemSpec& system = s->instance_->spec();
+  Coordinator& co = s->instance_->coordinator();
   const std::string where = s->mapping_.path + ": ";
   for (const EventDef& e : s->mapping_.events) {
     if (auto r = co.add_event(e); !r)
@@ -96,13 +88,13 @@ Expected<std::unique_ptr<Shadow>> Shadow::create(const std::string& mapping_path
   }
   // Which connections the system declares, to check the topics against.
   std::set<std::pair<std::string, std::string>> connections;
-  for (const spec::ConnectionSpec& c : sys.system->connections) connections.emplace(c.required, c.provided);
+  for (const spec::ConnectionSpec& c : system.connections) connections.emplace(c.required, c.provided);
   std::set<std::string> components;
-  for (const spec::ComponentSpec& c : sys.system->components) components.insert(c.name);
+  for (const spec::ComponentSpec& c : system.components) components.insert(c.name);
   for (const auto& n : s->mapping_.nodes) {
     if (components.count(n.first) == 0) {
       return fail(ErrorCode::NotFound,
-                  where + "nodes: system '" + sys.system->name + "' has no component '" + n.first + "'");
+                  where + "nodes: system '" + system.name + "' has no component '" + n.first + "'");
     }
   }
   for (const TopicMapping& t : s->mapping_.topics) {
@@ -118,7 +110,7 @@ Expected<std::unique_ptr<Shadow>> Shadow::create(const std::string& mapping_path
 }
 
 Expected<void> Shadow::bind() {
-  Coordinator& co = *coordinator_;
+  Coordinator& co = instance_->coordinator();
   // An interface "C.x" whose component is not in this coordinator is somebody else's: kNoMachine.
   auto machine_of = [&](const std::string& iface, const char* kind) -> Expected<MachineId> {
     const std::string component = iface.substr(0, iface.find('.'));
@@ -162,7 +154,7 @@ Expected<void> Shadow::bind() {
     }
     std::size_t total = 0;
     for (const FieldBinding& b : tm.signals) {
-      Signal* s = monitor_->signals().find(b.signal);
+      Signal* s = instance_->monitor().signals().find(b.signal);
       std::size_t width = b.path.width();
       if (width == 0) width = b.size != 0 ? b.size : (s != nullptr ? s->size() : 0);
       if (width == 0) {
@@ -171,7 +163,7 @@ Expected<void> Shadow::bind() {
                         "': declare the signal in the spec or give {\"field\": ..., \"size\": N}");
       }
       if (s == nullptr) {
-        auto created = monitor_->add_signal(b.signal, width);
+        auto created = instance_->monitor().add_signal(b.signal, width);
         if (!created) return fail(created.error().code, what + ": " + created.error().message);
         s = *created;
       } else if (s->size() != width) {
@@ -186,7 +178,7 @@ Expected<void> Shadow::bind() {
     for (auto [name, out] :
          {std::pair<const std::string*, Signal**>{&tm.rate_signal, &t->rate}, {&tm.age_signal, &t->age}}) {
       if (name->empty()) continue;
-      auto s = monitor_->add_signal(*name, 1);
+      auto s = instance_->monitor().add_signal(*name, 1);
       if (!s) return fail(s.error().code, what + ": " + s.error().message);
       *out = *s;
     }
@@ -212,7 +204,7 @@ Expected<void> Shadow::bind() {
         f.params["max_rate"] = (*check)->max_rate;
         f.params["window"] = static_cast<double>((*check)->window);
       }
-      if (auto r = monitor_->add_filter(std::move(f)); !r) return fail(r.error().code, what + ": " + r.error().message);
+      if (auto r = instance_->monitor().add_filter(std::move(f)); !r) return fail(r.error().code, what + ": " + r.error().message);
     }
     topics_.push_back(std::move(t));
   }
@@ -264,7 +256,7 @@ BridgeStats Shadow::stats() const noexcept {
 
 Expected<void> Shadow::add_loop(std::string_view component, Time period, Body body) {
   if (started_) return fail(ErrorCode::InvalidState, "add_loop() after start()");
-  auto c = coordinator_->find_component(component);
+  auto c = instance_->coordinator().find_component(component);
   if (!c) return tl::unexpected(c.error());
   if (period <= Time{0})
     return fail(ErrorCode::InvalidArgument, "loop of '" + std::string(component) + "': period must be positive");
@@ -291,18 +283,18 @@ Expected<void> Shadow::start() {
       if (!looped && std::find(t->run.begin(), t->run.end(), c) == t->run.end()) t->run.push_back(c);
     }
   }
-  observer_ = coordinator_->subscribe([this](const Record& r) {
+  observer_ = instance_->coordinator().subscribe([this](const Record& r) {
     if (r.kind != RecordKind::Event && r.kind != RecordKind::Injection) dirty_.store(true, std::memory_order_release);
   });
-  monitor_->start();
+  instance_->monitor().start();
   started_ = true;
   return {};
 }
 
 void Shadow::stop() noexcept {
   if (!started_) return;
-  monitor_->stop();
-  coordinator_->unsubscribe(observer_);
+  instance_->monitor().stop();
+  instance_->coordinator().unsubscribe(observer_);
   started_ = false;
 }
 
@@ -328,7 +320,7 @@ void Shadow::deliver(std::size_t i, Time now) {
   }
   t.last_arrival.store(now.count(), std::memory_order_release);
   messages_.fetch_add(1, std::memory_order_relaxed);
-  for (ComponentId c : t.run) monitor_->run_active(c, now);
+  for (ComponentId c : t.run) instance_->monitor().run_active(c, now);
 }
 
 void Shadow::reject(std::size_t i, const std::string& why) {
@@ -348,27 +340,27 @@ void Shadow::warn_throttled(const std::string& text) {
 void Shadow::run_loop(std::size_t i) {
   Loop& loop = *loops_[i];
   const auto begin = std::chrono::steady_clock::now();
-  const Time now = coordinator_->clock().now();
-  monitor_->run_active(loop.component, now);
-  const MachineId framework = coordinator_->framework_machine(loop.component);
+  const Time now = instance_->coordinator().clock().now();
+  instance_->monitor().run_active(loop.component, now);
+  const MachineId framework = instance_->coordinator().framework_machine(loop.component);
   try {
     if (loop.body) loop.body(now);
     if (loop.threw) {
       loop.threw = false;
-      coordinator_->generate(framework_event::completion_of(framework_event::kThreadException), framework);
+      instance_->coordinator().generate(framework_event::completion_of(framework_event::kThreadException), framework);
     }
   } catch (const std::exception& e) {
-    warn_("the loop of " + std::string(coordinator_->component_name(loop.component)) + " threw: " + e.what());
-    if (!loop.threw) coordinator_->generate(framework_event::kThreadException, framework);
+    warn_("the loop of " + std::string(instance_->coordinator().component_name(loop.component)) + " threw: " + e.what());
+    if (!loop.threw) instance_->coordinator().generate(framework_event::kThreadException, framework);
     loop.threw = true;
   } catch (...) {
-    if (!loop.threw) coordinator_->generate(framework_event::kThreadException, framework);
+    if (!loop.threw) instance_->coordinator().generate(framework_event::kThreadException, framework);
     loop.threw = true;
   }
   const bool overran = std::chrono::steady_clock::now() - begin > loop.period;
   if (overran != loop.overran) {
     loop.overran = overran;
-    coordinator_->generate(
+    instance_->coordinator().generate(
         overran ? framework_event::kPeriodOverrun : framework_event::completion_of(framework_event::kPeriodOverrun),
         framework);
   }
@@ -393,7 +385,7 @@ bool Shadow::tick(Time now) {
 
 void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot snap,
                          const std::optional<Condition>& outstanding) const {
-  const Coordinator& co = *coordinator_;
+  const Coordinator& co = instance_->coordinator();
   s.name = status_name(address);
   s.hardware_id = mapping_.hardware_id;
   s.level = to_diagnostic_level(snap.state);
@@ -432,7 +424,7 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
 }
 
 std::vector<Status> Shadow::statuses() {
-  const Coordinator& co = *coordinator_;
+  const Coordinator& co = instance_->coordinator();
   std::vector<Status> out;
   for (ComponentId c : id_range<ComponentId>(co.component_count())) {
     std::vector<MachineId> machines{co.framework_machine(c), co.application_machine(c)};
@@ -480,7 +472,7 @@ std::vector<Status> Shadow::statuses() {
 // ---- diagnostics in ------------------------------------------------------------------------------
 
 void Shadow::ingest(const std::vector<ReceivedStatus>& statuses, std::string_view sender) {
-  const Time now = coordinator_->clock().now();
+  const Time now = instance_->coordinator().clock().now();
   for (Ingest& in : ingests_) {
     bool touched = false;
     for (const ReceivedStatus& s : statuses) {
@@ -523,16 +515,16 @@ void Shadow::apply(Ingest& in) {
   }
   SampleCause cause;
   cause.filter = diagnostics_name_;
-  cause.signal = coordinator_->intern(in.cause.empty() ? in.rule->name : in.cause);
+  cause.signal = instance_->coordinator().intern(in.cause.empty() ? in.rule->name : in.cause);
   // Onsets first, then completions: WARN → ERROR never passes through Normal.
   for (std::size_t i = 0; i < 3; ++i) {
     if (want[i] && !in.active[i]) {
       cause.value = static_cast<double>(i + 1);
-      coordinator_->generate(in.onset[i], in.target, cause);
+      instance_->coordinator().generate(in.onset[i], in.target, cause);
     }
   }
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!want[i] && in.active[i]) coordinator_->generate(coordinator_->event(in.onset[i]).counterpart, in.target);
+    if (!want[i] && in.active[i]) instance_->coordinator().generate(instance_->coordinator().event(in.onset[i]).counterpart, in.target);
   }
   in.active = want;
 }
@@ -541,7 +533,7 @@ void Shadow::apply(Ingest& in) {
 
 void Shadow::check_graph(const GraphView& live) {
   graph_checks_.fetch_add(1, std::memory_order_relaxed);
-  const Coordinator& co = *coordinator_;
+  const Coordinator& co = instance_->coordinator();
   std::map<MachineId, std::set<std::string>> now;
   std::size_t problems = 0;
   auto report = [&](MachineId machine, std::string text) {
@@ -616,14 +608,14 @@ void Shadow::check_graph(const GraphView& live) {
       if (graph_problems_[p.first].count(text) == 0) warn_("ROS graph: " + text);
     }
     if (graph_problems_[p.first].empty()) {
-      cause.signal = coordinator_->intern(*p.second.begin());
-      coordinator_->generate(graph_event_, p.first, cause);
+      cause.signal = instance_->coordinator().intern(*p.second.begin());
+      instance_->coordinator().generate(graph_event_, p.first, cause);
     }
   }
   for (const auto& p : graph_problems_) {
     if (!p.second.empty() && now.count(p.first) == 0) {
       warn_("ROS graph: " + co.address_of(p.first) + " is complete again");
-      coordinator_->generate(co.event(graph_event_).counterpart, p.first);
+      instance_->coordinator().generate(co.event(graph_event_).counterpart, p.first);
     }
   }
   graph_problems_ = std::move(now);

@@ -18,4 +18,13 @@ void register_builtin_filters(FilterRegistry& registry) {
   (void)registry.alias("FilterTrendVel", "Derivative");
 }
 
+const FilterRegistry& builtin_filters() {
+  static const FilterRegistry registry = [] {
+    FilterRegistry r;
+    register_builtin_filters(r);
+    return r;
+  }();
+  return registry;
+}
+
 }  // namespace safecass

@@ -8,10 +8,6 @@ namespace safecass::builtin {
 
 namespace {
 
-[[nodiscard]] Expected<std::vector<std::size_t>> any_input_no_output(const FilterShape&) {
-  return std::vector<std::size_t>(1, 1);
-}
-
 /// At least `count` occurrences (rising edges of a non-zero input) within the last `window`
 /// seconds → onset; fewer → completion.
 class Occurrence final : public Filter {

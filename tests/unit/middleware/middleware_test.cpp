@@ -15,7 +15,10 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
+#include "safecass/middleware/supervisor.hpp"
 #include "safecass/spec/load.hpp"
+
+#include "../../../examples/custom_filter/frozen_filter.hpp"
 
 namespace safecass::middleware {
 namespace {
@@ -135,6 +138,44 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   auto node = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
   ASSERT_TRUE(node) << node.error().message;
   EXPECT_FALSE((*node)->stats().connected);
+}
+
+/// A system watched by a filter type that only the application's registry knows.
+constexpr const char* kFrozenSystem = R"({
+  "safecass": 1,
+  "system": "encoders",
+  "components": [ {
+    "component": "ENCODER",
+    "interfaces": { "provided": ["Angle"], "required": [] },
+    "signals": [ { "name": "angle" } ],
+    "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
+    "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
+                  "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
+  } ],
+  "coordinators": { "cell": ["ENCODER"] }
+})";
+
+TEST(Supervisor, BuildsItsViewWithTheApplicationsFilterRegistryAndWithoutItNamesTheUnknownType) {
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  ASSERT_TRUE(registry.add<Frozen>("Frozen"));
+  auto load = spec::load_system_from_text(kFrozenSystem, "encoders.json", registry);
+  ASSERT_TRUE(load.ok()) << spec::to_text(load.diagnostics);
+  const std::string keys = ::testing::TempDir() + "safecass-supervisor-keys-" + std::to_string(::getpid());
+  ASSERT_TRUE(create_bus_keys(*load.system, keys, KeyOptions::replacing()));
+  SupervisorOptions options;
+  options.ice = *parse_ice_endpoint("127.0.0.1:1");  // never reached: create() touches no network
+  options.keys_dir = keys;
+  options.print = [](const std::string&) {};
+  options.registry = &registry;
+  auto supervisor = Supervisor::create(*load.system, options);
+  ASSERT_TRUE(supervisor) << supervisor.error().message;
+  EXPECT_TRUE((*supervisor)->model().find_component("ENCODER"));
+
+  options.registry = nullptr;  // the built-in types alone
+  auto builtin_only = Supervisor::create(*load.system, options);
+  ASSERT_FALSE(builtin_only);
+  EXPECT_NE(builtin_only.error().message.find("Frozen"), std::string::npos) << builtin_only.error().message;
 }
 
 TEST(BusKeys, AreCreatedPrivateOncePerSignerAndNeverOverwriteAForeignFile) {

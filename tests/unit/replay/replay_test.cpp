@@ -18,7 +18,7 @@
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/runner/system.hpp"
+#include "safecass/native/system.hpp"
 
 namespace safecass::replay {
 namespace {
@@ -172,7 +172,7 @@ struct CountedWrites final : introspect::ActionObserver {
 TEST(ReadModelWrites, OnlyAWriteThatWasAppliedIsToldToTheActionObserver) {
   FilterRegistry registry;
   register_builtin_filters(registry);
-  auto system = runner::open_system(kRobodoc + "robodoc.json", registry);
+  auto system = native::open_system(kRobodoc + "robodoc.json", registry);
   ASSERT_TRUE(system.has_value());
   CountedWrites observer;
   introspect::LocalOptions lo;
@@ -192,7 +192,7 @@ TEST(ReplayRecording, AnOperatorsWritesThroughTheReadModelAreRecordedAsActionsAn
   register_builtin_filters(registry);
   const std::string path = scratch("operator.inputs");
   {
-    auto system = runner::open_system(kRobodoc + "robodoc.json", registry);
+    auto system = native::open_system(kRobodoc + "robodoc.json", registry);
     ASSERT_TRUE(system.has_value());
     SimulatedClock& clock = *(*system)->simulated_clock();
     auto inputs = InputRecorder::open((*system)->monitor(), path);

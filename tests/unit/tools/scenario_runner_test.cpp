@@ -93,7 +93,7 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
   const std::string path = load.scenario->path;
   auto opened = ScenarioRunner::open(std::move(*load.scenario), std::move(*system.system), registry);
   ASSERT_FALSE(opened) << "a scenario with a bad step is not opened";
-  const Diagnostics& problems = opened.error();
+  const spec::Diagnostics& problems = opened.error();
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(spec::format(problems[0]), path +
                                            ":3:7: error: an injected value is not a finite number: injected values "

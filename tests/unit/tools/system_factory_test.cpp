@@ -1,14 +1,24 @@
-// The one factory that puts a system together (tools/runner/include/safecass/runner/system.hpp).
+// The one factory that puts a system together (spec/include/safecass/spec/instance.hpp) and the
+// native runtime's system over it (extensions/native/include/safecass/native/system.hpp).
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "safecass/native/system.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/runner/system.hpp"
+#include "safecass/spec/instance.hpp"
+#include "safecass/spec/load.hpp"
+
+#include "../../../examples/custom_filter/frozen_filter.hpp"
 
 namespace safecass::runner {
 namespace {
 
 using ::testing::HasSubstr;
+using native::kDefaultTick;
+using native::open_system;
+using native::System;
+using native::SystemOptions;
+using spec::to_text;
 
 const std::string kRobodoc = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
 const std::string kStory = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/story.json";
@@ -17,6 +27,54 @@ FilterRegistry builtin() {
   FilterRegistry registry;
   register_builtin_filters(registry);
   return registry;
+}
+
+/// A component watched by a filter type that only the application's registry knows.
+constexpr const char* kEncoder = R"({
+  "component": "ENCODER",
+  "signals": [ { "name": "angle" } ],
+  "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
+  "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
+                "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
+})";
+
+TEST(SystemFactory, BuildsAFilterTypeThatOnlyTheApplicationsRegistryKnows) {
+  FilterRegistry registry = builtin();
+  ASSERT_TRUE(registry.add<Frozen>("Frozen"));
+  auto loaded = spec::load_system_from_text(kEncoder, "encoder.json", registry);
+  ASSERT_TRUE(loaded.ok()) << spec::to_text(loaded.diagnostics);
+  auto built = spec::build_instance(*loaded.system, registry);
+  ASSERT_TRUE(built) << to_text(built.error());
+  spec::Instance& instance = **built;
+  EXPECT_EQ(&instance.registry(), &registry);
+  EXPECT_EQ(instance.coordinator().name(), "ENCODER") << "a one-component file names its system after it";
+  ASSERT_NE(instance.monitor().find_filter("frozen_angle"), nullptr);
+  EXPECT_EQ(instance.monitor().find_filter("frozen_angle")->type(), "Frozen");
+}
+
+TEST(SystemFactory, AFilterTypeTheRegistryDoesNotKnowIsAnErrorAtItsPositionAndNothingIsBuilt) {
+  const FilterRegistry registry = builtin();
+  auto loaded = spec::load_system_from_text(kEncoder, "encoder.json", registry);
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_THAT(spec::to_text(loaded.diagnostics), HasSubstr("encoder.json:5:"));
+  EXPECT_THAT(spec::to_text(loaded.diagnostics), HasSubstr("Frozen"));
+}
+
+TEST(SystemFactory, AnInstanceIsNamedAfterItsCoordinatorThenTheGivenNameThenTheSystem) {
+  const FilterRegistry registry = builtin();
+  auto system = spec::load_valid_system(kRobodoc, registry);
+  ASSERT_TRUE(system) << to_text(system.error());
+  spec::InstanceOptions options;
+  EXPECT_EQ(spec::coordinator_name(*system, options), system->name);
+  options.name = "supervisor";
+  EXPECT_EQ(spec::coordinator_name(*system, options), "supervisor");
+  options.coordinator = "ui";
+  EXPECT_EQ(spec::coordinator_name(*system, options), "ui");
+  auto ui = spec::build_instance(*system, registry, options);
+  ASSERT_TRUE(ui) << to_text(ui.error());
+  EXPECT_EQ((*ui)->coordinator().name(), "ui");
+  EXPECT_TRUE((*ui)->coordinator().find_component("PENDANT"));
+  EXPECT_FALSE((*ui)->coordinator().find_component("JR3")) << "another coordinator's component";
 }
 
 TEST(SystemFactory, OpensTheWholeSystemWithOneTaskPerComponentOnItsOwnSimulatedClock) {

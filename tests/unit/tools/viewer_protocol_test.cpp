@@ -5,6 +5,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include "safecass/json/read.hpp"
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/protocol.hpp"
+
+#include "../../../examples/custom_filter/frozen_filter.hpp"
 
 namespace safecass::viewer {
 namespace {
@@ -374,6 +377,32 @@ TEST(ViewerInProcessSource, OpenReportsWhatIsMissingOrWrong) {
   auto d = InProcessSource::open(system_only);
   ASSERT_TRUE(d.has_value()) << d.error().message;
   EXPECT_EQ((*d)->view().coordinators.size(), 2u);
+}
+
+TEST(ViewerInProcessSource, ShowsASystemWhoseFilterTypeOnlyTheApplicationsRegistryKnows) {
+  const std::string path = ::testing::TempDir() + "viewer-encoder.json";
+  std::ofstream(path) << R"({
+  "component": "ENCODER",
+  "signals": [ { "name": "angle" } ],
+  "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
+  "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
+                "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
+})";
+  InProcessOptions builtin;
+  builtin.system = path;
+  builtin.log = nullptr;
+  auto refused = InProcessSource::open(builtin);
+  ASSERT_FALSE(refused.has_value());
+  EXPECT_THAT(refused.error().message, HasSubstr("Frozen"));
+
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  ASSERT_TRUE(registry.add<Frozen>("Frozen"));
+  InProcessOptions application = builtin;
+  application.registry = &registry;
+  auto shown = InProcessSource::open(application);
+  ASSERT_TRUE(shown.has_value()) << shown.error().message;
+  EXPECT_EQ((*shown)->view().coordinators.size(), 1u);
 }
 
 }  // namespace

@@ -17,7 +17,7 @@
 #include "safecass/record/recorder.hpp"
 #include "safecass/replay/source.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/spec/instance.hpp"
 
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG
 #include "safecass/replay/bag_source.hpp"
@@ -95,11 +95,11 @@ std::string sniff(const std::string& path) {
 /// The system, composed as `safecass run` composes it, with no scenario steps.
 std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::optional<Time> period,
                                             const std::string& input, const FilterRegistry& registry, std::FILE* err) {
-  spec::LoadResult sys = spec::load_system(path, registry);
-  for (const auto& d : sys.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(err, "%s\n", spec::format(d).c_str());
+  auto system = spec::load_valid_system(path, registry);
+  if (!system) {
+    spec::print(system.error(), err);
+    return nullptr;
   }
-  if (!sys.ok() || !sys.system) return nullptr;
   spec::Scenario sc;
   sc.path = input;
   sc.system = path;
@@ -107,18 +107,17 @@ std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::option
     sc.period = to_seconds(*period);
   } else {
     double smallest = 0.0;
-    for (const spec::ComponentSpec& c : sys.system->components) {
+    for (const spec::ComponentSpec& c : system->components) {
       if (c.period && (smallest == 0.0 || *c.period < smallest)) smallest = *c.period;
     }
     sc.period = smallest > 0.0 ? smallest : 0.001;
   }
-  auto opened = ScenarioRunner::open(std::move(sc), std::move(*sys.system), registry);
+  auto opened = ScenarioRunner::open(std::move(sc), std::move(*system), registry);
   if (!opened) {
-    runner::print(opened.error(), err);
+    spec::print(opened.error(), err);
     return nullptr;
   }
-  auto r = std::move(*opened);
-  return r;
+  return std::move(*opened);
 }
 
 std::string check_values(const std::string& what, std::size_t width, const std::vector<std::vector<double>>& values) {

@@ -12,6 +12,15 @@
 
 namespace safecass::runner {
 
+using native::build_system;
+using native::kDefaultTick;
+using native::System;
+using native::SystemOptions;
+using spec::Diagnostics;
+using spec::keep_errors;
+using spec::Opened;
+
+
 namespace {
 std::string secs(Time t) { return introspect::seconds_text(t); }
 

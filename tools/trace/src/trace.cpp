@@ -13,7 +13,7 @@
 #include "safecass/json/read.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/runner/system.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/spec/file.hpp"
 #include "safecass/spec/load.hpp"
 
@@ -245,7 +245,7 @@ private:
     }
 
     // The built system: events as the coordinator checked them, filters with their defaults.
-    auto built = runner::build_system(sys(), registry_);
+    auto built = native::build_system(sys(), registry_);
     if (!built) return std::move(built.error());
     system_ = std::move(*built);
     return {};
@@ -673,7 +673,7 @@ private:
   Trace trace_;
   spec::LoadResult loaded_;
   std::map<std::string, Verdict> verdicts_;
-  std::unique_ptr<runner::System> system_;
+  std::unique_ptr<native::System> system_;
   std::map<std::string, StageSource, std::less<>> stage_source_;
   std::map<std::string, std::pair<std::string, spec::Position>, std::less<>>
       event_source_;  ///< name → component, where

@@ -46,7 +46,7 @@ std::string file_name(const std::string& path) {
 }  // namespace
 
 struct InProcessSource::Impl {
-  FilterRegistry registry;  // outlives the runner's monitor
+  const FilterRegistry* registry = nullptr;  // outlives the runner's monitor
   std::unique_ptr<runner::ScenarioRunner> runner;
   runner::RunResult result;
   std::size_t failures_reported = 0;
@@ -94,10 +94,10 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   }
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  register_builtin_filters(impl->registry);
+  impl->registry = options.registry != nullptr ? options.registry : &builtin_filters();
 
-  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{options.scenario, options.system}, impl->registry);
-  if (!opened) return fail(ErrorCode::InvalidArgument, runner::to_text(opened.error()));
+  auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{options.scenario, options.system}, *impl->registry);
+  if (!opened) return fail(ErrorCode::InvalidArgument, spec::to_text(opened.error()));
   impl->runner = std::move(*opened);
   const spec::SystemSpec& loaded = impl->runner->system().spec();
   const spec::Scenario& scenario = impl->runner->scenario();
@@ -117,7 +117,7 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   local.period = to_seconds(impl->tick);
   local.scenario = options.scenario;
   local.duration = to_seconds(impl->duration);
-  impl->query = std::make_unique<introspect::LocalQuery>(impl->co(), impl->runner->monitor(), impl->registry, local);
+  impl->query = std::make_unique<introspect::LocalQuery>(impl->co(), impl->runner->monitor(), *impl->registry, local);
   impl->connections = detail::local_connections(*impl->query);
   Impl* self = impl.get();
   auto following = impl->query->follow([self](const introspect::HistoryEntry& e) { self->pending.push(e); });

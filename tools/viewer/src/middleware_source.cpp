@@ -11,7 +11,6 @@
 
 #include <fmt/format.h>
 
-#include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
@@ -19,7 +18,7 @@
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
-#include "safecass/spec/load.hpp"
+#include "safecass/spec/instance.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
 namespace safecass::viewer {
@@ -61,8 +60,9 @@ struct MiddlewareLink {
   std::string name;
   std::string token;       ///< empty without --token-file for it
   std::string read_token;  ///< its read credential, when it has one
-  std::unique_ptr<Coordinator> local;
-  std::unique_ptr<Monitor> monitor;  ///< the local model's filters and signals (for routing)
+  /// The coordinator's model, built from the system file: its rows before it answers, and its
+  /// filters and signals (for routing).
+  std::unique_ptr<spec::Instance> local;
   std::vector<std::string> components;
   std::thread thread;
 
@@ -81,7 +81,7 @@ struct MiddlewareLink {
 struct MiddlewareSource::Impl {
   MiddlewareOptions options;
   middleware::IceEndpoint ice;
-  FilterRegistry registry;  // outlives the local monitors
+  const FilterRegistry* registry = nullptr;  // outlives the local monitors
   std::string system_name;
   std::string description;
   std::vector<ConnectionView> connections;  ///< from the system file
@@ -294,16 +294,10 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
   if (!ice) return fail(ErrorCode::Parse, ice.error().message);  // it names --ice and the text
   impl->ice = *ice;
   if (options.system.empty()) return fail(ErrorCode::InvalidArgument, "--ice needs the system file (--system)");
-  register_builtin_filters(impl->registry);
-  spec::LoadResult loaded = spec::load_system(options.system, impl->registry);
-  if (!loaded.ok() || !loaded.system) {
-    std::string text;
-    for (const spec::Diagnostic& d : loaded.diagnostics) {
-      if (d.severity == spec::Diagnostic::Severity::Error) text += (text.empty() ? "" : "\n") + spec::format(d);
-    }
-    return fail(ErrorCode::Parse, text.empty() ? "cannot load system '" + options.system + "'" : text);
-  }
-  const spec::SystemSpec& system = *loaded.system;
+  impl->registry = options.registry != nullptr ? options.registry : &builtin_filters();
+  auto loaded = spec::load_valid_system(options.system, *impl->registry);
+  if (!loaded) return fail(ErrorCode::Parse, spec::to_text(loaded.error()));
+  const spec::SystemSpec& system = *loaded;
   if (system.coordinators.empty()) {
     return fail(ErrorCode::InvalidArgument,
                 "system '" + system.name + "' (" + options.system +
@@ -316,12 +310,12 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
     auto l = std::make_unique<MiddlewareLink>();
     l->name = name;
     l->components = components;
-    l->local = std::make_unique<Coordinator>(name);
-    l->monitor = std::make_unique<Monitor>(*l->local, impl->registry);
-    if (auto r = spec::instantiate(system, *l->local, *l->monitor, name); !r) {
-      return fail(r.error().code, "coordinator '" + name + "' of " + options.system + ": " + r.error().message);
-    }
-    introspect::LocalQuery skeleton(*l->local, *l->monitor, impl->registry);
+    spec::InstanceOptions only;
+    only.coordinator = name;
+    auto built = spec::build_instance(system, *impl->registry, only);
+    if (!built) return fail(ErrorCode::InvalidArgument, spec::to_text(built.error()));
+    l->local = std::move(*built);
+    introspect::LocalQuery skeleton(l->local->coordinator(), l->local->monitor(), *impl->registry);
     l->rows = *skeleton.state_list();
     l->shown_rows = l->rows;
     names += (names.empty() ? "" : ", ") + name;
@@ -499,12 +493,12 @@ Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
   MiddlewareLink* owner = nullptr;
   if (request.deep) {
     owner = impl_->owner(request.target);
-    if (owner == nullptr || owner->monitor->signals().find(request.target) == nullptr) {
+    if (owner == nullptr || owner->local->monitor().signals().find(request.target) == nullptr) {
       return fail(ErrorCode::NotFound, "no signal '" + request.target + "' (signals are written Component.signal)");
     }
   } else {
     for (auto& l : impl_->links) {
-      if (l->monitor->find_filter(request.target) != nullptr) owner = l.get();
+      if (l->local->monitor().find_filter(request.target) != nullptr) owner = l.get();
     }
     if (owner == nullptr) return fail(ErrorCode::NotFound, "no filter '" + request.target + "'");
   }

@@ -38,7 +38,7 @@ std::string file_name(const std::string& path) {
 }  // namespace
 
 struct ReplaySource::Impl {
-  FilterRegistry registry;  // outlives every session
+  const FilterRegistry* registry = &builtin_filters();  // outlives every session
   replay::ReplayOptions options;
   std::string description;
   // One replay of the log from its start; replaced (with what follows it) when going back.
@@ -70,7 +70,7 @@ struct ReplaySource::Impl {
   /// Opens a new replay of the log from its start, processed up to its first tick; the current
   /// one is kept when that fails.
   [[nodiscard]] Expected<void> restart() {
-    auto opened = replay::ReplaySession::open(options, registry);
+    auto opened = replay::ReplaySession::open(options, *registry);
     if (!opened) return tl::unexpected(opened.error());
     close();
     session = std::move(*opened);
@@ -82,7 +82,7 @@ struct ReplaySource::Impl {
     local.period = to_seconds(session->period());
     local.scenario = options.input;
     local.duration = to_seconds(session->end());
-    query = std::make_unique<introspect::LocalQuery>(r.coordinator(), r.monitor(), registry, local);
+    query = std::make_unique<introspect::LocalQuery>(r.coordinator(), r.monitor(), *registry, local);
     connections = detail::local_connections(*query);
     pending.clear();
     auto follow = query->follow([this](const introspect::HistoryEntry& e) {
@@ -148,7 +148,7 @@ Expected<std::unique_ptr<ReplaySource>> ReplaySource::open(const ReplaySourceOpt
     return fail(ErrorCode::InvalidArgument, "--speed: " + s.error().message);
   }
   auto impl = std::make_unique<Impl>();
-  register_builtin_filters(impl->registry);
+  if (options.registry != nullptr) impl->registry = options.registry;
   impl->options.system = options.system;
   impl->options.input = options.input;
   impl->options.format = options.format;

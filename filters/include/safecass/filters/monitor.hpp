@@ -31,10 +31,12 @@ class Banks;
 class Monitor {
 public:
   static constexpr std::chrono::nanoseconds kDefaultPeriod = std::chrono::milliseconds(5);
+  /// Samples each signal keeps by default.
+  static constexpr std::size_t kDefaultSignalHistory = 1024;
 
   /// `coordinator` and `registry` must outlive the monitor. `banks` false runs every filter as an
   /// object (docs/filters.md, "Filter banks": the reference the banks are tested against).
-  Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history = 1024,
+  Monitor(Coordinator& coordinator, const FilterRegistry& registry, std::size_t signal_history = kDefaultSignalHistory,
           bool banks = true);
   ~Monitor();
   Monitor(const Monitor&) = delete;

@@ -92,4 +92,9 @@ private:
 /// the 2016 names (`Filter` + type) as aliases.
 void register_builtin_filters(FilterRegistry& registry);
 
+/// The built-in types alone (register_builtin_filters()), made once on first use (thread-safe) and
+/// never changed: the registry of a program that has no filter type of its own, and the default
+/// of every library that takes a registry.
+const FilterRegistry& builtin_filters();
+
 }  // namespace safecass

@@ -20,6 +20,7 @@
 
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
+#include "safecass/filters/registry.hpp"
 #include "safecass/introspect/model.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/spec/system.hpp"
@@ -46,6 +47,9 @@ struct SupervisorOptions {
   /// at a fraction of the cost; a lost or stale state stream is detected from the heartbeats and
   /// resynchronised (docs/middleware.md, "The supervisor").
   bool records = true;
+  /// The filter types of the system file (an application's own included); it must outlive the
+  /// supervisor. Null: the built-in types.
+  const FilterRegistry* registry = nullptr;
   /// Receives each output line (transitions as they arrive, states, lost/recovered). The line is
   /// formatted only when the consumer calls text(). Default: `print`.
   std::function<void(const SupervisorLine&)> output;

@@ -3,9 +3,12 @@
 /// Problems found in a specification, each with the file, line and column of the offending value
 /// and its JSON pointer, formatted the way compilers do so that editors can jump to them.
 
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <tl/expected.hpp>
 
 namespace safecass::spec {
 
@@ -28,6 +31,12 @@ struct Diagnostic {
   std::string pointer;  ///< JSON pointer of the value in its file, e.g. /filter/1/argument/threshold
 };
 
+/// Every problem found in one piece of work (loading, building), in order.
+using Diagnostics = std::vector<Diagnostic>;
+/// A value, or every problem that kept it from being made.
+template <class T>
+using Opened = tl::expected<T, Diagnostics>;
+
 /// "file:line:col: error: message [pointer]" ("warning:", "note:" likewise). The " [pointer]" part is left
 /// out when the pointer is empty (the whole document), the ":line:col" part when line is 0.
 std::string format(const Diagnostic& diagnostic);
@@ -35,6 +44,15 @@ std::string format(const Diagnostic& diagnostic);
 /// One diagnostic as a one-line JSON object:
 /// {"file": ..., "line": L, "column": C, "severity": "error"|"warning"|"note", "message": ..., "pointer": ...}.
 std::string to_json(const Diagnostic& diagnostic);
+
+/// Keeps the errors of `diagnostics` and moves the others (warnings, notes) to `notes`, or drops
+/// them when `notes` is null. Returns the errors, in their order.
+Diagnostics keep_errors(Diagnostics diagnostics, Diagnostics* notes);
+
+/// Prints each diagnostic on its own line (format()) to `out`.
+void print(const Diagnostics& diagnostics, std::FILE* out);
+/// The diagnostics as text, one per line (format()), for an Error message.
+std::string to_text(const Diagnostics& diagnostics);
 
 /// "; did you mean 'x'?" when one of `candidates` is near enough to `word` to be a likely typo,
 /// else "". The suggestion rule of every diagnostic (specifications, scenarios).

@@ -34,6 +34,7 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/ros_common/fields.hpp"
 #include "safecass/ros_common/mapping.hpp"
+#include "safecass/spec/instance.hpp"
 
 namespace safecass::ros_common {
 
@@ -96,8 +97,10 @@ public:
   Shadow(const Shadow&) = delete;
   Shadow& operator=(const Shadow&) = delete;
 
-  Coordinator& coordinator() noexcept { return *coordinator_; }
-  Monitor& monitor() noexcept { return *monitor_; }
+  Coordinator& coordinator() noexcept { return instance_->coordinator(); }
+  Monitor& monitor() noexcept { return instance_->monitor(); }
+  /// The system file it was built from.
+  const spec::SystemSpec& system() const noexcept { return instance_->spec(); }
   const Mapping& mapping() const noexcept { return mapping_; }
 
   // ---- topics ----
@@ -178,8 +181,7 @@ private:
 
   Mapping mapping_;
   Warn warn_;
-  std::unique_ptr<Coordinator> coordinator_;
-  std::unique_ptr<Monitor> monitor_;
+  std::unique_ptr<spec::Instance> instance_;
   std::vector<std::unique_ptr<Topic>> topics_;
   std::vector<std::unique_ptr<Loop>> loops_;
   std::vector<Ingest> ingests_;

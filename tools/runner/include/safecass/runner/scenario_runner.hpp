@@ -25,7 +25,7 @@
 #include "safecass/native/runtime.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
-#include "safecass/runner/system.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
 #include "safecass/spec/system.hpp"
@@ -76,7 +76,7 @@ struct RunResult {
 
 /// Where a scenario run comes from.
 struct ScenarioSource {
-  /// A scenario file. Empty: the system runs with no steps, ticking at kDefaultTick.
+  /// A scenario file. Empty: the system runs with no steps, ticking at native::kDefaultTick.
   std::string scenario;
   /// The system file. Empty: the scenario's "system"; otherwise it replaces it.
   std::string system;
@@ -84,21 +84,21 @@ struct ScenarioSource {
 
 class ScenarioRunner {
 public:
-  /// Loads the scenario and its system, builds the system (build_system(), components that name
+  /// Loads the scenario and its system, builds the system (native::build_system(), components that name
   /// no period run at the scenario's period) and checks every name the scenario uses (signals,
   /// sizes, events, filters, addresses). Every problem is returned with its position, and then
   /// nothing was built. Warnings of the system file are appended to `notes` when given.
-  [[nodiscard]] static Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source,
+  [[nodiscard]] static spec::Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source,
                                                                     const FilterRegistry& registry,
-                                                                    Diagnostics* notes = nullptr);
+                                                                    spec::Diagnostics* notes = nullptr);
   /// The same from parts already loaded. `registry` must outlive the runner.
-  [[nodiscard]] static Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
+  [[nodiscard]] static spec::Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
                                                                     const FilterRegistry& registry);
   ~ScenarioRunner();
   ScenarioRunner(const ScenarioRunner&) = delete;
   ScenarioRunner& operator=(const ScenarioRunner&) = delete;
 
-  System& system() noexcept { return *system_; }
+  native::System& system() noexcept { return *system_; }
   Coordinator& coordinator() noexcept { return coordinator_; }
   Monitor& monitor() noexcept { return *monitor_; }
   native::Runtime& runtime() noexcept { return *runtime_; }
@@ -142,9 +142,9 @@ private:
     double from;
     double to;
   };
-  ScenarioRunner(spec::Scenario scenario, std::unique_ptr<System> system);
+  ScenarioRunner(spec::Scenario scenario, std::unique_ptr<native::System> system);
   /// Every name the scenario uses, checked against the built system.
-  Diagnostics check_names();
+  spec::Diagnostics check_names();
   void apply(const spec::ScenarioStep& step, Time now);
   /// The components a coordinator of the system file runs, or nullptr when `name` is none.
   const std::vector<std::string>* coordinator_components(const std::string& name) const;
@@ -155,7 +155,7 @@ private:
   std::string check_one(const spec::ScenarioStep& step, const std::string& address, const std::string& expected);
 
   spec::Scenario scenario_;
-  std::unique_ptr<System> system_;
+  std::unique_ptr<native::System> system_;
   SimulatedClock& clock_;
   Coordinator& coordinator_;
   Monitor* monitor_;

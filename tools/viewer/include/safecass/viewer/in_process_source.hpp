@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "safecass/filters/registry.hpp"
 #include "safecass/viewer/source.hpp"
 
 namespace safecass::viewer {
@@ -23,6 +24,9 @@ struct InProcessOptions {
   double speed = 1.0;    ///< simulated seconds per wall-clock second, in (0, 1000]
   /// Expectation failures of the scenario are printed here, one line each (null: not printed).
   std::FILE* log = stderr;
+  /// The filter types of the system file (an application's own included); it must outlive the
+  /// source. Null: the built-in types.
+  const FilterRegistry* registry = nullptr;
 };
 
 class InProcessSource final : public ViewSource {

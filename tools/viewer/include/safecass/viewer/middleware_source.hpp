@@ -30,6 +30,7 @@
 #include <memory>
 #include <string>
 
+#include "safecass/filters/registry.hpp"
 #include "safecass/viewer/source.hpp"
 
 namespace safecass::viewer {
@@ -37,6 +38,9 @@ namespace safecass::viewer {
 struct MiddlewareOptions {
   std::string ice;     ///< IceStorm, "HOST:PORT" or "PORT"
   std::string system;  ///< the system file: its coordinators and their components
+  /// The filter types of the system file (an application's own included); it must outlive the
+  /// source. Null: the built-in types.
+  const FilterRegistry* registry = nullptr;
   /// Coordinator name → its token file (written by `safecass run ... --allow-write --token-file`).
   std::map<std::string, std::string> token_files;
   bool allow_write = false;  ///< without it every write is refused here too

@@ -18,6 +18,7 @@
 #include <memory>
 #include <string>
 
+#include "safecass/filters/registry.hpp"
 #include "safecass/viewer/source.hpp"
 
 namespace safecass::viewer {
@@ -28,6 +29,9 @@ struct ReplaySourceOptions {
   std::string format;   ///< "recording", "csv", "bag", "rosbag2"; empty: from the file's first bytes
   std::string mapping;  ///< a bag: the ROS extension's mapping file
   double speed = 1.0;   ///< recording seconds per wall-clock second while playing, in (0, 1000]
+  /// The filter types of the system file (an application's own included); it must outlive the
+  /// source. Null: the built-in types.
+  const FilterRegistry* registry = nullptr;
 };
 
 class ReplaySource final : public ViewSource {
