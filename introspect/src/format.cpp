@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <optional>
 
 #include <fmt/format.h>
 #include <variant>
 
+#include "safecass/json/read.hpp"
 #include "safecass/json/write.hpp"
 
 namespace safecass::introspect {
@@ -341,6 +343,73 @@ std::string state_list_json(const std::vector<StateRow>& rows) {
            "\n";
   }
   return out;
+}
+
+std::string state_summary_text(const StateSummary& s) {
+  const std::size_t n = s.normal + s.warning + s.error;
+  std::string out = "SYSTEM " + state_text(s.system) + ": " + std::to_string(n) +
+                    (n == 1 ? " component, " : " components, ") + std::to_string(s.normal) + " Normal, " +
+                    std::to_string(s.warning) + " Warning, " + std::to_string(s.error) + " Error\n";
+  std::vector<std::vector<std::string>> table;
+  for (const StateSummary::Component& c : s.not_normal) {
+    table.push_back({"  " + c.name, state_text(c.state), c.outstanding.empty() ? "-" : c.outstanding});
+  }
+  return out + columns(table);
+}
+
+std::string state_summary_json(const StateSummary& s) {
+  json::JsonArray not_normal;
+  for (const StateSummary::Component& c : s.not_normal) {
+    not_normal.raw(json::JsonObject()
+                       .str("component", c.name)
+                       .str("state", to_string(c.state))
+                       .opt("outstanding", c.outstanding)
+                       .text());
+  }
+  return json::JsonObject()
+             .str("system", to_string(s.system))
+             .integer("normal", static_cast<long long>(s.normal))
+             .integer("warning", static_cast<long long>(s.warning))
+             .integer("error", static_cast<long long>(s.error))
+             .raw("not_normal", not_normal.text())
+             .text() +
+         "\n";
+}
+
+Expected<StateSummary> state_summary_from_json(std::string_view text) {
+  const json::JsonParse parsed = json::parse_json(text, 8);
+  if (!parsed.value || !parsed.value->is_object()) return fail(ErrorCode::Parse, "state summary: not a JSON object");
+  const json::JsonValue& v = *parsed.value;
+  const auto state_of = [](const json::JsonValue* field) -> std::optional<State> {
+    return field != nullptr && field->is_string() ? parse_state(field->string) : std::nullopt;
+  };
+  const auto count_of = [](const json::JsonValue* field) -> std::optional<std::size_t> {
+    if (field == nullptr || !field->is_number() || !field->integral || field->number < 0) return std::nullopt;
+    return static_cast<std::size_t>(field->number);
+  };
+  StateSummary s;
+  const auto system = state_of(v.find("system"));
+  const auto normal = count_of(v.find("normal"));
+  const auto warning = count_of(v.find("warning"));
+  const auto error = count_of(v.find("error"));
+  const json::JsonValue* list = v.find("not_normal");
+  if (!system || !normal || !warning || !error || list == nullptr || !list->is_array()) {
+    return fail(ErrorCode::Parse, "state summary: system, normal, warning, error or not_normal missing or wrong");
+  }
+  s.system = *system;
+  s.normal = *normal;
+  s.warning = *warning;
+  s.error = *error;
+  for (const json::JsonValue& c : list->array) {
+    const json::JsonValue* name = c.find("component");
+    const auto state = state_of(c.find("state"));
+    const json::JsonValue* outstanding = c.find("outstanding");
+    if (name == nullptr || !name->is_string() || !state || outstanding == nullptr) {
+      return fail(ErrorCode::Parse, "state summary: a component without a name or a state");
+    }
+    s.not_normal.push_back({name->string, *state, outstanding->is_string() ? outstanding->string : std::string()});
+  }
+  return s;
 }
 
 std::string filter_list_text(const std::vector<FilterRow>& rows) {

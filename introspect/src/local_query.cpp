@@ -1,5 +1,6 @@
 #include "safecass/introspect/local_query.hpp"
 #include "safecass/core/address.hpp"
+#include "safecass/introspect/format.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -355,6 +356,67 @@ Expected<void> LocalQuery::reset(std::string_view target, std::string_view who, 
   auto done = co_.reset(target, who, why);
   if (done && options_.actions != nullptr) options_.actions->reset(target, who, why);
   return done;
+}
+
+// ---- named reads ---------------------------------------------------------------------------------
+
+namespace {
+
+Expected<StateSummary> state_summary(LocalQuery& query) {
+  auto rows = query.state_list();
+  if (!rows) return tl::unexpected(rows.error());
+  StateSummary s;
+  for (const StateRow& r : *rows) {
+    if (r.kind == RowKind::System) s.system = r.state;
+    if (r.kind != RowKind::Component) continue;
+    (r.state == State::Normal ? s.normal : r.state == State::Warning ? s.warning : s.error) += 1;
+    if (r.state != State::Normal) s.not_normal.push_back({r.address, r.state, r.outstanding});
+  }
+  return s;
+}
+
+/// A read whose answer is `Value`: produced by `Produce`, written by `Json`, read back by `Parse`
+/// and shown by `Text`.
+template <class Value, Expected<Value> (*Produce)(LocalQuery&), std::string (*Json)(const Value&),
+          Expected<Value> (*Parse)(std::string_view), std::string (*Text)(const Value&)>
+constexpr NamedRead read_without_arguments(std::string_view name) {
+  return NamedRead{name,
+                   [](LocalQuery& query, const std::vector<std::string>&) -> Expected<std::string> {
+                     auto value = Produce(query);
+                     if (!value) return tl::unexpected(value.error());
+                     return Json(*value);
+                   },
+                   [](std::string_view json) -> Expected<std::string> {
+                     auto value = Parse(json);
+                     if (!value) return tl::unexpected(value.error());
+                     return Text(*value);
+                   }};
+}
+
+constexpr NamedRead kReads[] = {
+    read_without_arguments<StateSummary, state_summary, state_summary_json, state_summary_from_json,
+                           state_summary_text>("state summary"),
+};
+
+}  // namespace
+
+const NamedRead* find_read(std::string_view name) noexcept {
+  for (const NamedRead& r : kReads) {
+    if (r.name == name) return &r;
+  }
+  return nullptr;
+}
+
+Expected<std::string> read_text(std::string_view name, std::string_view json) {
+  const NamedRead* r = find_read(name);
+  if (r == nullptr) return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
+  return r->text(json);
+}
+
+Expected<std::string> LocalQuery::read(std::string_view name, const std::vector<std::string>& args) {
+  const NamedRead* r = find_read(name);
+  if (r == nullptr) return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
+  return r->answer(*this, args);
 }
 
 }  // namespace safecass::introspect

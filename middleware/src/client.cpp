@@ -431,6 +431,11 @@ Expected<introspect::Names> RemoteClient::names() {
   return impl_->call("names", [&] { return from_wire(impl_->control->names()); });
 }
 
+Expected<std::string> RemoteClient::read(std::string_view name, const std::vector<std::string>& args) {
+  const std::string what(name);
+  return impl_->call(what.c_str(), [&] { return impl_->control->read(what, args); });
+}
+
 Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introspect::RecordSink sink) {
   // Where the stream starts: the last record the coordinator has now; anything after it that
   // the first message does not carry is a gap, filled from the history.

@@ -205,6 +205,11 @@ public:
     return to_wire(value_or_raise(locked([&] { return query_.names(); })));
   }
 
+  std::string read(std::string name, Ice::StringSeq args, const Ice::Current& current) override {
+    check_read(current);
+    return value_or_raise(locked([&] { return query_.read(name, args); }));
+  }
+
 private:
   /// Reads need the read credential when the process has one (in the request context, key
   /// kReadCredentialKey); the write token is accepted too.

@@ -28,7 +28,7 @@ Instance::Instance(SystemSpec spec, const FilterRegistry& registry, const Instan
 Instance::~Instance() = default;
 
 [[nodiscard]] Opened<std::unique_ptr<Instance>> build_instance(SystemSpec system, const FilterRegistry& registry,
-                                                      const InstanceOptions& options) {
+                                                               const InstanceOptions& options) {
   const std::string file = system.path;
   std::unique_ptr<Instance> built(new Instance(std::move(system), registry, options));
   if (auto r = instantiate(built->spec_, built->coordinator_, built->monitor_, options.coordinator); !r) {
@@ -47,7 +47,7 @@ Instance::~Instance() = default;
 }
 
 [[nodiscard]] Opened<std::unique_ptr<Instance>> open_instance(const std::string& path, const FilterRegistry& registry,
-                                                     const InstanceOptions& options, Diagnostics* notes) {
+                                                              const InstanceOptions& options, Diagnostics* notes) {
   auto system = load_valid_system(path, registry, notes);
   if (!system) return tl::unexpected(std::move(system.error()));
   return build_instance(std::move(*system), registry, options);

@@ -114,6 +114,18 @@ public:
         out.reply.out += options_.json ? in::state_list_json(*rows) : in::state_list_text(*rows);
         return {};
       }
+      case Id::Read: {
+        auto answer = q.read(c.name, args);
+        if (!answer) return answer.error().message;
+        if (options_.json) {
+          out.reply.out += *answer;
+          return {};
+        }
+        auto text = in::read_text(c.name, *answer);
+        if (!text) return text.error().message;
+        out.reply.out += *text;
+        return {};
+      }
       case Id::StateHistory: return state_history(args, out);
       case Id::FilterList: {
         auto rows = q.filter_list();

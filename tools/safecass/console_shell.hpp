@@ -63,6 +63,9 @@ enum class Arg { None, Component, Address, Machine, Event, Filter, FilterOrType,
 
 enum class Id {
   StateList,
+  /// A named read (introspect's NamedRead, found by the command's name): answered as JSON by
+  /// SystemQuery::read() and shown by its formatter.
+  Read,
   StateHistory,
   FilterList,
   FilterInfo,

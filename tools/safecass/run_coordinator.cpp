@@ -28,10 +28,10 @@
 #include "safecass/middleware/node.hpp"
 #include "safecass/middleware/token.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/native/system.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
 

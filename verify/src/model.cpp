@@ -45,7 +45,8 @@ Expected<std::unique_ptr<Model>> Model::build(const spec::SystemSpec& system, co
   // One process: every component, every connection (cross-process ones become synchronous).
   auto built = spec::build_instance(system, registry, options);
   if (!built) {
-    return fail(ErrorCode::InvalidArgument, "cannot build system '" + system.name + "': " + spec::to_text(built.error()));
+    return fail(ErrorCode::InvalidArgument,
+                "cannot build system '" + system.name + "': " + spec::to_text(built.error()));
   }
   m->instance_ = std::move(*built);
   m->system_ = &m->instance_->spec();

@@ -21,8 +21,8 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/id_vector.hpp"
 #include "safecass/filters/monitor.hpp"
-#include "safecass/spec/instance.hpp"
 #include "safecass/spec/formula.hpp"
+#include "safecass/spec/instance.hpp"
 #include "safecass/verify/verify.hpp"
 
 namespace safecass::verify::detail {

@@ -1,10 +1,11 @@
 #include "safecass/native/system.hpp"
 
-
 namespace safecass::native {
 
 System::System(std::unique_ptr<SimulatedClock> clock, std::unique_ptr<spec::Instance> instance)
-    : own_clock_(std::move(clock)), instance_(std::move(instance)), runtime_(instance_->monitor(), Monitor::kDefaultPeriod) {}
+    : own_clock_(std::move(clock)),
+      instance_(std::move(instance)),
+      runtime_(instance_->monitor(), Monitor::kDefaultPeriod) {}
 
 System::~System() { runtime_.stop(); }
 
@@ -31,8 +32,7 @@ System::~System() { runtime_.stop(); }
   return built;
 }
 
-[[nodiscard]] spec::Opened<std::unique_ptr<System>> open_system(const std::string& path,
-                                                                const FilterRegistry& registry,
+[[nodiscard]] spec::Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
                                                                 const SystemOptions& options,
                                                                 spec::Diagnostics* notes) {
   auto system = spec::load_valid_system(path, registry, notes);

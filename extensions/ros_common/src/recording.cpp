@@ -4,8 +4,8 @@
 
 namespace safecass::ros_common {
 
-Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow,
-                                                             const std::string& history_path, FileLimits limits) {
+Expected<std::unique_ptr<NodeRecording>> NodeRecording::open(Shadow& shadow, const std::string& history_path,
+                                                             FileLimits limits) {
   std::unique_ptr<NodeRecording> r(new NodeRecording());
   auto h = Recorder::open(shadow.coordinator(), history_path, 65536, limits);
   if (!h) return tl::unexpected(h.error());

@@ -204,7 +204,8 @@ Expected<void> Shadow::bind() {
         f.params["max_rate"] = (*check)->max_rate;
         f.params["window"] = static_cast<double>((*check)->window);
       }
-      if (auto r = instance_->monitor().add_filter(std::move(f)); !r) return fail(r.error().code, what + ": " + r.error().message);
+      if (auto r = instance_->monitor().add_filter(std::move(f)); !r)
+        return fail(r.error().code, what + ": " + r.error().message);
     }
     topics_.push_back(std::move(t));
   }
@@ -350,7 +351,8 @@ void Shadow::run_loop(std::size_t i) {
       instance_->coordinator().generate(framework_event::completion_of(framework_event::kThreadException), framework);
     }
   } catch (const std::exception& e) {
-    warn_("the loop of " + std::string(instance_->coordinator().component_name(loop.component)) + " threw: " + e.what());
+    warn_("the loop of " + std::string(instance_->coordinator().component_name(loop.component)) +
+          " threw: " + e.what());
     if (!loop.threw) instance_->coordinator().generate(framework_event::kThreadException, framework);
     loop.threw = true;
   } catch (...) {
@@ -524,7 +526,8 @@ void Shadow::apply(Ingest& in) {
     }
   }
   for (std::size_t i = 0; i < 3; ++i) {
-    if (!want[i] && in.active[i]) instance_->coordinator().generate(instance_->coordinator().event(in.onset[i]).counterpart, in.target);
+    if (!want[i] && in.active[i])
+      instance_->coordinator().generate(instance_->coordinator().event(in.onset[i]).counterpart, in.target);
   }
   in.active = want;
 }

@@ -1,4 +1,5 @@
-// The read model's text of numbers and times (introspect/format.hpp), which every tool prints.
+// The read model's text of numbers and times (introspect/format.hpp), which every tool prints, and
+// the named reads (introspect/local_query.hpp) a live coordinator answers through one request.
 
 #include <gtest/gtest.h>
 
@@ -6,6 +7,7 @@
 #include <string>
 
 #include "safecass/introspect/format.hpp"
+#include "safecass/introspect/local_query.hpp"
 
 namespace safecass::introspect {
 namespace {
@@ -26,6 +28,58 @@ TEST(MarkupText, EscapesTheFiveMarkupCharactersAndCopiesEveryOtherByte) {
   EXPECT_EQ(markup_text("a<b>&\"c'd"), "a&lt;b&gt;&amp;&quot;c&#39;d");
   EXPECT_EQ(markup_text("JR3.s_A \xc2\xb0 \n"), "JR3.s_A \xc2\xb0 \n");
   EXPECT_EQ(markup_text(""), "");
+}
+
+StateSummary robodoc_in_trouble() {
+  StateSummary s;
+  s.system = State::Error;
+  s.normal = 3;
+  s.warning = 1;
+  s.error = 1;
+  s.not_normal = {{"BMM", State::Warning, "EVT_BONE_MOTION"}, {"JR3", State::Error, ""}};
+  return s;
+}
+
+TEST(StateSummary, ItsTextCountsTheComponentsByStateAndListsThoseNotNormal) {
+  EXPECT_EQ(state_summary_text(robodoc_in_trouble()),
+            "SYSTEM Error: 5 components, 3 Normal, 1 Warning, 1 Error\n"
+            "  BMM  Warning  EVT_BONE_MOTION\n"
+            "  JR3  Error    -\n");
+  EXPECT_EQ(state_summary_text(StateSummary{State::Normal, 1, 0, 0, {}}),
+            "SYSTEM Normal: 1 component, 1 Normal, 0 Warning, 0 Error\n");
+}
+
+TEST(StateSummary, ItsJsonIsOneLineThatReadsBackToTheSameValue) {
+  const std::string json = state_summary_json(robodoc_in_trouble());
+  EXPECT_EQ(json, R"({"system":"Error","normal":3,"warning":1,"error":1,"not_normal":[)"
+                  R"({"component":"BMM","state":"Warning","outstanding":"EVT_BONE_MOTION"},)"
+                  R"({"component":"JR3","state":"Error","outstanding":null}]})"
+                  "\n");
+  auto back = state_summary_from_json(json);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_EQ(*back, robodoc_in_trouble());
+}
+
+TEST(StateSummary, AnAnswerThatIsNotASummaryIsAParseErrorThatSaysSo) {
+  for (const char* bad : {"", "[]", R"({"system":"Fine","normal":1,"warning":0,"error":0,"not_normal":[]})",
+                          R"({"system":"Normal","normal":-1,"warning":0,"error":0,"not_normal":[]})",
+                          R"({"system":"Normal","normal":1,"warning":0,"error":0,"not_normal":[{"state":"Error"}]})"}) {
+    auto parsed = state_summary_from_json(bad);
+    ASSERT_FALSE(parsed) << bad;
+    EXPECT_EQ(parsed.error().code, ErrorCode::Parse) << bad;
+    EXPECT_NE(parsed.error().message.find("state summary"), std::string::npos) << bad;
+  }
+}
+
+TEST(NamedRead, AReadIsFoundByItsConsoleCommandAndAnUnknownOneIsNotFound) {
+  ASSERT_NE(find_read("state summary"), nullptr);
+  EXPECT_EQ(find_read("state gossip"), nullptr);
+  auto unknown = read_text("state gossip", "{}");
+  ASSERT_FALSE(unknown);
+  EXPECT_EQ(unknown.error().code, ErrorCode::NotFound);
+  auto text = read_text("state summary", state_summary_json(robodoc_in_trouble()));
+  ASSERT_TRUE(text) << text.error().message;
+  EXPECT_EQ(*text, state_summary_text(robodoc_in_trouble()));
 }
 
 }  // namespace

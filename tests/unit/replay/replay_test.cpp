@@ -14,11 +14,11 @@
 
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/record/input_log.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/replay/replay.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/native/system.hpp"
 
 namespace safecass::replay {
 namespace {

@@ -84,7 +84,8 @@ TEST(ConsoleShell, BadCommandLinesAreUsageLinesThatNeverReachTheBackend) {
   auto console = fake_console(calls, true);
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"frobnicate", "unknown command 'frobnicate' (usage: help [COMMAND])"},
-      {"state", "state: needs a subcommand (usage: state list [COMPONENT] | state history [ADDRESS] [N])"},
+      {"state",
+       "state: needs a subcommand (usage: state list [COMPONENT] | state summary | state history [ADDRESS] [N])"},
       {"state lst", "state: unknown subcommand 'lst'"},
       {"explain", "explain: missing arguments (usage: explain ADDRESS)"},
       {"event generate A B C", "event generate: too many arguments (usage: event generate EVENT TARGET)"},

@@ -83,6 +83,31 @@ TEST_F(ConsoleTest, StateListShowsEveryComponentAndMachineWithItsStateAndOutstan
   EXPECT_FALSE(contains(after, "JR3"));
 }
 
+TEST_F(ConsoleTest, StateSummaryCountsTheComponentsByStateAndListsThoseNotNormalAsStateListShowsThem) {
+  EXPECT_EQ(run("state summary").out, "SYSTEM Normal: 5 components, 5 Normal, 0 Warning, 0 Error\n");
+  run("event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A");
+  const std::string out = run("state summary").out;
+  EXPECT_TRUE(contains(out, "SYSTEM Error: 5 components, ")) << out;
+  EXPECT_TRUE(contains(out, "\n  CONTROL  Error")) << out;
+  EXPECT_TRUE(contains(out, "EVT_CONTROL_FORCE_FREEZE\n")) << out;
+  // Every component the summary lists is one that state list shows not Normal, and no other.
+  const std::string states = run("state list").out;
+  for (const char* component : {"JR3", "BMM", "CONTROL", "SERVO", "PENDANT"}) {
+    const bool listed = contains(out, "\n  " + std::string(component) + " ");
+    const bool normal =
+        contains(states, "\n" + std::string(component) + " ") &&
+        contains(states.substr(states.find("\n" + std::string(component) + " ")).substr(0, 40), "Normal");
+    EXPECT_NE(listed, normal) << component << "\n" << out << states;
+  }
+  auto json = open_console(true, true);
+  ASSERT_NE(json, nullptr);
+  EXPECT_EQ(json->execute("state summary").out,
+            R"({"system":"Normal","normal":5,"warning":0,"error":0,"not_normal":[]})"
+            "\n");
+  const ConsoleReply extra = console->execute("state summary JR3");
+  EXPECT_FALSE(extra.ok) << "state summary takes no argument";
+}
+
 TEST_F(ConsoleTest, StateHistoryShowsTheRecordsOfAnAddressOrOfTheSystem) {
   run("event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A");
   const std::string machine = run("state history CONTROL.s_A").out;
@@ -301,17 +326,32 @@ TEST_F(ConsoleTest, ResetClearsEveryConditionOfTheTargetAndRecordsTheReason) {
 
 TEST_F(ConsoleTest, HelpListsEveryCommandAndShowsOneCommandsUsage) {
   const std::string all = run("help").out;
-  for (const char* usage :
-       {"state list", "state history [ADDRESS] [N]", "filter list", "filter info NAME", "filter inject NAME SAMPLE...",
-        "filter dinject SIGNAL SAMPLE...", "filter dinload SIGNAL FILE", "event list", "event history [N]",
-        "event generate EVENT TARGET", "event broadcast EVENT", "connection list", "service list", "explain ADDRESS",
-        "watch [SECONDS]", "reset TARGET [REASON]", "time", "help [COMMAND]", "quit"}) {
+  for (const char* usage : {"state list",
+                            "state history [ADDRESS] [N]",
+                            "filter list",
+                            "filter info NAME",
+                            "filter inject NAME SAMPLE...",
+                            "filter dinject SIGNAL SAMPLE...",
+                            "filter dinload SIGNAL FILE",
+                            "event list",
+                            "event history [N]",
+                            "event generate EVENT TARGET",
+                            "event broadcast EVENT",
+                            "connection list",
+                            "service list",
+                            "explain ADDRESS",
+                            "watch [SECONDS]",
+                            "reset TARGET [REASON]",
+                            "time",
+                            "help [COMMAND]",
+                            "quit",
+                            "state summary"}) {
     EXPECT_TRUE(contains(all, usage)) << usage;
   }
   const std::string one = run("help filter dinload").out;
   EXPECT_TRUE(contains(one, "usage: filter dinload SIGNAL FILE")) << one;
   EXPECT_TRUE(contains(one, "needs --allow-write")) << one;
-  EXPECT_EQ(count_lines(run("help state").out), 2u);
+  EXPECT_EQ(count_lines(run("help state").out), 3u);  // state list, state summary, state history
   EXPECT_TRUE(contains(run("help exit").out, "usage: quit"));
 }
 
@@ -488,8 +528,9 @@ TEST_F(ConsoleTest, InjectingANonFiniteValueIsRefusedOnEveryPathAndChangesNothin
 TEST_F(ConsoleTest, UsageNamesTheCommandThatWasMistyped) {
   EXPECT_EQ(console->execute("filter info").err, "filter info: missing arguments (usage: filter info NAME)\n");
   EXPECT_EQ(console->execute("frob").err, "unknown command 'frob' (usage: help [COMMAND])\n");
-  EXPECT_EQ(console->execute("state").err,
-            "state: needs a subcommand (usage: state list [COMPONENT] | state history [ADDRESS] [N])\n");
+  EXPECT_EQ(
+      console->execute("state").err,
+      "state: needs a subcommand (usage: state list [COMPONENT] | state summary | state history [ADDRESS] [N])\n");
 }
 
 TEST(ConsoleOpen, ABadSystemOrScenarioIsAnErrorWithItsDiagnostics) {

@@ -13,12 +13,12 @@
 namespace safecass::runner {
 namespace {
 
-using ::testing::HasSubstr;
 using native::kDefaultTick;
 using native::open_system;
 using native::System;
 using native::SystemOptions;
 using spec::to_text;
+using ::testing::HasSubstr;
 
 const std::string kRobodoc = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
 const std::string kStory = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/story.json";

@@ -20,7 +20,6 @@ using spec::Diagnostics;
 using spec::keep_errors;
 using spec::Opened;
 
-
 namespace {
 std::string secs(Time t) { return introspect::seconds_text(t); }
 

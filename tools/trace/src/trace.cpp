@@ -11,9 +11,9 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/json/read.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/runner/scenario_runner.hpp"
-#include "safecass/native/system.hpp"
 #include "safecass/spec/file.hpp"
 #include "safecass/spec/load.hpp"
 

@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "safecass/core/expected.hpp"
 #include "safecass/introspect/model.hpp"
 
 namespace safecass::introspect {
@@ -89,6 +90,13 @@ std::string explain_json(const ExplainAnswer& a);
 
 std::string state_list_text(const std::vector<StateRow>& rows);
 std::string state_list_json(const std::vector<StateRow>& rows);
+/// "SYSTEM Error: 5 components, 3 Normal, 1 Warning, 1 Error", then one line per component that
+/// is not Normal (name, state, outstanding event).
+std::string state_summary_text(const StateSummary& summary);
+/// One line: {"system":..,"normal":N,"warning":N,"error":N,"not_normal":[{"component","state","outstanding"}]}.
+std::string state_summary_json(const StateSummary& summary);
+/// The inverse of state_summary_json(). Errors: Parse (what is missing or wrong).
+[[nodiscard]] Expected<StateSummary> state_summary_from_json(std::string_view json);
 std::string filter_list_text(const std::vector<FilterRow>& rows);
 std::string filter_list_json(const std::vector<FilterRow>& rows);
 std::string filter_info_text(const FilterInfo& info);

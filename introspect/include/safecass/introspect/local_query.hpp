@@ -46,6 +46,7 @@ public:
   [[nodiscard]] Expected<std::vector<ServiceRow>> service_list() override;
   [[nodiscard]] Expected<ExplainAnswer> explain(std::string_view address) override;
   [[nodiscard]] Expected<Names> names() override;
+  [[nodiscard]] Expected<std::string> read(std::string_view name, const std::vector<std::string>& args) override;
   [[nodiscard]] Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) override;
   [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;
   [[nodiscard]] Expected<void> broadcast(std::string_view event) override;
@@ -65,5 +66,21 @@ private:
   const FilterRegistry& registry_;
   LocalOptions options_;
 };
+
+/// A read that is answered as JSON through SystemQuery::read(), in-process and from a live
+/// coordinator alike: a new read command is one entry in the table of local_query.cpp (and one in
+/// the console's command table), with its value type and formatter (docs/contributing.md).
+struct NamedRead {
+  std::string_view name;  ///< the console command, "state summary"
+  /// The answer, as JSON, of a system in this process.
+  Expected<std::string> (*answer)(LocalQuery& query, const std::vector<std::string>& args);
+  /// A JSON answer as text, wherever it came from.
+  Expected<std::string> (*text)(std::string_view json);
+};
+
+/// The read called `name`, or null.
+const NamedRead* find_read(std::string_view name) noexcept;
+/// The JSON answer of the read called `name` as text. Errors: NotFound, Parse (not its answer).
+[[nodiscard]] Expected<std::string> read_text(std::string_view name, std::string_view json);
 
 }  // namespace safecass::introspect

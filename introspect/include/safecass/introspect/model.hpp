@@ -56,6 +56,25 @@ struct StateRow {
   friend bool operator==(const StateRow&, const StateRow&) = default;
 };
 
+/// The system at a glance (`state summary`): its state, how many components are in each state,
+/// and the components that are not Normal, in declaration order.
+struct StateSummary {
+  struct Component {
+    std::string name;
+    State state = State::Normal;
+    std::string outstanding;  ///< the outstanding event
+
+    friend bool operator==(const Component&, const Component&) = default;
+  };
+  State system = State::Normal;
+  std::size_t normal = 0;
+  std::size_t warning = 0;
+  std::size_t error = 0;
+  std::vector<Component> not_normal;
+
+  friend bool operator==(const StateSummary&, const StateSummary&) = default;
+};
+
 /// The root cause a history record carries (DESIGN §2.6).
 struct RootEntry {
   std::string event;

@@ -68,6 +68,10 @@ public:
   [[nodiscard]] virtual Expected<ExplainAnswer> explain(std::string_view address) = 0;
   /// The names TAB completes.
   [[nodiscard]] virtual Expected<Names> names() = 0;
+  /// A named read (NamedRead, local_query.hpp: `state summary`, ...): its answer as the JSON that
+  /// `--json` prints. A read added there needs no request of its own: a live coordinator answers it
+  /// through the one generic request. Errors: NotFound (no such read), those of the read.
+  [[nodiscard]] virtual Expected<std::string> read(std::string_view name, const std::vector<std::string>& args) = 0;
 
   // ---- the record stream ---------------------------------------------------------------------
   /// Calls `sink` for every record from now on, in order and each once (a remote query fills

@@ -88,6 +88,7 @@ public:
   [[nodiscard]] Expected<std::vector<introspect::ServiceRow>> service_list() override;
   [[nodiscard]] Expected<introspect::ExplainAnswer> explain(std::string_view address) override;
   [[nodiscard]] Expected<introspect::Names> names() override;
+  [[nodiscard]] Expected<std::string> read(std::string_view name, const std::vector<std::string>& args) override;
   /// Errors: Io (IceStorm cannot be reached to subscribe).
   [[nodiscard]] Expected<std::unique_ptr<introspect::Subscription>> follow(introspect::RecordSink sink) override;
   [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;

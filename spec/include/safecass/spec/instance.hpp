@@ -68,7 +68,7 @@ std::string coordinator_name(const SystemSpec& system, const InstanceOptions& op
 /// filters and connections. `registry` must outlive the Instance. An error is one diagnostic at
 /// the system file that names what could not be built.
 [[nodiscard]] Opened<std::unique_ptr<Instance>> build_instance(SystemSpec system, const FilterRegistry& registry,
-                                                      const InstanceOptions& options = {});
+                                                               const InstanceOptions& options = {});
 
 /// Loads the system file (load_system()): the specification, or its errors. Diagnostics that are
 /// not errors (warnings, notes) are appended to `notes` when given.
@@ -78,7 +78,7 @@ std::string coordinator_name(const SystemSpec& system, const InstanceOptions& op
 /// Loads the system file and builds it. Diagnostics that are not errors (warnings, notes) are
 /// appended to `notes` when given; errors are the unexpected side and nothing is built.
 [[nodiscard]] Opened<std::unique_ptr<Instance>> open_instance(const std::string& path, const FilterRegistry& registry,
-                                                     const InstanceOptions& options = {},
-                                                     Diagnostics* notes = nullptr);
+                                                              const InstanceOptions& options = {},
+                                                              Diagnostics* notes = nullptr);
 
 }  // namespace safecass::spec

@@ -73,8 +73,7 @@ private:
 
 /// Loads the system file and builds it. Diagnostics that are not errors (warnings, notes) are
 /// appended to `notes` when given; errors are the unexpected side and nothing is built.
-[[nodiscard]] spec::Opened<std::unique_ptr<System>> open_system(const std::string& path,
-                                                                const FilterRegistry& registry,
+[[nodiscard]] spec::Opened<std::unique_ptr<System>> open_system(const std::string& path, const FilterRegistry& registry,
                                                                 const SystemOptions& options = {},
                                                                 spec::Diagnostics* notes = nullptr);
 

@@ -19,8 +19,7 @@ namespace safecass::ros_common {
 class NodeRecording {
 public:
   /// Opens both files before anything runs. Errors: Io (path and reason).
-  [[nodiscard]] static Expected<std::unique_ptr<NodeRecording>> open(Shadow& shadow,
-                                                                     const std::string& history_path,
+  [[nodiscard]] static Expected<std::unique_ptr<NodeRecording>> open(Shadow& shadow, const std::string& history_path,
                                                                      FileLimits limits = {});
   /// Closes both files; the losses, one line each (empty: the recording is complete).
   std::vector<std::string> close();

@@ -23,9 +23,9 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/native/runtime.hpp"
+#include "safecass/native/system.hpp"
 #include "safecass/record/input_recorder.hpp"
 #include "safecass/record/recorder.hpp"
-#include "safecass/native/system.hpp"
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/scenario.hpp"
 #include "safecass/spec/system.hpp"
@@ -89,11 +89,12 @@ public:
   /// sizes, events, filters, addresses). Every problem is returned with its position, and then
   /// nothing was built. Warnings of the system file are appended to `notes` when given.
   [[nodiscard]] static spec::Opened<std::unique_ptr<ScenarioRunner>> open(const ScenarioSource& source,
-                                                                    const FilterRegistry& registry,
-                                                                    spec::Diagnostics* notes = nullptr);
+                                                                          const FilterRegistry& registry,
+                                                                          spec::Diagnostics* notes = nullptr);
   /// The same from parts already loaded. `registry` must outlive the runner.
-  [[nodiscard]] static spec::Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario, spec::SystemSpec system,
-                                                                    const FilterRegistry& registry);
+  [[nodiscard]] static spec::Opened<std::unique_ptr<ScenarioRunner>> open(spec::Scenario scenario,
+                                                                          spec::SystemSpec system,
+                                                                          const FilterRegistry& registry);
   ~ScenarioRunner();
   ScenarioRunner(const ScenarioRunner&) = delete;
   ScenarioRunner& operator=(const ScenarioRunner&) = delete;
