@@ -355,14 +355,15 @@ Expected<void> Monitor::inject_deep(std::string_view signal, const std::vector<s
   if (auto finite = check_finite("deep injection into signal " + s->name(), samples); !finite) return finite;
   for (const auto& v : samples) s->inject(at, v.data());
   const std::string text = "deep injection into signal " + s->name() + ": " + samples_text(samples);
-  bool recorded = false;
+  // One record on each machine whose filters read the signal (however many of them do), in the
+  // order of their first filter; one without a machine when no filter reads it.
+  std::vector<MachineId> machines;
   for (const auto& f : filters_) {
-    if (std::find(f->inputs().begin(), f->inputs().end(), s) != f->inputs().end()) {
-      record_injection(f->target(), text);
-      recorded = true;
-    }
+    if (std::find(f->inputs().begin(), f->inputs().end(), s) == f->inputs().end()) continue;
+    if (std::find(machines.begin(), machines.end(), f->target()) == machines.end()) machines.push_back(f->target());
   }
-  if (!recorded) record_injection(kNoMachine, text);
+  if (machines.empty()) machines.push_back(kNoMachine);
+  for (MachineId m : machines) record_injection(m, text);
   return {};
 }
 

@@ -197,6 +197,20 @@ TEST_F(ConsoleTest, DeepInjectionIsSeenByEveryConsumerOfTheSignal) {
   EXPECT_TRUE(contains(why, "JR3.ForceNorm = 50")) << why;
 }
 
+TEST_F(ConsoleTest, ADeepInjectionIsRecordedOnceOnEachMachineWhoseFiltersReadTheSignal) {
+  // JR3.ForceNorm is read by two filters of JR3.s_A (force_limit, force_warning): one record.
+  run("filter dinject JR3.ForceNorm 40");
+  const std::string norm = run("state history JR3 100").out;
+  EXPECT_EQ(count_lines(norm), 1u) << norm;
+  EXPECT_TRUE(contains(norm, "JR3.s_A  injection  (deep injection into signal JR3.ForceNorm: 40)")) << norm;
+  // JR3.Force is read by force_norm (s_A) and force_stale (s_F): one record on each.
+  run("filter dinject JR3.Force [0, 0, 10]");
+  const std::string force = run("state history JR3 100").out;
+  EXPECT_EQ(count_lines(force), 3u) << force;
+  EXPECT_TRUE(contains(force, "JR3.s_A  injection  (deep injection into signal JR3.Force: [0, 0, 10])")) << force;
+  EXPECT_TRUE(contains(force, "JR3.s_F  injection  (deep injection into signal JR3.Force: [0, 0, 10])")) << force;
+}
+
 TEST_F(ConsoleTest, DinloadInjectsEverySampleOfAFile) {
   const std::string file = write_file("console_dinload.txt", "# Fx Fy Fz\n0, 0, 10\n\n0 0 45  # too much\n0,0,46\n");
   const std::string out = run("filter dinload JR3.Force " + file).out;
