@@ -131,7 +131,7 @@ struct BenchSystem {
   }
 };
 
-void read_all(benchmark::State& state, const std::function<std::unique_ptr<replay::InputSource>()>& open) {
+void read_all(benchmark::State& state, const std::function<std::unique_ptr<InputSource>()>& open) {
   (void)recording_file();  // the logs are written once, before anything is timed
   (void)csv_file();
   BenchSystem sys;
@@ -140,8 +140,8 @@ void read_all(benchmark::State& state, const std::function<std::unique_ptr<repla
     auto src = open();
     if (!src->bind(sys.runner->monitor())) state.SkipWithError("bind failed");
     std::int64_t n = 0;
-    for (replay::Item i = src->next(); i.kind != replay::Item::Kind::End; i = src->next()) {
-      if (i.kind == replay::Item::Kind::Error) {
+    for (InputItem i = src->next(); i.kind != InputItem::Kind::End; i = src->next()) {
+      if (i.kind == InputItem::Kind::Error) {
         state.SkipWithError(src->error().c_str());
         break;
       }

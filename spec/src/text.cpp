@@ -1,7 +1,5 @@
 #include "text.hpp"
 
-#include "safecass/spec/suggest.hpp"
-
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -170,9 +168,3 @@ bool simple_name(std::string_view name) noexcept {
 }
 
 }  // namespace safecass::spec::detail
-
-namespace safecass::spec {
-std::string suggest(std::string_view word, const std::vector<std::string>& candidates) {
-  return detail::did_you_mean(word, candidates);
-}
-}  // namespace safecass::spec

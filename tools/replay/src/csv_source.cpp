@@ -149,10 +149,10 @@ public:
     return {};
   }
 
-  Item next() override {
-    Item item;
+  InputItem next() override {
+    InputItem item;
     if (failed_) {
-      item.kind = Item::Kind::Error;
+      item.kind = InputItem::Kind::Error;
       return item;
     }
     for (;;) {
@@ -160,14 +160,14 @@ public:
         const std::size_t g = emit_++;
         if (present_[g] != groups_[g].size) continue;
         ++samples_;
-        item.kind = Item::Kind::Sample;
+        item.kind = InputItem::Kind::Sample;
         item.time = row_time_;
         item.signal = groups_[g].signal;
         item.values = values_.data() + groups_[g].offset;
         return item;
       }
       if (!read_row()) {
-        item.kind = failed_ ? Item::Kind::Error : Item::Kind::End;
+        item.kind = failed_ ? InputItem::Kind::Error : InputItem::Kind::End;
         return item;
       }
       emit_ = 0;

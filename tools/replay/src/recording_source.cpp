@@ -3,36 +3,8 @@
 #include <set>
 
 #include "safecass/replay/source.hpp"
-#include "safecass/spec/suggest.hpp"
 
 namespace safecass::replay {
-
-std::vector<std::string> input_signal_names(const Monitor& monitor) {
-  std::set<const Signal*> outputs;
-  for (const auto& f : monitor.filters()) outputs.insert(f->outputs().begin(), f->outputs().end());
-  std::vector<std::string> out;
-  for (const auto& s : monitor.signals().all()) {
-    if (outputs.count(s.get()) == 0) out.push_back(s->name());
-  }
-  return out;
-}
-
-[[nodiscard]] Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name) {
-  Signal* s = monitor.signals().find(name);
-  if (s == nullptr) {
-    return fail(ErrorCode::NotFound, "unknown signal '" + name + "': the system has no such signal" +
-                                         spec::suggest(name, input_signal_names(monitor)));
-  }
-  for (const auto& f : monitor.filters()) {
-    for (const Signal* o : f->outputs()) {
-      if (o == s) {
-        return fail(ErrorCode::InvalidArgument,
-                    "signal '" + name + "' is computed by filter " + f->name() + ": a log feeds input signals only");
-      }
-    }
-  }
-  return s;
-}
 
 namespace {
 
@@ -45,28 +17,28 @@ public:
     return {};
   }
 
-  Item next() override {
-    Item item;
+  InputItem next() override {
+    InputItem item;
     for (;;) {
       switch (reader_->next()) {
         case InputLogReader::Item::Sample: {
           const std::uint16_t id = reader_->signal();
           if (id >= bound_.size() && !bind_up_to(id)) return error_item();
           ++samples_;
-          item.kind = Item::Kind::Sample;
+          item.kind = InputItem::Kind::Sample;
           item.time = reader_->time();
           item.signal = bound_[id];
           item.values = reader_->values();
           return item;
         }
         case InputLogReader::Item::Action:
-          item.kind = Item::Kind::Action;
+          item.kind = InputItem::Kind::Action;
           item.time = reader_->action().time;
           item.action = &reader_->action();
           return item;
         case InputLogReader::Item::Loss: lost_ += reader_->lost(); continue;
         case InputLogReader::Item::End: end_ = reader_->mark_time(); continue;
-        case InputLogReader::Item::Eof: item.kind = Item::Kind::End; return item;
+        case InputLogReader::Item::Eof: item.kind = InputItem::Kind::End; return item;
         case InputLogReader::Item::Error: error_ = reader_->error(); return error_item();
       }
     }
@@ -97,9 +69,9 @@ public:
   }
 
 private:
-  Item error_item() {
-    Item item;
-    item.kind = Item::Kind::Error;
+  InputItem error_item() {
+    InputItem item;
+    item.kind = InputItem::Kind::Error;
     return item;
   }
   bool bind_up_to(std::uint16_t id) {

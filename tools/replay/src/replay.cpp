@@ -20,7 +20,7 @@
 #include "safecass/spec/instance.hpp"
 
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG
-#include "safecass/replay/bag_source.hpp"
+#include "safecass/ros1/bag_source.hpp"
 #endif
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG2
 #include "safecass/replay/rosbag2_source.hpp"
@@ -70,7 +70,7 @@ std::string sniff(const std::string& path) {
       return fail(ErrorCode::InvalidArgument,
                   o.input + ": a ROS bag needs the ROS extension's mapping file (--mapping FILE)");
     }
-    return open_bag(o.input, o.mapping);
+    return ros1::open_bag(o.input, o.mapping);
 #else
     return fail(
         ErrorCode::InvalidArgument,
@@ -211,17 +211,17 @@ struct LogSpan {
 /// Fills `span`; false on error.
 bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, LogSpan& span, std::FILE* err) {
   for (;;) {
-    const Item item = src.next();
+    const InputItem item = src.next();
     switch (item.kind) {
-      case Item::Kind::End: span.end = src.end(); return true;
-      case Item::Kind::Error: std::fprintf(err, "%s\n", src.error().c_str()); return false;
-      case Item::Kind::Action:
+      case InputItem::Kind::End: span.end = src.end(); return true;
+      case InputItem::Kind::Error: std::fprintf(err, "%s\n", src.error().c_str()); return false;
+      case InputItem::Kind::Action:
         if (const std::string why = check_action(r, *item.action); !why.empty()) {
           std::fprintf(err, "%s: action at t=%s: %s\n", src.where().c_str(), secs(item.time).c_str(), why.c_str());
           return false;
         }
         [[fallthrough]];
-      case Item::Kind::Sample:
+      case InputItem::Kind::Sample:
         if (item.time >= w.from && item.time <= w.to) {
           if (!span.first) span.first = item.time;
           span.last = item.time;
@@ -271,9 +271,9 @@ public:
   /// Applies every input due at `now` to `a` and, when given, to `b` (with `map` from a's signals).
   void feed(Time now, ScenarioRunner& a, ScenarioRunner* b, const std::unordered_map<const Signal*, Signal*>* map) {
     while (!done_) {
-      if (pending_.kind == Item::Kind::End || pending_.kind == Item::Kind::Error) {
+      if (pending_.kind == InputItem::Kind::End || pending_.kind == InputItem::Kind::Error) {
         done_ = true;
-        failed_ = pending_.kind == Item::Kind::Error;
+        failed_ = pending_.kind == InputItem::Kind::Error;
         break;
       }
       if (pending_.time > now) break;
@@ -282,7 +282,7 @@ public:
         break;
       }
       if (pending_.time >= w_.from) {
-        if (pending_.kind == Item::Kind::Sample) {
+        if (pending_.kind == InputItem::Kind::Sample) {
           pending_.signal->push(pending_.time, pending_.values);
           if (b != nullptr) map->at(pending_.signal)->push(pending_.time, pending_.values);
           ++fed_;
@@ -308,7 +308,7 @@ public:
 private:
   InputSource& src_;
   Window w_;
-  Item pending_;
+  InputItem pending_;
   bool done_ = false;
   bool failed_ = false;
   std::optional<Time> last_;

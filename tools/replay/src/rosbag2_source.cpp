@@ -6,14 +6,14 @@
 #include <filesystem>
 #include <system_error>
 
-#include "message_source.hpp"
 #include "safecass/ros_common/cdr.hpp"
+#include "safecass/ros_common/message_source.hpp"
 
 namespace safecass::replay {
 
 namespace {
 
-class Rosbag2Source final : public detail::MessageSource {
+class Rosbag2Source final : public ros_common::MessageSource {
 public:
   using MessageSource::MessageSource;
   ~Rosbag2Source() override { close(); }
@@ -155,7 +155,7 @@ private:
 }  // namespace
 
 [[nodiscard]] Expected<std::unique_ptr<InputSource>> open_rosbag2(const std::string& bag, const std::string& mapping) {
-  auto m = detail::load_log_mapping(mapping);
+  auto m = ros_common::load_log_mapping(mapping);
   if (!m) return tl::unexpected(m.error());
   auto source = std::make_unique<Rosbag2Source>(bag, std::move(*m));
   if (auto opened = source->open(); !opened) return tl::unexpected(opened.error());

@@ -1,65 +1,16 @@
 #pragma once
 /// @file source.hpp
-/// Where a replay's inputs come from: a SAFECASS input recording (record/input_log.hpp), a CSV
-/// file, or a ROS 1 bag (with the ROS extension's mapping file). Each is read as a stream of
-/// items in time order, in constant memory, whatever the file's size.
-///
-/// bind() resolves the names the log uses against the replayed system first; then next() yields
-/// samples (already bound to their Signal) and actions. A problem in the log ends the stream with
-/// Item::Kind::Error and error() = "file:line[:col]: reason" (a recording: "file: record N (byte
-/// B): reason"; a bag: "file: message N: reason").
+/// The replay's own input sources (the interface is record/input_source.hpp): a SAFECASS input
+/// recording, a CSV file and a ROS 2 bag (rosbag2_source.hpp); a ROS 1 bag is the ROS 1
+/// extension's (safecass/ros1/bag_source.hpp).
 
-#include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
-#include <vector>
 
-#include "safecass/core/clock.hpp"
 #include "safecass/core/expected.hpp"
-#include "safecass/filters/monitor.hpp"
-#include "safecass/record/input_log.hpp"
+#include "safecass/record/input_source.hpp"
 
 namespace safecass::replay {
-
-struct Item {
-  enum class Kind : std::uint8_t { Sample, Action, End, Error };
-  Kind kind = Kind::End;
-  Time time{};
-  Signal* signal = nullptr;             ///< Sample: the bound signal
-  const double* values = nullptr;       ///< Sample: signal->size() values, valid until the next next()
-  const InputAction* action = nullptr;  ///< Action
-};
-
-class InputSource {
-public:
-  virtual ~InputSource() = default;
-  /// Resolves the log's signal names against `monitor` (input signals only: a filter's output is
-  /// computed by the replayed system, never fed). Errors: Parse, with where and why.
-  [[nodiscard]] virtual Expected<void> bind(Monitor& monitor) = 0;
-  virtual Item next() = 0;
-  /// After Item::Kind::Error.
-  virtual const std::string& error() const = 0;
-  /// The recorded run's tick period and first tick, when the log says.
-  virtual std::optional<Time> period() const { return std::nullopt; }
-  virtual std::optional<Time> start() const { return std::nullopt; }
-  /// After Item::Kind::End: the recorded run's last tick, when the log says.
-  virtual std::optional<Time> end() const { return std::nullopt; }
-  /// Things a person should know that are not errors (a torn last record, samples the recorder
-  /// lost), after the stream ended.
-  virtual std::vector<std::string> notes() const { return {}; }
-  /// Samples read so far.
-  virtual std::uint64_t samples() const = 0;
-  /// Where the last item was read: "file:line" (CSV), "file: record N" (a recording),
-  /// "file: message N" (a bag).
-  virtual std::string where() const = 0;
-};
-
-/// The signals a log may feed: every signal of `monitor` that no filter writes.
-std::vector<std::string> input_signal_names(const Monitor& monitor);
-/// Resolves `name` to an input signal of `monitor`, or says why not ("no signal 'X' in the
-/// system; did you mean 'Y'?", "signal 'X' is computed by filter F; ...").
-[[nodiscard]] Expected<Signal*> find_input_signal(Monitor& monitor, const std::string& name);
 
 std::unique_ptr<InputSource> open_recording(std::unique_ptr<InputLogReader> reader);
 /// A CSV log: a header naming a time column ("time" or "t", seconds) and one column per scalar

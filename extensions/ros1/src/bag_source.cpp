@@ -1,6 +1,6 @@
 // A ROS 1 bag as a replay source. C++17: Debian's ROS message headers do not compile as C++20.
 
-#include "safecass/replay/bag_source.hpp"
+#include "safecass/ros1/bag_source.hpp"
 
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
@@ -8,15 +8,15 @@
 #include <deque>
 #include <set>
 
-#include "message_source.hpp"
 #include "safecass/ros1/messages.hpp"
 #include "safecass/ros_common/mapping.hpp"
+#include "safecass/ros_common/message_source.hpp"
 
-namespace safecass::replay {
+namespace safecass::ros1 {
 
 namespace {
 
-class BagSource final : public detail::MessageSource {
+class BagSource final : public ros_common::MessageSource {
 public:
   using MessageSource::MessageSource;
 
@@ -89,11 +89,11 @@ private:
 }  // namespace
 
 [[nodiscard]] Expected<std::unique_ptr<InputSource>> open_bag(const std::string& bag, const std::string& mapping) {
-  auto m = detail::load_log_mapping(mapping);
+  auto m = ros_common::load_log_mapping(mapping);
   if (!m) return tl::unexpected(m.error());
   auto source = std::make_unique<BagSource>(bag, std::move(*m));
   if (auto opened = source->open(); !opened) return tl::unexpected(opened.error());
   return std::unique_ptr<InputSource>(std::move(source));
 }
 
-}  // namespace safecass::replay
+}  // namespace safecass::ros1

@@ -1,20 +1,19 @@
-#include "message_source.hpp"
+#include "safecass/ros_common/message_source.hpp"
 
-namespace safecass::replay::detail {
+namespace safecass::ros_common {
 
-[[nodiscard]] Expected<ros_common::Mapping> load_log_mapping(const std::string& path) {
-  ros_common::MappingLoad m = ros_common::load_mapping(path);
+[[nodiscard]] Expected<Mapping> load_log_mapping(const std::string& path) {
+  MappingLoad m = load_mapping(path);
   if (m.mapping) return std::move(*m.mapping);
-  std::string all;
-  for (const auto& d : m.diagnostics) all += (all.empty() ? "" : "\n") + spec::format(d);
+  const std::string all = spec::to_text(m.diagnostics);
   return fail(ErrorCode::Parse, all.empty() ? "cannot read mapping file '" + path + "'" : all);
 }
 
 Expected<void> MessageSource::bind(Monitor& monitor) {
   std::vector<std::string> names;
-  for (const ros_common::TopicMapping& t : mapping_.topics) {
+  for (const TopicMapping& t : mapping_.topics) {
     Topic topic{t, {}};
-    for (const ros_common::FieldBinding& b : t.signals) {
+    for (const FieldBinding& b : t.signals) {
       Signal* s = monitor.signals().find(b.signal);
       if (s == nullptr) {
         skipped_.insert(b.signal + " (" + t.topic + " " + b.path.text + ")");
@@ -47,14 +46,14 @@ const MessageSource::Topic* MessageSource::topic(std::string_view name) const {
   return nullptr;
 }
 
-bool MessageSource::feed(const Topic& t, const ros_common::MessageNumbers& numbers, Time time) {
+bool MessageSource::feed(const Topic& t, const MessageNumbers& numbers, Time time) {
   // All of a message's samples or none: a message that fails half-way pushes nothing.
   const std::size_t values_before = values_.size(), pending_before = pending_.size();
   for (const Binding& b : t.bindings) {
     const std::size_t at = values_.size();
     values_.resize(at + b.width);
     std::string why;
-    if (!ros_common::extract(b.path, numbers, values_.data() + at, b.width, why)) {
+    if (!extract(b.path, numbers, values_.data() + at, b.width, why)) {
       values_.resize(values_before);
       pending_.resize(pending_before);
       return fail_message(t.mapping.topic, why);
@@ -74,16 +73,16 @@ bool MessageSource::fail_log(const std::string& reason) {
   return false;
 }
 
-Item MessageSource::next() {
-  Item item;
+InputItem MessageSource::next() {
+  InputItem item;
   while (pending_.empty()) {
     if (failed_) {
-      item.kind = Item::Kind::Error;
+      item.kind = InputItem::Kind::Error;
       return item;
     }
     const Read r = read();
     if (r == Read::End) {
-      item.kind = Item::Kind::End;
+      item.kind = InputItem::Kind::End;
       return item;
     }
     if (r == Read::Error) failed_ = true;
@@ -91,7 +90,7 @@ Item MessageSource::next() {
   const Pending& p = pending_.front();
   current_.assign(values_.begin() + static_cast<std::ptrdiff_t>(p.offset),
                   values_.begin() + static_cast<std::ptrdiff_t>(p.offset + p.signal->size()));
-  item.kind = Item::Kind::Sample;
+  item.kind = InputItem::Kind::Sample;
   item.time = p.time;
   item.signal = p.signal;
   item.values = current_.data();
@@ -108,4 +107,4 @@ std::vector<std::string> MessageSource::notes() const {
   return out;
 }
 
-}  // namespace safecass::replay::detail
+}  // namespace safecass::ros_common

@@ -1,9 +1,10 @@
 #pragma once
 /// @file message_source.hpp
-/// What the replay sources of ROS logs share (a ROS 1 bag, a ROS 2 bag): the mapping file binds
-/// topics to the replayed system's input signals with the live bridges' field paths, and each
-/// message's numbers become samples, in order. A subclass reads its log format and calls feed()
-/// for each message of a bound topic. C++17 (the ROS 1 bag source includes ROS headers).
+/// What the input sources of ROS logs share (a ROS 1 bag, in the ROS 1 extension; a ROS 2 bag, in
+/// `safecass replay`): the mapping file binds topics to the replayed system's input signals with
+/// the live bridges' field paths, and each message's numbers become samples, in order. A subclass
+/// reads its log format and calls feed() for each message of a bound topic. C++17 (the ROS 1 bag
+/// source includes ROS headers).
 
 #include <cstdint>
 #include <deque>
@@ -12,20 +13,21 @@
 #include <string_view>
 #include <vector>
 
-#include "safecass/replay/source.hpp"
+#include "safecass/record/input_source.hpp"
+#include "safecass/ros_common/fields.hpp"
 #include "safecass/ros_common/mapping.hpp"
 
-namespace safecass::replay::detail {
+namespace safecass::ros_common {
 
 /// The mapping file of `path`, or every problem in it. Errors: Parse.
-[[nodiscard]] Expected<ros_common::Mapping> load_log_mapping(const std::string& path);
+[[nodiscard]] Expected<Mapping> load_log_mapping(const std::string& path);
 
 class MessageSource : public InputSource {
 public:
-  MessageSource(std::string path, ros_common::Mapping mapping) : path_(std::move(path)), mapping_(std::move(mapping)) {}
+  MessageSource(std::string path, Mapping mapping) : path_(std::move(path)), mapping_(std::move(mapping)) {}
 
   [[nodiscard]] Expected<void> bind(Monitor& monitor) final;
-  Item next() final;
+  InputItem next() final;
   const std::string& error() const final { return error_; }
   std::uint64_t samples() const final { return samples_; }
   std::string where() const final { return path_ + ": message " + std::to_string(index_); }
@@ -34,11 +36,11 @@ public:
 protected:
   struct Binding {
     Signal* signal;
-    ros_common::FieldPath path;
+    FieldPath path;
     std::size_t width;
   };
   struct Topic {
-    ros_common::TopicMapping mapping;
+    TopicMapping mapping;
     std::vector<Binding> bindings;
   };
   enum class Read : std::uint8_t { Message, End, Error };
@@ -52,14 +54,14 @@ protected:
   /// The bound topic named `name`, or null.
   const Topic* topic(std::string_view name) const;
   /// A message of `t` at `time` (since the log's first message): its samples, in binding order.
-  bool feed(const Topic& t, const ros_common::MessageNumbers& numbers, Time time);
+  bool feed(const Topic& t, const MessageNumbers& numbers, Time time);
   /// "file: message N (topic): reason".
   bool fail_message(const std::string& topic, const std::string& reason);
   /// "file: message N: reason".
   bool fail_log(const std::string& reason);
 
   const std::string& path() const { return path_; }
-  const ros_common::Mapping& mapping() const { return mapping_; }
+  const Mapping& mapping() const { return mapping_; }
   std::uint64_t index_ = 0;  ///< messages read, the current one included
 
 private:
@@ -69,7 +71,7 @@ private:
     std::size_t offset;
   };
   std::string path_;
-  ros_common::Mapping mapping_;
+  Mapping mapping_;
   std::vector<Topic> topics_;
   std::set<std::string> skipped_;
   std::deque<Pending> pending_;
@@ -80,4 +82,4 @@ private:
   std::string error_;
 };
 
-}  // namespace safecass::replay::detail
+}  // namespace safecass::ros_common
