@@ -6,15 +6,9 @@
 
 #include "safecass/core/address.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/text.hpp"
 
 namespace safecass {
-
-namespace {
-// The formats of the JSON writer's json::json_seconds and the read model's number text (json and introspect sit above
-// core, so they cannot be called from here).
-std::string seconds_text(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
-std::string number_text(double v) { return fmt::format("{:g}", v); }
-}  // namespace
 
 std::string to_string(const Explanation& e) {
   std::string out = e.machine;

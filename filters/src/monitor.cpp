@@ -1,5 +1,7 @@
 #include "safecass/filters/monitor.hpp"
+
 #include "safecass/core/address.hpp"
+#include "safecass/core/text.hpp"
 
 #include "banks.hpp"
 
@@ -301,11 +303,7 @@ std::string samples_text(const std::vector<std::vector<double>>& samples) {
   for (const auto& s : samples) {
     out += out.empty() ? "" : " ";
     if (s.size() != 1) out += "[";
-    for (std::size_t i = 0; i < s.size(); ++i) {
-      char buf[32];
-      std::snprintf(buf, sizeof buf, "%s%g", i ? ", " : "", s[i]);
-      out += buf;
-    }
+    for (std::size_t i = 0; i < s.size(); ++i) out += (i ? ", " : "") + number_text(s[i]);
     if (s.size() != 1) out += "]";
   }
   return out;

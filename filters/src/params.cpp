@@ -1,4 +1,5 @@
 #include "safecass/filters/params.hpp"
+#include "safecass/core/text.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -99,12 +100,6 @@ std::string describe(const ParamValue& v) {
     case 4: return "a list of numbers";
   }
   return "a value";
-}
-
-std::string number_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
 }
 
 }  // namespace

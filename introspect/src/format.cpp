@@ -82,10 +82,6 @@ std::string iso8601_local(std::int64_t unix_ns) {
                      (off % 3600) / 60);
 }
 
-std::string seconds_text(Time t) { return json::json_seconds(t); }
-
-std::string number_text(double v) { return fmt::format("{:.9g}", v); }
-
 std::string markup_text(std::string_view text) {
   std::string out;
   out.reserve(text.size());

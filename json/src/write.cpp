@@ -1,5 +1,7 @@
 #include "safecass/json/write.hpp"
 
+#include "safecass/core/text.hpp"
+
 #include <cmath>
 
 #include <fmt/format.h>
@@ -40,10 +42,10 @@ std::string json_string(std::string_view text) {
 
 std::string json_number(double v) {
   if (!std::isfinite(v)) return "null";
-  return fmt::format("{:.9g}", v);
+  return number_text(v);
 }
 
-std::string json_seconds(Time t) { return fmt::format("{:.6f}", to_seconds(t)); }
+std::string json_seconds(Time t) { return seconds_text(t); }
 
 std::string json_string_array(const std::vector<std::string>& items) {
   JsonArray a;

@@ -25,10 +25,9 @@ namespace safecass::tools::console {
 // ---- text helpers --------------------------------------------------------------------------------
 
 std::string_view trim(std::string_view s);
-// Times, numbers, tables and JSON: the read model's one formatter and JSON writer.
+// Tables and JSON: the read model's one formatter and JSON writer (numbers and times:
+// safecass/core/text.hpp, found in the enclosing namespace).
 using introspect::columns;
-using introspect::number_text;
-using introspect::seconds_text;
 using Json = json::JsonObject;
 inline std::string json_string(std::string_view s) { return json::json_string(s); }
 inline std::string json_list(const std::vector<std::string>& items) { return json::json_string_array(items); }

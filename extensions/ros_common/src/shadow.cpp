@@ -6,19 +6,12 @@
 #include <cstdio>
 #include <optional>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/spec/instance.hpp"
 
 namespace safecass::ros_common {
 
-namespace {
-
-std::string fmt_double(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 struct Shadow::Topic {
   const TopicMapping* map = nullptr;
@@ -408,7 +401,7 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
     if (root.sample.present()) {
       s.message +=
           ", " + std::string(co.name_of(root.sample.filter)) + " judged " + std::string(co.name_of(root.sample.signal));
-      if (root.sample.filter != graph_name_) s.message += " = " + fmt_double(root.sample.value);
+      if (root.sample.filter != graph_name_) s.message += " = " + number_text(root.sample.value);
     }
     s.message += ")";
     s.values.emplace_back("root_cause", cause);
@@ -418,10 +411,10 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
     if (root.sample.present()) {
       if (root.sample.filter != kNoName) s.values.emplace_back("filter", std::string(co.name_of(root.sample.filter)));
       if (root.sample.signal != kNoName) s.values.emplace_back("signal", std::string(co.name_of(root.sample.signal)));
-      s.values.emplace_back("value", fmt_double(root.sample.value));
+      s.values.emplace_back("value", number_text(root.sample.value));
     }
   }
-  s.values.emplace_back("since", fmt_double(to_seconds(outstanding->first)) + " s");
+  s.values.emplace_back("since", seconds_text(outstanding->first) + " s");
   s.values.emplace_back("count", std::to_string(outstanding->count));
 }
 

@@ -140,26 +140,11 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   EXPECT_FALSE((*node)->stats().connected);
 }
 
-/// A system watched by a filter type that only the application's registry knows.
-constexpr const char* kFrozenSystem = R"({
-  "safecass": 1,
-  "system": "encoders",
-  "components": [ {
-    "component": "ENCODER",
-    "interfaces": { "provided": ["Angle"], "required": [] },
-    "signals": [ { "name": "angle" } ],
-    "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
-    "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
-                  "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
-  } ],
-  "coordinators": { "cell": ["ENCODER"] }
-})";
-
 TEST(Supervisor, BuildsItsViewWithTheApplicationsFilterRegistryAndWithoutItNamesTheUnknownType) {
   FilterRegistry registry;
   register_builtin_filters(registry);
   ASSERT_TRUE(registry.add<Frozen>("Frozen"));
-  auto load = spec::load_system_from_text(kFrozenSystem, "encoders.json", registry);
+  auto load = spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/tests/data/custom_filter/encoders.json", registry);
   ASSERT_TRUE(load.ok()) << spec::to_text(load.diagnostics);
   const std::string keys = ::testing::TempDir() + "safecass-supervisor-keys-" + std::to_string(::getpid());
   ASSERT_TRUE(create_bus_keys(*load.system, keys, KeyOptions::replacing()));

@@ -6,7 +6,6 @@
 #include "safecass/native/system.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/instance.hpp"
-#include "safecass/spec/load.hpp"
 
 #include "../../../examples/custom_filter/frozen_filter.hpp"
 
@@ -29,35 +28,26 @@ FilterRegistry builtin() {
   return registry;
 }
 
-/// A component watched by a filter type that only the application's registry knows.
-constexpr const char* kEncoder = R"({
-  "component": "ENCODER",
-  "signals": [ { "name": "angle" } ],
-  "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
-  "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
-                "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
-})";
+const std::string kEncoders = std::string(SAFECASS_SOURCE_DIR) + "/tests/data/custom_filter/encoders.json";
 
 TEST(SystemFactory, BuildsAFilterTypeThatOnlyTheApplicationsRegistryKnows) {
   FilterRegistry registry = builtin();
   ASSERT_TRUE(registry.add<Frozen>("Frozen"));
-  auto loaded = spec::load_system_from_text(kEncoder, "encoder.json", registry);
-  ASSERT_TRUE(loaded.ok()) << spec::to_text(loaded.diagnostics);
-  auto built = spec::build_instance(*loaded.system, registry);
+  auto built = spec::open_instance(kEncoders, registry);
   ASSERT_TRUE(built) << to_text(built.error());
   spec::Instance& instance = **built;
   EXPECT_EQ(&instance.registry(), &registry);
-  EXPECT_EQ(instance.coordinator().name(), "ENCODER") << "a one-component file names its system after it";
+  EXPECT_EQ(instance.coordinator().name(), "encoders");
   ASSERT_NE(instance.monitor().find_filter("frozen_angle"), nullptr);
   EXPECT_EQ(instance.monitor().find_filter("frozen_angle")->type(), "Frozen");
 }
 
 TEST(SystemFactory, AFilterTypeTheRegistryDoesNotKnowIsAnErrorAtItsPositionAndNothingIsBuilt) {
   const FilterRegistry registry = builtin();
-  auto loaded = spec::load_system_from_text(kEncoder, "encoder.json", registry);
-  ASSERT_FALSE(loaded.ok());
-  EXPECT_THAT(spec::to_text(loaded.diagnostics), HasSubstr("encoder.json:5:"));
-  EXPECT_THAT(spec::to_text(loaded.diagnostics), HasSubstr("Frozen"));
+  auto built = spec::open_instance(kEncoders, registry);
+  ASSERT_FALSE(built);
+  EXPECT_THAT(to_text(built.error()), HasSubstr("encoders.json:13:"));
+  EXPECT_THAT(to_text(built.error()), HasSubstr("Frozen"));
 }
 
 TEST(SystemFactory, AnInstanceIsNamedAfterItsCoordinatorThenTheGivenNameThenTheSystem) {

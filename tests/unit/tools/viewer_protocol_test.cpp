@@ -5,7 +5,6 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <fstream>
 #include <memory>
 #include <string>
 #include <vector>
@@ -380,14 +379,7 @@ TEST(ViewerInProcessSource, OpenReportsWhatIsMissingOrWrong) {
 }
 
 TEST(ViewerInProcessSource, ShowsASystemWhoseFilterTypeOnlyTheApplicationsRegistryKnows) {
-  const std::string path = ::testing::TempDir() + "viewer-encoder.json";
-  std::ofstream(path) << R"({
-  "component": "ENCODER",
-  "signals": [ { "name": "angle" } ],
-  "event": [ { "name": "EVT_FROZEN", "severity": 60, "state_transition": ["N2E"] } ],
-  "filter": [ { "name": "frozen_angle", "class_name": "Frozen", "target": { "type": "s_A", "component": "ENCODER" },
-                "argument": { "input_signal": "angle", "samples": 3, "event_onset": "EVT_FROZEN" } } ]
-})";
+  const std::string path = std::string(SAFECASS_SOURCE_DIR) + "/tests/data/custom_filter/encoders.json";
   InProcessOptions builtin;
   builtin.system = path;
   builtin.log = nullptr;

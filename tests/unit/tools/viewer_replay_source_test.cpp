@@ -196,7 +196,7 @@ TEST_F(RecordedStory, ControlsRefuseWhatCannotBeDoneAndChangeNothing) {
   c.t = 9.0;
   auto r = source->control(c);
   ASSERT_FALSE(r.has_value());
-  EXPECT_THAT(r.error().message, HasSubstr("t=9 is outside the replay (0.000 s to 2.000 s)"));
+  EXPECT_THAT(r.error().message, HasSubstr("t=9 is outside the replay (0.000000 s to 2.000000 s)"));
   c.op = ReplayControl::Op::Speed;
   c.speed = 0.0;
   r = source->control(c);
@@ -313,7 +313,7 @@ TEST_F(RecordedStory, ProtocolCarriesTheReplayAndItsControlsAndGreetsPagesAgainW
   EXPECT_THAT(protocol.hello(), HasSubstr(R"("replay":{"start":0.000000,"end":2.000000,"period":0.001000,)"));
   EXPECT_THAT(protocol.hello(), HasSubstr(R"("clock":{"base":"simulated"})"));
   EXPECT_THAT(protocol.hello(), HasSubstr(R"({"required":"CONTROL.ForceData","provided":"JR3.ForceData"})"));
-  EXPECT_THAT(protocol.handle(R"({"op":"replay","action":"seek","t":1.2})"), HasSubstr("seeking to t=1.200"));
+  EXPECT_THAT(protocol.handle(R"({"op":"replay","action":"seek","t":1.2})"), HasSubstr("seeking to t=1.200000"));
   long long ms = 0;
   std::string pushed;
   for (int i = 0; i < 100 && !source->replay()->busy.empty(); ++i) pushed += protocol.update(ms += 10);
@@ -322,7 +322,7 @@ TEST_F(RecordedStory, ProtocolCarriesTheReplayAndItsControlsAndGreetsPagesAgainW
   EXPECT_THAT(pushed, HasSubstr(R"("kind":"component-transition")"));
   EXPECT_THAT(pushed, HasSubstr(R"("busy":"")"));
   // Back in time: the replay starts over, and every page is greeted again.
-  EXPECT_THAT(protocol.handle(R"({"op":"replay","action":"seek","t":0.1})"), HasSubstr("seeking to t=0.100"));
+  EXPECT_THAT(protocol.handle(R"({"op":"replay","action":"seek","t":0.1})"), HasSubstr("seeking to t=0.100000"));
   std::string again = protocol.update(ms += 10);
   EXPECT_THAT(again, HasSubstr(R"("type":"hello")"));
   // Bad controls get an error saying what is wrong.

@@ -32,7 +32,7 @@ namespace {
 
 using runner::ScenarioRunner;
 
-std::string secs(Time t) { return introspect::seconds_text(t); }
+std::string secs(Time t) { return seconds_text(t); }
 
 /// The format of a log from its first bytes: a recording's header, a bag's "#ROSBAG", SQLite's
 /// header or a directory (a ROS 2 bag), else CSV.
@@ -459,8 +459,7 @@ std::string cause_text(const Cause& c) {
   if (c.event.empty()) return "none";
   std::string out = c.origin + ":" + c.event;
   if (!c.filter.empty() || !c.signal.empty()) {
-    char v[40];
-    std::snprintf(v, sizeof v, "%.9g", c.value);
+    const std::string v = number_text(c.value);
     out += " [";
     if (!c.filter.empty()) out += "filter " + c.filter;
     if (!c.signal.empty()) out += std::string(c.filter.empty() ? "" : ", ") + c.signal + " = " + v;
@@ -502,7 +501,7 @@ void print_interval(const Interval& i, const std::string& address, const std::st
       if (std::isfinite(c.value)) {
         cause.num("value", c.value);
       } else {
-        cause.str("value", introspect::number_text(c.value));
+        cause.str("value", number_text(c.value));
       }
     }
     const std::string line = json::JsonObject()

@@ -21,7 +21,7 @@ using spec::keep_errors;
 using spec::Opened;
 
 namespace {
-std::string secs(Time t) { return introspect::seconds_text(t); }
+std::string secs(Time t) { return seconds_text(t); }
 
 /// "no X 'name'" with the nearest known name, if one is near.
 std::string unknown(const std::string& what, const std::string& name, const std::vector<std::string>& known) {

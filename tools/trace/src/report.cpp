@@ -26,12 +26,6 @@ std::string join(const std::vector<std::string>& items, const std::string& sep) 
   return out;
 }
 
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 std::string marker(Severity s, const std::string& kind, const std::string& text) {
   const std::string sev(to_string(s));
   std::string label = sev;
@@ -274,10 +268,10 @@ std::string excerpts(const Trace& t) {
       if (r.kind == timeline::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
     }
     out += "<figure class=\"excerpt\" data-hazard=\"" + introspect::markup_text(h.id) + "\" data-scenario=\"" +
-           introspect::markup_text(run->path) + "\" data-from=\"" + number(h.excerpt_from) + "\" data-to=\"" +
-           number(h.excerpt_to) + "\">\n<figcaption>" + introspect::markup_text(h.id) + " in " +
-           introspect::markup_text(run->path) + ", t = " + number(h.excerpt_from) + " s to " + number(h.excerpt_to) +
-           " s; " + introspect::markup_text(join(h.excerpt_components, ", ")) +
+           introspect::markup_text(run->path) + "\" data-from=\"" + number_text(h.excerpt_from) + "\" data-to=\"" +
+           number_text(h.excerpt_to) + "\">\n<figcaption>" + introspect::markup_text(h.id) + " in " +
+           introspect::markup_text(run->path) + ", t = " + number_text(h.excerpt_from) + " s to " +
+           number_text(h.excerpt_to) + " s; " + introspect::markup_text(join(h.excerpt_components, ", ")) +
            "</figcaption>\n<div class=\"excerpt-box\"><svg class=\"timeline-axis\" role=\"img\" aria-label=\"Time axis "
            "in seconds\"></svg>"
            "<svg class=\"timeline-lanes\" role=\"img\" aria-label=\"States during " +

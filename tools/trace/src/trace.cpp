@@ -9,6 +9,7 @@
 #include <map>
 #include <set>
 
+#include "safecass/core/text.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/native/system.hpp"
@@ -30,21 +31,15 @@ spec::Diagnostic error_at(spec::Position where, std::string message) {
   return spec::Diagnostic{spec::Diagnostic::Severity::Error, std::move(where), std::move(message), ""};
 }
 
-std::string number(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
 std::string param_text(const ParamValue& v) {
-  if (const double* d = std::get_if<double>(&v)) return number(*d);
+  if (const double* d = std::get_if<double>(&v)) return number_text(*d);
   if (const bool* b = std::get_if<bool>(&v)) return *b ? "true" : "false";
   if (const std::string* s = std::get_if<std::string>(&v)) return *s;
   std::string out = "[";
   if (const auto* list = std::get_if<std::vector<std::string>>(&v)) {
     for (std::size_t k = 0; k < list->size(); ++k) out += (k == 0 ? "" : ", ") + (*list)[k];
   } else if (const auto* nums = std::get_if<std::vector<double>>(&v)) {
-    for (std::size_t k = 0; k < nums->size(); ++k) out += (k == 0 ? "" : ", ") + number((*nums)[k]);
+    for (std::size_t k = 0; k < nums->size(); ++k) out += (k == 0 ? "" : ", ") + number_text((*nums)[k]);
   }
   return out + "]";
 }
@@ -293,9 +288,9 @@ private:
       l.where = src->second.where;
     }
     if (cfg.execution == ExecutionMode::Passive) {
-      l.period = number(to_seconds(Monitor::kDefaultPeriod)) + " s (monitor)";
+      l.period = number_text(to_seconds(Monitor::kDefaultPeriod)) + " s (monitor)";
     } else if (src != stage_source_.end() && src->second.period) {
-      l.period = number(*src->second.period) + " s (" + l.component + "'s period)";
+      l.period = number_text(*src->second.period) + " s (" + l.component + "'s period)";
     } else {
       l.period = "the scenario's tick (" + l.component + " names no period)";
     }

@@ -35,9 +35,6 @@ namespace {
 /// for long; the clock catches up over the next polls.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
 
-/// Seconds to the millisecond, in the confirmations of writes: "t=1.250".
-std::string seconds_text(Time t) { return fmt::format("{:.3f}", to_seconds(t)); }
-
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);

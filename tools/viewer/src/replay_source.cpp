@@ -20,8 +20,6 @@ namespace {
 /// At most this many ticks per poll, so that a poll never holds the event loop for long.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
 
-std::string seconds_text(Time t) { return fmt::format("{:.3f}", to_seconds(t)); }
-
 std::string file_name(const std::string& path) {
   const auto slash = path.find_last_of('/');
   return slash == std::string::npos ? path : path.substr(slash + 1);

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "safecass/core/expected.hpp"
+#include "safecass/core/text.hpp"
 #include "safecass/introspect/model.hpp"
 
 namespace safecass::introspect {
@@ -36,10 +37,6 @@ private:
 
 /// ISO 8601 in the local time zone with milliseconds: "2026-03-01T14:02:11.532+01:00".
 std::string iso8601_local(std::int64_t unix_ns);
-/// Seconds with six decimals: "0.301000".
-std::string seconds_text(Time t);
-/// A number as people read it, at most 9 significant digits: "1.5", "30".
-std::string number_text(double v);
 /// Text for an HTML or XML document (the timeline and trace pages, `safecass run --junit`):
 /// & < > " ' become character references; every other byte is copied.
 std::string markup_text(std::string_view text);
