@@ -372,7 +372,7 @@ std::string state_summary_json(const StateSummary& s) {
          "\n";
 }
 
-Expected<StateSummary> state_summary_from_json(std::string_view text) {
+[[nodiscard]] Expected<StateSummary> state_summary_from_json(std::string_view text) {
   const json::JsonParse parsed = json::parse_json(text, 8);
   if (!parsed.value || !parsed.value->is_object()) return fail(ErrorCode::Parse, "state summary: not a JSON object");
   const json::JsonValue& v = *parsed.value;

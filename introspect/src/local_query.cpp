@@ -362,7 +362,7 @@ Expected<void> LocalQuery::reset(std::string_view target, std::string_view who, 
 
 namespace {
 
-Expected<StateSummary> state_summary(LocalQuery& query) {
+[[nodiscard]] Expected<StateSummary> state_summary(LocalQuery& query) {
   auto rows = query.state_list();
   if (!rows) return tl::unexpected(rows.error());
   StateSummary s;
@@ -407,7 +407,7 @@ const NamedRead* find_read(std::string_view name) noexcept {
   return nullptr;
 }
 
-Expected<std::string> read_text(std::string_view name, std::string_view json) {
+[[nodiscard]] Expected<std::string> read_text(std::string_view name, std::string_view json) {
   const NamedRead* r = find_read(name);
   if (r == nullptr) return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
   return r->text(json);
