@@ -62,8 +62,8 @@ stress-test: build
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
-# Short libFuzzer runs of the spec loader and of the ROS inputs (clang, ASan + UBSan); the long
-# runs are in docs/spec-format.md.
+# Short libFuzzer runs of the spec loader, the ROS inputs and the named reads' answers (clang,
+# ASan + UBSan); the long runs are in docs/spec-format.md.
 FUZZ := $(BUILD)/fuzz
 fuzz-smoke: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
@@ -85,6 +85,14 @@ fuzz-smoke: deps
 	  -artifact_prefix=$(FUZZ)/ros- $(FUZZ)/ros-corpus >$(FUZZ)/ros-smoke.log 2>&1 \
 	  || { tail -40 $(FUZZ)/ros-smoke.log; echo "fuzz-smoke: the ROS input fuzzer found a failure"; exit 1; }
 	@echo "fuzz-smoke: ROS inputs (CDR, mapping files): no failure in 10 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/ros-smoke.log | tail -1))"
+	@cmake --build $(FUZZ) -j $(JOBS) --target read_answer_fuzz >/dev/null
+	@mkdir -p $(FUZZ)/read-corpus
+	@printf '%s\n' '{"system":"Error","normal":3,"warning":1,"error":1,"not_normal":[{"component":"BMM","state":"Warning","outstanding":"EVT_BONE_MOTION"},{"component":"JR3","state":"Error","outstanding":null}]}' \
+	  >$(FUZZ)/read-corpus/state_summary.json
+	@$(FUZZ)/bin/read_answer_fuzz -max_len=1024 -max_total_time=5 -print_final_stats=1 \
+	  -artifact_prefix=$(FUZZ)/read- $(FUZZ)/read-corpus >$(FUZZ)/read-smoke.log 2>&1 \
+	  || { tail -40 $(FUZZ)/read-smoke.log; echo "fuzz-smoke: the named-read answer fuzzer found a failure"; exit 1; }
+	@echo "fuzz-smoke: named-read answers: no failure in 5 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/read-smoke.log | tail -1))"
 
 # Benchmarks are built in Release in their own tree; results land in build/bench.json (every
 # repetition and the aggregates), run on one core (the last) when taskset is there.

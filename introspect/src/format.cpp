@@ -380,7 +380,10 @@ std::string state_summary_json(const StateSummary& s) {
     return field != nullptr && field->is_string() ? parse_state(field->string) : std::nullopt;
   };
   const auto count_of = [](const json::JsonValue* field) -> std::optional<std::size_t> {
-    if (field == nullptr || !field->is_number() || !field->integral || field->number < 0) return std::nullopt;
+    // A count is a whole number a double holds exactly (at most 2^53).
+    if (field == nullptr || !field->is_number() || !field->integral || field->number < 0 || field->number > 0x1p53) {
+      return std::nullopt;
+    }
     return static_cast<std::size_t>(field->number);
   };
   StateSummary s;

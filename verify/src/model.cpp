@@ -246,7 +246,7 @@ void Model::derive_addresses(const RootsAt& at) {
         if (d.all_required || std::find(d.required.begin(), d.required.end(), iface) != d.required.end())
           deps.push_back(r);
       }
-      make(name + ".s_S." + std::string(co.interface_name(co.provided_machines(c)[p])), deps, where);
+      make(address::service(name, co.interface_name(co.provided_machines(c)[p])), deps, where);
     }
   }
 }

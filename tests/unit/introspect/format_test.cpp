@@ -61,9 +61,11 @@ TEST(StateSummary, ItsJsonIsOneLineThatReadsBackToTheSameValue) {
 }
 
 TEST(StateSummary, AnAnswerThatIsNotASummaryIsAParseErrorThatSaysSo) {
-  for (const char* bad : {"", "[]", R"({"system":"Fine","normal":1,"warning":0,"error":0,"not_normal":[]})",
-                          R"({"system":"Normal","normal":-1,"warning":0,"error":0,"not_normal":[]})",
-                          R"({"system":"Normal","normal":1,"warning":0,"error":0,"not_normal":[{"state":"Error"}]})"}) {
+  for (const char* bad :
+       {"", "[]", R"({"system":"Fine","normal":1,"warning":0,"error":0,"not_normal":[]})",
+        R"({"system":"Normal","normal":-1,"warning":0,"error":0,"not_normal":[]})",
+        R"({"system":"Normal","normal":123456789012345678901234567890,"warning":0,"error":0,"not_normal":[]})",
+        R"({"system":"Normal","normal":1,"warning":0,"error":0,"not_normal":[{"state":"Error"}]})"}) {
     auto parsed = state_summary_from_json(bad);
     ASSERT_FALSE(parsed) << bad;
     EXPECT_EQ(parsed.error().code, ErrorCode::Parse) << bad;
