@@ -9,6 +9,7 @@
 
 #include "console.hpp"
 #include "console_shell.hpp"
+#include "safecass/introspect/local_query.hpp"
 
 namespace safecass::tools {
 namespace {
@@ -121,6 +122,17 @@ TEST(ConsoleShell, ABackendErrorIsPrintedWithTheCommandAndItsUsageInTextAndJson)
   EXPECT_EQ(r.err,
             "{\"ok\":false,\"command\":\"event generate\",\"error\":\"event generate refused: the request does "
             "not carry coordinator 'robot''s token\",\"usage\":\"event generate EVENT TARGET\"}\n");
+}
+
+TEST(ConsoleShell, EveryNamedReadCommandHasItsReadAndNoneWrites) {
+  std::size_t reads = 0;
+  for (const CommandSpec& c : console::commands()) {
+    if (c.id != console::Id::Read) continue;
+    ++reads;
+    EXPECT_NE(introspect::find_read(c.name), nullptr) << c.name << ": no NamedRead of that name in kReads";
+    EXPECT_FALSE(c.writes) << c.name << ": a named read is read-only";
+  }
+  EXPECT_GE(reads, 1u);  // state summary
 }
 
 TEST(ConsoleShell, HelpAndQuitAreAnsweredWithoutTheBackend) {
