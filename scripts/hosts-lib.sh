@@ -78,10 +78,13 @@ hosts_up() {
 hosts_cut() { ip -n "$(hosts_ns "$1")" link set eth0 down; }
 hosts_heal() {
   ip -n "$(hosts_ns "$1")" link set eth0 up
-  # An address comes back with its link; wait until it is usable.
-  local _
-  for _ in $(seq 50); do
-    ip -n "$(hosts_ns "$1")" -o addr show dev eth0 | grep -q tentative || return 0
+  # The host's IPv4 address comes back with its link; wait (5 s at most, by the clock: each `ip`
+  # can take seconds on a loaded machine) until it is usable. Only the IPv4 address counts: the
+  # hosts talk over it, and the IPv6 link-local address's duplicate detection, which can stay
+  # tentative for long under load, is not waited for.
+  local until=$((SECONDS + 5))
+  while [ $SECONDS -lt $until ]; do
+    ip -n "$(hosts_ns "$1")" -4 -o addr show dev eth0 | grep -q tentative || return 0
     sleep 0.1
   done
 }

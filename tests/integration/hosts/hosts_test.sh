@@ -19,7 +19,9 @@ rm -rf "$HOSTS_DIR"; mkdir -p "$HOSTS_DIR"; HOSTS_DIR=$(realpath "$HOSTS_DIR"); 
 system="$src/examples/robodoc/robodoc.json"
 failures=0
 finish() {
+  local down=$SECONDS
   hosts_down
+  echo "   hosts removed in $((SECONDS - down)) s (at ${SECONDS} s)"
   if [ $failures -ne 0 ]; then
     for f in "$HOSTS_DIR"/*.log; do echo "---- $f"; tail -15 "$f"; done
     exit 1
@@ -30,7 +32,9 @@ trap finish EXIT
 trap 'exit 143' INT TERM  # a timeout's SIGTERM too: the EXIT trap removes the hosts
 check() {  # check DESCRIPTION COMMAND...
   local what="$1"; shift
-  if "$@"; then echo "ok: $what"; else echo "FAILED: $what"; failures=$((failures + 1)); fi
+  # Each line says when it was reached (seconds since the script started), so that a slow run
+  # shows where its time went.
+  if "$@"; then echo "ok: $what [${SECONDS} s]"; else echo "FAILED: $what [${SECONDS} s]"; failures=$((failures + 1)); fi
 }
 # retry SECONDS COMMAND...: until COMMAND succeeds, for at most SECONDS.
 retry() {
@@ -72,6 +76,7 @@ hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' ice.env)")
 feed="$src/tests/integration/hosts/quiet_feed.json"
 [ "$case_name" = across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_healing ] &&
   feed="$src/tests/integration/hosts/late_fault_feed.json"
+echo "   hosts and IceStorm up at ${SECONDS} s"
 robot_started=$SECONDS
 hosts_start robot a "$bin/safecass" run "$system" --coordinator robot --ice "$ice" --listen 10.77.0.1 --duration 280 \
   --scenario "$feed" --allow-write --token-file "$HOSTS_DIR/robot.token"
@@ -130,7 +135,9 @@ across_hosts_a_partitioned_host_is_lost_within_the_bound_and_converges_after_hea
   # t = 20 s on the robot: its force crosses the limit on a, unseen by the others.
   retry 60 grep -Eq "\[robot\] JR3.s_A .*-> Error EVT_FORCE_ERROR" robot.log
   check "the robot raised its force fault while cut off" test $? -eq 0
+  start=$(now_ms)
   hosts_heal a
+  echo "   link a up again in $(($(now_ms) - start)) ms"
   start=$(now_ms)
   retry 30 ui_shows "Error +EVT_SERVICE_FAILURE"
   check "after healing, the ui on b holds the fault raised during the partition" test $? -eq 0
