@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <utility>
 
 #include <fmt/format.h>
@@ -34,11 +35,6 @@ namespace {
 /// At most this many ticks are processed per poll, so that a poll never holds the event loop
 /// for long; the clock catches up over the next polls.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
-
-std::string file_name(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
 
 }  // namespace
 
@@ -101,8 +97,10 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   impl->system_name = loaded.name;
   impl->duration = seconds_to_time(scenario.duration);
   impl->tick = seconds_to_time(scenario.period);
-  impl->description = "in-process: " + file_name(scenario.system) +
-                      (options.scenario.empty() ? std::string() : ", scenario " + file_name(options.scenario));
+  impl->description =
+      "in-process: " + std::filesystem::path(scenario.system).filename().string() +
+      (options.scenario.empty() ? std::string()
+                                : ", scenario " + std::filesystem::path(options.scenario).filename().string());
   char speed[32];
   std::snprintf(speed, sizeof speed, "%g", options.speed);
   impl->description += std::string(", speed ") + speed;

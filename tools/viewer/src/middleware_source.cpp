@@ -5,6 +5,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <filesystem>
 #include <mutex>
 #include <thread>
 #include <utility>
@@ -43,11 +44,6 @@ std::string wall_now() {
   return introspect::iso8601_local(
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
           .count());
-}
-
-std::string file_name(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
 std::string component_of(std::string_view address) { return std::string(address.substr(0, address.find('.'))); }
@@ -342,8 +338,8 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
       return fail(token.error().code, "--read-token-file " + name + "=" + path + ": " + token.error().message);
     l->read_token = *token;
   }
-  impl->description = "live: " + file_name(options.system) + " through IceStorm " + middleware::to_string(impl->ice) +
-                      ", coordinators " + names;
+  impl->description = "live: " + std::filesystem::path(options.system).filename().string() + " through IceStorm " +
+                      middleware::to_string(impl->ice) + ", coordinators " + names;
 
   Impl* self = impl.get();
   for (auto& l : impl->links) {

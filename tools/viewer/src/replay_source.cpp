@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <utility>
 
 #include <fmt/format.h>
@@ -19,11 +20,6 @@ namespace {
 
 /// At most this many ticks per poll, so that a poll never holds the event loop for long.
 constexpr std::int64_t kMaxTicksPerPoll = 5000;
-
-std::string file_name(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
 
 [[nodiscard]] Expected<void> check_speed(double speed) {
   if (!std::isfinite(speed) || speed <= 0.0 || speed > 1000.0) {
@@ -154,8 +150,9 @@ Expected<std::unique_ptr<ReplaySource>> ReplaySource::open(const ReplaySourceOpt
   impl->speed = options.speed;
   if (auto r = impl->restart(); !r) return tl::unexpected(r.error());
   impl->description =
-      fmt::format("replay of {} through {}, {} s to {} s", file_name(options.input), file_name(options.system),
-                  seconds_text(impl->session->start()), seconds_text(impl->session->end()));
+      fmt::format("replay of {} through {}, {} s to {} s", std::filesystem::path(options.input).filename().string(),
+                  std::filesystem::path(options.system).filename().string(), seconds_text(impl->session->start()),
+                  seconds_text(impl->session->end()));
   impl->rebase();
   return std::unique_ptr<ReplaySource>(new ReplaySource(std::move(impl)));
 }
