@@ -801,43 +801,58 @@ void Coordinator::generate(EventId event, MachineId target, const SampleCause& c
   processing_ = false;
 }
 
-Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
-  auto e = find_event(event);
+[[nodiscard]] Expected<GenerateTarget> resolve_generate(const Coordinator& co, std::string_view event,
+                                                        std::string_view target) {
+  auto e = co.find_event(event);
   if (!e) return tl::unexpected(e.error());
-  const Event& ev = events_[to_index(*e)];
+  const Event& ev = co.event(*e);
   if (!ev.is_onset && ev.counterpart == kNoEvent) {
     return fail(ErrorCode::InvalidState,
                 "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
   }
-  if (ev.is_broadcast()) {
-    generate(*e, kNoMachine);
-    return {};
-  }
-  auto m = find_machine(target);
+  if (ev.is_broadcast()) return GenerateTarget{*e, kNoMachine};
+  auto m = co.find_machine(target);
   if (!m) return tl::unexpected(m.error());
-  generate(*e, *m);
-  return {};
+  return GenerateTarget{*e, *m};
 }
 
-Expected<void> Coordinator::broadcast(std::string_view event) {
-  auto e = find_event(event);
+[[nodiscard]] Expected<EventId> resolve_broadcast(const Coordinator& co, std::string_view event) {
+  auto e = co.find_event(event);
   if (!e) return tl::unexpected(e.error());
-  if (!events_[to_index(*e)].is_broadcast()) {
+  if (const Event& ev = co.event(*e); !ev.is_broadcast()) {
     return fail(ErrorCode::InvalidArgument, "event '" + std::string(event) + "' has severity " +
-                                                std::to_string(events_[to_index(*e)].severity) +
-                                                "; broadcasts need severity 251-255");
+                                                std::to_string(ev.severity) + "; broadcasts need severity 251-255");
   }
-  generate(*e, kNoMachine);
-  return {};
+  return *e;
 }
 
-Expected<void> Coordinator::reset(std::string_view target, std::string_view who, std::string_view why) {
-  auto a = resolve(target);
+[[nodiscard]] Expected<Address> resolve_reset(const Coordinator& co, std::string_view target) {
+  auto a = co.resolve(target);
   if (!a) return tl::unexpected(a.error());
   if (a->kind == Address::Kind::Service) {
     return fail(ErrorCode::InvalidArgument, "cannot reset service state '" + std::string(target) +
                                                 "': it is derived; reset its component or a machine");
   }
+  return *a;
+}
+
+Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
+  auto t = resolve_generate(*this, event, target);
+  if (!t) return tl::unexpected(t.error());
+  generate(t->event, t->machine);
+  return {};
+}
+
+Expected<void> Coordinator::broadcast(std::string_view event) {
+  auto e = resolve_broadcast(*this, event);
+  if (!e) return tl::unexpected(e.error());
+  generate(*e, kNoMachine);
+  return {};
+}
+
+Expected<void> Coordinator::reset(std::string_view target, std::string_view who, std::string_view why) {
+  auto a = resolve_reset(*this, target);
+  if (!a) return tl::unexpected(a.error());
   reset(*a, who, why);
   return {};
 }

@@ -123,7 +123,7 @@ void Filter::run_merged(bool injected_run, bool restore, Time now) noexcept {
   }
 }
 
-Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
+Expected<void> Filter::check_injection(const std::vector<std::vector<double>>& samples) const {
   const std::vector<Signal*>& inputs = cold_->inputs;
   if (inputs.empty()) return fail(ErrorCode::InvalidArgument, "filter '" + name() + "' has no input to inject into");
   const std::size_t size = inputs[0]->size();
@@ -134,6 +134,11 @@ Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
                                                   inputs[0]->name() + "' has size " + std::to_string(size));
     }
   }
+  return {};
+}
+
+Expected<void> Filter::inject(const std::vector<std::vector<double>>& samples) {
+  if (auto ok = check_injection(samples); !ok) return ok;
   std::lock_guard lock(cold_->injection_mutex);
   cold_->injections.insert(cold_->injections.end(), samples.begin(), samples.end());
   if (!cold_->injections.empty()) detour_.fetch_or(kInjection, std::memory_order_acq_rel);

@@ -330,27 +330,51 @@ std::string value_text(double v) {
 }
 }  // namespace
 
-Expected<void> Monitor::inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples) {
-  Filter* f = find_filter(filter);
+Expected<void> Monitor::check_inject_shallow(std::string_view filter,
+                                             const std::vector<std::vector<double>>& samples) const {
+  const Filter* f = find_filter(filter);
   if (f == nullptr) return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "'");
-  if (auto finite = check_finite("shallow injection into filter " + f->name(), samples); !finite) return finite;
-  auto r = f->inject(samples);
-  if (!r) return r;
+  const std::string what = "shallow injection into filter " + f->name();
+  if (samples.empty()) return fail(ErrorCode::InvalidArgument, what + ": no samples");
+  if (auto ok = f->check_injection(samples); !ok) return ok;
+  return check_finite(what, samples);
+}
+
+Expected<void> Monitor::check_inject_deep(std::string_view signal,
+                                          const std::vector<std::vector<double>>& samples) const {
+  const Signal* s = signals_.find(signal);
+  if (s == nullptr) {
+    return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "' (signals are written Component.signal)");
+  }
+  const std::string what = "deep injection into signal " + s->name();
+  if (samples.empty()) return fail(ErrorCode::InvalidArgument, what + ": no samples");
+  if (samples.size() > s->buffer().capacity()) {
+    return fail(ErrorCode::InvalidArgument,
+                what + ": " + std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples") +
+                    " would overflow its history (" + std::to_string(s->buffer().capacity()) +
+                    " samples): inject fewer at once");
+  }
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    if (samples[i].size() != s->size()) {
+      return fail(ErrorCode::InvalidArgument, what + ": sample " + std::to_string(i + 1) + " has " +
+                                                  std::to_string(samples[i].size()) + " values; the signal has size " +
+                                                  std::to_string(s->size()));
+    }
+  }
+  return check_finite(what, samples);
+}
+
+Expected<void> Monitor::inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples) {
+  if (auto ok = check_inject_shallow(filter, samples); !ok) return ok;
+  Filter* f = find_filter(filter);
+  if (auto r = f->inject(samples); !r) return r;
   record_injection(f->target(), "shallow injection into filter " + f->name() + ": " + samples_text(samples));
   return {};
 }
 
 Expected<void> Monitor::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples, Time at) {
+  if (auto ok = check_inject_deep(signal, samples); !ok) return ok;
   Signal* s = signals_.find(signal);
-  if (s == nullptr) return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "'");
-  for (std::size_t i = 0; i < samples.size(); ++i) {
-    if (samples[i].size() != s->size()) {
-      return fail(ErrorCode::InvalidArgument, "deep injection into '" + s->name() + "': sample " +
-                                                  std::to_string(i + 1) + " has " + std::to_string(samples[i].size()) +
-                                                  " values; the signal has size " + std::to_string(s->size()));
-    }
-  }
-  if (auto finite = check_finite("deep injection into signal " + s->name(), samples); !finite) return finite;
   for (const auto& v : samples) s->inject(at, v.data());
   const std::string text = "deep injection into signal " + s->name() + ": " + samples_text(samples);
   // One record on each machine whose filters read the signal (however many of them do), in the

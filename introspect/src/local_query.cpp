@@ -312,50 +312,10 @@ Expected<std::unique_ptr<Subscription>> LocalQuery::follow(RecordSink sink) {
   return std::unique_ptr<Subscription>(std::make_unique<LocalSubscription>(co_, id));
 }
 
-Expected<void> LocalQuery::generate(std::string_view event, std::string_view target) {
-  auto done = co_.generate(event, target);
-  if (done && options_.actions != nullptr) options_.actions->generated(event, target);
-  return done;
-}
-
-Expected<void> LocalQuery::broadcast(std::string_view event) {
-  auto done = co_.broadcast(event);
-  if (done && options_.actions != nullptr) options_.actions->broadcast(event);
-  return done;
-}
-
-Expected<void> LocalQuery::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
-  if (samples.empty()) return fail(ErrorCode::InvalidArgument, "filter inject " + std::string(filter) + ": no samples");
-  if (monitor_.find_filter(filter) == nullptr)
-    return fail(ErrorCode::NotFound, "no filter '" + std::string(filter) + "' (see filter list)");
-  auto done = monitor_.inject_shallow(filter, samples);
-  if (done && options_.actions != nullptr) options_.actions->injected(filter, samples);
-  return done;
-}
-
-Expected<void> LocalQuery::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
-  if (samples.empty())
-    return fail(ErrorCode::InvalidArgument, "filter dinject " + std::string(signal) + ": no samples");
-  const Signal* s = monitor_.signals().find(signal);
-  if (s == nullptr)
-    return fail(ErrorCode::NotFound, "no signal '" + std::string(signal) + "' (signals are written Component.signal)");
-  if (samples.size() > s->buffer().capacity()) {
-    return fail(ErrorCode::InvalidArgument,
-                std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples") +
-                    " would overflow the history of '" + std::string(signal) + "' (" +
-                    std::to_string(s->buffer().capacity()) + " samples): inject fewer at once");
-  }
+Expected<void> LocalQuery::apply(const Action& action) {
   Time now = co_.clock().now();
   if (options_.base == TimeBase::Simulated && now < Time{0}) now = Time{0};
-  auto done = monitor_.inject_deep(signal, samples, now);
-  if (done && options_.actions != nullptr) options_.actions->injected_deep(signal, samples);
-  return done;
-}
-
-Expected<void> LocalQuery::reset(std::string_view target, std::string_view who, std::string_view why) {
-  auto done = co_.reset(target, who, why);
-  if (done && options_.actions != nullptr) options_.actions->reset(target, who, why);
-  return done;
+  return introspect::apply(action, co_, monitor_, now, options_.actions);
 }
 
 // ---- named reads ---------------------------------------------------------------------------------

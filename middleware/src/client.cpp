@@ -461,35 +461,30 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
   }
 }
 
-Expected<void> RemoteClient::generate(std::string_view event, std::string_view target) {
-  return impl_->call("event generate", [&] {
-    impl_->control->eventGenerate(impl_->options.token, std::string(event), std::string(target));
-  });
-}
-
-Expected<void> RemoteClient::broadcast(std::string_view event) {
-  return impl_->call("event broadcast",
-                     [&] { impl_->control->eventBroadcast(impl_->options.token, std::string(event)); });
-}
-
-Expected<void> RemoteClient::inject(std::string_view filter, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter inject",
-                     [&] { impl_->control->filterInject(impl_->options.token, std::string(filter), samples); });
-}
-
-Expected<void> RemoteClient::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) {
-  return impl_->call("filter dinject",
-                     [&] { impl_->control->filterDinject(impl_->options.token, std::string(signal), samples); });
-}
-
-Expected<void> RemoteClient::filter_dinload(const std::string& signal, const std::string& text) {
-  return impl_->call("filter dinload", [&] { impl_->control->filterDinload(impl_->options.token, signal, text); });
-}
-
-Expected<void> RemoteClient::reset(std::string_view target, std::string_view who, std::string_view why) {
-  return impl_->call("reset", [&] {
-    impl_->control->reset(impl_->options.token, std::string(target), std::string(who), std::string(why));
-  });
+Expected<void> RemoteClient::apply(const introspect::Action& action) {
+  const std::string& token = impl_->options.token;
+  const std::shared_ptr<wire::ControlPrx>& control = impl_->control;
+  return std::visit(
+      [&](const auto& a) -> Expected<void> {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, introspect::PushSample>) {
+          return fail(ErrorCode::InvalidArgument, "a sample of " + a.signal +
+                                                      " cannot be pushed over the bus: a coordinator's samples "
+                                                      "come from its own framework");
+        } else if constexpr (std::is_same_v<A, introspect::GenerateEvent>) {
+          return impl_->call("event generate", [&] { control->eventGenerate(token, a.event, a.target); });
+        } else if constexpr (std::is_same_v<A, introspect::BroadcastEvent>) {
+          return impl_->call("event broadcast", [&] { control->eventBroadcast(token, a.event); });
+        } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
+          return impl_->call("reset", [&] { control->reset(token, a.target, a.who, a.why); });
+        } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
+          return impl_->call("filter inject", [&] { control->filterInject(token, a.filter, a.samples); });
+        } else {
+          static_assert(std::is_same_v<A, introspect::InjectDeep>, "an Action alternative the client does not send");
+          return impl_->call("filter dinject", [&] { control->filterDinject(token, a.signal, a.samples); });
+        }
+      },
+      action);
 }
 
 std::uint64_t RemoteClient::records_refused() const { return impl_->refused.load() + impl_->undecodable->count(); }

@@ -5,14 +5,11 @@
 
 #include "control.hpp"
 
-#include <cmath>
-#include <cstdlib>
-#include <sstream>
-
 #include <mutex>
 
 #include "read_model_wire.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/introspect/sample_text.hpp"
 #include "safecass/middleware/token.hpp"
 
 namespace safecass::middleware::detail {
@@ -106,46 +103,21 @@ public:
 
   void filterInject(std::string token, std::string filter, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter inject");
-    if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter inject " + filter + ": no samples");
-    ok_or_raise(locked([&] { return query_.inject(filter, samples); }));
-    c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(samples.size()) +
-           " samples)");
+    const std::size_t n = samples.size();
+    apply(introspect::InjectShallow{filter, std::move(samples)});
+    c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(n) + " samples)");
   }
 
   void filterDinject(std::string token, std::string signal, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter dinject");
-    deep(signal, samples);
+    deep(std::move(signal), std::move(samples));
   }
 
   void filterDinload(std::string token, std::string signal, std::string text, const Ice::Current&) override {
     check_write(token, "filter dinload");
-    wire::SampleSeq samples;
-    std::istringstream lines(text);
-    std::string line;
-    for (int number = 1; std::getline(lines, line); ++number) {
-      line = line.substr(0, line.find('#'));
-      for (char& ch : line) {
-        if (ch == ',') ch = ' ';
-      }
-      std::istringstream words(line);
-      std::vector<double> values;
-      std::string word;
-      while (words >> word) {
-        char* end = nullptr;
-        const double v = std::strtod(word.c_str(), &end);
-        if (end == word.c_str() || *end != '\0' || !std::isfinite(v)) {
-          // Injected values are finite (Monitor's rule, docs/filters.md), said with the line.
-          raise(ErrorCode::Parse,
-                "filter dinload " + signal + ": line " + std::to_string(number) + ": '" + word +
-                    (end == word.c_str() || *end != '\0' ? "' is not a number"
-                                                         : "' is not a finite number: injected values must be finite"));
-        }
-        values.push_back(v);
-      }
-      if (!values.empty()) samples.push_back(std::move(values));
-    }
-    if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter dinload " + signal + ": no samples");
-    deep(signal, samples);
+    auto samples = introspect::parse_sample_file("filter dinload " + signal + " text", text);
+    if (!samples) raise(samples.error().code, samples.error().message);
+    deep(std::move(signal), std::move(*samples));
   }
 
   wire::EventEntrySeq eventList(const Ice::Current& current) override {
@@ -163,13 +135,13 @@ public:
 
   void eventGenerate(std::string token, std::string event, std::string target, const Ice::Current&) override {
     check_write(token, "event generate");
-    ok_or_raise(locked([&] { return query_.generate(event, target); }));
+    apply(introspect::GenerateEvent{event, target});
     c_.log("middleware: " + c_.name + ": event generate " + event + " " + target);
   }
 
   void eventBroadcast(std::string token, std::string event, const Ice::Current&) override {
     check_write(token, "event broadcast");
-    ok_or_raise(locked([&] { return query_.broadcast(event); }));
+    apply(introspect::BroadcastEvent{event});
     c_.log("middleware: " + c_.name + ": event broadcast " + event);
   }
 
@@ -186,7 +158,7 @@ public:
   void reset(std::string token, std::string target, std::string who, std::string why, const Ice::Current&) override {
     check_write(token, "reset");
     if (who.empty()) who = "remote";
-    ok_or_raise(locked([&] { return query_.reset(target, who, why); }));
+    apply(introspect::ResetState{target, who, why});
     c_.log("middleware: " + c_.name + ": reset " + target + " by " + who + ": " + why);
   }
 
@@ -238,11 +210,14 @@ private:
     }
   }
 
-  void deep(const std::string& signal, const wire::SampleSeq& samples) {
-    if (samples.empty()) raise(ErrorCode::InvalidArgument, "filter dinject " + signal + ": no samples");
-    ok_or_raise(locked([&] { return query_.inject_deep(signal, samples); }));
-    c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(samples.size()) +
-           " samples)");
+  void apply(const introspect::Action& action) {
+    ok_or_raise(locked([&] { return query_.apply(action); }));
+  }
+
+  void deep(std::string signal, wire::SampleSeq samples) {
+    const std::size_t n = samples.size();
+    apply(introspect::InjectDeep{signal, std::move(samples)});
+    c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(n) + " samples)");
   }
 
   /// The read model is used by one thread at a time (Ice may dispatch requests on several).

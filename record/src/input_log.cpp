@@ -8,6 +8,8 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <type_traits>
+#include <variant>
 
 namespace safecass {
 
@@ -55,19 +57,56 @@ void put_time(std::string& out, Time t) {
   put<std::int64_t>(out, t.count());
 }
 
-void put_action(std::string& out, const InputAction& a) {
+void put_action(std::string& out, const introspect::Action& action, Time t) {
+  // The format's layout: kind, then three texts (a, b, c) and the values (docs/record-format.md).
+  InputActionKind kind = InputActionKind::Generate;
+  std::string_view a, b, c;
+  const std::vector<std::vector<double>>* values = nullptr;
+  const bool written = std::visit(
+      [&](const auto& x) {
+        using X = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<X, introspect::PushSample>) {
+          return false;
+        } else if constexpr (std::is_same_v<X, introspect::GenerateEvent>) {
+          kind = InputActionKind::Generate;
+          a = x.event;
+          b = x.target;
+        } else if constexpr (std::is_same_v<X, introspect::BroadcastEvent>) {
+          kind = InputActionKind::Broadcast;
+          a = x.event;
+        } else if constexpr (std::is_same_v<X, introspect::ResetState>) {
+          kind = InputActionKind::Reset;
+          a = x.target;
+          b = x.who;
+          c = x.why;
+        } else if constexpr (std::is_same_v<X, introspect::InjectShallow>) {
+          kind = InputActionKind::InjectShallow;
+          a = x.filter;
+          values = &x.samples;
+        } else {
+          static_assert(std::is_same_v<X, introspect::InjectDeep>, "an Action alternative without its record");
+          kind = InputActionKind::InjectDeep;
+          a = x.signal;
+          values = &x.samples;
+        }
+        return true;
+      },
+      action);
+  if (!written) return;
   std::string payload;
-  put_text(payload, a.a);
-  put_text(payload, a.b);
-  put_text(payload, a.c);
-  put<std::uint32_t>(payload, static_cast<std::uint32_t>(a.values.size()));
-  for (const auto& v : a.values) {
-    put<std::uint16_t>(payload, static_cast<std::uint16_t>(v.size()));
-    for (double x : v) put(payload, x);
+  put_text(payload, a);
+  put_text(payload, b);
+  put_text(payload, c);
+  put<std::uint32_t>(payload, values == nullptr ? 0u : static_cast<std::uint32_t>(values->size()));
+  if (values != nullptr) {
+    for (const auto& v : *values) {
+      put<std::uint16_t>(payload, static_cast<std::uint16_t>(v.size()));
+      for (double x : v) put(payload, x);
+    }
   }
   out += static_cast<char>(kAction);
-  out += static_cast<char>(a.kind);
-  put<std::int64_t>(out, a.time.count());
+  out += static_cast<char>(kind);
+  put<std::int64_t>(out, t.count());
   put<std::uint32_t>(out, static_cast<std::uint32_t>(payload.size()));
   out += payload;
 }
@@ -290,10 +329,9 @@ InputLogReader::Item InputLogReader::next() {
           p += n;
           return true;
         };
-        action_ = InputAction{};
-        action_.kind = static_cast<InputActionKind>(kind);
-        action_.time = t;
-        bool ok = text(action_.a) && text(action_.b) && text(action_.c) && stop - p >= 4;
+        std::string a, b, c;
+        std::vector<std::vector<double>> values;
+        bool ok = text(a) && text(b) && text(c) && stop - p >= 4;
         if (ok) {
           const auto count = get<std::uint32_t>(p);
           p += 4;
@@ -311,10 +349,22 @@ InputLogReader::Item InputLogReader::next() {
             std::vector<double> v(w);
             std::memcpy(v.data(), p, 8u * w);
             p += 8u * w;
-            action_.values.push_back(std::move(v));
+            values.push_back(std::move(v));
           }
         }
         if (!ok || p != stop) return fail_at("malformed action payload");
+        switch (static_cast<InputActionKind>(kind)) {
+          case InputActionKind::Generate: action_ = introspect::GenerateEvent{std::move(a), std::move(b)}; break;
+          case InputActionKind::Broadcast: action_ = introspect::BroadcastEvent{std::move(a)}; break;
+          case InputActionKind::Reset:
+            action_ = introspect::ResetState{std::move(a), std::move(b), std::move(c)};
+            break;
+          case InputActionKind::InjectShallow:
+            action_ = introspect::InjectShallow{std::move(a), std::move(values)};
+            break;
+          case InputActionKind::InjectDeep: action_ = introspect::InjectDeep{std::move(a), std::move(values)}; break;
+        }
+        mark_time_ = t;
         pos_ += 14u + size;
         ++index_;
         return Item::Action;

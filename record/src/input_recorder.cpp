@@ -177,39 +177,15 @@ void InputRecorder::drain() {
   drain_locked();
 }
 
-void InputRecorder::action_locked(InputAction action) {
+void InputRecorder::applied(const introspect::Action& action, Time at) {
+  if (std::holds_alternative<introspect::PushSample>(action)) return;  // read from its signal by drain()
+  std::lock_guard lock(mutex_);
   if (closed_) return;
   drain_locked();
-  action.time = monitor_.coordinator().clock().now();
   open_chunk_locked();
-  input_log::put_action(chunk_.bytes, action);
+  input_log::put_action(chunk_.bytes, action, at);
   ++actions_;
   if (chunk_.bytes.size() >= chunk_limit_) seal_locked();
-}
-
-void InputRecorder::generate(std::string_view event, std::string_view target) {
-  std::lock_guard lock(mutex_);
-  action_locked(InputAction{InputActionKind::Generate, {}, std::string(event), std::string(target), {}, {}});
-}
-
-void InputRecorder::broadcast(std::string_view event) {
-  std::lock_guard lock(mutex_);
-  action_locked(InputAction{InputActionKind::Broadcast, {}, std::string(event), {}, {}, {}});
-}
-
-void InputRecorder::reset(std::string_view target, std::string_view who, std::string_view why) {
-  std::lock_guard lock(mutex_);
-  action_locked(InputAction{InputActionKind::Reset, {}, std::string(target), std::string(who), std::string(why), {}});
-}
-
-void InputRecorder::inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& values) {
-  std::lock_guard lock(mutex_);
-  action_locked(InputAction{InputActionKind::InjectShallow, {}, std::string(filter), {}, {}, values});
-}
-
-void InputRecorder::inject_deep(std::string_view signal, const std::vector<std::vector<double>>& values) {
-  std::lock_guard lock(mutex_);
-  action_locked(InputAction{InputActionKind::InjectDeep, {}, std::string(signal), {}, {}, values});
 }
 
 void InputRecorder::start_polling(std::chrono::milliseconds every) {

@@ -142,7 +142,7 @@ public:
       case Id::FilterInject: {
         auto samples = parse_samples({args.begin() + 1, args.end()});
         if (!samples) return samples.error().message;
-        if (auto r = q.inject(args[0], *samples); !r) return r.error().message;
+        if (auto r = q.apply(in::InjectShallow{args[0], *samples}); !r) return r.error().message;
         done(out, c, Json().str("filter", args[0]).integer("samples", static_cast<long long>(samples->size())),
              "queued " + count_text(samples->size()) + " into filter " + args[0] +
                  " (seen by that filter alone on its next runs: use watch)");
@@ -180,13 +180,13 @@ public:
         return {};
       }
       case Id::EventGenerate: {
-        if (auto r = q.generate(args[0], args[1]); !r) return r.error().message;
+        if (auto r = q.apply(in::GenerateEvent{args[0], args[1]}); !r) return r.error().message;
         done(out, c, Json().str("event", args[0]).str("target", args[1]), "generated " + args[0] + " on " + args[1],
              true);
         return {};
       }
       case Id::EventBroadcast: {
-        if (auto r = q.broadcast(args[0]); !r) return r.error().message;
+        if (auto r = q.apply(in::BroadcastEvent{args[0]}); !r) return r.error().message;
         done(out, c, Json().str("event", args[0]), "broadcast " + args[0], true);
         return {};
       }
@@ -213,7 +213,7 @@ public:
         std::string reason;
         for (std::size_t i = 1; i < args.size(); ++i) reason += (reason.empty() ? "" : " ") + args[i];
         if (reason.empty()) reason = "reset from the console";
-        if (auto r = q.reset(args[0], "console", reason); !r) return r.error().message;
+        if (auto r = q.apply(in::ResetState{args[0], "console", reason}); !r) return r.error().message;
         const std::string when = now_text();
         done(out, c, Json().str("target", args[0]).str("reason", reason),
              "reset " + args[0] + (when.empty() ? std::string() : " at " + when) + " (" + reason + ")");
@@ -269,7 +269,7 @@ private:
 
   std::string deep_inject(const CommandSpec& c, const std::string& signal,
                           const std::vector<std::vector<double>>& samples, Out& out) {
-    if (auto r = target_.query->inject_deep(signal, samples); !r) return r.error().message;
+    if (auto r = target_.query->apply(in::InjectDeep{signal, samples}); !r) return r.error().message;
     const std::string when = now_text();
     done(out, c, Json().str("signal", signal).integer("samples", static_cast<long long>(samples.size())),
          "wrote " + count_text(samples.size()) + " into signal " + signal +

@@ -18,6 +18,7 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/query.hpp"
+#include "safecass/introspect/sample_text.hpp"
 #include "safecass/json/write.hpp"
 
 namespace safecass::tools::console {
@@ -28,6 +29,10 @@ std::string_view trim(std::string_view s);
 // Tables and JSON: the read model's one formatter and JSON writer (numbers and times:
 // safecass/core/text.hpp, found in the enclosing namespace).
 using introspect::columns;
+using introspect::parse_number;
+using introspect::parse_sample;
+using introspect::parse_sample_file;
+using introspect::parse_samples;
 using Json = json::JsonObject;
 inline std::string json_string(std::string_view s) { return json::json_string(s); }
 inline std::string json_list(const std::vector<std::string>& items) { return json::json_string_array(items); }
@@ -37,21 +42,8 @@ inline std::string json_list(const std::vector<std::string>& items) { return jso
 /// Splits a command line into words: blanks separate words, `[...]` is one word (a vector sample),
 /// and '...' or "..." quote a word (the quotes are removed). Errors: an unterminated bracket or quote.
 [[nodiscard]] Expected<std::vector<std::string>> tokenize(std::string_view line);
-std::optional<double> parse_number(std::string_view s);
-/// The values of injected samples: numbers separated by commas and/or blanks. Errors name the
-/// offending text: not a number, or not finite (`nan`, `inf`, `-inf`: injected values must be
-/// finite, the rule of every injection path, docs/filters.md).
-[[nodiscard]] Expected<std::vector<double>> parse_numbers(std::string_view text);
-/// A sample: `1.5` (scalar) or `[1,2,3]` / `[1 2 3]` (vector) of finite numbers.
-[[nodiscard]] Expected<std::vector<double>> parse_sample(std::string_view word);
-/// Every word as a sample. Errors: the first word that is not one.
-[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_samples(const std::vector<std::string>& words);
 /// A whole number above 0.
 std::optional<long> parse_count(std::string_view s);
-/// The samples of a `filter dinload` file: one per line, numbers separated by spaces or commas,
-/// '#' starts a comment. Errors: "FILE:LINE: what", or "FILE: no samples".
-[[nodiscard]] Expected<std::vector<std::vector<double>>> parse_sample_file(const std::string& file,
-                                                                           std::string_view text);
 /// "1 sample", "3 samples".
 std::string count_text(std::size_t n);
 

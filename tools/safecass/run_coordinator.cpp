@@ -52,6 +52,7 @@ void say(const std::string& line) {
 struct Driver {
   Coordinator& co;
   Monitor& monitor;
+  const spec::SystemSpec& system;
   const spec::Scenario& scenario;
   Time start;
   int failures = 0;
@@ -87,46 +88,42 @@ struct Driver {
     return "no condition of " + address + " at its level has root cause " + expected;
   }
 
+  /// Whether `action` belongs to this process: its signal, filter or machine is one of ours (the
+  /// others belong to another coordinator's process).
+  bool applies_here(const introspect::Action& action) const {
+    return std::visit(
+        [&](const auto& x) {
+          using X = std::decay_t<decltype(x)>;
+          if constexpr (std::is_same_v<X, introspect::GenerateEvent> || std::is_same_v<X, introspect::ResetState>) {
+            return local_machine(x.target);
+          } else if constexpr (std::is_same_v<X, introspect::BroadcastEvent>) {
+            return true;
+          } else if constexpr (std::is_same_v<X, introspect::InjectShallow>) {
+            return monitor.find_filter(x.filter) != nullptr;
+          } else {  // PushSample, InjectDeep
+            return monitor.signals().find(x.signal) != nullptr;
+          }
+        },
+        action);
+  }
+
   void run_step(const spec::ScenarioStep& s) {
     const Time now = co.clock().now();
-    const spec::StepAction* a = s.action.get();  // null for a sample step
     switch (s.kind) {
-      case spec::ScenarioStep::Kind::Sample:
-        for (const auto& [name, values] : s.samples) {
-          if (Signal* signal = monitor.signals().find(name)) signal->push(now, values.data());
-        }
-        break;
       case spec::ScenarioStep::Kind::Ramp: break;  // handled by the ramp thread
+      case spec::ScenarioStep::Kind::Sample:
       case spec::ScenarioStep::Kind::Generate:
-        if (local_machine(a->target)) {
-          if (inputs != nullptr) inputs->generate(a->event, a->target);
-          if (auto r = co.generate(a->event, a->target); !r) say("scenario: generate: " + r.error().message);
-        }
-        break;
       case spec::ScenarioStep::Kind::Inject:
-        if (!a->deep) {
-          if (monitor.find_filter(a->filter) != nullptr) {
-            if (inputs != nullptr) inputs->inject_shallow(a->filter, a->values);
-            (void)monitor.inject_shallow(a->filter, a->values);
-          }
-        } else {
-          std::string signal = a->signal;
-          if (!a->filter.empty() && monitor.find_filter(a->filter) != nullptr)
-            signal = monitor.find_filter(a->filter)->inputs()[0]->name();
-          if (monitor.signals().find(signal) != nullptr) {
-            if (inputs != nullptr) inputs->inject_deep(signal, a->values);
-            (void)monitor.inject_deep(signal, a->values, now);
-          }
-        }
-        break;
       case spec::ScenarioStep::Kind::Reset:
-        if (local_machine(a->target)) {
-          if (inputs != nullptr) inputs->reset(a->target, "scenario", a->reason);
-          (void)co.reset(a->target, "scenario", a->reason);
+        for (const introspect::Action& action : runner::step_actions(s, monitor, system)) {
+          if (!applies_here(action)) continue;
+          if (auto r = introspect::apply(action, co, monitor, now, inputs); !r) {
+            say("scenario: " + std::string(introspect::action_name(action)) + ": " + r.error().message);
+          }
         }
         break;
       default: {
-        for (const auto& [address, expected] : a->expectations) {
+        for (const auto& [address, expected] : s.action->expectations) {
           if (!local_machine(address)) continue;
           std::string failure = check(s, address, expected);
           for (int i = 0; !failure.empty() && i < 20; ++i) {
@@ -271,7 +268,6 @@ struct BusPart {
   std::string token_path;
   std::unique_ptr<middleware::TokenFile> token_file;  ///< held (locked) until the process ends
   std::unique_ptr<middleware::TokenFile> read_token_file;
-  std::unique_ptr<RecordedActions> recorded_writes;  ///< the console's and viewer's writes, recorded
   std::unique_ptr<middleware::CoordinatorNode> node;
 };
 
@@ -321,10 +317,7 @@ bool join_bus(const RunArgs& args, native::System& built, const FilterRegistry& 
   if (!args.listen.empty()) options.listen_host = args.listen;
   options.lost_after = std::chrono::milliseconds(std::max(0, args.lost_after_ms));
   options.log = [](const std::string& line) { say(line); };
-  if (inputs != nullptr) {
-    bus.recorded_writes = std::make_unique<RecordedActions>(*inputs);
-    options.clock.actions = bus.recorded_writes.get();
-  }
+  options.clock.actions = inputs;  // the console's and viewer's writes, recorded (with --record)
   auto created = middleware::CoordinatorNode::create(built.coordinator(), built.monitor(), registry, built.spec(),
                                                      args.coordinator, options);
   if (!created) {
@@ -423,7 +416,7 @@ int run_coordinator(const RunArgs& args) {
   std::thread driver;
   std::unique_ptr<Driver> d;
   if (scenario) {
-    d = std::make_unique<Driver>(Driver{co, monitor, *scenario, start});
+    d = std::make_unique<Driver>(Driver{co, monitor, system, *scenario, start});
     d->inputs = inputs.get();
     driver = std::thread([&] { d->run(g_stop); });
   }

@@ -723,7 +723,8 @@ public:
     Expected<void> local =
         op.reset ? reference_.co->reset(op.target, "chaos", "burst") : reference_.co->generate(op.event, op.target);
     Expected<void> remote =
-        op.reset ? robot_client_->reset(op.target, "chaos", "burst") : robot_client_->generate(op.event, op.target);
+        robot_client_->apply(op.reset ? introspect::Action(introspect::ResetState{op.target, "chaos", "burst"})
+                                      : introspect::Action(introspect::GenerateEvent{op.event, op.target}));
     if (local.has_value() != remote.has_value()) {
       return op.text() + ": in-process " + (local ? "accepted" : "refused (" + local.error().message + ")") +
              ", robot " + (remote ? "accepted" : "refused (" + remote.error().message + ")");

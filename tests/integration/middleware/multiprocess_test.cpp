@@ -44,6 +44,7 @@ namespace safecass {
 namespace {
 
 using namespace std::chrono_literals;
+namespace in = introspect;
 
 std::string env(const char* name) {
   const char* v = std::getenv(name);
@@ -227,7 +228,7 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
     return state_of(*ui, "PENDANT") == State::Normal && state_of(*robot, "CONTROL") == State::Normal;
   })) << sys.logs();
 
-  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A")) << sys.logs();
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"})) << sys.logs();
   ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Error; })) << sys.logs();
   EXPECT_EQ(state_of(*ui, "PENDANT.s_R.Status"), State::Error);
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error);
@@ -242,7 +243,7 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
             std::string::npos)
       << expected;
 
-  ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A"));
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_FORCE_ERROR", "JR3.s_A"}));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
   EXPECT_TRUE(ui->explain("PENDANT")->conditions.empty());
 }
@@ -306,10 +307,10 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   for (int step = 0; step < 40; ++step) {
     const Op op = ops[random() % ops.size()];
     if (std::string(op.event) == "reset") {
-      ASSERT_TRUE(robot->reset(op.target, "audit test", "step " + std::to_string(step))) << sys.logs();
+      ASSERT_TRUE(robot->apply(in::ResetState{op.target, "audit test", "step " + std::to_string(step)})) << sys.logs();
       ASSERT_TRUE(reference.reset(op.target, "audit test", "step " + std::to_string(step)));
     } else {
-      ASSERT_TRUE(robot->generate(op.event, op.target)) << sys.logs();
+      ASSERT_TRUE(robot->apply(in::GenerateEvent{op.event, op.target})) << sys.logs();
       ASSERT_TRUE(reference.generate(op.event, op.target));
     }
     clock.advance(std::chrono::milliseconds(10));
@@ -435,23 +436,23 @@ TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {
   ASSERT_TRUE(anonymous && wrong && ui && robot) << sys.logs();
 
   for (auto* c : {anonymous.get(), wrong.get()}) {
-    auto r = c->generate("EVT_FORCE_ERROR", "JR3.s_A");
+    auto r = c->apply(in::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"});
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().code, ErrorCode::Denied) << r.error().message;
-    EXPECT_FALSE(c->reset("SYSTEM", "test", "no token"));
-    EXPECT_FALSE(c->inject("force_limit", {{50.0}}));
+    EXPECT_FALSE(c->apply(in::ResetState{"SYSTEM", "test", "no token"}));
+    EXPECT_FALSE(c->apply(in::InjectShallow{"force_limit", {{50.0}}}));
   }
-  auto read_only = ui->generate("EVT_TRACKING_ERROR", "PENDANT.s_R.Status");
+  auto read_only = ui->apply(in::GenerateEvent{"EVT_TRACKING_ERROR", "PENDANT.s_R.Status"});
   ASSERT_FALSE(read_only);
   EXPECT_NE(read_only.error().message.find("read-only"), std::string::npos) << read_only.error().message;
   EXPECT_EQ(state_of(*robot, "JR3"), State::Normal) << "refused writes changed nothing";
 
-  auto bad = robot->generate("EVT_NO_SUCH_EVENT", "JR3.s_A");
+  auto bad = robot->apply(in::GenerateEvent{"EVT_NO_SUCH_EVENT", "JR3.s_A"});
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().code, ErrorCode::NotFound);
-  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A"));
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"}));
   EXPECT_EQ(state_of(*robot, "JR3.s_A"), State::Error);
-  ASSERT_TRUE(robot->reset("JR3", "test", "operator reset"));
+  ASSERT_TRUE(robot->apply(in::ResetState{"JR3", "test", "operator reset"}));
   EXPECT_EQ(state_of(*robot, "JR3.s_A"), State::Normal);
   // Reads work for everyone.
   EXPECT_TRUE(anonymous->state_list());
@@ -550,15 +551,16 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   auto robot = sys.client("robot", *token);
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
-  ASSERT_TRUE(robot->generate("EVT_FORCE_ERROR", "JR3.s_A"));
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"}));
   ASSERT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Error; })) << sys.logs();
 
   ::kill(icestorm, SIGKILL);
   ::waitpid(icestorm, nullptr, 0);
   icestorm = -1;
   // IceStorm is down: each process keeps detecting and propagating locally.
-  ASSERT_TRUE(robot->generate("/EVT_FORCE_ERROR", "JR3.s_A")) << "remote operations do not go through IceStorm";
-  ASSERT_TRUE(robot->generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_FORCE_ERROR", "JR3.s_A"}))
+      << "remote operations do not go through IceStorm";
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}));
   EXPECT_EQ(state_of(*robot, "JR3"), State::Normal);
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error) << "local propagation does not wait for the network";
   std::this_thread::sleep_for(300ms);
@@ -578,7 +580,7 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
       << causes(ui->explain("PENDANT")->conditions) << sys.logs();
   EXPECT_NE(sys.ui->output().find("connected to IceStorm"), std::string::npos);
 
-  ASSERT_TRUE(robot->generate("/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"));
+  ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << "propagation works again\n"
                                                                                      << sys.logs();
 }

@@ -58,7 +58,29 @@ protected:
   Signal* v_;
 };
 
-/// Everything a reader yields, as text: "S C.x 0.5 [1]", "A 3 BMM scenario why", "L 0 2", "E 2".
+/// An action's texts and sample count: "EVT_X|C.s_A||0".
+std::string action_fields(const introspect::Action& action) {
+  return std::visit(
+      [](const auto& a) -> std::string {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, introspect::GenerateEvent>) {
+          return a.event + "|" + a.target + "||0";
+        } else if constexpr (std::is_same_v<A, introspect::BroadcastEvent>) {
+          return a.event + "|||0";
+        } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
+          return a.target + "|" + a.who + "|" + a.why + "|0";
+        } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
+          return a.filter + "|||" + std::to_string(a.samples.size());
+        } else if constexpr (std::is_same_v<A, introspect::InjectDeep>) {
+          return a.signal + "|||" + std::to_string(a.samples.size());
+        } else {
+          return a.signal + " (a sample: never an action record)";
+        }
+      },
+      action);
+}
+
+/// Everything a reader yields, as text: "S C.x 0.5 [1]", "A reset 2 BMM|scenario|why|0", "L 0 2", "E 2".
 std::string read_all(const std::string& path, std::string* error = nullptr, bool* truncated = nullptr) {
   auto r = InputLogReader::open(path);
   if (!r) {
@@ -79,10 +101,9 @@ std::string read_all(const std::string& path, std::string* error = nullptr, bool
         break;
       }
       case InputLogReader::Item::Action: {
-        const InputAction& a = (*r)->action();
-        std::snprintf(buf, sizeof buf, "A %d %g %s|%s|%s|%zu\n", static_cast<int>(a.kind), to_seconds(a.time),
-                      a.a.c_str(), a.b.c_str(), a.c.c_str(), a.values.size());
-        out += buf;
+        std::snprintf(buf, sizeof buf, "A %s %g ", std::string(introspect::action_name((*r)->action())).c_str(),
+                      to_seconds((*r)->mark_time()));
+        out += buf + action_fields((*r)->action()) + "\n";
         break;
       }
       case InputLogReader::Item::Loss:
@@ -115,9 +136,11 @@ TEST_F(InputRecording, EverySampleOfAnInputSignalAndEveryActionReadsBackInOrderW
   (*rec)->drain();
   at(0.001);
   x_->push(seconds_to_time(0.001), 2.5);
-  (*rec)->generate("EVT_X", "C.s_A");  // drains first: the sample comes before the action
-  (*rec)->reset("C", "scenario", "why not");
-  (*rec)->inject_shallow("f", {{1.0}, {2.0}});
+  const Time t = seconds_to_time(0.001);
+  (*rec)->applied(introspect::GenerateEvent{"EVT_X", "C.s_A"}, t);  // drains first: the sample comes before it
+  (*rec)->applied(introspect::PushSample{"C.x", {9.0}}, t);         // a sample is read from its signal, not here
+  (*rec)->applied(introspect::ResetState{"C", "scenario", "why not"}, t);
+  (*rec)->applied(introspect::InjectShallow{"f", {{1.0}, {2.0}}}, t);
   (*rec)->close(seconds_to_time(0.002));
 
   std::string error;
@@ -125,9 +148,9 @@ TEST_F(InputRecording, EverySampleOfAnInputSignalAndEveryActionReadsBackInOrderW
             "S C.x 0 [1.500000]\n"
             "S C.v 0 [1.000000 2.000000 3.000000]\n"
             "S C.x 0.001 [2.500000]\n"
-            "A 1 0.001 EVT_X|C.s_A||0\n"
-            "A 3 0.001 C|scenario|why not|0\n"
-            "A 4 0.001 f|||2\n"
+            "A generate 0.001 EVT_X|C.s_A||0\n"
+            "A reset 0.001 C|scenario|why not|0\n"
+            "A inject 0.001 f|||2\n"
             "E 0.002\n");
   EXPECT_EQ(error, "");
   const InputRecordStatus s = (*rec)->status();
@@ -157,7 +180,7 @@ TEST_F(InputRecording, AFileCutAtAnyByteIsReadUpToItsLastWholeRecordAndSaysItWas
   for (int i = 0; i < 20; ++i) {
     at(i * 0.001);
     x_->push(seconds_to_time(i * 0.001), i);
-    if (i % 7 == 0) (*rec)->generate("EVT_X", "C.s_A");
+    if (i % 7 == 0) (*rec)->applied(introspect::GenerateEvent{"EVT_X", "C.s_A"}, seconds_to_time(i * 0.001));
     (*rec)->drain();
   }
   (*rec)->close(seconds_to_time(0.02));

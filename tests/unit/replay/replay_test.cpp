@@ -154,18 +154,12 @@ TEST(ReplayRecording, TheRecordingOfARunReplaysToTheSameTransitionsAndTheSameHis
 /// Counts what a LocalQuery tells its observer.
 struct CountedWrites final : introspect::ActionObserver {
   std::vector<std::string> told;
-  void generated(std::string_view e, std::string_view t) override {
-    told.push_back("generate " + std::string(e) + " " + std::string(t));
-  }
-  void broadcast(std::string_view e) override { told.push_back("broadcast " + std::string(e)); }
-  void injected(std::string_view f, const std::vector<std::vector<double>>&) override {
-    told.push_back("inject " + std::string(f));
-  }
-  void injected_deep(std::string_view s, const std::vector<std::vector<double>>&) override {
-    told.push_back("dinject " + std::string(s));
-  }
-  void reset(std::string_view t, std::string_view, std::string_view) override {
-    told.push_back("reset " + std::string(t));
+  void applied(const introspect::Action& a, Time) override {
+    const auto* target = std::get_if<introspect::GenerateEvent>(&a);
+    const auto* reset = std::get_if<introspect::ResetState>(&a);
+    told.push_back(std::string(introspect::action_name(a)) +
+                   (target != nullptr ? " " + target->event + " " + target->target : "") +
+                   (reset != nullptr ? " " + reset->target : ""));
   }
 };
 
@@ -178,12 +172,12 @@ TEST(ReadModelWrites, OnlyAWriteThatWasAppliedIsToldToTheActionObserver) {
   introspect::LocalOptions lo;
   lo.actions = &observer;
   introspect::LocalQuery query((*system)->coordinator(), (*system)->monitor(), registry, lo);
-  EXPECT_FALSE(query.generate("EVT_NO_SUCH_EVENT", "JR3.s_A").has_value());
-  EXPECT_FALSE(query.inject("no_such_filter", {{1.0}}).has_value());
-  EXPECT_FALSE(query.inject_deep("JR3.NoSuchSignal", {{1.0}}).has_value());
+  EXPECT_FALSE(query.apply(introspect::GenerateEvent{"EVT_NO_SUCH_EVENT", "JR3.s_A"}).has_value());
+  EXPECT_FALSE(query.apply(introspect::InjectShallow{"no_such_filter", {{1.0}}}).has_value());
+  EXPECT_FALSE(query.apply(introspect::InjectDeep{"JR3.NoSuchSignal", {{1.0}}}).has_value());
   EXPECT_TRUE(observer.told.empty()) << "refused writes were told: " << observer.told.size();
-  ASSERT_TRUE(query.generate("EVT_FORCE_ERROR", "JR3.s_A").has_value());
-  ASSERT_TRUE(query.reset("JR3.s_A", "operator", "cleared").has_value());
+  ASSERT_TRUE(query.apply(introspect::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"}).has_value());
+  ASSERT_TRUE(query.apply(introspect::ResetState{"JR3.s_A", "operator", "cleared"}).has_value());
   EXPECT_THAT(observer.told, ::testing::ElementsAre("generate EVT_FORCE_ERROR JR3.s_A", "reset JR3.s_A"));
 }
 
@@ -197,15 +191,14 @@ TEST(ReplayRecording, AnOperatorsWritesThroughTheReadModelAreRecordedAsActionsAn
     SimulatedClock& clock = *(*system)->simulated_clock();
     auto inputs = InputRecorder::open((*system)->monitor(), path);
     ASSERT_TRUE(inputs.has_value()) << inputs.error().message;
-    RecordedActions recorded(**inputs);
     introspect::LocalOptions lo;
-    lo.actions = &recorded;
+    lo.actions = inputs->get();
     introspect::LocalQuery query((*system)->coordinator(), (*system)->monitor(), registry, lo);
     clock.set(std::chrono::milliseconds(250));
-    ASSERT_TRUE(query.generate("EVT_FORCE_ERROR", "JR3.s_A").has_value());
-    EXPECT_FALSE(query.generate("EVT_NO_SUCH_EVENT", "JR3.s_A").has_value());  // refused: not recorded
+    ASSERT_TRUE(query.apply(introspect::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"}).has_value());
+    EXPECT_FALSE(query.apply(introspect::GenerateEvent{"EVT_NO_SUCH_EVENT", "JR3.s_A"}).has_value());  // not recorded
     clock.set(std::chrono::milliseconds(500));
-    ASSERT_TRUE(query.generate("/EVT_FORCE_ERROR", "JR3.s_A").has_value());
+    ASSERT_TRUE(query.apply(introspect::GenerateEvent{"/EVT_FORCE_ERROR", "JR3.s_A"}).has_value());
     (*inputs)->close(std::chrono::milliseconds(600));
     EXPECT_EQ((*inputs)->status().actions, 2u);
   }
@@ -214,6 +207,30 @@ TEST(ReplayRecording, AnOperatorsWritesThroughTheReadModelAreRecordedAsActionsAn
   EXPECT_THAT(r.out, HasSubstr("t=0.250000  JR3.s_A  Normal -> Error  EVT_FORCE_ERROR"));
   EXPECT_THAT(r.out, HasSubstr("t=0.500000  JR3.s_A  Error -> Normal  /EVT_FORCE_ERROR"));
   EXPECT_THAT(r.err, HasSubstr("2 actions"));
+}
+
+TEST(ReplayRecording, AScenariosResetOfACoordinatorIsRecordedAsResetsOfItsComponentsAndReplays) {
+  // A coordinator of the system file ("robot") is not an address of the in-process coordinator:
+  // the runner applies (and records) a reset of each of its components, which a replay applies.
+  const std::string scenario = scratch("reset-robot.json");
+  std::ofstream(scenario)
+      << "{ \"system\": \"" << kRobodoc << "robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
+      << "  \"steps\": [\n"
+      << "    { \"at\": 0.001, \"generate\": { \"event\": \"EVT_FORCE_ERROR\", \"target\": \"JR3.s_A\" } },\n"
+      << "    { \"at\": 0.005, \"reset\": { \"target\": \"robot\", \"reason\": \"operator\" } } ] }\n";
+  const std::string inputs = scratch("reset-robot.inputs");
+  runner::RunOptions ro;
+  ro.quiet = true;
+  ro.inputs_path = inputs;
+  runner::RunResult result;
+  ASSERT_EQ(runner::run_scenario_file(scenario, builtin_filters(), ro, &result), 0);
+  ASSERT_TRUE(result.inputs.has_value());
+  EXPECT_EQ(result.inputs->actions, 5u) << "the generate and one reset of each of robot's 4 components";
+  const Ran r = replay(options(kRobodoc + "robodoc.json", inputs));
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("t=0.001000  JR3.s_A  Normal -> Error  EVT_FORCE_ERROR"));
+  EXPECT_THAT(r.out, HasSubstr("t=0.005000  JR3.s_A  Error -> Normal"));
+  EXPECT_THAT(r.err, HasSubstr("5 actions"));
 }
 
 TEST(ReplayCsv, ALogThatCannotBeReadIsAnIoErrorWithThePathAndReason) {

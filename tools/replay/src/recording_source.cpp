@@ -33,7 +33,7 @@ public:
         }
         case InputLogReader::Item::Action:
           item.kind = InputItem::Kind::Action;
-          item.time = reader_->action().time;
+          item.time = reader_->mark_time();
           item.action = &reader_->action();
           return item;
         case InputLogReader::Item::Loss: lost_ += reader_->lost(); continue;

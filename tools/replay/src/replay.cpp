@@ -120,78 +120,10 @@ std::unique_ptr<ScenarioRunner> open_system(const std::string& path, std::option
   return std::move(*opened);
 }
 
-std::string check_values(const std::string& what, std::size_t width, const std::vector<std::vector<double>>& values) {
-  for (std::size_t i = 0; i < values.size(); ++i) {
-    if (values[i].size() != width) {
-      return what + ": sample " + std::to_string(i + 1) + " has " + std::to_string(values[i].size()) + " values, " +
-             std::to_string(width) + " expected";
-    }
-    for (double v : values[i]) {
-      if (!std::isfinite(v)) return what + ": an injected value is not a finite number";
-    }
-  }
-  return {};
-}
-
-/// Why `a` cannot be applied to the system, or "".
-std::string check_action(ScenarioRunner& r, const InputAction& a) {
-  Coordinator& co = r.coordinator();
-  Monitor& m = r.monitor();
-  switch (a.kind) {
-    case InputActionKind::Generate:
-    case InputActionKind::Broadcast: {
-      auto e = co.find_event(a.a);
-      if (!e) return e.error().message;
-      if (a.kind == InputActionKind::Broadcast || co.event(*e).is_broadcast()) return {};
-      if (auto t = co.find_machine(a.b); !t) return t.error().message;
-      return {};
-    }
-    case InputActionKind::Reset: {
-      auto t = co.resolve(a.a);
-      if (!t) return t.error().message;
-      if (t->kind == Address::Kind::Service) return "cannot reset service state '" + a.a + "': it is derived";
-      return {};
-    }
-    case InputActionKind::InjectShallow: {
-      Filter* f = m.find_filter(a.a);
-      if (f == nullptr) return "no filter '" + a.a + "'";
-      if (f->inputs().empty()) return "filter '" + a.a + "' has no input";
-      return check_values("shallow injection into filter " + a.a, f->inputs()[0]->size(), a.values);
-    }
-    case InputActionKind::InjectDeep: {
-      const Signal* s = m.signals().find(a.a);
-      if (s == nullptr) return "no signal '" + a.a + "'";
-      return check_values("deep injection into signal " + a.a, s->size(), a.values);
-    }
-  }
-  return "unknown action";
-}
-
-/// Applies `a` as the scenario runner applies the same step, recording it when the runner records inputs.
-void apply_action(ScenarioRunner& r, const InputAction& a, Time now) {
-  InputRecorder* rec = r.input_recorder();
-  switch (a.kind) {
-    case InputActionKind::Generate:
-      if (rec != nullptr) rec->generate(a.a, a.b);
-      (void)r.coordinator().generate(a.a, a.b);
-      break;
-    case InputActionKind::Broadcast:
-      if (rec != nullptr) rec->broadcast(a.a);
-      (void)r.coordinator().broadcast(a.a);
-      break;
-    case InputActionKind::Reset:
-      if (rec != nullptr) rec->reset(a.a, a.b, a.c);
-      (void)r.coordinator().reset(a.a, a.b, a.c);
-      break;
-    case InputActionKind::InjectShallow:
-      if (rec != nullptr) rec->inject_shallow(a.a, a.values);
-      (void)r.monitor().inject_shallow(a.a, a.values);
-      break;
-    case InputActionKind::InjectDeep:
-      if (rec != nullptr) rec->inject_deep(a.a, a.values);
-      (void)r.monitor().inject_deep(a.a, a.values, now);
-      break;
-  }
+/// Applies `a` to the runner's system as every tool does (introspect::apply), recorded by the
+/// runner's input recorder when it has one.
+void apply_action(ScenarioRunner& r, const introspect::Action& a, Time now) {
+  (void)introspect::apply(a, r.coordinator(), r.monitor(), now, r.input_recorder());  // checked by check_log
 }
 
 struct Window {
@@ -216,8 +148,9 @@ bool check_log(InputSource& src, ScenarioRunner& r, const Window& w, LogSpan& sp
       case InputItem::Kind::End: span.end = src.end(); return true;
       case InputItem::Kind::Error: std::fprintf(err, "%s\n", src.error().c_str()); return false;
       case InputItem::Kind::Action:
-        if (const std::string why = check_action(r, *item.action); !why.empty()) {
-          std::fprintf(err, "%s: action at t=%s: %s\n", src.where().c_str(), secs(item.time).c_str(), why.c_str());
+        if (auto ok = introspect::check(*item.action, r.coordinator(), r.monitor()); !ok) {
+          std::fprintf(err, "%s: action at t=%s: %s\n", src.where().c_str(), secs(item.time).c_str(),
+                       ok.error().message.c_str());
           return false;
         }
         [[fallthrough]];

@@ -280,42 +280,53 @@ Diagnostics ScenarioRunner::check_names() {
   return out;
 }
 
-void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
-  const spec::StepAction* action = s.action.get();  // null for a sample step
-  InputRecorder* inputs = inputs_.get();            // records each action as it is applied (samples: drained)
+std::vector<introspect::Action> step_actions(const spec::ScenarioStep& s, const Monitor& monitor,
+                                             const spec::SystemSpec& system) {
+  std::vector<introspect::Action> out;
+  const spec::StepAction* a = s.action.get();  // null for a sample step
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Sample:
-      for (const auto& [name, values] : s.samples) monitor_->signals().find(name)->push(now, values.data());
+      for (const auto& [name, values] : s.samples) {
+        out.emplace_back(introspect::PushSample{std::string(name), values.to_vector()});
+      }
       break;
-    case spec::ScenarioStep::Kind::Ramp:
-      ramps_.push_back(Ramp{monitor_->signals().find(action->signal), now, seconds_to_time(action->until), action->from,
-                            action->to});
-      break;
-    case spec::ScenarioStep::Kind::Generate:
-      if (inputs != nullptr) inputs->generate(action->event, action->target);
-      (void)coordinator_.generate(action->event, action->target);
-      break;
+    case spec::ScenarioStep::Kind::Generate: out.emplace_back(introspect::GenerateEvent{a->event, a->target}); break;
     case spec::ScenarioStep::Kind::Inject:
-      if (!action->deep) {
-        if (inputs != nullptr) inputs->inject_shallow(action->filter, action->values);
-        (void)monitor_->inject_shallow(action->filter, action->values);
+      if (!a->deep) {
+        out.emplace_back(introspect::InjectShallow{a->filter, a->values});
       } else {
-        const std::string signal =
-            action->filter.empty() ? action->signal : monitor_->find_filter(action->filter)->inputs()[0]->name();
-        if (inputs != nullptr) inputs->inject_deep(signal, action->values);
-        (void)monitor_->inject_deep(signal, action->values, now);
+        std::string signal = a->signal;
+        if (const Filter* f = a->filter.empty() ? nullptr : monitor.find_filter(a->filter);
+            f != nullptr && !f->inputs().empty()) {
+          signal = f->inputs()[0]->name();
+        }
+        out.emplace_back(introspect::InjectDeep{std::move(signal), a->values});
       }
       break;
-    case spec::ScenarioStep::Kind::Reset:
-      if (inputs != nullptr) inputs->reset(action->target, "scenario", action->reason);
-      if (const auto* components = coordinator_components(action->target)) {
-        // A coordinator of the system: each of its components, as that coordinator's reset does.
-        for (const std::string& c : *components) (void)coordinator_.reset(c, "scenario", action->reason);
+    case spec::ScenarioStep::Kind::Reset: {
+      const auto group = std::find_if(system.coordinators.begin(), system.coordinators.end(),
+                                      [&](const auto& c) { return c.first == a->target; });
+      if (group == system.coordinators.end()) {
+        out.emplace_back(introspect::ResetState{a->target, "scenario", a->reason});
       } else {
-        (void)coordinator_.reset(action->target, "scenario", action->reason);
+        for (const std::string& c : group->second) out.emplace_back(introspect::ResetState{c, "scenario", a->reason});
       }
       break;
+    }
     default: break;
+  }
+  return out;
+}
+
+void ScenarioRunner::apply(const spec::ScenarioStep& s, Time now) {
+  if (s.kind == spec::ScenarioStep::Kind::Ramp) {
+    const spec::StepAction& a = *s.action;
+    ramps_.push_back(Ramp{monitor_->signals().find(a.signal), now, seconds_to_time(a.until), a.from, a.to});
+    return;
+  }
+  // Checked when the runner was opened (check_names): an action refused here is a bug, not input.
+  for (const introspect::Action& action : step_actions(s, *monitor_, system_->spec())) {
+    (void)introspect::apply(action, coordinator_, *monitor_, now, inputs_.get());
   }
 }
 

@@ -158,12 +158,14 @@ Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view add
 }
 
 Expected<std::string> InProcessSource::generate(std::string_view event, std::string_view target) {
-  if (auto r = impl_->query->generate(event, target); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->apply(introspect::GenerateEvent{std::string(event), std::string(target)}); !r)
+    return tl::unexpected(r.error());
   return "generated " + std::string(event) + " on " + std::string(target) + " at t=" + seconds_text(impl_->now());
 }
 
 Expected<std::string> InProcessSource::broadcast(std::string_view event) {
-  if (auto r = impl_->query->broadcast(event); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->apply(introspect::BroadcastEvent{std::string(event)}); !r)
+    return tl::unexpected(r.error());
   return "broadcast " + std::string(event) + " at t=" + seconds_text(impl_->now());
 }
 
@@ -171,15 +173,18 @@ Expected<std::string> InProcessSource::inject(const InjectRequest& request) {
   if (request.samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
   const std::string n = std::to_string(request.samples.size()) + (request.samples.size() == 1 ? " sample" : " samples");
   if (!request.deep) {
-    if (auto r = impl_->query->inject(request.target, request.samples); !r) return tl::unexpected(r.error());
+    if (auto r = impl_->query->apply(introspect::InjectShallow{request.target, request.samples}); !r)
+      return tl::unexpected(r.error());
     return "queued " + n + " into filter " + request.target + " at t=" + seconds_text(impl_->now());
   }
-  if (auto r = impl_->query->inject_deep(request.target, request.samples); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->apply(introspect::InjectDeep{request.target, request.samples}); !r)
+    return tl::unexpected(r.error());
   return "wrote " + n + " into signal " + request.target + " at t=" + seconds_text(impl_->now());
 }
 
 Expected<std::string> InProcessSource::reset(std::string_view target, std::string_view reason) {
-  if (auto r = impl_->query->reset(target, "viewer", reason); !r) return tl::unexpected(r.error());
+  if (auto r = impl_->query->apply(introspect::ResetState{std::string(target), "viewer", std::string(reason)}); !r)
+    return tl::unexpected(r.error());
   return "reset " + std::string(target) + " at t=" + seconds_text(impl_->now()) + " (" + std::string(reason) + ")";
 }
 

@@ -460,7 +460,8 @@ Expected<std::vector<Explanation>> MiddlewareSource::explain(std::string_view ad
 Expected<std::string> MiddlewareSource::generate(std::string_view event, std::string_view target) {
   auto w = impl_->writer(target, "event generate");
   if (!w) return tl::unexpected(w.error());
-  if (auto r = w->second->generate(std::string(event), std::string(target)); !r) return tl::unexpected(r.error());
+  if (auto r = w->second->apply(introspect::GenerateEvent{std::string(event), std::string(target)}); !r)
+    return tl::unexpected(r.error());
   return "generated " + std::string(event) + " on " + std::string(target) + " (coordinator " + w->first->name +
          ") at " + wall_now();
 }
@@ -472,7 +473,8 @@ Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
   std::string failed;
   for (auto& l : impl_->links) {
     auto w = impl_->writer_of(*l);
-    auto r = w ? w->second->broadcast(std::string(event)) : Expected<void>(tl::unexpected(w.error()));
+    auto r = w ? w->second->apply(introspect::BroadcastEvent{std::string(event)})
+               : Expected<void>(tl::unexpected(w.error()));
     if (!r) {
       if (done.empty()) return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message);
       failed += "; not on " + l->name + ": " + r.error().message;
@@ -500,8 +502,8 @@ Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
   }
   auto w = impl_->writer_of(*owner);
   if (!w) return tl::unexpected(w.error());
-  auto r = request.deep ? w->second->inject_deep(request.target, request.samples)
-                        : w->second->inject(request.target, request.samples);
+  auto r = request.deep ? w->second->apply(introspect::InjectDeep{request.target, request.samples})
+                        : w->second->apply(introspect::InjectShallow{request.target, request.samples});
   if (!r) return tl::unexpected(r.error());
   return (request.deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + request.target +
          " (coordinator " + owner->name + ") at " + wall_now();
@@ -512,8 +514,8 @@ Expected<std::string> MiddlewareSource::reset(std::string_view target, std::stri
     std::string done;
     for (auto& l : impl_->links) {
       auto w = impl_->writer_of(*l);
-      auto r =
-          w ? w->second->reset("SYSTEM", "viewer", std::string(reason)) : Expected<void>(tl::unexpected(w.error()));
+      auto r = w ? w->second->apply(introspect::ResetState{"SYSTEM", "viewer", std::string(reason)})
+                 : Expected<void>(tl::unexpected(w.error()));
       if (!r)
         return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message +
                                         (done.empty() ? "" : " (reset done on " + done + ")"));
@@ -523,7 +525,7 @@ Expected<std::string> MiddlewareSource::reset(std::string_view target, std::stri
   }
   auto w = impl_->writer(target, "reset");
   if (!w) return tl::unexpected(w.error());
-  if (auto r = w->second->reset(std::string(target), "viewer", std::string(reason)); !r)
+  if (auto r = w->second->apply(introspect::ResetState{std::string(target), "viewer", std::string(reason)}); !r)
     return tl::unexpected(r.error());
   return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at " + wall_now() + " (" +
          std::string(reason) + ")";

@@ -623,4 +623,22 @@ private:
   std::unordered_map<std::string_view, NameId, NameHash, std::equal_to<>> name_index_;
 };
 
+// ---- the checks of the name-based writes -----------------------------------------------------
+// What Coordinator::generate/broadcast/reset (the name-based forms) would act on, or why they
+// would refuse, changing nothing: a caller that must check a whole batch before applying any of it
+// (a replay, introspect's Action) checks with these, and the writes themselves use them.
+
+/// The event and machine that generate(event, target) processes. A broadcast event ignores
+/// `target` (machine kNoMachine). Errors: as Coordinator::generate.
+struct GenerateTarget {
+  EventId event = kNoEvent;
+  MachineId machine = kNoMachine;
+};
+[[nodiscard]] Expected<GenerateTarget> resolve_generate(const Coordinator& co, std::string_view event,
+                                                        std::string_view target);
+/// The broadcast event broadcast(event) processes. Errors: NotFound, InvalidArgument (not a broadcast).
+[[nodiscard]] Expected<EventId> resolve_broadcast(const Coordinator& co, std::string_view event);
+/// The address reset(target, ...) clears. Errors: as resolve(), InvalidArgument (a service state).
+[[nodiscard]] Expected<Address> resolve_reset(const Coordinator& co, std::string_view target);
+
 }  // namespace safecass

@@ -124,8 +124,11 @@ public:
   /// seen by this filter alone. The end of the injection restores reality (DESIGN §3): the first
   /// run after the queue ran out judges the first input's newest real sample once, as a new
   /// sample, even when the signal has not changed since (a sensor that publishes only on change).
-  /// Errors: InvalidArgument when a sample's size is not the input's.
+  /// Errors: those of check_injection(); then nothing is queued.
   [[nodiscard]] Expected<void> inject(const std::vector<std::vector<double>>& samples);
+  /// Why inject(samples) would refuse, changing nothing: InvalidArgument when the filter has no
+  /// input or a sample's size is not the first input's.
+  [[nodiscard]] Expected<void> check_injection(const std::vector<std::vector<double>>& samples) const;
   /// Forgets internal state and the detection (no completion is sent: the machine is reset
   /// separately). Call from the thread that runs the filter.
   void reset() noexcept;

@@ -76,14 +76,23 @@ public:
   bool running() const noexcept { return thread_.joinable(); }
 
   /// Shallow injection into one filter (see Filter::inject); recorded on the observer stream.
-  /// Errors: NotFound (no such filter), InvalidArgument (a wrong size, or a NaN or infinite value:
-  /// injected values must be finite, docs/filters.md); then nothing is queued.
+  /// Errors: those of check_inject_shallow(); then nothing is queued.
   [[nodiscard]] Expected<void> inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& samples);
   /// Deep injection: `samples` written into the signal's history buffer at time `at`, marked as
-  /// injected; every consumer sees them; recorded on the observer stream. Errors: NotFound,
-  /// InvalidArgument (a wrong size, or a non-finite value); then nothing is written.
+  /// injected; every consumer sees them; recorded on the observer stream. Errors: those of
+  /// check_inject_deep(); then nothing is written.
   [[nodiscard]] Expected<void> inject_deep(std::string_view signal, const std::vector<std::vector<double>>& samples,
                                            Time at);
+  /// Why inject_shallow(filter, samples) would refuse, changing nothing: NotFound (no such filter),
+  /// InvalidArgument (no samples, a filter without input, a wrong size, or a NaN or infinite
+  /// value: injected values must be finite, docs/filters.md).
+  [[nodiscard]] Expected<void> check_inject_shallow(std::string_view filter,
+                                                    const std::vector<std::vector<double>>& samples) const;
+  /// Why inject_deep(signal, samples, ...) would refuse, changing nothing: NotFound (no such
+  /// signal), InvalidArgument (no samples, more than the signal's history holds, a wrong size, a
+  /// non-finite value).
+  [[nodiscard]] Expected<void> check_inject_deep(std::string_view signal,
+                                                 const std::vector<std::vector<double>>& samples) const;
 
   /// Resolves a signal name as a filter of `component` would: bare names belong to it.
   std::string qualify(std::string_view signal, std::string_view component) const;

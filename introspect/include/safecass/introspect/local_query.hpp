@@ -13,7 +13,7 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
-#include "safecass/introspect/action_observer.hpp"
+#include "safecass/introspect/action.hpp"
 #include "safecass/introspect/query.hpp"
 
 namespace safecass::introspect {
@@ -25,7 +25,7 @@ struct LocalOptions {
   double period = 0.0;                ///< Simulated: the tick, seconds
   std::string scenario;               ///< Simulated: the scenario file, if any
   double duration = 0.0;              ///< Simulated: the scenario's duration, seconds
-  ActionObserver* actions = nullptr;  ///< told of every applied write; must outlive the query
+  ActionObserver* actions = nullptr;  ///< told of every applied action; must outlive the query
 };
 
 class LocalQuery final : public SystemQuery {
@@ -48,13 +48,9 @@ public:
   [[nodiscard]] Expected<Names> names() override;
   [[nodiscard]] Expected<std::string> read(std::string_view name, const std::vector<std::string>& args) override;
   [[nodiscard]] Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) override;
-  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;
-  [[nodiscard]] Expected<void> broadcast(std::string_view event) override;
-  [[nodiscard]] Expected<void> inject(std::string_view filter,
-                                      const std::vector<std::vector<double>>& samples) override;
-  [[nodiscard]] Expected<void> inject_deep(std::string_view signal,
-                                           const std::vector<std::vector<double>>& samples) override;
-  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
+  /// Applies `action` at the coordinator's clock (Simulated: never before 0), then tells
+  /// LocalOptions::actions.
+  [[nodiscard]] Expected<void> apply(const Action& action) override;
 
   /// The rows of one component (its extended state, s_F, s_A, each s_P, s_R and s_S), in the
   /// order of state_list(). For tools that show a coordinator before it answers.

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "safecass/core/expected.hpp"
+#include "safecass/introspect/action.hpp"
 #include "safecass/introspect/model.hpp"
 
 namespace safecass::introspect {
@@ -79,16 +80,11 @@ public:
   [[nodiscard]] virtual Expected<std::unique_ptr<Subscription>> follow(RecordSink sink) = 0;
 
   // ---- writes (the caller checked its own write access; a remote system checks its token) -----
-  [[nodiscard]] virtual Expected<void> generate(std::string_view event, std::string_view target) = 0;
-  [[nodiscard]] virtual Expected<void> broadcast(std::string_view event) = 0;
-  /// Shallow: queued into one filter's private input. Errors: NotFound, InvalidArgument.
-  [[nodiscard]] virtual Expected<void> inject(std::string_view filter,
-                                              const std::vector<std::vector<double>>& samples) = 0;
-  /// Deep: written into the signal's history at the system's current time. Errors: NotFound,
-  /// InvalidArgument (more samples than the signal's history holds, not finite).
-  [[nodiscard]] virtual Expected<void> inject_deep(std::string_view signal,
-                                                   const std::vector<std::vector<double>>& samples) = 0;
-  [[nodiscard]] virtual Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) = 0;
+  /// Applies one action (action.hpp) with the system's current time: a deep injection is written
+  /// at it. Errors: those of check() (NotFound, InvalidArgument, InvalidState), then nothing
+  /// changed; a remote system also Io, Denied (the token) and InvalidArgument for an action the
+  /// bus does not carry (a sample: samples come from the system's own framework).
+  [[nodiscard]] virtual Expected<void> apply(const Action& action) = 0;
 };
 
 }  // namespace safecass::introspect

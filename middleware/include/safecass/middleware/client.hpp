@@ -10,7 +10,7 @@
 ///   if (!client) { print(client.error().message); return; }
 ///   auto states = (*client)->state_list("CONTROL");        // Expected<std::vector<introspect::StateRow>>
 ///   auto why = (*client)->explain("PENDANT");               // Expected<introspect::ExplainAnswer>
-///   auto done = (*client)->generate("EVT_FORCE_ERROR", "JR3.s_A");  // a write: needs the token
+///   auto done = (*client)->apply(introspect::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"});  // needs the token
 /// ```
 /// connect() finds the coordinator by listening to the heartbeats on IceStorm: one signed by that
 /// coordinator's key (the system's keyring) gives its Control endpoint, which must be on this host
@@ -91,16 +91,9 @@ public:
   [[nodiscard]] Expected<std::string> read(std::string_view name, const std::vector<std::string>& args) override;
   /// Errors: Io (IceStorm cannot be reached to subscribe).
   [[nodiscard]] Expected<std::unique_ptr<introspect::Subscription>> follow(introspect::RecordSink sink) override;
-  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target) override;
-  [[nodiscard]] Expected<void> broadcast(std::string_view event) override;
-  [[nodiscard]] Expected<void> inject(std::string_view filter,
-                                      const std::vector<std::vector<double>>& samples) override;
-  [[nodiscard]] Expected<void> inject_deep(std::string_view signal,
-                                           const std::vector<std::vector<double>>& samples) override;
-  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why) override;
-  /// `text`: one sample per line, numbers separated by spaces or commas ('#' comments), parsed by
-  /// the coordinator.
-  [[nodiscard]] Expected<void> filter_dinload(const std::string& signal, const std::string& text);
+  /// Sends a write to the coordinator's Control with the token (a sample: refused here, see
+  /// SystemQuery::apply).
+  [[nodiscard]] Expected<void> apply(const introspect::Action& action) override;
 
   /// Records refused on the events topic (unauthenticated, forged, replayed or malformed) since
   /// connect(), and gaps filled from the coordinator's history.

@@ -20,6 +20,7 @@
 
 #include "safecass/core/clock.hpp"
 #include "safecass/core/expected.hpp"
+#include "safecass/introspect/action.hpp"
 
 namespace safecass {
 
@@ -32,20 +33,14 @@ struct InputLogHeader {
   std::string system;               ///< the recorded system's name (informative)
 };
 
-/// The operator actions a recording holds; replayed through the same coordinator/monitor calls.
+/// The kinds of an action record: every introspect::Action but PushSample (samples are sample
+/// records). Values are the format's.
 enum class InputActionKind : std::uint8_t {
-  Generate = 1,       ///< a = event, b = target address
+  Generate = 1,       ///< text a = event, b = target address
   Broadcast = 2,      ///< a = event
   Reset = 3,          ///< a = target address, b = who, c = why
   InjectShallow = 4,  ///< a = filter, values
   InjectDeep = 5,     ///< a = signal, values
-};
-
-struct InputAction {
-  InputActionKind kind = InputActionKind::Generate;
-  Time time{};
-  std::string a, b, c;
-  std::vector<std::vector<double>> values;
 };
 
 /// Record tags (one byte each); the layouts are in docs/record-format.md.
@@ -75,7 +70,8 @@ inline void put_sample(std::string& out, std::uint16_t id, const double* values,
   // Little-endian doubles (the format's byte order; the build checks the host's).
   std::memcpy(p + 3, values, 8 * width);
 }
-void put_action(std::string& out, const InputAction& action);
+/// An action record at time `t`. A PushSample writes nothing: a sample is a sample record.
+void put_action(std::string& out, const introspect::Action& action, Time t);
 void put_loss(std::string& out, Time t, std::uint16_t id, std::uint64_t count);
 void put_end(std::string& out, Time t);
 }  // namespace input_log
@@ -85,7 +81,7 @@ class InputLogReader {
 public:
   enum class Item : std::uint8_t {
     Sample,  ///< signal(), time(), values()
-    Action,  ///< action()
+    Action,  ///< action(), at mark_time()
     Loss,    ///< the recorder lost samples here: mark_time(), loss_signal(), lost()
     End,     ///< the recorder closed cleanly; mark_time() is the run's last tick
     Eof,     ///< no more items (see truncated())
@@ -106,7 +102,8 @@ public:
   Time time() const noexcept { return time_; }
   const double* values() const noexcept { return values_; }
   std::size_t width() const noexcept { return widths_[signal_]; }
-  const InputAction& action() const noexcept { return action_; }
+  const introspect::Action& action() const noexcept { return action_; }
+  /// The time of the last Action, Loss or End item.
   Time mark_time() const noexcept { return mark_time_; }
   std::uint16_t loss_signal() const noexcept { return loss_signal_; }
   std::uint64_t lost() const noexcept { return lost_; }
@@ -151,7 +148,7 @@ private:
   bool have_time_ = false;
   const double* values_ = nullptr;
   std::vector<double> aligned_;
-  InputAction action_;
+  introspect::Action action_;
   std::uint16_t loss_signal_ = 0;
   std::uint64_t lost_ = 0;
   std::string error_;

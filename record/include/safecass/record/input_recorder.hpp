@@ -18,9 +18,11 @@
 /// the writing, not the system: it is kept and counted. With FileLimits::max_bytes the file
 /// rotates; every segment starts with the header and the signal declarations, so each replays alone.
 ///
-/// Actions are recorded by the code that applies them (the scenario runner, a replay, a live
-/// driver) through generate()/reset()/...; each first drains the samples pushed before it, so the
-/// recording keeps their order.
+/// Actions are recorded as an introspect::ActionObserver: whatever applies them through
+/// introspect::apply() (the scenario runner, a replay, a live coordinator's console and viewer
+/// writes and scenario) tells the recorder, once per applied action. Each first drains the samples
+/// pushed before it, so the recording keeps their order. A PushSample is not an action record: its
+/// sample is read from its signal like every other.
 ///
 /// Lifecycle: open() (configuration of the monitor finished) → drain()/actions/start_polling() →
 /// close() (drained, an end record, everything written; also done by the destructor).
@@ -38,7 +40,7 @@
 #include <vector>
 
 #include "safecass/filters/monitor.hpp"
-#include "safecass/introspect/action_observer.hpp"
+#include "safecass/introspect/action.hpp"
 #include "safecass/record/file_limits.hpp"
 #include "safecass/record/input_log.hpp"
 
@@ -79,13 +81,13 @@ struct InputRecorderOptions {
   std::vector<std::string> signals;
 };
 
-class InputRecorder {
+class InputRecorder final : public introspect::ActionObserver {
 public:
   /// Creates `path`, writes the header and declares the input signals of `monitor`. Errors: Io
   /// (with the path and the reason), InvalidArgument (more than 65534 input signals).
   [[nodiscard]] static Expected<std::unique_ptr<InputRecorder>> open(Monitor& monitor, const std::string& path,
                                                                      InputRecorderOptions options = {});
-  ~InputRecorder();
+  ~InputRecorder() override;
   InputRecorder(const InputRecorder&) = delete;
   InputRecorder& operator=(const InputRecorder&) = delete;
 
@@ -97,11 +99,8 @@ public:
   /// Calls drain() every `every` from a thread until close() (live systems).
   void start_polling(std::chrono::milliseconds every = std::chrono::milliseconds(10));
 
-  void generate(std::string_view event, std::string_view target);
-  void broadcast(std::string_view event);
-  void reset(std::string_view target, std::string_view who, std::string_view why);
-  void inject_shallow(std::string_view filter, const std::vector<std::vector<double>>& values);
-  void inject_deep(std::string_view signal, const std::vector<std::vector<double>>& values);
+  /// Records an applied action at `at` (after draining the samples pushed before it).
+  void applied(const introspect::Action& action, Time at) override;
 
   /// Drains, writes the end record with `end` (the last tick of a simulated run; default: the
   /// clock's now), writes everything queued and closes the file. Idempotent.
@@ -122,7 +121,6 @@ private:
   };
   InputRecorder(Monitor& monitor, std::unique_ptr<detail::SegmentedFile> file, InputRecorderOptions options);
   void drain_locked();
-  void action_locked(InputAction action);
   /// Moves the open chunk to the queue, or drops it when the queue is full (never the `last`).
   void seal_locked(bool last = false);
   void open_chunk_locked();
@@ -164,28 +162,6 @@ private:
   std::thread poller_;
   bool polling_stop_ = false;
   std::condition_variable poll_wake_;
-};
-
-/// The writes a LocalQuery applies (an operator's console or viewer, over the bus) recorded as
-/// actions next to the inputs, so that a replay applies them at the same times:
-/// `LocalOptions::actions = &recorded` (a live `safecass run --coordinator ... --record`).
-class RecordedActions final : public introspect::ActionObserver {
-public:
-  explicit RecordedActions(InputRecorder& inputs) : inputs_(inputs) {}
-  void generated(std::string_view event, std::string_view target) override { inputs_.generate(event, target); }
-  void broadcast(std::string_view event) override { inputs_.broadcast(event); }
-  void injected(std::string_view filter, const std::vector<std::vector<double>>& samples) override {
-    inputs_.inject_shallow(filter, samples);
-  }
-  void injected_deep(std::string_view signal, const std::vector<std::vector<double>>& samples) override {
-    inputs_.inject_deep(signal, samples);
-  }
-  void reset(std::string_view target, std::string_view who, std::string_view why) override {
-    inputs_.reset(target, who, why);
-  }
-
-private:
-  InputRecorder& inputs_;
 };
 
 }  // namespace safecass

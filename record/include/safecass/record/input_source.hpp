@@ -27,9 +27,9 @@ struct InputItem {
   enum class Kind : std::uint8_t { Sample, Action, End, Error };
   Kind kind = Kind::End;
   Time time{};
-  Signal* signal = nullptr;             ///< Sample: the bound signal
-  const double* values = nullptr;       ///< Sample: signal->size() values, valid until the next next()
-  const InputAction* action = nullptr;  ///< Action
+  Signal* signal = nullptr;                    ///< Sample: the bound signal
+  const double* values = nullptr;              ///< Sample: signal->size() values, valid until the next next()
+  const introspect::Action* action = nullptr;  ///< Action
 };
 
 class InputSource {

@@ -22,6 +22,7 @@
 
 #include "safecass/core/coordinator.hpp"
 #include "safecass/filters/monitor.hpp"
+#include "safecass/introspect/action.hpp"
 #include "safecass/native/runtime.hpp"
 #include "safecass/native/system.hpp"
 #include "safecass/record/input_recorder.hpp"
@@ -174,6 +175,14 @@ private:
   std::unique_ptr<InputRecorder> inputs_;
   Coordinator::SubscriptionId printer_ = 0;
 };
+
+/// The actions of one scenario step, as every driver of a scenario applies them through
+/// introspect::apply(): one PushSample per sample of a `sample` step, the `generate`, the `inject`
+/// (deep into a filter: into that filter's first input) and the `reset` (of a coordinator of the
+/// system file: of each of its components, docs/semantics.md §4.5), with who = "scenario". Empty
+/// for a ramp (its samples are pushed tick by tick) and for expectations.
+std::vector<introspect::Action> step_actions(const spec::ScenarioStep& step, const Monitor& monitor,
+                                             const spec::SystemSpec& system);
 
 /// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,
 /// 1 an expectation failed, 2 invalid input, or a history file (RunOptions::record_path) that is
