@@ -19,18 +19,18 @@ std::string to_string(const Explanation& e) {
   out += " (severity " + std::to_string(e.severity) + ")";
   if (e.mirror) {
     out += " <- ";
-    out += e.root_origin + ":" + e.root_event;
+    out += e.root.name();
   }
-  out += " since " + seconds_text(e.root_time) + " s";
+  out += " since " + seconds_text(e.root.time) + " s";
   if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
-  if (!e.filter.empty() || !e.signal.empty()) {
+  if (!e.root.filter.empty() || !e.root.signal.empty()) {
     out += " [";
-    if (!e.filter.empty()) out += "filter " + e.filter;
-    if (!e.signal.empty()) {
-      if (!e.filter.empty()) out += ", ";
-      out += e.signal + " = " + number_text(e.value) + " at " + seconds_text(e.sample_time) + " s";
+    if (!e.root.filter.empty()) out += "filter " + e.root.filter;
+    if (!e.root.signal.empty()) {
+      if (!e.root.filter.empty()) out += ", ";
+      out += e.root.signal + " = " + number_text(e.root.value) + " at " + seconds_text(e.root.sample_time) + " s";
     }
-    if (e.injected) out += ", injected";
+    if (e.root.injected) out += ", injected";
     out += "]";
   }
   if (e.path.size() > 1) {
@@ -106,17 +106,8 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
     e.count = c->count;
     e.first = c->first;
     e.last = c->last;
-    e.root_event = events_[to_index(c->root.event)].name;
-    e.root_origin = c->root.remote != kNone && c->root.remote < remote_roots_.size()
-                        ? remote_roots_[c->root.remote].origin
-                        : machines_[c->root.origin].address;
-    e.root_time = c->root.time;
+    e.root = resolve_root(c->root);
     e.hazard = events_[to_index(c->root.event)].hazard;
-    if (c->root.sample.filter != kNoName) e.filter = std::string(name_of(c->root.sample.filter));
-    if (c->root.sample.signal != kNoName) e.signal = std::string(name_of(c->root.sample.signal));
-    e.value = c->root.sample.value;
-    e.sample_time = c->root.sample.sample_time;
-    e.injected = c->root.sample.injected;
     e.path = hop_path(id, *c);
     out.push_back(std::move(e));
   }

@@ -48,12 +48,26 @@ bool Coordinator::is_remote(ComponentId id) const noexcept {
   return components_.contains(id) && components_[id].remote;
 }
 
-std::string Coordinator::root_origin(const RootCause& root) const {
-  Lock lock(*this);
-  if (root.remote_origin != kNoName) return std::string(name_of(root.remote_origin));
-  if (root.remote != kNone && root.remote < remote_roots_.size()) return remote_roots_[root.remote].origin;
-  if (machines_.contains(root.origin)) return machines_[root.origin].address;
-  return {};
+ResolvedRoot Coordinator::resolve_root(const RootCause& root) const {
+  ResolvedRoot r;
+  if (root.event == kNoEvent || to_index(root.event) >= events_.size()) return r;
+  r.event = events_[to_index(root.event)].name;
+  // A root from another process names its origin there (interned when it arrived), not the local
+  // stand-in it came through; the name is kept by value, so it outlives the root's remote slot.
+  if (root.remote_origin != kNoName) {
+    r.origin = std::string(name_of(root.remote_origin));
+  } else if (machines_.contains(root.origin)) {
+    r.origin = machines_[root.origin].address;
+  }
+  r.time = root.time;
+  if (root.sample.filter != kNoName) r.filter = std::string(name_of(root.sample.filter));
+  if (root.sample.signal != kNoName) {
+    r.signal = std::string(name_of(root.sample.signal));
+    r.value = root.sample.value;
+    r.sample_time = root.sample.sample_time;
+  }
+  r.injected = root.sample.injected;
+  return r;
 }
 
 Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std::vector<RemoteRoot>& roots) {
@@ -67,17 +81,18 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
   std::vector<EventId> ids;
   ids.reserve(roots.size());
   for (std::size_t i = 0; i < roots.size(); ++i) {
-    const RemoteRoot& r = roots[i];
+    const ResolvedRoot& r = roots[i].root;
     const std::string what =
         "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
     auto e = find_event(r.event);
     if (!e) return fail(ErrorCode::InvalidArgument, what + ": no event '" + r.event + "' in this system");
     if (!events_[to_index(*e)].is_onset)
       return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
-    if (r.level == State::Normal) return fail(ErrorCode::InvalidArgument, what + ": level Normal is not a condition");
+    if (roots[i].level == State::Normal)
+      return fail(ErrorCode::InvalidArgument, what + ": level Normal is not a condition");
     if (r.origin.empty()) return fail(ErrorCode::InvalidArgument, what + ": empty origin");
     for (std::size_t j = 0; j < i; ++j) {
-      if (roots[j].origin == r.origin && roots[j].event == r.event && roots[j].time == r.time) {
+      if (roots[j].root.origin == r.origin && roots[j].root.event == r.event && roots[j].root.time == r.time) {
         return fail(ErrorCode::InvalidArgument, what + ": reported twice");
       }
     }
@@ -85,11 +100,11 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
   }
   std::vector<SampleCause> samples(roots.size());
   for (std::size_t i = 0; i < roots.size(); ++i) {
-    if (!roots[i].filter.empty()) samples[i].filter = intern(roots[i].filter);
-    if (!roots[i].signal.empty()) samples[i].signal = intern(roots[i].signal);
-    samples[i].value = roots[i].value;
-    samples[i].sample_time = roots[i].sample_time;
-    samples[i].injected = roots[i].injected;
+    if (!roots[i].root.filter.empty()) samples[i].filter = intern(roots[i].root.filter);
+    if (!roots[i].root.signal.empty()) samples[i].signal = intern(roots[i].root.signal);
+    samples[i].value = roots[i].root.value;
+    samples[i].sample_time = roots[i].root.sample_time;
+    samples[i].injected = roots[i].root.injected;
   }
 
   Lock lock(*this);
@@ -114,7 +129,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
   }
   auto same = [&](const Condition& c, std::size_t i) {
     const RemoteRootData& d = remote_roots_[c.root.remote];
-    return c.root.event == ids[i] && c.root.time == roots[i].time && d.origin == roots[i].origin;
+    return c.root.event == ids[i] && c.root.time == roots[i].root.time && d.origin == roots[i].root.origin;
   };
 
   // Roots no longer reported: clear them and everything they reached.
@@ -128,7 +143,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     }
     if (match < roots.size()) {
       RemoteRootData& d = remote_roots_[c.root.remote];
-      d.path = roots[match].path.empty() ? std::vector<std::string>{roots[match].origin} : roots[match].path;
+      d.path = roots[match].path.empty() ? std::vector<std::string>{roots[match].root.origin} : roots[match].path;
       wanted[match] = false;  // already held
       ++result.kept;
       continue;
@@ -154,8 +169,8 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     }
     RemoteRootData& d = remote_roots_[slot];
     d.used = true;
-    d.origin = roots[i].origin;
-    d.path = roots[i].path.empty() ? std::vector<std::string>{roots[i].origin} : roots[i].path;
+    d.origin = roots[i].root.origin;
+    d.path = roots[i].path.empty() ? std::vector<std::string>{roots[i].root.origin} : roots[i].path;
     const EventId mirror_event =
         roots[i].level == State::Error ? framework_event::kServiceFailure : framework_event::kServiceDegraded;
     Condition c;
@@ -165,7 +180,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     c.mirror = true;
     c.first = c.last = now;
     c.seq = ++condition_seq_;
-    c.root = RootCause{ids[i], proxy, roots[i].time, samples[i], slot, intern(roots[i].origin)};
+    c.root = RootCause{ids[i], proxy, roots[i].root.time, samples[i], slot, intern(roots[i].root.origin)};
     add_condition(proxy, c, now);
     propagate_onset(c);
     ++result.added;
@@ -203,7 +218,8 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
       const bool remote = k->root.remote != kNone && k->root.remote < remote_roots_.size();
       const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin].address;
       std::size_t i = 0;
-      while (i < out.size() && !(ids[i] == k->root.event && out[i].time == k->root.time && out[i].origin == origin))
+      while (i < out.size() &&
+             !(ids[i] == k->root.event && out[i].root.time == k->root.time && out[i].root.origin == origin))
         ++i;
       if (i < out.size()) {
         std::vector<std::string> path = hop_path(id, *k);
@@ -211,15 +227,8 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
         continue;
       }
       RemoteRoot r;
-      r.event = events_[to_index(k->root.event)].name;
-      r.origin = origin;
-      r.time = k->root.time;
+      r.root = resolve_root(k->root);
       r.level = k->level;
-      if (k->root.sample.filter != kNoName) r.filter = std::string(name_of(k->root.sample.filter));
-      if (k->root.sample.signal != kNoName) r.signal = std::string(name_of(k->root.sample.signal));
-      r.value = k->root.sample.value;
-      r.sample_time = k->root.sample.sample_time;
-      r.injected = k->root.sample.injected;
       r.path = hop_path(id, *k);
       out.push_back(std::move(r));
       ids.push_back(k->root.event);

@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
     if (name == "SERVO" && r.to == State::Error) {
       // Why are the servos stopped? explain() gives each root cause and the path it took.
       for (const Explanation& e : co.explain(Address{Address::Kind::Component, r.component})) {
-        std::printf("           explain(SERVO): %s:%s via", e.root_origin.c_str(), e.root_event.c_str());
+        std::printf("           explain(SERVO): %s:%s via", e.root.origin.c_str(), e.root.event.c_str());
         for (const std::string& hop : e.path) std::printf(" %s%s", hop == e.path.front() ? "" : "-> ", hop.c_str());
         std::printf("\n");
       }

@@ -188,7 +188,7 @@ std::string history_text(const HistoryEntry& e, const TimeFormat& time) {
     case RecordKind::Injection: out += "  injection"; break;
   }
   if (e.root) {
-    const RootEntry& r = *e.root;
+    const ResolvedRoot& r = *e.root;
     if (!(r.origin == e.machine && r.event == e.event)) out += "  <- " + r.origin + ":" + r.event;
     if (!r.filter.empty() || !r.signal.empty()) {
       out += "  [";
@@ -213,7 +213,7 @@ std::string history_json(const HistoryEntry& e) {
   if (e.kind == RecordKind::Event) j.str("level", to_string(e.level)).integer("severity", e.severity);
   if (e.mirror) j.boolean("mirror", true);
   if (e.root) {
-    const RootEntry& r = *e.root;
+    const ResolvedRoot& r = *e.root;
     json::JsonObject root;
     root.str("event", r.event).str("origin", r.origin).seconds("t", r.time);
     if (!r.filter.empty()) root.str("filter", r.filter);
@@ -264,17 +264,17 @@ std::string live_state_line(std::string_view address, State state, std::string_v
 std::string explanation_text(const Explanation& e, const TimeFormat& time) {
   std::string out =
       e.machine + ": " + state_text(e.level) + " " + e.event + " (severity " + std::to_string(e.severity) + ")";
-  if (e.mirror) out += " <- " + e.root_origin + ":" + e.root_event;
-  out += " since " + time.stamp(e.root_time);
+  if (e.mirror) out += " <- " + e.root.name();
+  out += " since " + time.stamp(e.root.time);
   if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
-  if (!e.filter.empty() || !e.signal.empty()) {
+  if (!e.root.filter.empty() || !e.root.signal.empty()) {
     out += " [";
-    if (!e.filter.empty()) out += "filter " + e.filter;
-    if (!e.signal.empty()) {
-      if (!e.filter.empty()) out += ", ";
-      out += e.signal + " = " + short_number(e.value) + " at " + time.stamp(e.sample_time);
+    if (!e.root.filter.empty()) out += "filter " + e.root.filter;
+    if (!e.root.signal.empty()) {
+      if (!e.root.filter.empty()) out += ", ";
+      out += e.root.signal + " = " + short_number(e.root.value) + " at " + time.stamp(e.root.sample_time);
     }
-    if (e.injected) out += ", injected";
+    if (e.root.injected) out += ", injected";
     out += "]";
   }
   if (e.path.size() > 1) out += " path " + joined(e.path, " -> ");
@@ -293,13 +293,14 @@ std::string explanation_json(const std::string& address, const Explanation& e) {
       .integer("count", e.count)
       .num("first", to_seconds(e.first))
       .num("last", to_seconds(e.last))
-      .str("root_event", e.root_event)
-      .str("root_origin", e.root_origin)
-      .num("root_t", to_seconds(e.root_time))
+      .str("root_event", e.root.event)
+      .str("root_origin", e.root.origin)
+      .num("root_t", to_seconds(e.root.time))
       .opt("hazard", e.hazard);
-  if (!e.filter.empty()) j.str("filter", e.filter);
-  if (!e.signal.empty()) j.str("signal", e.signal).num("value", e.value).num("sample_t", to_seconds(e.sample_time));
-  if (e.injected) j.boolean("injected", true);
+  if (!e.root.filter.empty()) j.str("filter", e.root.filter);
+  if (!e.root.signal.empty())
+    j.str("signal", e.root.signal).num("value", e.root.value).num("sample_t", to_seconds(e.root.sample_time));
+  if (e.root.injected) j.boolean("injected", true);
   return j.strings("path", e.path).text();
 }
 

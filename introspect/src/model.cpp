@@ -49,21 +49,7 @@ HistoryEntry history_entry(const Record& r, const Coordinator& co) {
   e.mirror = r.mirror;
   if (r.root.event != kNoEvent && to_index(r.root.event) < co.event_count() && r.root.origin != kNoMachine &&
       to_index(r.root.origin) < co.machine_count()) {
-    RootEntry root;
-    root.event = co.event(r.root.event).name;
-    // A root from another process names its origin there (interned when it arrived), not the
-    // local stand-in it came through: a live client's history names the same root as in-process.
-    root.origin =
-        r.root.remote_origin != kNoName ? std::string(co.name_of(r.root.remote_origin)) : co.address_of(r.root.origin);
-    root.time = r.root.time;
-    if (r.root.sample.filter != kNoName) root.filter = std::string(co.name_of(r.root.sample.filter));
-    if (r.root.sample.signal != kNoName) {
-      root.signal = std::string(co.name_of(r.root.sample.signal));
-      root.value = r.root.sample.value;
-      root.sample_time = r.root.sample.sample_time;
-    }
-    root.injected = r.root.sample.injected;
-    e.root = std::move(root);
+    e.root = co.resolve_root(r.root);
   }
   e.text = std::string(r.text);
   return e;

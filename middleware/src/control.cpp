@@ -246,8 +246,7 @@ wire::ExplainEntry to_wire(const Explanation& e) {
   w.severity = e.severity;
   w.mirror = e.mirror;
   w.outstanding = e.outstanding;
-  w.root = wire::Root{e.root_event, e.root_origin, e.root_time.count(),   to_wire(e.level), e.filter,
-                      e.signal,     e.value,       e.sample_time.count(), e.injected,       e.path};
+  w.root = root_to_wire(e.root, to_wire(e.level), e.path);
   w.hazard = e.hazard;
   w.line = to_string(e);
   w.count = static_cast<int>(e.count);
@@ -264,15 +263,8 @@ Explanation from_wire(const wire::ExplainEntry& w) {
   e.severity = w.severity;
   e.mirror = w.mirror;
   e.outstanding = w.outstanding;
-  e.root_event = w.root.event;
-  e.root_origin = w.root.origin;
-  e.root_time = Time{w.root.time};
+  root_from_wire(w.root, e.root);
   e.hazard = w.hazard;
-  e.filter = w.root.filter;
-  e.signal = w.root.signal;
-  e.value = w.root.value;
-  e.sample_time = Time{w.root.sampleTime};
-  e.injected = w.root.injected;
   e.path = w.root.path;
   e.count = static_cast<std::uint32_t>(w.count < 0 ? 0 : w.count);
   e.first = Time{w.first};

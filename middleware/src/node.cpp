@@ -282,9 +282,7 @@ struct CoordinatorNode::Impl {
     std::vector<RemoteRoot> now = co.service_roots(s.component, s.provided);
     roots.reserve(now.size());
     for (RemoteRoot& r : now) {
-      roots.push_back(wire::Root{std::move(r.event), std::move(r.origin), r.time.count(), to_wire(r.level),
-                                 std::move(r.filter), std::move(r.signal), r.value, r.sample_time.count(), r.injected,
-                                 std::move(r.path)});
+      roots.push_back(root_to_wire(r.root, to_wire(r.level), std::move(r.path)));
     }
     if (!force && same_roots(roots, s.last)) return;
     wire::StateUpdate u;
@@ -761,19 +759,12 @@ struct CoordinatorNode::Impl {
     roots.reserve(u.roots.size());
     for (const wire::Root& w : u.roots) {
       RemoteRoot r;
-      r.event = w.event;
-      r.origin = w.origin;
-      r.time = Time{w.time};
+      root_from_wire(w, r.root);
       if (!from_wire(w.level, r.level)) {
         updates_rejected.fetch_add(1);
         refuse(from, what() + ": root '" + printable(w.event) + "' has an invalid level; nothing changed");
         return;
       }
-      r.filter = w.filter;
-      r.signal = w.signal;
-      r.value = w.value;
-      r.sample_time = Time{w.sampleTime};
-      r.injected = w.injected;
       r.path = w.path;
       roots.push_back(std::move(r));
     }

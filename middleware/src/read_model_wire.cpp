@@ -7,6 +7,22 @@ namespace safecass::middleware::detail {
 
 namespace in = introspect;
 
+wire::Root root_to_wire(const ResolvedRoot& r, wire::Level level, std::vector<std::string> path) {
+  return wire::Root{r.event,  r.origin, r.time.count(),        level,      r.filter,
+                    r.signal, r.value,  r.sample_time.count(), r.injected, std::move(path)};
+}
+
+void root_from_wire(const wire::Root& w, ResolvedRoot& r) {
+  r.event = w.event;
+  r.origin = w.origin;
+  r.time = Time{w.time};
+  r.filter = w.filter;
+  r.signal = w.signal;
+  r.value = w.value;
+  r.sample_time = Time{w.sampleTime};
+  r.injected = w.injected;
+}
+
 namespace {
 
 State level_of(wire::Level l) {
@@ -106,11 +122,6 @@ ParamValue value_from_wire(const wire::ParamValue& w) {
   return w.text;
 }
 
-wire::Root root_to_wire(const in::RootEntry& r) {
-  return wire::Root{r.event,  r.origin, r.time.count(),        wire::Level::Normal, r.filter,
-                    r.signal, r.value,  r.sample_time.count(), r.injected,          {}};
-}
-
 template <class WireRecord>
 void fill(const in::HistoryEntry& e, WireRecord& w) {
   w.time = e.time.count();
@@ -142,15 +153,7 @@ bool read(const WireRecord& w, in::HistoryEntry& e) {
   if (w.hasRoot) {
     // Field by field into the entry's own storage: an entry reused for every record of a stream
     // (the supervisor's) does not allocate per record.
-    in::RootEntry& r = e.root ? *e.root : e.root.emplace();
-    r.event = w.root.event;
-    r.origin = w.root.origin;
-    r.time = Time{w.root.time};
-    r.filter = w.root.filter;
-    r.signal = w.root.signal;
-    r.value = w.root.value;
-    r.sample_time = Time{w.root.sampleTime};
-    r.injected = w.root.injected;
+    root_from_wire(w.root, e.root ? *e.root : e.root.emplace());
   } else {
     e.root.reset();
   }

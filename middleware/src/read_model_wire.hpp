@@ -8,6 +8,13 @@
 
 namespace safecass::middleware::detail {
 
+/// A root cause on the wire: one shape for a record's root, an explanation's and each root of a
+/// state update (which also carry the root's level and hop path).
+wire::Root root_to_wire(const ResolvedRoot& r, wire::Level level = wire::Level::Normal,
+                        std::vector<std::string> path = {});
+/// Field by field into `r`'s own storage: a root reused for every message does not allocate.
+void root_from_wire(const wire::Root& w, ResolvedRoot& r);
+
 wire::StateEntry to_wire(const introspect::StateRow& r);
 /// Errors (false): an unknown kind or level (a malformed message).
 bool from_wire(const wire::StateEntry& w, introspect::StateRow& out);

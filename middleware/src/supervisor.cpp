@@ -640,7 +640,7 @@ struct Supervisor::Impl {
           if (r.state != State::Normal) {
             const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
             for (const Explanation& e : why.conditions) {
-              if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root_origin + ":" + e.root_event;
+              if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root.name();
             }
           }
           rows.push_back(std::move(r));

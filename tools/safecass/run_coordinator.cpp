@@ -83,7 +83,7 @@ struct Driver {
     }
     const State level = co.state_of(a);
     for (const Explanation& e : co.explain(a)) {
-      if (e.level == level && e.root_origin + ":" + e.root_event == expected) return {};
+      if (e.level == level && e.root.name() == expected) return {};
     }
     return "no condition of " + address + " at its level has root cause " + expected;
   }

@@ -398,8 +398,8 @@ std::vector<std::string> rows_of(const std::vector<introspect::StateRow>& rows) 
 std::vector<std::string> causes_of(const std::vector<Explanation>& why) {
   std::vector<std::string> out;
   for (const Explanation& e : why) {
-    std::string line = e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin +
-                       ":" + e.root_event + " path";
+    std::string line = e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root.origin +
+                       ":" + e.root.event + " path";
     for (const std::string& hop : e.path) line += " " + hop;
     out.push_back(std::move(line));
   }
@@ -409,7 +409,7 @@ std::vector<std::string> causes_of(const std::vector<Explanation>& why) {
 
 bool has_root(const Expected<introspect::ExplainAnswer>& why, const std::string& event) {
   return why && std::any_of(why->conditions.begin(), why->conditions.end(),
-                            [&](const Explanation& e) { return e.root_event == event; });
+                            [&](const Explanation& e) { return e.root.event == event; });
 }
 
 /// "- wanted" / "+ got" lines of two sorted lists, empty when they are equal.
@@ -1151,7 +1151,7 @@ TEST(Chaos, WithAReplicatedBrokerEveryProcessConvergesAfterItsMasterOrAnotherRep
       auto in_process = [&] {
         auto why = chaos.reference().co->explain("PENDANT.s_R.Status");
         return why && std::any_of(why->begin(), why->end(),
-                                  [](const Explanation& e) { return e.root_event == "EVT_FORCE_ERROR"; });
+                                  [](const Explanation& e) { return e.root.event == "EVT_FORCE_ERROR"; });
       };
       double longest = 0;
       int toggles = 0;

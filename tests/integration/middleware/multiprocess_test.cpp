@@ -187,8 +187,8 @@ State state_of(middleware::RemoteClient& c, const std::string& address) {
 std::string causes(const std::vector<Explanation>& why) {
   std::string out;
   for (const Explanation& e : why) {
-    out += e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root_origin + ":" +
-           e.root_event + " path";
+    out += e.machine + " " + std::string(to_string(e.level)) + " " + e.event + " <- " + e.root.origin + ":" +
+           e.root.event + " path";
     for (const std::string& hop : e.path) out += " " + hop;
     out += "\n";
   }
@@ -299,7 +299,7 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
                             {"reset", "BMM"}};
   auto roots = [](const std::vector<Explanation>& why) {
     std::vector<std::string> out;
-    for (const Explanation& e : why) out.push_back(e.root_origin + ":" + e.root_event);
+    for (const Explanation& e : why) out.push_back(e.root.name());
     std::sort(out.begin(), out.end());
     return out;
   };
@@ -328,7 +328,7 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   for (std::size_t i = history_before; i < records.size(); ++i) {
     const Record& r = records[i];
     const std::string root_event = r.root.event == kNoEvent ? "" : reference.event(r.root.event).name;
-    const std::string root_origin = r.root.event == kNoEvent ? "" : reference.root_origin(r.root);
+    const std::string root_origin = r.root.event == kNoEvent ? "" : reference.resolve_root(r.root).origin;
     const std::string outcome = r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome));
     const std::string event = r.event == kNoEvent ? "" : reference.event(r.event).name;
     expected.push_back(
@@ -675,12 +675,11 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
     for (int i = 0; i < kInterfaces; ++i) {
       std::vector<std::string> want, got;
       for (const RemoteRoot& r : provider.co->service_roots(s, static_cast<std::uint32_t>(i))) {
-        want.push_back(r.origin + ":" + r.event + "@" + std::to_string(r.time.count()));
+        want.push_back(r.root.origin + ":" + r.root.event + "@" + std::to_string(r.root.time.count()));
       }
       auto why = client.co->explain("S.s_P.D" + std::to_string(i));
       if (!why) return false;
-      for (const Explanation& e : *why)
-        got.push_back(e.root_origin + ":" + e.root_event + "@" + std::to_string(e.root_time.count()));
+      for (const Explanation& e : *why) got.push_back(e.root.name() + "@" + std::to_string(e.root.time.count()));
       std::sort(want.begin(), want.end());
       std::sort(got.begin(), got.end());
       const State client_state = client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i)));

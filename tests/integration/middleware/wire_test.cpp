@@ -285,7 +285,7 @@ struct Bus {
     auto why = co.explain(machine);
     if (!why) return false;
     for (const Explanation& e : *why) {
-      if (e.event == event || e.root_event == event) return true;
+      if (e.event == event || e.root.event == event) return true;
     }
     return false;
   }

@@ -105,7 +105,7 @@ TEST(Concurrency, ObserversThatReadTheCoordinatorDoNotDeadlockWhileAnotherThread
     // Re-entry on the thread that holds the lock: reads run under it.
     if (r.kind == RecordKind::ComponentTransition && r.to == State::Error) {
       explained += co.explain(Address{Address::Kind::Component, r.component}).empty() ? 0 : 1;
-      (void)co.root_origin(r.root);
+      (void)co.resolve_root(r.root).origin;
     }
     if (r.kind == RecordKind::Transition) histories += co.history(r.machine).empty() ? 0 : 1;
     (void)co.dropped_requests();

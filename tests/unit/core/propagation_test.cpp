@@ -353,8 +353,8 @@ TEST(Propagation, TwoRootsReachingTheSameMachineGiveTwoMirrorsAndClearingOneLeav
   const auto why = g.co.explain("CONTROL.s_R.ForceData");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
-  EXPECT_EQ((*why)[0].root_event, "EVT_JR3_FAULT");
-  EXPECT_EQ((*why)[0].root_origin, "JR3.s_F");
+  EXPECT_EQ((*why)[0].root.event, "EVT_JR3_FAULT");
+  EXPECT_EQ((*why)[0].root.origin, "JR3.s_F");
   g.gen("/EVT_JR3_FAULT", "JR3.s_F");
   EXPECT_EQ(g.at("CONTROL"), N);
 }
@@ -432,13 +432,13 @@ TEST(Explain, GivesTheRootCauseAndHopPathOfAClientsError) {
   EXPECT_EQ(e.severity, 220);
   EXPECT_TRUE(e.mirror);
   EXPECT_TRUE(e.outstanding);
-  EXPECT_EQ(e.root_event, "EVT_FORCE_ERROR");
-  EXPECT_EQ(e.root_origin, "JR3.s_A");
-  EXPECT_EQ(e.root_time, seconds_to_time(0.1));
+  EXPECT_EQ(e.root.event, "EVT_FORCE_ERROR");
+  EXPECT_EQ(e.root.origin, "JR3.s_A");
+  EXPECT_EQ(e.root.time, seconds_to_time(0.1));
   EXPECT_EQ(e.hazard, "H-3");
-  EXPECT_EQ(e.filter, "force_limit");
-  EXPECT_EQ(e.signal, "JR3.ForceNorm");
-  EXPECT_DOUBLE_EQ(e.value, 35.0);
+  EXPECT_EQ(e.root.filter, "force_limit");
+  EXPECT_EQ(e.root.signal, "JR3.ForceNorm");
+  EXPECT_DOUBLE_EQ(e.root.value, 35.0);
   EXPECT_EQ(e.path, (std::vector<std::string>{"JR3.s_A", "JR3.s_S.ForceData", "CONTROL.s_R.ForceData"}));
   const std::string line = to_string(e);
   EXPECT_NE(line.find("CONTROL.s_R.ForceData"), std::string::npos) << line;
@@ -467,7 +467,7 @@ TEST(Explain, WorksForMachinesServicesComponentsAndTheSystem) {
   ASSERT_EQ(root->size(), 1u);
   EXPECT_FALSE((*root)[0].mirror);
   EXPECT_EQ((*root)[0].path, std::vector<std::string>{"JR3.s_A"});
-  EXPECT_EQ((*root)[0].root_origin, "JR3.s_A");
+  EXPECT_EQ((*root)[0].root.origin, "JR3.s_A");
 }
 
 TEST(Explain, AServiceAddressExplainsOnlyTheMachinesTheServiceDependsOn) {

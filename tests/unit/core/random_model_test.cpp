@@ -1065,9 +1065,9 @@ private:
     if (why->size() != conds.size()) return at + ": explain lists a different number of conditions";
     const auto& hops = oracle_->hops();
     for (const Explanation& x : *why) {
-      const std::string what = at + ": explain " + x.root_origin + ":" + x.root_event;
+      const std::string what = at + ": explain " + x.root.name();
       if (x.machine != at) return what + ": wrong machine";
-      if (x.path.empty() || x.path.front() != x.root_origin || x.path.back() != at) {
+      if (x.path.empty() || x.path.front() != x.root.origin || x.path.back() != at) {
         std::string p;
         for (const std::string& s : x.path) p += " " + s;
         return what + ": hop path does not lead from the origin to the holder:" + p;

@@ -67,8 +67,8 @@ struct Split {
 std::vector<std::string> lines(const Coordinator& co, std::string_view address) {
   std::vector<std::string> out;
   for (const Explanation& e : must(co.explain(address), "explain")) {
-    out.push_back(e.machine + " " + e.event + " " + std::string(to_string(e.level)) + " <- " + e.root_origin + ":" +
-                  e.root_event);
+    out.push_back(e.machine + " " + e.event + " " + std::string(to_string(e.level)) + " <- " + e.root.origin + ":" +
+                  e.root.event);
     for (const std::string& hop : e.path) out.back() += " / " + hop;
   }
   return out;
@@ -139,13 +139,22 @@ TEST(RemoteProvider, WarningsCrossOnlyAServiceThatPropagatesWarnings) {
   EXPECT_EQ(warnings.robot.outstanding("CONTROL.s_R.ForceData"), "EVT_SERVICE_DEGRADED");
 }
 
+/// A root without a sample.
+ResolvedRoot root_at(std::string event, std::string origin, Time time) {
+  ResolvedRoot r;
+  r.event = std::move(event);
+  r.origin = std::move(origin);
+  r.time = time;
+  return r;
+}
+
 TEST(RemoteProvider, AnUpdateNamingAnUnknownEventIsRefusedAndChangesNothing) {
   Split two;
   two.sensor.gen("EVT_FORCE_ERROR", "JR3.s_A");
   two.sync();
   std::vector<RemoteRoot> bad = two.sensor.co.service_roots(two.sensor.comp("JR3"), 0);
-  bad.push_back(RemoteRoot{"EVT_NO_SUCH_THING", "JR3.s_A", Time{5}, E, {}, {}, 0.0, {}, false, {"JR3.s_A"}});
-  bad.front().event = "EVT_FORCE_ERROR";
+  bad.push_back(RemoteRoot{root_at("EVT_NO_SUCH_THING", "JR3.s_A", Time{5}), E, {"JR3.s_A"}});
+  bad.front().root.event = "EVT_FORCE_ERROR";
   auto r = two.robot.co.apply_remote(two.proxy, bad);
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
@@ -155,9 +164,9 @@ TEST(RemoteProvider, AnUpdateNamingAnUnknownEventIsRefusedAndChangesNothing) {
 
 TEST(RemoteProvider, AnUpdateWithACompletionLevelNormalOrNoOriginIsRefused) {
   Split two;
-  RemoteRoot completion{"/EVT_FORCE_ERROR", "JR3.s_A", Time{1}, E, {}, {}, 0.0, {}, false, {}};
-  RemoteRoot normal{"EVT_FORCE_ERROR", "JR3.s_A", Time{1}, N, {}, {}, 0.0, {}, false, {}};
-  RemoteRoot nowhere{"EVT_FORCE_ERROR", "", Time{1}, E, {}, {}, 0.0, {}, false, {}};
+  RemoteRoot completion{root_at("/EVT_FORCE_ERROR", "JR3.s_A", Time{1}), E, {}};
+  RemoteRoot normal{root_at("EVT_FORCE_ERROR", "JR3.s_A", Time{1}), N, {}};
+  RemoteRoot nowhere{root_at("EVT_FORCE_ERROR", "", Time{1}), E, {}};
   for (const RemoteRoot& r : {completion, normal, nowhere}) {
     EXPECT_FALSE(two.robot.co.apply_remote(two.proxy, {r}));
   }
@@ -203,7 +212,7 @@ TEST(RemoteProvider, RootOriginNamesTheMachineInTheProvidersProcess) {
   two.sync();
   const auto c = two.robot.co.conditions(two.robot.machine("CONTROL.s_R.ForceData"));
   ASSERT_EQ(c.size(), 1u);
-  EXPECT_EQ(two.robot.co.root_origin(c[0].root), "JR3.s_A");
+  EXPECT_EQ(two.robot.co.resolve_root(c[0].root).origin, "JR3.s_A");
 }
 
 TEST(RemoteProvider, FilterDataOfTheRootCrossesWithIt) {
@@ -216,9 +225,9 @@ TEST(RemoteProvider, FilterDataOfTheRootCrossesWithIt) {
   two.sync();
   const auto why = must(two.robot.co.explain("CONTROL.s_R.ForceData"), "explain");
   ASSERT_EQ(why.size(), 1u);
-  EXPECT_EQ(why[0].filter, "force_limit");
-  EXPECT_EQ(why[0].signal, "JR3.ForceNorm");
-  EXPECT_DOUBLE_EQ(why[0].value, 42.5);
+  EXPECT_EQ(why[0].root.filter, "force_limit");
+  EXPECT_EQ(why[0].root.signal, "JR3.ForceNorm");
+  EXPECT_DOUBLE_EQ(why[0].root.value, 42.5);
 }
 
 /// Two processes whose connections form a cycle: A.in -> B.out (remote in A), B.in -> A.out
@@ -270,15 +279,8 @@ TEST(RemoteProvider, ARootThatClearsClearsEverywhereAroundACycleOfProcesses) {
 
 TEST(RemoteProvider, ARootWhosePathContainsTheReceivingMachineIsDropped) {
   Split two;
-  RemoteRoot looped{"EVT_FORCE_ERROR",
-                    "X.s_A",
-                    Time{1},
+  RemoteRoot looped{root_at("EVT_FORCE_ERROR", "X.s_A", Time{1}),
                     E,
-                    {},
-                    {},
-                    0.0,
-                    {},
-                    false,
                     {"X.s_A", "X.s_S.out", "CONTROL.s_R.ForceData", "CONTROL.s_S.Command", "JR3.s_R.in"}};
   const auto r = must(two.robot.co.apply_remote(two.proxy, {looped}), "apply_remote");
   EXPECT_EQ(r.dropped, 1u);
@@ -300,7 +302,7 @@ TEST(RemoteProvider, AHistoryRecordKeepsTheRootCauseItWasMadeWithAfterItsRemoteS
   std::vector<std::string> causes;
   for (const Record& r : two.robot.co.history(two.robot.machine("CONTROL.s_R.ForceData"))) {
     if (r.kind != RecordKind::Transition) continue;
-    causes.push_back(std::string(to_string(r.to)) + " <- " + two.robot.co.root_origin(r.root) + ":" +
+    causes.push_back(std::string(to_string(r.to)) + " <- " + two.robot.co.resolve_root(r.root).origin + ":" +
                      two.robot.co.event(r.root.event).name);
   }
   EXPECT_EQ(causes, (std::vector<std::string>{"Error <- JR3.s_A:EVT_FORCE_ERROR", "Normal <- JR3.s_A:EVT_FORCE_ERROR",

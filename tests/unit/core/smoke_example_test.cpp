@@ -20,8 +20,8 @@ TEST(CoreExample, ForceErrorPropagatesToTheClientAndClearsWithItsRoot) {
   const auto why = co.explain("CONTROL");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
-  EXPECT_EQ((*why)[0].root_event, "EVT_FORCE_ERROR");
-  EXPECT_EQ((*why)[0].root_origin, "JR3.s_A");
+  EXPECT_EQ((*why)[0].root.event, "EVT_FORCE_ERROR");
+  EXPECT_EQ((*why)[0].root.origin, "JR3.s_A");
   ASSERT_TRUE(co.generate("/EVT_FORCE_ERROR", "JR3.s_A"));
   EXPECT_EQ(co.extended_state(control), State::Normal);
 }

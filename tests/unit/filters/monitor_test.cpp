@@ -108,10 +108,10 @@ TEST_F(MonitorTest, FilterEventsCarryTheirRootCauseIntoExplain) {
   const auto why = co_.explain("C.s_A");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
-  EXPECT_EQ((*why)[0].filter, f->name());
-  EXPECT_EQ((*why)[0].signal, "C.force");
-  EXPECT_DOUBLE_EQ((*why)[0].value, 12.5);
-  EXPECT_EQ((*why)[0].sample_time, seconds_to_time(0.25));
+  EXPECT_EQ((*why)[0].root.filter, f->name());
+  EXPECT_EQ((*why)[0].root.signal, "C.force");
+  EXPECT_DOUBLE_EQ((*why)[0].root.value, 12.5);
+  EXPECT_EQ((*why)[0].root.sample_time, seconds_to_time(0.25));
 }
 
 TEST_F(MonitorTest, FilterRootCausePropagatesToConnectedClients) {
@@ -127,8 +127,8 @@ TEST_F(MonitorTest, FilterRootCausePropagatesToConnectedClients) {
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   EXPECT_TRUE((*why)[0].mirror);
-  EXPECT_EQ((*why)[0].filter, f->name());
-  EXPECT_DOUBLE_EQ((*why)[0].value, 20);
+  EXPECT_EQ((*why)[0].root.filter, f->name());
+  EXPECT_DOUBLE_EQ((*why)[0].root.value, 20);
   EXPECT_EQ((*why)[0].path.front(), "C.s_A");
   EXPECT_EQ((*why)[0].path.back(), "CLIENT.s_R.Data");
 }

@@ -84,7 +84,7 @@ TEST_F(InjectionTest, ShallowInjectionIsSeenByThatFilterAloneAndMarked) {
   EXPECT_NE(std::string(injections[0].text).find("shallow injection into filter target: 50"), std::string::npos);
   const auto why = co_.explain("C.s_A");
   ASSERT_TRUE(why);
-  EXPECT_TRUE((*why)[0].injected);
+  EXPECT_TRUE((*why)[0].root.injected);
   // After the injected sample is consumed, real samples are judged again.
   x->push(Time{2}, 1.0);
   monitor_.run_active(component_, Time{2});

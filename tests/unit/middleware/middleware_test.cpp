@@ -292,14 +292,13 @@ std::vector<RemoteRoot> roots_from_explain(const Coordinator& co, ComponentId co
   std::vector<RemoteRoot> out;
   for (const Explanation& e : co.explain(a)) {
     auto it = std::find_if(out.begin(), out.end(), [&](const RemoteRoot& r) {
-      return r.event == e.root_event && r.origin == e.root_origin && r.time == e.root_time;
+      return r.root.event == e.root.event && r.root.origin == e.root.origin && r.root.time == e.root.time;
     });
     if (it != out.end()) {
       if (e.path.size() < it->path.size()) it->path = e.path;
       continue;
     }
-    out.push_back(RemoteRoot{e.root_event, e.root_origin, e.root_time, e.level, e.filter, e.signal, e.value,
-                             e.sample_time, e.injected, e.path});
+    out.push_back(RemoteRoot{e.root, e.level, e.path});
   }
   return out;
 }
@@ -307,9 +306,10 @@ std::vector<RemoteRoot> roots_from_explain(const Coordinator& co, ComponentId co
 std::string text_of(const std::vector<RemoteRoot>& roots) {
   std::string out;
   for (const RemoteRoot& r : roots) {
-    out += r.origin + ":" + r.event + "@" + std::to_string(r.time.count()) + " " + std::string(to_string(r.level)) +
-           " filter=" + r.filter + " signal=" + r.signal + "=" + std::to_string(r.value) + "@" +
-           std::to_string(r.sample_time.count()) + (r.injected ? " injected" : "") + " path";
+    out += r.root.origin + ":" + r.root.event + "@" + std::to_string(r.root.time.count()) + " " +
+           std::string(to_string(r.level)) + " filter=" + r.root.filter + " signal=" + r.root.signal + "=" +
+           std::to_string(r.root.value) + "@" + std::to_string(r.root.sample_time.count()) +
+           (r.root.injected ? " injected" : "") + " path";
     for (const std::string& hop : r.path) out += " " + hop;
     out += "\n";
   }
@@ -363,18 +363,18 @@ TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
       const std::size_t n = random() % 4;
       for (std::size_t i = 0; i < n; ++i) {
         RemoteRoot r;
-        r.event = onsets[random() % onsets.size()];
-        r.origin = random() % 2 == 0 ? "S.s_A" : "S.s_F";
-        r.time = Time{static_cast<std::int64_t>(random() % 3) * 1000};
-        r.level = r.event == "EVT_W" ? State::Warning : State::Error;
-        r.path = {r.origin, "S.s_S.out"};
+        r.root.event = onsets[random() % onsets.size()];
+        r.root.origin = random() % 2 == 0 ? "S.s_A" : "S.s_F";
+        r.root.time = Time{static_cast<std::int64_t>(random() % 3) * 1000};
+        r.level = r.root.event == "EVT_W" ? State::Warning : State::Error;
+        r.path = {r.root.origin, "S.s_S.out"};
         if (random() % 2 == 0) {
-          r.filter = "f";
-          r.signal = "force";
-          r.value = 1.5;
+          r.root.filter = "f";
+          r.root.signal = "force";
+          r.root.value = 1.5;
         }
         if (std::none_of(roots.begin(), roots.end(), [&](const RemoteRoot& x) {
-              return x.event == r.event && x.origin == r.origin && x.time == r.time;
+              return x.root.event == r.root.event && x.root.origin == r.root.origin && x.root.time == r.root.time;
             })) {
           roots.push_back(r);
         }
@@ -391,9 +391,9 @@ TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
             << "step " << step << ", service " << name << " #" << p;
         if (std::string(name) == "A" && p == 0) {
           const bool any_remote =
-              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] == 'S'; });
+              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.root.origin[0] == 'S'; });
           const bool any_local =
-              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.origin[0] != 'S'; });
+              std::any_of(got.begin(), got.end(), [](const RemoteRoot& r) { return r.root.origin[0] != 'S'; });
           mixed += any_remote && any_local ? 1 : 0;
         }
       }

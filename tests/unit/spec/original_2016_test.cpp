@@ -148,7 +148,7 @@ TEST(Original2016, TheOriginalClassNamesAndArgumentsLoadAsTheirBuiltins) {
   const auto why = co.explain("Arm.s_A");
   ASSERT_TRUE(why);
   bool mode = false;
-  for (const Explanation& e : *why) mode = mode || e.root_event == "EVT_ARM_MODE";
+  for (const Explanation& e : *why) mode = mode || e.root.event == "EVT_ARM_MODE";
   EXPECT_TRUE(mode);
 }
 

@@ -22,8 +22,8 @@ TEST(LiveTimeline, ARootCauseWithoutItsTimeIsShownWithoutAMadeUpTime) {
   const timeline::HistoryParse parsed = timeline::parse_history(live);
   ASSERT_TRUE(parsed.errors.empty()) << parsed.errors.front().message;
   ASSERT_EQ(parsed.records.size(), 1u);
-  EXPECT_TRUE(parsed.records[0].has_root);
-  EXPECT_FALSE(parsed.records[0].root.has_t);
+  EXPECT_TRUE(parsed.records[0].root.has_value());
+  EXPECT_FALSE(parsed.records[0].root_time_known);
   const std::string model = timeline::timeline_model_json(parsed.records);
   EXPECT_THAT(model, HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR"));
   EXPECT_THAT(model, Not(HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at ")));
@@ -34,7 +34,7 @@ TEST(LiveTimeline, ARootCauseWithoutItsTimeIsShownWithoutAMadeUpTime) {
       "\"JR3.s_A\",\"t\":0.25}}\n";
   const timeline::HistoryParse with_time = timeline::parse_history(recorded);
   ASSERT_TRUE(with_time.errors.empty());
-  EXPECT_TRUE(with_time.records[0].root.has_t);
+  EXPECT_TRUE(with_time.records[0].root_time_known);
   EXPECT_THAT(timeline::timeline_model_json(with_time.records),
               HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR at 0.25 s"));
 }

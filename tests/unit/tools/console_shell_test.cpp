@@ -174,8 +174,8 @@ TEST(ConsoleShell, ExplanationsPrintOneLineEachWithEveryFieldInJsonAndSayWhenThe
   e.severity = 200;
   e.mirror = true;
   e.count = 3;
-  e.root_event = "EVT_FORCE_ERROR";
-  e.root_origin = "JR3.s_A";
+  e.root.event = "EVT_FORCE_ERROR";
+  e.root.origin = "JR3.s_A";
   e.path = {"JR3.s_A", "JR3.s_S.ForceData", "CONTROL.s_R.ForceData"};
   const introspect::ExplainAnswer answer{"CONTROL", State::Error, {e}};
   EXPECT_EQ(introspect::explain_text(answer, introspect::TimeFormat{}), to_string(e) + "\n")

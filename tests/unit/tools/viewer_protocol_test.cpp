@@ -326,8 +326,8 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   source->advance_to(0.102);
   const std::vector<Explanation> why = *source->explain("BMM.s_A");
   ASSERT_EQ(why.size(), 1u);
-  EXPECT_EQ(why[0].root_event, "EVT_BONE_MOTION");
-  EXPECT_TRUE(why[0].injected);
+  EXPECT_EQ(why[0].root.event, "EVT_BONE_MOTION");
+  EXPECT_TRUE(why[0].root.injected);
   // Shallow: queued into one filter.
   const json::JsonValue shallow =
       parse(protocol.handle(R"({"op":"inject","filter":"force_limit","samples":[[50],[50]],"token":"k"})"));

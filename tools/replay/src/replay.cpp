@@ -367,30 +367,24 @@ std::vector<std::string> addresses_of(const Coordinator& co) {
   return out;
 }
 
-struct Cause {
-  std::string origin, event, filter, signal;
-  double value = 0.0;
-  bool injected = false;
-};
-
 /// The cause of `address`'s state: the outstanding condition at its level (else the first there).
-Cause cause_of(const Coordinator& co, const Address& a) {
+ResolvedRoot cause_of(const Coordinator& co, const Address& a) {
   const State level = co.state_of(a);
-  Cause c;
+  ResolvedRoot c;
   bool found = false;
   for (const Explanation& e : co.explain(a)) {
     if (e.level != level) continue;
     if (found && !e.outstanding) continue;
-    c = Cause{e.root_origin, e.root_event, e.filter, e.signal, e.value, e.injected};
+    c = e.root;
     found = true;
     if (e.outstanding) break;
   }
   return c;
 }
 
-std::string cause_text(const Cause& c) {
+std::string cause_text(const ResolvedRoot& c) {
   if (c.event.empty()) return "none";
-  std::string out = c.origin + ":" + c.event;
+  std::string out = c.name();
   if (!c.filter.empty() || !c.signal.empty()) {
     const std::string v = number_text(c.value);
     out += " [";
@@ -407,7 +401,7 @@ struct Interval {
   bool open = true;
   State b = State::Normal, a = State::Normal;
   char side = 'B';
-  Cause cause;
+  ResolvedRoot cause;  ///< the first cause of the difference
 };
 
 struct Tracked {
@@ -424,7 +418,7 @@ namespace {
 /// text line with its first cause.
 void print_interval(const Interval& i, const std::string& address, const std::string& until, const ReplayOptions& o) {
   if (o.json) {
-    const Cause& c = i.cause;
+    const ResolvedRoot& c = i.cause;
     json::JsonObject cause;
     cause.str("system", i.side == 'B' ? "B" : "A").str("origin", c.origin).str("event", c.event);
     if (!c.filter.empty()) cause.str("filter", c.filter);

@@ -362,7 +362,7 @@ std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::st
       std::string seen;
       for (const Explanation& e : coordinator_.explain(a)) {
         if (e.level != level) continue;
-        const std::string cause = e.root_origin + ":" + e.root_event;
+        const std::string cause = e.root.name();
         if (cause == expected) return {};
         seen += (seen.empty() ? "" : ", ") + cause;
       }

@@ -210,26 +210,25 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
       f.fail("\"root\" must be an object, not " + std::string(json::type_name(root->type)));
     } else {
       FieldReader rf(*root);
-      r.has_root = true;
-      r.root.event = rf.string("event", true);
-      r.root.origin = rf.string("origin", true);
-      r.root.has_t = root->find("t") != nullptr;
-      r.root.t = rf.number("t", false).value_or(0.0);
-      r.root.filter = rf.string("filter", false);
-      r.root.signal = rf.string("signal", false);
-      r.root.has_signal = root->find("signal") != nullptr;
+      ResolvedRoot& root_cause = r.root.emplace();
+      root_cause.event = rf.string("event", true);
+      root_cause.origin = rf.string("origin", true);
+      r.root_time_known = root->find("t") != nullptr;
+      root_cause.time = seconds_to_time(rf.number("t", false).value_or(0.0));
+      root_cause.filter = rf.string("filter", false);
+      root_cause.signal = rf.string("signal", false);
       // A non-finite sample (it raised EVT_INVALID_SAMPLE) is written as "nan", "inf" or "-inf".
       const JsonValue* value = root->find("value");
       if (value != nullptr && value->is_string() &&
           (value->string == "nan" || value->string == "inf" || value->string == "-inf")) {
-        r.root.value = value->string == "nan"
-                           ? std::numeric_limits<double>::quiet_NaN()
-                           : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
+        root_cause.value = value->string == "nan"
+                               ? std::numeric_limits<double>::quiet_NaN()
+                               : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
       } else {
-        r.root.value = rf.number("value", false).value_or(0.0);
+        root_cause.value = rf.number("value", false).value_or(0.0);
       }
-      r.root.sample_t = rf.number("sample_t", false).value_or(0.0);
-      r.root.injected = rf.boolean("injected");
+      root_cause.sample_time = seconds_to_time(rf.number("sample_t", false).value_or(0.0));
+      root_cause.injected = rf.boolean("injected");
       if (rf.error()) f.fail("in \"root\": " + *rf.error());
     }
   }
@@ -311,18 +310,19 @@ int severity_rank(std::string_view state) { return state == "Error" ? 2 : state 
 
 /// The root cause of a record; `clears` when the record ends that condition (an improving transition).
 std::string root_lines(const HistoryRecord& r, bool clears = false) {
-  if (!r.has_root) return {};
-  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + r.root.origin + ":" +
-                    r.root.event + (r.root.has_t ? " at " + secs(r.root.t) + " s" : std::string());
-  if (!r.root.filter.empty() || r.root.has_signal || r.root.injected) {
+  if (!r.root) return {};
+  const ResolvedRoot& root = *r.root;
+  std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + root.name() +
+                    (r.root_time_known ? " at " + secs(to_seconds(root.time)) + " s" : std::string());
+  if (!root.filter.empty() || !root.signal.empty() || root.injected) {
     out += "\n";
     std::string detail;
-    if (!r.root.filter.empty()) detail += "filter " + r.root.filter;
-    if (r.root.has_signal) {
-      detail += (detail.empty() ? "" : ", ") + r.root.signal + " = " + num(r.root.value) + " (sample at " +
-                secs(r.root.sample_t) + " s)";
+    if (!root.filter.empty()) detail += "filter " + root.filter;
+    if (!root.signal.empty()) {
+      detail += (detail.empty() ? "" : ", ") + root.signal + " = " + num(root.value) + " (sample at " +
+                secs(to_seconds(root.sample_time)) + " s)";
     }
-    if (r.root.injected) detail += (detail.empty() ? "" : ", ") + std::string("injected sample");
+    if (root.injected) detail += (detail.empty() ? "" : ", ") + std::string("injected sample");
     out += detail;
   }
   return out;
@@ -356,7 +356,8 @@ std::string marker_tip(const Lane& lane, const Marker& m) {
   else if (m.kind == "joined")
     head = "Joined: onset " + r.event + " at the current level";
   else if (m.kind == "cleared")
-    head = "Cleared " + (r.event.empty() ? "condition " + r.root.event : r.event) + " (no state change)";
+    head = "Cleared " + (r.event.empty() ? "condition " + (r.root ? r.root->event : std::string()) : r.event) +
+           " (no state change)";
   else if (m.kind == "reset")
     head = "Reset (state before: " + r.from + ")";
   else

@@ -132,14 +132,14 @@ std::string explanation_to_json(const Explanation& e) {
       .integer("count", e.count)
       .raw("first", seconds(to_seconds(e.first)))
       .raw("last", seconds(to_seconds(e.last)))
-      .str("root_event", e.root_event)
-      .str("root_origin", e.root_origin)
-      .raw("root_t", seconds(to_seconds(e.root_time)));
+      .str("root_event", e.root.event)
+      .str("root_origin", e.root.origin)
+      .raw("root_t", seconds(to_seconds(e.root.time)));
   if (!e.hazard.empty()) o.str("hazard", e.hazard);
-  if (!e.filter.empty()) o.str("filter", e.filter);
-  if (!e.signal.empty())
-    o.str("signal", e.signal).num("value", e.value).raw("sample_t", seconds(to_seconds(e.sample_time)));
-  if (e.injected) o.boolean("injected", true);
+  if (!e.root.filter.empty()) o.str("filter", e.root.filter);
+  if (!e.root.signal.empty())
+    o.str("signal", e.root.signal).num("value", e.root.value).raw("sample_t", seconds(to_seconds(e.root.sample_time)));
+  if (e.root.injected) o.boolean("injected", true);
   o.raw("path", array(e.path, [](const std::string& hop) { return quote(hop); }));
   return o.text();
 }

@@ -19,7 +19,7 @@
 /// - callbacks and observers must not change the configuration or register callbacks/observers;
 /// - callbacks and observers run on the thread that caused the change, under the lock. They must
 ///   not block. An event they generate (or a reset they ask for) is queued and processed before the
-///   outer call returns. They may also read the coordinator (history(), explain(), root_origin(),
+///   outer call returns. They may also read the coordinator (history(), explain(), resolve_root(),
 ///   ...): the lock is a plain mutex, and a call from the thread that holds it runs under the lock
 ///   already held instead of locking again (see "lock discipline" below). An exception thrown by a
 ///   callback becomes EVT_CALLBACK_EXCEPTION on the component's s_F.
@@ -122,15 +122,8 @@ struct Explanation {
   std::uint32_t count = 0;
   Time first{};
   Time last{};
-  std::string root_event;
-  std::string root_origin;  ///< address of the origin machine
-  Time root_time{};
-  std::string hazard;  ///< of the root event
-  std::string filter;  ///< empty unless a filter fired the root
-  std::string signal;
-  double value = 0.0;
-  Time sample_time{};
-  bool injected = false;
+  ResolvedRoot root;
+  std::string hazard;             ///< of the root event
   std::vector<std::string> path;  ///< origin machine → services/interfaces … → this machine
 };
 
@@ -141,15 +134,8 @@ std::string to_string(const Explanation& e);
 /// of the full state that replaces the set held by a remote provided interface (apply_remote()).
 /// Identity across processes is (origin, event, time).
 struct RemoteRoot {
-  std::string event;           ///< the root onset's name (events are system-wide names)
-  std::string origin;          ///< address of the origin machine in the provider's process
-  Time time{};                 ///< onset time at the origin (the provider's clock)
+  ResolvedRoot root;           ///< identity across processes: (origin, event, time)
   State level = State::Error;  ///< the root's level (Warning or Error)
-  std::string filter;          ///< empty unless a filter fired the root
-  std::string signal;
-  double value = 0.0;
-  Time sample_time{};
-  bool injected = false;
   /// Hops from the origin to the provider's machine that feeds the service (as explain() writes
   /// them); the path-vector rule drops a root whose path already contains a receiving machine.
   std::vector<std::string> path;
@@ -269,8 +255,10 @@ public:
   /// local component): one RemoteRoot per root active at s_S.p (any level), with the shortest
   /// hop path that brings it to a machine feeding the service. Takes the lock; allocates.
   std::vector<RemoteRoot> service_roots(ComponentId component, std::uint32_t service) const;
-  /// The address of a root's origin machine; for a remote root, the address in its process.
-  std::string root_origin(const RootCause& root) const;
+  /// `root` with its names: the event, the origin machine's address (a remote root's in its own
+  /// process), the filter and signal. Takes no lock (it reads what configuration fixed and the
+  /// interned names); safe from observers and callbacks.
+  ResolvedRoot resolve_root(const RootCause& root) const;
 
   // ---- lookup --------------------------------------------------------------------------------
   [[nodiscard]] Expected<ComponentId> find_component(std::string_view name) const;
@@ -570,7 +558,7 @@ private:
   // - Callbacks and observers run under the mutex, on the thread that holds it (docs/semantics.md
   //   §5.3, §8.2). When one of them calls back into this coordinator, Lock finds `owner_` equal
   //   to the calling thread and does not lock again: generate(), broadcast() and reset() then see
-  //   `processing_` and queue their request; reads (history(), explain(), root_origin(), ...)
+  //   `processing_` and queue their request; reads (history(), explain(), resolve_root(), ...)
   //   read under the lock already held. Any other thread blocks until the outer operation ends.
   // - `owner_` is written only by the thread that holds the mutex (after locking, before
   //   unlocking), so a thread can find its own id there only while it really holds the mutex.

@@ -75,20 +75,6 @@ struct StateSummary {
   friend bool operator==(const StateSummary&, const StateSummary&) = default;
 };
 
-/// The root cause a history record carries (DESIGN §2.6).
-struct RootEntry {
-  std::string event;
-  std::string origin;  ///< address of the origin machine (in its own process)
-  Time time{};
-  std::string filter;  ///< empty unless a filter fired the root
-  std::string signal;  ///< empty unless the root has a sample
-  double value = 0.0;
-  Time sample_time{};
-  bool injected = false;
-
-  friend bool operator==(const RootEntry&, const RootEntry&) = default;
-};
-
 /// One record of the observer stream: an event processed (or ignored, masked), a machine or
 /// component transition, a reset, an injection.
 struct HistoryEntry {
@@ -104,8 +90,8 @@ struct HistoryEntry {
   State level = State::Normal;
   int severity = 0;
   bool mirror = false;
-  std::optional<RootEntry> root;
-  std::string text;  ///< reason of an ignored event, "who: why" of a reset
+  std::optional<ResolvedRoot> root;  ///< the root cause of the condition added or removed (DESIGN §2.6)
+  std::string text;                  ///< reason of an ignored event, "who: why" of a reset
 
   /// The machine, else the component, else "-".
   std::string_view where() const noexcept;

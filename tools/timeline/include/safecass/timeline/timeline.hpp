@@ -14,6 +14,7 @@
 #include <string_view>
 #include <vector>
 
+#include "safecass/core/condition.hpp"
 #include "safecass/json/read.hpp"
 
 namespace safecass::timeline {
@@ -33,18 +34,12 @@ struct HistoryRecord {
   std::string from, to;  ///< Normal, Warning, Error
   std::string level;     ///< Event: level of the condition added or removed
   int severity = 0;
-  bool mirror = false;    ///< a condition mirrored along a connection
-  bool has_root = false;  ///< root cause present
-  struct {
-    std::string event, origin, filter, signal;
-    double t = 0.0, value = 0.0, sample_t = 0.0;
-    bool has_signal = false;
-    bool has_t = false;  ///< the root's time is known (a live history fetched remotely has none)
-    bool injected = false;
-  } root;
-  std::string text;           ///< reason (ignored, reset "who: why") or injection description
-  std::uint64_t dropped = 0;  ///< Overflow: how many records the recorder dropped
-  json::JsonValue json;       ///< the line as read, re-emitted into the page
+  bool mirror = false;               ///< a condition mirrored along a connection
+  std::optional<ResolvedRoot> root;  ///< the root cause, when the record has one
+  bool root_time_known = false;      ///< the root's "t" was in the line
+  std::string text;                  ///< reason (ignored, reset "who: why") or injection description
+  std::uint64_t dropped = 0;         ///< Overflow: how many records the recorder dropped
+  json::JsonValue json;              ///< the line as read, re-emitted into the page
 };
 
 struct HistoryError {
