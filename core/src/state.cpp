@@ -75,6 +75,22 @@ std::string_view to_string(Outcome o) noexcept {
   return "?";
 }
 
+std::optional<RecordKind> parse_record_kind(std::string_view text) noexcept {
+  for (RecordKind k : {RecordKind::Event, RecordKind::Transition, RecordKind::ComponentTransition, RecordKind::Reset,
+                       RecordKind::Injection}) {
+    if (text == to_string(k)) return k;
+  }
+  return std::nullopt;
+}
+
+std::optional<Outcome> parse_outcome(std::string_view text) noexcept {
+  for (Outcome o : {Outcome::None, Outcome::Raised, Outcome::Override, Outcome::Joined, Outcome::Masked,
+                    Outcome::Cleared, Outcome::Ignored}) {
+    if (text == to_string(o)) return o;
+  }
+  return std::nullopt;
+}
+
 namespace {
 void default_fatal(const char* expression, const char* file, int line) noexcept {
   std::fprintf(stderr, "safecass: invariant failed: %s (%s:%d)\n", expression, file, line);

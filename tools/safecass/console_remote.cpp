@@ -92,20 +92,11 @@ int run_timeline_ice(const std::string& ice, const std::string& coordinator, con
     std::fprintf(stderr, "safecass timeline: %s\n", records.error().message.c_str());
     return 2;
   }
-  std::string text;
-  for (const introspect::HistoryEntry& r : *records) text += introspect::history_json(r) + "\n";
-  const timeline::HistoryParse parsed = timeline::parse_history(text);
-  if (!parsed.errors.empty()) {  // a record the page cannot draw: say which, write nothing
-    for (const timeline::HistoryError& e : parsed.errors) {
-      std::fprintf(stderr, "safecass timeline: coordinator '%s', record %d: %s\n", coordinator.c_str(), e.line,
-                   e.message.c_str());
-    }
-    return 2;
-  }
-  const int written = timeline::write_timeline_page(
-      parsed.records, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
+  const std::vector<timeline::HistoryRecord> drawn = timeline::records_of(*records);
+  const int written =
+      timeline::write_timeline_page(drawn, "coordinator " + coordinator + " (live, IceStorm " + ice + ")", html_out);
   if (written != 0) return written;
-  std::fprintf(stderr, "safecass timeline: %zu records of coordinator '%s' drawn in %s\n", parsed.records.size(),
+  std::fprintf(stderr, "safecass timeline: %zu records of coordinator '%s' drawn in %s\n", drawn.size(),
                coordinator.c_str(), html_out.c_str());
   return 0;
 }

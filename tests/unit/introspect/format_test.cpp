@@ -8,6 +8,7 @@
 
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/json/read.hpp"
 
 namespace safecass::introspect {
 namespace {
@@ -82,6 +83,94 @@ TEST(NamedRead, AReadIsFoundByItsConsoleCommandAndAnUnknownOneIsNotFound) {
   auto text = read_text("state summary", state_summary_json(robodoc_in_trouble()));
   ASSERT_TRUE(text) << text.error().message;
   EXPECT_EQ(*text, state_summary_text(robodoc_in_trouble()));
+}
+
+}  // namespace
+}  // namespace safecass::introspect
+
+namespace safecass::introspect {
+namespace {
+
+/// One entry of every kind, with and without a root cause (a sample, a non-finite value).
+std::vector<HistoryEntry> every_kind_of_entry() {
+  std::vector<HistoryEntry> out;
+  HistoryEntry e;
+  e.seq = 7;
+  e.time = std::chrono::microseconds(301000);
+  e.kind = RecordKind::Event;
+  e.outcome = Outcome::Raised;
+  e.component = "JR3";
+  e.machine = "JR3.s_A";
+  e.event = "EVT_FORCE_ERROR";
+  e.to = State::Error;
+  e.level = State::Error;
+  e.severity = 200;
+  ResolvedRoot root;
+  root.event = "EVT_FORCE_ERROR";
+  root.origin = "JR3.s_A";
+  root.time = e.time;
+  root.filter = "force_limit";
+  root.signal = "JR3.ForceNorm";
+  root.value = std::numeric_limits<double>::infinity();
+  root.sample_time = std::chrono::microseconds(300000);
+  root.injected = true;
+  e.root = root;
+  out.push_back(e);
+  HistoryEntry t = e;
+  t.kind = RecordKind::Transition;
+  t.outcome = Outcome::None;
+  t.level = State::Normal;
+  t.severity = 0;
+  t.mirror = true;
+  out.push_back(t);
+  HistoryEntry c;
+  c.kind = RecordKind::ComponentTransition;
+  c.component = "JR3";
+  c.from = State::Error;
+  c.to = State::Normal;
+  out.push_back(c);
+  HistoryEntry r;
+  r.kind = RecordKind::Reset;
+  r.machine = "JR3.s_A";
+  r.text = "console: cleared";
+  out.push_back(r);
+  HistoryEntry i;
+  i.kind = RecordKind::Injection;
+  i.machine = "JR3.s_A";
+  i.text = "deep injection into signal JR3.Fz: 50";
+  out.push_back(i);
+  return out;
+}
+
+TEST(HistoryRead, EveryEntryReadsBackFromItsHistoryLineAsItWas) {
+  for (const HistoryEntry& e : every_kind_of_entry()) {
+    const std::string line = history_json(e);
+    const json::JsonParse parsed = json::parse_json(line);
+    ASSERT_FALSE(parsed.error) << line;
+    auto back = history_entry_from_json(*parsed.value);
+    ASSERT_TRUE(back) << line << ": " << back.error().message;
+    EXPECT_EQ(*back, e) << line;
+    EXPECT_EQ(history_json(*back), line);
+  }
+}
+
+TEST(HistoryRead, ALineWithAWrongFieldSaysWhichAndWhy) {
+  const auto error_of = [](std::string_view line) {
+    const json::JsonParse parsed = json::parse_json(line);
+    if (parsed.error) return std::string("(not JSON)");
+    auto e = history_entry_from_json(*parsed.value);
+    return e ? std::string("(read)") : e.error().message;
+  };
+  EXPECT_EQ(error_of(R"({"t":1,"kind":"transition","machine":"A.s_A","from":"Normal","to":"Bad"})"),
+            R"("to" must be Normal, Warning or Error, not "Bad")");
+  EXPECT_EQ(error_of(R"({"t":1,"kind":"transition","from":"Normal","to":"Error"})"),
+            R"(missing "machine" (a transition record names its state machine))");
+  EXPECT_EQ(error_of(R"({"t":1,"kind":"event","machine":"A.s_A","from":"Normal","to":"Error","outcome":"won"})"),
+            R"(unknown outcome "won" (expected raised, override, joined, masked, cleared or ignored))");
+  EXPECT_EQ(error_of(R"({"t":1,"kind":"reset","machine":"A.s_A","from":"Error","to":"Normal","root":{"event":3}})"),
+            R"(in "root": "event" must be a string, not number)");
+  EXPECT_EQ(error_of(R"({"kind":"reset"})"), R"(missing "t")");
+  EXPECT_EQ(error_of(R"([1])"), "expected a JSON object (one record per line), not array");
 }
 
 }  // namespace

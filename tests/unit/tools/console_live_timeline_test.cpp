@@ -22,7 +22,7 @@ TEST(LiveTimeline, ARootCauseWithoutItsTimeIsShownWithoutAMadeUpTime) {
   const timeline::HistoryParse parsed = timeline::parse_history(live);
   ASSERT_TRUE(parsed.errors.empty()) << parsed.errors.front().message;
   ASSERT_EQ(parsed.records.size(), 1u);
-  EXPECT_TRUE(parsed.records[0].root.has_value());
+  EXPECT_TRUE(parsed.records[0].entry.root.has_value());
   EXPECT_FALSE(parsed.records[0].root_time_known);
   const std::string model = timeline::timeline_model_json(parsed.records);
   EXPECT_THAT(model, HasSubstr("root cause JR3.s_A:EVT_FORCE_ERROR"));

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/timeline/timeline.hpp"
 
@@ -73,6 +74,24 @@ TEST(Timeline, GoldenHistoryGivesTheExpectedLanesBarsAndMarkers) {
     std::ofstream(kSmallModel, std::ios::binary) << model << '\n';
   }
   EXPECT_EQ(model + '\n', read_text(kSmallModel));
+}
+
+TEST(Timeline, RecordsTakenFromMemoryDrawTheSamePageAsTheirHistoryLines) {
+  // A live coordinator's history and a trace's run are drawn from their records (records_of),
+  // with no JSON text in between: the same model as the history file of those records.
+  std::vector<introspect::HistoryEntry> entries;
+  for (const timeline::HistoryRecord& r : parse_ok(read_text(kSmall))) {
+    if (!r.overflow) entries.push_back(r.entry);
+  }
+  ASSERT_GT(entries.size(), 10u);
+  std::string lines;
+  for (const introspect::HistoryEntry& e : entries) lines += introspect::history_json(e) + "\n";
+  const std::vector<timeline::HistoryRecord> from_text = parse_ok(lines);
+  const std::vector<timeline::HistoryRecord> from_memory = timeline::records_of(entries);
+  EXPECT_EQ(timeline::timeline_model_json(from_memory), timeline::timeline_model_json(from_text));
+  // The page embeds each record as its history line (the file's numbers, not their shortest form).
+  const std::string page = timeline::render_timeline_page(from_memory, "t");
+  for (const introspect::HistoryEntry& e : entries) EXPECT_THAT(page, HasSubstr(introspect::history_json(e)));
 }
 
 TEST(Timeline, ModelIsValidJsonWithOneLanePerMachineAndOnePerComponent) {

@@ -24,7 +24,6 @@ namespace safecass::timeline {
 
 namespace {
 
-using Kind = HistoryRecord::Kind;
 using json::JsonValue;
 
 // ---------------------------------------------------------------------------------------------
@@ -90,166 +89,33 @@ std::string canonical(const JsonValue& v) {
 // ---------------------------------------------------------------------------------------------
 // Reading one line.
 
-std::optional<Kind> parse_kind(std::string_view s) {
-  if (s == "event") return Kind::Event;
-  if (s == "transition") return Kind::Transition;
-  if (s == "component-transition") return Kind::ComponentTransition;
-  if (s == "reset") return Kind::Reset;
-  if (s == "injection") return Kind::Injection;
-  if (s == "overflow") return Kind::Overflow;
-  return std::nullopt;
-}
-
-bool is_state(std::string_view s) { return s == "Normal" || s == "Warning" || s == "Error"; }
-
-bool is_outcome(std::string_view s) {
-  return s == "raised" || s == "override" || s == "joined" || s == "masked" || s == "cleared" || s == "ignored";
-}
-
-/// Reads the fields of one record object; the first problem is returned as a message.
-class FieldReader {
-public:
-  explicit FieldReader(const JsonValue& object) : object_(object) {}
-
-  const std::optional<std::string>& error() const { return error_; }
-
-  std::string string(std::string_view key, bool required) {
-    const JsonValue* v = object_.find(key);
-    if (v == nullptr) {
-      if (required) fail("missing \"" + std::string(key) + "\"");
-      return {};
-    }
-    if (!v->is_string()) {
-      fail("\"" + std::string(key) + "\" must be a string, not " + std::string(json::type_name(v->type)));
-      return {};
-    }
-    return v->string;
-  }
-
-  std::optional<double> number(std::string_view key, bool required) {
-    const JsonValue* v = object_.find(key);
-    if (v == nullptr) {
-      if (required) fail("missing \"" + std::string(key) + "\"");
-      return std::nullopt;
-    }
-    if (!v->is_number()) {
-      fail("\"" + std::string(key) + "\" must be a number, not " + std::string(json::type_name(v->type)));
-      return std::nullopt;
-    }
-    return v->number;
-  }
-
-  bool boolean(std::string_view key) {
-    const JsonValue* v = object_.find(key);
-    if (v == nullptr) return false;
-    if (!v->is_bool()) {
-      fail("\"" + std::string(key) + "\" must be true or false, not " + std::string(json::type_name(v->type)));
-      return false;
-    }
-    return v->boolean;
-  }
-
-  std::string state(std::string_view key, bool required) {
-    std::string s = string(key, required);
-    if (!s.empty() && !is_state(s))
-      fail("\"" + std::string(key) + "\" must be Normal, Warning or Error, not \"" + s + "\"");
-    return s;
-  }
-
-  void fail(std::string message) {
-    if (!error_) error_ = std::move(message);
-  }
-
-private:
-  const JsonValue& object_;
-  std::optional<std::string> error_;
-};
+/// A time in seconds as read ("0.301" reads back as 0.301: the nanoseconds divided, not
+/// multiplied by 1e-9, so that the page shows the file's numbers).
+double seconds(Time t) { return static_cast<double>(t.count()) / 1e9; }
+double t_of(const HistoryRecord& r) { return seconds(r.entry.time); }
+std::string state_of(State s) { return std::string(to_string(s)); }
 
 /// Checks and types one parsed line. Returns an error message, or nothing when the record is good.
 std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
-  if (!v.is_object())
-    return "expected a JSON object (one record per line), not " + std::string(json::type_name(v.type));
-  FieldReader f(v);
-  const std::string kind_text = f.string("kind", true);
-  if (f.error()) return f.error();
-  const auto kind = parse_kind(kind_text);
-  if (!kind) {
-    return "unknown record kind \"" + kind_text +
-           "\" (expected event, transition, component-transition, reset, injection or overflow)";
-  }
-  r.kind = *kind;
-  if (r.kind == Kind::Overflow) {
-    const auto dropped = f.number("dropped", true);
-    if (f.error()) return f.error();
-    if (*dropped < 0 || *dropped != std::floor(*dropped) || *dropped > 9.0e15) {
-      return "\"dropped\" must be a whole number of records, not " + num(*dropped);
+  if (const JsonValue* kind = v.is_object() ? v.find("kind") : nullptr;
+      kind != nullptr && kind->is_string() && kind->string == "overflow") {
+    r.overflow = true;
+    const JsonValue* dropped = v.find("dropped");
+    if (dropped == nullptr) return std::string("missing \"dropped\"");
+    if (!dropped->is_number()) {
+      return "\"dropped\" must be a number, not " + std::string(json::type_name(dropped->type));
     }
-    r.dropped = static_cast<std::uint64_t>(*dropped);
+    const double n = dropped->number;
+    if (n < 0 || n != std::floor(n) || n > 9.0e15)
+      return "\"dropped\" must be a whole number of records, not " + num(n);
+    r.dropped = static_cast<std::uint64_t>(n);
     return std::nullopt;
   }
-
-  r.t = f.number("t", true).value_or(0.0);
-  r.component = f.string("component", false);
-  r.machine = f.string("machine", false);
-  r.event = f.string("event", false);
-  r.text = f.string("text", false);
-  r.mirror = f.boolean("mirror");
-  const bool has_states = r.kind != Kind::Injection;
-  r.from = f.state("from", has_states);
-  r.to = f.state("to", has_states);
-  if (r.kind == Kind::Event) {
-    r.outcome = f.string("outcome", true);
-    if (!f.error() && !is_outcome(r.outcome)) {
-      f.fail("unknown outcome \"" + r.outcome + "\" (expected raised, override, joined, masked, cleared or ignored)");
-    }
-    r.level = f.state("level", false);
-    if (const auto sev = f.number("severity", false)) r.severity = static_cast<int>(std::clamp(*sev, 0.0, 255.0));
-  }
-  if (const JsonValue* root = v.find("root")) {
-    if (!root->is_object()) {
-      f.fail("\"root\" must be an object, not " + std::string(json::type_name(root->type)));
-    } else {
-      FieldReader rf(*root);
-      ResolvedRoot& root_cause = r.root.emplace();
-      root_cause.event = rf.string("event", true);
-      root_cause.origin = rf.string("origin", true);
-      r.root_time_known = root->find("t") != nullptr;
-      root_cause.time = seconds_to_time(rf.number("t", false).value_or(0.0));
-      root_cause.filter = rf.string("filter", false);
-      root_cause.signal = rf.string("signal", false);
-      // A non-finite sample (it raised EVT_INVALID_SAMPLE) is written as "nan", "inf" or "-inf".
-      const JsonValue* value = root->find("value");
-      if (value != nullptr && value->is_string() &&
-          (value->string == "nan" || value->string == "inf" || value->string == "-inf")) {
-        root_cause.value = value->string == "nan"
-                               ? std::numeric_limits<double>::quiet_NaN()
-                               : (value->string == "inf" ? 1.0 : -1.0) * std::numeric_limits<double>::infinity();
-      } else {
-        root_cause.value = rf.number("value", false).value_or(0.0);
-      }
-      root_cause.sample_time = seconds_to_time(rf.number("sample_t", false).value_or(0.0));
-      root_cause.injected = rf.boolean("injected");
-      if (rf.error()) f.fail("in \"root\": " + *rf.error());
-    }
-  }
-  if (f.error()) return f.error();
-
-  switch (r.kind) {
-    case Kind::Event:
-    case Kind::Transition:
-      if (r.machine.empty())
-        return std::string("missing \"machine\" (a ") + (r.kind == Kind::Event ? "event" : "transition") +
-               " record names its state machine)";
-      break;
-    case Kind::ComponentTransition:
-      if (r.component.empty()) return std::string("missing \"component\" (a component-transition names its component)");
-      break;
-    case Kind::Reset:
-    case Kind::Injection:
-      if (r.machine.empty() && r.component.empty()) return std::string("missing \"machine\" or \"component\"");
-      break;
-    case Kind::Overflow: break;
-  }
+  auto entry = introspect::history_entry_from_json(v);
+  if (!entry) return entry.error().message;
+  r.entry = std::move(*entry);
+  const JsonValue* root = v.find("root");
+  r.root_time_known = root == nullptr || root->find("t") != nullptr;
   return std::nullopt;
 }
 
@@ -257,8 +123,8 @@ std::optional<std::string> read_record(const JsonValue& v, HistoryRecord& r) {
 // The model.
 
 std::string component_of(const HistoryRecord& r) {
-  if (!r.component.empty()) return r.component;
-  return r.machine.substr(0, r.machine.find('.'));
+  if (!r.entry.component.empty()) return r.entry.component;
+  return r.entry.machine.substr(0, r.entry.machine.find('.'));
 }
 
 /// Where a machine's lane goes inside its component: framework, application, provided,
@@ -310,8 +176,8 @@ int severity_rank(std::string_view state) { return state == "Error" ? 2 : state 
 
 /// The root cause of a record; `clears` when the record ends that condition (an improving transition).
 std::string root_lines(const HistoryRecord& r, bool clears = false) {
-  if (!r.root) return {};
-  const ResolvedRoot& root = *r.root;
+  if (!r.entry.root) return {};
+  const ResolvedRoot& root = *r.entry.root;
   std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + root.name() +
                     (r.root_time_known ? " at " + secs(to_seconds(root.time)) + " s" : std::string());
   if (!root.filter.empty() || !root.signal.empty() || root.injected) {
@@ -334,44 +200,46 @@ std::string bar_tip(const Lane& lane, const Bar& b) {
          (b.to ? secs(*b.to) + " s (" + secs(*b.to - b.from) + " s)" : std::string("the end of the history"));
   if (b.entered == nullptr) return tip + "\nstate at the start of the history";
   const HistoryRecord& r = *b.entered;
-  if (!r.event.empty()) {
-    tip += "\nentered by " + r.event + " (history line " + std::to_string(r.line) + ")";
+  if (!r.entry.event.empty()) {
+    tip += "\nentered by " + r.entry.event + " (history line " + std::to_string(r.line) + ")";
   } else if (!b.reset_text.empty()) {
     tip += "\nentered by a reset (history line " + std::to_string(r.line) + ")\nreason: " + b.reset_text;
   } else {
     tip += "\nentered at history line " + std::to_string(r.line);
   }
-  return tip + root_lines(r, severity_rank(r.to) < severity_rank(r.from));
+  return tip + root_lines(r, severity_rank(state_of(r.entry.to)) < severity_rank(state_of(r.entry.from)));
 }
 
 std::string marker_tip(const Lane& lane, const Marker& m) {
   const HistoryRecord& r = *m.record;
   std::string head;
   if (m.kind == "ignored")
-    head = "Ignored completion " + r.event;
+    head = "Ignored completion " + r.entry.event;
   else if (m.kind == "masked")
-    head = "Masked onset " + r.event + " (below the current state)";
+    head = "Masked onset " + r.entry.event + " (below the current state)";
   else if (m.kind == "override")
-    head = "Override: onset " + r.event + " at the current level, now outstanding";
+    head = "Override: onset " + r.entry.event + " at the current level, now outstanding";
   else if (m.kind == "joined")
-    head = "Joined: onset " + r.event + " at the current level";
+    head = "Joined: onset " + r.entry.event + " at the current level";
   else if (m.kind == "cleared")
-    head = "Cleared " + (r.event.empty() ? "condition " + (r.root ? r.root->event : std::string()) : r.event) +
-           " (no state change)";
+    head =
+        "Cleared " +
+        (r.entry.event.empty() ? "condition " + (r.entry.root ? r.entry.root->event : std::string()) : r.entry.event) +
+        " (no state change)";
   else if (m.kind == "reset")
-    head = "Reset (state before: " + r.from + ")";
+    head = "Reset (state before: " + state_of(r.entry.from) + ")";
   else
     head = "Fault injection";
   std::string tip =
-      head + "\n" + lane.address + ", t = " + secs(r.t) + " s (history line " + std::to_string(r.line) + ")";
-  if (r.kind == Kind::Event) {
+      head + "\n" + lane.address + ", t = " + secs(t_of(r)) + " s (history line " + std::to_string(r.line) + ")";
+  if (r.entry.kind == RecordKind::Event) {
     tip += "\n";
-    if (!r.level.empty()) tip += "level " + r.level + ", ";
-    tip += "severity " + std::to_string(r.severity);
-    if (r.mirror) tip += ", mirrored from a provider";
+    tip += "level " + state_of(r.entry.level) + ", ";
+    tip += "severity " + std::to_string(r.entry.severity);
+    if (r.entry.mirror) tip += ", mirrored from a provider";
   }
   tip += root_lines(r);
-  if (!r.text.empty()) tip += (r.kind == Kind::Injection ? "\n" : "\nreason: ") + r.text;
+  if (!r.entry.text.empty()) tip += (r.entry.kind == RecordKind::Injection ? "\n" : "\nreason: ") + r.entry.text;
   return tip;
 }
 
@@ -386,15 +254,15 @@ std::string lane_json(const Lane& l) {
     bar.str("state", b.state).raw("from", num(b.from)).raw("to", b.to ? num(*b.to) : "null");
     if (b.entered != nullptr) {
       bar.integer("line", b.entered->line);
-      if (!b.entered->event.empty()) bar.str("event", b.entered->event);
+      if (!b.entered->entry.event.empty()) bar.str("event", b.entered->entry.event);
     }
     bars.raw(bar.str("tip", bar_tip(l, b)).text());
   }
   JsonArray markers(JsonArray::Layout::OnePerLine);
   for (const Marker& m : l.markers) {
     JsonObject marker;
-    marker.str("kind", m.kind).raw("t", num(m.record->t)).integer("line", m.record->line);
-    if (!m.record->event.empty()) marker.str("event", m.record->event);
+    marker.str("kind", m.kind).raw("t", num(t_of(*m.record))).integer("line", m.record->line);
+    if (!m.record->entry.event.empty()) marker.str("event", m.record->entry.event);
     markers.raw(marker.str("tip", marker_tip(l, m)).text());
   }
   return JsonObject()
@@ -444,16 +312,29 @@ HistoryParse parse_history(std::string_view text) {
       out.errors.push_back({line_no, std::move(*problem)});
       continue;
     }
-    if (r.kind != Kind::Overflow) {
-      if (last_t && r.t < *last_t) {
-        out.errors.push_back({line_no, "time " + secs(r.t) + " s is earlier than the previous record's (" +
+    if (!r.overflow) {
+      if (last_t && t_of(r) < *last_t) {
+        out.errors.push_back({line_no, "time " + secs(t_of(r)) + " s is earlier than the previous record's (" +
                                            secs(*last_t) + " s): records must be in time order"});
         continue;
       }
-      last_t = r.t;
+      last_t = t_of(r);
     }
-    r.json = std::move(*parsed.value);
+    r.json = canonical(*parsed.value);
     out.records.push_back(std::move(r));
+  }
+  return out;
+}
+
+std::vector<HistoryRecord> records_of(const std::vector<introspect::HistoryEntry>& entries) {
+  std::vector<HistoryRecord> out;
+  out.reserve(entries.size());
+  for (const introspect::HistoryEntry& e : entries) {
+    HistoryRecord r;
+    r.line = static_cast<int>(out.size()) + 1;
+    r.entry = e;
+    r.json = introspect::history_json(e);
+    out.push_back(std::move(r));
   }
   return out;
 }
@@ -478,9 +359,9 @@ Model build_model(const std::vector<HistoryRecord>& records) {
   Model m;
   bool any_time = false;
   for (const HistoryRecord& r : records) {
-    if (r.kind == Kind::Overflow) continue;
-    if (!any_time || r.t < m.start) m.start = r.t;
-    m.end = any_time ? std::max(m.end, r.t) : r.t;
+    if (r.overflow) continue;
+    if (!any_time || t_of(r) < m.start) m.start = t_of(r);
+    m.end = any_time ? std::max(m.end, t_of(r)) : t_of(r);
     any_time = true;
   }
   // Time 0 is the coordinator's start (clock epoch): show it unless a record comes before it.
@@ -500,18 +381,19 @@ Model build_model(const std::vector<HistoryRecord>& records) {
   };
   auto lane_of = [&](const HistoryRecord& r) -> Lane& {
     Group& g = group(component_of(r));
-    if (r.kind == Kind::ComponentTransition || r.machine.empty()) return g.extended;
-    Lane& l = g.machines[r.machine];
-    l.address = r.machine;
+    if (r.entry.kind == RecordKind::ComponentTransition || r.entry.machine.empty()) return g.extended;
+    Lane& l = g.machines[r.entry.machine];
+    l.address = r.entry.machine;
     return l;
   };
 
   // Pass 1: the lanes and the state each starts in (the "from" of its first record that has one).
   for (const HistoryRecord& r : records) {
-    if (r.kind == Kind::Overflow) continue;
+    if (r.overflow) continue;
     Lane& l = lane_of(r);
-    const bool tells_state = r.kind == Kind::ComponentTransition || (!l.component && r.kind != Kind::Injection);
-    if (!l.initial && tells_state) l.initial = r.from;
+    const bool tells_state =
+        r.entry.kind == RecordKind::ComponentTransition || (!l.component && r.entry.kind != RecordKind::Injection);
+    if (!l.initial && tells_state) l.initial = state_of(r.entry.from);
   }
   auto open = [&](Lane& l) {
     if (l.bars.empty()) l.bars.push_back(Bar{l.initial.value_or("Normal"), m.start, std::nullopt, nullptr, {}});
@@ -527,44 +409,44 @@ Model build_model(const std::vector<HistoryRecord>& records) {
   std::optional<double> previous_t;
   for (std::size_t i = 0; i < records.size(); ++i) {
     const HistoryRecord& r = records[i];
-    if (r.kind == Kind::Overflow) {
+    if (r.overflow) {
       std::optional<double> next_t;
       for (std::size_t j = i + 1; j < records.size(); ++j) {
-        if (records[j].kind != Kind::Overflow) {
-          next_t = records[j].t;
+        if (!records[j].overflow) {
+          next_t = t_of(records[j]);
           break;
         }
       }
       m.overflows.push_back({&r, previous_t.value_or(m.start), next_t});
       continue;
     }
-    previous_t = r.t;
+    previous_t = t_of(r);
     Lane& l = lane_of(r);
-    switch (r.kind) {
-      case Kind::Transition:
-      case Kind::ComponentTransition: {
+    switch (r.entry.kind) {
+      case RecordKind::Transition:
+      case RecordKind::ComponentTransition: {
         ++m.transitions;
-        l.bars.back().to = r.t;
-        Bar b{r.to, r.t, std::nullopt, &r, {}};
+        l.bars.back().to = t_of(r);
+        Bar b{state_of(r.entry.to), t_of(r), std::nullopt, &r, {}};
         const auto& resets = l.component ? component_reset : machine_reset;
         const auto it = resets.find(l.address);
-        if (r.event.empty() && it != resets.end() && it->second.t == r.t) b.reset_text = it->second.text;
+        if (r.entry.event.empty() && it != resets.end() && it->second.t == t_of(r)) b.reset_text = it->second.text;
         l.bars.push_back(std::move(b));
         break;
       }
-      case Kind::Event:
-        if (r.outcome == "ignored" || r.outcome == "masked" || r.outcome == "override" || r.outcome == "joined" ||
-            (r.outcome == "cleared" && r.from == r.to)) {
-          l.markers.push_back({r.outcome, &r});
+      case RecordKind::Event:
+        if (const Outcome o = r.entry.outcome; o == Outcome::Ignored || o == Outcome::Masked ||
+                                               o == Outcome::Override || o == Outcome::Joined ||
+                                               (o == Outcome::Cleared && r.entry.from == r.entry.to)) {
+          l.markers.push_back({std::string(to_string(o)), &r});
         }
         break;
-      case Kind::Reset:
+      case RecordKind::Reset:
         l.markers.push_back({"reset", &r});
-        machine_reset[l.address] = {r.t, r.text};
-        component_reset[component_of(r)] = {r.t, r.text};
+        machine_reset[l.address] = {t_of(r), r.entry.text};
+        component_reset[component_of(r)] = {t_of(r), r.entry.text};
         break;
-      case Kind::Injection: l.markers.push_back({"injection", &r}); break;
-      case Kind::Overflow: break;
+      case RecordKind::Injection: l.markers.push_back({"injection", &r}); break;
     }
   }
   for (const Group& g : m.groups) m.lanes += 1 + g.machines.size();
@@ -615,7 +497,7 @@ std::string model_json(const Model& m, std::size_t record_count) {
 
 std::string history_json(const std::vector<HistoryRecord>& records) {
   json::JsonArray lines(json::JsonArray::Layout::OnePerLine);
-  for (const HistoryRecord& r : records) lines.raw(canonical(r.json));
+  for (const HistoryRecord& r : records) lines.raw(r.json);
   return script_safe(lines.text());
 }
 

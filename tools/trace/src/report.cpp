@@ -240,7 +240,7 @@ std::string gap_table(const Trace& t) {
 }
 
 std::string excerpts(const Trace& t) {
-  std::map<std::string, std::vector<timeline::HistoryRecord>> parsed;  // by scenario
+  std::map<std::string, std::vector<timeline::HistoryRecord>> drawn;  // by scenario
   std::string out;
   for (const HazardTrace& h : t.hazards) {
     out += "<h3>" + introspect::markup_text(h.id) + " <span class=\"desc\">" + introspect::markup_text(h.description) +
@@ -259,13 +259,14 @@ std::string excerpts(const Trace& t) {
              introspect::markup_text(h.excerpt_scenario) + " (no history kept).</p>\n";
       continue;
     }
-    auto it = parsed.find(run->path);
-    if (it == parsed.end()) it = parsed.emplace(run->path, timeline::parse_history(run->history).records).first;
+    auto it = drawn.find(run->path);
+    if (it == drawn.end()) it = drawn.emplace(run->path, timeline::records_of(run->history)).first;
     const std::set<std::string> shown(h.excerpt_components.begin(), h.excerpt_components.end());
     std::vector<timeline::HistoryRecord> records;
     for (const timeline::HistoryRecord& r : it->second) {
-      const std::string component = !r.component.empty() ? r.component : r.machine.substr(0, r.machine.find('.'));
-      if (r.kind == timeline::HistoryRecord::Kind::Overflow || shown.count(component) != 0) records.push_back(r);
+      const introspect::HistoryEntry& e = r.entry;
+      const std::string component = !e.component.empty() ? e.component : e.machine.substr(0, e.machine.find('.'));
+      if (r.overflow || shown.count(component) != 0) records.push_back(r);
     }
     out += "<figure class=\"excerpt\" data-hazard=\"" + introspect::markup_text(h.id) + "\" data-scenario=\"" +
            introspect::markup_text(run->path) + "\" data-from=\"" + number_text(h.excerpt_from) + "\" data-to=\"" +

@@ -11,6 +11,7 @@
 
 #include "safecass/core/text.hpp"
 #include "safecass/filters/monitor.hpp"
+#include "safecass/introspect/model.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/native/system.hpp"
 #include "safecass/record/recorder.hpp"
@@ -374,10 +375,7 @@ private:
     sr.path = path;
     const bool keep_history = options_.histories;
     const auto id = rc.subscribe([&](const Record& r) {
-      if (keep_history) {
-        sr.history += record_to_json(r, rc);
-        sr.history += '\n';
-      }
+      if (keep_history) sr.history.push_back(introspect::history_entry(r, rc));
       if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent &&
           to_index(r.event) >= framework_event::kCount) {
         const Event& e = rc.event(r.event);

@@ -6,6 +6,7 @@
 /// not in the stream: they only update the condition's count and last time (DESIGN §2.4).
 
 #include <cstdint>
+#include <optional>
 #include <string_view>
 
 #include "safecass/core/condition.hpp"
@@ -52,5 +53,8 @@ struct Record {
 
 std::string_view to_string(RecordKind k) noexcept;
 std::string_view to_string(Outcome o) noexcept;
+/// The kind or outcome named exactly as to_string() names it (a history file's text).
+std::optional<RecordKind> parse_record_kind(std::string_view text) noexcept;
+std::optional<Outcome> parse_outcome(std::string_view text) noexcept;
 
 }  // namespace safecass

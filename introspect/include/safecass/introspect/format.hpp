@@ -15,6 +15,7 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/core/text.hpp"
 #include "safecass/introspect/model.hpp"
+#include "safecass/json/read.hpp"
 
 namespace safecass::introspect {
 
@@ -56,6 +57,15 @@ std::string history_text(const HistoryEntry& e, const TimeFormat& time);
 /// Deterministic: same entry, same bytes. A non-finite sample value is written as a string
 /// ("nan", "inf", "-inf") so that it is not lost.
 std::string history_json(const HistoryEntry& e);
+/// A history-file line read back (one parsed JSON object): the one reader of what history_json()
+/// writes, for the timeline and trace. "kind", "t" and, but for an injection, "from" and "to" are
+/// required, an event needs its "outcome" and "machine", a transition its "machine", a component
+/// transition its "component", a reset or injection one of them; "seq", "level", "severity",
+/// "mirror", "root" and "text" are optional. Errors (Parse): the first wrong field, said as
+/// `missing "machine" (...)` or `"to" must be Normal, Warning or Error, not "Bad"`; a root's
+/// prefixed `in "root": `. An overflow line ({"kind":"overflow"}) is not a record: its kind is
+/// unknown here.
+[[nodiscard]] Expected<HistoryEntry> history_entry_from_json(const json::JsonValue& line);
 /// Whether `watch` shows a record as it happens: transitions, resets, injections, and masked or
 /// ignored events.
 bool shown_while_watching(const HistoryEntry& e) noexcept;

@@ -3,7 +3,8 @@
 // self-contained static HTML page of Normal/Warning/Error swimlanes.
 //
 // The work is split in three pure steps, so that each can be tested on its own:
-//   parse_history()        text → typed records, every malformed line reported with its number;
+//   parse_history()        text → records, every malformed line reported with its number
+//                          (records_of(): records already in memory);
 //   timeline_model_json()  records → the page's data model (lanes, bars, markers, overflow bands);
 //   render_timeline_page() records → the whole page (template, CSS and JS embedded at build time).
 // run_timeline() reads a file, runs the three and writes the page.
@@ -14,32 +15,20 @@
 #include <string_view>
 #include <vector>
 
-#include "safecass/core/condition.hpp"
-#include "safecass/json/read.hpp"
+#include "safecass/introspect/model.hpp"
 
 namespace safecass::timeline {
 
-/// One line of a history file, checked and typed. Field names follow record_to_json()
-/// (record/src/recorder.cpp); a field absent from the line is empty (strings) or false/0.
+/// One record the timeline draws: a history record (introspect's HistoryEntry, the one record
+/// type: read from a history line by introspect::history_entry_from_json, or taken from a live
+/// coordinator) or an overflow mark the recorder wrote where it dropped records.
 struct HistoryRecord {
-  enum class Kind : std::uint8_t { Event, Transition, ComponentTransition, Reset, Injection, Overflow };
-
-  int line = 0;  ///< 1-based line number in the history file
-  Kind kind = Kind::Event;
-  double t = 0.0;         ///< seconds since the coordinator's clock started (not for Overflow)
-  std::string outcome;    ///< Event: raised, override, joined, masked, cleared, ignored
-  std::string component;  ///< component name
-  std::string machine;    ///< machine address (JR3.s_A, CONTROL.s_R.ForceData)
-  std::string event;
-  std::string from, to;  ///< Normal, Warning, Error
-  std::string level;     ///< Event: level of the condition added or removed
-  int severity = 0;
-  bool mirror = false;               ///< a condition mirrored along a connection
-  std::optional<ResolvedRoot> root;  ///< the root cause, when the record has one
-  bool root_time_known = false;      ///< the root's "t" was in the line
-  std::string text;                  ///< reason (ignored, reset "who: why") or injection description
-  std::uint64_t dropped = 0;         ///< Overflow: how many records the recorder dropped
-  json::JsonValue json;              ///< the line as read, re-emitted into the page
+  int line = 0;                    ///< 1-based line number in the history file (or the record's number)
+  bool overflow = false;           ///< {"kind":"overflow","dropped":N}: the recorder dropped records here
+  std::uint64_t dropped = 0;       ///< overflow: how many
+  introspect::HistoryEntry entry;  ///< every record but an overflow mark
+  bool root_time_known = true;     ///< false when the line's root cause had no "t"
+  std::string json;                ///< the record as JSON (the line as read), re-emitted into the page
 };
 
 struct HistoryError {
@@ -62,6 +51,10 @@ struct HistoryParse {
 /// last line (see HistoryParse::torn), which a killed recorder leaves behind. Overflow lines
 /// (`{"kind":"overflow","dropped":N}`) are records too.
 HistoryParse parse_history(std::string_view text);
+
+/// Records taken as they are (a live coordinator's history, a trace's run), numbered from 1, for
+/// timeline_model_json() and render_timeline_page(): no JSON text in between.
+std::vector<HistoryRecord> records_of(const std::vector<introspect::HistoryEntry>& entries);
 
 /// The data model the page draws, as JSON (deterministic; safe to embed in a <script> element):
 /// {"start","end","records","transitions","overflows":[...],"groups":[{"component","lanes":[

@@ -23,6 +23,7 @@
 
 #include "safecass/core/expected.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/model.hpp"
 #include "safecass/spec/diagnostics.hpp"
 
 namespace safecass::trace {
@@ -118,8 +119,8 @@ struct ScenarioResult {
   int checks = 0;
   std::vector<std::string> failures;
   double duration = 0.0;  ///< seconds of simulated time
-  /// The run's history as JSON lines (record_to_json), kept only with TraceOptions::histories.
-  std::string history;
+  /// The run's history, kept only with TraceOptions::histories.
+  std::vector<introspect::HistoryEntry> history;
 };
 
 struct SpecFile {
