@@ -3,15 +3,16 @@
 // run by the native runtime in real time.
 //
 //   peer_detection --out FILE [--signals N] [--rate R] [--seconds S] [--components K]
-//                  [--history H]
+//                  [--history H] [--order after-body|before-body]
 //
 // K components (default 1: one control loop) share the N signals. Each component's task runs at
-// R Hz: the native runtime runs its ACTIVE filters, then its body, which writes a new sample of
-// each of its signals (the control loop's measurements). Every 10 ms one signal, in turn, crosses
-// its threshold for 5 ms. Latency: the crossing sample's time → the N2E transition of its
-// component's s_A that the Threshold causes (observer on the coordinator's stream, same clock).
-// A sample written in one cycle is judged at the start of the next one, so the expected latency
-// is one period plus the filters' run. CPU: the process's user + system time over the run
+// R Hz: its body writes a new sample of each of its signals (the control loop's measurements) and
+// the native runtime runs its ACTIVE filters right after (native::FilterOrder::AfterBody), so each
+// sample is judged in the cycle that wrote it. Every 10 ms one signal, in turn, crosses its
+// threshold for 5 ms. Latency: the crossing sample's time → the N2E transition of its component's
+// s_A that the Threshold causes (observer on the coordinator's stream, same clock): the loop's
+// writes and the filters' run. With --order before-body (the filters first, then the body) a
+// sample waits for the next cycle: one period more. CPU: the process's user + system time over the run
 // (getrusage) / wall time, in % of one core; it includes writing the samples.
 // Writes {"cpu_percent", "p50_us", "p99_us", "max_us", "samples", ...} to FILE.
 
@@ -91,6 +92,7 @@ int main(int argc, char** argv) {
   int signals = 1000, components = 1;
   std::size_t history = 1024;  // samples each signal's history buffer keeps (the Monitor's default)
   double rate = 1000.0, seconds = 30.0;
+  native::FilterOrder order = native::FilterOrder::AfterBody;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--out")
@@ -103,6 +105,10 @@ int main(int argc, char** argv) {
       rate = std::clamp(std::atof(argv[i + 1]), 1.0, 10000.0);
     else if (key == "--history")
       history = static_cast<std::size_t>(std::clamp(std::atoi(argv[i + 1]), 2, 1 << 20));
+    else if (key == "--order" &&
+             (std::string(argv[i + 1]) == "after-body" || std::string(argv[i + 1]) == "before-body"))
+      order =
+          std::string(argv[i + 1]) == "after-body" ? native::FilterOrder::AfterBody : native::FilterOrder::BeforeBody;
     else if (key == "--seconds")
       seconds = std::max(1.0, std::atof(argv[i + 1]));
     else {
@@ -160,10 +166,13 @@ int main(int argc, char** argv) {
   native::Runtime runtime(monitor);
   const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate));
   for (Loop& loop : loops) {
-    (void)runtime.add_task(loop.component, period, [&loop, &crossing](Time now) {
-      const int hot = crossing.load(std::memory_order_relaxed);
-      for (const auto& [index, signal] : loop.signals) signal->push(now, index == hot ? 20.0 : 1.0);
-    });
+    (void)runtime.add_task(
+        loop.component, period,
+        [&loop, &crossing](Time now) {
+          const int hot = crossing.load(std::memory_order_relaxed);
+          for (const auto& [index, signal] : loop.signals) signal->push(now, index == hot ? 20.0 : 1.0);
+        },
+        order);
   }
   runtime.start();
   std::this_thread::sleep_for(500ms);  // warm-up: condition vectors grown, caches warm
@@ -200,10 +209,11 @@ int main(int argc, char** argv) {
                 "{\n  \"signals\": %d,\n  \"filters\": %d,\n  \"components\": %d,\n  \"rate_hz\": %.0f,\n"
                 "  \"seconds\": %.2f,\n  \"cpu_s\": %.3f,\n  \"cpu_percent\": %.2f,\n  %s,\n"
                 "  \"crossings\": %d,\n  \"period_us\": %.0f,\n  \"other_transitions\": %llu,\n"
-                "  \"signal_history\": %zu,\n"
+                "  \"signal_history\": %zu,\n  \"filter_order\": \"%s\",\n"
                 "  \"runtime\": \"native runtime, real time, ACTIVE filters in the component's task\"\n}\n",
                 signals, 3 * signals, components, rate, wall, cpu, cpu_percent, peers::latency_members(copy).c_str(),
-                crossings, period_us, static_cast<unsigned long long>(unexpected.load()), history);
+                crossings, period_us, static_cast<unsigned long long>(unexpected.load()), history,
+                order == native::FilterOrder::AfterBody ? "after-body" : "before-body");
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   return copy.size() >= static_cast<std::size_t>(crossings) * 9 / 10 ? 0 : 1;

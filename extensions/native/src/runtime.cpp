@@ -13,7 +13,7 @@ Runtime::Runtime(Monitor& monitor, Time monitor_period)
 
 Runtime::~Runtime() { stop(); }
 
-Expected<void> Runtime::add_task(ComponentId component, Time period, Body body) {
+Expected<void> Runtime::add_task(ComponentId component, Time period, Body body, FilterOrder order) {
   if (to_index(component) >= coordinator_.component_count()) {
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   }
@@ -23,14 +23,15 @@ Expected<void> Runtime::add_task(ComponentId component, Time period, Body body) 
     if (t.component == component)
       return fail(ErrorCode::InvalidArgument, "component '" + name + "' already has a task");
   }
-  tasks_.push_back(Task{component, period, std::move(body)});
+  tasks_.push_back(Task{component, period, std::move(body), order});
   return {};
 }
 
-Expected<void> Runtime::set_body(ComponentId component, Body body) {
+Expected<void> Runtime::set_body(ComponentId component, Body body, FilterOrder order) {
   for (Task& t : tasks_) {
     if (t.component == component) {
       t.body = std::move(body);
+      t.order = order;
       return {};
     }
   }
@@ -38,7 +39,16 @@ Expected<void> Runtime::set_body(ComponentId component, Body body) {
 }
 
 void Runtime::cycle(Task& task, Time now) noexcept {
-  monitor_.run_active(task.component, now);
+  if (task.order == FilterOrder::AfterBody) {
+    run_body(task, now);
+    monitor_.run_active(task.component, now);
+  } else {
+    monitor_.run_active(task.component, now);
+    run_body(task, now);
+  }
+}
+
+void Runtime::run_body(Task& task, Time now) noexcept {
   if (!task.body) return;
   const MachineId framework = coordinator_.framework_machine(task.component);
   try {

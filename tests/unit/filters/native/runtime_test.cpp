@@ -55,6 +55,24 @@ TEST(NativeRuntime, ARealTimeTaskRunsOncePerPeriodWithoutDrift) {
   EXPECT_GE(cycles.load(), 35) << "in " << elapsed << " s";
 }
 
+TEST(NativeRuntime, FiltersAfterTheBodyJudgeTheSampleItWroteInTheSameCycleAndBeforeItTheNextOne) {
+  for (const native::FilterOrder order : {native::FilterOrder::AfterBody, native::FilterOrder::BeforeBody}) {
+    System s;
+    ASSERT_TRUE(s.co.add_event(EventDef{"EVT_LIMIT", 50, {Transition::N2E}, "", false, "", ""}));
+    ASSERT_TRUE(s.monitor.add_filter(s.threshold(ExecutionMode::Active)));
+    native::Runtime runtime(s.monitor);
+    Signal* x = s.monitor.signals().find("LOOP.x");
+    ASSERT_TRUE(runtime.add_task(
+        s.component, 1ms, [x](Time now) { x->push(now, 20.0); }, order));
+    const MachineId app = s.co.application_machine(s.component);
+    runtime.step(Time{0});
+    EXPECT_EQ(s.co.state(app), order == native::FilterOrder::AfterBody ? State::Error : State::Normal)
+        << "after the cycle that wrote the sample";
+    runtime.step(Time{1ms});
+    EXPECT_EQ(s.co.state(app), State::Error) << "one cycle later, in either order";
+  }
+}
+
 TEST(NativeRuntime, TheMonitorThreadRunsOnlyWhenThereArePassiveFilters) {
   {
     System s;
