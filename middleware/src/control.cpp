@@ -110,14 +110,14 @@ public:
 
   void filterDinject(std::string token, std::string signal, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter dinject");
-    deep(std::move(signal), std::move(samples));
+    deep(signal, std::move(samples));
   }
 
   void filterDinload(std::string token, std::string signal, std::string text, const Ice::Current&) override {
     check_write(token, "filter dinload");
     auto samples = introspect::parse_sample_file("filter dinload " + signal + " text", text);
     if (!samples) raise(samples.error().code, samples.error().message);
-    deep(std::move(signal), std::move(*samples));
+    deep(signal, std::move(*samples));
   }
 
   wire::EventEntrySeq eventList(const Ice::Current& current) override {
@@ -214,7 +214,7 @@ private:
     ok_or_raise(locked([&] { return query_.apply(action); }));
   }
 
-  void deep(std::string signal, wire::SampleSeq samples) {
+  void deep(const std::string& signal, wire::SampleSeq samples) {
     const std::size_t n = samples.size();
     apply(introspect::InjectDeep{signal, std::move(samples)});
     c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(n) + " samples)");
