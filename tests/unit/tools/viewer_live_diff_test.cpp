@@ -158,12 +158,7 @@ public:
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view) const override {
     return std::vector<Explanation>{};
   }
-  [[nodiscard]] Expected<std::string> generate(std::string_view, std::string_view) override {
-    return fail(ErrorCode::Denied, "no");
-  }
-  [[nodiscard]] Expected<std::string> broadcast(std::string_view) override { return fail(ErrorCode::Denied, "no"); }
-  [[nodiscard]] Expected<std::string> inject(const InjectRequest&) override { return fail(ErrorCode::Denied, "no"); }
-  [[nodiscard]] Expected<std::string> reset(std::string_view, std::string_view) override {
+  [[nodiscard]] Expected<std::string> apply(const introspect::Action&) override {
     return fail(ErrorCode::Denied, "no");
   }
 

@@ -127,7 +127,7 @@ TEST(ViewerMiddlewareSource, CoordinatorsThatDoNotAnswerAreShownUnreachableWithT
   ASSERT_FALSE(why.has_value());
   EXPECT_THAT(why.error().message, HasSubstr("no component 'NOPE' in system 'robodoc'"));
   EXPECT_FALSE(s.explain("coordinator:arm").has_value());
-  auto done = s.generate("EVT_FORCE_ERROR", "JR3.s_A");
+  auto done = s.apply(introspect::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"});
   ASSERT_FALSE(done.has_value());
   EXPECT_THAT(done.error().message, HasSubstr("read-only"));
 }
@@ -165,19 +165,19 @@ TEST(ViewerMiddlewareSource, WritesNeedTheTokenOfTheCoordinatorThatOwnsTheTarget
   ::rmdir(dir.c_str());
   ASSERT_TRUE(source.has_value()) << source.error().message;
   MiddlewareSource& s = **source;
-  auto r = s.reset("PENDANT", "test");
+  auto r = s.apply(introspect::ResetState{"PENDANT", "viewer", "test"});
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("no token for coordinator 'ui'"));
-  r = s.generate("EVT_FORCE_ERROR", "JR3.s_A");  // robot has a token, but does not answer
+  r = s.apply(introspect::GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"});  // robot has a token, but does not answer
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("coordinator 'robot' is unreachable"));
-  r = s.inject({false, "no_such_filter", {{1.0}}});
+  r = s.apply(introspect::InjectShallow{"no_such_filter", {{1.0}}});
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("no filter 'no_such_filter'"));
-  r = s.inject({true, "JR3.NoSignal", {{1.0}}});
+  r = s.apply(introspect::InjectDeep{"JR3.NoSignal", {{1.0}}});
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("no signal 'JR3.NoSignal'"));
-  r = s.inject({false, "force_limit", {{1.0}}});  // robot's filter: routed to robot
+  r = s.apply(introspect::InjectShallow{"force_limit", {{1.0}}});  // robot's filter: routed to robot
   ASSERT_FALSE(r.has_value());
   EXPECT_THAT(r.error().message, HasSubstr("coordinator 'robot' is unreachable"));
 }

@@ -205,11 +205,11 @@ TEST_F(RecordedStory, ControlsRefuseWhatCannotBeDoneAndChangeNothing) {
   EXPECT_EQ(source->replay()->speed, 1.0);
   EXPECT_DOUBLE_EQ(source->now(), 0.5);
   // Read-only: the recording is what happened.
-  auto w = source->generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A");
+  auto w = source->apply(introspect::GenerateEvent{"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"});
   ASSERT_FALSE(w.has_value());
   EXPECT_THAT(w.error().message, HasSubstr("read-only"));
-  EXPECT_FALSE(source->reset("SYSTEM", "x").has_value());
-  EXPECT_FALSE(source->inject(InjectRequest{false, "force_limit", {{50.0}}}).has_value());
+  EXPECT_FALSE(source->apply(introspect::ResetState{"SYSTEM", "viewer", "x"}).has_value());
+  EXPECT_FALSE(source->apply(introspect::InjectShallow{"force_limit", {{50.0}}}).has_value());
   seek(*source, 2.0);
   c.op = ReplayControl::Op::Next;
   r = source->control(c);

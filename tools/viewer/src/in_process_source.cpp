@@ -157,35 +157,28 @@ Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view add
   return detail::local_explain(*impl_->query, impl_->co(), impl_->coordinators, address);
 }
 
-Expected<std::string> InProcessSource::generate(std::string_view event, std::string_view target) {
-  if (auto r = impl_->query->apply(introspect::GenerateEvent{std::string(event), std::string(target)}); !r)
-    return tl::unexpected(r.error());
-  return "generated " + std::string(event) + " on " + std::string(target) + " at t=" + seconds_text(impl_->now());
-}
-
-Expected<std::string> InProcessSource::broadcast(std::string_view event) {
-  if (auto r = impl_->query->apply(introspect::BroadcastEvent{std::string(event)}); !r)
-    return tl::unexpected(r.error());
-  return "broadcast " + std::string(event) + " at t=" + seconds_text(impl_->now());
-}
-
-Expected<std::string> InProcessSource::inject(const InjectRequest& request) {
-  if (request.samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
-  const std::string n = std::to_string(request.samples.size()) + (request.samples.size() == 1 ? " sample" : " samples");
-  if (!request.deep) {
-    if (auto r = impl_->query->apply(introspect::InjectShallow{request.target, request.samples}); !r)
-      return tl::unexpected(r.error());
-    return "queued " + n + " into filter " + request.target + " at t=" + seconds_text(impl_->now());
-  }
-  if (auto r = impl_->query->apply(introspect::InjectDeep{request.target, request.samples}); !r)
-    return tl::unexpected(r.error());
-  return "wrote " + n + " into signal " + request.target + " at t=" + seconds_text(impl_->now());
-}
-
-Expected<std::string> InProcessSource::reset(std::string_view target, std::string_view reason) {
-  if (auto r = impl_->query->apply(introspect::ResetState{std::string(target), "viewer", std::string(reason)}); !r)
-    return tl::unexpected(r.error());
-  return "reset " + std::string(target) + " at t=" + seconds_text(impl_->now()) + " (" + std::string(reason) + ")";
+Expected<std::string> InProcessSource::apply(const introspect::Action& action) {
+  if (auto r = impl_->query->apply(action); !r) return tl::unexpected(r.error());
+  const std::string at = " at t=" + seconds_text(impl_->now());
+  const auto samples = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); };
+  return std::visit(
+      [&](const auto& a) -> std::string {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, introspect::GenerateEvent>) {
+          return "generated " + a.event + " on " + a.target + at;
+        } else if constexpr (std::is_same_v<A, introspect::BroadcastEvent>) {
+          return "broadcast " + a.event + at;
+        } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
+          return "reset " + a.target + at + " (" + a.why + ")";
+        } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
+          return "queued " + samples(a.samples.size()) + " into filter " + a.filter + at;
+        } else if constexpr (std::is_same_v<A, introspect::InjectDeep>) {
+          return "wrote " + samples(a.samples.size()) + " into signal " + a.signal + at;
+        } else {
+          return "pushed a sample of " + a.signal + at;
+        }
+      },
+      action);
 }
 
 }  // namespace safecass::viewer

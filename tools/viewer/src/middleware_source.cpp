@@ -457,24 +457,44 @@ Expected<std::vector<Explanation>> MiddlewareSource::explain(std::string_view ad
   return all;
 }
 
-Expected<std::string> MiddlewareSource::generate(std::string_view event, std::string_view target) {
-  auto w = impl_->writer(target, "event generate");
-  if (!w) return tl::unexpected(w.error());
-  if (auto r = w->second->apply(introspect::GenerateEvent{std::string(event), std::string(target)}); !r)
-    return tl::unexpected(r.error());
-  return "generated " + std::string(event) + " on " + std::string(target) + " (coordinator " + w->first->name +
-         ") at " + wall_now();
+Expected<std::string> MiddlewareSource::apply(const introspect::Action& action) {
+  return std::visit(
+      [&](const auto& a) -> Expected<std::string> {
+        using A = std::decay_t<decltype(a)>;
+        if constexpr (std::is_same_v<A, introspect::GenerateEvent>) {
+          return generate(a.event, a.target);
+        } else if constexpr (std::is_same_v<A, introspect::BroadcastEvent>) {
+          return broadcast(a.event);
+        } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
+          return reset(a);
+        } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
+          return inject(false, a.filter, a.samples);
+        } else if constexpr (std::is_same_v<A, introspect::InjectDeep>) {
+          return inject(true, a.signal, a.samples);
+        } else {
+          return fail(ErrorCode::InvalidArgument, "a sample of " + a.signal +
+                                                      " cannot be pushed to a live coordinator: its samples come from "
+                                                      "its own framework");
+        }
+      },
+      action);
 }
 
-Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
+Expected<std::string> MiddlewareSource::generate(const std::string& event, const std::string& target) {
+  auto w = impl_->writer(target, "event generate");
+  if (!w) return tl::unexpected(w.error());
+  if (auto r = w->second->apply(introspect::GenerateEvent{event, target}); !r) return tl::unexpected(r.error());
+  return "generated " + event + " on " + target + " (coordinator " + w->first->name + ") at " + wall_now();
+}
+
+Expected<std::string> MiddlewareSource::broadcast(const std::string& event) {
   // Every coordinator defines every event of the system, so the first refusal (an unknown event,
   // a wrong token) comes before anything was changed.
   std::string done;
   std::string failed;
   for (auto& l : impl_->links) {
     auto w = impl_->writer_of(*l);
-    auto r = w ? w->second->apply(introspect::BroadcastEvent{std::string(event)})
-               : Expected<void>(tl::unexpected(w.error()));
+    auto r = w ? w->second->apply(introspect::BroadcastEvent{event}) : Expected<void>(tl::unexpected(w.error()));
     if (!r) {
       if (done.empty()) return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message);
       failed += "; not on " + l->name + ": " + r.error().message;
@@ -482,53 +502,53 @@ Expected<std::string> MiddlewareSource::broadcast(std::string_view event) {
     }
     done += (done.empty() ? "" : ", ") + l->name;
   }
-  return "broadcast " + std::string(event) + " on coordinators " + done + " at " + wall_now() + failed;
+  return "broadcast " + event + " on coordinators " + done + " at " + wall_now() + failed;
 }
 
-Expected<std::string> MiddlewareSource::inject(const InjectRequest& request) {
-  if (request.samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
-  const std::string n = std::to_string(request.samples.size()) + (request.samples.size() == 1 ? " sample" : " samples");
+Expected<std::string> MiddlewareSource::inject(bool deep, const std::string& target,
+                                               const std::vector<std::vector<double>>& samples) {
+  if (samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
+  const std::string n = std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples");
   MiddlewareLink* owner = nullptr;
-  if (request.deep) {
-    owner = impl_->owner(request.target);
-    if (owner == nullptr || owner->local->monitor().signals().find(request.target) == nullptr) {
-      return fail(ErrorCode::NotFound, "no signal '" + request.target + "' (signals are written Component.signal)");
+  if (deep) {
+    owner = impl_->owner(target);
+    if (owner == nullptr || owner->local->monitor().signals().find(target) == nullptr) {
+      return fail(ErrorCode::NotFound, "no signal '" + target + "' (signals are written Component.signal)");
     }
   } else {
     for (auto& l : impl_->links) {
-      if (l->local->monitor().find_filter(request.target) != nullptr) owner = l.get();
+      if (l->local->monitor().find_filter(target) != nullptr) owner = l.get();
     }
-    if (owner == nullptr) return fail(ErrorCode::NotFound, "no filter '" + request.target + "'");
+    if (owner == nullptr) return fail(ErrorCode::NotFound, "no filter '" + target + "'");
   }
   auto w = impl_->writer_of(*owner);
   if (!w) return tl::unexpected(w.error());
-  auto r = request.deep ? w->second->apply(introspect::InjectDeep{request.target, request.samples})
-                        : w->second->apply(introspect::InjectShallow{request.target, request.samples});
+  auto r = deep ? w->second->apply(introspect::InjectDeep{target, samples})
+                : w->second->apply(introspect::InjectShallow{target, samples});
   if (!r) return tl::unexpected(r.error());
-  return (request.deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + request.target +
-         " (coordinator " + owner->name + ") at " + wall_now();
+  return (deep ? "wrote " + n + " into signal " : "queued " + n + " into filter ") + target + " (coordinator " +
+         owner->name + ") at " + wall_now();
 }
 
-Expected<std::string> MiddlewareSource::reset(std::string_view target, std::string_view reason) {
+Expected<std::string> MiddlewareSource::reset(const introspect::ResetState& reset) {
+  const std::string& target = reset.target;
+  const std::string& reason = reset.why;
   if (target == "SYSTEM") {
     std::string done;
     for (auto& l : impl_->links) {
       auto w = impl_->writer_of(*l);
-      auto r = w ? w->second->apply(introspect::ResetState{"SYSTEM", "viewer", std::string(reason)})
-                 : Expected<void>(tl::unexpected(w.error()));
+      auto r = w ? w->second->apply(reset) : Expected<void>(tl::unexpected(w.error()));
       if (!r)
         return fail(r.error().code, "coordinator '" + l->name + "': " + r.error().message +
                                         (done.empty() ? "" : " (reset done on " + done + ")"));
       done += (done.empty() ? "" : ", ") + l->name;
     }
-    return "reset SYSTEM (coordinators " + done + ") at " + wall_now() + " (" + std::string(reason) + ")";
+    return "reset SYSTEM (coordinators " + done + ") at " + wall_now() + " (" + reason + ")";
   }
   auto w = impl_->writer(target, "reset");
   if (!w) return tl::unexpected(w.error());
-  if (auto r = w->second->apply(introspect::ResetState{std::string(target), "viewer", std::string(reason)}); !r)
-    return tl::unexpected(r.error());
-  return "reset " + std::string(target) + " (coordinator " + w->first->name + ") at " + wall_now() + " (" +
-         std::string(reason) + ")";
+  if (auto r = w->second->apply(reset); !r) return tl::unexpected(r.error());
+  return "reset " + target + " (coordinator " + w->first->name + ") at " + wall_now() + " (" + reason + ")";
 }
 
 }  // namespace safecass::viewer

@@ -448,12 +448,15 @@ std::string Protocol::handle(std::string_view message) {
     if (problem.empty()) token = token_of();
     if (!problem.empty()) return error_reply(r.id, r.op, problem);
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
-    auto done = broadcast ? source_.broadcast(event) : source_.generate(event, target);
+    auto done = broadcast ? source_.apply(introspect::BroadcastEvent{event})
+                          : source_.apply(introspect::GenerateEvent{event, target});
     if (!done) return error_reply(r.id, r.op, done.error().message);
     return reply(r).str("text", *done).text();
   }
   if (r.op == "inject") {
-    InjectRequest request;
+    bool deep = false;
+    std::string target;
+    std::vector<std::vector<double>> samples;
     problem = check_keys(object, {"id", "op", "filter", "signal", "samples", "token"});
     const bool has_filter = object.find("filter") != nullptr;
     const bool has_signal = object.find("signal") != nullptr;
@@ -463,14 +466,15 @@ std::string Protocol::handle(std::string_view message) {
           "history)";
     }
     if (problem.empty()) {
-      request.deep = has_signal;
-      problem = get_string(object, has_signal ? "signal" : "filter", request.target);
+      deep = has_signal;
+      problem = get_string(object, has_signal ? "signal" : "filter", target);
     }
-    if (problem.empty()) problem = get_samples(object, request.samples);
+    if (problem.empty()) problem = get_samples(object, samples);
     if (problem.empty()) token = token_of();
     if (!problem.empty()) return error_reply(r.id, r.op, problem);
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
-    auto done = source_.inject(request);
+    auto done = deep ? source_.apply(introspect::InjectDeep{target, std::move(samples)})
+                     : source_.apply(introspect::InjectShallow{target, std::move(samples)});
     if (!done) return error_reply(r.id, r.op, done.error().message);
     return reply(r).str("text", *done).text();
   }
@@ -483,7 +487,7 @@ std::string Protocol::handle(std::string_view message) {
     if (problem.empty()) token = token_of();
     if (!problem.empty()) return error_reply(r.id, r.op, problem);
     if (std::string refused = refuse_write(r.id, r.op, token); !refused.empty()) return refused;
-    auto done = source_.reset(target, reason);
+    auto done = source_.apply(introspect::ResetState{target, "viewer", reason});
     if (!done) return error_reply(r.id, r.op, done.error().message);
     return reply(r).str("text", *done).text();
   }

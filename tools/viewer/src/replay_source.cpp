@@ -188,10 +188,7 @@ tl::unexpected<Error> read_only() {
 }
 }  // namespace
 
-Expected<std::string> ReplaySource::generate(std::string_view, std::string_view) { return read_only(); }
-Expected<std::string> ReplaySource::broadcast(std::string_view) { return read_only(); }
-Expected<std::string> ReplaySource::inject(const InjectRequest&) { return read_only(); }
-Expected<std::string> ReplaySource::reset(std::string_view, std::string_view) { return read_only(); }
+Expected<std::string> ReplaySource::apply(const introspect::Action&) { return read_only(); }
 
 std::optional<ReplayView> ReplaySource::replay() const {
   ReplayView r;

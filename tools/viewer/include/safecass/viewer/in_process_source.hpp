@@ -45,10 +45,7 @@ public:
   bool running() const override;
   std::vector<std::string> take_records() override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
-  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
-  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
-  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  [[nodiscard]] Expected<std::string> apply(const introspect::Action& action) override;
 
   /// Advances the simulated clock to `t` (seconds) at once, ignoring the wall clock; later polls
   /// continue from there. For tests.

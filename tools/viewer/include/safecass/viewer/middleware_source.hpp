@@ -75,10 +75,9 @@ public:
   /// Changes when poll() took new state lists or statuses: they arrive after their records.
   std::uint64_t view_version() const override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
-  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
-  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
-  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  /// Sent to the coordinator that owns the action's target (a broadcast and a reset of SYSTEM: to
+  /// every coordinator), with that coordinator's token.
+  [[nodiscard]] Expected<std::string> apply(const introspect::Action& action) override;
 
   /// The status of a coordinator: "" (answering), "connecting", "unreachable" or "lost".
   /// For tests and the start-up message.
@@ -87,6 +86,11 @@ public:
 private:
   struct Impl;
   explicit MiddlewareSource(std::unique_ptr<Impl> impl);
+  [[nodiscard]] Expected<std::string> generate(const std::string& event, const std::string& target);
+  [[nodiscard]] Expected<std::string> broadcast(const std::string& event);
+  [[nodiscard]] Expected<std::string> inject(bool deep, const std::string& target,
+                                             const std::vector<std::vector<double>>& samples);
+  [[nodiscard]] Expected<std::string> reset(const introspect::ResetState& reset);
   std::unique_ptr<Impl> impl_;
 };
 

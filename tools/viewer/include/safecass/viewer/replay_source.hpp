@@ -50,10 +50,7 @@ public:
   std::vector<std::string> take_records() override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
   /// Refused: a replay is read-only.
-  [[nodiscard]] Expected<std::string> generate(std::string_view event, std::string_view target) override;
-  [[nodiscard]] Expected<std::string> broadcast(std::string_view event) override;
-  [[nodiscard]] Expected<std::string> inject(const InjectRequest& request) override;
-  [[nodiscard]] Expected<std::string> reset(std::string_view target, std::string_view reason) override;
+  [[nodiscard]] Expected<std::string> apply(const introspect::Action& action) override;
 
   std::optional<ReplayView> replay() const override;
   [[nodiscard]] Expected<std::string> control(const ReplayControl& control) override;

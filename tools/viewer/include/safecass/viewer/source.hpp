@@ -19,6 +19,7 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
 #include "safecass/core/state.hpp"
+#include "safecass/introspect/action.hpp"
 
 namespace safecass::viewer {
 
@@ -94,14 +95,6 @@ struct SystemView {
   std::int64_t wall_offset_ns = 0;
 };
 
-/// A fault-injection request: shallow into one filter's private input, or deep into a signal's
-/// history (seen by every consumer).
-struct InjectRequest {
-  bool deep = false;
-  std::string target;  ///< filter name (shallow) or signal "Component.signal" (deep)
-  std::vector<std::vector<double>> samples;
-};
-
 class ViewSource {
 public:
   virtual ~ViewSource() = default;
@@ -121,12 +114,11 @@ public:
   /// root cause and hop path. Errors: NotFound / Parse for an unknown or malformed address.
   [[nodiscard]] virtual Expected<std::vector<Explanation>> explain(std::string_view address) const = 0;
 
-  // Write operations. The server checks write access and the token before calling them; each
-  // returns one line saying what was done, or an error that says what is wrong and changes nothing.
-  [[nodiscard]] virtual Expected<std::string> generate(std::string_view event, std::string_view target) = 0;
-  [[nodiscard]] virtual Expected<std::string> broadcast(std::string_view event) = 0;
-  [[nodiscard]] virtual Expected<std::string> inject(const InjectRequest& request) = 0;
-  [[nodiscard]] virtual Expected<std::string> reset(std::string_view target, std::string_view reason) = 0;
+  /// Applies an operator's write (generate, broadcast, reset, shallow or deep injection) through
+  /// the one action path (introspect::apply, in this process or at the coordinator that owns its
+  /// target). The server checks write access and the token first. Returns one line saying what was
+  /// done, or an error that says what is wrong and changes nothing.
+  [[nodiscard]] virtual Expected<std::string> apply(const introspect::Action& action) = 0;
 
   // A replay (ReplaySource) can be moved in time; other sources are not replays.
   /// Where the replay stands; nullopt for a source that is not a replay.
