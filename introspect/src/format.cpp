@@ -291,15 +291,15 @@ std::string explanation_json(const std::string& address, const Explanation& e) {
       .boolean("mirror", e.mirror)
       .boolean("outstanding", e.outstanding)
       .integer("count", e.count)
-      .num("first", to_seconds(e.first))
-      .num("last", to_seconds(e.last))
+      .seconds("first", e.first)
+      .seconds("last", e.last)
       .str("root_event", e.root.event)
       .str("root_origin", e.root.origin)
-      .num("root_t", to_seconds(e.root.time))
+      .seconds("root_t", e.root.time)
       .opt("hazard", e.hazard);
   if (!e.root.filter.empty()) j.str("filter", e.root.filter);
   if (!e.root.signal.empty())
-    j.str("signal", e.root.signal).num("value", e.root.value).num("sample_t", to_seconds(e.root.sample_time));
+    j.str("signal", e.root.signal).num("value", e.root.value).seconds("sample_t", e.root.sample_time);
   if (e.root.injected) j.boolean("injected", true);
   return j.strings("path", e.path).text();
 }

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/json/write.hpp"
 
@@ -118,29 +119,6 @@ std::string view_to_json(const SystemView& v, const std::optional<ReplayView>& r
                                 }))
       .raw("clock", clock_json(v));
   if (replay) o.raw("replay", replay_json(*replay));
-  return o.text();
-}
-
-std::string explanation_to_json(const Explanation& e) {
-  Object o;
-  o.str("machine", e.machine)
-      .str("event", e.event)
-      .raw("level", state_text(e.level))
-      .integer("severity", e.severity)
-      .boolean("mirror", e.mirror)
-      .boolean("outstanding", e.outstanding)
-      .integer("count", e.count)
-      .raw("first", seconds(to_seconds(e.first)))
-      .raw("last", seconds(to_seconds(e.last)))
-      .str("root_event", e.root.event)
-      .str("root_origin", e.root.origin)
-      .raw("root_t", seconds(to_seconds(e.root.time)));
-  if (!e.hazard.empty()) o.str("hazard", e.hazard);
-  if (!e.root.filter.empty()) o.str("filter", e.root.filter);
-  if (!e.root.signal.empty())
-    o.str("signal", e.root.signal).num("value", e.root.value).raw("sample_t", seconds(to_seconds(e.root.sample_time)));
-  if (e.root.injected) o.boolean("injected", true);
-  o.raw("path", array(e.path, [](const std::string& hop) { return quote(hop); }));
   return o.text();
 }
 
@@ -435,7 +413,10 @@ std::string Protocol::handle(std::string_view message) {
     Object o = reply(r);
     o.str("address", address);
     if (it != states.end()) o.raw("state", state_text(it->second.first)).str("outstanding", it->second.second);
-    return o.raw("conditions", array(*conditions, explanation_to_json)).text();
+    return o
+        .raw("conditions",
+             array(*conditions, [&](const Explanation& e) { return introspect::explanation_json(address, e); }))
+        .text();
   }
   if (r.op == "generate" || r.op == "broadcast") {
     std::string event;
