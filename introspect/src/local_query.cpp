@@ -367,16 +367,24 @@ const NamedRead* find_read(std::string_view name) noexcept {
   return nullptr;
 }
 
+namespace {
+/// The read named `name`. Errors: NotFound.
+[[nodiscard]] Expected<const NamedRead*> named_read(std::string_view name) {
+  if (const NamedRead* r = find_read(name)) return r;
+  return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
+}
+}  // namespace
+
 [[nodiscard]] Expected<std::string> read_text(std::string_view name, std::string_view json) {
-  const NamedRead* r = find_read(name);
-  if (r == nullptr) return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
-  return r->text(json);
+  auto r = named_read(name);
+  if (!r) return tl::unexpected(r.error());
+  return (*r)->text(json);
 }
 
 Expected<std::string> LocalQuery::read(std::string_view name, const std::vector<std::string>& args) {
-  const NamedRead* r = find_read(name);
-  if (r == nullptr) return fail(ErrorCode::NotFound, "no read '" + std::string(name) + "'");
-  return r->answer(*this, args);
+  auto r = named_read(name);
+  if (!r) return tl::unexpected(r.error());
+  return (*r)->answer(*this, args);
 }
 
 }  // namespace safecass::introspect
