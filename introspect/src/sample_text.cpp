@@ -6,6 +6,8 @@
 
 namespace safecass::introspect {
 
+std::string count_text(std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); }
+
 std::optional<double> parse_number(std::string_view s) {
   if (!s.empty() && s.front() == '+') s.remove_prefix(1);
   if (s.empty()) return std::nullopt;

@@ -66,8 +66,6 @@ std::optional<long> parse_count(std::string_view s) {
   return v;
 }
 
-std::string count_text(std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); }
-
 // ---- the command table ---------------------------------------------------------------------------
 
 const std::vector<CommandSpec>& commands() {

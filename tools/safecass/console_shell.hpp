@@ -29,6 +29,7 @@ std::string_view trim(std::string_view s);
 // Tables and JSON: the read model's one formatter and JSON writer (numbers and times:
 // safecass/core/text.hpp, found in the enclosing namespace).
 using introspect::columns;
+using introspect::count_text;
 using introspect::parse_number;
 using introspect::parse_sample;
 using introspect::parse_sample_file;
@@ -44,8 +45,6 @@ inline std::string json_list(const std::vector<std::string>& items) { return jso
 [[nodiscard]] Expected<std::vector<std::string>> tokenize(std::string_view line);
 /// A whole number above 0.
 std::optional<long> parse_count(std::string_view s);
-/// "1 sample", "3 samples".
-std::string count_text(std::size_t n);
 
 // ---- the command table ---------------------------------------------------------------------------
 

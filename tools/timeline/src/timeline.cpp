@@ -172,21 +172,19 @@ struct LastReset {
   std::string text;
 };
 
-int severity_rank(std::string_view state) { return state == "Error" ? 2 : state == "Warning" ? 1 : 0; }
-
 /// The root cause of a record; `clears` when the record ends that condition (an improving transition).
 std::string root_lines(const HistoryRecord& r, bool clears = false) {
   if (!r.entry.root) return {};
   const ResolvedRoot& root = *r.entry.root;
   std::string out = std::string(clears ? "\nclears root cause " : "\nroot cause ") + root.name() +
-                    (r.root_time_known ? " at " + secs(to_seconds(root.time)) + " s" : std::string());
+                    (r.root_time_known ? " at " + secs(seconds(root.time)) + " s" : std::string());
   if (!root.filter.empty() || !root.signal.empty() || root.injected) {
     out += "\n";
     std::string detail;
     if (!root.filter.empty()) detail += "filter " + root.filter;
     if (!root.signal.empty()) {
       detail += (detail.empty() ? "" : ", ") + root.signal + " = " + num(root.value) + " (sample at " +
-                secs(to_seconds(root.sample_time)) + " s)";
+                secs(seconds(root.sample_time)) + " s)";
     }
     if (root.injected) detail += (detail.empty() ? "" : ", ") + std::string("injected sample");
     out += detail;
@@ -207,7 +205,7 @@ std::string bar_tip(const Lane& lane, const Bar& b) {
   } else {
     tip += "\nentered at history line " + std::to_string(r.line);
   }
-  return tip + root_lines(r, severity_rank(state_of(r.entry.to)) < severity_rank(state_of(r.entry.from)));
+  return tip + root_lines(r, r.entry.to < r.entry.from);
 }
 
 std::string marker_tip(const Lane& lane, const Marker& m) {

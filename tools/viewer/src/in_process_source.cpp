@@ -12,6 +12,7 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/introspect/sample_text.hpp"
 #include "safecass/json/write.hpp"
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/load.hpp"
@@ -160,7 +161,6 @@ Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view add
 Expected<std::string> InProcessSource::apply(const introspect::Action& action) {
   if (auto r = impl_->query->apply(action); !r) return tl::unexpected(r.error());
   const std::string at = " at t=" + seconds_text(impl_->now());
-  const auto samples = [](std::size_t n) { return std::to_string(n) + (n == 1 ? " sample" : " samples"); };
   return std::visit(
       [&](const auto& a) -> std::string {
         using A = std::decay_t<decltype(a)>;
@@ -171,9 +171,9 @@ Expected<std::string> InProcessSource::apply(const introspect::Action& action) {
         } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
           return "reset " + a.target + at + " (" + a.why + ")";
         } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
-          return "queued " + samples(a.samples.size()) + " into filter " + a.filter + at;
+          return "queued " + introspect::count_text(a.samples.size()) + " into filter " + a.filter + at;
         } else if constexpr (std::is_same_v<A, introspect::InjectDeep>) {
-          return "wrote " + samples(a.samples.size()) + " into signal " + a.signal + at;
+          return "wrote " + introspect::count_text(a.samples.size()) + " into signal " + a.signal + at;
         } else {
           return "pushed a sample of " + a.signal + at;
         }

@@ -15,6 +15,7 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
+#include "safecass/introspect/sample_text.hpp"
 #include "safecass/json/write.hpp"
 #include "safecass/middleware/client.hpp"
 #include "safecass/middleware/node.hpp"
@@ -508,7 +509,7 @@ Expected<std::string> MiddlewareSource::broadcast(const std::string& event) {
 Expected<std::string> MiddlewareSource::inject(bool deep, const std::string& target,
                                                const std::vector<std::vector<double>>& samples) {
   if (samples.empty()) return fail(ErrorCode::InvalidArgument, "no samples to inject");
-  const std::string n = std::to_string(samples.size()) + (samples.size() == 1 ? " sample" : " samples");
+  const std::string n = introspect::count_text(samples.size());
   MiddlewareLink* owner = nullptr;
   if (deep) {
     owner = impl_->owner(target);

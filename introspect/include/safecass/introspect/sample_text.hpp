@@ -15,6 +15,8 @@
 
 namespace safecass::introspect {
 
+/// "1 sample", "3 samples": how a confirmation counts the samples of an injection.
+std::string count_text(std::size_t n);
 /// A number as typed ("+1", "2.5e-3", "nan"): nullopt when the whole text is not one.
 std::optional<double> parse_number(std::string_view s);
 /// Finite numbers separated by commas and/or blanks. Errors (Parse) name the offending text.
