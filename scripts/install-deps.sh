@@ -17,8 +17,8 @@ packages=(
   libexpected-dev libcli11-dev nlohmann-json3-dev libedit-dev libfmt-dev
   clang libclang-rt-14-dev
 )
-# `make lint` (scripts/lint): clang-format and clang-tidy 14.
-packages+=(clang-format clang-tidy)
+# `make lint` (scripts/lint): clang-format and clang-tidy 14; Universal Ctags for the function-length check.
+packages+=(clang-format clang-tidy universal-ctags)
 # ROS 2 over DDS (extensions/dds, examples/dds_robodoc, `make ros2-demo`): Eclipse Cyclone DDS's C
 # library and its IDL compiler (idlc) and tools (ddsperf).
 packages+=(cyclonedds-dev cyclonedds-tools libcycloneddsidl0)

@@ -8,6 +8,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <type_traits>
 #include <variant>
 
@@ -240,6 +241,74 @@ InputLogReader::Item InputLogReader::fail_at(std::string reason) {
   return Item::Error;
 }
 
+namespace {
+
+/// The action of an action record's payload (`size` bytes at `p`); nullopt when it is malformed.
+std::optional<introspect::Action> decode_action(InputActionKind kind, const char* p, std::size_t size) {
+  const char* stop = p + size;
+  const auto text = [&](std::string& out) {
+    if (stop - p < 2) return false;
+    const auto n = get<std::uint16_t>(p);
+    p += 2;
+    if (stop - p < n) return false;
+    out.assign(p, n);
+    p += n;
+    return true;
+  };
+  std::string a, b, c;
+  if (!text(a) || !text(b) || !text(c) || stop - p < 4) return std::nullopt;
+  const auto count = get<std::uint32_t>(p);
+  p += 4;
+  std::vector<std::vector<double>> values;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (stop - p < 2) return std::nullopt;
+    const auto w = get<std::uint16_t>(p);
+    p += 2;
+    if (stop - p < 8 * static_cast<std::ptrdiff_t>(w)) return std::nullopt;
+    std::vector<double> v(w);
+    std::memcpy(v.data(), p, 8u * w);
+    p += 8u * w;
+    values.push_back(std::move(v));
+  }
+  if (p != stop) return std::nullopt;
+  switch (kind) {
+    case InputActionKind::Generate: return introspect::GenerateEvent{std::move(a), std::move(b)};
+    case InputActionKind::Broadcast: return introspect::BroadcastEvent{std::move(a)};
+    case InputActionKind::Reset: return introspect::ResetState{std::move(a), std::move(b), std::move(c)};
+    case InputActionKind::InjectShallow: return introspect::InjectShallow{std::move(a), std::move(values)};
+    case InputActionKind::InjectDeep: return introspect::InjectDeep{std::move(a), std::move(values)};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+bool InputLogReader::declare_signal(std::uint16_t len) {
+  const auto refuse = [this](std::string reason) {
+    fail_at(std::move(reason));
+    return false;
+  };
+  const auto id = get<std::uint16_t>(buffer_.data() + pos_ + 1);
+  const auto width = get<std::uint16_t>(buffer_.data() + pos_ + 3);
+  std::string name(buffer_.data() + pos_ + 7, len);
+  if (width == 0) return refuse("signal " + name + " is declared with width 0");
+  if (id > input_log::kMaxSignals) return refuse("signal id " + std::to_string(id) + " is out of range");
+  if (id < names_.size()) {
+    if (names_[id] != name || widths_[id] != width) {
+      return refuse("signal id " + std::to_string(id) + " is declared again as " + name + " (it was " + names_[id] +
+                    ")");
+    }
+    return true;
+  }
+  if (id != names_.size())
+    return refuse("signal id " + std::to_string(id) + " is declared before id " + std::to_string(names_.size()));
+  names_.push_back(std::move(name));
+  widths_.push_back(width);
+  last_time_.push_back(Time::min());
+  if (aligned_.size() < width) aligned_.resize(width);
+  return true;
+}
+
 InputLogReader::Item InputLogReader::next() {
   if (failed_) return Item::Error;
   for (;;) {
@@ -285,27 +354,9 @@ InputLogReader::Item InputLogReader::next() {
       }
       case input_log::kSignal: {
         if (!whole(7)) return error_.empty() ? Item::Eof : fail_at(error_);
-        const auto id = get<std::uint16_t>(buffer_.data() + pos_ + 1);
-        const auto width = get<std::uint16_t>(buffer_.data() + pos_ + 3);
         const auto len = get<std::uint16_t>(buffer_.data() + pos_ + 5);
         if (!whole(7u + len)) return error_.empty() ? Item::Eof : fail_at(error_);
-        std::string name(buffer_.data() + pos_ + 7, len);
-        if (width == 0) return fail_at("signal " + name + " is declared with width 0");
-        if (id > input_log::kMaxSignals) return fail_at("signal id " + std::to_string(id) + " is out of range");
-        if (id < names_.size()) {
-          if (names_[id] != name || widths_[id] != width) {
-            return fail_at("signal id " + std::to_string(id) + " is declared again as " + name + " (it was " +
-                           names_[id] + ")");
-          }
-        } else {
-          if (id != names_.size())
-            return fail_at("signal id " + std::to_string(id) + " is declared before id " +
-                           std::to_string(names_.size()));
-          names_.push_back(std::move(name));
-          widths_.push_back(width);
-          last_time_.push_back(Time::min());
-          if (aligned_.size() < width) aligned_.resize(width);
-        }
+        if (!declare_signal(len)) return Item::Error;
         pos_ += 7u + len;
         ++index_;
         continue;
@@ -318,52 +369,9 @@ InputLogReader::Item InputLogReader::next() {
         if (kind < 1 || kind > 5) return fail_at("unknown action kind " + std::to_string(kind));
         if (size > kMaxPayload) return fail_at("action of " + std::to_string(size) + " bytes (at most 16 MiB)");
         if (!whole(14u + size)) return error_.empty() ? Item::Eof : fail_at(error_);
-        const char* p = buffer_.data() + pos_ + 14;
-        const char* stop = p + size;
-        const auto text = [&](std::string& out) {
-          if (stop - p < 2) return false;
-          const auto n = get<std::uint16_t>(p);
-          p += 2;
-          if (stop - p < n) return false;
-          out.assign(p, n);
-          p += n;
-          return true;
-        };
-        std::string a, b, c;
-        std::vector<std::vector<double>> values;
-        bool ok = text(a) && text(b) && text(c) && stop - p >= 4;
-        if (ok) {
-          const auto count = get<std::uint32_t>(p);
-          p += 4;
-          for (std::uint32_t i = 0; ok && i < count; ++i) {
-            if (stop - p < 2) {
-              ok = false;
-              break;
-            }
-            const auto w = get<std::uint16_t>(p);
-            p += 2;
-            if (stop - p < 8 * static_cast<std::ptrdiff_t>(w)) {
-              ok = false;
-              break;
-            }
-            std::vector<double> v(w);
-            std::memcpy(v.data(), p, 8u * w);
-            p += 8u * w;
-            values.push_back(std::move(v));
-          }
-        }
-        if (!ok || p != stop) return fail_at("malformed action payload");
-        switch (static_cast<InputActionKind>(kind)) {
-          case InputActionKind::Generate: action_ = introspect::GenerateEvent{std::move(a), std::move(b)}; break;
-          case InputActionKind::Broadcast: action_ = introspect::BroadcastEvent{std::move(a)}; break;
-          case InputActionKind::Reset:
-            action_ = introspect::ResetState{std::move(a), std::move(b), std::move(c)};
-            break;
-          case InputActionKind::InjectShallow:
-            action_ = introspect::InjectShallow{std::move(a), std::move(values)};
-            break;
-          case InputActionKind::InjectDeep: action_ = introspect::InjectDeep{std::move(a), std::move(values)}; break;
-        }
+        auto action = decode_action(static_cast<InputActionKind>(kind), buffer_.data() + pos_ + 14, size);
+        if (!action) return fail_at("malformed action payload");
+        action_ = std::move(*action);
         mark_time_ = t;
         pos_ += 14u + size;
         ++index_;

@@ -127,6 +127,8 @@ private:
   /// Makes `n` bytes available at pos_; false at the end of the file.
   bool need(std::size_t n);
   Item fail_at(std::string reason);
+  /// Reads the signal record at pos_ (its name is `len` bytes); false (after fail_at) when it is refused.
+  bool declare_signal(std::uint16_t len);
 
   int fd_ = -1;
   std::string path_;
