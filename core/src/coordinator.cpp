@@ -196,7 +196,6 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
     owned_clock_ = std::make_unique<SteadyClock>();
     clock_ = owned_clock_.get();
   }
-  pending_.reserve(options_.pending_capacity);
   for (const FrameworkEventSpec& spec : kFrameworkEvents) {
     Event onset;
     onset.name = spec.name;
@@ -406,7 +405,7 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
       data.required.push_back(found);
     }
   }
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   // Only conditions on this component's own machines can flow through its services.
   for (MachineId id : component_machines(c)) {
     if (!machines_[id].conditions.empty()) {
@@ -463,6 +462,10 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
                                                 std::string(provider_provided) +
                                                 ": a component cannot require its own service");
   }
+  if (delivering_here()) {
+    return fail(ErrorCode::InvalidState, "connection " + std::string(client_required) + " -> " +
+                                             std::string(provider_provided) + ": made from a callback or observer");
+  }
   if (cc.required_connection[r] != kNoConnection) {
     const Connection& old = connections_[to_index(cc.required_connection[r])];
     return fail(ErrorCode::Duplicate,
@@ -470,7 +473,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
                     components_[old.provider].name + "." +
                     std::string(interface_name(components_[old.provider].provided[old.provided])));
   }
-  Lock lock(*this);
+  std::unique_lock lock(mutex_);
   const auto id = id_at<ConnectionId>(connections_.size());
   connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
@@ -480,7 +483,6 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   // reachability). Whatever it carries is active at one of the provider's machines: when they
   // are all Normal there is nothing to carry (the common case while a system is being built).
   if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
-  processing_ = true;
   for (MachineId m : id_range<MachineId>(machines_.size())) {
     const std::vector<Condition> snapshot(machines_[m].conditions.begin(), machines_[m].conditions.end());
     for (const Condition& c : snapshot) {
@@ -488,8 +490,9 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
       if (!c.mirror || (c.root.remote != kNone && c.root.origin == m)) propagate_onset(c);
     }
   }
-  drain_pending();
-  processing_ = false;
+  const Sealed sealed = seal();
+  lock.unlock();
+  finish(sealed);
   return id;
 }
 
@@ -681,13 +684,13 @@ State Coordinator::state_of(const Address& a) const noexcept {
 }
 
 std::vector<Condition> Coordinator::conditions(MachineId id) const {
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   const ConditionSet& set = machines_[id].conditions;
   return std::vector<Condition>(set.begin(), set.end());
 }
 
 std::optional<Condition> Coordinator::outstanding(MachineId id) const {
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   const MachineData& m = machines_[id];
   if (m.conditions.outstanding() == nullptr) return std::nullopt;
   return *m.conditions.outstanding();
@@ -709,7 +712,7 @@ std::vector<Record> newest(const History& h, std::size_t limit, Keep keep, Decod
 }  // namespace
 
 std::vector<Record> Coordinator::history(MachineId id) const {
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   return newest(
       history_, options_.history_capacity,
       [id](const StoredRecord& s) { return s.kind != RecordKind::ComponentTransition && s.subject == to_index(id); },
@@ -717,7 +720,7 @@ std::vector<Record> Coordinator::history(MachineId id) const {
 }
 
 std::vector<Record> Coordinator::component_history(ComponentId id) const {
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   return newest(
       history_, options_.history_capacity,
       [id](const StoredRecord& s) { return s.kind == RecordKind::ComponentTransition && s.subject == to_index(id); },
@@ -726,7 +729,7 @@ std::vector<Record> Coordinator::component_history(ComponentId id) const {
 
 std::vector<Record> Coordinator::history(const Address& scope) const {
   if (scope.kind == Address::Kind::Machine) return history(scope.machine);
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   const bool system = scope.kind == Address::Kind::System;
   return newest(
       history_, history_.size, [&](const StoredRecord& s) { return system || stored_component(s) == scope.component; },
@@ -735,70 +738,274 @@ std::vector<Record> Coordinator::history(const Address& scope) const {
 
 // ---- callbacks and observers -----------------------------------------------------------------
 
+/// The writes that callbacks and observers request while one write's records are handed out
+/// (and while the writes they requested are): made in order by the thread that made the write.
+/// Storage is bound on the first request, to the thread's spare queue when its outermost write
+/// does not use it already, so a callback that writes does not allocate once the spare has grown.
+class Coordinator::Requests {
+public:
+  explicit Requests(std::size_t capacity) : capacity_(capacity) {}
+  ~Requests() {
+    if (spare_) {
+      queue_->clear();
+      spare_busy_ = false;
+    }
+  }
+  Requests(const Requests&) = delete;
+  Requests& operator=(const Requests&) = delete;
+  void push(const Pending& op) {
+    if (queue_ == nullptr) bind();
+    queue_->push_back(op);
+  }
+  std::size_t size() const noexcept { return queue_ == nullptr ? 0 : queue_->size(); }
+  const Pending& operator[](std::size_t i) const noexcept { return (*queue_)[i]; }
+
+private:
+  void bind() {
+    spare_ = !spare_busy_;
+    if (!spare_) {
+      queue_ = &own_;
+      return;
+    }
+    spare_busy_ = true;
+    queue_ = &spare_queue_;
+    queue_->reserve(capacity_);
+  }
+  std::size_t capacity_;
+  std::vector<Pending>* queue_ = nullptr;
+  std::vector<Pending> own_;
+  bool spare_ = false;
+};
+
+thread_local std::vector<Coordinator::Pending> Coordinator::spare_queue_;
+thread_local bool Coordinator::spare_busy_ = false;
+
+bool Coordinator::delivering_here() const noexcept {
+  const std::thread::id deliverer = deliverer_.load(std::memory_order_relaxed);
+  // The first test spares the usual case (nobody hands out records) the thread's id.
+  return deliverer != std::thread::id{} && deliverer == std::this_thread::get_id();
+}
+
+void Coordinator::register_now(Registration registration) {
+  if (delivering_here()) {
+    deferred_.push_back(std::move(registration));  // applied when this thread's turn ends
+    return;
+  }
+  // A turn of its own: no list it changes is being walked meanwhile.
+  std::uint64_t ticket = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    ticket = ++issued_;
+  }
+  wait_turn(ticket);
+  deferred_.push_back(std::move(registration));
+  apply_registrations();
+  end_turn(ticket);
+}
+
 void Coordinator::on_machine(MachineId id, StateCallbacks callbacks) {
-  Lock lock(*this);
-  machines_[id].callbacks.push_back(std::move(callbacks));
+  register_now(Registration{Registration::Kind::Machine, to_index(id), std::move(callbacks), {}});
 }
 
 void Coordinator::on_component(ComponentId id, StateCallbacks callbacks) {
-  Lock lock(*this);
-  components_[id].callbacks.push_back(std::move(callbacks));
+  register_now(Registration{Registration::Kind::Component, to_index(id), std::move(callbacks), {}});
 }
 
 Coordinator::SubscriptionId Coordinator::subscribe(std::function<void(const Record&)> observer) {
-  Lock lock(*this);
-  const SubscriptionId id = next_subscription_++;
-  observers_.emplace_back(id, std::move(observer));
+  SubscriptionId id = 0;
+  {
+    const std::lock_guard lock(mutex_);
+    id = next_subscription_++;
+  }
+  register_now(Registration{Registration::Kind::Subscribe, id, {}, std::move(observer)});
   return id;
 }
 
 void Coordinator::unsubscribe(SubscriptionId id) {
-  Lock lock(*this);
-  std::erase_if(observers_, [id](const auto& o) { return o.first == id; });
+  register_now(Registration{Registration::Kind::Unsubscribe, id, {}, {}});
+}
+
+void Coordinator::apply_registrations() noexcept {
+  const std::lock_guard lock(mutex_);
+  for (Registration& r : deferred_) {
+    switch (r.kind) {
+      case Registration::Kind::Machine:
+        machines_[id_at<MachineId>(r.id)].callbacks.push_back(std::move(r.callbacks));
+        break;
+      case Registration::Kind::Component:
+        components_[id_at<ComponentId>(r.id)].callbacks.push_back(std::move(r.callbacks));
+        break;
+      case Registration::Kind::Subscribe: observers_.emplace_back(r.id, std::move(r.observer)); break;
+      case Registration::Kind::Unsubscribe:
+        std::erase_if(observers_, [id = r.id](const auto& o) { return o.first == id; });
+        break;
+    }
+  }
+  deferred_.clear();
+  observed_ = !observers_.empty();
 }
 
 void Coordinator::publish(Record record) {
-  Lock lock(*this);
-  if (record.machine != kNoMachine && machines_.contains(record.machine)) {
-    record.component = machines_[record.machine].component;
-    // The history keeps texts by id: the monitor interns its injection texts already (a hit).
-    this->record(record, record.text.empty() ? kNone : to_index(intern(record.text)));
-  } else {
-    record.seq = ++record_seq_;
-    emit(record);
-  }
-}
-
-void Coordinator::emit(const Record& r) noexcept {
-  for (auto& [id, fn] : observers_) {
-    try {
-      fn(r);
-    } catch (...) {
-      // Observers must not throw; a throwing observer must still not break monitoring.
-    }
-  }
+  // Queued or not, the record's text must outlive the caller's: the interned copy does.
+  if (!record.text.empty()) record.text = name_of(intern(record.text));
+  Pending op;
+  op.kind = PendingKind::Publish;
+  op.record = record;
+  write(op);
 }
 
 void Coordinator::record(Record& r, std::uint32_t text) noexcept {
   r.seq = ++record_seq_;
   history_.push(r, text);
-  if (!observers_.empty()) emit(r);
+  stage(r, false);
 }
 
-// ---- event processing ------------------------------------------------------------------------
+// ---- writes ----------------------------------------------------------------------------------
 
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
   SAFECASS_ASSERT(to_index(event) < event_table_.size());
   SAFECASS_ASSERT(machines_.contains(target) || event_table_[to_index(event)]->is_broadcast());
-  Lock lock(*this);
-  if (processing_) {
-    pending_.push_back(Pending{PendingKind::Generate, event, target, cause, Address{}, kNoName});
+  if (delivering_here()) {
+    Pending op;
+    op.event = event;
+    op.machine = target;
+    op.cause = cause;
+    requests_->push(op);  // made once the records being handed out have been (write())
     return;
   }
-  processing_ = true;
-  process(event, target, cause);
-  if (!pending_.empty()) drain_pending();
-  processing_ = false;
+  // write() without building a Pending: this is the hot path of every filter event.
+  Sealed sealed;
+  {
+    const std::lock_guard lock(mutex_);
+    process(event, target, cause);
+    sealed = seal();
+  }
+  if (sealed.ticket != 0) finish(sealed);
+}
+
+void Coordinator::write(const Pending& op) noexcept {
+  if (delivering_here()) {
+    // From a callback or observer of this coordinator: made once the records being handed out
+    // have been (they belong to a write whose turn this thread holds).
+    requests_->push(op);
+    return;
+  }
+  Sealed sealed;
+  {
+    const std::lock_guard lock(mutex_);
+    run(op);
+    sealed = seal();
+  }
+  finish(sealed);
+}
+
+void Coordinator::finish(Sealed sealed) noexcept {
+  if (sealed.ticket == 0) return;
+  // A callback loop could queue writes for ever; the bound keeps the monitored system alive.
+  constexpr std::size_t kMaxChained = std::size_t{1} << 16;
+  Requests queue(options_.pending_capacity);
+  deliver(sealed, queue);
+  for (std::size_t next = 0; next < queue.size(); ++next) {
+    if (next == kMaxChained) {
+      const std::lock_guard lock(mutex_);
+      dropped_requests_ += queue.size() - next;
+      break;
+    }
+    const Pending op = queue[next];  // deliver() may grow the queue
+    {
+      const std::lock_guard lock(mutex_);
+      run(op);
+      sealed = seal();
+    }
+    if (sealed.ticket != 0) deliver(sealed, queue);
+  }
+}
+
+Coordinator::Sealed Coordinator::seal() noexcept {
+  std::size_t first = outbox_.size();
+  while (first > 0 && outbox_[first - 1].ticket == 0) --first;
+  if (first == outbox_.size()) return {};
+  const std::uint64_t ticket = ++issued_;
+  // The usual case: every earlier turn is over. Take this one now: the staged records are all this
+  // write's (earlier ones left the outbox when they were handed out; a later write cannot stage
+  // while the lock is held).
+  if (delivered_.load(std::memory_order_acquire) + 1 == ticket) {
+    handing_.swap(outbox_);  // both keep their capacity
+    return {ticket, true};
+  }
+  for (std::size_t i = first; i < outbox_.size(); ++i) outbox_[i].ticket = ticket;
+  return {ticket, false};
+}
+
+void Coordinator::wait_turn(std::uint64_t ticket) noexcept {
+  // Counted among the waiters first, so the thread whose turn ends sees that it must wake us.
+  waiters_.fetch_add(1);
+  for (std::uint64_t done = delivered_.load(); done + 1 != ticket; done = delivered_.load()) delivered_.wait(done);
+  waiters_.fetch_sub(1);
+}
+
+void Coordinator::end_turn(std::uint64_t ticket) noexcept {
+  // Sequentially consistent, as the waiters' count and load: either a waiter counted itself before
+  // this load, and is woken, or its own load comes after this store and it does not wait. Waking
+  // costs a read-modify-write on a line shared by the process; most turns have no waiter.
+  delivered_.store(ticket);
+  if (waiters_.load() != 0) delivered_.notify_all();
+}
+
+void Coordinator::deliver(Sealed sealed, Requests& queue) noexcept {
+  if (!sealed.turn) {
+    wait_turn(sealed.ticket);  // every earlier write's records first
+    const std::lock_guard lock(mutex_);
+    std::size_t n = 0;
+    while (n < outbox_.size() && outbox_[n].ticket == sealed.ticket) ++n;
+    handing_.assign(outbox_.begin(), outbox_.begin() + static_cast<std::ptrdiff_t>(n));
+    outbox_.erase(outbox_.begin(), outbox_.begin() + static_cast<std::ptrdiff_t>(n));
+  }
+  requests_ = &queue;
+  deliverer_.store(std::this_thread::get_id(), std::memory_order_relaxed);
+  for (const Delivery& d : handing_) {
+    if (d.observe) {
+      for (auto& [id, fn] : observers_) {
+        try {
+          fn(d.record);
+        } catch (...) {
+          // Observers must not throw; a throwing observer must still not break monitoring.
+        }
+      }
+    }
+    if (d.callbacks) fire(d, queue);
+  }
+  deliverer_.store(std::thread::id{}, std::memory_order_relaxed);
+  requests_ = nullptr;
+  handing_.clear();
+  if (!deferred_.empty()) apply_registrations();
+  end_turn(sealed.ticket);
+}
+
+void Coordinator::fire(const Delivery& d, Requests& queue) noexcept {
+  const Record& r = d.record;
+  const bool machine = r.kind == RecordKind::Transition;
+  std::vector<StateCallbacks>& callbacks =
+      machine ? machines_[r.machine].callbacks : components_[r.component].callbacks;
+  const TransitionInfo info{r.component,
+                            machine ? r.machine : kNoMachine,
+                            transition_between(r.from, r.to),
+                            r.event,
+                            r.root.event == kNoEvent ? nullptr : &r.root,
+                            r.time};
+  for (StateCallbacks& cb : callbacks) {
+    try {
+      if (cb.on_exit) cb.on_exit(r.from);
+      if (cb.on_transition) cb.on_transition(info);
+      if (cb.on_entry) cb.on_entry(r.to);
+    } catch (...) {
+      // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
+      Pending op;
+      op.event = framework_event::kCallbackException;
+      op.machine = components_[r.component].framework;
+      queue.push(op);
+    }
+  }
 }
 
 [[nodiscard]] Expected<GenerateTarget> resolve_generate(const Coordinator& co, std::string_view event,
@@ -861,37 +1068,30 @@ void Coordinator::reset(const Address& target, std::string_view who, std::string
   std::string text(who);
   text += ": ";
   text += why;
-  const NameId reason = intern(text);
-  Lock lock(*this);
-  Pending op{PendingKind::Reset, kNoEvent, kNoMachine, SampleCause{}, target, reason};
-  if (processing_) {
-    pending_.push_back(op);
-    return;
-  }
-  processing_ = true;
-  run(op);
-  drain_pending();
-  processing_ = false;
+  Pending op;
+  op.kind = PendingKind::Reset;
+  op.address = target;
+  op.why = intern(text);
+  write(op);
 }
 
 void Coordinator::run(const Pending& op) noexcept {
   switch (op.kind) {
     case PendingKind::Generate: process(op.event, op.machine, op.cause); return;
     case PendingKind::Reset: reset_locked(op.address, op.why, clock_->now()); return;
+    case PendingKind::Publish: {
+      Record record = op.record;
+      if (record.machine != kNoMachine && machines_.contains(record.machine)) {
+        record.component = machines_[record.machine].component;
+        // The history keeps texts by id (publish() interned this one).
+        this->record(record, record.text.empty() ? kNone : to_index(intern(record.text)));  // a hit
+      } else {
+        record.seq = ++record_seq_;
+        stage(record, false);
+      }
+      return;
+    }
   }
-}
-
-void Coordinator::drain_pending() noexcept {
-  // Events generated by callbacks while processing. A callback that keeps generating events on
-  // every transition could loop forever; the bound keeps the monitored system alive.
-  constexpr std::size_t kMaxChained = 1u << 16;
-  std::size_t i = 0;
-  for (; i < pending_.size() && i < kMaxChained; ++i) {
-    const Pending op = pending_[i];
-    run(op);
-  }
-  dropped_requests_ += pending_.size() - i;
-  pending_.clear();
 }
 
 void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
@@ -1026,11 +1226,9 @@ void Coordinator::update_machine(MachineId id, State old_state, EventId event, c
     r.from = old_state;
     r.to = state;
     if (root != nullptr) r.root = *root;
-    record(r, kNone);
-    if (!m.callbacks.empty()) {
-      const TransitionInfo info{m.component, id, transition_between(old_state, state), event, root, now};
-      fire(m.callbacks, m.component, info, old_state, state);
-    }
+    r.seq = ++record_seq_;
+    history_.push(r, kNone);
+    stage(r, !m.callbacks.empty());
   }
   update_component(m.component, event, root, now);
 }
@@ -1072,26 +1270,7 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   r.to = c.state;
   if (root != nullptr) r.root = *root;
   history_.push(r, kNone);
-  if (!observers_.empty()) emit(r);
-  if (c.callbacks.empty()) return;
-  const TransitionInfo info{id, kNoMachine, transition_between(old, c.state), event, root, now};
-  fire(c.callbacks, id, info, old, c.state);
-}
-
-void Coordinator::fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info,
-                       State from, State to) noexcept {
-  for (StateCallbacks& cb : callbacks) {
-    try {
-      if (cb.on_exit) cb.on_exit(from);
-      if (cb.on_transition) cb.on_transition(info);
-      if (cb.on_entry) cb.on_entry(to);
-    } catch (...) {
-      // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
-      SampleCause cause;
-      pending_.push_back(Pending{PendingKind::Generate, framework_event::kCallbackException,
-                                 components_[component].framework, cause, Address{}, kNoName});
-    }
-  }
+  stage(r, !c.callbacks.empty());
 }
 
 // ---- propagation (DESIGN §2.6) ---------------------------------------------------------------

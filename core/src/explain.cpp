@@ -1,47 +1,11 @@
 // explain(): each active condition with its root cause and the path of hops it took (DESIGN §2.6).
 
-#include <fmt/format.h>
-
 #include <algorithm>
 
 #include "safecass/core/address.hpp"
 #include "safecass/core/coordinator.hpp"
-#include "safecass/core/text.hpp"
 
 namespace safecass {
-
-std::string to_string(const Explanation& e) {
-  std::string out = e.machine;
-  out += ": ";
-  out += to_string(e.level);
-  out += ' ';
-  out += e.event;
-  out += " (severity " + std::to_string(e.severity) + ")";
-  if (e.mirror) {
-    out += " <- ";
-    out += e.root.name();
-  }
-  out += " since " + seconds_text(e.root.time) + " s";
-  if (!e.hazard.empty()) out += " [hazard " + e.hazard + "]";
-  if (!e.root.filter.empty() || !e.root.signal.empty()) {
-    out += " [";
-    if (!e.root.filter.empty()) out += "filter " + e.root.filter;
-    if (!e.root.signal.empty()) {
-      if (!e.root.filter.empty()) out += ", ";
-      out += e.root.signal + " = " + number_text(e.root.value) + " at " + seconds_text(e.root.sample_time) + " s";
-    }
-    if (e.root.injected) out += ", injected";
-    out += "]";
-  }
-  if (e.path.size() > 1) {
-    out += " path ";
-    for (std::size_t i = 0; i < e.path.size(); ++i) {
-      if (i > 0) out += " -> ";
-      out += e.path[i];
-    }
-  }
-  return out;
-}
 
 std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition& condition) const {
   if (!condition.mirror) return {machines_[holder].address};
@@ -115,7 +79,7 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
 }
 
 std::vector<Explanation> Coordinator::explain(const Address& address) const {
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   std::vector<MachineId> machines;
   switch (address.kind) {
     case Address::Kind::System:

@@ -107,9 +107,10 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     samples[i].injected = roots[i].root.injected;
   }
 
-  Lock lock(*this);
-  if (processing_) return fail(ErrorCode::InvalidState, "apply_remote() called from a callback or observer");
-  processing_ = true;
+  if (delivering_here()) {
+    return fail(ErrorCode::InvalidState, "apply_remote() called from a callback or observer");
+  }
+  std::unique_lock lock(mutex_);
   RemoteApplyResult result;
   const Time now = clock_->now();
   MachineData& m = machines_[proxy];
@@ -185,8 +186,9 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     propagate_onset(c);
     ++result.added;
   }
-  drain_pending();
-  processing_ = false;
+  const Sealed sealed = seal();
+  lock.unlock();
+  finish(sealed);
   return result;
 }
 
@@ -197,7 +199,7 @@ namespace safecass {
 std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::uint32_t service) const {
   // The same roots, levels and shortest paths as explain() of the service address gives, built
   // straight from the conditions: no Explanation (machine, event and hazard texts) per condition.
-  Lock lock(*this);
+  const std::lock_guard lock(mutex_);
   std::vector<RemoteRoot> out;
   if (!components_.contains(component) || service >= components_[component].provided.size()) return out;
   const ComponentData& c = components_[component];

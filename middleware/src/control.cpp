@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "read_model_wire.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
 #include "safecass/introspect/sample_text.hpp"
 #include "safecass/middleware/token.hpp"
@@ -248,7 +249,7 @@ wire::ExplainEntry to_wire(const Explanation& e) {
   w.outstanding = e.outstanding;
   w.root = root_to_wire(e.root, to_wire(e.level), e.path);
   w.hazard = e.hazard;
-  w.line = to_string(e);
+  w.line = introspect::explanation_text(e, introspect::TimeFormat{});
   w.count = static_cast<int>(e.count);
   w.first = e.first.count();
   w.last = e.last.count();

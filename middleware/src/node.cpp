@@ -167,7 +167,7 @@ struct CoordinatorNode::Impl {
     std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
-  std::mutex peer_mutex;       ///< held, peers; taken before the coordinator's lock, never after
+  std::mutex peer_mutex;       ///< held, peers; taken before a coordinator write, never inside an observer
   std::string stream_scratch;  ///< under peer_mutex: a stream's name, its storage reused per update
   std::int64_t started = 0;
 
@@ -225,7 +225,7 @@ struct CoordinatorNode::Impl {
     }
   }
 
-  // -- coordinator side (under the coordinator's lock: no network, no blocking) --
+  // -- coordinator side (an observer, on the writing thread: no network, no blocking) --
   void on_record(const Record& r) {
     // Wakes the publisher only when it has something to do now: an interface that was clean
     // became dirty, the first event record while it holds none (it starts the kEventDelay
@@ -959,7 +959,7 @@ struct CoordinatorNode::Impl {
 
   // -- watch thread: fail toward safe on loss (DESIGN §4) --
 
-  /// Raises the loss of a peer (under peer_mutex; the coordinator's lock is taken after it).
+  /// Raises the loss of a peer (under peer_mutex; the coordinator write comes after it).
   void declare_lost(const std::string& who, Peer& peer, const std::string& silent) {
     peer.lost = true;
     if (who == kSupervisorSigner) {

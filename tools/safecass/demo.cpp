@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/introspect/format.hpp"
 
 namespace safecass::tools {
 
@@ -96,7 +97,8 @@ int run_demo() {
       explained = true;
       std::printf("\n  Why is SERVO in Error? explain(\"SERVO\"):\n");
       const std::vector<Explanation> why = must(co.explain("SERVO"));
-      for (const Explanation& e : why) std::printf("    %s\n", to_string(e).c_str());
+      for (const Explanation& e : why)
+        std::printf("    %s\n", introspect::explanation_text(e, introspect::TimeFormat{}).c_str());
       std::printf("\n");
     }
   }

@@ -66,28 +66,6 @@ struct Driver {
     return !co.is_remote(a->component);
   }
 
-  std::string check(const spec::ScenarioStep& s, const std::string& address, const std::string& expected) const {
-    const Address a = *co.resolve(address);
-    if (s.kind == spec::ScenarioStep::Kind::Expect) {
-      const auto want = parse_state(expected);
-      const State got = co.state_of(a);
-      if (want && got == *want) return {};
-      return address + " is " + std::string(to_string(got)) + ", expected " + expected;
-    }
-    if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
-      if (a.kind != Address::Kind::Component && a.kind != Address::Kind::Machine) return {};
-      const StateSnapshot snap = a.kind == Address::Kind::Component ? co.extended(a.component) : co.snapshot(a.machine);
-      const std::string got = snap.outstanding == kNoEvent ? "none" : co.event(snap.outstanding).name;
-      return got == expected ? std::string()
-                             : "outstanding event of " + address + " is " + got + ", expected " + expected;
-    }
-    const State level = co.state_of(a);
-    for (const Explanation& e : co.explain(a)) {
-      if (e.level == level && e.root.name() == expected) return {};
-    }
-    return "no condition of " + address + " at its level has root cause " + expected;
-  }
-
   /// Whether `action` belongs to this process: its signal, filter or machine is one of ours (the
   /// others belong to another coordinator's process).
   bool applies_here(const introspect::Action& action) const {
@@ -125,10 +103,10 @@ struct Driver {
       default: {
         for (const auto& [address, expected] : s.action->expectations) {
           if (!local_machine(address)) continue;
-          std::string failure = check(s, address, expected);
+          std::string failure = runner::expectation_problem(co, s, address, expected);
           for (int i = 0; !failure.empty() && i < 20; ++i) {
             std::this_thread::sleep_for(std::chrono::milliseconds(10));
-            failure = check(s, address, expected);
+            failure = runner::expectation_problem(co, s, address, expected);
           }
           ++checks;
           if (!failure.empty()) {
@@ -388,8 +366,7 @@ int run_coordinator(const RunArgs& args) {
   }
   co.subscribe([&co](const Record& r) {
     if (r.kind != RecordKind::Transition && r.kind != RecordKind::ComponentTransition) return;
-    // history_entry() resolves a remote root's origin with the coordinator's lock, which this
-    // thread holds (it is recursive).
+    // The coordinator's lock is free while observers run: history_entry() may read it.
     say("[" + std::string(co.name()) + "] " + introspect::live_line(introspect::history_entry(r, co)));
   });
   std::unique_ptr<Recorder> recorder;

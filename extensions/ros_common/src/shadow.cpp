@@ -396,7 +396,7 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
   if (!outstanding) return;
   const RootCause& root = outstanding->root;
   if (root.event != kNoEvent && root.origin != kNoMachine) {
-    const std::string cause = co.address_of(root.origin) + ":" + co.event(root.event).name;
+    const std::string cause = co.resolve_root(root).name();  // a remote root: its origin in its own process
     s.message += " (cause " + cause;
     if (root.sample.present()) {
       s.message +=

@@ -445,6 +445,45 @@ TEST(Callbacks, ACallbackSeesTheNewStateWhenItsEntryFires) {
   EXPECT_EQ(seen_component, W);
 }
 
+TEST(Callbacks, CallbacksRunOnceTheWriteIsCompleteSoTheOriginsCallbackSeesItsClientUpdated) {
+  // C requires P's Out: a fault at P.s_A reaches C.s_R.In in the same write. P.s_A's callback runs
+  // after the whole write, so it reads C's required interface after the propagation.
+  Gcm g;
+  g.component("P", {"Out"}, {});
+  g.component("C", {}, {"In"});
+  g.pair("EF", 50, E);
+  test::must(g.co.connect("C.In", "P.Out"), "connect");
+  State client_seen = N;
+  g.co.on_machine(g.machine("P.s_A"), StateCallbacks{{}, {}, [&](State) { client_seen = g.at("C.s_R.In"); }});
+  g.gen("EF", "P.s_A");
+  EXPECT_EQ(client_seen, E);
+}
+
+TEST(Callbacks, AMachineThatChangesTwiceInOneWriteFiresBothTransitionsEachReadingTheStateTheWriteLeft) {
+  // C.s_R.In mirrors every root active at P.Out: connecting while P.s_F holds a warning and P.s_A
+  // an error carries both in one write (machine by machine: s_F first), N → W → E. Both
+  // transitions fire, in order; both entries read Error, the state the write left.
+  Gcm g;
+  g.component("P", {"Out"}, {});
+  g.component("C", {}, {"In"});
+  g.pair("EF", 50, E);
+  g.pair("WF", 20, W);
+  ServiceDependency warnings;
+  warnings.propagate = W;
+  test::must(g.co.set_service(g.comp("P"), "Out", warnings), "set_service");
+  g.gen("WF", "P.s_F");
+  g.gen("EF", "P.s_A");
+  std::vector<std::pair<State, State>> entries;  // (entered, read back)
+  g.co.on_machine(g.machine("C.s_R.In"),
+                  StateCallbacks{{}, {}, [&](State s) { entries.emplace_back(s, g.at("C.s_R.In")); }});
+  test::must(g.co.connect("C.In", "P.Out"), "connect");
+  ASSERT_EQ(entries.size(), 2u);
+  EXPECT_EQ(entries[0].first, W);
+  EXPECT_EQ(entries[1].first, E);
+  EXPECT_EQ(entries[0].second, E);
+  EXPECT_EQ(entries[1].second, E);
+}
+
 // ---- dispatch ---------------------------------------------------------------------------------------
 
 struct DispatchCount {

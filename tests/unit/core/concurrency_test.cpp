@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <thread>
@@ -45,7 +46,8 @@ TEST(Concurrency, OperationsFromSeveralThreadsNeverInterleaveAndRecordsStayInOrd
   Chain chain;
   Coordinator& co = chain.co;
   std::vector<std::uint64_t> seqs;
-  co.subscribe([&seqs](const Record& r) { seqs.push_back(r.seq); });  // under the lock: no mutex needed
+  // Records are handed out one write at a time, in order: no mutex needed.
+  co.subscribe([&seqs](const Record& r) { seqs.push_back(r.seq); });
   std::vector<std::thread> threads;
   for (int k = 0; k < kThreads; ++k) {
     threads.emplace_back([&chain, k] {
@@ -102,7 +104,7 @@ TEST(Concurrency, ObserversThatReadTheCoordinatorDoNotDeadlockWhileAnotherThread
   std::uint64_t explained = 0;
   std::uint64_t histories = 0;
   co.subscribe([&](const Record& r) {
-    // Re-entry on the thread that holds the lock: reads run under it.
+    // The lock is free while observers run: reads take it as from anywhere else.
     if (r.kind == RecordKind::ComponentTransition && r.to == State::Error) {
       explained += co.explain(Address{Address::Kind::Component, r.component}).empty() ? 0 : 1;
       (void)co.resolve_root(r.root).origin;
@@ -137,7 +139,7 @@ TEST(Concurrency, EventsGeneratedByCallbacksAreQueuedWhileOtherThreadsWait) {
   Chain chain;
   Coordinator& co = chain.co;
   // Whenever C1 enters Error (only C0's fault reaches it), its callback clears the root at C0
-  // (re-entrant generate: queued, processed before the outer call returns); another thread
+  // (a write from a callback: queued, made before the outer call returns); another thread
   // meanwhile raises and clears C2, whose fault reaches C3.
   std::atomic<int> entered{0};
   co.on_component(chain.components[1], StateCallbacks{nullptr, nullptr, [&](State s) {
@@ -159,6 +161,45 @@ TEST(Concurrency, EventsGeneratedByCallbacksAreQueuedWhileOtherThreadsWait) {
   EXPECT_EQ(entered.load(), kRounds);
   EXPECT_EQ(co.dropped_requests(), 0u);
   EXPECT_EQ(co.coordinator_state(), State::Normal);
+}
+
+TEST(Concurrency, NoLockIsHeldWhileObserversAndCallbacksRunSoAnotherThreadCanReadAndWrite) {
+  Chain chain;
+  Coordinator& co = chain.co;
+  // From inside an observer and a callback, another thread reads the history (takes the lock) and
+  // raises a fault at C2 (takes the lock to make the change). Were the lock held, neither would get
+  // through. Its records wait for their turn: they are handed out after the current write's.
+  std::vector<std::thread> others;
+  const auto another_thread_gets_through = [&](int k) {
+    std::atomic<bool> read{false};
+    others.emplace_back([&co, &chain, &read, k] {
+      (void)co.history(Address{});
+      read = true;
+      co.generate(chain.onsets[static_cast<std::size_t>(k)], chain.app(k));
+    });
+    for (int i = 0; i < 2000 && !(read && co.state(chain.app(k)) == State::Error); ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return read && co.state(chain.app(k)) == State::Error;
+  };
+  int observed = 0, called = 0;
+  bool observer_ok = false, callback_ok = false;
+  co.subscribe([&](const Record& r) {
+    if (r.kind == RecordKind::ComponentTransition && r.component == chain.components[0] && r.to == State::Error) {
+      ++observed;
+      observer_ok = another_thread_gets_through(2);
+    }
+  });
+  co.on_component(chain.components[1], StateCallbacks{nullptr, nullptr, [&](State s) {
+                                                        if (s != State::Error || called++ > 0) return;
+                                                        callback_ok = another_thread_gets_through(3);
+                                                      }});
+  co.generate(chain.onsets[0], chain.app(0));
+  for (auto& t : others) t.join();  // their records were handed out once this write's were
+  EXPECT_EQ(observed, 1);
+  EXPECT_EQ(called, 1);
+  EXPECT_TRUE(observer_ok) << "another thread could not read or write while an observer ran";
+  EXPECT_TRUE(callback_ok) << "another thread could not read or write while a callback ran";
 }
 
 TEST(Concurrency, ResetsFromSeveralThreadsLeaveTheSystemNormal) {

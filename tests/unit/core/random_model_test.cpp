@@ -980,7 +980,15 @@ private:
               : (t.info.machine != MachineId{x.id} || t.info.component != co_.machine_component(MachineId{x.id}))) {
         return who + ": on_transition names the wrong machine or component";
       }
-      if (n.read_back != n.state) return who + ": on_entry(new) runs before the new state can be read";
+      // Callbacks run once the write that caused them is complete (docs/semantics.md §5.2): on_entry
+      // reads the state that write left, the `to` of this transition or of a later one of the same
+      // machine in this step.
+      bool read_back_known = n.read_back == n.state;
+      for (std::size_t k = i + 3; !read_back_known && k < calls_.size(); k += 3) {
+        const CallbackCall& later = calls_[k + 2];
+        read_back_known = later.component == x.component && later.id == x.id && later.state == n.read_back;
+      }
+      if (!read_back_known) return who + ": on_entry(new) reads a state the write never left it in";
       tracked = n.state;
       ++triples[{x.component, x.id}];
     }

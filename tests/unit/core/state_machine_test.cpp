@@ -812,6 +812,31 @@ TEST(History, AnUnsubscribedObserverReceivesNothingMore) {
   EXPECT_EQ(calls, after_first);
 }
 
+TEST(History, ARegistrationMadeByAnObserverTakesEffectAfterTheRecordsBeingHandedOut) {
+  Machine m;
+  int first_calls = 0, second_calls = 0;
+  std::uint64_t second_first_seq = 0, last_seq_of_first_write = 0;
+  Coordinator::SubscriptionId first = 0;
+  first = m.co.subscribe([&](const Record& r) {
+    ++first_calls;
+    last_seq_of_first_write = r.seq;
+    if (first_calls > 1) return;
+    // The first record of the first write: leave, and bring another observer in.
+    m.co.unsubscribe(first);
+    (void)m.co.subscribe([&](const Record& later) {
+      if (second_calls++ == 0) second_first_seq = later.seq;
+    });
+  });
+  m.gen("E50", "C.s_A");
+  const int first_write_records = first_calls;
+  EXPECT_GT(first_write_records, 1) << "the first write's records all reach the observer that left during them";
+  EXPECT_EQ(second_calls, 0) << "the new observer sees none of the records being handed out";
+  m.gen("/E50", "C.s_A");
+  EXPECT_EQ(first_calls, first_write_records) << "the observer that left sees nothing of the next write";
+  EXPECT_GT(second_calls, 0);
+  EXPECT_GT(second_first_seq, last_seq_of_first_write);
+}
+
 TEST(History, AThrowingObserverDoesNotStopProcessingOrOtherObservers) {
   Machine m;
   int calls = 0;

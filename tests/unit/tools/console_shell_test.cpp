@@ -177,9 +177,18 @@ TEST(ConsoleShell, ExplanationsPrintOneLineEachWithEveryFieldInJsonAndSayWhenThe
   e.root.event = "EVT_FORCE_ERROR";
   e.root.origin = "JR3.s_A";
   e.path = {"JR3.s_A", "JR3.s_S.ForceData", "CONTROL.s_R.ForceData"};
+  e.root.time = seconds_to_time(0.1);
+  e.hazard = "H-3";
+  e.root.filter = "force_limit";
+  e.root.signal = "JR3.ForceNorm";
+  e.root.value = 35.0;
+  e.root.sample_time = seconds_to_time(0.1);
   const introspect::ExplainAnswer answer{"CONTROL", State::Error, {e}};
-  EXPECT_EQ(introspect::explain_text(answer, introspect::TimeFormat{}), to_string(e) + "\n")
-      << "simulated times read as the core's own line";
+  EXPECT_EQ(introspect::explain_text(answer, introspect::TimeFormat{}),
+            "CONTROL.s_R.ForceData: Error EVT_SERVICE_FAILURE (severity 200) <- JR3.s_A:EVT_FORCE_ERROR since "
+            "0.100000 s [hazard H-3] [filter force_limit, JR3.ForceNorm = 35 at 0.100000 s] path JR3.s_A -> "
+            "JR3.s_S.ForceData -> CONTROL.s_R.ForceData\n")
+      << "one line with the root, its time, hazard, filter data and path; simulated times in seconds";
   const std::string json = introspect::explain_json(answer);
   EXPECT_NE(json.find("\"count\":3"), std::string::npos) << json;
   EXPECT_NE(json.find("\"root_origin\":\"JR3.s_A\""), std::string::npos) << json;

@@ -7,22 +7,23 @@
 /// is ConditionSet (condition_set.hpp), one per machine; the coordinator orchestrates: records,
 /// callbacks, propagation, history.
 ///
-/// Lifecycle: configure (add components, interfaces, events, services, connections), then run
-/// (generate, reset, read). Configuration calls are not safe against concurrent readers: finish
-/// the configuration before other threads start reading or generating. After that:
+/// Lifecycle: configure (add components, interfaces, events, services, connections, callbacks),
+/// then run (generate, reset, read). Configuration calls are not safe against concurrent readers:
+/// finish the configuration before other threads start reading or generating. After that:
 /// - state reads (`state()`, `extended()`, `service_state()`, `dispatch()`) are lock-free, wait-free
 ///   and never allocate;
-/// - `generate()` takes the coordinator's lock; once the condition vectors have grown to their
-///   working size it does not allocate. `reset()` takes the lock and may allocate (it records who
-///   and why). All local consequences (propagation, callbacks, observers) have happened when they
-///   return;
-/// - callbacks and observers must not change the configuration or register callbacks/observers;
-/// - callbacks and observers run on the thread that caused the change, under the lock. They must
-///   not block. An event they generate (or a reset they ask for) is queued and processed before the
-///   outer call returns. They may also read the coordinator (history(), explain(), resolve_root(),
-///   ...): the lock is a plain mutex, and a call from the thread that holds it runs under the lock
-///   already held instead of locking again (see "lock discipline" below). An exception thrown by a
-///   callback becomes EVT_CALLBACK_EXCEPTION on the component's s_F.
+/// - a write (`generate()`, `broadcast()`, `reset()`, `apply_remote()`, `publish()`) takes the
+///   coordinator's lock for the change and its propagation; once the condition vectors have grown
+///   to their working size `generate()` does not allocate. `reset()` may allocate (it records who
+///   and why);
+/// - callbacks and observers run after the change, with the lock released, on the thread that made
+///   the change, before its write returns; the records of all writes reach them in the order the
+///   writes were made (one write's are handed out when the earlier writes' have been). They must not
+///   block. They may read the coordinator (history(), explain(), ...: plain calls that take the
+///   lock); a write they make is queued and made, as a write of its own, once the current one has
+///   been handed out, before the outer call returns; a registration they make takes effect after
+///   the records being handed out. An exception thrown by a callback becomes EVT_CALLBACK_EXCEPTION
+///   on the component's s_F (docs/semantics.md §5).
 
 #include <array>
 #include <atomic>
@@ -111,7 +112,8 @@ struct StateCallbacks {
   std::function<void(State)> on_entry;
 };
 
-/// One active condition, with its root cause and the path it took (DESIGN §2.6 `explain`).
+/// One active condition, with its root cause and the path it took (DESIGN §2.6 `explain`). Its
+/// text and JSON are the read model's (introspect::explanation_text, explanation_json).
 struct Explanation {
   std::string machine;  ///< address of the machine holding the condition
   std::string event;
@@ -126,9 +128,6 @@ struct Explanation {
   std::string hazard;             ///< of the root event
   std::vector<std::string> path;  ///< origin machine → services/interfaces … → this machine
 };
-
-/// One line: "CONTROL.s_R.ForceData Error EVT_SERVICE_FAILURE ← JR3.s_A:EVT_FORCE_ERROR (...) via ...".
-std::string to_string(const Explanation& e);
 
 /// A root condition reported by another process for one of its provided interfaces: one element
 /// of the full state that replaces the set held by a remote provided interface (apply_remote()).
@@ -162,7 +161,7 @@ struct CoordinatorOptions {
   std::size_t history_records = 8192;                      ///< the ring holds at least this many records
   std::size_t history_per_address = 8;                     ///< ... and this many per machine and component
   std::size_t history_records_max = std::size_t{1} << 20;  ///< ... and at most this many
-  std::size_t pending_capacity = 256;                      ///< events generated from callbacks, reserved up front
+  std::size_t pending_capacity = 256;  ///< writes made by callbacks and observers, reserved up front per thread
 };
 
 namespace detail {
@@ -225,7 +224,8 @@ public:
   [[nodiscard]] Expected<void> set_service(ComponentId component, std::string_view provided,
                                            const ServiceDependency& dependency);
   /// Connects `client_required` ("C.r") to `provider_provided` ("P.p").
-  /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected).
+  /// Errors: NotFound, InvalidArgument (malformed, self-connection), Duplicate (already connected),
+  /// InvalidState (called from a callback or observer of this coordinator).
   [[nodiscard]] Expected<ConnectionId> connect(std::string_view client_required, std::string_view provider_provided);
 
   // ---- remote providers (cross-process propagation, DESIGN §2.6 and §4) --------------------
@@ -248,7 +248,7 @@ public:
   /// processes cannot latch). Takes the lock; callbacks and observers run as for generate().
   /// Errors (nothing is changed): NotFound (not a remote provided interface), InvalidArgument
   /// (unknown or non-onset event, level Normal, empty origin), InvalidState (called from a
-  /// callback or observer).
+  /// callback or observer of this coordinator: it returns a result, so it cannot be queued).
   [[nodiscard]] Expected<RemoteApplyResult> apply_remote(MachineId remote_provided,
                                                          const std::vector<RemoteRoot>& roots);
   /// The full state another process needs for service `service` (a provided interface index of a
@@ -338,10 +338,10 @@ public:
     }
   }
 
-  /// Events and resets requested from callbacks beyond the chain bound (65536 per outer call) and
+  /// Writes requested by callbacks and observers beyond the chain bound (65536 per outer call) and
   /// therefore not processed. Non-zero means a callback loop: a bug in the application.
   std::uint64_t dropped_requests() const {
-    Lock lock(*this);
+    const std::lock_guard lock(mutex_);
     return dropped_requests_;
   }
 
@@ -365,6 +365,10 @@ public:
   std::vector<Explanation> explain(const Address& address) const;
 
   // ---- callbacks and observers ---------------------------------------------------------------
+  // A registration waits until the records being handed out (by another thread) have been; once
+  // it returns, the callbacks or observer see every later record, and an unsubscribed observer is
+  // never called again. Made from inside a callback or observer, it takes effect once the records
+  // being handed out have been.
   using SubscriptionId = std::uint32_t;
   /// Registers callbacks on one machine.
   void on_machine(MachineId id, StateCallbacks callbacks);
@@ -374,7 +378,7 @@ public:
   SubscriptionId subscribe(std::function<void(const Record&)> observer);
   void unsubscribe(SubscriptionId id);
   /// Publishes a record that originates outside the core (e.g. an injection) on the stream and,
-  /// when it names a machine, in that machine's history.
+  /// when it names a machine, in that machine's history. A write, as generate().
   void publish(Record record);
 
 private:
@@ -476,15 +480,35 @@ private:
     State state = State::Normal;
     std::uint8_t severity = 0;  ///< the outstanding condition's severity
   };
-  enum class PendingKind : std::uint8_t { Generate, Reset };
+  /// One write: what generate(), reset() and publish() do under the lock, and what a callback or
+  /// observer asks them to do (queued until the records being handed out have been).
+  enum class PendingKind : std::uint8_t { Generate, Reset, Publish };
   struct Pending {
-    PendingKind kind;
-    EventId event;
-    MachineId machine;
+    PendingKind kind = PendingKind::Generate;
+    EventId event = kNoEvent;
+    MachineId machine = kNoMachine;
     SampleCause cause;
     Address address;
-    NameId why;  ///< Reset: the interned "who: why" text
+    NameId why = kNoName;  ///< Reset: the interned "who: why" text
+    Record record;         ///< Publish
   };
+  /// A record to hand out after the write that made it, with the lock released: to the observers,
+  /// and for a transition with callbacks, to the callbacks of its machine (or component).
+  struct Delivery {
+    Record record;
+    std::uint64_t ticket = 0;  ///< the write it belongs to (writes are handed out in ticket order)
+    bool observe = false;
+    bool callbacks = false;
+  };
+  /// A registration made from inside a callback or observer, applied after the records being
+  /// handed out.
+  struct Registration {
+    enum class Kind : std::uint8_t { Machine, Component, Subscribe, Unsubscribe } kind;
+    std::uint32_t id = 0;  ///< machine, component or subscription
+    StateCallbacks callbacks;
+    std::function<void(const Record&)> observer;
+  };
+  class Requests;  ///< the writes requested while records are handed out (coordinator.cpp)
 
   static constexpr std::uint64_t pack(StateSnapshot s) noexcept {
     return static_cast<std::uint64_t>(s.state) | (static_cast<std::uint64_t>(s.outstanding) << 8);
@@ -501,9 +525,40 @@ private:
   static std::vector<MachineId> component_machines(const ComponentData& c);
   bool depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept;
 
-  // Processing (lock held).
+  // Writes: one operation under the lock, then its records handed out without it.
+  /// Makes `op` and hands its records out (finish()); queued instead when called from a callback
+  /// or observer of this coordinator.
+  void write(const Pending& op) noexcept;
+  /// The write `op` under the lock: processing, propagation, records staged in outbox_.
   void run(const Pending& op) noexcept;
-  void drain_pending() noexcept;
+  /// A write's staged records: their ticket (0: none) and whether this thread holds their turn
+  /// already (the records in handing_).
+  struct Sealed {
+    std::uint64_t ticket = 0;
+    bool turn = false;
+  };
+  /// After a write: hands its records out, then makes the writes its callbacks and observers
+  /// queued, and theirs, at most 65536 of them.
+  void finish(Sealed sealed) noexcept;
+  /// Closes the staged records of the write just made (mutex_ held) with the next ticket, and
+  /// takes their turn at once when it can.
+  Sealed seal() noexcept;
+  /// Hands out the records of a sealed write once every earlier write's have been; the writes its
+  /// callbacks and observers make are appended to `queue`.
+  void deliver(Sealed sealed, Requests& queue) noexcept;
+  /// Calls the callbacks of a transition record's machine or component.
+  void fire(const Delivery& d, Requests& queue) noexcept;
+  /// Applies the registrations made while records were handed out (the turn held).
+  void apply_registrations() noexcept;
+  /// Makes a registration in a turn of its own; deferred when called while handing out.
+  void register_now(Registration registration);
+  /// Waits until every earlier ticket's turn is over.
+  void wait_turn(std::uint64_t ticket) noexcept;
+  /// Ends the turn of `ticket` and wakes the threads waiting for theirs.
+  void end_turn(std::uint64_t ticket) noexcept;
+  /// True on the thread that is handing out this coordinator's records (from its callbacks and
+  /// observers): its writes are queued and its registrations deferred.
+  bool delivering_here() const noexcept;
   void process(EventId event, MachineId target, const SampleCause& cause) noexcept;
   void process_onset(const Event& event, MachineId target, const SampleCause& cause, Time now) noexcept;
   void process_completion(const Event& event, MachineId target, Time now) noexcept;
@@ -521,9 +576,10 @@ private:
                       std::uint32_t text) noexcept;
   void update_machine(MachineId id, State old_state, EventId event, const RootCause* root, Time now) noexcept;
   void update_component(ComponentId id, EventId event, const RootCause* root, Time now) noexcept;
-  void fire(std::vector<StateCallbacks>& callbacks, ComponentId component, const TransitionInfo& info, State from,
-            State to) noexcept;
-  void emit(const Record& r) noexcept;
+  /// Stages a record for the observers and, when `callbacks`, for the callbacks of its subject.
+  void stage(const Record& r, bool callbacks) noexcept {
+    if (observed_ || callbacks) outbox_.push_back(Delivery{r, 0, observed_, callbacks});
+  }
   /// Numbers, stores and publishes a machine or component record; `text` as in StoredRecord.
   void record(Record& r, std::uint32_t text) noexcept;
   std::vector<Explanation> explain_machine(MachineId id) const;
@@ -550,46 +606,32 @@ private:
   std::vector<Connection> connections_;
 
   // ---- lock discipline ------------------------------------------------------------------------
-  // One plain mutex guards everything that changes at run time (conditions, history, queue,
-  // callbacks, observers); state reads never take it (they read the published atomic words).
-  // - Every public member that needs it takes it exactly once, on entry, through Lock. Private
-  //   members (processing, propagation, records, explain_machine, hop_path, ...) assume it is
-  //   held and never take it; no public member that locks calls another public member that locks.
-  // - Callbacks and observers run under the mutex, on the thread that holds it (docs/semantics.md
-  //   §5.3, §8.2). When one of them calls back into this coordinator, Lock finds `owner_` equal
-  //   to the calling thread and does not lock again: generate(), broadcast() and reset() then see
-  //   `processing_` and queue their request; reads (history(), explain(), resolve_root(), ...)
-  //   read under the lock already held. Any other thread blocks until the outer operation ends.
-  // - `owner_` is written only by the thread that holds the mutex (after locking, before
-  //   unlocking), so a thread can find its own id there only while it really holds the mutex.
-  // - names_mutex_ is taken after mutex_ (intern()/name_of() while processing), never before.
-  class Lock {
-  public:
-    explicit Lock(const Coordinator& co) : co_(co) {
-      if (co_.owner_.load(std::memory_order_relaxed) == std::this_thread::get_id()) return;  // re-entry
-      co_.mutex_.lock();
-      co_.owner_.store(std::this_thread::get_id(), std::memory_order_relaxed);
-      locked_ = true;
-    }
-    ~Lock() {
-      if (!locked_) return;
-      co_.owner_.store(std::thread::id{}, std::memory_order_relaxed);
-      co_.mutex_.unlock();
-    }
-    Lock(const Lock&) = delete;
-    Lock& operator=(const Lock&) = delete;
-
-  private:
-    const Coordinator& co_;
-    bool locked_ = false;
-  };
+  // - mutex_ guards everything that changes at run time (conditions, history, staged records,
+  //   tickets); state reads never take it (they read the published atomic words). Every public
+  //   member that needs it takes it once, on entry; private members assume it is held. It is never
+  //   held while a callback or observer runs, so nothing ever takes it twice on one thread.
+  // - Turns: a write stages its records in outbox_ and takes the next ticket under mutex_; with
+  //   mutex_ released, it waits until `delivered_` reaches the ticket before it, hands its records
+  //   out, and ends its turn by moving `delivered_` on. A registration takes a ticket too and
+  //   changes the lists in its own turn, so no list is changed while it is walked. The turn holder
+  //   alone touches handing_, deferred_ and requests_, and walks the lists. The thread handing out
+  //   records (deliverer_) defers its own registrations and queues its own writes instead.
+  // - Lock order: mutex_, then names_mutex_; never the other way. Waiting for a turn holds no lock.
   mutable std::mutex mutex_;
-  mutable std::atomic<std::thread::id> owner_{};
-  bool processing_ = false;
+  std::atomic<std::uint64_t> delivered_{0};   ///< the last ticket whose records were handed out
+  std::atomic<std::uint32_t> waiters_{0};     ///< threads waiting for their turn
+  std::atomic<std::thread::id> deliverer_{};  ///< the thread handing out records now; none: id{}
+  Requests* requests_ = nullptr;              ///< its queue of requested writes (that thread only)
+  std::uint64_t issued_ = 0;                  ///< the last ticket issued (mutex_)
+  std::vector<Delivery> outbox_;              ///< staged records of the writes not yet handed out (mutex_)
+  std::vector<Delivery> handing_;             ///< the records being handed out (the turn holder)
+  std::vector<Registration> deferred_;        ///< registrations waiting for the end of a turn (the turn holder)
+  bool observed_ = false;                     ///< observers_ is not empty (mutex_)
+  static thread_local std::vector<Pending> spare_queue_;  ///< the queue of this thread's outermost write
+  static thread_local bool spare_busy_;
   std::uint64_t condition_seq_ = 0;
   std::uint64_t record_seq_ = 0;
   std::uint64_t dropped_requests_ = 0;
-  std::vector<Pending> pending_;
   std::vector<MachineSummary> summaries_;   ///< by machine id, kept by update_machine()
   std::vector<MachineId> work_;             ///< BFS queue for propagation, reserved up front
   std::vector<std::uint64_t> visit_marks_;  ///< per machine: last BFS that visited it

@@ -184,6 +184,13 @@ private:
 std::vector<introspect::Action> step_actions(const spec::ScenarioStep& step, const Monitor& monitor,
                                              const spec::SystemSpec& system);
 
+/// Checks one expectation of an `expect`, `expect_outstanding` or `expect_cause` step against the
+/// coordinator that holds `address` (a component, machine, service or SYSTEM of it): empty when it
+/// is met, else what was found against what was expected ("JR3 is Normal, expected Error"). The
+/// scenario runner and a live coordinator's scenario (`safecass run --scenario`) both check with it.
+std::string expectation_problem(const Coordinator& co, const spec::ScenarioStep& step, const std::string& address,
+                                const std::string& expected);
+
 /// Loads a scenario and its system and runs it; prints diagnostics to `err`. Returns 0 passed,
 /// 1 an expectation failed, 2 invalid input, or a history file (RunOptions::record_path) that is
 /// incomplete: a write error or dropped records, each said on `err` with the file, the count and
