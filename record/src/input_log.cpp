@@ -266,8 +266,8 @@ std::optional<introspect::Action> decode_action(InputActionKind kind, const char
     p += 2;
     if (stop - p < 8 * static_cast<std::ptrdiff_t>(w)) return std::nullopt;
     std::vector<double> v(w);
-    std::memcpy(v.data(), p, 8u * w);
-    p += 8u * w;
+    std::memcpy(v.data(), p, std::size_t{8} * w);
+    p += std::size_t{8} * w;
     values.push_back(std::move(v));
   }
   if (p != stop) return std::nullopt;
