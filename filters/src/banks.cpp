@@ -163,8 +163,10 @@ void Banks::run(Time now) noexcept {
       r.taken = r.cursor.take_single(r.time, &r.value);
     }
   }
+  others_ran_ = false;
   for (const Step& step : steps_) {
     if (step.object != nullptr) {
+      others_ran_ = true;
       step.object->run(now);
     } else {
       run_reader(readers_[step.reader], now);
@@ -200,8 +202,10 @@ std::size_t Banks::read(Reader& reader) noexcept {
     plain = finite_[0] != 0;
     samples = 1;
     // A sample written since the read ahead, during this run (an application's observer of an
-    // earlier filter's event), is read now, as the filters one by one would read it.
-    if (!reader.cursor.unread()) {
+    // earlier filter's event), is read now, as the filters one by one would read it. Only code
+    // run on this thread in between can have written one before this reader's turn: a sample
+    // another thread writes meanwhile may as well come after the run (and is read by the next).
+    if (!others_ran_ || !reader.cursor.unread()) {
       plain_ = plain;
       return 1;
     }
@@ -306,6 +310,7 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
 
 void Banks::run_out(Member& m, const Reader& reader, Time now) noexcept {
   Filter& f = *m.filter;
+  others_ran_ = true;
   f.run(now);
   m.reported = f.detected();
   m.slow = f.invalid_count_ != 0;
@@ -315,6 +320,7 @@ void Banks::run_out(Member& m, const Reader& reader, Time now) noexcept {
 
 void Banks::deliver(Member& m, std::size_t j) noexcept {
   Filter& f = *m.filter;
+  others_ran_ = true;
   f.deliver(0, SampleView{times_[j], sample(j), width_, injected_[j] != 0});
   f.current_injected_ = false;
   m.slow = f.invalid_count_ != 0;

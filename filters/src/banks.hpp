@@ -102,6 +102,7 @@ private:
   /// Sample `j` of this read through the object path (non-finite, injected, or the input marked).
   [[gnu::cold]] void deliver(Member& m, std::size_t j) noexcept;
   [[gnu::cold]] void report(Member& m, bool detected, double value, Time time) noexcept {
+    others_ran_ = true;  // the event's observers and callbacks
     m.filter->report(detected, value, time);
     m.reported = m.filter->detected();
   }
@@ -130,7 +131,10 @@ private:
   std::vector<char> injected_;
   std::vector<char> finite_;
   std::size_t width_ = 1;
-  bool plain_ = true;                      ///< every sample of the current read is finite and not injected
+  bool plain_ = true;  ///< every sample of the current read is finite and not injected
+  /// Code other than the banks' (an object filter, an event's observers and callbacks) ran on
+  /// this thread during this run, so it may have written a signal read ahead.
+  bool others_ran_ = false;
   std::atomic<std::uint32_t> changes_{0};  ///< bumped by a member's set_enabled() and inject()
   std::uint32_t seen_ = 0;
 };
