@@ -39,7 +39,7 @@ class LiveSystem:
         subprocess.run([self.binary, "keys", os.path.join(self.source, "examples/robodoc/robodoc.json"), "--out", keys,
                         "--replace"], check=True, stdout=subprocess.DEVNULL, timeout=20)
         os.environ["SAFECASS_KEYS"] = keys
-        subprocess.run([os.path.join(self.source, "scripts", "start-icestorm"), "--port", "0", "--dir",
+        subprocess.run([os.path.join(self.source, "scripts", "start-icestorm"), "--port", "0", "--replace", "--dir",
                         os.path.join(self.scratch, "icestorm"), "--env", env_file],
                        check=True, stdout=subprocess.DEVNULL, timeout=20)
         values = dict(line.strip().split("=", 1) for line in open(env_file) if "=" in line)

@@ -262,7 +262,7 @@ public:
   bool start() {
     const std::string command = script_ + (replicas_ > 0 ? " --replicas " + std::to_string(replicas_) : "") +
                                 " --port " + (port_.empty() ? "0" : port_) + " --dir " + dir_ + " --env " + env_file_ +
-                                " >/dev/null";
+                                " --replace >/dev/null";
     bool started = false;
     for (int attempt = 0; attempt < 5 && !started; ++attempt) {
       if (attempt > 0) std::this_thread::sleep_for(500ms);

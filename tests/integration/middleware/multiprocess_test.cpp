@@ -174,14 +174,16 @@ struct TwoProcesses {
   }
 };
 
-State state_of(middleware::RemoteClient& c, const std::string& address) {
+/// The state of `address` as `c` reads it; nothing when the read fails or has no such row (never
+/// taken for Normal).
+std::optional<State> state_of(middleware::RemoteClient& c, const std::string& address) {
   const auto component = address.substr(0, address.find('.'));
   auto rows = c.state_list(component);
-  if (!rows) return State::Normal;
+  if (!rows) return std::nullopt;
   for (const auto& r : *rows) {
     if (r.address == address) return r.state;
   }
-  return State::Normal;
+  return std::nullopt;
 }
 
 std::string causes(const std::vector<Explanation>& why) {
@@ -245,7 +247,9 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
 
   ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_FORCE_ERROR", "JR3.s_A"}));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << sys.logs();
-  EXPECT_TRUE(ui->explain("PENDANT")->conditions.empty());
+  const auto after = ui->explain("PENDANT");
+  ASSERT_TRUE(after) << after.error().message;
+  EXPECT_TRUE(after->conditions.empty());
 }
 
 /// One history record as a line both sides can produce: what happened and its root cause.
@@ -529,7 +533,7 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   const std::string dir = p.scratch + "/restart-icestorm";
   const std::string env_file = p.scratch + "/restart-icestorm.env";
   const std::string start = p.source + "/scripts/start-icestorm";
-  ASSERT_EQ(std::system((start + " --port 0 --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
+  ASSERT_EQ(std::system((start + " --port 0 --replace --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
   const std::string port = env_file_value(env_file, "ICESTORM_PORT");
   pid_t icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
   struct Kill {
@@ -577,7 +581,12 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
       },
       10000ms))
       << "after resync the ui holds exactly the robot's current roots\n"
-      << causes(ui->explain("PENDANT")->conditions) << sys.logs();
+      <<
+      [&] {
+        const auto why = ui->explain("PENDANT");
+        return why ? causes(why->conditions) : "(explain failed: " + why.error().message + ")";
+      }()
+      << sys.logs();
   EXPECT_NE(sys.ui->output().find("connected to IceStorm"), std::string::npos);
 
   ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}));

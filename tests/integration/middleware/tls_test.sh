@@ -29,7 +29,7 @@ check() {  # check DESCRIPTION COMMAND...
 "$bin" keys "$system" --out keys --replace >/dev/null 2>&1 || { echo "keys failed"; exit 1; }
 "$bin" keys "$system" --out other-system --replace >/dev/null 2>&1 || { echo "keys (other CA) failed"; exit 1; }
 export SAFECASS_KEYS="$scratch/keys"
-icestorm=$("$src/scripts/start-icestorm" --port 0 --dir ice --env ice.env) || { echo "start-icestorm failed"; exit 1; }
+icestorm=$("$src/scripts/start-icestorm" --port 0 --dir ice --env ice.env --replace) || { echo "start-icestorm failed"; exit 1; }
 port=$(sed -n 's/^ICESTORM_PORT=//p' ice.env)
 grep -q "ssl -h 127.0.0.1 -p $port" ice/icebox.config
 check "IceStorm's endpoints are TLS, from the keys alone" test $? -eq 0
@@ -89,6 +89,17 @@ SAFECASS_KEYS="$scratch/no-certs-secret" "$bin" supervisor "$system" --ice 192.0
 check "the supervisor refuses it too" test $? -eq 2
 SAFECASS_KEYS="$scratch/no-certs" console --coordinator ui --ice 192.0.2.1:4061 -c "state list" > far-console.txt 2>&1
 check "the console refuses it too" test $? -ne 0
+
+# A directory an IceBox still uses (its caller killed before it could stop it) is refused, with
+# the PID, and taken over with --replace.
+"$src/scripts/start-icestorm" --port 0 --dir ice > in-use.txt 2>&1
+check "start-icestorm refuses a directory an earlier IceBox still uses" test $? -eq 2
+check "and names its PID" grep -q "in use by PID(s) $icestorm " in-use.txt
+replaced=$("$src/scripts/start-icestorm" --port 0 --dir ice --env ice.env --replace)
+check "--replace stops that IceBox and starts another on the directory" test $? -eq 0
+gone() { ! kill -0 "$icestorm" 2>/dev/null || grep -q '^State:.*Z' "/proc/$icestorm/status" 2>/dev/null; }
+check "the earlier IceBox is gone" gone
+kill "$replaced" 2>/dev/null
 
 if [ $failures -ne 0 ]; then
   echo "--- robot.log"; tail -20 robot.log; echo "--- ui.log"; tail -20 ui.log
