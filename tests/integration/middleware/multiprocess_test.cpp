@@ -533,7 +533,8 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   const std::string dir = p.scratch + "/restart-icestorm";
   const std::string env_file = p.scratch + "/restart-icestorm.env";
   const std::string start = p.source + "/scripts/start-icestorm";
-  ASSERT_EQ(std::system((start + " --port 0 --replace --dir " + dir + " --env " + env_file + " >/dev/null").c_str()), 0);
+  ASSERT_EQ(std::system((start + " --port 0 --replace --dir " + dir + " --env " + env_file + " >/dev/null").c_str()),
+            0);
   const std::string port = env_file_value(env_file, "ICESTORM_PORT");
   pid_t icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
   struct Kill {
