@@ -117,6 +117,10 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls, cons
   // 2 s, so that the same call still reaches the next replica.
   init.properties->setProperty("Ice.Override.ConnectTimeout", ice.locator ? "700" : tls.enabled() ? "2000" : "500");
   init.properties->setProperty("Ice.Default.InvocationTimeout", "2000");
+  // Closing a connection waits for the peer to acknowledge, by default up to the endpoint's
+  // timeout (60 s): a process stopping (a console quitting) beside a stalled peer would wait that
+  // long in Communicator::destroy. One second is enough for a live peer on any of our links.
+  init.properties->setProperty("Ice.Override.CloseTimeout", "1000");
   init.properties->setProperty("Ice.RetryIntervals", "-1");
   init.properties->setProperty("Ice.Warn.Connections", "0");
   // A message that fails to dispatch is counted and logged, rate-limited, by the servant's Guard
