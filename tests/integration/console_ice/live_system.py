@@ -41,7 +41,7 @@ class LiveSystem:
         os.environ["SAFECASS_KEYS"] = keys
         subprocess.run([os.path.join(self.source, "scripts", "start-icestorm"), "--port", "0", "--replace", "--dir",
                         os.path.join(self.scratch, "icestorm"), "--env", env_file],
-                       check=True, stdout=subprocess.DEVNULL, timeout=20)
+                       check=True, stdout=subprocess.DEVNULL, timeout=45)  # the script waits 30 s itself
         values = dict(line.strip().split("=", 1) for line in open(env_file) if "=" in line)
         self.icestorm_pid = int(values["ICESTORM_PID"])
         self.port = int(values["ICESTORM_PORT"])

@@ -106,7 +106,8 @@ async function startIceStorm() {
   const env = path.join(scratch, 'icestorm.env');
   fs.rmSync(env, { force: true });
   fs.rmSync(path.join(scratch, 'icestorm'), { recursive: true, force: true });  // no subscribers of an earlier run
-  const r = await run(path.join(root, 'scripts/start-icestorm'), ['--port', '0', '--replace', '--dir', path.join(scratch, 'icestorm'), '--env', env]);
+  // The script waits up to 30 s for IceStorm itself (a loaded machine): a longer bound here.
+  const r = await run(path.join(root, 'scripts/start-icestorm'), ['--port', '0', '--replace', '--dir', path.join(scratch, 'icestorm'), '--env', env], 45000);
   if (fs.existsSync(env)) {
     const values = Object.fromEntries(fs.readFileSync(env, 'utf8').split('\n').filter((l) => l.includes('='))
       .map((l) => [l.slice(0, l.indexOf('=')), l.slice(l.indexOf('=') + 1).trim()]));
