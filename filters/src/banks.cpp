@@ -18,8 +18,8 @@ bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
     kind = Kind::Threshold;
   } else if (dynamic_cast<Watchdog*>(&filter) != nullptr) {
     kind = Kind::Watchdog;
-  } else if (auto* average = dynamic_cast<MovingAverage*>(&filter); average != nullptr && average->scalar()) {
-    kind = Kind::Average;
+  } else if (auto* average = dynamic_cast<MovingAverage*>(&filter); average != nullptr) {
+    kind = average->scalar() ? Kind::Average : Kind::VectorAverage;
   } else if (dynamic_cast<Debounce*>(&filter) != nullptr) {
     kind = Kind::Debounce;
   } else if (dynamic_cast<Frequency*>(&filter) != nullptr) {
@@ -29,7 +29,8 @@ bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
   } else {
     return false;
   }
-  return scalar || kind == Kind::Watchdog || kind == Kind::Frequency || kind == Kind::Norm;
+  return scalar || kind == Kind::VectorAverage || kind == Kind::Watchdog || kind == Kind::Frequency ||
+         kind == Kind::Norm;
 }
 
 void Banks::add(Filter* filter) {
@@ -87,47 +88,57 @@ void Banks::add(Filter* filter) {
   filter->cold_->bank_changes = &changes_;
 }
 
-template <class F, class State>
-State& Banks::place(Member& member, std::vector<State>& bank) {
+template <class State, class Get>
+State& Banks::place(Member& member, std::vector<State>& bank, Get get) {
   // Moves the filter's state into its bank; when the bank's array grows, every member of that
   // kind is pointed at its element's new address.
   const State* before = bank.data();
   bank.emplace_back();
   member.index = static_cast<std::uint32_t>(bank.size() - 1);
-  static_cast<F*>(member.filter)->state().adopt(&bank.back());
+  get(*member.filter).adopt(&bank.back());
   if (bank.data() != before) {
     for (Member& m : members_) {
-      if (m.kind == member.kind && &m != &member) static_cast<F*>(m.filter)->state().rebind(&bank[m.index]);
+      if (m.kind == member.kind && &m != &member) get(*m.filter).rebind(&bank[m.index]);
     }
   }
   return bank.back();
 }
 
 void Banks::adopt(Member& member) {
+  // The banked state of a filter of type F.
+  const auto state = []<class F>(F*) {
+    return [](Filter & f) -> auto& { return static_cast<F&>(f).state(); };
+  };
   switch (member.kind) {
-    case Kind::Threshold: place<Threshold>(member, thresholds_); break;
-    case Kind::Watchdog: place<Watchdog>(member, watchdogs_); break;
+    case Kind::Threshold: place(member, thresholds_, state(static_cast<Threshold*>(nullptr))); break;
+    case Kind::Watchdog: place(member, watchdogs_, state(static_cast<Watchdog*>(nullptr))); break;
     case Kind::Average: {
-      builtin::AverageState& s = place<MovingAverage>(member, averages_);
+      builtin::AverageState& s = place(member, averages_, state(static_cast<MovingAverage*>(nullptr)));
       keep_ring(member, s.ring, s.window);
       break;
     }
-    case Kind::Debounce: place<Debounce>(member, debounces_); break;
+    case Kind::VectorAverage: {
+      builtin::VectorAverageState& s = place(
+          member, vector_averages_, [](Filter & f) -> auto& { return static_cast<MovingAverage&>(f).vector_state(); });
+      keep_ring(member, s.block, builtin::VectorAverageState::block_size(s.window, s.width));
+      break;
+    }
+    case Kind::Debounce: place(member, debounces_, state(static_cast<Debounce*>(nullptr))); break;
     case Kind::Frequency: {
-      builtin::FrequencyState& s = place<Frequency>(member, frequencies_);
+      builtin::FrequencyState& s = place(member, frequencies_, state(static_cast<Frequency*>(nullptr)));
       keep_ring(member, s.ring, s.window);
       break;
     }
-    case Kind::Norm: place<Norm>(member, norms_); break;
+    case Kind::Norm: place(member, norms_, state(static_cast<Norm*>(nullptr))); break;
   }
 }
 
-void Banks::keep_ring(const Member& member, double* ring, std::uint32_t window) {
+void Banks::keep_ring(const Member& member, double* ring, std::size_t length) {
   // The ring goes next to the rings of the filters before it; when rings_ grows, every state is
   // pointed at its ring's new address.
   const double* before = rings_.data();
   ring_list_.push_back(Ring{member.kind, member.index, static_cast<std::uint32_t>(rings_.size())});
-  rings_.insert(rings_.end(), ring, ring + window);
+  rings_.insert(rings_.end(), ring, ring + length);
   if (rings_.data() != before) {
     for (const Ring& r : ring_list_) ring_of(r) = rings_.data() + r.offset;
   } else {
@@ -136,7 +147,11 @@ void Banks::keep_ring(const Member& member, double* ring, std::uint32_t window) 
 }
 
 double*& Banks::ring_of(const Ring& ring) noexcept {
-  return ring.kind == Kind::Average ? averages_[ring.index].ring : frequencies_[ring.index].ring;
+  switch (ring.kind) {
+    case Kind::Average: return averages_[ring.index].ring;
+    case Kind::VectorAverage: return vector_averages_[ring.index].block;
+    default: return frequencies_[ring.index].ring;
+  }
 }
 
 void Banks::run(Time now) noexcept {
@@ -273,6 +288,14 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
         each_sample(m, samples, [&](std::size_t j) {
           const double mean = s.step(*sample(j));
           if (s.output != nullptr) s.output->push(times_[j], mean);
+        });
+        break;
+      }
+      case Kind::VectorAverage: {
+        builtin::VectorAverageState& s = vector_averages_[m.index];
+        each_sample(m, samples, [&](std::size_t j) {
+          const double* means = s.step(sample(j));
+          if (s.output != nullptr) s.output->push(times_[j], means);
         });
         break;
       }

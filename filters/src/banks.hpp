@@ -44,7 +44,7 @@ public:
   std::size_t banked() const noexcept { return members_.size(); }
 
 private:
-  enum class Kind : std::uint8_t { Threshold, Watchdog, Average, Debounce, Frequency, Norm };
+  enum class Kind : std::uint8_t { Threshold, Watchdog, Average, VectorAverage, Debounce, Frequency, Norm };
   struct Member {
     Filter* filter = nullptr;
     std::uint32_t index = 0;   ///< its state in the array of its kind
@@ -69,8 +69,8 @@ private:
     Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader]
     std::uint32_t reader = 0;
   };
-  /// The ring of a banked filter's state (MovingAverage's samples, Frequency's intervals), kept in
-  /// rings_ after the others'.
+  /// The ring of a banked filter's state (MovingAverage's samples, with a vector's sums and means;
+  /// Frequency's intervals), kept in rings_ after the others'.
   struct Ring {
     Kind kind;
     std::uint32_t index;
@@ -79,9 +79,10 @@ private:
 
   bool bankable(Filter& filter, Kind& kind) const noexcept;
   void adopt(Member& member);
-  template <class F, class State>
-  State& place(Member& member, std::vector<State>& bank);
-  void keep_ring(const Member& member, double* ring, std::uint32_t window);
+  /// Moves `member`'s state, `get(filter)`, into `bank`.
+  template <class State, class Get>
+  State& place(Member& member, std::vector<State>& bank, Get get);
+  void keep_ring(const Member& member, double* ring, std::size_t length);
   double*& ring_of(const Ring& ring) noexcept;
   [[gnu::cold]] void refresh() noexcept;
   /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_.
@@ -120,6 +121,7 @@ private:
   std::vector<builtin::ThresholdState> thresholds_;
   std::vector<builtin::WatchdogState> watchdogs_;
   std::vector<builtin::AverageState> averages_;
+  std::vector<builtin::VectorAverageState> vector_averages_;
   std::vector<builtin::DebounceState> debounces_;
   std::vector<builtin::FrequencyState> frequencies_;
   std::vector<builtin::NormState> norms_;

@@ -1,12 +1,11 @@
 #pragma once
 // The built-in filters that can run in a bank (docs/filters.md, "Filter banks"): Threshold,
-// Watchdog and MovingAverage. Each keeps the state it judges with in a small struct with the step
-// function that updates it. The filter object points at that struct: at first its own copy, and
-// once a bank adopts it, the bank's element in an array of such structs. Run as an object or in a
-// bank, the filter goes through the same step function on the same state, so the two cannot
-// disagree on the arithmetic; what the bank does differently (one read of each sample for every
-// filter of its signal, no virtual call, no object touched unless an event is due) is what the
-// differential test checks (tests/unit/filters/bank_test.cpp).
+// Watchdog, MovingAverage (scalar and vector), Debounce, Frequency and Norm. Each keeps the state it judges with in a
+// small struct with the step function that updates it. The filter object points at that struct: at first its own copy,
+// and once a bank adopts it, the bank's element in an array of such structs. Run as an object or in a bank, the filter
+// goes through the same step function on the same state, so the two cannot disagree on the arithmetic; what the bank
+// does differently (one read of each sample for every filter of its signal, no virtual call, no object touched unless
+// an event is due) is what the differential test checks (tests/unit/filters/bank_test.cpp).
 
 #include <algorithm>
 #include <cmath>
@@ -95,6 +94,47 @@ struct AverageState {
   void reset() noexcept {
     count = next = 0;
     sum = 0.0;
+  }
+};
+
+/// A vector MovingAverage's state: one block of (window + 2) × width values, the ring of the last
+/// `window` samples, then the running sums, then the means last computed. The arithmetic is the
+/// scalar's, element by element.
+struct VectorAverageState {
+  double* block = nullptr;  ///< the filter object's, or its bank's
+  Signal* output = nullptr;
+  std::uint32_t window = 1;
+  std::uint32_t width = 1;
+  std::uint32_t next = 0;
+  std::uint32_t count = 0;
+
+  static std::size_t block_size(std::size_t window, std::size_t width) noexcept { return (window + 2) * width; }
+  /// One sample of `width` finite values; returns the means of the last `window` samples
+  /// (`width` values, kept until the next step).
+  const double* step(const double* x) noexcept {
+    double* sums = block + std::size_t{window} * width;
+    double* means = sums + width;
+    double* slot = block + std::size_t{next} * width;
+    for (std::uint32_t i = 0; i < width; ++i) {
+      if (count == window) sums[i] -= slot[i];
+      slot[i] = x[i];
+      sums[i] += x[i];
+    }
+    if (++next == window) next = 0;
+    if (count < window) ++count;
+    // Recompute exactly once per window so rounding errors of the running sums cannot accumulate.
+    if (next == 0) {
+      std::fill(sums, sums + width, 0.0);
+      for (std::uint32_t k = 0; k < count; ++k)
+        for (std::uint32_t i = 0; i < width; ++i) sums[i] += block[std::size_t{k} * width + i];
+    }
+    for (std::uint32_t i = 0; i < width; ++i) means[i] = sums[i] / static_cast<double>(count);
+    return means;
+  }
+  void reset() noexcept {
+    count = next = 0;
+    double* sums = block + std::size_t{window} * width;
+    std::fill(sums, sums + width, 0.0);
   }
 };
 
@@ -252,8 +292,8 @@ private:
   BankedState<WatchdogState> state_;
 };
 
-/// Mean of the last `window` samples (fewer at start-up), element-wise. A scalar's state can be
-/// banked; a vector's stays in the object.
+/// Mean of the last `window` samples (fewer at start-up), element-wise. Scalar or vector, its
+/// state can be banked.
 class MovingAverage final : public Filter {
 public:
   static constexpr const char* kType = "MovingAverage";
@@ -261,32 +301,34 @@ public:
   static FilterManifest manifest();
   [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s);
   bool scalar() const noexcept { return size_ == 1; }
+  /// A scalar's state; vector_state() a vector's.
   BankedState<AverageState>& state() noexcept { return scalar_; }
+  BankedState<VectorAverageState>& vector_state() noexcept { return vector_; }
 
 protected:
   void on_sample(std::size_t, const SampleView& s) noexcept override {
     if (size_ == 1) {
       write(0, s.time, scalar_->step(s[0]));
-      return;
+    } else {
+      write(0, s.time, vector_->step(s.data));
     }
-    on_vector(s);
   }
-  void on_reset() noexcept override;
+  void on_reset() noexcept override {
+    if (size_ == 1) {
+      scalar_->reset();
+    } else {
+      vector_->reset();
+    }
+  }
 
 private:
-  void on_vector(const SampleView& s) noexcept;
-
   // A scalar's window of up to kInline samples is kept inside the object (docs/filters.md,
-  // "Memory layout"); a larger window, and a vector's ring, running sum and output, in heap_.
+  // "Memory layout"); a larger window, and a vector's block, in heap_.
   static constexpr std::size_t kInline = 16;
   std::size_t window_;
   std::size_t size_;
   BankedState<AverageState> scalar_;
-  std::size_t next_ = 0;    ///< a vector's
-  std::size_t count_ = 0;   ///< a vector's
-  double* ring_ = nullptr;  ///< window_ samples of size_ values
-  double* sum_ = nullptr;   ///< a vector's running sum (size_ values)
-  double* out_ = nullptr;   ///< a vector's average written (size_ values)
+  BankedState<VectorAverageState> vector_;
   double inline_[kInline] = {};
   std::vector<double> heap_;
 };

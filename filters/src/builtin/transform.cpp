@@ -87,19 +87,21 @@ private:
 
 MovingAverage::MovingAverage(FilterInit init)
     : Filter(std::move(init)), window_(static_cast<std::size_t>(number("window"))), size_(inputs()[0]->size()) {
+  Signal* output = outputs().empty() ? nullptr : outputs()[0];
   if (size_ == 1) {
     if (window_ > kInline) heap_.assign(window_, 0.0);
-    ring_ = window_ > kInline ? heap_.data() : inline_;
     AverageState& s = scalar_.own();
-    s.ring = ring_;
+    s.ring = window_ > kInline ? heap_.data() : inline_;
     s.window = static_cast<std::uint32_t>(window_);
-    s.output = outputs().empty() ? nullptr : outputs()[0];
+    s.output = output;
     return;
   }
-  heap_.assign((window_ + 2) * size_, 0.0);  // the ring, the running sum, the output
-  ring_ = heap_.data();
-  sum_ = ring_ + window_ * size_;
-  out_ = sum_ + size_;
+  heap_.assign(VectorAverageState::block_size(window_, size_), 0.0);
+  VectorAverageState& v = vector_.own();
+  v.block = heap_.data();
+  v.output = output;
+  v.window = static_cast<std::uint32_t>(window_);
+  v.width = static_cast<std::uint32_t>(size_);
 }
 
 FilterManifest MovingAverage::manifest() {
@@ -119,34 +121,6 @@ FilterManifest MovingAverage::manifest() {
 
 Expected<std::vector<std::size_t>> MovingAverage::output_sizes(const FilterShape& s) {
   return same_size<MovingAverage>(s);
-}
-
-void MovingAverage::on_vector(const SampleView& s) noexcept {
-  double* slot = &ring_[next_ * size_];
-  for (std::size_t i = 0; i < size_; ++i) {
-    if (count_ == window_) sum_[i] -= slot[i];
-    slot[i] = s[i];
-    sum_[i] += s[i];
-  }
-  if (++next_ == window_) next_ = 0;
-  if (count_ < window_) ++count_;
-  // Recompute exactly once per window so rounding errors of the running sum cannot accumulate.
-  if (next_ == 0) {
-    std::fill(sum_, sum_ + size_, 0.0);
-    for (std::size_t k = 0; k < count_; ++k)
-      for (std::size_t i = 0; i < size_; ++i) sum_[i] += ring_[k * size_ + i];
-  }
-  for (std::size_t i = 0; i < size_; ++i) out_[i] = sum_[i] / static_cast<double>(count_);
-  write(0, s.time, out_);
-}
-
-void MovingAverage::on_reset() noexcept {
-  if (size_ == 1) {
-    scalar_->reset();
-    return;
-  }
-  count_ = next_ = 0;
-  std::fill(sum_, sum_ + size_, 0.0);
 }
 
 Norm::Norm(FilterInit init) : Filter(std::move(init)) {

@@ -170,7 +170,7 @@ TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
 
 TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsAndDetours) {
   // Banks (docs/filters.md): a Threshold, a Watchdog and a MovingAverage per signal, a vector's
-  // Norm → MovingAverage → Threshold, a Debounce and a Frequency, in banks;
+  // Norm → MovingAverage → Threshold and its own MovingAverage, a Debounce and a Frequency, in banks;
   // several samples per run, a NaN now and then, a deep injection, a filter disabled and enabled
   // again: none of it allocates after the warm-up (the deep injection's ring is made by the
   // first injection, in the warm-up).
@@ -189,9 +189,10 @@ TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsA
   s.add("MovingAverage", {{"input_signal", std::string("norm")}, {"output_signal", std::string("avg")}});
   s.add("Threshold",
         {{"input_signal", std::string("avg")}, {"threshold", 30.0}, {"event_onset", std::string("EVT_X")}});
+  s.add("MovingAverage", {{"input_signal", std::string("force")}, {"output_signal", std::string("mean_force")}});
   s.add("Debounce", {{"input_signal", std::string("x0")}, {"event_onset", std::string("EVT_X")}});
   s.add("Frequency", {{"input_signal", std::string("x1")}, {"min_rate", 1.0}, {"event_onset", std::string("EVT_X")}});
-  ASSERT_EQ(s.monitor.banked_count(), 155U);
+  ASSERT_EQ(s.monitor.banked_count(), 156U);
   Filter* toggled = s.monitor.filters()[1].get();
   const double f[] = {1, 2, 3};
   auto cycle = [&](int i) {

@@ -2,7 +2,8 @@
 // same filters, not new semantics. The differential test runs one random system twice, its
 // filters run as objects (Monitor(..., banks = false)) and in banks, and requires byte-equal
 // observer streams, outputs, detections and missed-sample counts after every cycle. The systems
-// mix every banked type (Threshold, Watchdog, MovingAverage, Debounce, Frequency, Norm) with an
+// mix every banked type (Threshold, Watchdog, MovingAverage of scalars and of vectors, Debounce,
+// Frequency, Norm) with an
 // object filter (Range) in between, ACTIVE and PASSIVE, scalar and vector signals, pipelines (a
 // filter on an earlier filter's output), EDGE and LEVEL, persistence in samples and seconds; the
 // signals mix noise around the limits, steps, ramps, zeros, NaN and ±inf; the runs mix several
@@ -254,11 +255,19 @@ private:
         events();
         if (pick(0, 1) == 0) output(c, "age" + std::to_string(i));
         break;
-      case 2:
+      case 2: {
         c.type = "MovingAverage";
-        c.params = {{"input_signal", scalar_input()}, {"window", static_cast<double>(pick(1, 5))}};
-        output(c, "mean" + std::to_string(i));
+        const std::string input = any_input();
+        c.params = {{"input_signal", input}, {"window", static_cast<double>(pick(1, 5))}};
+        const std::string name = "mean" + std::to_string(i);
+        if (width_of(input) == 1) {
+          output(c, name);
+        } else {  // a vector's means: a vector signal, which the scalar filters after it do not read
+          c.params["output_signal"] = name;
+          signals_.emplace_back(name, width_of(input));
+        }
         break;
+      }
       case 3:
         c.type = "Debounce";
         c.params = {{"input_signal", scalar_input()}, {"release", static_cast<double>(pick(1, 3))}};
@@ -362,6 +371,31 @@ TEST(FilterBank, BuiltInFiltersOfOneSignalShareOneBankReaderAndCustomTypesStayOb
   add("Range", {{"input_signal", std::string("x")}, {"min", 0.0}, {"max", 1.0}, {"event_onset", std::string("EVT_1")}});
   EXPECT_EQ(w.monitor().banked_count(), 3U);
   EXPECT_EQ(w.monitor().filters().size(), 4U);  // the console and the read model list all four
+}
+
+TEST(FilterBank, AVectorsMovingAverageIsBankedAndWritesTheElementWiseMeans) {
+  World w(true);
+  Signal* v = *w.monitor().add_signal("C.v", 3);
+  FilterConfig c;
+  c.type = "MovingAverage";
+  c.target.component = "C";
+  c.params = {{"input_signal", std::string("v")}, {"window", 2.0}, {"output_signal", std::string("mean")}};
+  ASSERT_TRUE(w.monitor().add_filter(c));
+  EXPECT_EQ(w.monitor().banked_count(), 1U);
+  const double first[] = {1.0, 2.0, 3.0};
+  const double second[] = {3.0, 6.0, -3.0};
+  v->push(Time{1}, first);
+  v->push(Time{2}, second);
+  w.monitor().run_active(ComponentId{0}, Time{2});
+  const Signal* mean = w.monitor().signals().find("C.mean");
+  ASSERT_NE(mean, nullptr);
+  Time t{};
+  double out[3] = {};
+  ASSERT_TRUE(mean->latest(t, out));
+  EXPECT_EQ(t, Time{2});
+  EXPECT_EQ(out[0], 2.0);
+  EXPECT_EQ(out[1], 4.0);
+  EXPECT_EQ(out[2], 0.0);
 }
 
 TEST(FilterBank, ASampleAnObserverWritesDuringTheRunIsJudgedInThatRunAsByTheFiltersOneByOne) {
