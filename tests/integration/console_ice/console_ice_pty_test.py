@@ -24,7 +24,7 @@ def main():
         print(__doc__, file=sys.stderr)
         return 2
     binary, source, scratch = sys.argv[1:]
-    signal.alarm(90)  # a last resort: the default action ends this script
+    signal.alarm(110)  # a last resort: the default action ends this script
     system = LiveSystem(binary, source, scratch)
     console = None
     stopped = False  # the coordinator stopped with SIGSTOP (continued before it is stopped for good)
@@ -33,8 +33,11 @@ def main():
         console = Console(os.path.abspath(binary), source,
                           ("--ice", system.ice, "--coordinator", "robot", "--allow-write", "--token-file",
                            system.token_file, "--timeout", "5000"))
+        # Connecting is several steps, each with its own bound (the heartbeat found within
+        # --timeout, a proof of life, the first reads, Ice's 2 s calls): on a loaded machine they
+        # add up to more than the 15 s any later line gets.
         console.expect(r"coordinator robot on IceStorm 127\.0\.0\.1:\d+ \(4 components\), live, writes allowed",
-                       "banner")
+                       "banner", timeout=60)
         console.expect(r"safecass> ", "first prompt")
 
         # TAB completes a command word, then a component name fetched from the coordinator.

@@ -1161,10 +1161,14 @@ TEST(Chaos, WithAReplicatedBrokerEveryProcessConvergesAfterItsMasterOrAnotherRep
         failure = chaos.apply(before ? clear : raise);
         const bool after = in_process();
         if (!failure.empty() || after == before) break;  // another fault hides the marker: no figure
+        // The failover is IceStorm's election (about a second idle); beside two busy loops and
+        // another test the replicas' election rounds time out and start again, and it took over
+        // 10 s. The processes stay fail-safe meanwhile (the robot lost, the ui in Error); the
+        // figure printed says how long it took.
         if (!eventually([&] { return has_root(chaos.ui()->explain("PENDANT.s_R.Status"), "EVT_FORCE_ERROR") == after; },
-                        10000ms)) {
+                        30000ms)) {
           failure = "the ui does not show the fault raised " +
-                    std::to_string(static_cast<int>(seconds_since(killed) * 1000)) + " ms after the kill within 10 s";
+                    std::to_string(static_cast<int>(seconds_since(killed) * 1000)) + " ms after the kill within 30 s";
         }
         longest = std::max(longest, seconds_since(sent) * 1000);
         ++toggles;

@@ -55,9 +55,10 @@ class Console:
         self.raw += chunk
         return True
 
-    def expect(self, pattern, what):
-        """Waits until `pattern` (a regex) appears in the output after what was matched before."""
-        deadline = time.monotonic() + TIMEOUT
+    def expect(self, pattern, what, timeout=TIMEOUT):
+        """Waits until `pattern` (a regex) appears in the output after what was matched before, for
+        at most `timeout` seconds."""
+        deadline = time.monotonic() + timeout
         regex = re.compile(pattern)
         while True:
             match = regex.search(self.text(), self.seen)
