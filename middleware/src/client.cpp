@@ -41,13 +41,14 @@ public:
       : coordinator_(std::move(coordinator)), keys_(keys), ic_(std::move(ic)) {}
   void on_beat(const wire::Signed& m) {
     if (m.signer != coordinator_) return;  // other coordinators' heartbeats, or forgeries of them
-    wire::Heartbeat h;
+    const OpenedHeartbeat opened = open_heartbeat(keys_, ic_, m);
+    const wire::Heartbeat& h = opened.beat;
     std::lock_guard lock(mutex_);
-    if (const std::string why = open_signed(keys_, ic_, m, kKindHeartbeat, h); !why.empty()) {
+    if (!opened.why.empty()) {
       ++refused_;
       return;
     }
-    if (h.coordinator != coordinator_ || h.control.empty()) return;
+    if (h.control.empty()) return;
     if (std::find(tried_.begin(), tried_.end(), h.control) != tried_.end() || control_ == h.control) return;
     control_ = h.control;
     cv_.notify_all();

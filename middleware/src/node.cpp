@@ -782,16 +782,12 @@ struct CoordinatorNode::Impl {
   }
 
   void on_beat(const wire::Signed& m) {
-    wire::Heartbeat hb;
-    if (const std::string why = open_signed(*keyring, ic, m, kKindHeartbeat, hb); !why.empty()) {
-      refuse(m.signer, "a heartbeat signed '" + printable(m.signer) + "': " + why);
+    const OpenedHeartbeat opened = open_heartbeat(*keyring, ic, m);
+    if (!opened.why.empty()) {
+      refuse(opened.source, opened.why);
       return;
     }
-    if (hb.coordinator != m.signer) {
-      refuse(m.signer,
-             "a heartbeat naming '" + printable(hb.coordinator) + "' signed by '" + printable(m.signer) + "'");
-      return;
-    }
+    const wire::Heartbeat& hb = opened.beat;
     const std::int64_t now = steady_ns();
     if (hb.coordinator == name) {
       if (hb.incarnation == incarnation) {
@@ -803,10 +799,6 @@ struct CoordinatorNode::Impl {
                                              "receivers follow the newer one");
         duplicates_seen.fetch_add(1);  // after the line: a reader of the count finds it logged
       }
-      return;
-    }
-    if (const std::string why = incarnation_out_of_bounds("a heartbeat", m.signer, hb.incarnation); !why.empty()) {
-      refuse(m.signer + "/incarnation", why);  // its own line: not hidden behind another refusal
       return;
     }
     std::lock_guard lock(peer_mutex);

@@ -15,6 +15,22 @@ std::string incarnation_out_of_bounds(std::string_view what, std::string_view wh
          (incarnation <= 0 ? " is not a start time" : " is more than 60 s ahead of this host's clock");
 }
 
+OpenedHeartbeat open_heartbeat(const Keyring& keys, const std::shared_ptr<Ice::Communicator>& ic,
+                               const wire::Signed& m) {
+  OpenedHeartbeat h;
+  h.source = m.signer;
+  if (const std::string why = open_signed(keys, ic, m, kKindHeartbeat, h.beat); !why.empty()) {
+    h.why = "a heartbeat signed '" + printable(m.signer) + "': " + why;
+  } else if (h.beat.coordinator != m.signer) {
+    h.why = "a heartbeat naming '" + printable(h.beat.coordinator) + "' signed by '" + printable(m.signer) + "'";
+  } else if (std::string bounds = incarnation_out_of_bounds("a heartbeat", m.signer, h.beat.incarnation);
+             !bounds.empty()) {
+    h.why = std::move(bounds);
+    h.source = m.signer + "/incarnation";
+  }
+  return h;
+}
+
 std::string older_incarnation(std::int64_t seen, std::int64_t newest) {
   return "incarnation " + std::to_string(seen) + " is older than " + std::to_string(newest) +
          " (a replay, or two processes with one name)";

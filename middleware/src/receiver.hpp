@@ -47,6 +47,19 @@ std::string older_incarnation(std::int64_t seen, std::int64_t newest);
 /// the future than kIncarnationMargin. Empty when it is acceptable.
 std::string incarnation_out_of_bounds(std::string_view what, std::string_view who, std::int64_t incarnation);
 
+/// A heartbeat opened as every receiver must before anything in it is believed (DESIGN §7): signed
+/// by a key of the keyring, of kind "heartbeat", naming its signer as its coordinator, and of an
+/// incarnation within bounds. Whether its process is the one proven alive is the receiver's
+/// PeerFreshness to say.
+struct OpenedHeartbeat {
+  wire::Heartbeat beat;
+  std::string why;     ///< empty: opened; else why it is refused
+  std::string source;  ///< the DropLog source to count a refusal under (an incarnation out of
+                       ///< bounds has its own, so that no other refusal of that signer hides it)
+};
+OpenedHeartbeat open_heartbeat(const Keyring& keys, const std::shared_ptr<Ice::Communicator>& ic,
+                               const wire::Signed& m);
+
 /// The names of a peer's streams in its heartbeat's list (wire::Heartbeat::lastSeq): its event
 /// records, and the state of each provided interface "C.p".
 inline constexpr std::string_view kEventsStream = "events";

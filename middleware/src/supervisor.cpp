@@ -146,11 +146,11 @@ struct Supervisor::Impl {
     drops->drop(source, "supervisor: refused " + what);
   }
 
-  /// Checks an authenticated message (heartbeats signed, every other kind sealed) and decodes it.
+  /// Checks a sealed message (state updates, event records) and decodes it; heartbeats, which are
+  /// signed, are opened by open_heartbeat().
   template <class Seq>
   bool open(const wire::Signed& m, std::string_view kind, Seq& out) {
-    const std::string why =
-        kind == kKindHeartbeat ? open_signed(*keyring, ic, m, kind, out) : open_sealed(*signer, ic, m, kind, out);
+    const std::string why = open_sealed(*signer, ic, m, kind, out);
     if (!why.empty()) {
       refuse(m.signer, "a " + std::string(kind) + " message signed '" + printable(m.signer) + "': " + why);
       return false;
@@ -492,22 +492,18 @@ struct Supervisor::Impl {
   }
 
   void on_beat(const wire::Signed& m) {
-    wire::Heartbeat h;
-    if (!open(m, kKindHeartbeat, h)) return;
-    if (h.coordinator != m.signer) {
-      refuse(m.signer, "a heartbeat naming '" + printable(h.coordinator) + "' signed by '" + printable(m.signer) + "'");
+    const OpenedHeartbeat opened = open_heartbeat(*keyring, ic, m);
+    if (!opened.why.empty()) {
+      refuse(opened.source, opened.why);
       return;
     }
+    const wire::Heartbeat& h = opened.beat;
     if (h.coordinator == kSupervisorSigner) {
       if (h.incarnation != incarnation) {
         drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
                                                 std::to_string(h.incarnation) + ", ours " +
                                                 std::to_string(incarnation) + ")");
       }
-      return;
-    }
-    if (const std::string why = incarnation_out_of_bounds("a heartbeat", h.coordinator, h.incarnation); !why.empty()) {
-      refuse(m.signer + "/incarnation", why);  // its own line: not hidden behind another refusal
       return;
     }
     std::vector<std::string> recovered;

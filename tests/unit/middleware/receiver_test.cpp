@@ -2,11 +2,14 @@
 // without a bus: what one receiver believes of one peer's process.
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "receiver.hpp"
+#include "safecass/middleware/keys.hpp"
 
 namespace safecass::middleware::detail {
 namespace {
@@ -94,6 +97,61 @@ TEST(IncarnationBounds, AnIncarnationNotPositiveOrMoreThanAMinuteAheadOfTheClock
   EXPECT_TRUE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation()).empty());
   EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", 0).empty());
   EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation() + 61'000'000'000).empty());
+}
+
+/// Two members' keys (robot, ui) and a communicator to encode with.
+struct Members2 {
+  std::shared_ptr<Ice::Communicator> ic = Ice::initialize();
+  std::optional<Keyring> keys;
+  std::optional<Signer> robot;
+  Members2() {
+    spec::SystemSpec system;
+    system.name = "two";
+    system.coordinators = {{"robot", {"JR3"}}, {"ui", {"PENDANT"}}};
+    const std::string dir = ::testing::TempDir() + "safecass-receiver-keys-" + std::to_string(::getpid());
+    EXPECT_TRUE(create_bus_keys(system, dir, KeyOptions::replacing()));
+    auto k = Keyring::load(dir);
+    EXPECT_TRUE(k);
+    keys = std::move(*k);
+    auto s = Signer::load(dir, "robot", *keys);
+    EXPECT_TRUE(s);
+    robot = std::move(*s);
+  }
+  ~Members2() { ic->destroy(); }
+  wire::Signed beat(const std::string& coordinator, std::int64_t incarnation) const {
+    wire::Heartbeat h;
+    h.coordinator = coordinator;
+    h.incarnation = incarnation;
+    h.seq = 1;
+    return robot->sign(kKindHeartbeat, encode(ic, h));
+  }
+};
+
+TEST(OpenHeartbeat, AHeartbeatIsOpenedOnlySignedAsAHeartbeatNamingItsSignerAndOfAnIncarnationWithinBounds) {
+  Members2 m;
+  ASSERT_TRUE(m.robot);
+  const OpenedHeartbeat good = open_heartbeat(*m.keys, m.ic, m.beat("robot", new_incarnation()));
+  EXPECT_TRUE(good.why.empty()) << good.why;
+  EXPECT_EQ(good.beat.coordinator, "robot");
+
+  const OpenedHeartbeat other = open_heartbeat(*m.keys, m.ic, m.beat("ui", new_incarnation()));
+  EXPECT_NE(other.why.find("naming 'ui' signed by 'robot'"), std::string::npos) << other.why;
+  EXPECT_EQ(other.source, "robot");
+
+  wire::Signed tampered = m.beat("robot", new_incarnation());
+  tampered.body.back() ^= 1;
+  const OpenedHeartbeat forged = open_heartbeat(*m.keys, m.ic, tampered);
+  EXPECT_NE(forged.why.find("a heartbeat signed 'robot'"), std::string::npos) << forged.why;
+
+  wire::Signed as_state = m.robot->sign("state", m.beat("robot", new_incarnation()).body);
+  EXPECT_FALSE(open_heartbeat(*m.keys, m.ic, as_state).why.empty()) << "another kind";
+
+  // Out of bounds: refused under a source of its own, so that no other refusal hides it.
+  for (const std::int64_t incarnation : {std::int64_t{0}, std::int64_t{INT64_MAX - 1}}) {
+    const OpenedHeartbeat far = open_heartbeat(*m.keys, m.ic, m.beat("robot", incarnation));
+    EXPECT_NE(far.why.find("incarnation"), std::string::npos) << far.why;
+    EXPECT_EQ(far.source, "robot/incarnation");
+  }
 }
 
 }  // namespace
