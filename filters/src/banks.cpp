@@ -104,32 +104,36 @@ State& Banks::place(Member& member, std::vector<State>& bank, Get get) {
   return bank.back();
 }
 
+namespace {
+/// The banked state of a filter of built-in type F.
+template <class F>
+auto& state_of(Filter& filter) noexcept {
+  return static_cast<F&>(filter).state();
+}
+auto& vector_state_of(Filter& filter) noexcept { return static_cast<MovingAverage&>(filter).vector_state(); }
+}  // namespace
+
 void Banks::adopt(Member& member) {
-  // The banked state of a filter of type F.
-  const auto state = []<class F>(F*) {
-    return [](Filter & f) -> auto& { return static_cast<F&>(f).state(); };
-  };
   switch (member.kind) {
-    case Kind::Threshold: place(member, thresholds_, state(static_cast<Threshold*>(nullptr))); break;
-    case Kind::Watchdog: place(member, watchdogs_, state(static_cast<Watchdog*>(nullptr))); break;
+    case Kind::Threshold: place(member, thresholds_, state_of<Threshold>); break;
+    case Kind::Watchdog: place(member, watchdogs_, state_of<Watchdog>); break;
     case Kind::Average: {
-      builtin::AverageState& s = place(member, averages_, state(static_cast<MovingAverage*>(nullptr)));
+      builtin::AverageState& s = place(member, averages_, state_of<MovingAverage>);
       keep_ring(member, s.ring, s.window);
       break;
     }
     case Kind::VectorAverage: {
-      builtin::VectorAverageState& s = place(
-          member, vector_averages_, [](Filter & f) -> auto& { return static_cast<MovingAverage&>(f).vector_state(); });
+      builtin::VectorAverageState& s = place(member, vector_averages_, vector_state_of);
       keep_ring(member, s.block, builtin::VectorAverageState::block_size(s.window, s.width));
       break;
     }
-    case Kind::Debounce: place(member, debounces_, state(static_cast<Debounce*>(nullptr))); break;
+    case Kind::Debounce: place(member, debounces_, state_of<Debounce>); break;
     case Kind::Frequency: {
-      builtin::FrequencyState& s = place(member, frequencies_, state(static_cast<Frequency*>(nullptr)));
+      builtin::FrequencyState& s = place(member, frequencies_, state_of<Frequency>);
       keep_ring(member, s.ring, s.window);
       break;
     }
-    case Kind::Norm: place(member, norms_, state(static_cast<Norm*>(nullptr))); break;
+    case Kind::Norm: place(member, norms_, state_of<Norm>); break;
   }
 }
 
