@@ -88,7 +88,15 @@ console() {  # console HOST ARGS...: the console, on HOST (never longer than 20 
   shift
   on "$host" timeout 20 "$bin/safecass" console --ice "$ice" --timeout 3000 "$@"
 }
-ui_shows() { console b --coordinator ui -c "state list PENDANT" 2>/dev/null | grep -Eq "PENDANT.s_R.Status  $1"; }
+# ui_shows PATTERN: the ui's PENDANT.s_R.Status row, read by a console on b, matches. What a try
+# that does not match printed goes to ui-query.log (shown when the case fails).
+ui_shows() {
+  local out
+  out=$(console b --coordinator ui -c "state list PENDANT" 2>&1)
+  grep -Eq "PENDANT.s_R.Status  $1" <<<"$out" && return 0
+  printf '[%s s] %s\n' "$SECONDS" "$out" >>"$HOSTS_DIR/ui-query.log"
+  return 1
+}
 generate() {  # generate EVENT: on the robot's JR3.s_A, from host c, with the robot's token
   console c --coordinator robot --token-file "$HOSTS_DIR/robot.token" --allow-write -c "event generate $1 JR3.s_A" \
     >>generate.log 2>&1
