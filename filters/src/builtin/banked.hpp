@@ -1,11 +1,13 @@
 #pragma once
 // The built-in filters that can run in a bank (docs/filters.md, "Filter banks"): Threshold,
-// Watchdog, MovingAverage (scalar and vector), Debounce, Frequency and Norm. Each keeps the state it judges with in a
-// small struct with the step function that updates it. The filter object points at that struct: at first its own copy,
-// and once a bank adopts it, the bank's element in an array of such structs. Run as an object or in a bank, the filter
-// goes through the same step function on the same state, so the two cannot disagree on the arithmetic; what the bank
-// does differently (one read of each sample for every filter of its signal, no virtual call, no object touched unless
-// an event is due) is what the differential test checks (tests/unit/filters/bank_test.cpp).
+// Watchdog, MovingAverage (scalar and vector), Debounce, Frequency and Norm. Each keeps the state
+// it judges with in a small struct with the step function that updates it. The filter object
+// points at that struct: at first its own copy, and once a bank adopts it, the bank's element in
+// an array of such structs. Run as an object or in a bank, the filter goes through the same step
+// function on the same state, so the two cannot disagree on the arithmetic; what the bank does
+// differently (one read of each sample for every filter of its signal, no virtual call, no object
+// touched unless an event is due) is what the differential test checks
+// (tests/unit/filters/bank_test.cpp).
 
 #include <algorithm>
 #include <cmath>

@@ -400,40 +400,48 @@ TEST(FilterBank, AVectorsMovingAverageIsBankedAndWritesTheElementWiseMeans) {
 
 TEST(FilterBank, ASampleAnObserverWritesDuringTheRunIsJudgedInThatRunAsByTheFiltersOneByOne) {
   // The signals no filter writes are read ahead of the run; one that something else writes during
-  // the run (here an observer of the first filter's event) must still be read at its step.
-  auto build = [](World& w) {
-    Signal* x = *w.monitor().add_signal("C.x");
-    Signal* y = *w.monitor().add_signal("C.y");
-    for (const char* input : {"x", "y"}) {
-      FilterConfig c;
-      c.name = std::string("limit_") + input;
-      c.type = "Threshold";
-      c.target.component = "C";
-      c.params = {{"input_signal", std::string(input)},
-                  {"threshold", 10.0},
-                  {"event_onset", std::string(input[0] == 'x' ? "EVT_0" : "EVT_1")}};
-      ASSERT_TRUE(w.monitor().add_filter(c));
+  // the run (here an observer of the first filter's event) must still be read at its step. The
+  // first filter is banked (Threshold) or an object (Range): either's event runs the observer.
+  for (const std::string first : {"Threshold", "Range"}) {
+    auto build = [&first](World& w) {
+      Signal* x = *w.monitor().add_signal("C.x");
+      Signal* y = *w.monitor().add_signal("C.y");
+      for (const char* input : {"x", "y"}) {
+        FilterConfig c;
+        c.name = std::string("limit_") + input;
+        c.type = input[0] == 'x' ? first : "Threshold";
+        c.target.component = "C";
+        c.params = {{"input_signal", std::string(input)},
+                    {"event_onset", std::string(input[0] == 'x' ? "EVT_0" : "EVT_1")}};
+        if (c.type == "Range") {
+          c.params["min"] = 0.0;
+          c.params["max"] = 10.0;
+        } else {
+          c.params["threshold"] = 10.0;
+        }
+        ASSERT_TRUE(w.monitor().add_filter(c));
+      }
+      const EventId onset = *w.coordinator().find_event("EVT_0");
+      w.coordinator().subscribe([y, onset](const Record& r) {
+        if (r.kind == RecordKind::Event && r.event == onset && r.outcome != Outcome::Ignored) y->push(r.time, 20.0);
+      });
+      x->push(Time{1}, 1.0);
+      y->push(Time{1}, 1.0);
+      x->push(Time{2}, 20.0);  // limit_x's onset: the observer writes y = 20 during the run
+    };
+    World objects(false);
+    World banks(true);
+    build(objects);
+    build(banks);
+    ASSERT_EQ(banks.monitor().banked_count(), first == "Range" ? 1U : 2U);
+    for (World* w : {&objects, &banks}) {
+      w->clock().set(Time{3});
+      w->monitor().run_active(ComponentId{0}, Time{3});
     }
-    const EventId onset = *w.coordinator().find_event("EVT_0");
-    w.coordinator().subscribe([y, onset](const Record& r) {
-      if (r.kind == RecordKind::Event && r.event == onset && r.outcome != Outcome::Ignored) y->push(r.time, 20.0);
-    });
-    x->push(Time{1}, 1.0);
-    y->push(Time{1}, 1.0);
-    x->push(Time{2}, 20.0);  // limit_x's onset: the observer writes y = 20 during the run
-  };
-  World objects(false);
-  World banks(true);
-  build(objects);
-  build(banks);
-  ASSERT_EQ(banks.monitor().banked_count(), 2U);
-  for (World* w : {&objects, &banks}) {
-    w->clock().set(Time{3});
-    w->monitor().run_active(ComponentId{0}, Time{3});
+    EXPECT_EQ(objects.log(), banks.log()) << first;
+    EXPECT_TRUE(objects.monitor().find_filter("limit_y")->detected()) << first;
+    EXPECT_TRUE(banks.monitor().find_filter("limit_y")->detected()) << first;
   }
-  EXPECT_EQ(objects.log(), banks.log());
-  EXPECT_TRUE(objects.monitor().find_filter("limit_y")->detected());
-  EXPECT_TRUE(banks.monitor().find_filter("limit_y")->detected());
 }
 
 TEST(FilterBank, AFilterDisabledAndInjectedFromAnotherThreadWhileItsBankRunsStaysExactAfterward) {
