@@ -14,6 +14,7 @@
 #include <thread>
 
 #include "auth.hpp"
+#include "bus_link.hpp"
 #include "control.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
@@ -145,11 +146,10 @@ struct CoordinatorNode::Impl {
   /// A remote provided interface held here (under peer_mutex).
   struct Held {
     MachineId proxy;
-    std::string provider;           ///< the coordinator that runs the provider
-    std::int64_t incarnation = 0;   ///< of the provider process whose update the held state is
-    std::int64_t last_seq = 0;      ///< the last update applied, of that incarnation
-    bool behind = false;            ///< a heartbeat said we missed its last update
-    std::int64_t behind_since = 0;  ///< steady ns of the first heartbeat that showed it behind (0: caught up)
+    std::string provider;          ///< the coordinator that runs the provider
+    std::int64_t incarnation = 0;  ///< of the provider process whose update the held state is
+    std::int64_t last_seq = 0;     ///< the last update applied, of that incarnation
+    bool behind = false;           ///< a heartbeat said we missed its last update
   };
   std::map<std::string, Held, std::less<>> held;
   /// Another signer on the bus (a coordinator, or the supervisor), as its authenticated
@@ -159,11 +159,10 @@ struct CoordinatorNode::Impl {
     std::int64_t resync_incarnation = 0;  ///< of its last accepted resync request
     std::int64_t resync_seq = 0;          ///< last accepted resync request of that incarnation
     std::int64_t last_resync = 0;         ///< when we last asked it to republish
-    std::int64_t last_beat = 0;           ///< steady ns of its last accepted heartbeat (0: never)
+    Liveness live;                        ///< lost or not, and since when it was heard
     std::int64_t last_honoured = 0;       ///< when we last republished at its request
     bool resync_pending = false;          ///< a request arrived too soon after the last one
     bool provider = false;                ///< it runs a provider of an interface held here
-    bool lost = false;                    ///< EVT_COORDINATOR_LOST / EVT_SUPERVISOR_LOST is raised
     std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
   };
   std::map<std::string, Peer, std::less<>> peers;
@@ -184,17 +183,12 @@ struct CoordinatorNode::Impl {
 
   std::shared_ptr<Ice::Communicator> ic;
   std::shared_ptr<Ice::ObjectAdapter> adapter;
-  std::unique_ptr<Link> link;
-  std::mutex link_mutex;  ///< guards the publisher proxies while the link thread reconnects
-  std::shared_ptr<wire::StateTopicPrx> state_pub;
-  std::shared_ptr<wire::EventTopicPrx> event_pub;
-  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
-  std::shared_ptr<wire::ResyncTopicPrx> resync_pub;
+  /// The topics this process publishes on, in BusLink's order.
+  enum Topic : std::size_t { kPublishState, kPublishEvents, kPublishHeartbeat, kPublishResync };
+  std::unique_ptr<BusLink> link;
   std::string control;
 
   std::atomic<bool> running{false};
-  std::atomic<bool> connected{false};
-  std::atomic<std::int64_t> last_own_heartbeat{0};
   std::atomic<std::int64_t> event_seq{0};
   std::atomic<std::int64_t> heartbeat_seq{0};  ///< the last heartbeat sent
   std::atomic<std::int64_t> resync_seq{0};
@@ -204,13 +198,12 @@ struct CoordinatorNode::Impl {
   std::unique_ptr<Prover> prover;  ///< proves peers' processes alive (destroyed after the communicator)
   std::thread watch_thread;
   std::thread publisher_thread;
-  std::thread link_thread;
   Coordinator::SubscriptionId subscription = 0;
 
   std::atomic<std::uint64_t> updates_published{0}, updates_applied{0}, updates_rejected{0}, updates_missed{0},
-      events_published{0}, events_dropped{0}, resyncs_requested{0}, connects{0}, resubscriptions{0},
-      state_messages_published{0}, event_messages_published{0}, providers_lost{0}, duplicates_seen{0},
-      oversized_messages{0}, roots_truncated{0}, updates_unproven{0};
+      events_published{0}, events_dropped{0}, resyncs_requested{0}, state_messages_published{0},
+      event_messages_published{0}, providers_lost{0}, duplicates_seen{0}, oversized_messages{0}, roots_truncated{0},
+      updates_unproven{0};
   OversizeLog record_oversize;  ///< publisher thread only
 
   Impl(Coordinator& c, Monitor& m, const FilterRegistry& r, const spec::SystemSpec& s, std::string n, NodeOptions o)
@@ -513,7 +506,7 @@ struct CoordinatorNode::Impl {
       todo.clear();
       {
         std::unique_lock lock(queue_mutex);
-        if (!connected.load()) {
+        if (!link->connected()) {
           queue_cv.wait_for(lock, std::chrono::milliseconds(20));
           continue;  // records and dirty marks wait (bounded) for the reconnection
         }
@@ -550,13 +543,8 @@ struct CoordinatorNode::Impl {
           any_dirty = false;
         }
       }
-      std::shared_ptr<wire::StateTopicPrx> spub;
-      std::shared_ptr<wire::EventTopicPrx> epub;
-      {
-        std::lock_guard lock(link_mutex);
-        spub = state_pub;
-        epub = event_pub;
-      }
+      const auto spub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(kPublishState));
+      const auto epub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kPublishEvents));
       if (spub == nullptr || epub == nullptr) {
         redo(todo);
         continue;
@@ -572,7 +560,7 @@ struct CoordinatorNode::Impl {
         }
       } catch (const Ice::Exception& e) {
         log("middleware: " + name + ": publishing failed (" + std::string(e.ice_id()) + "); will reconnect and resync");
-        connected.store(false);
+        link->reconnect();
         redo(todo);
       }
     }
@@ -588,77 +576,13 @@ struct CoordinatorNode::Impl {
     any_dirty = any_dirty || !todo.empty();
   }
 
-  // -- link thread --
-  void link_loop() {
-    std::uint64_t failed_connects = 0;
-    std::int64_t last_down_report = 0;
-    bool reported_down = false;
-    std::int64_t connected_at = 0;
-    const auto period = options.heartbeat;
-    while (running.load()) {
-      if (!connected.load()) {
-        try {
-          link->connect({state_topic(name), kEventTopic, heartbeat_topic(name), kResyncTopic});
-          {
-            std::lock_guard lock(link_mutex);
-            state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(state_topic(name)));
-            event_pub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kEventTopic));
-            heartbeat_pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(heartbeat_topic(name)));
-            resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
-          }
-          connected_at = steady_ns();
-          last_own_heartbeat.store(connected_at);
-          connected.store(true);
-          connects.fetch_add(1);
-          log("middleware: " + name + ": connected to IceStorm at " + to_string(options.ice) + "; resynchronising");
-          reported_down = false;
-          failed_connects = 0;
-          mark_all(true);
-          resync_pub->resync(resync_request(""));
-          resyncs_requested.fetch_add(1);
-        } catch (const Ice::Exception& e) {
-          // Said once, then every 5 s while it lasts, so a reconnection that keeps failing shows why.
-          const std::int64_t now = steady_ns();
-          ++failed_connects;
-          if (!reported_down || now - last_down_report > std::chrono::nanoseconds(std::chrono::seconds(5)).count()) {
-            log("middleware: " + name + ": IceStorm at " + to_string(options.ice) + " unreachable (" +
-                std::string(e.ice_id()) +
-                (reported_down ? ", " + std::to_string(failed_connects) + " attempts so far" : std::string()) +
-                "); running locally, retrying");
-            reported_down = true;
-            last_down_report = now;
-          }
-          sleep_for(std::chrono::milliseconds(200));
-          continue;
-        }
-      }
-      try {
-        if (const std::vector<std::string> made = link->check(); !made.empty()) {
-          // What arrived on those topics meanwhile is lost: every provider republishes its state.
-          log("middleware: " + name + ": " + resubscribed_line(made));
-          resubscriptions.fetch_add(made.size());
-          mark_all(true);
-          resync_pub->resync(resync_request(""));
-          resyncs_requested.fetch_add(1);
-        }
-        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, heartbeat())));
-        honour_pending_resyncs();
-        const std::int64_t now = steady_ns();
-        const std::int64_t silent = now - last_own_heartbeat.load();
-        if (now - connected_at > 5 * std::chrono::nanoseconds(period).count() &&
-            silent > 5 * std::chrono::nanoseconds(period).count()) {
-          log("middleware: " + name + ": own heartbeat did not come back; resubscribing");
-          connected.store(false);
-          continue;
-        }
-      } catch (const Ice::Exception& e) {
-        log("middleware: " + name + ": lost IceStorm (" + std::string(e.ice_id()) + "); running locally, reconnecting");
-        connected.store(false);
-        reported_down = true;
-        continue;
-      }
-      sleep_for(period);
-    }
+  // -- link thread (BusLink) --
+
+  /// Connected, or subscriptions made again: everything is republished, and every provider asked to.
+  void rejoined() {
+    mark_all(true);
+    Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync))->resync(resync_request(""));
+    resyncs_requested.fetch_add(1);
   }
 
   void sleep_for(std::chrono::milliseconds d) {
@@ -777,7 +701,7 @@ struct CoordinatorNode::Impl {
     h.incarnation = u.incarnation;
     h.last_seq = u.seq;
     h.behind = false;
-    h.behind_since = 0;
+    peer.live.caught_up(stream_scratch);
     updates_applied.fetch_add(1);
   }
 
@@ -791,7 +715,7 @@ struct CoordinatorNode::Impl {
     const std::int64_t now = steady_ns();
     if (hb.coordinator == name) {
       if (hb.incarnation == incarnation) {
-        last_own_heartbeat.store(now);
+        link->own_heartbeat_heard();
       } else {
         drops->drop(name + "/duplicate", "middleware: " + name + ": another process runs coordinator '" + name +
                                              "' (incarnation " + std::to_string(hb.incarnation) + ", ours " +
@@ -837,35 +761,26 @@ struct CoordinatorNode::Impl {
   /// An authentic, fresh heartbeat of `peer` (under peer_mutex): it is alive; what it lists
   /// sent that is not held here is asked for, and a loss clears once everything is held.
   void believe(const wire::Heartbeat& hb, Peer& peer, std::int64_t now, bool proof) {
-    peer.last_beat = now;
-    bool need = proof;  // a process just proven: nothing it sent before is taken, ask for all
-    bool caught_up = true;
+    bool need = proof;          // a process just proven: nothing it sent before is taken, ask for all
+    std::string behind_stream;  // the first stream it lists ahead of what is held here
     for (auto& [iface, h] : held) {
       if (h.provider != hb.coordinator) continue;
       state_stream(stream_scratch, iface);
       const auto s = hb.lastSeq.find(stream_scratch);
       const std::int64_t have = h.incarnation == hb.incarnation ? h.last_seq : 0;
       const bool behind = s == hb.lastSeq.end() || s->second > have;
-      caught_up = caught_up && !behind;
       // Two heartbeats in a row: the update may simply be on its way on the other topic. A lost
       // provider is asked at once: its clients stay in Error until they have its state.
-      if (behind && (h.behind || peer.lost)) need = true;
+      if (behind && (h.behind || peer.live.lost())) need = true;
       h.behind = behind;
-      if (!behind) {
-        h.behind_since = 0;
-      } else if (h.behind_since == 0) {
-        h.behind_since = now;  // lost if not caught up within the loss bound (watch_loop)
-      }
+      if (behind && behind_stream.empty()) behind_stream = stream_scratch;
     }
-    if (peer.lost && caught_up) recover(hb.coordinator, peer);
+    // Lost if not caught up within the loss bound (watch_loop); back once caught up.
+    if (peer.live.believed(now, behind_stream)) recover(hb.coordinator, peer);
     if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
-    std::shared_ptr<wire::ResyncTopicPrx> pub;
-    {
-      std::lock_guard link_lock(link_mutex);
-      pub = resync_pub;
-    }
+    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync));
     if (pub == nullptr) return;
     try {
       pub->resync(resync_request(hb.coordinator));
@@ -953,7 +868,6 @@ struct CoordinatorNode::Impl {
 
   /// Raises the loss of a peer (under peer_mutex; the coordinator write comes after it).
   void declare_lost(const std::string& who, Peer& peer, const std::string& silent) {
-    peer.lost = true;
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is gone (" + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
@@ -970,7 +884,6 @@ struct CoordinatorNode::Impl {
 
   /// Clears the loss of a peer that is back and whose state we hold again (under peer_mutex).
   void recover(const std::string& who, Peer& peer) {
-    peer.lost = false;
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
       for (ComponentId c : id_range<ComponentId>(co.component_count())) {
@@ -985,32 +898,17 @@ struct CoordinatorNode::Impl {
   }
 
   void watch_loop() {
-    const std::int64_t bound = std::chrono::nanoseconds(lost_after()).count();
     while (running.load()) {
       sleep_for(std::chrono::milliseconds(10));
       const std::int64_t now = steady_ns();
       std::lock_guard lock(peer_mutex);
       for (auto& [who, peer] : peers) {
-        if (peer.lost) continue;
         // A provider is watched from the node's start (never heard of is as bad as gone); the
         // supervisor only once it has been seen (a system may run without one).
-        const bool watched = peer.provider || (who == kSupervisorSigner && peer.last_beat != 0);
+        const bool watched = peer.provider || (who == kSupervisorSigner && peer.live.last_beat() != 0);
         if (!watched) continue;
-        const std::int64_t since = peer.last_beat != 0 ? peer.last_beat : started;
-        if (now - since > bound) {
-          declare_lost(who, peer,
-                       (peer.last_beat != 0 ? "no heartbeat for " : "no heartbeat proven alive for ") +
-                           std::to_string((now - since) / 1'000'000) + " ms");
-          continue;
-        }
-        // A stream its heartbeats show ahead of what is held here, not caught up within the
-        // bound (a lost subscription, updates dropped on the way): as bad as a silent provider.
-        for (const auto& [iface, h] : held) {
-          if (h.provider != who || h.behind_since == 0 || now - h.behind_since <= bound) continue;
-          declare_lost(who, peer,
-                       "its heartbeats list state of " + iface + " not received for " +
-                           std::to_string((now - h.behind_since) / 1'000'000) + " ms");
-          break;
+        if (const std::string why = peer.live.check(now, started, lost_after(), "this node started"); !why.empty()) {
+          declare_lost(who, peer, why);
         }
       }
     }
@@ -1128,7 +1026,17 @@ Expected<void> CoordinatorNode::start() {
         [&d](const Ice::ByteSeq& nonce) { return make_proof(*d.signer, d.ic, nonce, d.heartbeat(false)); }};
     auto control = d.adapter->add(guarded(make_control(context)), Ice::Identity{"control-" + d.name, "safecass"});
     d.control = control->ice_toString();
-    d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
+    BusLinkOptions bus;
+    bus.who = who;
+    bus.publish_on = {state_topic(d.name), kEventTopic, heartbeat_topic(d.name), kResyncTopic};
+    bus.heartbeat_topic = Impl::kPublishHeartbeat;
+    bus.period = d.options.heartbeat;
+    bus.while_down = "running locally";
+    bus.heartbeat = [&d] { return d.signer->sign(kKindHeartbeat, encode(d.ic, d.heartbeat())); };
+    bus.rejoined = [&d] { d.rejoined(); };
+    bus.every_period = [&d] { d.honour_pending_resyncs(); };
+    bus.log = [&d](const std::string& line) { d.log(line); };
+    d.link = std::make_unique<BusLink>(d.ic, d.options.ice, d.options.tls, std::move(bus));
     std::vector<std::string> providers;  // the coordinators whose interfaces this one holds
     for (const auto& [iface, h] : d.held) {
       if (!h.provider.empty() && std::find(providers.begin(), providers.end(), h.provider) == providers.end()) {
@@ -1153,7 +1061,7 @@ Expected<void> CoordinatorNode::start() {
   d.started = steady_ns();
   d.running.store(true);
   d.publisher_thread = std::thread([&d] { d.publisher_loop(); });
-  d.link_thread = std::thread([&d] { d.link_loop(); });
+  d.link->start();
   d.watch_thread = std::thread([&d] { d.watch_loop(); });
   return {};
 }
@@ -1164,7 +1072,7 @@ void CoordinatorNode::stop() noexcept {
   d.co.unsubscribe(d.subscription);
   d.queue_cv.notify_all();
   if (d.publisher_thread.joinable()) d.publisher_thread.join();
-  if (d.link_thread.joinable()) d.link_thread.join();
+  d.link->stop();
   if (d.watch_thread.joinable()) d.watch_thread.join();
   try {
     d.ic->shutdown();
@@ -1172,7 +1080,6 @@ void CoordinatorNode::stop() noexcept {
     d.ic->destroy();
   } catch (...) {
   }
-  d.connected.store(false);
 }
 
 NodeStats CoordinatorNode::stats() const {
@@ -1185,11 +1092,11 @@ NodeStats CoordinatorNode::stats() const {
   s.events_published = d.events_published.load();
   s.events_dropped = d.events_dropped.load();
   s.resyncs_requested = d.resyncs_requested.load();
-  s.connects = d.connects.load();
-  s.resubscriptions = d.resubscriptions.load();
+  s.connects = d.link ? d.link->connects() : 0;
+  s.resubscriptions = d.link ? d.link->resubscriptions() : 0;
   s.state_messages_published = d.state_messages_published.load();
   s.event_messages_published = d.event_messages_published.load();
-  s.connected = d.connected.load();
+  s.connected = d.link && d.link->connected();
   s.messages_refused = d.drops ? d.drops->count() : 0;
   s.providers_lost = d.providers_lost.load();
   s.duplicates_seen = d.duplicates_seen.load();

@@ -56,6 +56,43 @@ bool Members::runs(std::string_view coordinator, std::string_view component) con
 
 std::string_view Members::component_of(std::string_view address) { return address.substr(0, address.find('.')); }
 
+// ---- Liveness -----------------------------------------------------------------------------------
+
+bool Liveness::believed(std::int64_t now, std::string_view behind) {
+  last_beat_ = now;
+  if (behind.empty()) {
+    behind_since_ = 0;
+  } else if (behind_since_ == 0) {
+    behind_since_ = now;
+    behind_.assign(behind);
+  }
+  if (!lost_ || behind_since_ != 0) return false;
+  lost_ = false;
+  return true;
+}
+
+std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::chrono::milliseconds bound,
+                            std::string_view since) {
+  if (lost_) return {};
+  const std::int64_t bound_ns = std::chrono::nanoseconds(bound).count();
+  const std::string bound_text = std::to_string(bound.count()) + " ms";
+  const std::int64_t last = last_beat_ != 0 ? last_beat_ : watched_since;
+  if (last != 0 && now - last > bound_ns) {
+    lost_ = true;
+    return "no heartbeat for " + bound_text +
+           (last_beat_ != 0 ? std::string() : " (never proven alive since " + std::string(since) + ")");
+  }
+  if (behind_since_ != 0 && now - behind_since_ > bound_ns) {
+    lost_ = true;
+    const std::string_view stream = behind_;
+    const std::string what = stream.starts_with(kStateStreamPrefix)
+                                 ? "state of " + printable(stream.substr(kStateStreamPrefix.size()))
+                                 : "the stream '" + printable(stream) + "'";
+    return "its heartbeats list " + what + " not received for " + bound_text;
+  }
+  return {};
+}
+
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
 PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::string& why) const {

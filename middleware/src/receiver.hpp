@@ -130,6 +130,38 @@ private:
   std::map<std::string, Stream, std::less<>> streams_;
 };
 
+/// Whether one peer a receiver follows is lost: the loss rule of DESIGN §4 and §7, the same for
+/// every receiver. Watched from a start (a peer never heard of is as bad as a gone one), a peer is
+/// lost when no heartbeat of it was believed for longer than the loss bound, or when a stream its
+/// heartbeats show ahead of what the receiver holds has not caught up within the bound (a lost
+/// subscription, updates dropped on the way). It is back once a heartbeat is believed with every
+/// stream caught up. Not thread-safe: the owner holds its own lock.
+class Liveness {
+public:
+  /// A heartbeat of the peer believed at `now` (steady ns); `behind` names a stream it lists ahead
+  /// of what is held (empty: none). True when this ends a loss: the owner clears its loss event.
+  bool believed(std::int64_t now, std::string_view behind);
+  /// An update of `stream` was taken: if it is the stream that was behind, it caught up (until
+  /// the next heartbeat says otherwise).
+  void caught_up(std::string_view stream) noexcept {
+    if (stream == behind_) behind_since_ = 0;
+  }
+  /// Called by the owner's watch at `now`: why the peer is lost from now on (the owner raises its
+  /// loss event), or empty. `watched_since` is when the owner started watching it (0: not yet),
+  /// `bound` the loss bound; `since` says what started the watch ("the supervisor connected").
+  std::string check(std::int64_t now, std::int64_t watched_since, std::chrono::milliseconds bound,
+                    std::string_view since);
+  bool lost() const noexcept { return lost_; }
+  /// When its last heartbeat was believed (0: never).
+  std::int64_t last_beat() const noexcept { return last_beat_; }
+
+private:
+  std::int64_t last_beat_ = 0;
+  std::int64_t behind_since_ = 0;  ///< since when its heartbeats show `behind_` ahead (0: caught up)
+  std::string behind_;
+  bool lost_ = false;
+};
+
 /// Asks a peer's Alive endpoint (named in its heartbeat) to sign a fresh nonce, and checks the
 /// answer: kind "proof", signed by the peer's key, the nonce ours. At most one question per peer
 /// at a time, and one per `retry` after a failure. Answers are delivered to `on_proven` on an Ice

@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "auth.hpp"
+#include "bus_link.hpp"
 #include "ice_util.hpp"
 #include "read_model_wire.hpp"
 #include "receiver.hpp"
@@ -58,10 +59,12 @@ struct Supervisor::Impl {
   };
   static constexpr std::chrono::milliseconds kReorderGrace{250};
   static constexpr std::size_t kMaxGaps = 64;  ///< more open gaps than this: the oldest is reported at once
+  /// Between two of the supervisor's heartbeats (coordinators lose it after their loss bound, 3
+  /// heartbeat periods by default: 300 ms).
+  static constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
 
   struct Peer {
     std::vector<std::string> components;
-    std::int64_t last_heartbeat = 0;
     PeerFreshness fresh;  ///< its proven process, heartbeats and state streams
     /// The newest incarnation heard from but not proven yet, and the lowest number of its records
     /// it was heard to have sent (its first heartbeat's list, or its first record's number - 1):
@@ -80,20 +83,17 @@ struct Supervisor::Impl {
     bool events_behind = false;  ///< the last heartbeat listed event records not received
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
-    bool seen = false;
-    bool lost = false;
-    bool states_behind = false;     ///< the last heartbeat listed state updates not received
-    std::int64_t behind_since = 0;  ///< steady ns since its heartbeats list state not received (0: none)
+    bool states_behind = false;  ///< the last heartbeat listed state updates not received
+    Liveness live;               ///< lost or not, and since when it was heard
   };
   mutable std::mutex mutex;
   std::map<std::string, Peer, std::less<>> peers;
   TextMap<ViewRow> view;  ///< by address: one hash per record or update (view() sorts)
 
   std::shared_ptr<Ice::Communicator> ic;
-  std::unique_ptr<Link> link;
-  std::shared_ptr<wire::ResyncTopicPrx> resync_pub;
-  std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub;
-  std::mutex link_mutex;  ///< resync_pub, written by the link thread, read by the dispatch thread
+  /// The topics the supervisor publishes on, in BusLink's order.
+  enum Topic : std::size_t { kPublishResync, kPublishHeartbeat };
+  std::unique_ptr<BusLink> link;
   std::optional<Signer> signer;
   std::optional<Keyring> keyring;
   std::shared_ptr<DropLog> drops;
@@ -105,7 +105,6 @@ struct Supervisor::Impl {
   std::atomic<std::int64_t> resync_seq{0};
   std::atomic<bool> running{false};
   std::atomic<std::int64_t> watching_since{0};  ///< steady_ns() of the first connection to IceStorm
-  std::thread link_thread;
   std::thread watch_thread;
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
@@ -211,7 +210,6 @@ struct Supervisor::Impl {
         peer.reported.clear();
         peer.events_behind = false;
         peer.states_behind = false;
-        peer.behind_since = 0;
         const std::int64_t heard =
             peer.unproven_incarnation == beat.incarnation ? std::min(peer.unproven_floor, joined) : joined;
         if (options.records && heard < joined) {
@@ -230,11 +228,7 @@ struct Supervisor::Impl {
   }
 
   void request_resync(const std::string& who) {
-    std::shared_ptr<wire::ResyncTopicPrx> pub;
-    {
-      std::lock_guard lock(link_mutex);
-      pub = resync_pub;
-    }
+    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync));
     if (pub == nullptr) return;
     try {
       pub->resync(signer->seal(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner), incarnation,
@@ -479,6 +473,7 @@ struct Supervisor::Impl {
           refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": " + why);
           return;
       }
+      p->second.live.caught_up(stream);
       auto row = view.find(address);
       if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
       ViewRow& r = row->second;
@@ -499,7 +494,9 @@ struct Supervisor::Impl {
     }
     const wire::Heartbeat& h = opened.beat;
     if (h.coordinator == kSupervisorSigner) {
-      if (h.incarnation != incarnation) {
+      if (h.incarnation == incarnation) {
+        link->own_heartbeat_heard();
+      } else {
         drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
                                                 std::to_string(h.incarnation) + ", ours " +
                                                 std::to_string(incarnation) + ")");
@@ -531,7 +528,7 @@ struct Supervisor::Impl {
         case PeerFreshness::Verdict::Refuse:
           // An older incarnation still beating while a newer one runs: two processes, one name.
           if (h.incarnation < known &&
-              steady_ns() - peer.last_heartbeat <= std::chrono::nanoseconds(options.lost_after).count()) {
+              steady_ns() - peer.live.last_beat() <= std::chrono::nanoseconds(options.lost_after).count()) {
             drops->drop(h.coordinator + "/duplicate",
                         "supervisor: two processes run coordinator '" + printable(h.coordinator) + "' (incarnations " +
                             std::to_string(h.incarnation) + " and " + std::to_string(known) + ")");
@@ -570,13 +567,15 @@ struct Supervisor::Impl {
     // longer than the loss bound: lost (watch_loop). (Following the records, a gap in them
     // already has the view refreshed.)
     std::int64_t states_missed = 0;
+    std::string_view behind;  // the first state stream it lists ahead of what the view holds
     for (const auto& [stream, last] : h.lastSeq) {
       if (options.records) break;
       if (!std::string_view(stream).starts_with(kStateStreamPrefix)) continue;
       const std::int64_t have = peer.fresh.last(stream);
-      if (last > have) states_missed += last - have;
+      if (last <= have) continue;
+      states_missed += last - have;
+      if (behind.empty()) behind = stream;
     }
-    const std::int64_t now = steady_ns();
     if (states_missed > 0 && peer.states_behind) {
       print("supervisor: " + std::to_string(states_missed) + " state update(s) of '" + printable(h.coordinator) +
             "' missed; asking for its full state");
@@ -585,18 +584,9 @@ struct Supervisor::Impl {
     } else {
       peer.states_behind = states_missed > 0;
     }
-    if (states_missed == 0) {
-      peer.behind_since = 0;
-    } else if (peer.behind_since == 0) {
-      peer.behind_since = now;
-    }
-    if (!peer.seen) print("supervisor: coordinator '" + h.coordinator + "' is up");
-    peer.seen = true;
-    peer.last_heartbeat = now;
-    if (peer.lost && peer.behind_since == 0) {
-      peer.lost = false;
-      recovered = peer.components;
-    }
+    if (peer.live.last_beat() == 0) print("supervisor: coordinator '" + h.coordinator + "' is up");
+    // Lost if not caught up within the loss bound (watch_loop); back once caught up.
+    if (peer.live.believed(steady_ns(), behind)) recovered = peer.components;
   }
 
   void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
@@ -691,24 +681,12 @@ struct Supervisor::Impl {
         std::string why;
       };
       std::vector<Lost> lost_now;
-      const std::int64_t bound = std::chrono::nanoseconds(options.lost_after).count();
-      const std::string bound_text = std::to_string(options.lost_after.count()) + " ms";
       {
         std::lock_guard lock(mutex);
         for (auto& [name, peer] : peers) {
-          if (peer.lost) continue;
-          const std::int64_t last = peer.seen ? peer.last_heartbeat : since;
-          if (last != 0 && now - last > bound) {
-            peer.lost = true;
-            lost_now.push_back(Lost{name, peer.components,
-                                    "no heartbeat for " + bound_text +
-                                        (peer.seen ? "" : " (never proven alive since the supervisor connected)")});
-          } else if (peer.behind_since != 0 && now - peer.behind_since > bound) {
-            // Its heartbeats list state updates not received, for longer than the bound: a lost
-            // subscription or updates dropped on the way are as bad as silence.
-            peer.lost = true;
-            lost_now.push_back(
-                Lost{name, peer.components, "state updates listed by its heartbeats not received for " + bound_text});
+          if (std::string why = peer.live.check(now, since, options.lost_after, "the supervisor connected");
+              !why.empty()) {
+            lost_now.push_back(Lost{name, peer.components, std::move(why)});
           }
         }
       }
@@ -730,41 +708,12 @@ struct Supervisor::Impl {
     return h;
   }
 
-  void link_loop() {
-    bool connected = false;
-    bool reported = false;
-    while (running.load()) {
-      try {
-        if (!connected) {
-          link->connect({kResyncTopic, heartbeat_topic(kSupervisorSigner)});
-          heartbeat_pub =
-              Ice::uncheckedCast<wire::HeartbeatTopicPrx>(link->publisher(heartbeat_topic(kSupervisorSigner)));
-          {
-            std::lock_guard lock(link_mutex);
-            resync_pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kResyncTopic));
-          }
-          request_resync("");
-          connected = true;
-          reported = false;
-          print("supervisor: connected to IceStorm at " + to_string(options.ice));
-          // From now on every coordinator of the system file is watched, heard from or not.
-          std::int64_t unset = 0;
-          (void)watching_since.compare_exchange_strong(unset, steady_ns());
-        }
-        if (const std::vector<std::string> made = link->check(); !made.empty()) {
-          // What arrived on those topics meanwhile is lost: every coordinator republishes its state.
-          print("supervisor: " + resubscribed_line(made));
-          request_resync("");
-        }
-        // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
-        heartbeat_pub->beat(signer->sign(kKindHeartbeat, encode(ic, heartbeat(true))));
-      } catch (const Ice::Exception& e) {
-        if (!reported) print("supervisor: IceStorm unreachable (" + std::string(e.ice_id()) + "); retrying");
-        reported = true;
-        connected = false;
-      }
-      for (int i = 0; i < 5 && running.load(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
+  /// Connected, or subscriptions made again (link thread): every coordinator republishes its state.
+  void rejoined() {
+    request_resync("");
+    // From now on every coordinator of the system file is watched, heard from or not.
+    std::int64_t unset = 0;
+    (void)watching_since.compare_exchange_strong(unset, steady_ns());
   }
 };
 
@@ -877,7 +826,16 @@ Expected<void> Supervisor::start() {
     d.ic = make_communicator(d.options.tls, d.options.ice);
     auto adapter = d.ic->createObjectAdapterWithEndpoints("SafecassSupervisor",
                                                           protocol(d.options.tls) + " -h " + d.options.listen_host);
-    d.link = std::make_unique<Link>(d.ic, d.options.ice, d.options.tls);
+    BusLinkOptions bus;
+    bus.who = "supervisor";
+    bus.publish_on = {kResyncTopic, heartbeat_topic(kSupervisorSigner)};
+    bus.heartbeat_topic = Impl::kPublishHeartbeat;
+    // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
+    bus.period = Impl::kHeartbeatPeriod;
+    bus.heartbeat = [&d] { return d.signer->sign(kKindHeartbeat, encode(d.ic, d.heartbeat(true))); };
+    bus.rejoined = [&d] { d.rejoined(); };
+    bus.log = [&d](const std::string& line) { d.print(line); };
+    d.link = std::make_unique<BusLink>(d.ic, d.options.ice, d.options.tls, std::move(bus));
     d.prover = std::make_unique<Prover>(
         d.ic, *d.keyring, [&d](const std::string& who, const wire::Heartbeat& beat) { d.on_proven(who, beat); },
         [&d](const std::string& who, const std::string& why) {
@@ -898,7 +856,8 @@ Expected<void> Supervisor::start() {
       d.link->subscribe_to(state_topic(name), state);
       d.link->subscribe_to(heartbeat_topic(name), beat);
     }
-    d.link->subscribe_to(heartbeat_topic(kSupervisorSigner), beat);  // another supervisor is said
+    // Its own heartbeat coming back proves its subscriptions work; another supervisor's is said.
+    d.link->subscribe_to(heartbeat_topic(kSupervisorSigner), beat);
     d.alive = guarded(std::make_shared<AliveServant>(d))->ice_toString();
     adapter->activate();
   } catch (const Ice::Exception& e) {
@@ -907,7 +866,7 @@ Expected<void> Supervisor::start() {
     return fail(ErrorCode::Io, std::string("supervisor: cannot listen: ") + e.what());
   }
   d.running.store(true);
-  d.link_thread = std::thread([&d] { d.link_loop(); });
+  d.link->start();
   d.watch_thread = std::thread([&d] { d.watch_loop(); });
   return {};
 }
@@ -915,7 +874,7 @@ Expected<void> Supervisor::start() {
 void Supervisor::stop() noexcept {
   Impl& d = *impl_;
   if (!d.running.exchange(false)) return;
-  if (d.link_thread.joinable()) d.link_thread.join();
+  d.link->stop();
   if (d.watch_thread.joinable()) d.watch_thread.join();
   try {
     d.ic->shutdown();
@@ -938,7 +897,7 @@ std::vector<std::string> Supervisor::lost() const {
   std::lock_guard lock(impl_->mutex);
   std::vector<std::string> out;
   for (const auto& [name, peer] : impl_->peers) {
-    if (peer.lost) out.push_back(name);
+    if (peer.live.lost()) out.push_back(name);
   }
   return out;
 }

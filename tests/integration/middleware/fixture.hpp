@@ -7,12 +7,16 @@
 #include <Ice/Ice.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "auth.hpp"      // middleware/src: the product's keyring
 #include "ice_util.hpp"  // middleware/src: the product's TLS properties
 #include "safecass/middleware/keys.hpp"
 
@@ -32,13 +36,34 @@ inline std::string icestorm_env(const std::string& key) {
 /// The directory of the CA the fixture's IceStorm admits.
 inline std::string ca_dir() { return icestorm_env("ICESTORM_TLS"); }
 
-/// The bus keys of `system` in `dir`, their certificates signed by the fixture's CA.
+/// The whole content of `path` (empty when it cannot be read).
+inline std::string file_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// True when `dir` already holds the bus keys of every member of `system`, made with the fixture's
+/// CA in `ca` (during this run of the tests: the fixture makes a new CA every run).
+inline bool has_keys(const spec::SystemSpec& system, const std::string& dir, const std::string& ca) {
+  const std::string ca_pem = file_text(ca + "/ca.pem");
+  if (ca_pem.empty() || file_text(dir + "/ca.pem") != ca_pem || !middleware::detail::Keyring::load(dir)) return false;
+  std::vector<std::string> members{"supervisor"};
+  for (const auto& [name, _] : system.coordinators) members.push_back(name);
+  return std::all_of(members.begin(), members.end(), [&](const std::string& m) {
+    return std::filesystem::exists(dir + "/" + m + ".secret") && std::filesystem::exists(dir + "/" + m + ".pem");
+  });
+}
+
+/// The bus keys of `system` in `dir`, their certificates signed by the fixture's CA. Keys that a
+/// test of this run made there already are kept: making them writes and syncs 16 files, and on a
+/// loaded machine one such sync held a test for its whole timeout.
 [[nodiscard]] inline bool make_keys(const spec::SystemSpec& system, const std::string& dir) {
   const std::string ca = ca_dir();
   if (ca.empty()) {
     ADD_FAILURE() << "the fixture's IceStorm runs without the system's CA (no ICESTORM_TLS)";
     return false;
   }
+  if (has_keys(system, dir, ca)) return true;
   middleware::KeyOptions options = middleware::KeyOptions::replacing();
   options.ca_dir = ca;
   auto made = middleware::create_bus_keys(system, dir, options);

@@ -93,6 +93,59 @@ TEST(PeerFreshness, AStreamCannotJumpMoreThanTwoToTheTwentyAheadEvenFromItsOwnPr
   EXPECT_EQ(peer.stream(stream, kRun, 1, missed, why), Verdict::Accept) << "the stream is not frozen";
 }
 
+constexpr std::int64_t kMs = 1'000'000;  // steady ns
+constexpr std::chrono::milliseconds kBound{300};
+
+TEST(Liveness, APeerNeverHeardFromIsLostOnceTheBoundHasPassedSinceTheWatchBegan) {
+  Liveness live;
+  EXPECT_EQ(live.check(1000 * kMs, 0, kBound, "start"), "") << "nothing is watched before the watch begins";
+  EXPECT_EQ(live.check(1300 * kMs, 1000 * kMs, kBound, "start"), "") << "at the bound, not yet";
+  EXPECT_EQ(live.check(1301 * kMs, 1000 * kMs, kBound, "start"),
+            "no heartbeat for 300 ms (never proven alive since start)");
+  EXPECT_TRUE(live.lost());
+  EXPECT_EQ(live.check(2000 * kMs, 1000 * kMs, kBound, "start"), "") << "a loss is said once";
+}
+
+TEST(Liveness, APeerSilentForLongerThanTheBoundIsLostAndABelievedHeartbeatBringsItBack) {
+  Liveness live;
+  EXPECT_FALSE(live.believed(100 * kMs, ""));
+  EXPECT_EQ(live.last_beat(), 100 * kMs);
+  EXPECT_EQ(live.check(400 * kMs, 1, kBound, "start"), "");
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "no heartbeat for 300 ms");
+  EXPECT_TRUE(live.lost());
+  EXPECT_TRUE(live.believed(500 * kMs, "")) << "back: the owner clears its loss event";
+  EXPECT_FALSE(live.lost());
+  EXPECT_FALSE(live.believed(600 * kMs, "")) << "said once";
+}
+
+TEST(Liveness, AStreamItsHeartbeatsShowAheadNotCaughtUpWithinTheBoundIsLostAsASilentPeerIs) {
+  Liveness live;
+  EXPECT_FALSE(live.believed(100 * kMs, "state:P.a"));
+  EXPECT_FALSE(live.believed(200 * kMs, "state:P.a"));
+  EXPECT_FALSE(live.believed(350 * kMs, "state:P.a"));
+  EXPECT_EQ(live.check(400 * kMs, 1, kBound, "start"), "") << "behind since 100 ms: not yet past the bound";
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "its heartbeats list state of P.a not received for 300 ms")
+      << "heartbeats kept coming: behind, not silent, and lost all the same";
+  EXPECT_FALSE(live.believed(450 * kMs, "state:P.a")) << "still behind: still lost";
+  EXPECT_TRUE(live.lost());
+  EXPECT_TRUE(live.believed(500 * kMs, "")) << "caught up: back";
+}
+
+TEST(Liveness, AnUpdateOfTheStreamThatWasBehindCatchesItUpUntilTheNextHeartbeatSaysOtherwise) {
+  Liveness live;
+  EXPECT_FALSE(live.believed(100 * kMs, "state:P.a"));
+  live.caught_up("state:P.b");
+  EXPECT_FALSE(live.believed(350 * kMs, "state:P.a"));
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start").substr(0, 19), "its heartbeats list")
+      << "another stream's update is no catch-up";
+  Liveness again;
+  EXPECT_FALSE(again.believed(100 * kMs, "state:P.a"));
+  again.caught_up("state:P.a");
+  EXPECT_FALSE(again.believed(200 * kMs, ""));
+  EXPECT_EQ(again.check(401 * kMs, 1, kBound, "start"), "");
+  EXPECT_FALSE(again.lost());
+}
+
 TEST(IncarnationBounds, AnIncarnationNotPositiveOrMoreThanAMinuteAheadOfTheClockIsRefused) {
   EXPECT_TRUE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation()).empty());
   EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", 0).empty());

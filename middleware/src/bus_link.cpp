@@ -1,0 +1,102 @@
+// One member process's link to the bus (bus_link.hpp).
+
+#include "bus_link.hpp"
+
+#include <algorithm>
+
+namespace safecass::middleware::detail {
+
+BusLink::BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, const TlsOptions& tls,
+                 BusLinkOptions options)
+    : ic_(ic), where_(to_string(ice)), options_(std::move(options)), link_(std::move(ic), ice, tls) {}
+
+void BusLink::start() {
+  if (running_.exchange(true)) return;
+  thread_ = std::thread([this] { loop(); });
+}
+
+void BusLink::stop() noexcept {
+  running_.store(false);
+  if (thread_.joinable()) thread_.join();
+  connected_.store(false);
+}
+
+std::shared_ptr<Ice::ObjectPrx> BusLink::publisher(std::size_t topic) const {
+  std::lock_guard lock(publishers_mutex_);
+  return topic < publishers_.size() ? publishers_[topic] : nullptr;
+}
+
+void BusLink::sleep_for(std::chrono::milliseconds d) const {
+  const auto until = std::chrono::steady_clock::now() + d;
+  while (running_.load() && std::chrono::steady_clock::now() < until) {
+    std::this_thread::sleep_for(std::min<std::chrono::milliseconds>(d, std::chrono::milliseconds(20)));
+  }
+}
+
+bool BusLink::connect() {
+  try {
+    link_.connect(options_.publish_on);
+    {
+      std::lock_guard lock(publishers_mutex_);
+      publishers_.clear();
+      for (const std::string& topic : options_.publish_on) publishers_.push_back(link_.publisher(topic));
+    }
+    connected_at_ = steady_ns();
+    last_own_heartbeat_.store(connected_at_);
+    connected_.store(true);
+    connects_.fetch_add(1);
+    options_.log(options_.who + ": connected to IceStorm at " + where_ + "; resynchronising");
+    reported_down_ = false;
+    failed_connects_ = 0;
+    options_.rejoined();
+    return true;
+  } catch (const Ice::Exception& e) {
+    // Said once, then every 5 s while it lasts, so a reconnection that keeps failing shows why.
+    const std::int64_t now = steady_ns();
+    ++failed_connects_;
+    if (!reported_down_ || now - last_down_report_ > std::chrono::nanoseconds(std::chrono::seconds(5)).count()) {
+      options_.log(options_.who + ": IceStorm at " + where_ + " unreachable (" + std::string(e.ice_id()) +
+                   (reported_down_ ? ", " + std::to_string(failed_connects_) + " attempts so far" : std::string()) +
+                   ")" + (options_.while_down.empty() ? "" : "; " + options_.while_down) + ", retrying");
+      reported_down_ = true;
+      last_down_report_ = now;
+    }
+    return false;
+  }
+}
+
+void BusLink::loop() {
+  const std::chrono::milliseconds period = options_.period;
+  const std::int64_t echo_bound = 5 * std::chrono::nanoseconds(period).count();
+  while (running_.load()) {
+    if (!connected_.load() && !connect()) {
+      sleep_for(std::min(period, std::chrono::milliseconds(200)));
+      continue;
+    }
+    try {
+      if (const std::vector<std::string> made = link_.check(); !made.empty()) {
+        // What arrived on those topics meanwhile is lost: every provider republishes its state.
+        options_.log(options_.who + ": " + resubscribed_line(made));
+        resubscriptions_.fetch_add(made.size());
+        options_.rejoined();
+      }
+      Ice::uncheckedCast<wire::HeartbeatTopicPrx>(publisher(options_.heartbeat_topic))->beat(options_.heartbeat());
+      if (options_.every_period) options_.every_period();
+      const std::int64_t now = steady_ns();
+      if (now - connected_at_ > echo_bound && now - last_own_heartbeat_.load() > echo_bound) {
+        options_.log(options_.who + ": own heartbeat did not come back; resubscribing");
+        connected_.store(false);
+        continue;
+      }
+    } catch (const Ice::Exception& e) {
+      options_.log(options_.who + ": lost IceStorm (" + std::string(e.ice_id()) + ")" +
+                   (options_.while_down.empty() ? "" : "; " + options_.while_down) + ", reconnecting");
+      connected_.store(false);
+      reported_down_ = true;
+      continue;
+    }
+    sleep_for(period);
+  }
+}
+
+}  // namespace safecass::middleware::detail

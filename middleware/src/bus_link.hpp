@@ -1,0 +1,95 @@
+#pragma once
+// Internal: one member process's link to the bus, the same for the coordinator node and the
+// supervisor (DESIGN §7 "The bus, precisely"). It keeps the connection to IceStorm: connects, and
+// reconnects when IceStorm is lost; makes again every subscription IceStorm no longer holds; and
+// reconnects when the process's own heartbeat stops coming back (its subscriptions do not work).
+// It sends the process's heartbeat every period. Whenever what arrived meanwhile may be lost
+// (connected, a subscription made again) it tells its owner, who asks for a republish: nothing
+// is taken for current that may have been missed.
+
+#include <Ice/Ice.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "ice_util.hpp"
+#include "safecass.h"
+
+namespace safecass::middleware::detail {
+
+/// What a BusLink needs of its owner.
+struct BusLinkOptions {
+  std::string who;                          ///< the prefix of its log lines ("middleware: robot", "supervisor")
+  std::vector<std::string> publish_on;      ///< the topics the process publishes on (BusLink::publisher)
+  std::size_t heartbeat_topic = 0;          ///< the index in `publish_on` of its own heartbeat topic
+  std::chrono::milliseconds period{100};    ///< between two heartbeats
+  std::string while_down;                   ///< what the process does meanwhile, said when IceStorm is lost
+  std::function<wire::Signed()> heartbeat;  ///< the next signed heartbeat
+  /// Connected, or subscriptions made again: what arrived meanwhile may be lost. Link thread;
+  /// the publishers are set.
+  std::function<void()> rejoined;
+  std::function<void()> every_period;  ///< after each heartbeat sent (optional), link thread
+  std::function<void(const std::string&)> log;
+};
+
+class BusLink {
+public:
+  BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, const TlsOptions& tls, BusLinkOptions options);
+  ~BusLink() { stop(); }
+  BusLink(const BusLink&) = delete;
+  BusLink& operator=(const BusLink&) = delete;
+
+  /// Subscribes `subscriber` to `topic` on every connection; before start().
+  void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber) {
+    link_.subscribe_to(std::move(topic), std::move(subscriber));
+  }
+  /// Starts the link thread: it connects, then beats every period until stop().
+  void start();
+  /// Stops and joins the link thread (before the communicator is destroyed).
+  void stop() noexcept;
+
+  /// The oneway publisher on `publish_on[topic]`; nullptr until connected. Any thread.
+  [[nodiscard]] std::shared_ptr<Ice::ObjectPrx> publisher(std::size_t topic) const;
+  /// Sending on the link failed (another thread): the link thread reconnects and resynchronises.
+  void reconnect() noexcept { connected_.store(false); }
+  /// The process's own heartbeat of this run came back (its dispatch thread): its subscriptions work.
+  void own_heartbeat_heard() noexcept { last_own_heartbeat_.store(steady_ns()); }
+
+  [[nodiscard]] bool connected() const noexcept { return connected_.load(); }
+  [[nodiscard]] std::uint64_t connects() const noexcept { return connects_.load(); }
+  /// Subscriptions made again after IceStorm had lost them.
+  [[nodiscard]] std::uint64_t resubscriptions() const noexcept { return resubscriptions_.load(); }
+
+private:
+  void loop();
+  /// Connects; false (said, rate-limited) when IceStorm cannot be reached.
+  bool connect();
+  void sleep_for(std::chrono::milliseconds d) const;
+
+  std::shared_ptr<Ice::Communicator> ic_;
+  std::string where_;  ///< IceStorm's endpoint, as said in the log
+  BusLinkOptions options_;
+  Link link_;  ///< link thread only
+  mutable std::mutex publishers_mutex_;
+  std::vector<std::shared_ptr<Ice::ObjectPrx>> publishers_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> connected_{false};
+  std::atomic<std::int64_t> last_own_heartbeat_{0};
+  std::atomic<std::uint64_t> connects_{0};
+  std::atomic<std::uint64_t> resubscriptions_{0};
+  // Link thread only: how the failures to connect are said (once, then every 5 s with a count).
+  std::uint64_t failed_connects_ = 0;
+  std::int64_t last_down_report_ = 0;
+  bool reported_down_ = false;
+  std::int64_t connected_at_ = 0;
+  std::thread thread_;
+};
+
+}  // namespace safecass::middleware::detail
