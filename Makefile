@@ -190,9 +190,9 @@ package: build
 	@cd $(BUILD) && cpack
 	@ls $(BUILD)/packages/*.deb
 
-# clang-format (check only), the [[nodiscard]] check and clang-tidy over the sources changed since
-# the tidied baseline of .ci/tidy-baseline (scripts/lint). LINT_CHECK=format, =nodiscard or =tidy
-# runs one of them; LINT_CHECK=tidy-all runs clang-tidy over every source (docs/contributing.md, "Lint").
+# clang-format (check only), the [[nodiscard]], names, function-length and namespace checks, and
+# clang-tidy over the sources changed since the tidied baseline of .ci/tidy-baseline (scripts/lint).
+# LINT_CHECK=format, =nodiscard, =names, =functions, =namespaces or =tidy runs one of them; LINT_CHECK=tidy-all runs clang-tidy over every source (docs/contributing.md, "Lint").
 # (Not LINT: GNU make defines LINT = lint itself.)
 LINT_CHECK ?= all
 lint: build

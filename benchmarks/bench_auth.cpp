@@ -71,7 +71,7 @@ BENCHMARK(BM_Ed25519Verify)->Arg(256)->Arg(4096)->Unit(benchmark::kMicrosecond);
 namespace {
 
 struct Bus {
-  std::vector<safecass::middleware::detail::Signer> members;  // [0] sends, the others receive
+  std::vector<safecass::middleware::Signer> members;  // [0] sends, the others receive
   explicit Bus(std::size_t receivers) {
     safecass::spec::SystemSpec system;
     system.name = "bench";
@@ -81,13 +81,12 @@ struct Bus {
     char dir[] = "/tmp/safecass-bench-keys-XXXXXX";
     if (::mkdtemp(dir) == nullptr) return;
     if (!safecass::middleware::create_bus_keys(system, dir, safecass::middleware::KeyOptions::replacing())) return;
-    auto keyring = safecass::middleware::detail::Keyring::load(dir);
+    auto keyring = safecass::middleware::Keyring::load(dir);
     if (!keyring) return;
     // The supervisor sends; every coordinator receives.
-    if (auto s = safecass::middleware::detail::Signer::load(dir, "supervisor", *keyring))
-      members.push_back(std::move(*s));
+    if (auto s = safecass::middleware::Signer::load(dir, "supervisor", *keyring)) members.push_back(std::move(*s));
     for (const auto& [name, _] : system.coordinators) {
-      if (auto s = safecass::middleware::detail::Signer::load(dir, name, *keyring)) members.push_back(std::move(*s));
+      if (auto s = safecass::middleware::Signer::load(dir, name, *keyring)) members.push_back(std::move(*s));
     }
     (void)std::system(("rm -rf " + std::string(dir)).c_str());
   }

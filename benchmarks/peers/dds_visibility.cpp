@@ -35,7 +35,7 @@
 
 namespace {
 
-namespace ros2 = safecass::dds::ros2;
+namespace ros2 = safecass::dds;
 using namespace std::chrono_literals;
 
 /// The node: the bridge until SIGTERM.

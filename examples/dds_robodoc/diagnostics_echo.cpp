@@ -35,7 +35,7 @@ const char* level_name(unsigned level) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  namespace ros2 = safecass::dds::ros2;
+  namespace ros2 = safecass::dds;
   std::string prefix;
   double seconds = 0.0;
   int domain = -1;

@@ -46,7 +46,7 @@ int usage(const char* why) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  namespace ros2 = safecass::dds::ros2;
+  namespace ros2 = safecass::dds;
   double rate = 200.0, fz = 5.0, seconds = 0.0;
   int domain = -1;
   bool as_float64 = false;

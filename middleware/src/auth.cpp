@@ -146,10 +146,10 @@ bool valid_address(std::string_view a) {
 }
 
 /// The CA of `dir` (ca.pem and ca.key), or NotFound when it holds neither.
-[[nodiscard]] Expected<detail::Pem> read_ca(const std::string& dir) {
+[[nodiscard]] Expected<Pem> read_ca(const std::string& dir) {
   auto certificate = read_small_file(dir + "/ca.pem");
   auto key = read_small_file(dir + "/ca.key");
-  if (certificate && key) return detail::Pem{*certificate, *key};
+  if (certificate && key) return Pem{*certificate, *key};
   if (!certificate && certificate.error().code == ErrorCode::NotFound && !key &&
       key.error().code == ErrorCode::NotFound) {
     return fail(ErrorCode::NotFound, dir + " holds no CA (ca.pem, ca.key)");
@@ -162,8 +162,7 @@ bool valid_address(std::string_view a) {
 
 /// The system's CA for `dir`: that of `ca_dir` when given (its ca.pem copied to `dir`); else kept
 /// when `dir` holds one (so that the certificates made again stay trusted); else made.
-[[nodiscard]] Expected<detail::Pem> system_ca(const std::string& dir, std::string_view system_name,
-                                              const std::string& ca_dir) {
+[[nodiscard]] Expected<Pem> system_ca(const std::string& dir, std::string_view system_name, const std::string& ca_dir) {
   if (!ca_dir.empty()) {
     auto ca = read_ca(ca_dir);
     if (!ca) return ca;
@@ -174,7 +173,7 @@ bool valid_address(std::string_view a) {
   }
   auto kept = read_ca(dir);
   if (kept || kept.error().code != ErrorCode::NotFound) return kept;
-  auto ca = detail::make_ca(system_name);
+  auto ca = make_ca(system_name);
   if (!ca) return ca;
   if (auto r = write_new_file(dir + "/ca.key", ca->key, 0600, false, "CA key"); !r) return tl::unexpected(r.error());
   if (auto r = write_new_file(dir + "/ca.pem", ca->certificate, 0644, false, "CA"); !r) {
@@ -184,11 +183,11 @@ bool valid_address(std::string_view a) {
 }
 
 /// A certificate signed by the system's CA for each of `names`, as NAME.pem and NAME.key.
-[[nodiscard]] Expected<void> write_certificates(const std::string& dir, const detail::Pem& ca,
+[[nodiscard]] Expected<void> write_certificates(const std::string& dir, const Pem& ca,
                                                 const std::vector<std::string>& names,
                                                 const std::vector<std::string>& addresses) {
   for (const std::string& name : names) {
-    auto made = detail::make_certificate(ca, name, addresses);
+    auto made = make_certificate(ca, name, addresses);
     if (!made) return tl::unexpected(made.error());
     if (auto r = write_new_file(dir + "/" + name + ".key", made->key, 0600, true, "TLS key"); !r) return r;
     if (auto r = write_new_file(dir + "/" + name + ".pem", made->certificate, 0644, true, "certificate"); !r) return r;
@@ -207,7 +206,7 @@ bool valid_address(std::string_view a) {
   for (const std::string& a : options.addresses) {
     if (!valid_address(a)) {
       return fail(ErrorCode::InvalidArgument,
-                  "address '" + detail::printable(a) + "': expected IP:ADDRESS or DNS:NAME (e.g. IP:10.0.0.5)");
+                  "address '" + printable(a) + "': expected IP:ADDRESS or DNS:NAME (e.g. IP:10.0.0.5)");
     }
   }
   if (!options.ca_dir.empty()) {
@@ -221,8 +220,8 @@ bool valid_address(std::string_view a) {
                                                   "system's other keys and certificates)");
     }
     if (!valid_signer_name(name)) {
-      return fail(ErrorCode::InvalidArgument, "coordinator name '" + detail::printable(name) +
-                                                  "' cannot name a key (letters, digits, '_' and '-' only)");
+      return fail(ErrorCode::InvalidArgument,
+                  "coordinator name '" + printable(name) + "' cannot name a key (letters, digits, '_' and '-' only)");
     }
     names.push_back(name);
   }
@@ -280,8 +279,6 @@ bool is_loopback_host(std::string_view host) noexcept {
 }
 
 // ---- internal: auth.hpp -----------------------------------------------------------------------
-
-namespace detail {
 
 Expected<Keyring> Keyring::load(const std::string& dir) {
   if (!sodium_ready()) return fail(ErrorCode::Io, "libsodium could not be initialised");
@@ -512,5 +509,4 @@ std::int64_t new_incarnation() noexcept {
   return ns > 0 ? ns : 1;
 }
 
-}  // namespace detail
 }  // namespace safecass::middleware

@@ -30,7 +30,7 @@
 #include "safecass.h"
 #include "safecass/core/expected.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// Message kinds (wire::Signed::kind).
 inline constexpr std::string_view kKindState = "state";
@@ -159,4 +159,4 @@ private:
 /// restart always has a larger one than any earlier run.
 std::int64_t new_incarnation() noexcept;
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

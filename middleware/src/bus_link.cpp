@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 BusLink::BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, const TlsOptions& tls,
                  BusLinkOptions options)
@@ -99,4 +99,4 @@ void BusLink::loop() {
   }
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

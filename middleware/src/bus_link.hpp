@@ -22,7 +22,7 @@
 #include "ice_util.hpp"
 #include "safecass.h"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// What a BusLink needs of its owner.
 struct BusLinkOptions {
@@ -92,4 +92,4 @@ private:
   std::thread thread_;
 };
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

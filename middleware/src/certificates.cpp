@@ -13,7 +13,7 @@
 
 #include <memory>
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 namespace {
 
@@ -148,4 +148,4 @@ bool signed_by(const std::string& certificate, const std::string& ca_certificate
   return ok;
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -9,7 +9,7 @@
 
 #include "safecass/core/expected.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// A certificate and its private key, both PEM.
 struct Pem {
@@ -30,4 +30,4 @@ struct Pem {
 /// True when `certificate` (PEM) was issued and signed by `ca_certificate` (PEM).
 bool signed_by(const std::string& certificate, const std::string& ca_certificate);
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -16,8 +16,6 @@
 
 namespace safecass::middleware {
 
-using namespace detail;
-
 namespace {
 
 ErrorCode code_of(const std::string& text) {

@@ -13,7 +13,7 @@
 #include "safecass/introspect/sample_text.hpp"
 #include "safecass/middleware/token.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 namespace {
 
@@ -273,4 +273,4 @@ Explanation from_wire(const wire::ExplainEntry& w) {
   return e;
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

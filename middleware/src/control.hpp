@@ -10,7 +10,7 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/local_query.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 struct ControlContext {
   Coordinator& co;
@@ -35,4 +35,4 @@ std::shared_ptr<wire::Control> make_control(ControlContext context);
 wire::ExplainEntry to_wire(const Explanation& e);
 Explanation from_wire(const wire::ExplainEntry& w);
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -50,7 +50,7 @@ TlsOptions tls_from_keys(const std::string& keys_dir, TlsOptions given, std::str
 
 }  // namespace safecass::middleware
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 std::string listen_host_towards(const IceEndpoint& ice) {
   if (is_loopback_host(ice.host)) return "127.0.0.1";
@@ -196,9 +196,9 @@ std::int64_t steady_ns() noexcept {
       .count();
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 void Link::connect(const std::vector<std::string>& publish_on) {
   // Every attempt on connections of its own: after a partition the old ones may look open while
@@ -272,4 +272,4 @@ std::vector<std::string> Link::check() {
   return made;
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -16,7 +16,7 @@
 #include "safecass/core/coordinator.hpp"
 #include "safecass/middleware/node.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// State updates go to one topic per coordinator, "safecass.state.<coordinator>": a process
 /// receives only the streams of the providers it holds, never its own.
@@ -87,9 +87,9 @@ bool from_wire(wire::Level l, State& out) noexcept;
 std::string_view outcome_text(Outcome o) noexcept;
 std::int64_t steady_ns() noexcept;
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// A connection to IceStorm: the topics a process subscribes to and publishes on. connect() may
 /// be called again after a failure (IceStorm restarted, a partition healed): it closes the old
@@ -137,4 +137,4 @@ private:
   std::uint64_t generation_ = 0;  ///< connect() attempts: each on connections of its own
 };
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -24,8 +24,6 @@
 
 namespace safecass::middleware {
 
-using namespace detail;
-
 [[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view whole) {
   IceEndpoint e;
   std::string_view text = whole;

@@ -3,7 +3,7 @@
 #include "control.hpp"
 #include "safecass/introspect/format.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 namespace in = introspect;
 
@@ -415,4 +415,4 @@ in::Names from_wire(const wire::NamesEntry& w) {
   return n;
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

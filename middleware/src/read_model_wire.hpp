@@ -6,7 +6,7 @@
 #include "ice_util.hpp"
 #include "safecass/introspect/model.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 /// A root cause on the wire: one shape for a record's root, an explanation's and each root of a
 /// state update (which also carry the root's level and hop path).
@@ -43,4 +43,4 @@ introspect::ClockInfo from_wire(const wire::ClockEntry& w);
 wire::NamesEntry to_wire(const introspect::Names& n);
 introspect::Names from_wire(const wire::NamesEntry& w);
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -6,7 +6,7 @@
 
 #include "ice_util.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 std::string incarnation_out_of_bounds(std::string_view what, std::string_view who, std::int64_t incarnation) {
   const std::int64_t limit = new_incarnation() + std::chrono::nanoseconds(kIncarnationMargin).count();
@@ -350,4 +350,4 @@ bool Guard::dispatch(Ice::Request& request) {
   }
 }
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

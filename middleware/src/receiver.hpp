@@ -26,7 +26,7 @@
 #include "safecass.h"
 #include "safecass/spec/system.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 
 inline constexpr std::string_view kKindProof = "proof";
 /// Bytes of a receiver's nonce (wire::Alive::prove).
@@ -239,4 +239,4 @@ private:
   std::string what_;
 };
 
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

@@ -26,8 +26,6 @@
 
 namespace safecass::middleware {
 
-using namespace detail;
-
 namespace {
 /// Hashes std::string and std::string_view alike, so that a lookup by a view of a message's text
 /// makes no string.

@@ -55,8 +55,4 @@ std::string to_json(const Diagnostic& d) {
       .text();
 }
 
-std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {
-  return detail::did_you_mean(word, candidates);
-}
-
 }  // namespace safecass::spec

@@ -1,6 +1,6 @@
 #include "keys.hpp"
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 namespace {
 
@@ -314,4 +314,4 @@ std::vector<const ObjectKind*> all_kinds() {
           &dependency_kind(), &connection_kind(), &hazard_kind(),    &invariant_kind()};
 }
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

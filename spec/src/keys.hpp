@@ -7,7 +7,7 @@
 #include <utility>
 #include <vector>
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 enum class Shape : unsigned char {
   String,  ///< a string
@@ -80,4 +80,4 @@ std::vector<const ObjectKind*> all_kinds();
 inline constexpr int kFormatVersion = 1;
 inline constexpr double kMaxSignalSize = 4096;
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

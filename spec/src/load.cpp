@@ -9,8 +9,6 @@
 
 namespace safecass::spec {
 
-namespace detail {
-
 Position Sink::position(const Site& site) const {
   Position p;
   if (site.file >= 0 && static_cast<std::size_t>(site.file) < documents.size()) {
@@ -185,8 +183,6 @@ LoadResult load(const std::string& path, const std::string* text, const FilterRe
 
 }  // namespace
 
-}  // namespace detail
-
 bool LoadResult::ok() const { return errors() == 0; }
 
 std::size_t LoadResult::errors() const {
@@ -198,12 +194,12 @@ std::size_t LoadResult::errors() const {
 std::size_t LoadResult::warnings() const { return diagnostics.size() - errors(); }
 
 LoadResult load_system(const std::string& path, const FilterRegistry& registry) {
-  return detail::load(path, nullptr, registry);
+  return load(path, nullptr, registry);
 }
 
 LoadResult load_system_from_text(std::string_view text, const std::string& name, const FilterRegistry& registry) {
   const std::string copy(text);
-  return detail::load(name, &copy, registry);
+  return load(name, &copy, registry);
 }
 
 }  // namespace safecass::spec

@@ -17,7 +17,7 @@
 #include "safecass/spec/diagnostics.hpp"
 #include "safecass/spec/system.hpp"
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 /// Where a value is: index of its file, position, JSON pointer in that file.
 struct Site {
@@ -228,4 +228,4 @@ struct FrameworkEvent {
 };
 const std::vector<FrameworkEvent>& framework_events();
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

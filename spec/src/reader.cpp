@@ -15,7 +15,7 @@
 #include "model.hpp"
 #include "text.hpp"
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 namespace {
 
@@ -881,4 +881,4 @@ void read_files(const std::string& path, const std::string* text, Sink& sink, Mo
   Reader(sink, model).run(path, text);
 }
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

@@ -203,7 +203,7 @@ public:
         const std::string suggestion = did_you_mean(m.key, candidates);
         error(m.key_position, pointer + "/" + m.key,
               "unknown key \"" + m.key + "\"" + (suggestion.empty() ? " (expected one of: " + list + ")" : suggestion));
-        if (const auto near = detail::nearest(m.key, candidates)) suggested.push_back(*near);
+        if (const auto near = nearest(m.key, candidates)) suggested.push_back(*near);
       }
     }
     return suggested;
@@ -403,7 +403,7 @@ bool read_at(Reader& r, const json::JsonValue& step, const std::string& base, do
     // A misspelled "at" is one error, the unknown key with its suggestion.
     for (const json::JsonMember& m : step.object) {
       if (std::find(std::begin(kActions), std::end(kActions), m.key) != std::end(kActions)) continue;
-      if (detail::nearest(m.key, {"at"})) {
+      if (nearest(m.key, {"at"})) {
         r.error(m.key_position, base + "/" + escape_pointer(m.key),
                 "unknown key \"" + m.key + "\"; did you mean 'at'?");
         return false;

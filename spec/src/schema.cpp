@@ -13,10 +13,6 @@ namespace safecass::spec {
 
 namespace {
 
-using detail::Key;
-using detail::ObjectKind;
-using detail::Shape;
-
 /// A JSON value under construction: members keep their insertion order, so the text is stable.
 struct Node {
   enum class Kind { Scalar, Object, Array } kind = Kind::Object;
@@ -37,7 +33,7 @@ struct Node {
     n.scalar = std::move(s);
     return n;
   }
-  static Node number(double d) { return raw(detail::number_text(d)); }
+  static Node number(double d) { return raw(number_text(d)); }
   static Node array() {
     Node n;
     n.kind = Kind::Array;
@@ -301,7 +297,7 @@ Node argument_schema(const FilterManifest& m) {
 /// A filter (or, with `stage`, a pipeline stage, whose input and output the pipeline may fill
 /// in): class_name names every type and alias; argument follows the named type.
 Node filter_schema(const FilterRegistry& registry, const std::vector<const FilterManifest*>& manifests, bool stage) {
-  Node schema = object_schema(detail::filter_kind());
+  Node schema = object_schema(filter_kind());
   if (stage) {
     *schema.member("description") = Node::text(
         "a pipeline stage: a filter whose input may come from the previous stage and whose "
@@ -364,8 +360,8 @@ std::string json_schema(const FilterRegistry& registry) {
   Node& defs = root.set("$defs", Node{});
 
   const std::vector<const FilterManifest*> manifests = registry.manifests();
-  for (const ObjectKind* kind : detail::all_kinds()) {
-    if (kind == &detail::filter_kind()) {
+  for (const ObjectKind* kind : all_kinds()) {
+    if (kind == &filter_kind()) {
       defs.set("filter", filter_schema(registry, manifests, false));
       defs.set("stage", filter_schema(registry, manifests, true));
     } else {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 namespace {
 char lower(char c) noexcept { return (c >= 'A' && c <= 'Z') ? static_cast<char>(c - 'A' + 'a') : c; }
@@ -167,4 +167,4 @@ bool simple_name(std::string_view name) noexcept {
   return token_name(name) && name.find('.') == std::string_view::npos;
 }
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "safecass/json/read.hpp"
+#include "safecass/spec/diagnostics.hpp"
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 /// Levenshtein distance, case-insensitive (ASCII).
 std::size_t edit_distance(std::string_view a, std::string_view b);
@@ -16,8 +17,7 @@ std::size_t edit_distance(std::string_view a, std::string_view b);
 /// The candidate nearest to `word`, if it is near enough to be a likely typo.
 std::optional<std::string> nearest(std::string_view word, const std::vector<std::string>& candidates);
 
-/// "; did you mean 'x'?" or "".
-std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates);
+// did_you_mean(): safecass/spec/diagnostics.hpp.
 
 /// `pointer` + "/" + the escaped token (RFC 6901: ~ -> ~0, / -> ~1).
 std::string pointer_join(const std::string& pointer, std::string_view token);
@@ -48,4 +48,4 @@ bool simple_name(std::string_view name) noexcept;
 /// Non-empty, no white space or control characters (events, filters).
 bool token_name(std::string_view name) noexcept;
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

@@ -12,7 +12,7 @@
 #include "model.hpp"
 #include "text.hpp"
 
-namespace safecass::spec::detail {
+namespace safecass::spec {
 
 namespace {
 
@@ -1345,4 +1345,4 @@ private:
 
 void validate(Model& model, const FilterRegistry& registry, Sink& sink) { Validator(model, registry, sink).run(); }
 
-}  // namespace safecass::spec::detail
+}  // namespace safecass::spec

@@ -35,7 +35,6 @@
 
 namespace safecass::tools {
 
-using namespace console;
 namespace in = introspect;
 
 namespace {
@@ -407,7 +406,7 @@ struct InProcessSystem {
 
 }  // namespace
 
-Expected<std::unique_ptr<Backend>> console::make_backend(Target target, ConsoleOptions options) {
+[[nodiscard]] Expected<std::unique_ptr<Backend>> make_backend(Target target, ConsoleOptions options) {
   auto backend = std::make_unique<QueryBackend>(std::move(target), options);
   if (auto r = backend->init(); !r) return tl::unexpected(r.error());
   return std::unique_ptr<Backend>(std::move(backend));

@@ -28,9 +28,7 @@ class App;
 
 namespace safecass::tools {
 
-namespace console {
 class Backend;
-}
 
 struct ConsoleArgs {
   std::string system;           ///< system file (default: the scenario's "system")
@@ -72,7 +70,7 @@ struct ConsoleOptions {
 class Console {
 public:
   /// A console whose commands `backend` runs.
-  Console(std::unique_ptr<console::Backend> backend, ConsoleOptions options);
+  Console(std::unique_ptr<Backend> backend, ConsoleOptions options);
 
   /// Loads and builds the system. `system` may be empty when `scenario` names its system.
   /// Errors: Io/Parse/InvalidArgument with every diagnostic of the system or scenario, one per line.
@@ -99,7 +97,7 @@ private:
   ConsoleReply failure(std::string_view command, const std::string& message, std::string_view usage) const;
   std::string help(const std::vector<std::string>& args, ConsoleReply& reply) const;
 
-  std::unique_ptr<console::Backend> backend_;
+  std::unique_ptr<Backend> backend_;
   ConsoleOptions options_;
 };
 

@@ -13,7 +13,6 @@
 
 namespace safecass::tools {
 
-using namespace console;
 using middleware::RemoteClient;
 
 namespace {

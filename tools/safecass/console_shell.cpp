@@ -12,7 +12,7 @@
 #include <set>
 #include <sstream>
 
-namespace safecass::tools::console {
+namespace safecass::tools {
 
 // ---- text helpers --------------------------------------------------------------------------------
 
@@ -225,12 +225,6 @@ Arg arg_kind(const CommandSpec& c, std::size_t arg) {
 }
 
 }  // namespace
-
-}  // namespace safecass::tools::console
-
-namespace safecass::tools {
-
-using namespace console;
 
 Console::Console(std::unique_ptr<Backend> backend, ConsoleOptions options)
     : backend_(std::move(backend)), options_(options) {}

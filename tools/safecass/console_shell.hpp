@@ -1,7 +1,7 @@
 #pragma once
 // The part of `safecass console` that does not depend on where the system runs: the command table,
 // the parser of command lines, TAB completion, usage and error lines, `help`, and the text and
-// JSON helpers every printer uses. One console::Backend runs the parsed commands (console.cpp),
+// JSON helpers every printer uses. One Backend runs the parsed commands (console.cpp),
 // over a SystemQuery: a system in this process in simulated time (LocalQuery) or a live
 // coordinator through the middleware (RemoteClient, console_remote.cpp). Internal to tools/safecass.
 
@@ -21,7 +21,7 @@
 #include "safecass/introspect/sample_text.hpp"
 #include "safecass/json/write.hpp"
 
-namespace safecass::tools::console {
+namespace safecass::tools {
 
 // ---- text helpers --------------------------------------------------------------------------------
 
@@ -138,4 +138,4 @@ struct Target {
 /// (a live coordinator that does not answer while the names are fetched: Io).
 [[nodiscard]] Expected<std::unique_ptr<Backend>> make_backend(Target target, ConsoleOptions options);
 
-}  // namespace safecass::tools::console
+}  // namespace safecass::tools

@@ -7,7 +7,7 @@
 
 #include "safecass/spec/load.hpp"
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 namespace {
 
@@ -367,4 +367,4 @@ std::vector<std::size_t> Model::cone(const std::vector<std::size_t>& seed_roots,
   return out;
 }
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

@@ -25,7 +25,7 @@
 #include "safecass/spec/instance.hpp"
 #include "safecass/verify/verify.hpp"
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 /// An onset that can occur at one machine (a possible root condition).
 struct Root {
@@ -132,4 +132,4 @@ private:
   IdVector<IdVector<bool, MachineId>, MachineId> reach_warning_;  ///< ... a Warning root
 };
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

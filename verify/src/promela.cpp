@@ -4,7 +4,7 @@
 #include <map>
 #include <set>
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 namespace {
 
@@ -207,4 +207,4 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
   return out;
 }
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

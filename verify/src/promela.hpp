@@ -7,7 +7,7 @@
 
 #include "model.hpp"
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 /// What the Promela text is for.
 struct PromelaSpec {
@@ -35,4 +35,4 @@ std::string compare_text(std::size_t address, spec::Formula::Compare op, State l
 /// expression, for propositional formulas). Addresses must be in the model.
 std::string formula_text(const Model& model, const spec::Formula& f, bool ltl);
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

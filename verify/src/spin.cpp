@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 namespace fs = std::filesystem;
 
@@ -196,4 +196,4 @@ bool write_file(const std::string& path, const std::string& text) {
   return marked_lines(r->output, nullptr, nullptr);
 }
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

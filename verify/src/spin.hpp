@@ -8,7 +8,7 @@
 
 #include "safecass/core/expected.hpp"
 
-namespace safecass::verify::detail {
+namespace safecass::verify {
 
 /// A command's output (stdout and stderr together) and exit status.
 struct CommandResult {
@@ -81,4 +81,4 @@ struct PanResult {
 /// "Spin Version 6.5.2 -- ..." or an Io error saying SPIN is not installed.
 [[nodiscard]] Expected<std::string> spin_version(const std::string& spin);
 
-}  // namespace safecass::verify::detail
+}  // namespace safecass::verify

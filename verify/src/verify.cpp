@@ -54,8 +54,6 @@ int Report::exit_code() const {
 
 namespace {
 
-using detail::Model;
-using detail::RootClass;
 namespace fs = std::filesystem;
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
@@ -143,7 +141,7 @@ public:
       for (std::size_t c = 0; c < classes.size(); ++c) {
         for (std::size_t x : classes[c].members) class_of[x] = c;
       }
-      detail::PromelaSpec spec;
+      PromelaSpec spec;
       spec.title = "system " + m_.system().name + ": ";
       spec.classes = classes;
       std::set<std::size_t> addresses;
@@ -155,8 +153,8 @@ public:
         spec.claims.emplace_back("p" + std::to_string(i), claim(check, class_of));
       }
       spec.addresses.assign(addresses.begin(), addresses.end());
-      const std::string model = detail::write_promela(m_, spec);
-      detail::PanOptions pan;
+      const std::string model = write_promela(m_, spec);
+      PanOptions pan;
       pan.ltl = group_ltl[g];
       pan.memory_mb = options_.memory_mb;
       // Slots for the states the classes allow; the table (8 bytes a slot) takes at most a
@@ -167,7 +165,7 @@ public:
       pan.spin = options_.spin;
       pan.cc = options_.cc;
       const std::string name = "model" + std::to_string(g);
-      auto binary = detail::compile(dir_, name, model, pan);
+      auto binary = compile(dir_, name, model, pan);
       const double compile_seconds = seconds_since(start);
       for (std::size_t k = 0; k < groups[g].size(); ++k) {
         const std::size_t i = groups[g][k];
@@ -182,7 +180,7 @@ public:
           r.message = binary.error().message;
           continue;
         }
-        auto result = detail::check_claim(dir_, name, *binary, "p" + std::to_string(i), pan);
+        auto result = check_claim(dir_, name, *binary, "p" + std::to_string(i), pan);
         // The compilation is shared: each property of the group is charged its share.
         r.seconds = compile_seconds / static_cast<double>(groups[g].size()) + seconds_since(claim_start);
         if (!result) {
@@ -193,18 +191,18 @@ public:
         r.states = result->states;
         r.memory_mb = result->memory_mb;
         switch (result->outcome) {
-          case detail::PanResult::Outcome::Holds: r.verdict = PropertyResult::Verdict::Holds; break;
-          case detail::PanResult::Outcome::MemoryLimit:
+          case PanResult::Outcome::Holds: r.verdict = PropertyResult::Verdict::Holds; break;
+          case PanResult::Outcome::MemoryLimit:
             r.verdict = PropertyResult::Verdict::Undecided;
             r.message = "the search reached the memory bound (" + std::to_string(options_.memory_mb) + " MB) after " +
                         std::to_string(r.states) + " states";
             r.advice = advice(classes);
             break;
-          case detail::PanResult::Outcome::Failed:
+          case PanResult::Outcome::Failed:
             r.verdict = PropertyResult::Verdict::Undecided;
             r.message = "SPIN's verifier did not finish:\n" + result->output;
             break;
-          case detail::PanResult::Outcome::Violated:
+          case PanResult::Outcome::Violated:
             r.verdict = PropertyResult::Verdict::Violated;
             counterexample(check, r, classes, *result, model);
             break;
@@ -240,13 +238,13 @@ private:
       for (std::size_t c : active) any += (any.empty() ? "" : " || ") + std::string("ACTIVE_") + std::to_string(c);
       std::string need;
       for (const auto& [a, level] : check.reaction) {
-        need += (need.empty() ? "" : " && ") + detail::compare_text(a, spec::Formula::Compare::Ge, level);
+        need += (need.empty() ? "" : " && ") + compare_text(a, spec::Formula::Compare::Ge, level);
       }
       if (any.empty() || need.empty()) return "[] true";
       return "[] (!(" + any + ") || (" + need + "))";
     }
-    if (check.formula->is_state_invariant()) return "[] " + detail::formula_text(m_, check.formula->operands[0], false);
-    return detail::formula_text(m_, *check.formula, true);
+    if (check.formula->is_state_invariant()) return "[] " + formula_text(m_, check.formula->operands[0], false);
+    return formula_text(m_, *check.formula, true);
   }
 
   /// Which abstraction would help a property whose state space is too large.
@@ -278,7 +276,7 @@ private:
 
   /// Replays the trail on the coordinator, writes the scenario, and says what failed.
   void counterexample(const Check& check, PropertyResult& r, const std::vector<RootClass>& classes,
-                      const detail::PanResult& pan, const std::string& model) {
+                      const PanResult& pan, const std::string& model) {
     Coordinator& co = m_.coordinator();
     (void)co.reset(std::string_view("SYSTEM"), "verify", "counterexample");
     std::vector<Step> steps;
@@ -294,7 +292,7 @@ private:
         if (a >= classes.size()) continue;
         bool done = false;
         for (std::size_t x : classes[a].members) {
-          const detail::Root& root = m_.roots()[x];
+          const Root& root = m_.roots()[x];
           const auto id = co.find_event(root.event);
           const Condition* active = nullptr;
           std::vector<Condition> conditions = co.conditions(root.machine);
@@ -320,7 +318,7 @@ private:
         (void)co.reset(co.address_of(m), "verify", "counterexample");
       } else if (kind == "bon" || kind == "boff") {
         if (a >= m_.broadcasts().size()) continue;
-        const detail::Broadcast& b = m_.broadcasts()[a];
+        const Broadcast& b = m_.broadcasts()[a];
         steps.push_back(Step{Step::Kind::Generate, kind == "bon" ? b.event : b.completion, ""});
         (void)co.generate(steps.back().event, "");
       }
@@ -335,7 +333,7 @@ private:
       }
       std::string active;
       for (std::size_t x : check.linked) {
-        const detail::Root& root = m_.roots()[x];
+        const Root& root = m_.roots()[x];
         const auto id = co.find_event(root.event);
         for (const Condition& c : co.conditions(root.machine)) {
           if (!c.mirror && id && c.event == *id)
@@ -575,7 +573,7 @@ namespace {
 void structural_properties(const spec::SystemSpec& system, const Model& model, Report& report) {
   const Coordinator& co = model.coordinator();
   std::set<std::string> reported;
-  for (const detail::Root& r : model.roots()) {
+  for (const Root& r : model.roots()) {
     if (r.clearable() || r.latched) continue;
     const std::string subject = r.event + (r.broadcast >= 0 ? std::string() : "@" + co.address_of(r.machine));
     if (!reported.insert(subject).second) continue;
@@ -654,11 +652,11 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
   if (!property_list) return tl::unexpected(property_list.error());
   std::vector<Check>& checks = *property_list;
 
-  auto dir = detail::WorkDir::create(options.work_dir);
+  auto dir = WorkDir::create(options.work_dir);
   if (!dir) return tl::unexpected(dir.error());
   if (!checks.empty()) {
-    if (auto v = detail::spin_version(options.spin); !v) return tl::unexpected(v.error());
-    if (auto c = detail::compiler_check(options.cc); !c) return tl::unexpected(c.error());
+    if (auto v = spin_version(options.spin); !v) return tl::unexpected(v.error());
+    if (auto c = compiler_check(options.cc); !c) return tl::unexpected(c.error());
   }
   Verifier verifier(model, options, dir->path());
   std::vector<Check> searched;
@@ -686,20 +684,20 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
   Model& model = **built;
   std::vector<std::size_t> all;
   for (std::size_t i = 0; i < model.roots().size(); ++i) all.push_back(i);
-  detail::PromelaSpec spec;
+  PromelaSpec spec;
   spec.title = "system " + system.name + ": random simulation";
   spec.classes = model.classes(all, false);
   for (std::size_t a = 0; a < model.addresses().size(); ++a) spec.addresses.push_back(a);
   spec.print_states = true;
-  auto dir = detail::WorkDir::create(options.work_dir);
+  auto dir = WorkDir::create(options.work_dir);
   if (!dir) return tl::unexpected(dir.error());
   // SPIN counts statements, not model steps; it stops where it stops, and the last step may be
   // cut short: ask for more and keep the whole steps.
-  auto lines = detail::simulate_model(dir->path(), detail::write_promela(model, spec), seed,
-                                      steps * (spec.addresses.size() + 3 * spec.classes.size() + 16), options.spin);
+  auto lines = simulate_model(dir->path(), write_promela(model, spec), seed,
+                              steps * (spec.addresses.size() + 3 * spec.classes.size() + 16), options.spin);
   if (!lines) return tl::unexpected(lines.error());
   Simulation sim;
-  for (const detail::AddressInfo& a : model.addresses()) sim.addresses.push_back(a.address);
+  for (const AddressInfo& a : model.addresses()) sim.addresses.push_back(a.address);
   const Coordinator& co = model.coordinator();
   for (const std::string& line : *lines) {
     std::istringstream in(line);
@@ -724,12 +722,12 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
     in >> a >> level;
     // Without merging, class c is root c.
     if (kind == "on" || kind == "off") {
-      const detail::Root& r = model.roots()[spec.classes.at(a).first()];
+      const Root& r = model.roots()[spec.classes.at(a).first()];
       sim.steps.push_back(Step{Step::Kind::Generate, kind == "on" ? r.event : r.completion, co.address_of(r.machine)});
     } else if (kind == "reset") {
       sim.steps.push_back(Step{Step::Kind::Reset, "", co.address_of(static_cast<MachineId>(a))});
     } else if (kind == "bon" || kind == "boff") {
-      const detail::Broadcast& b = model.broadcasts().at(a);
+      const Broadcast& b = model.broadcasts().at(a);
       sim.steps.push_back(Step{Step::Kind::Generate, kind == "bon" ? b.event : b.completion, ""});
     }
   }
@@ -743,11 +741,11 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
   Model& model = **built;
   std::vector<std::size_t> all;
   for (std::size_t i = 0; i < model.roots().size(); ++i) all.push_back(i);
-  detail::PromelaSpec spec;
+  PromelaSpec spec;
   spec.title = "system " + system.name;
   spec.classes = model.classes(all, false);
   for (std::size_t a = 0; a < model.addresses().size(); ++a) spec.addresses.push_back(a);
-  return detail::write_promela(model, spec);
+  return write_promela(model, spec);
 }
 
 }  // namespace safecass::verify

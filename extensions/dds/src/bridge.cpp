@@ -137,9 +137,9 @@ Expected<void> Bridge::add_loop(std::string_view component, Time period, Body bo
 }
 
 Expected<void> Bridge::Impl::join() {
-  auto joined = ros2::join(options.domain, options.loopback);
+  auto joined = dds::join(options.domain, options.loopback);
   if (!joined) return tl::unexpected(joined.error());
-  domain = *ros2::domain_id(options.domain);
+  domain = *dds::domain_id(options.domain);
   // The domain is left to the process: deleting it would delete every participant in it, other
   // bridges' and the application's too.
   participant = Entity(joined->participant);
@@ -147,7 +147,7 @@ Expected<void> Bridge::Impl::join() {
   // The topics' readers keep more than ROS 2's default 10 samples (history depth is not matched
   // against the writer's): a burst while the spinning thread is busy must not overwrite a sample
   // before its filters judge it (the ROS 1 bridge queues 100 as well).
-  dds_qos_t* qos = ros2::qos(kReaderDepth);
+  dds_qos_t* qos = dds::qos(kReaderDepth);
   const Mapping& m = shadow->mapping();
   auto check = [](dds_entity_t e, const std::string& what) -> Expected<void> {
     if (e < 0) return fail(ErrorCode::Io, dds_error(what.c_str(), e));
@@ -156,8 +156,8 @@ Expected<void> Bridge::Impl::join() {
   Expected<void> ok;
   for (std::size_t i = 0; ok && i < shadow->topic_count(); ++i) {
     const ros_common::TopicMapping& t = shadow->topic(i);
-    const std::string name = ros2::dds_topic(t.topic);
-    const dds_entity_t topic = dds_create_topic(pp, &ros2::descriptor(t.type), name.c_str(), nullptr, nullptr);
+    const std::string name = dds::dds_topic(t.topic);
+    const dds_entity_t topic = dds_create_topic(pp, &dds::descriptor(t.type), name.c_str(), nullptr, nullptr);
     ok = check(topic, "topic " + name);
     if (!ok) break;
     const dds_entity_t reader = dds_create_reader(pp, topic, qos, nullptr);
@@ -167,21 +167,21 @@ Expected<void> Bridge::Impl::join() {
   dds_delete_qos(qos);
   if (!ok) return ok;
   // Diagnostics out as diagnostic_updater, in as diagnostic_aggregator (not our own).
-  const std::string out_name = ros2::dds_topic(m.publish_topic);
+  const std::string out_name = dds::dds_topic(m.publish_topic);
   const dds_entity_t out =
-      dds_create_topic(pp, &ros2::diagnostic_array_descriptor(), out_name.c_str(), nullptr, nullptr);
+      dds_create_topic(pp, &dds::diagnostic_array_descriptor(), out_name.c_str(), nullptr, nullptr);
   if (auto r = check(out, "topic " + out_name); !r) return r;
-  qos = ros2::qos(ros2::kDiagnosticsWriterDepth);
+  qos = dds::qos(dds::kDiagnosticsWriterDepth);
   writer = dds_create_writer(pp, out, qos, nullptr);
   dds_delete_qos(qos);
   if (auto r = check(writer, "writer of " + out_name); !r) return r;
   if (shadow->ingests()) {
-    const std::string in_name = ros2::dds_topic(m.ingest_topic);
+    const std::string in_name = dds::dds_topic(m.ingest_topic);
     const dds_entity_t in = in_name == out_name ? out
-                                                : dds_create_topic(pp, &ros2::diagnostic_array_descriptor(),
+                                                : dds_create_topic(pp, &dds::diagnostic_array_descriptor(),
                                                                    in_name.c_str(), nullptr, nullptr);
     if (auto r = check(in, "topic " + in_name); !r) return r;
-    qos = ros2::qos(ros2::kDiagnosticsReaderDepth);
+    qos = dds::qos(dds::kDiagnosticsReaderDepth);
     dds_qset_ignorelocal(qos, DDS_IGNORELOCAL_PARTICIPANT);
     ingest_reader = dds_create_reader(pp, in, qos, nullptr);
     dds_delete_qos(qos);
@@ -412,11 +412,11 @@ void Bridge::Impl::check_graph() {
       if (!infos[static_cast<std::size_t>(k)].valid_data) continue;
       const auto* e = static_cast<const dds_builtintopic_endpoint_t*>(samples[static_cast<std::size_t>(k)]);
       if (e->topic_name == nullptr || e->type_name == nullptr) continue;
-      const auto topic = ros2::ros_topic(e->topic_name);
+      const auto topic = dds::ros_topic(e->topic_name);
       if (!topic) continue;
       for (std::size_t i = 0; i < shadow->topic_count(); ++i) {
         if (shadow->topic(i).topic != *topic) continue;
-        if (e->type_name == ros2::dds_type(shadow->topic(i).type)) {
+        if (e->type_name == dds::dds_type(shadow->topic(i).type)) {
           // The bridge's own readers are not a ROS node's subscription (GraphView::kSelf).
           endpoints[*topic].insert(std::memcmp(&e->participant_key, &self, sizeof self) == 0
                                        ? std::string(ros_common::GraphView::kSelf)

@@ -4,7 +4,7 @@
 
 #include "ros2_msgs.h"
 
-namespace safecass::dds::ros2 {
+namespace safecass::dds {
 
 std::string dds_topic(std::string_view ros_name) {
   std::string out(kTopicPrefix);
@@ -98,4 +98,4 @@ std::string loopback_config() {
          "</Domain></CycloneDDS>";
 }
 
-}  // namespace safecass::dds::ros2
+}  // namespace safecass::dds

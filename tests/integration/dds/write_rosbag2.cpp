@@ -22,7 +22,7 @@
 
 namespace {
 
-namespace ros2 = safecass::dds::ros2;
+namespace ros2 = safecass::dds;
 
 /// The CDR bytes of samples of one type, as Cyclone DDS serialises them.
 class Serialiser {

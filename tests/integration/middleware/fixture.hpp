@@ -46,7 +46,7 @@ inline std::string file_text(const std::string& path) {
 /// CA in `ca` (during this run of the tests: the fixture makes a new CA every run).
 inline bool has_keys(const spec::SystemSpec& system, const std::string& dir, const std::string& ca) {
   const std::string ca_pem = file_text(ca + "/ca.pem");
-  if (ca_pem.empty() || file_text(dir + "/ca.pem") != ca_pem || !middleware::detail::Keyring::load(dir)) return false;
+  if (ca_pem.empty() || file_text(dir + "/ca.pem") != ca_pem || !middleware::Keyring::load(dir)) return false;
   std::vector<std::string> members{"supervisor"};
   for (const auto& [name, _] : system.coordinators) members.push_back(name);
   return std::all_of(members.begin(), members.end(), [&](const std::string& m) {
@@ -78,7 +78,7 @@ inline std::shared_ptr<Ice::Communicator> communicator(
     const std::vector<std::pair<std::string, std::string>>& extra = {}) {
   Ice::InitializationData init;
   init.properties = Ice::createProperties();
-  middleware::detail::set_tls_properties(init.properties, middleware::TlsOptions{dir, name});
+  middleware::set_tls_properties(init.properties, middleware::TlsOptions{dir, name});
   for (const auto& [key, value] : extra) init.properties->setProperty(key, value);
   return Ice::initialize(init);
 }

@@ -115,7 +115,7 @@ public:
   explicit Tap(std::shared_ptr<Ice::Communicator> ic) : ic_(std::move(ic)) {}
   void take(const wire::Signed& m) {
     Batch batch;
-    const bool ok = middleware::detail::decode(ic_, m.body, batch);
+    const bool ok = middleware::decode(ic_, m.body, batch);
     std::lock_guard lock(mutex_);
     sizes_.push_back(m.body.size());
     signed_sizes_.emplace_back(m.signer, m.body.size());

@@ -112,14 +112,14 @@ public:
   }
 
   std::unique_ptr<tools::Console> local_console(bool json) {
-    tools::console::Target t;
+    tools::Target t;
     introspect::LocalOptions o;
     o.name = "robot";
     o.period = period_;
     o.duration = duration_;
     t.query = std::make_unique<introspect::LocalQuery>(runner_->coordinator(), runner_->monitor(), registry_, o);
     t.subject = "in-process";
-    auto backend = tools::console::make_backend(std::move(t), tools::ConsoleOptions{json, false});
+    auto backend = tools::make_backend(std::move(t), tools::ConsoleOptions{json, false});
     EXPECT_TRUE(backend.has_value());
     return std::make_unique<tools::Console>(std::move(*backend), tools::ConsoleOptions{json, false});
   }
@@ -135,10 +135,10 @@ public:
       why = client.error().message;
       return nullptr;
     }
-    tools::console::Target t;
+    tools::Target t;
     t.query = std::move(*client);
     t.subject = "live";
-    auto backend = tools::console::make_backend(std::move(t), tools::ConsoleOptions{json, false});
+    auto backend = tools::make_backend(std::move(t), tools::ConsoleOptions{json, false});
     if (!backend) {
       why = backend.error().message;
       return nullptr;

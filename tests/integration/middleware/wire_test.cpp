@@ -82,9 +82,9 @@ constexpr const char* kSystem = R"({ "safecass": 1, "system": "wire",
                    { "required": "C.D2", "provided": "P.D2" }, { "required": "C.D3", "provided": "P.D3" } ],
   "coordinators": { "wire-p": ["P"], "wire-c": ["C"] } })";
 
-using middleware::detail::encode;
-using middleware::detail::Keyring;
-using middleware::detail::Signer;
+using middleware::encode;
+using middleware::Keyring;
+using middleware::Signer;
 
 constexpr std::int64_t kIncarnation = 42;
 
@@ -270,11 +270,11 @@ struct Bus {
         if (events_sent) h.lastSeq["events"] = *events_sent;
       }
     }
-    heartbeat_pub(name)->beat(key.sign(middleware::detail::kKindHeartbeat, encode(ice.communicator(), h)));
+    heartbeat_pub(name)->beat(key.sign(middleware::kKindHeartbeat, encode(ice.communicator(), h)));
   }
   /// Publishes `batch` signed by `key`; a genuine batch also advances what the heartbeat lists.
   void send(const Signer& key, const wire::StateUpdateSeq& batch) {
-    state_pub->updates(key.seal(middleware::detail::kKindState, encode(ice.communicator(), batch)));
+    state_pub->updates(key.seal(middleware::kKindState, encode(ice.communicator(), batch)));
     if (&key != &*provider) return;
     std::lock_guard lock(mutex);
     for (const wire::StateUpdate& u : batch) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.seq);
@@ -300,15 +300,15 @@ wire::Signed FakeAlive::prove(Ice::ByteSeq nonce, const Ice::Current&) {
   std::lock_guard lock(bus_.mutex);
   if (name_ == "wire-p" && !bus_.proving.load()) return {};
   if (name_ == "wire-p") {
-    return middleware::detail::make_proof(*bus_.provider, bus_.ice.communicator(), nonce,
-                                          bus_.provider_heartbeat(bus_.newest, bus_.beat_seq));
+    return middleware::make_proof(*bus_.provider, bus_.ice.communicator(), nonce,
+                                  bus_.provider_heartbeat(bus_.newest, bus_.beat_seq));
   }
   wire::Heartbeat h;
   h.coordinator = name_;
   h.incarnation = kIncarnation;
   h.seq = bus_.beat_seq;
   h.control = bus_.supervisor_alive_proxy;
-  return middleware::detail::make_proof(*bus_.supervisor, bus_.ice.communicator(), nonce, h);
+  return middleware::make_proof(*bus_.supervisor, bus_.ice.communicator(), nonce, h);
 }
 
 TEST(Wire, ABadUpdateInABatchIsRefusedAloneAndTheOthersApply) {
@@ -361,7 +361,7 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   bus.send(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
   // 4. Claiming wire-p as signer with another key's signature, and with no signature at all.
   wire::Signed relabelled = bus.other->seal(
-      middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
+      middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
   relabelled.signer = "wire-p";
   bus.state_pub->updates(relabelled);
   wire::Signed unsigned_message = relabelled;
@@ -376,7 +376,7 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   // 8. A heartbeat kind sent on the state topic.
   wire::Heartbeat hb;
   hb.coordinator = "wire-p";
-  bus.state_pub->updates(bus.provider->sign(middleware::detail::kKindHeartbeat, encode(ic, hb)));
+  bus.state_pub->updates(bus.provider->sign(middleware::kKindHeartbeat, encode(ic, hb)));
 
   EXPECT_TRUE(eventually([&] { return bus.node->stats().messages_refused - before.messages_refused >= 9; }))
       << bus.all_log();
@@ -543,19 +543,18 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   };
   auto ic = bus.ice.communicator();
   events->records(bus.attacker->seal(
-      middleware::detail::kKindEvents,
+      middleware::kKindEvents,
       encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Transition, "P.s_A\n[wire-p] FORGED", "")})));
   events->records(bus.provider->seal(
-      middleware::detail::kKindEvents,
+      middleware::kKindEvents,
       encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "operator\n[wire-p] FAKE LINE")})));
   ASSERT_TRUE(eventually([&] { return output().find("[wire-p] reset P (") != std::string::npos; })) << output();
   EXPECT_NE(output().find("[wire-p] reset P (operator\\x0a[wire-p] FAKE LINE)"), std::string::npos) << output();
   EXPECT_EQ(output().find("\n[wire-p] FAKE LINE"), std::string::npos) << output();
   EXPECT_EQ(output().find("FORGED"), std::string::npos) << output();
   // The same genuine record again is a replay.
-  events->records(
-      bus.provider->seal(middleware::detail::kKindEvents,
-                         encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "again")})));
+  events->records(bus.provider->seal(
+      middleware::kKindEvents, encode(ic, wire::EventMessageSeq{record(1, wire::RecordKind::Reset, "P", "again")})));
 
   // Back with a newer incarnation (a restart): its view is refreshed. The old incarnation still
   // beating beside it is a second process with the same name, and is reported.
@@ -696,11 +695,17 @@ TEST(Wire, ANonMemberCanNeitherListNorUnsubscribeNorCreateATopicAtTheBrokerAndTh
     Ice::CommunicatorHolder ice;
     std::string manager;
   };
+  // Each call bounded: a broker that never answers an outsider (the stress runs saw a plain-TCP
+  // request to the TLS port wait for ever) is a refusal too, not a hung test.
+  const std::pair<std::string, std::string> bounded{"Ice.Default.InvocationTimeout", "3000"};
+  Ice::InitializationData plain;
+  plain.properties = Ice::createProperties();
+  plain.properties->setProperty(bounded.first, bounded.second);
   std::vector<Outsider> outsiders;
-  outsiders.push_back({"plain TCP", Ice::CommunicatorHolder(Ice::initialize()),
+  outsiders.push_back({"plain TCP", Ice::CommunicatorHolder(Ice::initialize(plain)),
                        "SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port + " -t 1000"});
   outsiders.push_back({"a certificate of another CA",
-                       Ice::CommunicatorHolder(fixture::communicator(outsider_keys, "reader")),
+                       Ice::CommunicatorHolder(fixture::communicator(outsider_keys, "reader", {bounded})),
                        fixture::topic_manager(bus.port) + " -t 1000"});
   for (Outsider& o : outsiders) {
     auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(o.ice->stringToProxy(o.manager));
@@ -819,7 +824,7 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   m.component = "P";
   m.text = "operator: not followed";
   events->records(
-      bus.provider->seal(middleware::detail::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
+      bus.provider->seal(middleware::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
 
   // An update the heartbeat lists but that never came: reported after two heartbeats.
   {
@@ -857,7 +862,7 @@ struct RecordSender {
   }
 
   void send_batch(const wire::EventMessageSeq& batch) {
-    events_->records(bus_.provider->seal(middleware::detail::kKindEvents, encode(bus_.ice.communicator(), batch)));
+    events_->records(bus_.provider->seal(middleware::kKindEvents, encode(bus_.ice.communicator(), batch)));
   }
 
   static wire::EventMessage record(std::int64_t seq) {
@@ -1117,7 +1122,7 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
   const auto start = std::chrono::steady_clock::now();
   for (std::int64_t i = 1; i <= 300; ++i) {
     resync->resync(bus.supervisor->seal(
-        middleware::detail::kKindResync,
+        middleware::kKindResync,
         encode(bus.ice.communicator(), wire::ResyncRequest{"supervisor", kIncarnation, i, "wire-p"})));
   }
   const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(std::chrono::steady_clock::now() - start);
@@ -1131,13 +1136,13 @@ TEST(Wire, AFloodOfResyncRequestsCostsAtMostOneRepublishPerHeartbeatPeriod) {
 }
 
 TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {
-  EXPECT_EQ(middleware::detail::printable("robot"), "robot");
-  EXPECT_EQ(middleware::detail::printable("a\nb\rc\x1b[2J\\"), "a\\x0ab\\x0dc\\x1b[2J\\\\");
+  EXPECT_EQ(middleware::printable("robot"), "robot");
+  EXPECT_EQ(middleware::printable("a\nb\rc\x1b[2J\\"), "a\\x0ab\\x0dc\\x1b[2J\\\\");
   // Capped: a 128 KB name is not a 128 KB line.
   const std::string huge(std::size_t{128} * 1024, 'n');
-  const std::string shown = middleware::detail::printable(huge);
-  EXPECT_EQ(shown, std::string(middleware::detail::kMaxPrintable, 'n') + "...(+" +
-                       std::to_string(huge.size() - middleware::detail::kMaxPrintable) + " bytes)");
+  const std::string shown = middleware::printable(huge);
+  EXPECT_EQ(shown, std::string(middleware::kMaxPrintable, 'n') + "...(+" +
+                       std::to_string(huge.size() - middleware::kMaxPrintable) + " bytes)");
 }
 
 /// An Alive endpoint that answers every nonce with a proof it recorded earlier (a genuine proof of
@@ -1162,8 +1167,8 @@ struct Impostor {
   std::string proxy;
   explicit Impostor(Bus& bus) {
     std::lock_guard lock(bus.mutex);
-    const Ice::ByteSeq old_nonce(middleware::detail::kNonceBytes, 7);
-    alive = std::make_shared<ReplayingAlive>(middleware::detail::make_proof(
+    const Ice::ByteSeq old_nonce(middleware::kNonceBytes, 7);
+    alive = std::make_shared<ReplayingAlive>(middleware::make_proof(
         *bus.provider, bus.ice.communicator(), old_nonce, bus.provider_heartbeat(kIncarnation, bus.beat_seq)));
     adapter = bus.ice->createObjectAdapterWithEndpoints("", fixture::kAdapterEndpoint);
     proxy = adapter->add(alive, Ice::stringToIdentity("safecass/control-wire-p"))->ice_toString();
@@ -1307,10 +1312,10 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
   auto own = Ice::uncheckedCast<wire::StateTopicPrx>(bus.topic("safecass.state.wire-c")->getPublisher()->ice_oneway());
   wire::StateUpdate lie = update("P.D0", 2, "", wire::Level::Normal);
   lie.coordinator = "wire-c";
-  own->updates(bus.other->seal(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
+  own->updates(bus.other->seal(middleware::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
   // wire-p itself, 2^21 ahead (sent raw: its heartbeats do not list it).
   bus.state_pub->updates(bus.provider->seal(
-      middleware::detail::kKindState,
+      middleware::kKindState,
       encode(ic, wire::StateUpdateSeq{update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)})));
   // wire-p's key, an incarnation near 2^63: refused, it does not lock wire-p out.
   bus.beat(*bus.provider, "wire-p", std::numeric_limits<std::int64_t>::max() - 1);
@@ -1389,7 +1394,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
     for (const Topic& t : topics) pubs.push_back(bus.topic(t.name)->getPublisher()->ice_batchOneway());
     // Forged: an attacker's seal and signature under a hostile signer name.
     wire::Signed forged = bus.attacker->seal(
-        middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 99, "", wire::Level::Normal)}));
+        middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 99, "", wire::Level::Normal)}));
     forged.signer = evil_name;
     Ice::ByteSeq forged_bytes;
     {
@@ -1452,7 +1457,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
 
   // Then 300 forged messages with 128 KiB signer names (64 MB of log before names were capped).
   {
-    wire::Signed huge = bus.attacker->seal(middleware::detail::kKindState, encode(ic, wire::StateUpdateSeq{}));
+    wire::Signed huge = bus.attacker->seal(middleware::kKindState, encode(ic, wire::StateUpdateSeq{}));
     huge.signer = std::string(std::size_t{128} * 1024, 'n');
     for (int i = 0; i < 300; ++i) bus.state_pub->updates(huge);
   }
@@ -1520,7 +1525,7 @@ TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) 
   const std::int64_t refused = static_cast<std::int64_t>((*client)->records_refused());
   auto ic = bus.ice.communicator();
   for (std::int64_t incarnation : {std::int64_t{1}, std::numeric_limits<std::int64_t>::max() / 2}) {
-    events->records(bus.other->seal(middleware::detail::kKindEvents,
+    events->records(bus.other->seal(middleware::kKindEvents,
                                     encode(ic, wire::EventMessageSeq{record(incarnation, 1, "not this run")})));
   }
   ASSERT_TRUE(eventually([&] { return static_cast<std::int64_t>((*client)->records_refused()) >= refused + 2; }));

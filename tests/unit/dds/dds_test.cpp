@@ -22,7 +22,7 @@
 #include "safecass/ros_common/cdr.hpp"
 
 using namespace safecass;
-namespace ros2 = safecass::dds::ros2;
+namespace ros2 = safecass::dds;
 
 namespace {
 

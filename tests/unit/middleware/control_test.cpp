@@ -36,8 +36,8 @@ struct Robot {
     EXPECT_TRUE(load.ok());
     EXPECT_TRUE(spec::instantiate(*load.system, co, monitor, "robot"));
     co.subscribe([this](const Record& r) { injections += r.kind == RecordKind::Injection ? 1 : 0; });
-    control = detail::make_control(
-        detail::ControlContext{co, monitor, registry, "robot", true, kToken, [](const std::string&) {}, {}, {}, {}});
+    control = make_control(
+        ControlContext{co, monitor, registry, "robot", true, kToken, [](const std::string&) {}, {}, {}, {}});
   }
 
   /// The message of the OperationError `call` throws, or "(accepted)".

@@ -221,7 +221,7 @@ TEST(BusKeys, MakeTheSystemsCaAndACertificateSignedByItForEveryMemberIceStormAnd
   EXPECT_EQ(file_mode(keys + "/ca.key"), 0600u);
   for (const char* name : {"robot", "ui", "supervisor", "icestorm", "reader"}) {
     const std::string path = keys + "/" + name;
-    EXPECT_TRUE(detail::signed_by(file_text(path + ".pem"), ca)) << name;
+    EXPECT_TRUE(signed_by(file_text(path + ".pem"), ca)) << name;
     EXPECT_EQ(file_mode(path + ".pem"), 0644u) << name;
     EXPECT_EQ(file_mode(path + ".key"), 0600u) << name;
   }
@@ -231,18 +231,18 @@ TEST(BusKeys, MakeTheSystemsCaAndACertificateSignedByItForEveryMemberIceStormAnd
   ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
   EXPECT_EQ(file_text(keys + "/ca.pem"), ca);
   EXPECT_NE(file_text(keys + "/robot.pem"), first_robot);
-  EXPECT_TRUE(detail::signed_by(file_text(keys + "/robot.pem"), ca));
+  EXPECT_TRUE(signed_by(file_text(keys + "/robot.pem"), ca));
 
   // Another system's CA does not vouch for these certificates.
   const std::string other = keys + "-other";
   ASSERT_TRUE(create_bus_keys(*r.load.system, other, KeyOptions::replacing()));
-  EXPECT_FALSE(detail::signed_by(file_text(keys + "/robot.pem"), file_text(other + "/ca.pem")));
+  EXPECT_FALSE(signed_by(file_text(keys + "/robot.pem"), file_text(other + "/ca.pem")));
 
   // A system that shares the broker signs with its CA (--ca DIR): the CA's key is not copied.
   const std::string shared = keys + "-shared";
   ASSERT_TRUE(create_bus_keys(*r.load.system, shared, with_ca(keys)));
   EXPECT_EQ(file_text(shared + "/ca.pem"), ca);
-  EXPECT_TRUE(detail::signed_by(file_text(shared + "/robot.pem"), ca));
+  EXPECT_TRUE(signed_by(file_text(shared + "/robot.pem"), ca));
   EXPECT_EQ(file_mode(shared + "/ca.key"), 0u) << "the CA's key stays where it is";
 }
 

@@ -11,7 +11,7 @@
 #include "receiver.hpp"
 #include "safecass/middleware/keys.hpp"
 
-namespace safecass::middleware::detail {
+namespace safecass::middleware {
 namespace {
 
 using Verdict = PeerFreshness::Verdict;
@@ -208,4 +208,4 @@ TEST(OpenHeartbeat, AHeartbeatIsOpenedOnlySignedAsAHeartbeatNamingItsSignerAndOf
 }
 
 }  // namespace
-}  // namespace safecass::middleware::detail
+}  // namespace safecass::middleware

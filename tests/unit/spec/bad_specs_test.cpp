@@ -11,7 +11,7 @@
 
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
@@ -74,4 +74,4 @@ TEST(BadSpecCorpus, HoldsAtLeast25CasesEachWithItsGoldenFile) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

@@ -6,7 +6,7 @@
 #include "safecass/core/clock.hpp"
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
@@ -219,4 +219,4 @@ TEST(GoodSpecs, ProvidedInterfaceWithoutServiceEntryGetsTheConservativeDefault) 
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

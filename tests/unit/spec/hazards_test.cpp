@@ -10,7 +10,7 @@
 #include "safecass/spec/formula.hpp"
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
@@ -165,4 +165,4 @@ TEST(InvariantGrammar, DeepNestingIsRefusedNotACrash) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

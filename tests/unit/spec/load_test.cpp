@@ -5,7 +5,7 @@
 
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 using ::testing::HasSubstr;
@@ -419,4 +419,4 @@ TEST(SpecLoad, WatchdogDefaultsToTheFrameworkStaleEvents) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

@@ -9,7 +9,7 @@
 #include "safecass/json/read.hpp"
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
@@ -80,4 +80,4 @@ TEST(SpecSchema, IncludesUserFilterTypes) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

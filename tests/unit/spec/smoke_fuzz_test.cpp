@@ -13,7 +13,7 @@
 #include "safecass/json/write.hpp"
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
@@ -215,4 +215,4 @@ TEST(SpecSmokeFuzz, EveryValueReplacedByEveryOtherTypeIsReportedNotCrashed) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

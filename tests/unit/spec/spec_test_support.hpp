@@ -12,7 +12,7 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/spec.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 
 /// Moves to the source root before any test runs (ctest does too; this covers running the
 /// binary by hand).
@@ -49,4 +49,4 @@ inline LoadResult load_text(std::string_view text, const std::string& name = "te
   return load_system_from_text(text, name, builtin_registry());
 }
 
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

@@ -7,7 +7,7 @@
 #include "spec_commands.hpp"
 #include "spec_test_support.hpp"
 
-namespace safecass::spec::test {
+namespace safecass::spec {
 namespace {
 
 using ::testing::HasSubstr;
@@ -71,4 +71,4 @@ TEST(SpecSchemaCommand, PrintsTheSchema) {
 }
 
 }  // namespace
-}  // namespace safecass::spec::test
+}  // namespace safecass::spec

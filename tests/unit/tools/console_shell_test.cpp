@@ -14,10 +14,6 @@
 namespace safecass::tools {
 namespace {
 
-using console::Arg;
-using console::CommandSpec;
-using console::Out;
-
 /// Records every command it is asked to run; fails with `error` when set.
 struct Calls {
   std::vector<std::string> commands;  ///< "name|arg|arg..."
@@ -25,7 +21,7 @@ struct Calls {
   std::string error;
 };
 
-class FakeBackend final : public console::Backend {
+class FakeBackend final : public Backend {
 public:
   explicit FakeBackend(Calls& calls) : calls_(calls) {}
   std::string run(const CommandSpec& c, const std::vector<std::string>& args, Out& out) override {
@@ -126,8 +122,8 @@ TEST(ConsoleShell, ABackendErrorIsPrintedWithTheCommandAndItsUsageInTextAndJson)
 
 TEST(ConsoleShell, EveryNamedReadCommandHasItsReadAndNoneWrites) {
   std::size_t reads = 0;
-  for (const CommandSpec& c : console::commands()) {
-    if (c.id != console::Id::Read) continue;
+  for (const CommandSpec& c : commands()) {
+    if (c.id != Id::Read) continue;
     ++reads;
     EXPECT_NE(introspect::find_read(c.name), nullptr) << c.name << ": no NamedRead of that name in kReads";
     EXPECT_FALSE(c.writes) << c.name << ": a named read is read-only";
@@ -197,13 +193,13 @@ TEST(ConsoleShell, ExplanationsPrintOneLineEachWithEveryFieldInJsonAndSayWhenThe
 }
 
 TEST(ConsoleShell, ASampleFileIsReadLineByLineAndItsErrorsNameTheLine) {
-  auto good = console::parse_sample_file("f.txt", "# force\n1, 2 3\n\n4 # trailing\n");
+  auto good = parse_sample_file("f.txt", "# force\n1, 2 3\n\n4 # trailing\n");
   ASSERT_TRUE(good) << good.error().message;
   EXPECT_EQ(*good, (std::vector<std::vector<double>>{{1, 2, 3}, {4}}));
-  auto bad = console::parse_sample_file("f.txt", "1\n2 x\n");
+  auto bad = parse_sample_file("f.txt", "1\n2 x\n");
   ASSERT_FALSE(bad);
   EXPECT_EQ(bad.error().message, "f.txt:2: 'x' is not a number");
-  auto empty = console::parse_sample_file("f.txt", "# nothing\n");
+  auto empty = parse_sample_file("f.txt", "# nothing\n");
   ASSERT_FALSE(empty);
   EXPECT_EQ(empty.error().message, "f.txt: no samples");
 }

@@ -47,7 +47,7 @@ struct InProcessSource::Impl {
   InProcessOptions options;
   std::string system_name;
   std::string description;
-  detail::Coordinators coordinators;
+  Coordinators coordinators;
   std::vector<ConnectionView> connections;
   Time duration{};
   Time tick{};
@@ -56,7 +56,7 @@ struct InProcessSource::Impl {
   Time base_sim{};
   std::unique_ptr<introspect::LocalQuery> query;        // what the source reads and writes through
   std::unique_ptr<introspect::Subscription> following;  // the records, for take_records()
-  detail::PendingRecords pending;
+  PendingRecords pending;
 
   ~Impl() {
     following.reset();  // before the query and the runner
@@ -106,7 +106,7 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   std::snprintf(speed, sizeof speed, "%g", options.speed);
   impl->description += std::string(", speed ") + speed;
 
-  impl->coordinators = detail::coordinators_of(loaded, impl->co());
+  impl->coordinators = coordinators_of(loaded, impl->co());
 
   introspect::LocalOptions local;
   local.name = impl->system_name;
@@ -114,7 +114,7 @@ Expected<std::unique_ptr<InProcessSource>> InProcessSource::open(const InProcess
   local.scenario = options.scenario;
   local.duration = to_seconds(impl->duration);
   impl->query = std::make_unique<introspect::LocalQuery>(impl->co(), impl->runner->monitor(), *impl->registry, local);
-  impl->connections = detail::local_connections(*impl->query);
+  impl->connections = local_connections(*impl->query);
   Impl* self = impl.get();
   auto following = impl->query->follow([self](const introspect::HistoryEntry& e) { self->pending.push(e); });
   if (!following) return tl::unexpected(following.error());
@@ -144,7 +144,7 @@ double InProcessSource::now() const { return to_seconds(impl_->now()); }
 bool InProcessSource::running() const { return impl_->now() < impl_->duration; }
 
 SystemView InProcessSource::view() const {
-  SystemView v = detail::local_view(*impl_->query, impl_->coordinators, impl_->connections);
+  SystemView v = local_view(*impl_->query, impl_->coordinators, impl_->connections);
   v.system = impl_->system_name;
   v.description = impl_->description;
   v.t = now();
@@ -155,7 +155,7 @@ SystemView InProcessSource::view() const {
 std::vector<std::string> InProcessSource::take_records() { return impl_->pending.take(); }
 
 Expected<std::vector<Explanation>> InProcessSource::explain(std::string_view address) const {
-  return detail::local_explain(*impl_->query, impl_->co(), impl_->coordinators, address);
+  return local_explain(*impl_->query, impl_->co(), impl_->coordinators, address);
 }
 
 Expected<std::string> InProcessSource::apply(const introspect::Action& action) {

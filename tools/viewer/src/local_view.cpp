@@ -7,7 +7,7 @@
 #include "safecass/json/write.hpp"
 #include "safecass/viewer/live_diff.hpp"
 
-namespace safecass::viewer::detail {
+namespace safecass::viewer {
 
 Coordinators coordinators_of(const spec::SystemSpec& system, const Coordinator& co) {
   auto ids_of = [&co](const std::vector<std::string>& names) {
@@ -98,4 +98,4 @@ void PendingRecords::clear() {
   dropped_ = 0;
 }
 
-}  // namespace safecass::viewer::detail
+}  // namespace safecass::viewer

@@ -14,7 +14,7 @@
 #include "safecass/spec/system.hpp"
 #include "safecass/viewer/source.hpp"
 
-namespace safecass::viewer::detail {
+namespace safecass::viewer {
 
 /// The coordinators of a system file with their components (one named after the coordinator
 /// holding every component when the file names none).
@@ -49,4 +49,4 @@ private:
   std::uint64_t dropped_ = 0;
 };
 
-}  // namespace safecass::viewer::detail
+}  // namespace safecass::viewer

@@ -39,10 +39,10 @@ struct ReplaySource::Impl {
   std::unique_ptr<replay::ReplaySession> session;
   std::unique_ptr<introspect::LocalQuery> query;
   std::unique_ptr<introspect::Subscription> following;
-  detail::Coordinators coordinators;
+  Coordinators coordinators;
   std::vector<ConnectionView> connections;
   std::string system_name;
-  detail::PendingRecords pending;
+  PendingRecords pending;
   std::uint64_t generation = 0;
   bool transition_seen = false;  // since the last "next" began
   // Controls. Playing: replay time = base_sim + (wall - base_wall) * speed.
@@ -69,7 +69,7 @@ struct ReplaySource::Impl {
     close();
     session = std::move(*opened);
     runner::ScenarioRunner& r = session->runner();
-    coordinators = detail::coordinators_of(r.system().spec(), r.coordinator());
+    coordinators = coordinators_of(r.system().spec(), r.coordinator());
     system_name = r.system().spec().name;
     introspect::LocalOptions local;
     local.name = system_name;
@@ -77,7 +77,7 @@ struct ReplaySource::Impl {
     local.scenario = options.input;
     local.duration = to_seconds(session->end());
     query = std::make_unique<introspect::LocalQuery>(r.coordinator(), r.monitor(), *registry, local);
-    connections = detail::local_connections(*query);
+    connections = local_connections(*query);
     pending.clear();
     auto follow = query->follow([this](const introspect::HistoryEntry& e) {
       if (e.kind == RecordKind::Transition || e.kind == RecordKind::ComponentTransition) transition_seen = true;
@@ -164,7 +164,7 @@ void ReplaySource::settle() {
 }
 
 SystemView ReplaySource::view() const {
-  SystemView v = detail::local_view(*impl_->query, impl_->coordinators, impl_->connections);
+  SystemView v = local_view(*impl_->query, impl_->coordinators, impl_->connections);
   v.system = impl_->system_name;
   v.description = impl_->description;
   v.t = now();
@@ -179,7 +179,7 @@ bool ReplaySource::running() const { return !impl_->at_end(); }
 std::vector<std::string> ReplaySource::take_records() { return impl_->pending.take(); }
 
 Expected<std::vector<Explanation>> ReplaySource::explain(std::string_view address) const {
-  return detail::local_explain(*impl_->query, impl_->session->runner().coordinator(), impl_->coordinators, address);
+  return local_explain(*impl_->query, impl_->session->runner().coordinator(), impl_->coordinators, address);
 }
 
 namespace {

@@ -36,7 +36,7 @@ using ros_common::Mapping;
 struct BridgeOptions {
   /// The DDS domain; -1: ROS_DOMAIN_ID, else 0.
   int domain = -1;
-  /// Keep the participant on 127.0.0.1 (ros2::loopback_config()) unless CYCLONEDDS_URI configures
+  /// Keep the participant on 127.0.0.1 (loopback_config()) unless CYCLONEDDS_URI configures
   /// Cyclone DDS; false: Cyclone's own defaults or CYCLONEDDS_URI.
   bool loopback = true;
   /// Where warnings go (default: stderr).

@@ -27,7 +27,7 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/ros_common/fields.hpp"
 
-namespace safecass::dds::ros2 {
+namespace safecass::dds {
 
 /// The prefix of every ROS topic on DDS.
 inline constexpr std::string_view kTopicPrefix = "rt";
@@ -81,4 +81,4 @@ struct Participant {
 /// endpoints go within ~2 s). Used when CYCLONEDDS_URI is not set.
 std::string loopback_config();
 
-}  // namespace safecass::dds::ros2
+}  // namespace safecass::dds
