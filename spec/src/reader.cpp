@@ -460,6 +460,22 @@ private:
     stack_.pop_back();
   }
 
+  /// Calls `each(element, its pointer, its index)` for each element of the array `list` (at
+  /// `pointer`) that is an object; any other element is an error at it: "`must`, not <its type>".
+  template <class Each>
+  void for_each_object(int doc, const json::JsonValue& list, const std::string& pointer, const std::string& must,
+                       Each&& each) {
+    for (std::size_t i = 0; i < list.array.size(); ++i) {
+      const json::JsonValue& e = list.array[i];
+      const std::string p = pointer_join(pointer, i);
+      if (!e.is_object()) {
+        sink_.error(Site{doc, e.position, p}, must + ", not " + a_type(e.type));
+        continue;
+      }
+      each(e, p, i);
+    }
+  }
+
   void read_system(int doc, const json::JsonValue& root, const std::string& pointer, bool top) {
     Fields f(sink_, doc, root, pointer, system_kind(), named("system", root, "system"));
     if (top) {
@@ -492,66 +508,49 @@ private:
       }
     }
     if (const json::JsonValue* list = f.get("connections")) {
-      for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const json::JsonValue& entry = list->array[i];
-        const std::string p = pointer_join(f.pointer("connections"), i);
-        if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p},
-                      "a connection must be an object {\"required\": \"C.r\", \"provided\": \"P.p\"}, not " +
-                          a_type(entry.type));
-          continue;
-        }
-        Fields c(sink_, doc, entry, p, connection_kind(), "connection");
-        ConnectionItem item;
-        item.site = c.object_site();
-        item.required_site = c.site("required");
-        item.provided_site = c.site("provided");
-        const json::JsonValue* r = c.get("required");
-        const json::JsonValue* pr = c.get("provided");
-        if (r != nullptr) item.required = r->string;
-        if (pr != nullptr) item.provided = pr->string;
-        item.complete = r != nullptr && pr != nullptr;
-        model_.connections.push_back(std::move(item));
-      }
+      for_each_object(doc, *list, f.pointer("connections"),
+                      "a connection must be an object {\"required\": \"C.r\", \"provided\": \"P.p\"}",
+                      [&](const json::JsonValue& entry, const std::string& p, std::size_t) {
+                        Fields c(sink_, doc, entry, p, connection_kind(), "connection");
+                        ConnectionItem item;
+                        item.site = c.object_site();
+                        item.required_site = c.site("required");
+                        item.provided_site = c.site("provided");
+                        const json::JsonValue* r = c.get("required");
+                        const json::JsonValue* pr = c.get("provided");
+                        if (r != nullptr) item.required = r->string;
+                        if (pr != nullptr) item.provided = pr->string;
+                        item.complete = r != nullptr && pr != nullptr;
+                        model_.connections.push_back(std::move(item));
+                      });
     }
     if (const json::JsonValue* list = f.get("hazards")) {
       model_.has_hazards = true;
-      for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const json::JsonValue& entry = list->array[i];
-        const std::string p = pointer_join(f.pointer("hazards"), i);
-        if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p},
-                      "a hazard must be an object {\"id\": ..., \"reaction\": {...}}, not " + a_type(entry.type));
-          continue;
-        }
-        model_.hazards.push_back(read_hazard(doc, entry, p));
-      }
+      for_each_object(doc, *list, f.pointer("hazards"), "a hazard must be an object {\"id\": ..., \"reaction\": {...}}",
+                      [&](const json::JsonValue& entry, const std::string& p, std::size_t) {
+                        model_.hazards.push_back(read_hazard(doc, entry, p));
+                      });
     }
     if (const json::JsonValue* list = f.get("invariants")) {
-      for (std::size_t i = 0; i < list->array.size(); ++i) {
-        const json::JsonValue& entry = list->array[i];
-        const std::string p = pointer_join(f.pointer("invariants"), i);
-        if (!entry.is_object()) {
-          sink_.error(Site{doc, entry.position, p},
-                      "an invariant must be an object {\"name\": ..., \"formula\": ...}, not " + a_type(entry.type));
-          continue;
-        }
-        Fields fi(sink_, doc, entry, p, invariant_kind(), named("invariant", entry, "name"));
-        InvariantItem item;
-        item.site = fi.object_site();
-        item.name_site = fi.site("name");
-        item.formula_site = fi.site("formula");
-        if (const json::JsonValue* n = fi.get("name")) {
-          item.name = n->string;
-          item.has_name = true;
-        }
-        if (const json::JsonValue* t = fi.get("formula")) {
-          item.formula = t->string;
-          item.has_formula = true;
-        }
-        if (const json::JsonValue* d = fi.get("description")) item.description = d->string;
-        model_.invariants.push_back(std::move(item));
-      }
+      for_each_object(doc, *list, f.pointer("invariants"),
+                      "an invariant must be an object {\"name\": ..., \"formula\": ...}",
+                      [&](const json::JsonValue& entry, const std::string& p, std::size_t) {
+                        Fields fi(sink_, doc, entry, p, invariant_kind(), named("invariant", entry, "name"));
+                        InvariantItem item;
+                        item.site = fi.object_site();
+                        item.name_site = fi.site("name");
+                        item.formula_site = fi.site("formula");
+                        if (const json::JsonValue* n = fi.get("name")) {
+                          item.name = n->string;
+                          item.has_name = true;
+                        }
+                        if (const json::JsonValue* t = fi.get("formula")) {
+                          item.formula = t->string;
+                          item.has_formula = true;
+                        }
+                        if (const json::JsonValue* d = fi.get("description")) item.description = d->string;
+                        model_.invariants.push_back(std::move(item));
+                      });
     }
     if (const json::JsonValue* coordinators = f.get("coordinators")) {
       const std::string base = f.pointer("coordinators");
@@ -603,108 +602,88 @@ private:
     }
     if (const json::JsonValue* signals = f.get("signals")) {
       c.has_signals = true;
-      for (std::size_t i = 0; i < signals->array.size(); ++i) {
-        const json::JsonValue& s = signals->array[i];
-        const std::string p = pointer_join(f.pointer("signals"), i);
-        if (!s.is_object()) {
-          sink_.error(Site{doc, s.position, p},
-                      ctx + ": a signal must be an object {\"name\": ..., \"size\": ...}, not " + a_type(s.type));
-          continue;
-        }
-        Fields fs(sink_, doc, s, p, signal_kind(), named("signal", s, "name"));
-        const json::JsonValue* name = fs.get("name");
-        if (name == nullptr) continue;
-        SignalItem item;
-        item.name = name->string.find('.') == std::string::npos ? c.name + "." + name->string : name->string;
-        item.site = fs.site("name");
-        if (const json::JsonValue* size = fs.get("size")) item.size = static_cast<std::size_t>(size->number);
-        c.signals.push_back(std::move(item));
-      }
+      for_each_object(
+          doc, *signals, f.pointer("signals"), ctx + ": a signal must be an object {\"name\": ..., \"size\": ...}",
+          [&](const json::JsonValue& s, const std::string& p, std::size_t) {
+            Fields fs(sink_, doc, s, p, signal_kind(), named("signal", s, "name"));
+            const json::JsonValue* name = fs.get("name");
+            if (name == nullptr) return;
+            SignalItem item;
+            item.name = name->string.find('.') == std::string::npos ? c.name + "." + name->string : name->string;
+            item.site = fs.site("name");
+            if (const json::JsonValue* size = fs.get("size")) item.size = static_cast<std::size_t>(size->number);
+            c.signals.push_back(std::move(item));
+          });
     }
     if (const json::JsonValue* events = f.get("event")) {
-      for (std::size_t i = 0; i < events->array.size(); ++i) {
-        const json::JsonValue& e = events->array[i];
-        const std::string p = pointer_join(f.pointer("event"), i);
-        if (!e.is_object()) {
-          sink_.error(Site{doc, e.position, p}, ctx + ": an event must be an object, not " + a_type(e.type));
-          continue;
-        }
-        c.events.push_back(read_event(doc, e, p, c.name));
-      }
+      for_each_object(doc, *events, f.pointer("event"), ctx + ": an event must be an object",
+                      [&](const json::JsonValue& e, const std::string& p, std::size_t) {
+                        c.events.push_back(read_event(doc, e, p, c.name));
+                      });
     }
     if (const json::JsonValue* filters = f.get("filter")) {
-      for (std::size_t i = 0; i < filters->array.size(); ++i) {
-        const json::JsonValue& e = filters->array[i];
-        const std::string p = pointer_join(f.pointer("filter"), i);
-        if (!e.is_object()) {
-          sink_.error(Site{doc, e.position, p}, ctx + ": a filter must be an object, not " + a_type(e.type));
-          continue;
-        }
-        FilterEntryItem entry;
-        entry.site = Site{doc, e.position, p};
-        if (e.find_member("pipeline") != nullptr) {
-          Fields fp(sink_, doc, e, p, pipeline_kind(), named("pipeline", e, "name"));
-          entry.name_site = fp.site("name");
-          if (const json::JsonValue* n = fp.get("name"))
-            entry.pipeline = n->string;
-          else
-            entry.pipeline = "?";
-          TargetDefault target;
-          if (const json::JsonValue* t = fp.get("target"))
-            target = read_target(doc, *t, fp.pointer("target"), fp.context(), c.name);
-          if (const json::JsonValue* stages = fp.get("pipeline")) {
-            for (std::size_t k = 0; k < stages->array.size(); ++k) {
-              const json::JsonValue& s = stages->array[k];
-              const std::string sp = pointer_join(fp.pointer("pipeline"), k);
-              if (!s.is_object()) {
-                sink_.error(Site{doc, s.position, sp},
-                            fp.context() + ": a stage must be a filter object, not " + a_type(s.type));
-                continue;
-              }
-              FilterItem stage = read_filter(doc, s, sp, c.name, target);
-              stage.pipeline = entry.pipeline;
-              stage.stage = k;
-              entry.stages.push_back(std::move(stage));
-            }
-          }
-        } else {
-          entry.stages.push_back(read_filter(doc, e, p, c.name, TargetDefault{}));
-        }
-        c.filters.push_back(std::move(entry));
-      }
+      for_each_object(doc, *filters, f.pointer("filter"), ctx + ": a filter must be an object",
+                      [&](const json::JsonValue& e, const std::string& p, std::size_t) {
+                        c.filters.push_back(read_filter_entry(doc, e, p, c.name));
+                      });
     }
     if (const json::JsonValue* services = f.get("service")) {
-      for (std::size_t i = 0; i < services->array.size(); ++i) {
-        const json::JsonValue& s = services->array[i];
-        const std::string p = pointer_join(f.pointer("service"), i);
-        if (!s.is_object()) {
-          sink_.error(Site{doc, s.position, p}, ctx + ": a service must be an object, not " + a_type(s.type));
-          continue;
-        }
-        Fields fs(sink_, doc, s, p, service_kind(), named("service", s, "name"));
-        ServiceItem item;
-        item.site = fs.object_site();
-        item.name_site = fs.site("name");
-        if (const json::JsonValue* n = fs.get("name")) {
-          item.provided = n->string;
-          item.has_name = true;
-        }
-        if (const json::JsonValue* d = fs.get("dependency")) {
-          Fields fd(sink_, doc, *d, fs.pointer("dependency"), dependency_kind(), fs.context() + " dependency");
-          ServiceDependency dep = ServiceDependency::provided_only();
-          if (const json::JsonValue* b = fd.get("s_F")) dep.framework = b->boolean;
-          if (const json::JsonValue* b = fd.get("s_A")) dep.application = b->boolean;
-          item.required = fd.names("s_R");
-          for (const Name& r : item.required) dep.required.push_back(r.text);
-          item.dependency = std::move(dep);
-        }
-        if (const json::JsonValue* pr = fs.get("propagate")) {
-          item.dependency.propagate = pr->string == "warning" ? State::Warning : State::Error;
-        }
-        c.services.push_back(std::move(item));
-      }
+      for_each_object(doc, *services, f.pointer("service"), ctx + ": a service must be an object",
+                      [&](const json::JsonValue& s, const std::string& p, std::size_t) {
+                        Fields fs(sink_, doc, s, p, service_kind(), named("service", s, "name"));
+                        ServiceItem item;
+                        item.site = fs.object_site();
+                        item.name_site = fs.site("name");
+                        if (const json::JsonValue* n = fs.get("name")) {
+                          item.provided = n->string;
+                          item.has_name = true;
+                        }
+                        if (const json::JsonValue* d = fs.get("dependency")) {
+                          Fields fd(sink_, doc, *d, fs.pointer("dependency"), dependency_kind(),
+                                    fs.context() + " dependency");
+                          ServiceDependency dep = ServiceDependency::provided_only();
+                          if (const json::JsonValue* b = fd.get("s_F")) dep.framework = b->boolean;
+                          if (const json::JsonValue* b = fd.get("s_A")) dep.application = b->boolean;
+                          item.required = fd.names("s_R");
+                          for (const Name& r : item.required) dep.required.push_back(r.text);
+                          item.dependency = std::move(dep);
+                        }
+                        if (const json::JsonValue* pr = fs.get("propagate")) {
+                          item.dependency.propagate = pr->string == "warning" ? State::Warning : State::Error;
+                        }
+                        c.services.push_back(std::move(item));
+                      });
     }
     if (const json::JsonValue* period = f.get("period")) c.period = period->number;
+  }
+
+  /// One entry of a component's "filter" list: a filter, or a pipeline of them.
+  FilterEntryItem read_filter_entry(int doc, const json::JsonValue& e, const std::string& p,
+                                    const std::string& component) {
+    FilterEntryItem entry;
+    entry.site = Site{doc, e.position, p};
+    if (e.find_member("pipeline") == nullptr) {
+      entry.stages.push_back(read_filter(doc, e, p, component, TargetDefault{}));
+      return entry;
+    }
+    Fields fp(sink_, doc, e, p, pipeline_kind(), named("pipeline", e, "name"));
+    entry.name_site = fp.site("name");
+    const json::JsonValue* n = fp.get("name");
+    entry.pipeline = n != nullptr ? n->string : "?";
+    TargetDefault target;
+    if (const json::JsonValue* t = fp.get("target")) {
+      target = read_target(doc, *t, fp.pointer("target"), fp.context(), component);
+    }
+    if (const json::JsonValue* stages = fp.get("pipeline")) {
+      for_each_object(doc, *stages, fp.pointer("pipeline"), fp.context() + ": a stage must be a filter object",
+                      [&](const json::JsonValue& s, const std::string& sp, std::size_t k) {
+                        FilterItem stage = read_filter(doc, s, sp, component, target);
+                        stage.pipeline = entry.pipeline;
+                        stage.stage = k;
+                        entry.stages.push_back(std::move(stage));
+                      });
+    }
+    return entry;
   }
 
   HazardItem read_hazard(int doc, const json::JsonValue& e, const std::string& pointer) {
