@@ -273,22 +273,31 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   return id;
 }
 
-Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
+Expected<std::string> Coordinator::new_interface(ComponentId component, std::string_view name, MachineKind kind) const {
   if (!components_.contains(component))
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
-  ComponentData& c = components_[component];
+  const ComponentData& c = components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
                                                 "' must be non-empty, without dots or spaces");
   }
-  for (MachineId m : c.provided) {
-    if (machines_[m].address == address::provided(c.name, name)) {
-      return fail(ErrorCode::Duplicate,
-                  "duplicate provided interface '" + std::string(name) + "' in component '" + c.name + "'");
+  const bool provided = kind == MachineKind::Provided;
+  std::string address = provided ? address::provided(c.name, name) : address::required(c.name, name);
+  for (MachineId m : provided ? c.provided : c.required) {
+    if (machines_[m].address == address) {
+      return fail(ErrorCode::Duplicate, std::string("duplicate ") + (provided ? "provided" : "required") +
+                                            " interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
   }
+  return address;
+}
+
+Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
+  auto address = new_interface(component, name, MachineKind::Provided);
+  if (!address) return tl::unexpected(address.error());
+  ComponentData& c = components_[component];
   const auto iface = static_cast<std::uint32_t>(c.provided.size());
-  const MachineId id = add_machine(component, MachineKind::Provided, iface, address::provided(c.name, name));
+  const MachineId id = add_machine(component, MachineKind::Provided, iface, std::move(*address));
   c.provided.push_back(id);
   c.services.push_back(ServiceData{});
   ++c.machine_state_count[index(State::Normal)];
@@ -297,21 +306,11 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 }
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
-  if (!components_.contains(component))
-    return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
+  auto address = new_interface(component, name, MachineKind::Required);
+  if (!address) return tl::unexpected(address.error());
   ComponentData& c = components_[component];
-  if (!valid_name(name)) {
-    return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
-                                                "' must be non-empty, without dots or spaces");
-  }
-  for (MachineId m : c.required) {
-    if (machines_[m].address == address::required(c.name, name)) {
-      return fail(ErrorCode::Duplicate,
-                  "duplicate required interface '" + std::string(name) + "' in component '" + c.name + "'");
-    }
-  }
   const auto iface = static_cast<std::uint32_t>(c.required.size());
-  const MachineId id = add_machine(component, MachineKind::Required, iface, address::required(c.name, name));
+  const MachineId id = add_machine(component, MachineKind::Required, iface, std::move(*address));
   c.required.push_back(id);
   c.required_connection.push_back(kNoConnection);
   ++c.machine_state_count[index(State::Normal)];

@@ -92,4 +92,27 @@ private:
   std::thread thread_;
 };
 
+/// A typed publisher of one of a BusLink's topics, for a thread that publishes often: the typed
+/// proxy is made again only when the link's publisher changed (a reconnection). One thread only.
+template <class Prx>
+class TypedPublisher {
+public:
+  TypedPublisher(const BusLink& link, std::size_t topic) : link_(link), topic_(topic) {}
+  /// nullptr until the link is connected.
+  [[nodiscard]] const std::shared_ptr<Prx>& get() {
+    std::shared_ptr<Ice::ObjectPrx> now = link_.publisher(topic_);
+    if (now != raw_) {
+      raw_ = std::move(now);
+      typed_ = raw_ == nullptr ? nullptr : Ice::uncheckedCast<Prx>(raw_);
+    }
+    return typed_;
+  }
+
+private:
+  const BusLink& link_;
+  std::size_t topic_;
+  std::shared_ptr<Ice::ObjectPrx> raw_;
+  std::shared_ptr<Prx> typed_;
+};
+
 }  // namespace safecass::middleware

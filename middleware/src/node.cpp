@@ -499,6 +499,8 @@ struct CoordinatorNode::Impl {
     std::vector<std::pair<std::size_t, bool>> todo;
     wire::StateUpdateSeq updates;
     std::vector<Stream*> updated;
+    TypedPublisher<wire::StateTopicPrx> state_publisher(*link, kPublishState);
+    TypedPublisher<wire::EventTopicPrx> event_publisher(*link, kPublishEvents);
     const std::int64_t delay = std::chrono::nanoseconds(kEventDelay).count();
     while (running.load()) {
       todo.clear();
@@ -541,8 +543,8 @@ struct CoordinatorNode::Impl {
           any_dirty = false;
         }
       }
-      const auto spub = Ice::uncheckedCast<wire::StateTopicPrx>(link->publisher(kPublishState));
-      const auto epub = Ice::uncheckedCast<wire::EventTopicPrx>(link->publisher(kPublishEvents));
+      const auto& spub = state_publisher.get();
+      const auto& epub = event_publisher.get();
       if (spub == nullptr || epub == nullptr) {
         redo(todo);
         continue;

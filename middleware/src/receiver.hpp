@@ -24,6 +24,7 @@
 
 #include "auth.hpp"
 #include "safecass.h"
+#include "safecass/core/text_map.hpp"
 #include "safecass/spec/system.hpp"
 
 namespace safecass::middleware {
@@ -84,7 +85,7 @@ public:
   static std::string_view component_of(std::string_view address);
 
 private:
-  std::map<std::string, std::string, std::less<>> owner_;  // component -> coordinator
+  TextMap<std::string> owner_;  // component -> coordinator
 };
 
 /// What one receiver believes of one peer's process: the proven incarnation, its heartbeats' and

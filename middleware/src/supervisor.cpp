@@ -2,6 +2,7 @@
 
 #include "safecass/middleware/supervisor.hpp"
 #include "safecass/core/address.hpp"
+#include "safecass/core/text_map.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -25,17 +26,6 @@
 #include "safecass/spec/instance.hpp"
 
 namespace safecass::middleware {
-
-namespace {
-/// Hashes std::string and std::string_view alike, so that a lookup by a view of a message's text
-/// makes no string.
-struct TextHash {
-  using is_transparent = void;
-  std::size_t operator()(std::string_view text) const noexcept { return std::hash<std::string_view>{}(text); }
-};
-template <class V>
-using TextMap = std::unordered_map<std::string, V, TextHash, std::equal_to<>>;
-}  // namespace
 
 struct Supervisor::Impl {
   const spec::SystemSpec& system;

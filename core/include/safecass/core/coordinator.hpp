@@ -49,6 +49,7 @@
 #include "safecass/core/ids.hpp"
 #include "safecass/core/observer.hpp"
 #include "safecass/core/state.hpp"
+#include "safecass/core/text_map.hpp"
 
 namespace safecass {
 
@@ -518,6 +519,10 @@ private:
   }
 
   EventId add_event_unchecked(Event event);
+  /// The address of a new provided or required interface `name` of `component`, or why it
+  /// cannot be added: no such component, a name that is not one, a duplicate.
+  [[nodiscard]] Expected<std::string> new_interface(ComponentId component, std::string_view name,
+                                                    MachineKind kind) const;
   MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
   /// Recomputes the fan-out edges of `provider`'s machines (its connections as a provider).
   void rebuild_fanout(ComponentId provider);
@@ -595,13 +600,9 @@ private:
   // element never moves once added (references handed out stay valid while the model grows).
   detail::StableVector<MachineData, MachineId> machines_;
   detail::StableVector<ComponentData, ComponentId> components_;
-  struct NameHash {
-    using is_transparent = void;
-    std::size_t operator()(std::string_view s) const noexcept { return std::hash<std::string_view>{}(s); }
-  };
-  std::unordered_map<std::string, ComponentId, NameHash, std::equal_to<>> component_index_;  ///< by name
+  TextMap<ComponentId> component_index_;  ///< by name
   std::deque<Event> events_;
-  std::unordered_map<std::string, EventId, NameHash, std::equal_to<>> event_index_;  ///< by name
+  TextMap<EventId> event_index_;           ///< by name
   std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
   std::vector<Connection> connections_;
 
@@ -650,7 +651,7 @@ private:
   mutable std::mutex names_mutex_;
   std::deque<std::string> names_;  ///< by NameId; elements never move
   /// names_ by text (views of its elements): intern() finds a known text without allocating.
-  std::unordered_map<std::string_view, NameId, NameHash, std::equal_to<>> name_index_;
+  std::unordered_map<std::string_view, NameId, TextHash, std::equal_to<>> name_index_;
 };
 
 // ---- the checks of the name-based writes -----------------------------------------------------
