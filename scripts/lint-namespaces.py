@@ -14,7 +14,7 @@ import re
 import sys
 
 MAX_LEVELS = 2
-NAMESPACE = re.compile(r"\b(inline\s+)?namespace\b\s*([A-Za-z_][\w:]*)?\s*(=)?")
+NAMESPACE = re.compile(r"\b(?:inline\s+)?namespace\b\s*([A-Za-z_][\w:]*)?\s*(=)?")
 
 
 def code_of(text):
@@ -75,14 +75,13 @@ def check(path):
     found = []
     stack = []  # per open brace: the namespace names it opens ([] for any other brace)
     pending = None  # a namespace declaration waiting for its brace
-    pos = 0
     for m in re.finditer(r"[{};]|\b(?:inline\s+)?namespace\b", code):
         token = m.group(0)
         if token.endswith("namespace"):
             decl = NAMESPACE.match(code, m.start())
-            if decl and decl.group(3):  # an alias: namespace fs = std::filesystem;
+            if decl and decl.group(2):  # an alias: namespace fs = std::filesystem;
                 continue
-            name = decl.group(2) if decl else None
+            name = decl.group(1) if decl else None
             pending = (name.split("::") if name else [], code.count("\n", 0, m.start()) + 1, name)
             continue
         if token == "{":
@@ -101,7 +100,6 @@ def check(path):
                 stack.pop()
         else:
             pending = None
-        pos = m.end()
     return found
 
 

@@ -8,7 +8,7 @@ namespace safecass::middleware {
 
 BusLink::BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, const TlsOptions& tls,
                  BusLinkOptions options)
-    : ic_(ic), where_(to_string(ice)), options_(std::move(options)), link_(std::move(ic), ice, tls) {}
+    : where_(to_string(ice)), options_(std::move(options)), link_(std::move(ic), ice, tls) {}
 
 void BusLink::start() {
   if (running_.exchange(true)) return;

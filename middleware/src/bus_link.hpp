@@ -73,7 +73,6 @@ private:
   bool connect();
   void sleep_for(std::chrono::milliseconds d) const;
 
-  std::shared_ptr<Ice::Communicator> ic_;
   std::string where_;  ///< IceStorm's endpoint, as said in the log
   BusLinkOptions options_;
   Link link_;  ///< link thread only

@@ -585,13 +585,6 @@ struct CoordinatorNode::Impl {
     resyncs_requested.fetch_add(1);
   }
 
-  void sleep_for(std::chrono::milliseconds d) {
-    const auto until = std::chrono::steady_clock::now() + d;
-    while (running.load() && std::chrono::steady_clock::now() < until) {
-      std::this_thread::sleep_for(std::min<std::chrono::milliseconds>(d, std::chrono::milliseconds(20)));
-    }
-  }
-
   /// A sealed request that `target` (empty: everybody) republish its full state.
   wire::Signed resync_request(const std::string& target) {
     const wire::ResyncRequest r{name, incarnation, ++resync_seq, target};
@@ -899,7 +892,7 @@ struct CoordinatorNode::Impl {
 
   void watch_loop() {
     while (running.load()) {
-      sleep_for(std::chrono::milliseconds(10));
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
       const std::int64_t now = steady_ns();
       std::lock_guard lock(peer_mutex);
       for (auto& [who, peer] : peers) {

@@ -75,11 +75,11 @@ std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::c
                             std::string_view since) {
   if (lost_) return {};
   const std::int64_t bound_ns = std::chrono::nanoseconds(bound).count();
-  const std::string bound_text = std::to_string(bound.count()) + " ms";
+  const auto bound_text = [&] { return std::to_string(bound.count()) + " ms"; };  // only for a loss said
   const std::int64_t last = last_beat_ != 0 ? last_beat_ : watched_since;
   if (last != 0 && now - last > bound_ns) {
     lost_ = true;
-    return "no heartbeat for " + bound_text +
+    return "no heartbeat for " + bound_text() +
            (last_beat_ != 0 ? std::string() : " (never proven alive since " + std::string(since) + ")");
   }
   if (behind_since_ != 0 && now - behind_since_ > bound_ns) {
@@ -88,7 +88,7 @@ std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::c
     const std::string what = stream.starts_with(kStateStreamPrefix)
                                  ? "state of " + printable(stream.substr(kStateStreamPrefix.size()))
                                  : "the stream '" + printable(stream) + "'";
-    return "its heartbeats list " + what + " not received for " + bound_text;
+    return "its heartbeats list " + what + " not received for " + bound_text();
   }
   return {};
 }

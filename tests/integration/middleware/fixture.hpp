@@ -11,7 +11,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
@@ -19,6 +18,7 @@
 #include "auth.hpp"      // middleware/src: the product's keyring
 #include "ice_util.hpp"  // middleware/src: the product's TLS properties
 #include "safecass/middleware/keys.hpp"
+#include "safecass/spec/file.hpp"
 
 namespace safecass::fixture {
 
@@ -36,17 +36,12 @@ inline std::string icestorm_env(const std::string& key) {
 /// The directory of the CA the fixture's IceStorm admits.
 inline std::string ca_dir() { return icestorm_env("ICESTORM_TLS"); }
 
-/// The whole content of `path` (empty when it cannot be read).
-inline std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
 /// True when `dir` already holds the bus keys of every member of `system`, made with the fixture's
 /// CA in `ca` (during this run of the tests: the fixture makes a new CA every run).
 inline bool has_keys(const spec::SystemSpec& system, const std::string& dir, const std::string& ca) {
-  const std::string ca_pem = file_text(ca + "/ca.pem");
-  if (ca_pem.empty() || file_text(dir + "/ca.pem") != ca_pem || !middleware::Keyring::load(dir)) return false;
+  const auto ca_pem = spec::read_regular_file(ca + "/ca.pem");
+  const auto ours = spec::read_regular_file(dir + "/ca.pem");
+  if (!ca_pem || !ours || *ours != *ca_pem || !middleware::Keyring::load(dir)) return false;
   std::vector<std::string> members{"supervisor"};
   for (const auto& [name, _] : system.coordinators) members.push_back(name);
   return std::all_of(members.begin(), members.end(), [&](const std::string& m) {
