@@ -192,7 +192,7 @@ package: build
 
 # clang-format (check only), the [[nodiscard]], names, function-length and namespace checks, and
 # clang-tidy over the sources changed since the tidied baseline of .ci/tidy-baseline (scripts/lint).
-# LINT_CHECK=format, =nodiscard, =names, =functions, =namespaces or =tidy runs one of them; LINT_CHECK=tidy-all runs clang-tidy over every source (docs/contributing.md, "Lint").
+# LINT_CHECK=format, =nodiscard, =names, =functions, =namespaces, =surface or =tidy runs one of them; LINT_CHECK=tidy-all runs clang-tidy over every source (docs/contributing.md, "Lint").
 # (Not LINT: GNU make defines LINT = lint itself.)
 LINT_CHECK ?= all
 lint: build

@@ -40,7 +40,7 @@ struct Chain {
       }
       components.push_back(c);
     }
-    head = co.application_machine(components.front());
+    head = co.structure().application_machine(components.front());
     onset = *co.add_event(EventDef{"EVT_ERR", 50, {Transition::N2E, Transition::W2E}, "", false, "", ""});
     completion = *co.add_event(EventDef{"/EVT_ERR", 50, {Transition::E2N, Transition::E2W}, "", false, "", ""});
   }
@@ -48,7 +48,7 @@ struct Chain {
   /// One onset and its completion; true when the onset reached the last component.
   bool round() {
     co.generate(onset, head);
-    const bool reached = co.extended_state(components.back()) == State::Error;
+    const bool reached = co.extended(components.back()).state == State::Error;
     co.generate(completion, head);
     return reached && co.coordinator_state() == State::Normal;
   }
@@ -57,7 +57,7 @@ struct Chain {
 void BM_ReadExtendedState(benchmark::State& state) {
   Chain chain(1);
   const ComponentId c = chain.components.front();
-  for (auto _ : state) benchmark::DoNotOptimize(chain.co.extended_state(c));
+  for (auto _ : state) benchmark::DoNotOptimize(chain.co.extended(c).state);
 }
 BENCHMARK(BM_ReadExtendedState);
 
@@ -71,7 +71,7 @@ void BM_EventTransition(benchmark::State& state) {
     chain.co.generate(chain.onset, chain.head);
     chain.co.generate(chain.completion, chain.head);
   }
-  benchmark::DoNotOptimize(chain.co.extended_state(chain.components.front()));
+  benchmark::DoNotOptimize(chain.co.extended(chain.components.front()).state);
 }
 BENCHMARK(BM_EventTransition);
 

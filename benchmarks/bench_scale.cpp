@@ -84,15 +84,15 @@ void BM_ScalePropagate(benchmark::State& state) {
   Coordinator co("tree", &clock);
   Monitor monitor(co, tree.registry);
   if (!spec::instantiate(*r.system, co, monitor)) state.SkipWithError("instantiate failed");
-  const MachineId root = co.application_machine(*co.find_component("C0"));
-  const EventId onset = *co.find_event("EVT_FAULT");
-  const EventId completion = *co.find_event("/EVT_FAULT");
-  const ComponentId last = *co.find_component("C" + std::to_string(n - 1));
+  const MachineId root = co.structure().application_machine(*co.structure().find_component("C0"));
+  const EventId onset = *co.structure().find_event("EVT_FAULT");
+  const EventId completion = *co.structure().find_event("/EVT_FAULT");
+  const ComponentId last = *co.structure().find_component("C" + std::to_string(n - 1));
   for (auto _ : state) {
     co.generate(onset, root);
-    if (co.extended_state(last) != State::Error) state.SkipWithError("the fault did not reach the last component");
+    if (co.extended(last).state != State::Error) state.SkipWithError("the fault did not reach the last component");
     co.generate(completion, root);
-    if (co.extended_state(last) != State::Normal) state.SkipWithError("the fault did not clear everywhere");
+    if (co.extended(last).state != State::Normal) state.SkipWithError("the fault did not clear everywhere");
   }
   state.SetComplexityN(n);
 }
@@ -119,9 +119,10 @@ void BM_ScaleEventRate(benchmark::State& state) {
   Monitor monitor(co, tree.registry);
   if (!spec::instantiate(*r.system, co, monitor)) state.SkipWithError("instantiate failed");
   std::vector<MachineId> targets;
-  for (int k = 0; k < n; ++k) targets.push_back(co.application_machine(*co.find_component("C" + std::to_string(k))));
-  const EventId onset = *co.find_event("EVT_FAULT");
-  const EventId completion = *co.find_event("/EVT_FAULT");
+  for (int k = 0; k < n; ++k)
+    targets.push_back(co.structure().application_machine(*co.structure().find_component("C" + std::to_string(k))));
+  const EventId onset = *co.structure().find_event("EVT_FAULT");
+  const EventId completion = *co.structure().find_event("/EVT_FAULT");
   std::size_t k = 0;
   for (auto _ : state) {
     co.generate(onset, targets[k]);

@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
   };
   std::vector<Loop> loops;
   for (int c = 0; c < components; ++c) {
-    Loop loop{*co.find_component("LOOP" + std::to_string(c)), {}};
+    Loop loop{*co.structure().find_component("LOOP" + std::to_string(c)), {}};
     for (int i = c; i < signals; i += components) {
       loop.signals.emplace_back(i, monitor.signals().find("LOOP" + std::to_string(c) + ".S" + std::to_string(i)));
     }
@@ -149,7 +149,7 @@ int main(int argc, char** argv) {
   std::vector<double> latencies;
   std::atomic<std::uint64_t> unexpected{0};
   std::vector<MachineId> watched;
-  for (const Loop& l : loops) watched.push_back(co.application_machine(l.component));
+  for (const Loop& l : loops) watched.push_back(co.structure().application_machine(l.component));
   co.subscribe([&](const Record& r) {
     if (r.kind != RecordKind::Transition) return;
     if (r.to == State::Normal) return;

@@ -140,7 +140,7 @@ void BM_PeerSafecassEvent(benchmark::State& state) {
   safecass::Coordinator co("bench");
   const safecass::ComponentId c = *co.add_component("C");
   (void)co.add_provided(c, "out");
-  const safecass::MachineId target = co.application_machine(c);
+  const safecass::MachineId target = co.structure().application_machine(c);
   using safecass::Transition;
   const safecass::EventId onset =
       *co.add_event(safecass::EventDef{"EVT_ERR", 50, {Transition::N2E, Transition::W2E}, "", false, "", ""});

@@ -192,9 +192,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::vector<MachineId> targets;
-  for (int k = 0; k < components; ++k) targets.push_back(*co.find_machine("C" + std::to_string(k) + ".s_A"));
-  const EventId onset = *co.find_event("EVT_FAULT");
-  const EventId completion = *co.find_event("/EVT_FAULT");
+  for (int k = 0; k < components; ++k)
+    targets.push_back(*co.structure().find_machine("C" + std::to_string(k) + ".s_A"));
+  const EventId onset = *co.structure().find_event("EVT_FAULT");
+  const EventId completion = *co.structure().find_event("/EVT_FAULT");
   const auto period = std::chrono::nanoseconds(static_cast<std::int64_t>(1e9 / rate));
   bool raised = false;
   auto cycle = [&] {

@@ -159,7 +159,7 @@ std::string_view Coordinator::text_of(std::uint32_t text) const {
     case kTextNotActive: return ConditionSet::kIgnoredNotActive;
     case kTextLatched: return ConditionSet::kIgnoredLatched;
     case kTextNoLongerReported: return "no longer reported by the provider";
-    default: return name_of(NameId{text});
+    default: return structure_.name_of(NameId{text});
   }
 }
 
@@ -191,7 +191,7 @@ Record Coordinator::decode(const StoredRecord& s) const {
 // ---- construction and configuration ----------------------------------------------------------
 
 Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOptions options)
-    : name_(std::move(name)), clock_(clock), options_(options) {
+    : structure_(std::move(name)), clock_(clock), options_(options) {
   if (clock_ == nullptr) {
     owned_clock_ = std::make_unique<SteadyClock>();
     clock_ = owned_clock_.get();
@@ -211,19 +211,19 @@ Coordinator::Coordinator(std::string name, const Clock* clock, CoordinatorOption
     completion.completes = spec.name;
     completion.counterpart = onset_id;
     const EventId completion_id = add_event_unchecked(std::move(completion));
-    events_[to_index(onset_id)].counterpart = completion_id;
+    structure_.events_[to_index(onset_id)].counterpart = completion_id;
   }
-  SAFECASS_ASSERT(events_.size() == framework_event::kCount);
+  SAFECASS_ASSERT(structure_.events_.size() == framework_event::kCount);
 }
 
 Coordinator::~Coordinator() = default;
 
 EventId Coordinator::add_event_unchecked(Event event) {
-  event.id = id_at<EventId>(events_.size());
-  event_index_.emplace(event.name, event.id);
-  events_.push_back(std::move(event));
-  event_table_.push_back(&events_.back());  // deque elements never move
-  return events_.back().id;
+  event.id = id_at<EventId>(structure_.events_.size());
+  structure_.event_index_.emplace(event.name, event.id);
+  structure_.events_.push_back(std::move(event));
+  structure_.event_table_.push_back(&structure_.events_.back());  // deque elements never move
+  return structure_.events_.back().id;
 }
 
 Expected<ComponentId> Coordinator::add_component(std::string_view name) {
@@ -231,7 +231,7 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
     return fail(ErrorCode::InvalidArgument,
                 "component name '" + std::string(name) + "' must be non-empty, without dots or spaces");
   }
-  if (find_component(name)) {
+  if (structure_.find_component(name)) {
     return fail(ErrorCode::Duplicate, "duplicate component '" + std::string(name) + "'");
   }
   if (name == "SYSTEM") {
@@ -239,23 +239,26 @@ Expected<ComponentId> Coordinator::add_component(std::string_view name) {
                 "component name 'SYSTEM' is reserved: it is the address of the whole system");
   }
   const auto id = id_at<ComponentId>(components_.size());
+  Structure::Component& shape = structure_.components_.emplace_back();
+  shape.name = std::string(name);
   ComponentData& cd = components_.emplace_back();
-  cd.name = std::string(name);
   cd.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   size_history();
-  component_index_.emplace(std::string(name), id);
-  cd.framework = add_machine(id, MachineKind::Framework, kNone, address::framework(cd.name));
-  cd.application = add_machine(id, MachineKind::Application, kNone, address::application(cd.name));
+  structure_.component_index_.emplace(std::string(name), id);
+  shape.framework = add_machine(id, MachineKind::Framework, kNone, address::framework(shape.name));
+  shape.application = add_machine(id, MachineKind::Application, kNone, address::application(shape.name));
   cd.machine_state_count[index(State::Normal)] = 2;
   return id;
 }
 
 MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address) {
+  Structure::Machine& shape = structure_.machines_.emplace_back();
+  shape.kind = kind;
+  shape.component = component;
+  shape.iface = iface;
+  shape.address = std::move(address);
   MachineData& m = machines_.emplace_back();
-  m.kind = kind;
   m.component = component;
-  m.iface = iface;
-  m.address = std::move(address);
   m.snapshot.store(pack(StateSnapshot{}), std::memory_order_relaxed);
   const auto id = id_at<MachineId>(machines_.size() - 1);
   ComponentData& c = components_[component];
@@ -276,7 +279,7 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
 Expected<std::string> Coordinator::new_interface(ComponentId component, std::string_view name, MachineKind kind) const {
   if (!components_.contains(component))
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
-  const ComponentData& c = components_[component];
+  const Structure::Component& c = structure_.components_[component];
   if (!valid_name(name)) {
     return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
                                                 "' must be non-empty, without dots or spaces");
@@ -284,7 +287,7 @@ Expected<std::string> Coordinator::new_interface(ComponentId component, std::str
   const bool provided = kind == MachineKind::Provided;
   std::string address = provided ? address::provided(c.name, name) : address::required(c.name, name);
   for (MachineId m : provided ? c.provided : c.required) {
-    if (machines_[m].address == address) {
+    if (structure_.machines_[m].address == address) {
       return fail(ErrorCode::Duplicate, std::string("duplicate ") + (provided ? "provided" : "required") +
                                             " interface '" + std::string(name) + "' in component '" + c.name + "'");
     }
@@ -295,12 +298,12 @@ Expected<std::string> Coordinator::new_interface(ComponentId component, std::str
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
   auto address = new_interface(component, name, MachineKind::Provided);
   if (!address) return tl::unexpected(address.error());
-  ComponentData& c = components_[component];
-  const auto iface = static_cast<std::uint32_t>(c.provided.size());
+  Structure::Component& shape = structure_.components_[component];
+  const auto iface = static_cast<std::uint32_t>(shape.provided.size());
   const MachineId id = add_machine(component, MachineKind::Provided, iface, std::move(*address));
-  c.provided.push_back(id);
-  c.services.push_back(ServiceData{});
-  ++c.machine_state_count[index(State::Normal)];
+  shape.provided.push_back(id);
+  shape.services.emplace_back();
+  ++components_[component].machine_state_count[index(State::Normal)];
   rebuild_fanout(component);
   return id;
 }
@@ -308,12 +311,12 @@ Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
   auto address = new_interface(component, name, MachineKind::Required);
   if (!address) return tl::unexpected(address.error());
-  ComponentData& c = components_[component];
-  const auto iface = static_cast<std::uint32_t>(c.required.size());
+  Structure::Component& shape = structure_.components_[component];
+  const auto iface = static_cast<std::uint32_t>(shape.required.size());
   const MachineId id = add_machine(component, MachineKind::Required, iface, std::move(*address));
-  c.required.push_back(id);
-  c.required_connection.push_back(kNoConnection);
-  ++c.machine_state_count[index(State::Normal)];
+  shape.required.push_back(id);
+  shape.required_connection.push_back(kNoConnection);
+  ++components_[component].machine_state_count[index(State::Normal)];
   rebuild_fanout(component);
   return id;
 }
@@ -321,7 +324,7 @@ Expected<MachineId> Coordinator::add_required(ComponentId component, std::string
 Expected<EventId> Coordinator::add_event(const EventDef& def) {
   const std::string where = "event '" + def.name + "'";
   if (def.name.empty()) return fail(ErrorCode::InvalidArgument, "an event needs a name");
-  if (find_event(def.name)) return fail(ErrorCode::Duplicate, "duplicate " + where);
+  if (structure_.find_event(def.name)) return fail(ErrorCode::Duplicate, "duplicate " + where);
   if (def.severity < kMinSeverity || def.severity > kMaxSeverity) {
     return fail(ErrorCode::InvalidArgument, where + ": severity " + std::to_string(def.severity) + " is outside 1-255");
   }
@@ -344,9 +347,9 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
       return fail(ErrorCode::InvalidArgument, where + ": only a completion may say which onset it 'completes'");
     }
     // A completion defined earlier may be waiting for this onset.
-    for (Event& other : events_) {
+    for (Event& other : structure_.events_) {
       if (!other.is_onset && other.counterpart == kNoEvent && other.completes == def.name) {
-        other.counterpart = id_at<EventId>(events_.size());
+        other.counterpart = id_at<EventId>(structure_.events_.size());
         e.counterpart = other.id;
       }
     }
@@ -360,13 +363,13 @@ Expected<EventId> Coordinator::add_event(const EventDef& def) {
       }
       e.completes = def.name.substr(1);
     }
-    if (auto o = find_event(e.completes)) {
-      Event& target = events_[to_index(*o)];
+    if (auto o = structure_.find_event(e.completes)) {
+      Event& target = structure_.events_[to_index(*o)];
       if (!target.is_onset) {
         return fail(ErrorCode::InvalidArgument, where + ": completes '" + e.completes + "', which is not an onset");
       }
       e.counterpart = *o;
-      if (target.counterpart == kNoEvent) target.counterpart = id_at<EventId>(events_.size());
+      if (target.counterpart == kNoEvent) target.counterpart = id_at<EventId>(structure_.events_.size());
     }
   }
   return add_event_unchecked(std::move(e));
@@ -376,10 +379,10 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
                                         const ServiceDependency& dependency) {
   if (!components_.contains(component))
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
-  ComponentData& c = components_[component];
+  Structure::Component& c = structure_.components_[component];
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < c.provided.size(); ++i) {
-    if (interface_name(c.provided[i]) == provided) p = i;
+    if (structure_.interface_name(c.provided[i]) == provided) p = i;
   }
   if (p == kNone) {
     return fail(ErrorCode::NotFound, "service '" + std::string(provided) + "' of component '" + c.name +
@@ -389,13 +392,13 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
     return fail(ErrorCode::InvalidArgument,
                 "service '" + c.name + "." + std::string(provided) + "': propagate must be Warning or Error");
   }
-  ServiceData data;
+  Structure::Service data;
   data.dependency = dependency;
   if (!dependency.all_required) {
     for (const std::string& r : dependency.required) {
       std::uint32_t found = kNone;
       for (std::uint32_t i = 0; i < c.required.size(); ++i) {
-        if (interface_name(c.required[i]) == r) found = i;
+        if (structure_.interface_name(c.required[i]) == r) found = i;
       }
       if (found == kNone) {
         return fail(ErrorCode::NotFound, "service '" + c.name + "." + std::string(provided) +
@@ -406,7 +409,7 @@ Expected<void> Coordinator::set_service(ComponentId component, std::string_view 
   }
   const std::lock_guard lock(mutex_);
   // Only conditions on this component's own machines can flow through its services.
-  for (MachineId id : component_machines(c)) {
+  for (MachineId id : structure_.machines_of(component)) {
     if (!machines_[id].conditions.empty()) {
       return fail(ErrorCode::InvalidState, "service '" + c.name + "." + std::string(provided) +
                                                "': dependencies cannot change while conditions are active");
@@ -425,7 +428,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
       return fail(ErrorCode::InvalidArgument,
                   std::string(role) + " '" + std::string(text) + "' must be written Component.Interface");
     }
-    auto comp = find_component(text.substr(0, dot));
+    auto comp = structure_.find_component(text.substr(0, dot));
     if (!comp) {
       return fail(ErrorCode::NotFound, std::string(role) + " '" + std::string(text) + "': no component '" +
                                            std::string(text.substr(0, dot)) + "'");
@@ -436,11 +439,11 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   if (!client) return tl::unexpected(client.error());
   auto provider = split(provider_provided, "provided interface");
   if (!provider) return tl::unexpected(provider.error());
-  ComponentData& cc = components_[client->first];
-  ComponentData& pc = components_[provider->first];
+  Structure::Component& cc = structure_.components_[client->first];
+  Structure::Component& pc = structure_.components_[provider->first];
   std::uint32_t r = kNone;
   for (std::uint32_t i = 0; i < cc.required.size(); ++i) {
-    if (interface_name(cc.required[i]) == client->second) r = i;
+    if (structure_.interface_name(cc.required[i]) == client->second) r = i;
   }
   if (r == kNone) {
     return fail(ErrorCode::NotFound, "connection " + std::string(client_required) + " -> " +
@@ -449,7 +452,7 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   }
   std::uint32_t p = kNone;
   for (std::uint32_t i = 0; i < pc.provided.size(); ++i) {
-    if (interface_name(pc.provided[i]) == provider->second) p = i;
+    if (structure_.interface_name(pc.provided[i]) == provider->second) p = i;
   }
   if (p == kNone) {
     return fail(ErrorCode::NotFound, "connection " + std::string(client_required) + " -> " +
@@ -466,22 +469,23 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
                                              std::string(provider_provided) + ": made from a callback or observer");
   }
   if (cc.required_connection[r] != kNoConnection) {
-    const Connection& old = connections_[to_index(cc.required_connection[r])];
+    const Connection& old = structure_.connections_[to_index(cc.required_connection[r])];
     return fail(ErrorCode::Duplicate,
                 "required interface " + std::string(client_required) + " is already connected to " +
-                    components_[old.provider].name + "." +
-                    std::string(interface_name(components_[old.provider].provided[old.provided])));
+                    std::string(structure_.component_name(old.provider)) + "." +
+                    std::string(structure_.interface_name(structure_.provided_machines(old.provider)[old.provided])));
   }
   std::unique_lock lock(mutex_);
-  const auto id = id_at<ConnectionId>(connections_.size());
-  connections_.push_back(Connection{client->first, r, provider->first, p});
+  const auto id = id_at<ConnectionId>(structure_.connections_.size());
+  structure_.connections_.push_back(Connection{client->first, r, provider->first, p});
   cc.required_connection[r] = id;
   pc.provider_connections.push_back(id);
   rebuild_fanout(provider->first);
   // A connection made while faults are active carries them at once (mirrors are defined by
   // reachability). Whatever it carries is active at one of the provider's machines: when they
   // are all Normal there is nothing to carry (the common case while a system is being built).
-  if (pc.machine_state_count[index(State::Normal)] == component_machines(pc).size()) return id;
+  const ComponentData& provider_state = components_[provider->first];
+  if (provider_state.machine_state_count[index(State::Normal)] == provider_state.machine_count) return id;
   for (MachineId m : id_range<MachineId>(machines_.size())) {
     const std::vector<Condition> snapshot(machines_[m].conditions.begin(), machines_[m].conditions.end());
     for (const Condition& c : snapshot) {
@@ -495,16 +499,18 @@ Expected<ConnectionId> Coordinator::connect(std::string_view client_required, st
   return id;
 }
 
-bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept {
+bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, MachineId id) const noexcept {
+  const Structure::Machine& m = structure_.machines_[id];
   if (m.component != component) return false;
-  const ServiceDependency& d = components_[component].services[provided].dependency;
+  const Structure::Service& service = structure_.components_[component].services[provided];
+  const ServiceDependency& d = service.dependency;
   switch (m.kind) {
     case MachineKind::Framework: return d.framework;
     case MachineKind::Application: return d.application;
     case MachineKind::Provided: return m.iface == provided;
     case MachineKind::Required: {
       if (d.all_required) return true;
-      const auto& req = components_[component].services[provided].required;
+      const auto& req = service.required;
       return std::find(req.begin(), req.end(), m.iface) != req.end();
     }
   }
@@ -512,147 +518,26 @@ bool Coordinator::depends_on(ComponentId component, std::uint32_t provided, cons
 }
 
 void Coordinator::rebuild_fanout(ComponentId provider_id) {
-  const ComponentData& provider = components_[provider_id];
-  const std::vector<MachineId> machines = component_machines(provider);
+  const Structure::Component& provider = structure_.components_[provider_id];
+  const std::vector<MachineId> machines = structure_.machines_of(provider_id);
   for (MachineId m : machines) machines_[m].fanout.clear();
   for (ConnectionId k : provider.provider_connections) {
-    const Connection& conn = connections_[to_index(k)];
-    const MachineId client_machine = components_[conn.client].required[conn.required];
+    const Connection& conn = structure_.connections_[to_index(k)];
+    const MachineId client_machine = structure_.components_[conn.client].required[conn.required];
     const State min_level = provider.services[conn.provided].dependency.propagate;
     for (MachineId m : machines) {
-      if (depends_on(conn.provider, conn.provided, machines_[m])) {
+      if (depends_on(conn.provider, conn.provided, m)) {
         machines_[m].fanout.push_back(Edge{client_machine, min_level, k});
       }
     }
   }
 }
 
-std::vector<MachineId> Coordinator::component_machines(const ComponentData& c) {
-  std::vector<MachineId> out{c.framework, c.application};
-  out.insert(out.end(), c.provided.begin(), c.provided.end());
-  out.insert(out.end(), c.required.begin(), c.required.end());
-  return out;
-}
-
-// ---- lookup ----------------------------------------------------------------------------------
-
-Expected<ComponentId> Coordinator::find_component(std::string_view name) const {
-  if (const auto it = component_index_.find(name); it != component_index_.end()) return it->second;
-  return fail(ErrorCode::NotFound, "no component '" + std::string(name) + "'");
-}
-
-Expected<EventId> Coordinator::find_event(std::string_view name) const {
-  if (const auto it = event_index_.find(name); it != event_index_.end()) return it->second;
-  return fail(ErrorCode::NotFound, "no event '" + std::string(name) + "'");
-}
-
-Expected<Address> Coordinator::resolve(std::string_view text) const {
-  Address a;
-  // SYSTEM, or the coordinator's own name when no component has that name.
-  if (text == "SYSTEM" || (text == name_ && !find_component(text))) return a;
-  const auto dot = text.find('.');
-  auto comp = find_component(text.substr(0, dot));
-  if (!comp)
-    return fail(ErrorCode::NotFound,
-                "address '" + std::string(text) + "': no component '" + std::string(text.substr(0, dot)) + "'");
-  a.component = *comp;
-  const ComponentData& c = components_[*comp];
-  if (dot == std::string_view::npos) {
-    a.kind = Address::Kind::Component;
-    return a;
-  }
-  const std::string_view rest = text.substr(dot + 1);
-  a.kind = Address::Kind::Machine;
-  if (rest == "s_F") {
-    a.machine = c.framework;
-    return a;
-  }
-  if (rest == "s_A") {
-    a.machine = c.application;
-    return a;
-  }
-  const auto dot2 = rest.find('.');
-  const std::string_view kind = rest.substr(0, dot2);
-  if (dot2 == std::string_view::npos || (kind != "s_P" && kind != "s_R" && kind != "s_S")) {
-    return fail(ErrorCode::Parse,
-                "address '" + std::string(text) + "': expected C, C.s_F, C.s_A, C.s_P.p, C.s_R.r, C.s_S.p or SYSTEM");
-  }
-  const std::string_view iface = rest.substr(dot2 + 1);
-  const auto& list = kind == "s_R" ? c.required : c.provided;
-  for (std::uint32_t i = 0; i < list.size(); ++i) {
-    if (interface_name(list[i]) == iface) {
-      if (kind == "s_S") {
-        a.kind = Address::Kind::Service;
-        a.service = i;
-      } else {
-        a.machine = list[i];
-      }
-      return a;
-    }
-  }
-  return fail(ErrorCode::NotFound, "address '" + std::string(text) + "': component '" + c.name + "' has no " +
-                                       (kind == "s_R" ? "required" : "provided") + " interface '" + std::string(iface) +
-                                       "'");
-}
-
-Expected<MachineId> Coordinator::find_machine(std::string_view address) const {
-  auto a = resolve(address);
-  if (!a) return tl::unexpected(a.error());
-  if (a->kind != Address::Kind::Machine) {
-    return fail(ErrorCode::InvalidArgument,
-                "address '" + std::string(address) + "' is not a state machine (use C.s_F, C.s_A, C.s_P.p or C.s_R.r)");
-  }
-  return a->machine;
-}
-
-std::string_view Coordinator::component_name(ComponentId id) const noexcept { return components_[id].name; }
-MachineId Coordinator::framework_machine(ComponentId id) const noexcept { return components_[id].framework; }
-MachineId Coordinator::application_machine(ComponentId id) const noexcept { return components_[id].application; }
-const std::vector<MachineId>& Coordinator::provided_machines(ComponentId id) const noexcept {
-  return components_[id].provided;
-}
-const std::vector<MachineId>& Coordinator::required_machines(ComponentId id) const noexcept {
-  return components_[id].required;
-}
-MachineKind Coordinator::machine_kind(MachineId id) const noexcept { return machines_[id].kind; }
-ComponentId Coordinator::machine_component(MachineId id) const noexcept { return machines_[id].component; }
-const std::string& Coordinator::address_of(MachineId id) const noexcept { return machines_[id].address; }
-
-std::string_view Coordinator::interface_name(MachineId id) const noexcept {
-  const MachineData& m = machines_[id];
-  switch (m.kind) {
-    case MachineKind::Framework: return "s_F";
-    case MachineKind::Application: return "s_A";
-    case MachineKind::Provided:
-    case MachineKind::Required: break;
-  }
-  const std::string_view a = m.address;
-  return a.substr(a.rfind('.') + 1);
-}
-
-const ServiceDependency& Coordinator::service(ComponentId component, std::uint32_t provided) const noexcept {
-  return components_[component].services[provided].dependency;
-}
-
-NameId Coordinator::intern(std::string_view text) {
-  std::lock_guard lock(names_mutex_);
-  if (const auto it = name_index_.find(text); it != name_index_.end()) return it->second;
-  const auto id = id_at<NameId>(names_.size());
-  name_index_.emplace(std::string_view(names_.emplace_back(text)), id);
-  return id;
-}
-
-std::string_view Coordinator::name_of(NameId id) const {
-  std::lock_guard lock(names_mutex_);
-  if (to_index(id) >= names_.size()) return {};
-  return names_[to_index(id)];
-}
-
 // ---- reads -----------------------------------------------------------------------------------
 
 State Coordinator::service_state(ComponentId component, std::uint32_t provided) const noexcept {
-  const ComponentData& c = components_[component];
-  const ServiceData& s = c.services[provided];
+  const Structure::Component& c = structure_.components_[component];
+  const Structure::Service& s = c.services[provided];
   State st = state(c.provided[provided]);
   if (s.dependency.framework) st = st * state(c.framework);
   if (s.dependency.application) st = st * state(c.application);
@@ -667,7 +552,7 @@ State Coordinator::service_state(ComponentId component, std::uint32_t provided) 
 State Coordinator::coordinator_state() const noexcept {
   State s = State::Normal;
   for (ComponentId c : id_range<ComponentId>(components_.size())) {
-    if (!components_[c].remote) s = s * extended_state(c);
+    if (!structure_.components_[c].remote) s = s * extended(c).state;
   }
   return s;
 }
@@ -675,7 +560,7 @@ State Coordinator::coordinator_state() const noexcept {
 State Coordinator::state_of(const Address& a) const noexcept {
   switch (a.kind) {
     case Address::Kind::System: return coordinator_state();
-    case Address::Kind::Component: return extended_state(a.component);
+    case Address::Kind::Component: return extended(a.component).state;
     case Address::Kind::Machine: return state(a.machine);
     case Address::Kind::Service: return service_state(a.component, a.service);
   }
@@ -846,7 +731,7 @@ void Coordinator::apply_registrations() noexcept {
 
 void Coordinator::publish(Record record) {
   // Queued or not, the record's text must outlive the caller's: the interned copy does.
-  if (!record.text.empty()) record.text = name_of(intern(record.text));
+  if (!record.text.empty()) record.text = structure_.name_of(intern(record.text));
   Pending op;
   op.kind = PendingKind::Publish;
   op.record = record;
@@ -862,8 +747,8 @@ void Coordinator::record(Record& r, std::uint32_t text) noexcept {
 // ---- writes ----------------------------------------------------------------------------------
 
 void Coordinator::generate(EventId event, MachineId target, const SampleCause& cause) noexcept {
-  SAFECASS_ASSERT(to_index(event) < event_table_.size());
-  SAFECASS_ASSERT(machines_.contains(target) || event_table_[to_index(event)]->is_broadcast());
+  SAFECASS_ASSERT(to_index(event) < structure_.event_table_.size());
+  SAFECASS_ASSERT(machines_.contains(target) || structure_.event_table_[to_index(event)]->is_broadcast());
   if (delivering_here()) {
     Pending op;
     op.event = event;
@@ -1001,66 +886,10 @@ void Coordinator::fire(const Delivery& d, Requests& queue) noexcept {
       // §2.5: monitoring never crashes the monitored system; the fault becomes a framework event.
       Pending op;
       op.event = framework_event::kCallbackException;
-      op.machine = components_[r.component].framework;
+      op.machine = structure_.components_[r.component].framework;
       queue.push(op);
     }
   }
-}
-
-[[nodiscard]] Expected<GenerateTarget> resolve_generate(const Coordinator& co, std::string_view event,
-                                                        std::string_view target) {
-  auto e = co.find_event(event);
-  if (!e) return tl::unexpected(e.error());
-  const Event& ev = co.event(*e);
-  if (!ev.is_onset && ev.counterpart == kNoEvent) {
-    return fail(ErrorCode::InvalidState,
-                "event '" + ev.name + "' completes '" + ev.completes + "', which is not defined");
-  }
-  if (ev.is_broadcast()) return GenerateTarget{*e, kNoMachine};
-  auto m = co.find_machine(target);
-  if (!m) return tl::unexpected(m.error());
-  return GenerateTarget{*e, *m};
-}
-
-[[nodiscard]] Expected<EventId> resolve_broadcast(const Coordinator& co, std::string_view event) {
-  auto e = co.find_event(event);
-  if (!e) return tl::unexpected(e.error());
-  if (const Event& ev = co.event(*e); !ev.is_broadcast()) {
-    return fail(ErrorCode::InvalidArgument, "event '" + std::string(event) + "' has severity " +
-                                                std::to_string(ev.severity) + "; broadcasts need severity 251-255");
-  }
-  return *e;
-}
-
-[[nodiscard]] Expected<Address> resolve_reset(const Coordinator& co, std::string_view target) {
-  auto a = co.resolve(target);
-  if (!a) return tl::unexpected(a.error());
-  if (a->kind == Address::Kind::Service) {
-    return fail(ErrorCode::InvalidArgument, "cannot reset service state '" + std::string(target) +
-                                                "': it is derived; reset its component or a machine");
-  }
-  return *a;
-}
-
-Expected<void> Coordinator::generate(std::string_view event, std::string_view target) {
-  auto t = resolve_generate(*this, event, target);
-  if (!t) return tl::unexpected(t.error());
-  generate(t->event, t->machine);
-  return {};
-}
-
-Expected<void> Coordinator::broadcast(std::string_view event) {
-  auto e = resolve_broadcast(*this, event);
-  if (!e) return tl::unexpected(e.error());
-  generate(*e, kNoMachine);
-  return {};
-}
-
-Expected<void> Coordinator::reset(std::string_view target, std::string_view who, std::string_view why) {
-  auto a = resolve_reset(*this, target);
-  if (!a) return tl::unexpected(a.error());
-  reset(*a, who, why);
-  return {};
 }
 
 void Coordinator::reset(const Address& target, std::string_view who, std::string_view why) {
@@ -1094,14 +923,14 @@ void Coordinator::run(const Pending& op) noexcept {
 }
 
 void Coordinator::process(EventId event_id, MachineId target, const SampleCause& cause) noexcept {
-  const Event& event = *event_table_[to_index(event_id)];
+  const Event& event = *structure_.event_table_[to_index(event_id)];
   const Time now = clock_->now();
   if (event.is_broadcast()) {
     for (ComponentId c : id_range<ComponentId>(components_.size())) {
       if (event.is_onset) {
-        process_onset(event, components_[c].application, cause, now);
+        process_onset(event, structure_.components_[c].application, cause, now);
       } else {
-        process_completion(event, components_[c].application, now);
+        process_completion(event, structure_.components_[c].application, now);
       }
     }
     return;
@@ -1125,7 +954,7 @@ void Coordinator::process_onset(const Event& event, MachineId target, const Samp
 
 void Coordinator::process_completion(const Event& event, MachineId target, Time now) noexcept {
   MachineData& m = machines_[target];
-  const Event* onset = event.counterpart == kNoEvent ? nullptr : event_table_[to_index(event.counterpart)];
+  const Event* onset = event.counterpart == kNoEvent ? nullptr : structure_.event_table_[to_index(event.counterpart)];
   const ConditionChange change = m.conditions.complete(onset);
   if (change.outcome == Outcome::Ignored) {
     Record r;
@@ -1251,10 +1080,11 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
   if (c.contiguous) {
     for (MachineId m : id_range(c.first_machine, to_index(c.first_machine) + c.machine_count)) consider(m);
   } else {
-    consider(c.framework);
-    consider(c.application);
-    for (MachineId p : c.provided) consider(p);
-    for (MachineId r : c.required) consider(r);
+    const Structure::Component& shape = structure_.components_[id];
+    consider(shape.framework);
+    consider(shape.application);
+    for (MachineId p : shape.provided) consider(p);
+    for (MachineId r : shape.required) consider(r);
   }
   c.outstanding = best == nullptr ? kNoEvent : best->event;
   c.snapshot.store(pack(StateSnapshot{c.state, c.outstanding}), std::memory_order_release);
@@ -1296,7 +1126,7 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
       Condition c;
       c.event = mirror_event;
       c.level = level;
-      c.severity = event_table_[to_index(mirror_event)]->severity;
+      c.severity = structure_.event_table_[to_index(mirror_event)]->severity;
       c.mirror = true;
       c.via = e.via;
       c.first = c.last = now;
@@ -1329,7 +1159,7 @@ void Coordinator::propagate_clear(const RootCause& root, State level, Time now) 
 }
 
 void Coordinator::reset_locked(const Address& target, NameId reason, Time now) noexcept {
-  const std::string_view text = name_of(reason);
+  const std::string_view text = structure_.name_of(reason);
   std::vector<MachineId> targets;
   switch (target.kind) {
     case Address::Kind::System:
@@ -1337,11 +1167,7 @@ void Coordinator::reset_locked(const Address& target, NameId reason, Time now) n
       break;
     case Address::Kind::Component:
     case Address::Kind::Service: {
-      const ComponentData& c = components_[target.component];
-      targets.push_back(c.framework);
-      targets.push_back(c.application);
-      targets.insert(targets.end(), c.provided.begin(), c.provided.end());
-      targets.insert(targets.end(), c.required.begin(), c.required.end());
+      targets = structure_.machines_of(target.component);
       break;
     }
     case Address::Kind::Machine: targets.push_back(target.machine); break;

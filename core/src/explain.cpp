@@ -8,7 +8,7 @@
 namespace safecass {
 
 std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition& condition) const {
-  if (!condition.mirror) return {machines_[holder].address};
+  if (!condition.mirror) return {structure_.address_of(holder)};
   // The shortest path of hops the condition's level passes, found by a breadth-first search from
   // the origin along the same edges propagation uses. Walking back from the holder instead can
   // circle a cycle of connections forever (every machine on the cycle holds a mirror).
@@ -29,13 +29,13 @@ std::vector<std::string> Coordinator::hop_path(MachineId holder, const Condition
       queue.push_back(e.to);
     }
   }
-  std::vector<std::string> reversed{machines_[holder].address};
+  std::vector<std::string> reversed{structure_.address_of(holder)};
   for (MachineId at = holder; at != origin && parent_edge[to_index(at)] != kUnseen;) {
     const auto [from, edge] = edges[parent_edge[to_index(at)]];
-    const Connection& conn = connections_[to_index(edge->via)];
-    const ComponentData& provider = components_[conn.provider];
-    reversed.push_back(address::service(provider.name, interface_name(provider.provided[conn.provided])));
-    reversed.push_back(machines_[from].address);
+    const Connection& conn = structure_.connections_[to_index(edge->via)];
+    const MachineId provided = structure_.provided_machines(conn.provider)[conn.provided];
+    reversed.push_back(address::service(structure_.component_name(conn.provider), structure_.interface_name(provided)));
+    reversed.push_back(structure_.address_of(from));
     at = from;
   }
   std::reverse(reversed.begin(), reversed.end());
@@ -61,8 +61,8 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
   std::vector<Explanation> out;
   for (const Condition* c : sorted) {
     Explanation e;
-    e.machine = m.address;
-    e.event = events_[to_index(c->event)].name;
+    e.machine = structure_.address_of(id);
+    e.event = structure_.event(c->event).name;
     e.level = c->level;
     e.severity = c->severity;
     e.mirror = c->mirror;
@@ -71,7 +71,7 @@ std::vector<Explanation> Coordinator::explain_machine(MachineId id) const {
     e.first = c->first;
     e.last = c->last;
     e.root = resolve_root(c->root);
-    e.hazard = events_[to_index(c->root.event)].hazard;
+    e.hazard = structure_.event(c->root.event).hazard;
     e.path = hop_path(id, *c);
     out.push_back(std::move(e));
   }
@@ -85,25 +85,12 @@ std::vector<Explanation> Coordinator::explain(const Address& address) const {
     case Address::Kind::System:
       for (MachineId m : id_range<MachineId>(machines_.size())) machines.push_back(m);
       break;
-    case Address::Kind::Component: {
-      const ComponentData& c = components_[address.component];
-      machines.push_back(c.framework);
-      machines.push_back(c.application);
-      machines.insert(machines.end(), c.provided.begin(), c.provided.end());
-      machines.insert(machines.end(), c.required.begin(), c.required.end());
-      break;
-    }
-    case Address::Kind::Service: {
-      const ComponentData& c = components_[address.component];
-      for (MachineId m : {c.framework, c.application}) {
-        if (depends_on(address.component, address.service, machines_[m])) machines.push_back(m);
-      }
-      machines.push_back(c.provided[address.service]);
-      for (MachineId m : c.required) {
-        if (depends_on(address.component, address.service, machines_[m])) machines.push_back(m);
+    case Address::Kind::Component: machines = structure_.machines_of(address.component); break;
+    case Address::Kind::Service:
+      for (MachineId m : structure_.machines_of(address.component)) {
+        if (depends_on(address.component, address.service, m)) machines.push_back(m);
       }
       break;
-    }
     case Address::Kind::Machine: machines.push_back(address.machine); break;
   }
   std::vector<Explanation> out;
@@ -112,12 +99,6 @@ std::vector<Explanation> Coordinator::explain(const Address& address) const {
     out.insert(out.end(), std::make_move_iterator(part.begin()), std::make_move_iterator(part.end()));
   }
   return out;
-}
-
-Expected<std::vector<Explanation>> Coordinator::explain(std::string_view address) const {
-  auto a = resolve(address);
-  if (!a) return tl::unexpected(a.error());
-  return explain(*a);
 }
 
 }  // namespace safecass

@@ -24,8 +24,8 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   const std::string_view component = provider_provided.substr(0, dot);
   const std::string_view iface = provider_provided.substr(dot + 1);
   ComponentId id = kNoComponent;
-  if (auto found = find_component(component)) {
-    if (!components_[*found].remote) {
+  if (auto found = structure_.find_component(component)) {
+    if (!structure_.components_[*found].remote) {
       return fail(ErrorCode::Duplicate, "remote provided interface '" + text + "': component '" +
                                             std::string(component) + "' runs in this process");
     }
@@ -34,7 +34,7 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
     auto added = add_component(component);
     if (!added) return tl::unexpected(added.error());
     id = *added;
-    components_[id].remote = true;
+    structure_.components_[id].remote = true;
   }
   auto machine = add_provided(id, iface);
   if (!machine) return tl::unexpected(machine.error());
@@ -44,25 +44,21 @@ Expected<MachineId> Coordinator::add_remote_provided(std::string_view provider_p
   return *machine;
 }
 
-bool Coordinator::is_remote(ComponentId id) const noexcept {
-  return components_.contains(id) && components_[id].remote;
-}
-
 ResolvedRoot Coordinator::resolve_root(const RootCause& root) const {
   ResolvedRoot r;
-  if (root.event == kNoEvent || to_index(root.event) >= events_.size()) return r;
-  r.event = events_[to_index(root.event)].name;
+  if (root.event == kNoEvent || to_index(root.event) >= structure_.event_count()) return r;
+  r.event = structure_.event(root.event).name;
   // A root from another process names its origin there (interned when it arrived), not the local
   // stand-in it came through; the name is kept by value, so it outlives the root's remote slot.
   if (root.remote_origin != kNoName) {
-    r.origin = std::string(name_of(root.remote_origin));
+    r.origin = std::string(structure_.name_of(root.remote_origin));
   } else if (machines_.contains(root.origin)) {
-    r.origin = machines_[root.origin].address;
+    r.origin = structure_.address_of(root.origin);
   }
   r.time = root.time;
-  if (root.sample.filter != kNoName) r.filter = std::string(name_of(root.sample.filter));
+  if (root.sample.filter != kNoName) r.filter = std::string(structure_.name_of(root.sample.filter));
   if (root.sample.signal != kNoName) {
-    r.signal = std::string(name_of(root.sample.signal));
+    r.signal = std::string(structure_.name_of(root.sample.signal));
     r.value = root.sample.value;
     r.sample_time = root.sample.sample_time;
   }
@@ -71,12 +67,12 @@ ResolvedRoot Coordinator::resolve_root(const RootCause& root) const {
 }
 
 Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std::vector<RemoteRoot>& roots) {
-  if (!machines_.contains(proxy) || machines_[proxy].kind != MachineKind::Provided ||
-      !components_[machines_[proxy].component].remote) {
+  if (!machines_.contains(proxy) || structure_.machine_kind(proxy) != MachineKind::Provided ||
+      !structure_.is_remote(structure_.machine_component(proxy))) {
     return fail(ErrorCode::NotFound,
                 "machine " + std::to_string(to_index(proxy)) + " is not a remote provided interface");
   }
-  const std::string& where = machines_[proxy].address;
+  const std::string& where = structure_.address_of(proxy);
   // Check everything before changing anything.
   std::vector<EventId> ids;
   ids.reserve(roots.size());
@@ -84,9 +80,9 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     const ResolvedRoot& r = roots[i].root;
     const std::string what =
         "update of " + where + ", root " + std::to_string(i) + " ('" + r.event + "' at '" + r.origin + "')";
-    auto e = find_event(r.event);
+    auto e = structure_.find_event(r.event);
     if (!e) return fail(ErrorCode::InvalidArgument, what + ": no event '" + r.event + "' in this system");
-    if (!events_[to_index(*e)].is_onset)
+    if (!structure_.event(*e).is_onset)
       return fail(ErrorCode::InvalidArgument, what + ": '" + r.event + "' is not an onset");
     if (roots[i].level == State::Normal)
       return fail(ErrorCode::InvalidArgument, what + ": level Normal is not a condition");
@@ -120,7 +116,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
   std::vector<bool> wanted(roots.size(), true);
   for (std::size_t i = 0; i < roots.size(); ++i) {
     for (const Edge& e : m.fanout) {
-      const std::string& receiver = machines_[e.to].address;
+      const std::string& receiver = structure_.address_of(e.to);
       if (std::find(roots[i].path.begin(), roots[i].path.end(), receiver) != roots[i].path.end()) {
         wanted[i] = false;
         ++result.dropped;
@@ -177,7 +173,7 @@ Expected<RemoteApplyResult> Coordinator::apply_remote(MachineId proxy, const std
     Condition c;
     c.event = mirror_event;
     c.level = roots[i].level;
-    c.severity = event_table_[to_index(mirror_event)]->severity;
+    c.severity = structure_.event(mirror_event).severity;
     c.mirror = true;
     c.first = c.last = now;
     c.seq = ++condition_seq_;
@@ -201,8 +197,7 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
   // straight from the conditions: no Explanation (machine, event and hazard texts) per condition.
   const std::lock_guard lock(mutex_);
   std::vector<RemoteRoot> out;
-  if (!components_.contains(component) || service >= components_[component].provided.size()) return out;
-  const ComponentData& c = components_[component];
+  if (!components_.contains(component) || service >= structure_.provided_machines(component).size()) return out;
   std::vector<EventId> ids;  // out[i]'s root event, compared by id rather than by name
   std::vector<const Condition*> sorted;
   auto visit = [&](MachineId id) {
@@ -218,7 +213,7 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
     });
     for (const Condition* k : sorted) {
       const bool remote = k->root.remote != kNone && k->root.remote < remote_roots_.size();
-      const std::string& origin = remote ? remote_roots_[k->root.remote].origin : machines_[k->root.origin].address;
+      const std::string& origin = remote ? remote_roots_[k->root.remote].origin : structure_.address_of(k->root.origin);
       std::size_t i = 0;
       while (i < out.size() &&
              !(ids[i] == k->root.event && out[i].root.time == k->root.time && out[i].root.origin == origin))
@@ -236,12 +231,8 @@ std::vector<RemoteRoot> Coordinator::service_roots(ComponentId component, std::u
       ids.push_back(k->root.event);
     }
   };
-  for (MachineId m : {c.framework, c.application}) {
-    if (depends_on(component, service, machines_[m])) visit(m);
-  }
-  visit(c.provided[service]);
-  for (MachineId m : c.required) {
-    if (depends_on(component, service, machines_[m])) visit(m);
+  for (MachineId m : structure_.machines_of(component)) {
+    if (depends_on(component, service, m)) visit(m);
   }
   return out;
 }

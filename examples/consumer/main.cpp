@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   }
   Coordinator& co = (*opened)->coordinator();
   Monitor& monitor = (*opened)->monitor();
-  const auto gripper = co.find_component("GRIPPER");
+  const auto gripper = co.structure().find_component("GRIPPER");
   Signal* force = monitor.signals().find("GRIPPER.Force");
   if (!gripper || force == nullptr) {
     std::fprintf(stderr, "%s: no component GRIPPER with signal Force\n", argv[1]);

@@ -32,8 +32,11 @@ int main() {
     angle->push(clock.now(), samples[i]);
     monitor.run_active(encoder, clock.now());
     std::printf("t=%d ms angle=%.2f ENCODER %s\n", i, samples[i],
-                std::string(to_string(co.extended_state(encoder))).c_str());
+                std::string(to_string(co.extended(encoder).state)).c_str());
   }
   // Frozen at samples 3-5 (Error), moving again at sample 6 (Normal).
-  return co.extended_state(encoder) == State::Normal && co.history(co.application_machine(encoder)).size() >= 2 ? 0 : 1;
+  return co.extended(encoder).state == State::Normal &&
+                 co.history(co.structure().application_machine(encoder)).size() >= 2
+             ? 0
+             : 1;
 }

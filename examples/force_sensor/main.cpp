@@ -25,13 +25,13 @@ int main(int argc, char** argv) {
   SimulatedClock& clock = *system.simulated_clock();
   Coordinator& co = system.coordinator();
   native::Runtime& runtime = system.runtime();
-  const ComponentId sensor = *co.find_component("FORCE_SENSOR");
+  const ComponentId sensor = *co.structure().find_component("FORCE_SENSOR");
   Signal* force = system.monitor().signals().find("FORCE_SENSOR.Force");
 
   co.subscribe([&co](const Record& r) {
     if (r.kind == RecordKind::ComponentTransition) {
       std::printf("t=%.3f s  FORCE_SENSOR %s -> %s (%s)\n", to_seconds(r.time), std::string(to_string(r.from)).c_str(),
-                  std::string(to_string(r.to)).c_str(), co.event(r.event).name.c_str());
+                  std::string(to_string(r.to)).c_str(), co.structure().event(r.event).name.c_str());
     }
   });
   int transitions_expected_seen = 0;
@@ -41,9 +41,9 @@ int main(int argc, char** argv) {
     const double f = ms < 300 ? ms * 0.12 : (600 - ms) * 0.12;  // 0 -> 36 N -> 0
     force->push(now, f);
     runtime.step(now);
-    if (ms == 300 && co.extended_state(sensor) == State::Error) ++transitions_expected_seen;
+    if (ms == 300 && co.extended(sensor).state == State::Error) ++transitions_expected_seen;
   }
-  const bool ok = transitions_expected_seen == 1 && co.extended_state(sensor) == State::Normal;
+  const bool ok = transitions_expected_seen == 1 && co.extended(sensor).state == State::Normal;
   std::printf("%s\n", ok ? "force limit detected at 30 N and cleared below 28 N" : "unexpected behaviour");
   return ok ? 0 : 1;
 }

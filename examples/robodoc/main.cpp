@@ -27,7 +27,7 @@ std::string secs(Time t) {
 /// CONTROL's control loop, as in the paper: one handler per extended state.
 class ControlTask {
 public:
-  explicit ControlTask(Coordinator& co) : co_(co), id_(*co.find_component("CONTROL")) {}
+  explicit ControlTask(Coordinator& co) : co_(co), id_(*co.structure().find_component("CONTROL")) {}
 
   void operator()(Time now) {
     co_.dispatch(
@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
   runner::ScenarioRunner& run = **opened;
   Coordinator& co = run.coordinator();
   ControlTask control(co);
-  (void)run.runtime().set_body(*co.find_component("CONTROL"), [&control](Time now) { control(now); });
+  (void)run.runtime().set_body(*co.structure().find_component("CONTROL"), [&control](Time now) { control(now); });
 
   std::printf("ROBODOC, simulated: JR3 force sensor and bone motion monitor -> CONTROL -> SERVO, pendant.\n");
   std::printf("Safety features: force warning 25 N and limit 30 N on JR3, bone motion 1 mm on BMM (latched),\n");
@@ -85,20 +85,21 @@ int main(int argc, char** argv) {
   // The story: every change of a component's extended state, with the reason.
   co.subscribe([&co](const Record& r) {
     if (r.kind == RecordKind::Reset && r.from != State::Normal) {
-      std::printf("%s  %s reset by %s\n", secs(r.time).c_str(), co.address_of(r.machine).c_str(),
+      std::printf("%s  %s reset by %s\n", secs(r.time).c_str(), co.structure().address_of(r.machine).c_str(),
                   std::string(r.text).c_str());
     }
     if (r.kind != RecordKind::ComponentTransition) return;
-    const std::string name(co.component_name(r.component));
+    const std::string name(co.structure().component_name(r.component));
     std::printf("%s  %-8s %s -> %s", secs(r.time).c_str(), name.c_str(), std::string(to_string(r.from)).c_str(),
                 std::string(to_string(r.to)).c_str());
     if (r.to > r.from && r.root.event != kNoEvent) {
-      std::printf("   because %s:%s", co.address_of(r.root.origin).c_str(), co.event(r.root.event).name.c_str());
+      std::printf("   because %s:%s", co.structure().address_of(r.root.origin).c_str(),
+                  co.structure().event(r.root.event).name.c_str());
       if (r.root.sample.filter != kNoName) {
-        std::printf(" (filter %s judged %s: %.2f)", std::string(co.name_of(r.root.sample.filter)).c_str(),
-                    std::string(co.name_of(r.root.sample.signal)).c_str(), r.root.sample.value);
+        std::printf(" (filter %s judged %s: %.2f)", std::string(co.structure().name_of(r.root.sample.filter)).c_str(),
+                    std::string(co.structure().name_of(r.root.sample.signal)).c_str(), r.root.sample.value);
       }
-      const std::string& hazard = co.event(r.root.event).hazard;
+      const std::string& hazard = co.structure().event(r.root.event).hazard;
       if (!hazard.empty()) std::printf(" [hazard %s]", hazard.c_str());
     }
     std::printf("\n");

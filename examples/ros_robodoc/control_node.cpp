@@ -25,7 +25,7 @@ namespace {
 class ControlLoop {
 public:
   ControlLoop(Coordinator& co, Signal* tracking, ros::Publisher command)
-      : co_(co), id_(*co.find_component("CONTROL")), tracking_(tracking), command_(std::move(command)) {}
+      : co_(co), id_(*co.structure().find_component("CONTROL")), tracking_(tracking), command_(std::move(command)) {}
 
   void operator()(Time now) {
     co_.dispatch(
@@ -98,8 +98,8 @@ int main(int argc, char** argv) {
     if (r.kind != RecordKind::ComponentTransition) return;
     std::string why;
     if (r.to > r.from && r.root.event != kNoEvent)
-      why = "  because " + co.address_of(r.root.origin) + ":" + co.event(r.root.event).name;
-    ROS_INFO("%s %s -> %s%s", std::string(co.component_name(r.component)).c_str(),
+      why = "  because " + co.structure().address_of(r.root.origin) + ":" + co.structure().event(r.root.event).name;
+    ROS_INFO("%s %s -> %s%s", std::string(co.structure().component_name(r.component)).c_str(),
              std::string(to_string(r.from)).c_str(), std::string(to_string(r.to)).c_str(), why.c_str());
   });
   if (auto r = (*bridge)->start(); !r) {

@@ -191,7 +191,7 @@ void Filter::invalid_sample(std::size_t input, const SampleView& sample, bool in
   const SampleCause cause{c.name_id, c.inputs[input]->name_id(), value, sample.time, current_injected_};
   const EventId event =
       invalid ? framework_event::kInvalidSample : framework_event::completion_of(framework_event::kInvalidSample);
-  c.coordinator->generate(event, c.coordinator->framework_machine(c.component), cause);
+  c.coordinator->generate(event, c.coordinator->structure().framework_machine(c.component), cause);
 }
 
 double Filter::number(std::string_view param) const {

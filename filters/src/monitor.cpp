@@ -31,7 +31,7 @@ Expected<Signal*> Monitor::add_signal(std::string_view name, std::size_t size) {
   if (dot == std::string_view::npos) {
     return fail(ErrorCode::InvalidArgument, "signal name '" + std::string(name) + "' must be Component.signal");
   }
-  auto component = coordinator_.find_component(name.substr(0, dot));
+  auto component = coordinator_.structure().find_component(name.substr(0, dot));
   if (!component) {
     return fail(ErrorCode::NotFound,
                 "signal '" + std::string(name) + "': no component '" + std::string(name.substr(0, dot)) + "'");
@@ -68,19 +68,19 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
   FilterInit init;
   init.coordinator = &coordinator_;
   // Target machine.
-  auto component = coordinator_.find_component(config.target.component);
+  auto component = coordinator_.structure().find_component(config.target.component);
   if (!component) {
     return fail(ErrorCode::NotFound, where + ": target component '" + config.target.component + "' not found");
   }
   init.component = *component;
   switch (config.target.kind) {
-    case MachineKind::Framework: init.target = coordinator_.framework_machine(*component); break;
-    case MachineKind::Application: init.target = coordinator_.application_machine(*component); break;
+    case MachineKind::Framework: init.target = coordinator_.structure().framework_machine(*component); break;
+    case MachineKind::Application: init.target = coordinator_.structure().application_machine(*component); break;
     case MachineKind::Provided:
     case MachineKind::Required: {
       const std::string machine =
           address::machine(config.target.kind, config.target.component, config.target.interface);
-      auto m = coordinator_.find_machine(machine);
+      auto m = coordinator_.structure().find_machine(machine);
       if (!m) return fail(ErrorCode::NotFound, where + ": target " + machine + " does not exist");
       init.target = *m;
       break;
@@ -133,7 +133,7 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
       continue;
     }
     const auto dot = full.find('.');
-    if (!coordinator_.find_component(std::string_view(full).substr(0, dot))) {
+    if (!coordinator_.structure().find_component(std::string_view(full).substr(0, dot))) {
       return fail(ErrorCode::NotFound,
                   where + ": parameter '" + manifest.outputs[k] + "': no component for '" + full + "'");
     }
@@ -149,11 +149,11 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
     const auto it = config.params.find(event_params[k]->name);
     if (it == config.params.end()) continue;
     const std::string& name = std::get<std::string>(it->second);
-    auto e = coordinator_.find_event(name);
+    auto e = coordinator_.structure().find_event(name);
     if (!e)
       return fail(ErrorCode::NotFound, where + ": parameter '" + event_params[k]->name + "': no event '" + name + "'");
     const bool want_onset = k == 0;
-    if (coordinator_.event(*e).is_onset != want_onset) {
+    if (coordinator_.structure().event(*e).is_onset != want_onset) {
       return fail(ErrorCode::InvalidArgument,
                   where + ": parameter '" + event_params[k]->name + "': event '" + name + "' is " +
                       (want_onset ? "a completion; an onset is needed" : "an onset; a completion is needed"));
@@ -161,12 +161,12 @@ Expected<FilterInit> Monitor::prepare(FilterConfig config,
     (want_onset ? init.onset : init.completion) = *e;
   }
   if (init.onset != kNoEvent && init.completion == kNoEvent)
-    init.completion = coordinator_.event(init.onset).counterpart;
+    init.completion = coordinator_.structure().event(init.onset).counterpart;
   if (init.completion != kNoEvent && init.onset != kNoEvent &&
-      coordinator_.event(init.completion).counterpart != init.onset) {
-    return fail(ErrorCode::InvalidArgument, where + ": completion '" + coordinator_.event(init.completion).name +
-                                                "' does not complete onset '" + coordinator_.event(init.onset).name +
-                                                "'");
+      coordinator_.structure().event(init.completion).counterpart != init.onset) {
+    return fail(ErrorCode::InvalidArgument,
+                where + ": completion '" + coordinator_.structure().event(init.completion).name +
+                    "' does not complete onset '" + coordinator_.structure().event(init.onset).name + "'");
   }
   init.name_id = coordinator_.intern(config.name);
   init.config = std::move(config);
@@ -293,7 +293,7 @@ void Monitor::record_injection(MachineId machine, std::string text) {
   r.kind = RecordKind::Injection;
   r.time = coordinator_.clock().now();
   r.machine = machine;
-  r.text = coordinator_.name_of(coordinator_.intern(text));
+  r.text = coordinator_.structure().name_of(coordinator_.intern(text));
   coordinator_.publish(r);
 }
 

@@ -1,4 +1,5 @@
 #include "safecass/introspect/action.hpp"
+#include "safecass/core/named.hpp"
 
 #include <string>
 #include <type_traits>
@@ -38,13 +39,13 @@ std::string_view action_name(const Action& action) noexcept {
           if (auto s = sample_signal(monitor, a); !s) return tl::unexpected(s.error());
           return {};
         } else if constexpr (std::is_same_v<A, GenerateEvent>) {
-          if (auto t = resolve_generate(co, a.event, a.target); !t) return tl::unexpected(t.error());
+          if (auto t = resolve_generate(co.structure(), a.event, a.target); !t) return tl::unexpected(t.error());
           return {};
         } else if constexpr (std::is_same_v<A, BroadcastEvent>) {
-          if (auto e = resolve_broadcast(co, a.event); !e) return tl::unexpected(e.error());
+          if (auto e = resolve_broadcast(co.structure(), a.event); !e) return tl::unexpected(e.error());
           return {};
         } else if constexpr (std::is_same_v<A, ResetState>) {
-          if (auto t = resolve_reset(co, a.target); !t) return tl::unexpected(t.error());
+          if (auto t = resolve_reset(co.structure(), a.target); !t) return tl::unexpected(t.error());
           return {};
         } else if constexpr (std::is_same_v<A, InjectShallow>) {
           return monitor.check_inject_shallow(a.filter, a.samples);
@@ -68,11 +69,11 @@ std::string_view action_name(const Action& action) noexcept {
           (*s)->push(now, a.values.data());
           return {};
         } else if constexpr (std::is_same_v<A, GenerateEvent>) {
-          return co.generate(a.event, a.target);
+          return generate(co, a.event, a.target);
         } else if constexpr (std::is_same_v<A, BroadcastEvent>) {
-          return co.broadcast(a.event);
+          return broadcast(co, a.event);
         } else if constexpr (std::is_same_v<A, ResetState>) {
-          return co.reset(a.target, a.who, a.why);
+          return reset(co, a.target, a.who, a.why);
         } else if constexpr (std::is_same_v<A, InjectShallow>) {
           return monitor.inject_shallow(a.filter, a.samples);
         } else if constexpr (std::is_same_v<A, InjectDeep>) {

@@ -12,7 +12,8 @@ namespace safecass::introspect {
 namespace {
 
 std::string outstanding_name(const Coordinator& co, StateSnapshot s) {
-  return s.state == State::Normal || s.outstanding == kNoEvent ? std::string() : co.event(s.outstanding).name;
+  return s.state == State::Normal || s.outstanding == kNoEvent ? std::string()
+                                                               : co.structure().event(s.outstanding).name;
 }
 
 RowKind row_kind(MachineKind k) {
@@ -55,7 +56,7 @@ std::vector<HistoryEntry> tail(const Coordinator& co, const std::vector<Record>&
 
 LocalQuery::LocalQuery(Coordinator& co, Monitor& monitor, const FilterRegistry& registry, LocalOptions options)
     : co_(co), monitor_(monitor), registry_(registry), options_(std::move(options)) {
-  if (options_.name.empty()) options_.name = std::string(co_.name());
+  if (options_.name.empty()) options_.name = std::string(co_.structure().name());
 }
 
 std::string LocalQuery::name() const { return options_.name; }
@@ -78,21 +79,24 @@ Expected<ClockInfo> LocalQuery::clock() {
 
 std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
   std::vector<StateRow> out;
-  const std::string name(co_.component_name(id));
+  const std::string name(co_.structure().component_name(id));
   const StateSnapshot ext = co_.extended(id);
   out.push_back({name, RowKind::Component, ext.state, outstanding_name(co_, ext)});
   auto machine = [&](MachineId m) {
     const StateSnapshot s = co_.snapshot(m);
-    out.push_back({co_.address_of(m), row_kind(co_.machine_kind(m)), s.state, outstanding_name(co_, s)});
-  };
-  machine(co_.framework_machine(id));
-  machine(co_.application_machine(id));
-  for (const MachineId m : co_.provided_machines(id)) machine(m);
-  for (const MachineId m : co_.required_machines(id)) machine(m);
-  const auto& provided = co_.provided_machines(id);
-  for (std::uint32_t p = 0; p < provided.size(); ++p) {
     out.push_back(
-        {address::service(name, co_.interface_name(provided[p])), RowKind::Service, co_.service_state(id, p), {}});
+        {co_.structure().address_of(m), row_kind(co_.structure().machine_kind(m)), s.state, outstanding_name(co_, s)});
+  };
+  machine(co_.structure().framework_machine(id));
+  machine(co_.structure().application_machine(id));
+  for (const MachineId m : co_.structure().provided_machines(id)) machine(m);
+  for (const MachineId m : co_.structure().required_machines(id)) machine(m);
+  const auto& provided = co_.structure().provided_machines(id);
+  for (std::uint32_t p = 0; p < provided.size(); ++p) {
+    out.push_back({address::service(name, co_.structure().interface_name(provided[p])),
+                   RowKind::Service,
+                   co_.service_state(id, p),
+                   {}});
   }
   return out;
 }
@@ -100,16 +104,16 @@ std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
 Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view component) {
   std::vector<StateRow> out;
   if (!component.empty()) {
-    auto id = co_.find_component(component);
-    if (!id || co_.is_remote(*id)) {
+    auto id = co_.structure().find_component(component);
+    if (!id || co_.structure().is_remote(*id)) {
       return fail(ErrorCode::NotFound,
                   "no component '" + std::string(component) + "' in coordinator '" + options_.name + "'");
     }
     return component_rows(*id);
   }
   out.push_back({"SYSTEM", RowKind::System, co_.coordinator_state(), {}});
-  for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
-    if (co_.is_remote(id)) continue;
+  for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
+    if (co_.structure().is_remote(id)) continue;
     std::vector<StateRow> rows = component_rows(id);
     out.insert(out.end(), std::make_move_iterator(rows.begin()), std::make_move_iterator(rows.end()));
   }
@@ -120,7 +124,7 @@ Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, 
                                                         HistoryFilter filter) {
   Address a;  // SYSTEM
   if (!scope.empty() && scope != "SYSTEM") {
-    auto r = co_.resolve(scope);
+    auto r = co_.structure().resolve(scope);
     if (!r) return tl::unexpected(r.error());
     a = *r;
     if (a.kind == Address::Kind::Service) a.kind = Address::Kind::Component;
@@ -144,7 +148,7 @@ Expected<std::vector<FilterRow>> LocalQuery::filter_list() {
     FilterRow r;
     r.name = f->name();
     r.type = f->type();
-    r.target = f->target() == kNoMachine ? std::string() : co_.address_of(f->target());
+    r.target = f->target() == kNoMachine ? std::string() : co_.structure().address_of(f->target());
     r.active = f->execution() == ExecutionMode::Active;
     r.edge = f->detection() == DetectionMode::Edge;
     r.enabled = f->enabled();
@@ -196,8 +200,8 @@ Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
 
 Expected<std::vector<EventRow>> LocalQuery::event_list() {
   std::vector<EventRow> out;
-  for (EventId id : id_range<EventId>(co_.event_count())) {
-    const Event& e = co_.event(id);
+  for (EventId id : id_range<EventId>(co_.structure().event_count())) {
+    const Event& e = co_.structure().event(id);
     EventRow r;
     r.name = e.name;
     r.severity = e.severity;
@@ -207,7 +211,7 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
          {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (e.transitions.contains(t)) r.transitions.push_back(t);
     }
-    r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.event(e.counterpart).name;
+    r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.structure().event(e.counterpart).name;
     r.latched = e.latched;
     r.framework = to_index(id) < framework_event::kCount;
     r.hazard = e.hazard;
@@ -219,17 +223,19 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
 
 Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
   std::vector<ConnectionRow> out;
-  for (const Connection& k : co_.connections()) {
-    const MachineId required = co_.required_machines(k.client)[k.required];
-    const MachineId provided = co_.provided_machines(k.provider)[k.provided];
+  for (const Connection& k : co_.structure().connections()) {
+    const MachineId required = co_.structure().required_machines(k.client)[k.required];
+    const MachineId provided = co_.structure().provided_machines(k.provider)[k.provided];
     ConnectionRow r;
-    r.required = std::string(co_.component_name(k.client)) + "." + std::string(co_.interface_name(required));
-    r.provided = std::string(co_.component_name(k.provider)) + "." + std::string(co_.interface_name(provided));
-    r.remote = co_.is_remote(k.provider);
+    r.required = std::string(co_.structure().component_name(k.client)) + "." +
+                 std::string(co_.structure().interface_name(required));
+    r.provided = std::string(co_.structure().component_name(k.provider)) + "." +
+                 std::string(co_.structure().interface_name(provided));
+    r.remote = co_.structure().is_remote(k.provider);
     r.required_state = co_.state(required);
     if (!r.remote) {
       r.service_state = co_.service_state(k.provider, k.provided);
-      r.propagate = co_.service(k.provider, k.provided).propagate;
+      r.propagate = co_.structure().service(k.provider, k.provided).propagate;
     }
     out.push_back(std::move(r));
   }
@@ -238,22 +244,22 @@ Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
 
 Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
   std::vector<ServiceRow> out;
-  for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
-    if (co_.is_remote(id)) continue;
-    const auto& provided = co_.provided_machines(id);
+  for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
+    if (co_.structure().is_remote(id)) continue;
+    const auto& provided = co_.structure().provided_machines(id);
     for (std::uint32_t i = 0; i < provided.size(); ++i) {
-      const std::string p(co_.interface_name(provided[i]));
-      const ServiceDependency& d = co_.service(id, i);
+      const std::string p(co_.structure().interface_name(provided[i]));
+      const ServiceDependency& d = co_.structure().service(id, i);
       ServiceRow r;
-      r.address = address::service(co_.component_name(id), p);
+      r.address = address::service(co_.structure().component_name(id), p);
       r.state = co_.service_state(id, i);
       r.propagate = d.propagate;
       r.depends_on.push_back("s_P." + p);
       if (d.framework) r.depends_on.emplace_back("s_F");
       if (d.application) r.depends_on.emplace_back("s_A");
       if (d.all_required) {
-        for (const MachineId m : co_.required_machines(id))
-          r.depends_on.push_back("s_R." + std::string(co_.interface_name(m)));
+        for (const MachineId m : co_.structure().required_machines(id))
+          r.depends_on.push_back("s_R." + std::string(co_.structure().interface_name(m)));
       } else {
         for (const std::string& name : d.required) r.depends_on.push_back("s_R." + name);
       }
@@ -268,15 +274,15 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
   a.address = std::string(address);
   if (address == "SYSTEM") {
     a.state = co_.coordinator_state();
-    for (ComponentId id : id_range<ComponentId>(co_.component_count())) {
-      if (co_.is_remote(id)) continue;
+    for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
+      if (co_.structure().is_remote(id)) continue;
       std::vector<Explanation> part = co_.explain(Address{Address::Kind::Component, id});
       a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()),
                           std::make_move_iterator(part.end()));
     }
     return a;
   }
-  auto resolved = co_.resolve(address);
+  auto resolved = co_.structure().resolve(address);
   if (!resolved) return tl::unexpected(resolved.error());
   a.state = co_.state_of(*resolved);
   a.conditions = co_.explain(*resolved);
@@ -286,20 +292,20 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
 Expected<Names> LocalQuery::names() {
   Names n;
   n.addresses.emplace_back("SYSTEM");
-  for (ComponentId i : id_range<ComponentId>(co_.component_count())) {
-    if (co_.is_remote(i)) continue;
-    n.components.emplace_back(co_.component_name(i));
-    n.addresses.emplace_back(co_.component_name(i));
-    for (const MachineId p : co_.provided_machines(i)) {
-      n.addresses.push_back(address::service(co_.component_name(i), co_.interface_name(p)));
+  for (ComponentId i : id_range<ComponentId>(co_.structure().component_count())) {
+    if (co_.structure().is_remote(i)) continue;
+    n.components.emplace_back(co_.structure().component_name(i));
+    n.addresses.emplace_back(co_.structure().component_name(i));
+    for (const MachineId p : co_.structure().provided_machines(i)) {
+      n.addresses.push_back(address::service(co_.structure().component_name(i), co_.structure().interface_name(p)));
     }
   }
-  for (MachineId m : id_range<MachineId>(co_.machine_count())) {
-    if (co_.is_remote(co_.machine_component(m))) continue;
-    n.machines.push_back(co_.address_of(m));
-    n.addresses.push_back(co_.address_of(m));
+  for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) {
+    if (co_.structure().is_remote(co_.structure().machine_component(m))) continue;
+    n.machines.push_back(co_.structure().address_of(m));
+    n.addresses.push_back(co_.structure().address_of(m));
   }
-  for (EventId e : id_range<EventId>(co_.event_count())) n.events.push_back(co_.event(e).name);
+  for (EventId e : id_range<EventId>(co_.structure().event_count())) n.events.push_back(co_.structure().event(e).name);
   for (const auto& f : monitor_.filters()) n.filters.push_back(f->name());
   for (const FilterManifest* m : registry_.manifests()) n.filter_types.push_back(m->type);
   for (const auto& s : monitor_.signals().all()) n.signals.push_back(s->name());

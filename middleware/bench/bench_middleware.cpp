@@ -144,9 +144,9 @@ int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, d
              std::chrono::microseconds pause) {
   Process p;
   if (!p.build("sensor", ice, interfaces) || !p.wait_connected()) return 2;
-  const EventId onset = *p.co->find_event("EVT_FORCE_ERROR");
-  const EventId completion = *p.co->find_event("/EVT_FORCE_ERROR");
-  const MachineId target = *p.co->find_machine("JR3.s_A");
+  const EventId onset = *p.co->structure().find_event("EVT_FORCE_ERROR");
+  const EventId completion = *p.co->structure().find_event("/EVT_FORCE_ERROR");
+  const MachineId target = *p.co->structure().find_machine("JR3.s_A");
   write_byte(out, 'r');
   for (char c = read_byte(in); c == 'L' || c == 'T'; c = read_byte(in)) {
     std::uint64_t counts[3] = {0, 0, 0};
@@ -160,11 +160,12 @@ int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, d
     } else {
       // Each Di's root set is never empty and differs after every step ({A}, {A,B}, {B}, {B,A'},
       // {A'}, ...): every generate() below is one state change of one interface.
-      const EventId other = *p.co->find_event("EVT_JR3_FAULT");
-      const EventId other_done = *p.co->find_event("/EVT_JR3_FAULT");
+      const EventId other = *p.co->structure().find_event("EVT_JR3_FAULT");
+      const EventId other_done = *p.co->structure().find_event("/EVT_JR3_FAULT");
       const EventId steps[4] = {other, completion, onset, other_done};
       std::vector<MachineId> targets;
-      for (int i = 0; i < interfaces; ++i) targets.push_back(*p.co->find_machine("JR3.s_P.D" + std::to_string(i)));
+      for (int i = 0; i < interfaces; ++i)
+        targets.push_back(*p.co->structure().find_machine("JR3.s_P.D" + std::to_string(i)));
       for (MachineId t : targets) p.co->generate(onset, t);
       std::this_thread::sleep_for(100ms);
       // The client counts from here: these first onsets are not part of the measurement.
@@ -297,7 +298,7 @@ int main(int argc, char** argv) {
   std::vector<double> latencies;
   std::atomic<bool> measuring{false};
   client.co->on_machine(
-      *client.co->find_machine("CONTROL.s_R.ForceData"),
+      *client.co->structure().find_machine("CONTROL.s_R.ForceData"),
       StateCallbacks{nullptr,
                      [&](const TransitionInfo& info) {
                        if (!measuring.load() || info.transition != Transition::N2E || info.root == nullptr) return;
@@ -331,7 +332,7 @@ int main(int argc, char** argv) {
   // The final state arrived: every Di back to Normal at the client.
   bool final_ok = true;
   for (int i = 0; i < interfaces; ++i) {
-    const MachineId m = *client.co->find_machine("CONTROL.s_R.D" + std::to_string(i));
+    const MachineId m = *client.co->structure().find_machine("CONTROL.s_R.D" + std::to_string(i));
     for (int wait = 0; wait < 200 && client.co->state(m) != State::Normal; ++wait) std::this_thread::sleep_for(5ms);
     final_ok = final_ok && client.co->state(m) == State::Normal;
   }

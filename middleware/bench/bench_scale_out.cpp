@@ -128,9 +128,9 @@ int provider(const spec::SystemSpec& system, int index, int k, double rate, doub
   Member m;
   if (!m.join(system, "P" + std::to_string(index), ice, keys)) return 2;
   std::vector<MachineId> targets;
-  for (int c = 0; c < k; ++c) targets.push_back(*m.co->find_machine(component(index, c) + ".s_A"));
-  const EventId onset = *m.co->find_event("EVT_FAULT");
-  const EventId completion = *m.co->find_event("/EVT_FAULT");
+  for (int c = 0; c < k; ++c) targets.push_back(*m.co->structure().find_machine(component(index, c) + ".s_A"));
+  const EventId onset = *m.co->structure().find_event("EVT_FAULT");
+  const EventId completion = *m.co->structure().find_event("/EVT_FAULT");
   write_text(out, "r");
   if (read_byte(in) != 'g') return 0;
   const auto before = m.node->stats();
@@ -268,7 +268,7 @@ public:
     for (int p = 0; p < n; ++p) {
       for (int c = 0; c < k; ++c) {
         watcher.co->on_machine(
-            *watcher.co->find_machine("W.s_R." + component(p, c)),
+            *watcher.co->structure().find_machine("W.s_R." + component(p, c)),
             StateCallbacks{nullptr,
                            [this, &watcher](const TransitionInfo& info) {
                              // A loss the watcher raises itself has a local root.
@@ -362,7 +362,7 @@ int main(int argc, char** argv) {
   Latencies latencies;
   latencies.watch(watcher, n, k);
   // The measurement starts from a settled system: the watcher holds every provider proven alive.
-  const MachineId w = *watcher.co->find_machine("W");
+  const MachineId w = *watcher.co->structure().find_machine("W");
   for (int i = 0; i < 3000 && watcher.co->state(w) != State::Normal; ++i) std::this_thread::sleep_for(10ms);
   const bool settled = watcher.co->state(w) == State::Normal;
   if (!settled) std::fprintf(stderr, "bench_scale_out: the watcher did not hear every provider within 30 s\n");

@@ -99,7 +99,7 @@ bool same_roots(const wire::RootSeq& a, const wire::RootSeq& b) {
         if (s.provided == iface) propagate = s.dependency.propagate;
       }
     }
-    if (!coordinator.find_machine(address::provided(provider, iface))) {
+    if (!coordinator.structure().find_machine(address::provided(provider, iface))) {
       if (auto r = coordinator.add_remote_provided(k.provided, propagate); !r) return tl::unexpected(r.error());
     }
     if (auto r = coordinator.connect(k.required, k.provided); !r) return tl::unexpected(r.error());
@@ -225,7 +225,8 @@ struct CoordinatorNode::Impl {
     {
       std::lock_guard lock(queue_mutex);
       // Records of stand-ins for remote components are that component's process's to publish.
-      if (r.kind != RecordKind::Event && !(to_index(r.component) < co.component_count() && co.is_remote(r.component))) {
+      if (r.kind != RecordKind::Event &&
+          !(to_index(r.component) < co.structure().component_count() && co.structure().is_remote(r.component))) {
         if (records.size() < kQueueCapacity) {
           records.push_back(r);
           wake = (records.size() == 1 && !publisher_holds_events) || records.size() == kMaxBatch;
@@ -601,8 +602,8 @@ struct CoordinatorNode::Impl {
     h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
     for (const auto& s : streams) h.lastSeq[state_stream(s->iface)] = s->seq.load();
     h.lastSeq[std::string(kEventsStream)] = event_seq.load();
-    for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-      if (!co.is_remote(c)) h.components.emplace_back(co.component_name(c));
+    for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+      if (!co.structure().is_remote(c)) h.components.emplace_back(co.structure().component_name(c));
     }
     {
       std::lock_guard lock(peer_mutex);
@@ -864,8 +865,9 @@ struct CoordinatorNode::Impl {
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is gone (" + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
-      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-        if (!co.is_remote(c)) co.generate(framework_event::kSupervisorLost, co.framework_machine(c));
+      for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+        if (!co.structure().is_remote(c))
+          co.generate(framework_event::kSupervisorLost, co.structure().framework_machine(c));
       }
       return;
     }
@@ -879,9 +881,10 @@ struct CoordinatorNode::Impl {
   void recover(const std::string& who, Peer& peer) {
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
-      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-        if (!co.is_remote(c)) {
-          co.generate(framework_event::completion_of(framework_event::kSupervisorLost), co.framework_machine(c));
+      for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+        if (!co.structure().is_remote(c)) {
+          co.generate(framework_event::completion_of(framework_event::kSupervisorLost),
+                      co.structure().framework_machine(c));
         }
       }
       return;
@@ -943,35 +946,35 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   Impl* d = impl.get();
   impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->log(line); });
   impl->incarnation = new_incarnation();
-  impl->streams_of.resize(coordinator.component_count());
-  for (ComponentId c : id_range<ComponentId>(coordinator.component_count())) {
-    if (coordinator.is_remote(c)) {
-      for (MachineId m : coordinator.provided_machines(c)) {
-        const std::string iface =
-            std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(m));
-        const std::string provider(impl->members.coordinator_of(coordinator.component_name(c)));
+  impl->streams_of.resize(coordinator.structure().component_count());
+  for (ComponentId c : id_range<ComponentId>(coordinator.structure().component_count())) {
+    if (coordinator.structure().is_remote(c)) {
+      for (MachineId m : coordinator.structure().provided_machines(c)) {
+        const std::string iface = std::string(coordinator.structure().component_name(c)) + "." +
+                                  std::string(coordinator.structure().interface_name(m));
+        const std::string provider(impl->members.coordinator_of(coordinator.structure().component_name(c)));
         impl->held.emplace(iface, Impl::Held{m, provider});
         if (!provider.empty()) impl->peers[provider].provider = true;
       }
       continue;
     }
-    const auto& provided = coordinator.provided_machines(c);
+    const auto& provided = coordinator.structure().provided_machines(c);
     for (std::uint32_t p = 0; p < provided.size(); ++p) {
       auto s = std::make_unique<Impl::Stream>();
       s->component = c;
       s->provided = p;
-      s->iface =
-          std::string(coordinator.component_name(c)) + "." + std::string(coordinator.interface_name(provided[p]));
+      s->iface = std::string(coordinator.structure().component_name(c)) + "." +
+                 std::string(coordinator.structure().interface_name(provided[p]));
       impl->streams_of[c].push_back(impl->streams.size());
       impl->streams.push_back(std::move(s));
     }
   }
   // The required interfaces each provider coordinator feeds: where its loss is raised.
-  for (const Connection& k : coordinator.connections()) {
-    if (!coordinator.is_remote(k.provider) || coordinator.is_remote(k.client)) continue;
-    const std::string_view provider = impl->members.coordinator_of(coordinator.component_name(k.provider));
+  for (const Connection& k : coordinator.structure().connections()) {
+    if (!coordinator.structure().is_remote(k.provider) || coordinator.structure().is_remote(k.client)) continue;
+    const std::string_view provider = impl->members.coordinator_of(coordinator.structure().component_name(k.provider));
     if (provider.empty()) continue;
-    impl->peers[std::string(provider)].feeds.push_back(coordinator.required_machines(k.client)[k.required]);
+    impl->peers[std::string(provider)].feeds.push_back(coordinator.structure().required_machines(k.client)[k.required]);
   }
   return std::unique_ptr<CoordinatorNode>(new CoordinatorNode(std::move(impl)));
 }

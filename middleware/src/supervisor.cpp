@@ -2,6 +2,7 @@
 
 #include "safecass/middleware/supervisor.hpp"
 #include "safecass/core/address.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/core/text_map.hpp"
 
 #include <algorithm>
@@ -580,7 +581,7 @@ struct Supervisor::Impl {
   void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
     if (recovered.empty()) return;
     print("supervisor: coordinator '" + who + "' recovered");
-    for (const std::string& c : recovered) (void)model().generate("/EVT_COORDINATOR_LOST", address::framework(c));
+    for (const std::string& c : recovered) (void)generate(model(), "/EVT_COORDINATOR_LOST", address::framework(c));
   }
 
   /// After records of a coordinator were missed, its rows in the view may be stale: read its
@@ -680,7 +681,7 @@ struct Supervisor::Impl {
       }
       for (const auto& [name, components, why] : lost_now) {
         print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
-        for (const std::string& c : components) (void)model().generate("EVT_COORDINATOR_LOST", address::framework(c));
+        for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
       }
     }
   }

@@ -74,7 +74,7 @@ Expected<std::unique_ptr<InputRecorder>> InputRecorder::open(Monitor& monitor, c
   header.period = r->options_.period;
   header.start = monitor.coordinator().clock().now();
   header.clock = r->options_.clock;
-  header.system = monitor.coordinator().name();
+  header.system = monitor.coordinator().structure().name();
   std::string preamble;
   input_log::put_header(preamble, header);
   for (std::size_t i = 0; i < r->inputs_.size(); ++i) {

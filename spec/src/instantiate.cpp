@@ -53,7 +53,7 @@ tl::unexpected<Error> in(std::string_view what, const Error& e) {
   }
   for (const ComponentSpec& c : system.components) {
     if (!is_local(c.name)) continue;
-    const ComponentId id = *coordinator.find_component(c.name);
+    const ComponentId id = *coordinator.structure().find_component(c.name);
     for (const ServiceSpec& s : c.services) {
       if (auto r = coordinator.set_service(id, s.provided, s.dependency); !r) return tl::unexpected(r.error());
     }

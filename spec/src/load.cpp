@@ -50,13 +50,13 @@ const std::vector<FrameworkEvent>& framework_events() {
     std::vector<FrameworkEvent> out;
     const Coordinator probe("framework-events");
     for (EventId id : id_range<EventId>(framework_event::kCount)) {
-      const Event& e = probe.event(id);
+      const Event& e = probe.structure().event(id);
       FrameworkEvent f;
       f.name = e.name;
       f.onset = e.is_onset;
       f.severity = e.severity;
       f.transitions = e.transitions;
-      if (e.counterpart != kNoEvent) f.counterpart = probe.event(e.counterpart).name;
+      if (e.counterpart != kNoEvent) f.counterpart = probe.structure().event(e.counterpart).name;
       out.push_back(std::move(f));
     }
     return out;

@@ -431,7 +431,7 @@ Expected<std::unique_ptr<Console>> Console::open(const std::string& system, cons
   Coordinator& co = sys->runner->coordinator();
   Target target;
   target.query = std::make_unique<in::LocalQuery>(co, sys->runner->monitor(), builtin_filters(), local);
-  target.subject = "system " + system_path + " (" + std::to_string(co.component_count()) + " components" +
+  target.subject = "system " + system_path + " (" + std::to_string(co.structure().component_count()) + " components" +
                    (scenario.empty() ? "" : ", scenario " + scenario) + ")";
   InProcessSystem* raw = sys.get();
   target.advance = [raw](Time t) {

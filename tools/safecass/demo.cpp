@@ -10,6 +10,7 @@
 
 #include "commands.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/introspect/format.hpp"
 
 namespace safecass::tools {
@@ -51,7 +52,7 @@ int run_demo() {
   const EventId high_on = must(co.add_event(high));
   const EventId high_off = must(co.add_event(high_clear));
 
-  const MachineId jr3_app = co.application_machine(jr3);
+  const MachineId jr3_app = co.structure().application_machine(jr3);
   const NameId filter = co.intern("force_limit");
   const NameId signal = co.intern("JR3.ForceNorm");
 
@@ -60,9 +61,9 @@ int run_demo() {
 
   co.subscribe([&co](const Record& r) {
     if (r.kind == RecordKind::Transition) {
-      std::printf("  t=%.3f s  %-24s %s -> %s  (%s)\n", to_seconds(r.time), co.address_of(r.machine).c_str(),
-                  std::string(to_string(r.from)).c_str(), std::string(to_string(r.to)).c_str(),
-                  co.event(r.event).name.c_str());
+      std::printf("  t=%.3f s  %-24s %s -> %s  (%s)\n", to_seconds(r.time),
+                  co.structure().address_of(r.machine).c_str(), std::string(to_string(r.from)).c_str(),
+                  std::string(to_string(r.to)).c_str(), co.structure().event(r.event).name.c_str());
     }
   });
 
@@ -93,10 +94,10 @@ int run_demo() {
       std::printf("  t=%.3f s  CONTROL loop: %s\n", t, mode.c_str());
       last_mode = mode;
     }
-    if (!explained && co.extended_state(servo) == State::Error) {
+    if (!explained && co.extended(servo).state == State::Error) {
       explained = true;
       std::printf("\n  Why is SERVO in Error? explain(\"SERVO\"):\n");
-      const std::vector<Explanation> why = must(co.explain("SERVO"));
+      const std::vector<Explanation> why = must(explain(co, "SERVO"));
       for (const Explanation& e : why)
         std::printf("    %s\n", introspect::explanation_text(e, introspect::TimeFormat{}).c_str());
       std::printf("\n");

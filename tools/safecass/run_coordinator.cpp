@@ -60,10 +60,10 @@ struct Driver {
   InputRecorder* inputs = nullptr;  ///< records the actions it applies (with --record)
 
   bool local_machine(const std::string& address) const {
-    auto a = co.resolve(address);
+    auto a = co.structure().resolve(address);
     if (!a) return false;
     if (a->kind == Address::Kind::System) return true;
-    return !co.is_remote(a->component);
+    return !co.structure().is_remote(a->component);
   }
 
   /// Whether `action` belongs to this process: its signal, filter or machine is one of ours (the
@@ -367,7 +367,7 @@ int run_coordinator(const RunArgs& args) {
   co.subscribe([&co](const Record& r) {
     if (r.kind != RecordKind::Transition && r.kind != RecordKind::ComponentTransition) return;
     // The coordinator's lock is free while observers run: history_entry() may read it.
-    say("[" + std::string(co.name()) + "] " + introspect::live_line(introspect::history_entry(r, co)));
+    say("[" + std::string(co.structure().name()) + "] " + introspect::live_line(introspect::history_entry(r, co)));
   });
   std::unique_ptr<Recorder> recorder;
   std::unique_ptr<InputRecorder> inputs;
@@ -378,7 +378,8 @@ int run_coordinator(const RunArgs& args) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::size_t local = 0;
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) local += co.is_remote(c) ? 0 : 1;
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count()))
+    local += co.structure().is_remote(c) ? 0 : 1;
   say("safecass run: coordinator '" + args.coordinator + "' of system '" + system.name + "', " + std::to_string(local) +
       " components, pid " + std::to_string(::getpid()) +
       (args.ice.empty() ? std::string(", no middleware") : ", IceStorm " + args.ice) +

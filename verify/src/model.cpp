@@ -5,6 +5,7 @@
 #include <set>
 #include <tuple>
 
+#include "safecass/core/named.hpp"
 #include "safecass/spec/load.hpp"
 
 namespace safecass::verify {
@@ -55,7 +56,7 @@ Expected<std::unique_ptr<Model>> Model::build(const spec::SystemSpec& system, co
 }
 
 Expected<void> Model::derive(const FilterRegistry& registry) {
-  at_machine_.assign(instance_->coordinator().machine_count(), {});
+  at_machine_.assign(instance_->coordinator().structure().machine_count(), {});
   derive_roots(registry);
   derive_reach();
   const RootsAt at = roots_at();
@@ -78,9 +79,9 @@ void Model::derive_roots(const FilterRegistry& registry) {
   std::set<std::string, std::less<>> generated;
   std::map<std::string, int, std::less<>> broadcast_index;
   const auto add_root = [&](const std::string& event, MachineId machine, const std::string& source) {
-    auto id = co.find_event(event);
+    auto id = co.structure().find_event(event);
     if (!id) return;
-    const Event& e = co.event(*id);
+    const Event& e = co.structure().event(*id);
     if (!e.is_onset) return;
     if (e.is_broadcast()) {
       if (broadcast_index.count(event) > 0) return;
@@ -88,13 +89,13 @@ void Model::derive_roots(const FilterRegistry& registry) {
       broadcast_index[event] = b;
       Broadcast bc;
       bc.event = event;
-      if (e.counterpart != kNoEvent) bc.completion = co.event(e.counterpart).name;
-      for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-        if (co.is_remote(c)) continue;
+      if (e.counterpart != kNoEvent) bc.completion = co.structure().event(e.counterpart).name;
+      for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+        if (co.structure().is_remote(c)) continue;
         Root r;
         r.event = event;
         r.completion = bc.completion;
-        r.machine = co.application_machine(c);
+        r.machine = co.structure().application_machine(c);
         r.transitions = e.transitions;
         r.latched = e.latched;
         r.hazard = e.hazard;
@@ -110,7 +111,7 @@ void Model::derive_roots(const FilterRegistry& registry) {
     if (!seen.emplace(event, machine).second) return;
     Root r;
     r.event = event;
-    if (e.counterpart != kNoEvent) r.completion = co.event(e.counterpart).name;
+    if (e.counterpart != kNoEvent) r.completion = co.structure().event(e.counterpart).name;
     r.machine = machine;
     r.transitions = e.transitions;
     r.latched = e.latched;
@@ -128,7 +129,7 @@ void Model::derive_roots(const FilterRegistry& registry) {
         if (!onset.empty()) generated.insert(onset);
         if (!completion.empty()) generated.insert(completion);
         if (onset.empty()) continue;
-        auto machine = co.find_machine(machine_of(stage.target));
+        auto machine = co.structure().find_machine(machine_of(stage.target));
         if (!machine) continue;
         add_root(onset, *machine, "filter '" + stage.name + "'");
       }
@@ -137,15 +138,15 @@ void Model::derive_roots(const FilterRegistry& registry) {
   // Onsets a component declares and no filter generates: the component's own code raises them
   // on its s_A (the paper's SC::Generate). Broadcasts: on every s_A.
   for (const spec::ComponentSpec& c : system_->components) {
-    auto comp = co.find_component(c.name);
+    auto comp = co.structure().find_component(c.name);
     if (!comp) continue;
     for (const EventDef& e : c.events) {
-      auto id = co.find_event(e.name);
-      if (!id || !co.event(*id).is_onset) continue;
-      if (co.event(*id).is_broadcast()) {
+      auto id = co.structure().find_event(e.name);
+      if (!id || !co.structure().event(*id).is_onset) continue;
+      if (co.structure().event(*id).is_broadcast()) {
         add_root(e.name, kNoMachine, "broadcast");
       } else if (generated.count(e.name) == 0) {
-        add_root(e.name, co.application_machine(*comp), "the code of component '" + c.name + "'");
+        add_root(e.name, co.structure().application_machine(*comp), "the code of component '" + c.name + "'");
       }
     }
   }
@@ -161,7 +162,7 @@ void Model::derive_reach() {
   // From the coordinator itself: a root of each level at each machine that holds roots, and
   // where its mirrors land.
   Coordinator& co = instance_->coordinator();
-  const std::size_t machines = co.machine_count();
+  const std::size_t machines = co.structure().machine_count();
   reach_error_.assign(machines, IdVector<bool, MachineId>(machines, false));
   reach_warning_.assign(machines, IdVector<bool, MachineId>(machines, false));
   for (MachineId origin : id_range<MachineId>(machines)) {
@@ -176,13 +177,13 @@ void Model::derive_reach() {
           if (c.mirror && c.root.origin == origin) reach[m] = true;
         }
       }
-      (void)co.reset(std::string_view("SYSTEM"), "verify", "probe");
+      (void)reset(co, std::string_view("SYSTEM"), "verify", "probe");
     }
   }
 }
 
 Model::RootsAt Model::roots_at() const {
-  const std::size_t machines = instance_->coordinator().machine_count();
+  const std::size_t machines = instance_->coordinator().structure().machine_count();
   const auto machine_roots = [&](MachineId m, bool error) {
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < roots_.size(); ++i) {
@@ -219,40 +220,40 @@ void Model::derive_addresses(const RootsAt& at) {
   std::vector<MachineId> all;
   std::map<std::string, spec::Position, std::less<>> component_where;
   for (const spec::ComponentSpec& c : system_->components) component_where[c.name] = c.where;
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-    if (co.is_remote(c)) continue;
-    std::vector<MachineId> ms{co.framework_machine(c), co.application_machine(c)};
-    for (MachineId p : co.provided_machines(c)) ms.push_back(p);
-    for (MachineId r : co.required_machines(c)) ms.push_back(r);
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+    if (co.structure().is_remote(c)) continue;
+    std::vector<MachineId> ms{co.structure().framework_machine(c), co.structure().application_machine(c)};
+    for (MachineId p : co.structure().provided_machines(c)) ms.push_back(p);
+    for (MachineId r : co.structure().required_machines(c)) ms.push_back(r);
     all.insert(all.end(), ms.begin(), ms.end());
   }
   make("SYSTEM", all, {});
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-    if (co.is_remote(c)) continue;
-    const std::string name(co.component_name(c));
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+    if (co.structure().is_remote(c)) continue;
+    const std::string name(co.structure().component_name(c));
     const spec::Position where = component_where[name];
-    std::vector<MachineId> ms{co.framework_machine(c), co.application_machine(c)};
-    for (MachineId p : co.provided_machines(c)) ms.push_back(p);
-    for (MachineId r : co.required_machines(c)) ms.push_back(r);
+    std::vector<MachineId> ms{co.structure().framework_machine(c), co.structure().application_machine(c)};
+    for (MachineId p : co.structure().provided_machines(c)) ms.push_back(p);
+    for (MachineId r : co.structure().required_machines(c)) ms.push_back(r);
     make(name, ms, where);
-    for (MachineId m : ms) make(co.address_of(m), {m}, where);
-    for (std::uint32_t p = 0; p < co.provided_machines(c).size(); ++p) {
-      const ServiceDependency& d = co.service(c, p);
-      std::vector<MachineId> deps{co.provided_machines(c)[p]};
-      if (d.framework) deps.push_back(co.framework_machine(c));
-      if (d.application) deps.push_back(co.application_machine(c));
-      for (MachineId r : co.required_machines(c)) {
-        const std::string iface(co.interface_name(r));
+    for (MachineId m : ms) make(co.structure().address_of(m), {m}, where);
+    for (std::uint32_t p = 0; p < co.structure().provided_machines(c).size(); ++p) {
+      const ServiceDependency& d = co.structure().service(c, p);
+      std::vector<MachineId> deps{co.structure().provided_machines(c)[p]};
+      if (d.framework) deps.push_back(co.structure().framework_machine(c));
+      if (d.application) deps.push_back(co.structure().application_machine(c));
+      for (MachineId r : co.structure().required_machines(c)) {
+        const std::string iface(co.structure().interface_name(r));
         if (d.all_required || std::find(d.required.begin(), d.required.end(), iface) != d.required.end())
           deps.push_back(r);
       }
-      make(address::service(name, co.interface_name(co.provided_machines(c)[p])), deps, where);
+      make(address::service(name, co.structure().interface_name(co.structure().provided_machines(c)[p])), deps, where);
     }
   }
 }
 
 void Model::derive_levels(const RootsAt& at) {
-  const std::size_t machines = instance_->coordinator().machine_count();
+  const std::size_t machines = instance_->coordinator().structure().machine_count();
   can_.assign(roots_.size(), {false, false, false});
   IdVector<std::array<bool, 3>, MachineId> possible(machines, {true, false, false});
   for (bool changed = true; changed;) {

@@ -90,7 +90,7 @@ public:
   /// Roots of a hazard.
   std::vector<std::size_t> linked(std::string_view hazard) const;
   /// The machine index of an address that is a machine, for resets.
-  const std::string& machine_address(MachineId m) const { return instance_->coordinator().address_of(m); }
+  const std::string& machine_address(MachineId m) const { return instance_->coordinator().structure().address_of(m); }
 
   /// The root classes among `roots` (sorted indices): each broadcast root alone; the others
   /// merged with their interchangeable peers when `merge`.

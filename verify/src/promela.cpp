@@ -85,7 +85,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
     const RootClass& k = spec.classes[c];
     const Root& r = roots[k.first()];
     out += "byte w" + std::to_string(c) + ", e" + std::to_string(c) + ";  /* " + std::to_string(k.members.size()) +
-           " onset(s) at " + comment(co.address_of(r.machine)) + ":";
+           " onset(s) at " + comment(co.structure().address_of(r.machine)) + ":";
     for (std::size_t m : k.members) out += " " + comment(roots[m].event);
     if (r.latched) out += " (latched)";
     if (!r.clearable() && !r.latched) out += " (no completion)";
@@ -102,7 +102,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
   for (const RootClass& k : spec.classes) {
     const Root& r = roots[k.first()];
     if (r.constant_level()) continue;
-    needed.insert(static_cast<std::size_t>(model.address_index(co.address_of(r.machine))));
+    needed.insert(static_cast<std::size_t>(model.address_index(co.structure().address_of(r.machine))));
   }
   for (std::size_t a : needed) {
     const AddressInfo& info = model.addresses()[a];
@@ -145,7 +145,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
     const Root& r = roots[spec.classes[c].first()];
     const auto inc = [&](State l) { return std::string(l == State::Error ? "e" : "w") + std::to_string(c) + "++"; };
     if (r.constant_level()) return indent + inc(r.level[0]) + ";\n";
-    const std::string st = "ST_" + std::to_string(model.address_index(co.address_of(r.machine)));
+    const std::string st = "ST_" + std::to_string(model.address_index(co.structure().address_of(r.machine)));
     return indent + "if\n" + indent + ":: " + st + " == 0 -> " + inc(r.level[0]) + "\n" + indent + ":: " + st +
            " == 1 -> " + inc(r.level[1]) + "\n" + indent + ":: else -> " + inc(r.level[2]) + "\n" + indent + "fi;\n";
   };
@@ -160,7 +160,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
     if (r.broadcast >= 0) continue;
     const std::string id = std::to_string(c);
     out += "  /* onset " + comment(r.event) + (k.members.size() > 1 ? " (or an interchangeable one)" : "") + " on " +
-           comment(co.address_of(r.machine)) + " */\n";
+           comment(co.structure().address_of(r.machine)) + " */\n";
     out += step("w" + id + " + e" + id + " < " + std::to_string(k.members.size()), raise(c, "       "), "on " + id);
     if (r.clearable()) {
       out += step("w" + id + " > 0", "       w" + id + "--;\n", "off " + id + " 1");
@@ -197,7 +197,7 @@ std::string write_promela(const Model& model, const PromelaSpec& spec) {
       guard += (guard.empty() ? "" : " || ") + std::string("ACTIVE_") + std::to_string(c);
       body += "       w" + std::to_string(c) + " = 0; e" + std::to_string(c) + " = 0;\n";
     }
-    out += "  /* reset " + comment(co.address_of(m)) + " */\n";
+    out += "  /* reset " + comment(co.structure().address_of(m)) + " */\n";
     out += step("(" + guard + ")", body, "reset " + std::to_string(to_index(m)));
   }
   if (spec.classes.empty()) out += "  :: skip\n";

@@ -1,6 +1,7 @@
 // `safecass verify`: properties, their models, SPIN's verdicts, counterexamples as scenarios.
 
 #include "safecass/verify/verify.hpp"
+#include "safecass/core/named.hpp"
 
 #include <algorithm>
 #include <cctype>
@@ -278,7 +279,7 @@ private:
   void counterexample(const Check& check, PropertyResult& r, const std::vector<RootClass>& classes,
                       const PanResult& pan, const std::string& model) {
     Coordinator& co = m_.coordinator();
-    (void)co.reset(std::string_view("SYSTEM"), "verify", "counterexample");
+    (void)reset(co, std::string_view("SYSTEM"), "verify", "counterexample");
     std::vector<Step> steps;
     std::string problem;
     for (const std::string& line : pan.trail) {
@@ -293,34 +294,34 @@ private:
         bool done = false;
         for (std::size_t x : classes[a].members) {
           const Root& root = m_.roots()[x];
-          const auto id = co.find_event(root.event);
+          const auto id = co.structure().find_event(root.event);
           const Condition* active = nullptr;
           std::vector<Condition> conditions = co.conditions(root.machine);
           for (const Condition& c : conditions) {
             if (!c.mirror && id && c.event == *id) active = &c;
           }
           if (kind == "on" && active == nullptr) {
-            steps.push_back(Step{Step::Kind::Generate, root.event, co.address_of(root.machine)});
+            steps.push_back(Step{Step::Kind::Generate, root.event, co.structure().address_of(root.machine)});
           } else if (kind == "off" && active != nullptr && static_cast<int>(active->level) == level) {
-            steps.push_back(Step{Step::Kind::Generate, root.completion, co.address_of(root.machine)});
+            steps.push_back(Step{Step::Kind::Generate, root.completion, co.structure().address_of(root.machine)});
           } else {
             continue;
           }
-          (void)co.generate(steps.back().event, steps.back().target);
+          (void)generate(co, steps.back().event, steps.back().target);
           done = true;
           break;
         }
         if (!done) problem = "the trail's step '" + line + "' has no counterpart in the coordinator";
       } else if (kind == "reset") {
         const auto m = static_cast<MachineId>(a);
-        if (to_index(m) >= co.machine_count()) continue;
-        steps.push_back(Step{Step::Kind::Reset, "", co.address_of(m)});
-        (void)co.reset(co.address_of(m), "verify", "counterexample");
+        if (to_index(m) >= co.structure().machine_count()) continue;
+        steps.push_back(Step{Step::Kind::Reset, "", co.structure().address_of(m)});
+        (void)reset(co, co.structure().address_of(m), "verify", "counterexample");
       } else if (kind == "bon" || kind == "boff") {
         if (a >= m_.broadcasts().size()) continue;
         const Broadcast& b = m_.broadcasts()[a];
         steps.push_back(Step{Step::Kind::Generate, kind == "bon" ? b.event : b.completion, ""});
-        (void)co.generate(steps.back().event, "");
+        (void)generate(co, steps.back().event, "");
       }
     }
     // The failing expectation: what the property required and the coordinator does not show.
@@ -328,21 +329,21 @@ private:
     if (r.kind == PropertyResult::Kind::Reaction) {
       for (const auto& [a, level] : check.reaction) {
         const std::string& address = m_.addresses()[a].address;
-        const auto resolved = co.resolve(address);
+        const auto resolved = co.structure().resolve(address);
         if (resolved && co.state_of(*resolved) < level) expect.emplace_back(address, level);
       }
       std::string active;
       for (std::size_t x : check.linked) {
         const Root& root = m_.roots()[x];
-        const auto id = co.find_event(root.event);
+        const auto id = co.structure().find_event(root.event);
         for (const Condition& c : co.conditions(root.machine)) {
           if (!c.mirror && id && c.event == *id)
-            active += (active.empty() ? "" : ", ") + root.event + " on " + co.address_of(root.machine);
+            active += (active.empty() ? "" : ", ") + root.event + " on " + co.structure().address_of(root.machine);
         }
       }
       std::string below;
       for (const auto& [address, level] : expect) {
-        const auto resolved = co.resolve(address);
+        const auto resolved = co.structure().resolve(address);
         below += (below.empty() ? "" : ", ") + address + " is " + level_name(co.state_of(*resolved)) +
                  ", not at least " + level_name(level);
       }
@@ -358,7 +359,7 @@ private:
       std::set<std::string> seen;
       for (const spec::Formula* atom : atoms) {
         if (!seen.insert(atom->address).second) continue;
-        const auto resolved = co.resolve(atom->address);
+        const auto resolved = co.structure().resolve(atom->address);
         if (resolved)
           actual += (actual.empty() ? "" : ", ") + atom->address + " is " + level_name(co.state_of(*resolved));
       }
@@ -433,7 +434,7 @@ private:
     }
     std::vector<State> actual;
     for (const std::string& a : addresses) {
-      const auto resolved = co.resolve(a);
+      const auto resolved = co.structure().resolve(a);
       actual.push_back(resolved ? co.state_of(*resolved) : State::Normal);
     }
     const std::size_t n = std::min<std::size_t>(addresses.size(), 10);
@@ -575,7 +576,8 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
   std::set<std::string> reported;
   for (const Root& r : model.roots()) {
     if (r.clearable() || r.latched) continue;
-    const std::string subject = r.event + (r.broadcast >= 0 ? std::string() : "@" + co.address_of(r.machine));
+    const std::string subject =
+        r.event + (r.broadcast >= 0 ? std::string() : "@" + co.structure().address_of(r.machine));
     if (!reported.insert(subject).second) continue;
     PropertyResult p;
     p.kind = PropertyResult::Kind::NeedsReset;
@@ -585,8 +587,8 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
     p.where = r.where;
     p.text = "every onset can be cleared";
     p.message = "onset '" + r.event + "' on " +
-                (r.broadcast >= 0 ? std::string("every s_A") : co.address_of(r.machine)) + " (from " + r.source +
-                ") has no completion and is not latched: nothing but a reset can clear it";
+                (r.broadcast >= 0 ? std::string("every s_A") : co.structure().address_of(r.machine)) + " (from " +
+                r.source + ") has no completion and is not latched: nothing but a reset can clear it";
     report.properties.push_back(std::move(p));
   }
   for (const spec::HazardSpec& h : system.hazards) {
@@ -723,9 +725,10 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
     // Without merging, class c is root c.
     if (kind == "on" || kind == "off") {
       const Root& r = model.roots()[spec.classes.at(a).first()];
-      sim.steps.push_back(Step{Step::Kind::Generate, kind == "on" ? r.event : r.completion, co.address_of(r.machine)});
+      sim.steps.push_back(
+          Step{Step::Kind::Generate, kind == "on" ? r.event : r.completion, co.structure().address_of(r.machine)});
     } else if (kind == "reset") {
-      sim.steps.push_back(Step{Step::Kind::Reset, "", co.address_of(static_cast<MachineId>(a))});
+      sim.steps.push_back(Step{Step::Kind::Reset, "", co.structure().address_of(static_cast<MachineId>(a))});
     } else if (kind == "bon" || kind == "boff") {
       const Broadcast& b = model.broadcasts().at(a);
       sim.steps.push_back(Step{Step::Kind::Generate, kind == "bon" ? b.event : b.completion, ""});

@@ -274,8 +274,8 @@ void Bridge::Impl::spin() {
 void Bridge::Impl::fail_safe(const std::string& why) {
   warn(why);
   Coordinator& co = shadow->coordinator();
-  for (ComponentId c : id_range<ComponentId>(co.component_count()))
-    co.generate(framework_event::kThreadException, co.framework_machine(c));
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count()))
+    co.generate(framework_event::kThreadException, co.structure().framework_machine(c));
 }
 
 void Bridge::Impl::step() {

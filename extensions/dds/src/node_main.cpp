@@ -96,8 +96,8 @@ int main(int argc, char** argv) {
     return 3;
   }
   std::fprintf(stderr, "safecass_dds_node: %zu components of '%s' on ROS 2 domain %d\n",
-               (*bridge)->coordinator().component_count(), std::string((*bridge)->coordinator().name()).c_str(),
-               (*bridge)->domain());
+               (*bridge)->coordinator().structure().component_count(),
+               std::string((*bridge)->coordinator().structure().name()).c_str(), (*bridge)->domain());
   int signal = 0;
   sigwait(&stop_signals, &signal);
   (*bridge)->stop();

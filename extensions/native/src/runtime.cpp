@@ -14,10 +14,10 @@ Runtime::Runtime(Monitor& monitor, Time monitor_period)
 Runtime::~Runtime() { stop(); }
 
 Expected<void> Runtime::add_task(ComponentId component, Time period, Body body, FilterOrder order) {
-  if (to_index(component) >= coordinator_.component_count()) {
+  if (to_index(component) >= coordinator_.structure().component_count()) {
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
   }
-  const std::string name(coordinator_.component_name(component));
+  const std::string name(coordinator_.structure().component_name(component));
   if (period <= Time{0}) return fail(ErrorCode::InvalidArgument, "task of '" + name + "': period must be positive");
   for (const Task& t : tasks_) {
     if (t.component == component)
@@ -50,7 +50,7 @@ void Runtime::cycle(Task& task, Time now) noexcept {
 
 void Runtime::run_body(Task& task, Time now) noexcept {
   if (!task.body) return;
-  const MachineId framework = coordinator_.framework_machine(task.component);
+  const MachineId framework = coordinator_.structure().framework_machine(task.component);
   try {
     task.body(now);
     if (task.threw) {
@@ -112,7 +112,7 @@ void Runtime::start() {
   stop_.store(false);
   for (Task& task : tasks_) {
     threads_.emplace_back([this, &task] {
-      const MachineId framework = coordinator_.framework_machine(task.component);
+      const MachineId framework = coordinator_.structure().framework_machine(task.component);
       const std::int64_t period = task.period.count();
       std::int64_t next = monotonic_ns();
       while (!stop_.load(std::memory_order_acquire)) {

@@ -21,7 +21,7 @@ System::~System() { runtime_.stop(); }
   std::unique_ptr<System> built(new System(std::move(clock), std::move(*instance)));
   spec::Diagnostics problems;
   for (const spec::ComponentSpec& c : built->spec().components) {
-    auto id = built->coordinator().find_component(c.name);
+    auto id = built->coordinator().structure().find_component(c.name);
     if (!id) continue;  // another coordinator's component: connected by the middleware, not run here
     const Time period = c.period ? seconds_to_time(*c.period) : options.component_period;
     if (auto r = built->runtime_.add_task(*id, period); !r) {

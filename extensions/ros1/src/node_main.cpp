@@ -58,8 +58,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "safecass_ros1_node: %s\n", r.error().message.c_str());
     return 3;
   }
-  ROS_INFO("safecass: %zu components of '%s' on the ROS graph", (*bridge)->coordinator().component_count(),
-           std::string((*bridge)->coordinator().name()).c_str());
+  ROS_INFO("safecass: %zu components of '%s' on the ROS graph", (*bridge)->coordinator().structure().component_count(),
+           std::string((*bridge)->coordinator().structure().name()).c_str());
   ros::spin();
   (*bridge)->stop();
   return safecass::ros_common::NodeRecording::finish(recording);

@@ -75,7 +75,7 @@ Expected<std::unique_ptr<Shadow>> Shadow::create(const std::string& mapping_path
       return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
   }
   for (const EventDef& e : default_ros_events()) {
-    if (co.find_event(e.name)) continue;
+    if (co.structure().find_event(e.name)) continue;
     if (auto r = co.add_event(e); !r)
       return fail(r.error().code, where + "event '" + e.name + "': " + r.error().message);
   }
@@ -107,25 +107,25 @@ Expected<void> Shadow::bind() {
   // An interface "C.x" whose component is not in this coordinator is somebody else's: kNoMachine.
   auto machine_of = [&](const std::string& iface, const char* kind) -> Expected<MachineId> {
     const std::string component = iface.substr(0, iface.find('.'));
-    if (!co.find_component(component)) return kNoMachine;
-    return co.find_machine(component + "." + kind + "." + iface.substr(iface.find('.') + 1));
+    if (!co.structure().find_component(component)) return kNoMachine;
+    return co.structure().find_machine(component + "." + kind + "." + iface.substr(iface.find('.') + 1));
   };
   auto check_target = [&](const std::string& address) -> Expected<FilterTarget> {
-    auto m = co.find_machine(address);
+    auto m = co.structure().find_machine(address);
     if (!m) return tl::unexpected(m.error());
     FilterTarget t;
-    t.kind = co.machine_kind(*m);
-    t.component = std::string(co.component_name(co.machine_component(*m)));
+    t.kind = co.structure().machine_kind(*m);
+    t.component = std::string(co.structure().component_name(co.structure().machine_component(*m)));
     if (t.kind == MachineKind::Provided || t.kind == MachineKind::Required)
-      t.interface = std::string(co.interface_name(*m));
+      t.interface = std::string(co.structure().interface_name(*m));
     return t;
   };
   auto need_onset = [&](const std::string& event, const std::string& what) -> Expected<EventId> {
-    auto e = co.find_event(event);
+    auto e = co.structure().find_event(event);
     if (!e) return fail(ErrorCode::NotFound, what + ": no event '" + event + "'");
-    if (!co.event(*e).is_onset)
+    if (!co.structure().event(*e).is_onset)
       return fail(ErrorCode::InvalidArgument, what + ": '" + event + "' is a completion, not an onset");
-    if (co.event(*e).counterpart == kNoEvent) {
+    if (co.structure().event(*e).counterpart == kNoEvent) {
       return fail(ErrorCode::InvalidArgument, what + ": '" + event + "' has no completion, so it could never clear");
     }
     return *e;
@@ -189,7 +189,7 @@ Expected<void> Shadow::bind() {
       f.execution = ExecutionMode::Passive;
       f.params["input_signal"] = tm.rate_signal;
       f.params["event_onset"] = (*check)->event;
-      f.params["event_completion"] = co.event(co.event(*onset).counterpart).name;
+      f.params["event_completion"] = co.structure().event(co.structure().event(*onset).counterpart).name;
       if (watchdog) {
         f.params["timeout"] = (*check)->timeout;
       } else {
@@ -207,7 +207,7 @@ Expected<void> Shadow::bind() {
     Ingest in;
     in.rule = &rule;
     const std::string what = "ingest rule '" + rule.name + "'";
-    auto m = co.find_machine(rule.target);
+    auto m = co.structure().find_machine(rule.target);
     if (!m) return fail(m.error().code, what + ": " + m.error().message);
     in.target = *m;
     const std::array<const std::string*, 3> names{&rule.warn, &rule.error, &rule.stale};
@@ -223,7 +223,7 @@ Expected<void> Shadow::bind() {
   graph_event_ = *g;
   graph_name_ = co.intern("ros:graph");
   diagnostics_name_ = co.intern("ros:diagnostics");
-  if (mapping_.hardware_id.empty()) mapping_.hardware_id = std::string(co.name());
+  if (mapping_.hardware_id.empty()) mapping_.hardware_id = std::string(co.structure().name());
   return {};
 }
 
@@ -250,7 +250,7 @@ BridgeStats Shadow::stats() const noexcept {
 
 Expected<void> Shadow::add_loop(std::string_view component, Time period, Body body) {
   if (started_) return fail(ErrorCode::InvalidState, "add_loop() after start()");
-  auto c = instance_->coordinator().find_component(component);
+  auto c = instance_->coordinator().structure().find_component(component);
   if (!c) return tl::unexpected(c.error());
   if (period <= Time{0})
     return fail(ErrorCode::InvalidArgument, "loop of '" + std::string(component) + "': period must be positive");
@@ -336,7 +336,7 @@ void Shadow::run_loop(std::size_t i) {
   const auto begin = std::chrono::steady_clock::now();
   const Time now = instance_->coordinator().clock().now();
   instance_->monitor().run_active(loop.component, now);
-  const MachineId framework = instance_->coordinator().framework_machine(loop.component);
+  const MachineId framework = instance_->coordinator().structure().framework_machine(loop.component);
   try {
     if (loop.body) loop.body(now);
     if (loop.threw) {
@@ -344,7 +344,7 @@ void Shadow::run_loop(std::size_t i) {
       instance_->coordinator().generate(framework_event::completion_of(framework_event::kThreadException), framework);
     }
   } catch (const std::exception& e) {
-    warn_("the loop of " + std::string(instance_->coordinator().component_name(loop.component)) +
+    warn_("the loop of " + std::string(instance_->coordinator().structure().component_name(loop.component)) +
           " threw: " + e.what());
     if (!loop.threw) instance_->coordinator().generate(framework_event::kThreadException, framework);
     loop.threw = true;
@@ -389,7 +389,7 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
     s.message = "Normal";
     return;
   }
-  const Event& e = co.event(snap.outstanding);
+  const Event& e = co.structure().event(snap.outstanding);
   s.message = std::string(to_string(snap.state)) + ": " + e.name;
   s.values.emplace_back("outstanding", e.name);
   s.values.emplace_back("severity", std::to_string(e.severity));
@@ -399,18 +399,21 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
     const std::string cause = co.resolve_root(root).name();  // a remote root: its origin in its own process
     s.message += " (cause " + cause;
     if (root.sample.present()) {
-      s.message +=
-          ", " + std::string(co.name_of(root.sample.filter)) + " judged " + std::string(co.name_of(root.sample.signal));
+      s.message += ", " + std::string(co.structure().name_of(root.sample.filter)) + " judged " +
+                   std::string(co.structure().name_of(root.sample.signal));
       if (root.sample.filter != graph_name_) s.message += " = " + number_text(root.sample.value);
     }
     s.message += ")";
     s.values.emplace_back("root_cause", cause);
-    if (!co.event(root.event).hazard.empty()) s.values.emplace_back("hazard", co.event(root.event).hazard);
-    if (!co.event(root.event).description.empty())
-      s.values.emplace_back("description", co.event(root.event).description);
+    if (!co.structure().event(root.event).hazard.empty())
+      s.values.emplace_back("hazard", co.structure().event(root.event).hazard);
+    if (!co.structure().event(root.event).description.empty())
+      s.values.emplace_back("description", co.structure().event(root.event).description);
     if (root.sample.present()) {
-      if (root.sample.filter != kNoName) s.values.emplace_back("filter", std::string(co.name_of(root.sample.filter)));
-      if (root.sample.signal != kNoName) s.values.emplace_back("signal", std::string(co.name_of(root.sample.signal)));
+      if (root.sample.filter != kNoName)
+        s.values.emplace_back("filter", std::string(co.structure().name_of(root.sample.filter)));
+      if (root.sample.signal != kNoName)
+        s.values.emplace_back("signal", std::string(co.structure().name_of(root.sample.signal)));
       s.values.emplace_back("value", number_text(root.sample.value));
     }
   }
@@ -421,10 +424,10 @@ void Shadow::fill_status(Status& s, const std::string& address, StateSnapshot sn
 std::vector<Status> Shadow::statuses() {
   const Coordinator& co = instance_->coordinator();
   std::vector<Status> out;
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-    std::vector<MachineId> machines{co.framework_machine(c), co.application_machine(c)};
-    for (MachineId m : co.provided_machines(c)) machines.push_back(m);
-    for (MachineId m : co.required_machines(c)) machines.push_back(m);
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+    std::vector<MachineId> machines{co.structure().framework_machine(c), co.structure().application_machine(c)};
+    for (MachineId m : co.structure().provided_machines(c)) machines.push_back(m);
+    for (MachineId m : co.structure().required_machines(c)) machines.push_back(m);
     // The component: its extended state, explained by the machine that holds its outstanding event.
     const StateSnapshot ext = co.extended(c);
     std::optional<Condition> why;
@@ -436,13 +439,15 @@ std::vector<Status> Shadow::statuses() {
       }
     }
     Status status;
-    fill_status(status, std::string(co.component_name(c)), ext, why);
-    if (const std::string* node = mapping_.node_of(co.component_name(c))) status.values.emplace_back("ros_node", *node);
+    fill_status(status, std::string(co.structure().component_name(c)), ext, why);
+    if (const std::string* node = mapping_.node_of(co.structure().component_name(c)))
+      status.values.emplace_back("ros_node", *node);
     out.push_back(std::move(status));
     for (MachineId m : machines) {
       Status ms;
       const StateSnapshot snap = co.snapshot(m);
-      fill_status(ms, co.address_of(m), snap, snap.state == State::Normal ? std::nullopt : co.outstanding(m));
+      fill_status(ms, co.structure().address_of(m), snap,
+                  snap.state == State::Normal ? std::nullopt : co.outstanding(m));
       out.push_back(std::move(ms));
     }
   }
@@ -520,7 +525,7 @@ void Shadow::apply(Ingest& in) {
   }
   for (std::size_t i = 0; i < 3; ++i) {
     if (!want[i] && in.active[i])
-      instance_->coordinator().generate(instance_->coordinator().event(in.onset[i]).counterpart, in.target);
+      instance_->coordinator().generate(instance_->coordinator().structure().event(in.onset[i]).counterpart, in.target);
   }
   in.active = want;
 }
@@ -554,15 +559,16 @@ void Shadow::check_graph(const GraphView& live) {
     for (const std::string& node : it->second) {
       if (node != GraphView::kSelf) return true;
     }
-    const auto c = co.find_component(iface.substr(0, iface.find('.')));
+    const auto c = co.structure().find_component(iface.substr(0, iface.find('.')));
     return c && std::any_of(loops_.begin(), loops_.end(), [&](const auto& l) { return l->component == *c; });
   };
   auto component_of = [](const std::string& iface) { return iface.substr(0, iface.find('.')); };
   if (live.nodes_known) {
     for (const auto& n : mapping_.nodes) {
       if (live.nodes.count(n.second) != 0) continue;
-      auto c = co.find_component(n.first);
-      report(c ? co.framework_machine(*c) : kNoMachine, "node " + n.second + " of " + n.first + " is not running");
+      auto c = co.structure().find_component(n.first);
+      report(c ? co.structure().framework_machine(*c) : kNoMachine,
+             "node " + n.second + " of " + n.first + " is not running");
     }
   }
   for (const auto& t : topics_) {
@@ -610,8 +616,8 @@ void Shadow::check_graph(const GraphView& live) {
   }
   for (const auto& p : graph_problems_) {
     if (!p.second.empty() && now.count(p.first) == 0) {
-      warn_("ROS graph: " + co.address_of(p.first) + " is complete again");
-      instance_->coordinator().generate(co.event(graph_event_).counterpart, p.first);
+      warn_("ROS graph: " + co.structure().address_of(p.first) + " is complete again");
+      instance_->coordinator().generate(co.structure().event(graph_event_).counterpart, p.first);
     }
   }
   graph_problems_ = std::move(now);

@@ -72,6 +72,7 @@
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
@@ -361,21 +362,22 @@ struct Reference {
 /// row, sorted (built as the Control servant builds its reply).
 std::vector<std::string> rows_of(const Coordinator& co, const std::vector<std::string>& components) {
   std::vector<std::string> out;
-  auto name = [&](EventId e) { return e == kNoEvent ? std::string() : co.event(e).name; };
+  auto name = [&](EventId e) { return e == kNoEvent ? std::string() : co.structure().event(e).name; };
   auto row = [&](const std::string& address, State s, const std::string& outstanding) {
     out.push_back(address + " " + std::string(to_string(s)) + (outstanding.empty() ? "" : " " + outstanding));
   };
   for (const std::string& c : components) {
-    const ComponentId id = *co.find_component(c);
+    const ComponentId id = *co.structure().find_component(c);
     const StateSnapshot s = co.extended(id);
     row(c, s.state, name(s.outstanding));
-    std::vector<MachineId> machines{co.framework_machine(id), co.application_machine(id)};
-    for (MachineId m : co.provided_machines(id)) machines.push_back(m);
-    for (MachineId m : co.required_machines(id)) machines.push_back(m);
-    for (MachineId m : machines) row(co.address_of(m), co.snapshot(m).state, name(co.snapshot(m).outstanding));
-    const auto& provided = co.provided_machines(id);
+    std::vector<MachineId> machines{co.structure().framework_machine(id), co.structure().application_machine(id)};
+    for (MachineId m : co.structure().provided_machines(id)) machines.push_back(m);
+    for (MachineId m : co.structure().required_machines(id)) machines.push_back(m);
+    for (MachineId m : machines)
+      row(co.structure().address_of(m), co.snapshot(m).state, name(co.snapshot(m).outstanding));
+    const auto& provided = co.structure().provided_machines(id);
     for (std::uint32_t p = 0; p < provided.size(); ++p) {
-      row(c + ".s_S." + std::string(co.interface_name(provided[p])), co.service_state(id, p), "");
+      row(c + ".s_S." + std::string(co.structure().interface_name(provided[p])), co.service_state(id, p), "");
     }
   }
   std::sort(out.begin(), out.end());
@@ -721,7 +723,7 @@ public:
   std::string apply(const Operation& op) {
     reference_.clock.advance(1ms);  // distinct onset times, as in the real run
     Expected<void> local =
-        op.reset ? reference_.co->reset(op.target, "chaos", "burst") : reference_.co->generate(op.event, op.target);
+        op.reset ? reset(*reference_.co, op.target, "chaos", "burst") : generate(*reference_.co, op.event, op.target);
     Expected<void> remote =
         robot_client_->apply(op.reset ? introspect::Action(introspect::ResetState{op.target, "chaos", "burst"})
                                       : introspect::Action(introspect::GenerateEvent{op.event, op.target}));
@@ -734,7 +736,7 @@ public:
 
   /// The new robot process starts clean: the reference forgets the robot's faults too.
   void reference_robot_restarted() {
-    for (const std::string& c : components_["robot"]) ASSERT_TRUE(reference_.co->reset(c, "chaos", "robot restarted"));
+    for (const std::string& c : components_["robot"]) ASSERT_TRUE(reset(*reference_.co, c, "chaos", "robot restarted"));
   }
 
   /// Polls divergence() every 20 ms for at most `bound`; true once it is empty, else `problem`
@@ -761,14 +763,14 @@ public:
           out += who + ": explain " + c + " failed: " + why.error().message + "\n";
           continue;
         }
-        out += diff(who + " explain " + c, causes_of(*reference_.co->explain(c)), causes_of(why->conditions));
+        out += diff(who + " explain " + c, causes_of(*explain(*reference_.co, c)), causes_of(why->conditions));
       }
     }
     const SupervisorLog s(supervisor_->log());
     std::vector<std::string> want, got;
     for (const auto& [address, row] : s.view) {
       got.push_back("[" + row.first + "] " + address + " " + row.second);
-      auto a = reference_.co->resolve(address);
+      auto a = reference_.co->structure().resolve(address);
       want.push_back("[" + row.first + "] " + address + " " +
                      (a ? std::string(to_string(reference_.co->state_of(*a))) : std::string("(no such address)")));
     }
@@ -1149,7 +1151,7 @@ TEST(Chaos, WithAReplicatedBrokerEveryProcessConvergesAfterItsMasterOrAnotherRep
       // For 3 s after the kill the robot raises and clears the marker fault, each time as soon
       // as the ui shows the last one: the longest of those waits is how long updates stopped.
       auto in_process = [&] {
-        auto why = chaos.reference().co->explain("PENDANT.s_R.Status");
+        auto why = explain(*chaos.reference().co, "PENDANT.s_R.Status");
         return why && std::any_of(why->begin(), why->end(),
                                   [](const Explanation& e) { return e.root.event == "EVT_FORCE_ERROR"; });
       };

@@ -32,6 +32,7 @@
 
 #include "fixture.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/client.hpp"
@@ -208,7 +209,7 @@ std::string in_process(const std::function<void(Coordinator&)>& setup, const std
   Monitor monitor(co, registry);
   EXPECT_TRUE(spec::instantiate(*load.system, co, monitor));
   setup(co);
-  return causes(*co.explain(address));
+  return causes(*explain(co, address));
 }
 
 std::string ice_of_fixture() {
@@ -236,7 +237,7 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error);
 
   const std::string expected =
-      in_process([](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
+      in_process([](Coordinator& co) { ASSERT_TRUE(generate(co, "EVT_FORCE_ERROR", "JR3.s_A")); }, "PENDANT");
   auto remote = ui->explain("PENDANT");
   ASSERT_TRUE(remote) << remote.error().message;
   EXPECT_EQ(causes(remote->conditions), expected);
@@ -288,7 +289,7 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   Coordinator reference("robodoc", &clock);
   Monitor monitor(reference, registry);
   ASSERT_TRUE(spec::instantiate(*load.system, reference, monitor));
-  const MachineId pendant = *reference.find_machine("PENDANT.s_R.Status");
+  const MachineId pendant = *reference.structure().find_machine("PENDANT.s_R.Status");
   const auto history_before = reference.history(pendant).size();
 
   struct Op {
@@ -312,13 +313,13 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
     const Op op = ops[random() % ops.size()];
     if (std::string(op.event) == "reset") {
       ASSERT_TRUE(robot->apply(in::ResetState{op.target, "audit test", "step " + std::to_string(step)})) << sys.logs();
-      ASSERT_TRUE(reference.reset(op.target, "audit test", "step " + std::to_string(step)));
+      ASSERT_TRUE(reset(reference, op.target, "audit test", "step " + std::to_string(step)));
     } else {
       ASSERT_TRUE(robot->apply(in::GenerateEvent{op.event, op.target})) << sys.logs();
-      ASSERT_TRUE(reference.generate(op.event, op.target));
+      ASSERT_TRUE(generate(reference, op.event, op.target));
     }
     clock.advance(std::chrono::milliseconds(10));
-    const auto want = roots(*reference.explain("PENDANT.s_R.Status"));
+    const auto want = roots(*explain(reference, "PENDANT.s_R.Status"));
     ASSERT_TRUE(eventually([&] {
       auto got = ui->explain("PENDANT.s_R.Status");
       return got && roots(got->conditions) == want;
@@ -331,10 +332,10 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   const auto records = reference.history(pendant);
   for (std::size_t i = history_before; i < records.size(); ++i) {
     const Record& r = records[i];
-    const std::string root_event = r.root.event == kNoEvent ? "" : reference.event(r.root.event).name;
+    const std::string root_event = r.root.event == kNoEvent ? "" : reference.structure().event(r.root.event).name;
     const std::string root_origin = r.root.event == kNoEvent ? "" : reference.resolve_root(r.root).origin;
     const std::string outcome = r.outcome == Outcome::None ? "" : std::string(to_string(r.outcome));
-    const std::string event = r.event == kNoEvent ? "" : reference.event(r.event).name;
+    const std::string event = r.event == kNoEvent ? "" : reference.structure().event(r.event).name;
     expected.push_back(
         history_line(std::string(to_string(r.kind)), outcome, event, r.from, r.to, root_origin, root_event));
     if (r.kind == RecordKind::Transition) {
@@ -574,7 +575,7 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
             0);
   icestorm = static_cast<pid_t>(std::stol(env_file_value(env_file, "ICESTORM_PID")));
   const std::string expected = in_process(
-      [](Coordinator& co) { ASSERT_TRUE(co.generate("EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A")); }, "PENDANT");
+      [](Coordinator& co) { ASSERT_TRUE(generate(co, "EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A")); }, "PENDANT");
   EXPECT_TRUE(eventually(
       [&] {
         auto why = ui->explain("PENDANT");
@@ -666,9 +667,11 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   std::this_thread::sleep_for(300ms);  // subscriptions settle, initial resync done
 
   std::vector<MachineId> targets;
-  for (int i = 0; i < kInterfaces; ++i) targets.push_back(*provider.co->find_machine("S.s_P.D" + std::to_string(i)));
-  const std::vector<EventId> events{*provider.co->find_event("EVT_E"), *provider.co->find_event("/EVT_E"),
-                                    *provider.co->find_event("EVT_F"), *provider.co->find_event("/EVT_F")};
+  for (int i = 0; i < kInterfaces; ++i)
+    targets.push_back(*provider.co->structure().find_machine("S.s_P.D" + std::to_string(i)));
+  const std::vector<EventId> events{
+      *provider.co->structure().find_event("EVT_E"), *provider.co->structure().find_event("/EVT_E"),
+      *provider.co->structure().find_event("EVT_F"), *provider.co->structure().find_event("/EVT_F")};
   const auto before = provider.node->stats();
   const auto applied_before = client.node->stats().updates_applied;
   std::mt19937 random(7);
@@ -679,7 +682,7 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
   }
   // Every interface ends in the provider's exact final state: the same roots (origin, event, onset
   // time) at the client's stand-in S.s_P.Di as at the provider's service S.s_S.Di.
-  const ComponentId s = *provider.co->find_component("S");
+  const ComponentId s = *provider.co->structure().find_component("S");
   std::string mismatch;
   auto same_everywhere = [&] {
     for (int i = 0; i < kInterfaces; ++i) {
@@ -687,12 +690,12 @@ TEST(MultiProcess, ABurstOverManyInterfacesIsBatchedAndEndsInTheProvidersExactSt
       for (const RemoteRoot& r : provider.co->service_roots(s, static_cast<std::uint32_t>(i))) {
         want.push_back(r.root.origin + ":" + r.root.event + "@" + std::to_string(r.root.time.count()));
       }
-      auto why = client.co->explain("S.s_P.D" + std::to_string(i));
+      auto why = explain(*client.co, "S.s_P.D" + std::to_string(i));
       if (!why) return false;
       for (const Explanation& e : *why) got.push_back(e.root.name() + "@" + std::to_string(e.root.time.count()));
       std::sort(want.begin(), want.end());
       std::sort(got.begin(), got.end());
-      const State client_state = client.co->state(*client.co->find_machine("A.s_R.D" + std::to_string(i)));
+      const State client_state = client.co->state(*client.co->structure().find_machine("A.s_R.D" + std::to_string(i)));
       const State provider_state = provider.co->service_state(s, static_cast<std::uint32_t>(i));
       if (want != got || client_state != provider_state) {
         mismatch = "D" + std::to_string(i) + ": provider " + std::string(to_string(provider_state)) + " " +

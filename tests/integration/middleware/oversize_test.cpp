@@ -30,6 +30,7 @@
 #include "auth.hpp"
 #include "fixture.hpp"
 #include "safecass.h"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/keys.hpp"
@@ -261,10 +262,12 @@ struct Bus {
     EXPECT_TRUE(eventually([&] { return n.node->stats().connected; }));
   }
 
-  State client_state(const std::string& address) { return client.co->state_of(*client.co->resolve(address)); }
+  State client_state(const std::string& address) {
+    return client.co->state_of(*client.co->structure().resolve(address));
+  }
   /// The roots the client holds for P's interface `iface` (its stand-in P.s_P.iface).
   std::vector<Condition> held(const std::string& iface) {
-    return client.co->conditions(*client.co->find_machine("P.s_P." + iface));
+    return client.co->conditions(*client.co->structure().find_machine("P.s_P." + iface));
   }
   /// The last update of P.`iface` the tap saw.
   std::optional<wire::StateUpdate> last_update(const std::string& iface) {
@@ -284,9 +287,9 @@ TEST(Oversize, AStateUpdateTooLargeForOneMessageGoesOutWithItsMostSevereRootsAnd
   constexpr int kErrors = 3;
   Bus bus(kWarnings, kErrors);
   Coordinator& p = *bus.provider.co;
-  for (int i = 0; i < kWarnings; ++i) ASSERT_TRUE(p.generate(long_event("WARNING", i), "P.s_A"));
-  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(p.generate(long_event("ERROR", i), "P.s_A"));
-  const ComponentId pc = *p.find_component("P");
+  for (int i = 0; i < kWarnings; ++i) ASSERT_TRUE(generate(p, long_event("WARNING", i), "P.s_A"));
+  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(generate(p, long_event("ERROR", i), "P.s_A"));
+  const ComponentId pc = *p.structure().find_component("P");
   ASSERT_EQ(p.service_roots(pc, 0).size(), std::size_t{kWarnings + kErrors});
   bus.start_provider();  // its first message carries the whole state: about 10 KB of roots
   ASSERT_TRUE(bus.provider.node && bus.client.node);
@@ -328,10 +331,10 @@ TEST(Oversize, AStateUpdateTooLargeForOneMessageGoesOutWithItsMostSevereRootsAnd
 
   // The errors clear: the state is still too large, the client follows it down to Warning, and
   // to Normal when the warnings clear too.
-  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(p.generate("/" + long_event("ERROR", i), "P.s_A"));
+  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(generate(p, "/" + long_event("ERROR", i), "P.s_A"));
   EXPECT_TRUE(eventually([&] { return bus.client_state("C.s_R.D") == State::Warning; }))
       << bus.provider.all_log() << bus.client.all_log();
-  for (int i = 0; i < kWarnings; ++i) ASSERT_TRUE(p.generate("/" + long_event("WARNING", i), "P.s_A"));
+  for (int i = 0; i < kWarnings; ++i) ASSERT_TRUE(generate(p, "/" + long_event("WARNING", i), "P.s_A"));
   EXPECT_TRUE(eventually([&] { return bus.client_state("C.s_R.D") == State::Normal && bus.held("D").empty(); }))
       << bus.provider.all_log();
   for (std::size_t size : bus.states->sizes()) EXPECT_LE(size, kLimit);
@@ -344,7 +347,7 @@ TEST(Oversize, ABatchTooLargeForOneMessageIsSplitAndEveryUpdateArrivesWhole) {
   Bus bus(0, 5);
   Coordinator& p = *bus.provider.co;
   for (int i = 0; i < 5; ++i) {
-    for (int e = 0; e < 8; ++e) ASSERT_TRUE(p.generate(long_event("ERROR", i), "P.s_P.E" + std::to_string(e)));
+    for (int e = 0; e < 8; ++e) ASSERT_TRUE(generate(p, long_event("ERROR", i), "P.s_P.E" + std::to_string(e)));
   }
   const std::size_t before = bus.states->batches().size();
   bus.start_provider();  // on connecting it sends every interface in one cycle
@@ -381,10 +384,10 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
   Coordinator& p = *bus.provider.co;
   // About 17 records of ~400 bytes (events and transitions on every interface): more than one
   // message when they share a cycle.
-  for (int e = 0; e < 8; ++e) ASSERT_TRUE(p.generate(long_event("ERROR", 0), "P.s_P.E" + std::to_string(e)));
+  for (int e = 0; e < 8; ++e) ASSERT_TRUE(generate(p, long_event("ERROR", 0), "P.s_P.E" + std::to_string(e)));
   // A reset whose reason is 10,000 bytes: its record alone does not fit.
   const std::string reason(10000, 'r');
-  ASSERT_TRUE(p.reset("P.s_A", "operator", reason));
+  ASSERT_TRUE(reset(p, "P.s_A", "operator", reason));
 
   std::vector<wire::EventMessage> seen;
   ASSERT_TRUE(eventually([&] {
@@ -423,7 +426,7 @@ TEST(Oversize, AStateOfMegabytesIsCutToTheDefaultLimitAndCrossesIceStormWhole) {
   constexpr std::size_t kName = 400'000;
   Bus bus(0, kErrors, kName, middleware::kDefaultMaxMessageBytes);
   Coordinator& p = *bus.provider.co;
-  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(p.generate(long_event("ERROR", i, kName), "P.s_A"));
+  for (int i = 0; i < kErrors; ++i) ASSERT_TRUE(generate(p, long_event("ERROR", i, kName), "P.s_A"));
   bus.start_provider();
   ASSERT_TRUE(bus.provider.node && bus.client.node);
   ASSERT_TRUE(

@@ -38,6 +38,7 @@
 #include "fixture.hpp"
 #include "receiver.hpp"
 #include "safecass.h"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
@@ -279,7 +280,7 @@ struct Bus {
     std::lock_guard lock(mutex);
     for (const wire::StateUpdate& u : batch) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.seq);
   }
-  State state(const std::string& machine) { return co.state(*co.find_machine(machine)); }
+  State state(const std::string& machine) { return co.state(*co.structure().find_machine(machine)); }
   std::string all_log() {
     std::lock_guard lock(mutex);
     std::string all;
@@ -287,7 +288,7 @@ struct Bus {
     return all;
   }
   bool explains(const std::string& machine, const std::string& event) {
-    auto why = co.explain(machine);
+    auto why = explain(co, machine);
     if (!why) return false;
     for (const Explanation& e : *why) {
       if (e.event == event || e.root.event == event) return true;
@@ -411,7 +412,8 @@ TEST(Wire, AClientRaisesCoordinatorLostWhenItsProviderFallsSilentAndClearsOnceIt
   for (const char* r : {"C.s_R.D0", "C.s_R.D1", "C.s_R.D2", "C.s_R.D3"}) {
     EXPECT_TRUE(bus.explains(r, "EVT_COORDINATOR_LOST")) << r;
   }
-  EXPECT_EQ(bus.co.extended_state(*bus.co.find_component("C")), State::Error) << "dispatch() in the client sees Error";
+  EXPECT_EQ(bus.co.extended(*bus.co.structure().find_component("C")).state, State::Error)
+      << "dispatch() in the client sees Error";
   EXPECT_EQ(bus.node->stats().providers_lost, 1u);
 
   // Back, but with a state the client has not received yet (seq 2): still lost.
@@ -747,7 +749,7 @@ TEST(Wire, TheSupervisorReportsLostACoordinatorOfTheSystemItNeverHeardFrom) {
     std::this_thread::sleep_for(100ms);
   }
   EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
-  EXPECT_EQ(sup.model().state(*sup.model().find_machine("P.s_F")), State::Error) << out.all();
+  EXPECT_EQ(sup.model().state(*sup.model().structure().find_machine("P.s_F")), State::Error) << out.all();
   EXPECT_NE(out.all().find("coordinator 'wire-p' lost: no heartbeat for 600 ms (never proven alive since the "
                            "supervisor connected)"),
             std::string::npos)
@@ -756,8 +758,9 @@ TEST(Wire, TheSupervisorReportsLostACoordinatorOfTheSystemItNeverHeardFrom) {
 
   bus.beating.store(true);  // its first authentic heartbeat: up, and recovered
   EXPECT_TRUE(eventually([&] { return sup.lost().empty(); })) << out.all();
-  EXPECT_TRUE(eventually([&] { return sup.model().state(*sup.model().find_machine("P.s_F")) == State::Normal; }))
-      << out.all();
+  EXPECT_TRUE(eventually([&] {
+    return sup.model().state(*sup.model().structure().find_machine("P.s_F")) == State::Normal;
+  })) << out.all();
   supervisor->stop();
 }
 
@@ -841,8 +844,9 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   // A coordinator that falls silent is lost: the view gets worse, never stale-green.
   bus.beating.store(false);
   EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
-  EXPECT_TRUE(eventually([&] { return sup.model().state(*sup.model().find_machine("P.s_F")) == State::Error; }))
-      << out.all();
+  EXPECT_TRUE(eventually([&] {
+    return sup.model().state(*sup.model().structure().find_machine("P.s_F")) == State::Error;
+  })) << out.all();
   (*supervisor)->stop();
 }
 
@@ -1530,7 +1534,7 @@ TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) 
   }
   ASSERT_TRUE(eventually([&] { return static_cast<std::int64_t>((*client)->records_refused()) >= refused + 2; }));
   // What wire-c really records is shown.
-  ASSERT_TRUE(bus.co.reset("C", "operator", "real").has_value());
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "real").has_value());
   ASSERT_TRUE(eventually([&] {
     std::lock_guard lock(mutex);
     return std::any_of(shown.begin(), shown.end(),

@@ -118,7 +118,7 @@ struct Rig {
 
   Rig() {
     single = *co.add_component("SINGLE");
-    single_app = co.application_machine(single);
+    single_app = co.structure().application_machine(single);
     (void)co.add_provided(single, "out");
     for (int i = 0; i < 10; ++i) {
       const ComponentId c = *co.add_component("C" + std::to_string(i));
@@ -129,7 +129,7 @@ struct Rig {
       }
       chain.push_back(c);
     }
-    head_app = co.application_machine(chain.front());
+    head_app = co.structure().application_machine(chain.front());
     onset = *co.add_event(EventDef{"EVT_ERR", 50, {Transition::N2E, Transition::W2E}, "", false, "", ""});
     completion = *co.add_event(EventDef{"/EVT_ERR", 50, {Transition::E2N, Transition::E2W}, "", false, "", ""});
     warning = *co.add_event(EventDef{"EVT_WARN", 40, {Transition::N2W}, "", false, "", ""});
@@ -139,15 +139,15 @@ struct Rig {
   /// Onset then completion on one machine; true when both caused the expected transitions.
   bool single_round() {
     co.generate(onset, single_app);
-    const bool raised = co.state(single_app) == State::Error && co.extended_state(single) == State::Error;
+    const bool raised = co.state(single_app) == State::Error && co.extended(single).state == State::Error;
     co.generate(completion, single_app);
-    return raised && co.state(single_app) == State::Normal && co.extended_state(single) == State::Normal;
+    return raised && co.state(single_app) == State::Normal && co.extended(single).state == State::Normal;
   }
 
   /// Onset at the head of the chain then its completion; true when it reached and left the tail.
   bool chain_round() {
     co.generate(onset, head_app);
-    const bool reached = co.extended_state(chain.back()) == State::Error;
+    const bool reached = co.extended(chain.back()).state == State::Error;
     co.generate(completion, head_app);
     return reached && co.coordinator_state() == State::Normal;
   }
@@ -177,7 +177,7 @@ TEST(CoreAllocation, LockFreeReadsAndDispatchAllocateNothing) {
   long sink = 0;
   auto read_everything = [&] {
     for (int i = 0; i < kRounds; ++i) {
-      sink += static_cast<long>(rig.co.extended_state(rig.single));
+      sink += static_cast<long>(rig.co.extended(rig.single).state);
       sink += static_cast<long>(rig.co.extended(rig.single).outstanding);
       sink += static_cast<long>(rig.co.snapshot(rig.single_app).outstanding);
       sink += static_cast<long>(rig.co.state(rig.single_app));
@@ -225,12 +225,12 @@ TEST(CoreAllocation, WithAnObserverAndCallbacksOnEveryMachineTheHotPathsStillAll
   long records = 0;
   long callbacks = 0;
   rig.co.subscribe([&records](const Record&) { ++records; });
-  for (MachineId m : id_range<MachineId>(rig.co.machine_count())) {
+  for (MachineId m : id_range<MachineId>(rig.co.structure().machine_count())) {
     rig.co.on_machine(
         m, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});
   }
-  for (ComponentId c : id_range<ComponentId>(rig.co.component_count())) {
+  for (ComponentId c : id_range<ComponentId>(rig.co.structure().component_count())) {
     rig.co.on_component(
         c, StateCallbacks{[&callbacks](State) { ++callbacks; }, [&callbacks](const TransitionInfo&) { ++callbacks; },
                           [&callbacks](State) { ++callbacks; }});
@@ -271,7 +271,7 @@ TEST(CoreAllocation, RefreshesIgnoredCompletionsMaskedOnsetsAndWarningPropagatio
     rig.co.generate(rig.warning, rig.head_app);       // refresh
     rig.co.generate(rig.completion, rig.single_app);  // ignored: not active
     rig.co.generate(rig.completion, rig.head_app);    // E2W everywhere: the warning is still present
-    ok = ok && rig.co.extended_state(rig.chain.back()) == State::Warning;
+    ok = ok && rig.co.extended(rig.chain.back()).state == State::Warning;
     rig.co.generate(rig.warning_completion, rig.head_app);
     ok = ok && rig.co.coordinator_state() == State::Normal;
     return ok;
@@ -316,7 +316,7 @@ TEST(CoreAllocation, InterningAKnownNameAndAnEventWithFilterDataAllocateNothing)
   EXPECT_TRUE(ok);
   EXPECT_EQ(use.allocations, 0);
   EXPECT_EQ(use.deallocations, 0);
-  EXPECT_EQ(rig.co.name_of(filter), "force_limit");
+  EXPECT_EQ(rig.co.structure().name_of(filter), "force_limit");
 }
 
 }  // namespace

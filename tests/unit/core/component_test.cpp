@@ -9,6 +9,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -40,23 +41,25 @@ const char* const kMachinesOfC[] = {"C.s_F", "C.s_A", "C.s_P.p", "C.s_P.q", "C.s
 TEST(ComponentModel, AComponentOwnsFrameworkApplicationProvidedAndRequiredMachines) {
   Comp c;
   const ComponentId id = c.comp("C");
-  EXPECT_EQ(c.co.machine_kind(c.co.framework_machine(id)), MachineKind::Framework);
-  EXPECT_EQ(c.co.machine_kind(c.co.application_machine(id)), MachineKind::Application);
-  ASSERT_EQ(c.co.provided_machines(id).size(), 2u);
-  ASSERT_EQ(c.co.required_machines(id).size(), 2u);
-  EXPECT_EQ(c.co.address_of(c.co.framework_machine(id)), "C.s_F");
-  EXPECT_EQ(c.co.address_of(c.co.application_machine(id)), "C.s_A");
-  EXPECT_EQ(c.co.address_of(c.co.provided_machines(id)[1]), "C.s_P.q");
-  EXPECT_EQ(c.co.address_of(c.co.required_machines(id)[0]), "C.s_R.r1");
-  EXPECT_EQ(c.co.interface_name(c.co.provided_machines(id)[0]), "p");
-  EXPECT_EQ(c.co.interface_name(c.co.required_machines(id)[1]), "r2");
-  for (MachineId m : c.co.provided_machines(id)) EXPECT_EQ(c.co.machine_kind(m), MachineKind::Provided);
-  for (MachineId m : c.co.required_machines(id)) EXPECT_EQ(c.co.machine_kind(m), MachineKind::Required);
+  EXPECT_EQ(c.co.structure().machine_kind(c.co.structure().framework_machine(id)), MachineKind::Framework);
+  EXPECT_EQ(c.co.structure().machine_kind(c.co.structure().application_machine(id)), MachineKind::Application);
+  ASSERT_EQ(c.co.structure().provided_machines(id).size(), 2u);
+  ASSERT_EQ(c.co.structure().required_machines(id).size(), 2u);
+  EXPECT_EQ(c.co.structure().address_of(c.co.structure().framework_machine(id)), "C.s_F");
+  EXPECT_EQ(c.co.structure().address_of(c.co.structure().application_machine(id)), "C.s_A");
+  EXPECT_EQ(c.co.structure().address_of(c.co.structure().provided_machines(id)[1]), "C.s_P.q");
+  EXPECT_EQ(c.co.structure().address_of(c.co.structure().required_machines(id)[0]), "C.s_R.r1");
+  EXPECT_EQ(c.co.structure().interface_name(c.co.structure().provided_machines(id)[0]), "p");
+  EXPECT_EQ(c.co.structure().interface_name(c.co.structure().required_machines(id)[1]), "r2");
+  for (MachineId m : c.co.structure().provided_machines(id))
+    EXPECT_EQ(c.co.structure().machine_kind(m), MachineKind::Provided);
+  for (MachineId m : c.co.structure().required_machines(id))
+    EXPECT_EQ(c.co.structure().machine_kind(m), MachineKind::Required);
   for (const char* a : kMachinesOfC) {
-    EXPECT_EQ(c.co.machine_component(c.machine(a)), id) << a;
+    EXPECT_EQ(c.co.structure().machine_component(c.machine(a)), id) << a;
     EXPECT_EQ(c.at(a), N) << a;
   }
-  EXPECT_EQ(c.co.machine_count(), 6u + 3u);
+  EXPECT_EQ(c.co.structure().machine_count(), 6u + 3u);
 }
 
 // ---- service state ----------------------------------------------------------------------------------
@@ -143,7 +146,7 @@ TEST(ServiceState, ServiceEntryErrorsNameTheServiceAndChangeNothing) {
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
   EXPECT_NE(r.error().message.find("nope"), std::string::npos);
-  EXPECT_TRUE(c.co.service(c.comp("C"), 0).all_required) << "the failed entry must not be applied";
+  EXPECT_TRUE(c.co.structure().service(c.comp("C"), 0).all_required) << "the failed entry must not be applied";
 
   r = c.co.set_service(c.comp("C"), "zz", ServiceDependency{});
   ASSERT_FALSE(r);
@@ -155,7 +158,7 @@ TEST(ServiceState, ServiceEntryErrorsNameTheServiceAndChangeNothing) {
   r = c.co.set_service(c.comp("C"), "p", normal);
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
-  EXPECT_EQ(c.co.service(c.comp("C"), 0).propagate, E);
+  EXPECT_EQ(c.co.structure().service(c.comp("C"), 0).propagate, E);
 
   r = c.co.set_service(ComponentId{99}, "p", ServiceDependency{});
   ASSERT_FALSE(r);
@@ -169,10 +172,10 @@ TEST(ServiceState, TheServiceEntryCannotChangeWhileTheComponentHoldsConditions) 
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidState);
   EXPECT_NE(r.error().message.find("C.p"), std::string::npos) << r.error().message;
-  EXPECT_TRUE(c.co.service(c.comp("C"), 0).application) << "the entry is unchanged";
+  EXPECT_TRUE(c.co.structure().service(c.comp("C"), 0).application) << "the entry is unchanged";
   c.gen("/WF", "C.s_A");
   EXPECT_TRUE(c.co.set_service(c.comp("C"), "p", ServiceDependency::provided_only()));
-  EXPECT_FALSE(c.co.service(c.comp("C"), 0).application);
+  EXPECT_FALSE(c.co.structure().service(c.comp("C"), 0).application);
 }
 
 // Only conditions on C's own machines can flow through C's services (anything that reaches C
@@ -181,7 +184,7 @@ TEST(ServiceState, AConditionOnAnotherComponentDoesNotBlockTheChange) {
   Comp c;
   c.gen("WF", "D.s_A");
   EXPECT_TRUE(c.co.set_service(c.comp("C"), "p", ServiceDependency::provided_only()));
-  EXPECT_FALSE(c.co.service(c.comp("C"), 0).application);
+  EXPECT_FALSE(c.co.structure().service(c.comp("C"), 0).application);
 }
 
 // ---- extended state ---------------------------------------------------------------------------------
@@ -191,7 +194,7 @@ TEST(ExtendedState, IsTheProductOfEveryMachineOfTheComponent) {
     Comp c;
     c.gen("WF", source);
     EXPECT_EQ(c.at("C"), W) << source;
-    EXPECT_EQ(c.co.extended_state(c.comp("C")), W) << source;
+    EXPECT_EQ(c.co.extended(c.comp("C")).state, W) << source;
     EXPECT_EQ(c.at("D"), N) << source;
     c.gen("EF", source);
     EXPECT_EQ(c.at("C"), E) << source;
@@ -395,7 +398,7 @@ TEST(Callbacks, EventsGeneratedFromACallbackAreProcessedBeforeTheOuterGenerateRe
                                                        if (s == E) c.co.generate(c.id("WF"), c.machine("D.s_A"));
                                                      }});
   c.co.on_component(c.comp("D"), StateCallbacks{{}, {}, [&](State s) {
-                                                  if (s == W) test::must(c.co.generate("EF", "D.s_F"), "generate");
+                                                  if (s == W) test::must(generate(c.co, "EF", "D.s_F"), "generate");
                                                 }});
   c.gen("EF", "C.s_A");
   EXPECT_EQ(c.at("D.s_A"), W);
@@ -407,7 +410,7 @@ TEST(Callbacks, AResetRequestedFromACallbackIsAppliedBeforeTheOuterCallReturns) 
   Comp c;
   c.co.on_machine(c.machine("C.s_A"), StateCallbacks{{}, {}, [&](State s) {
                                                        if (s == E)
-                                                         test::must(c.co.reset("D", "C", "interlock"), "reset");
+                                                         test::must(reset(c.co, "D", "C", "interlock"), "reset");
                                                      }});
   c.pair("LATCHED", 40, E, true);
   c.gen("LATCHED", "D.s_A");
@@ -439,7 +442,7 @@ TEST(Callbacks, ACallbackSeesTheNewStateWhenItsEntryFires) {
   c.co.on_machine(c.machine("C.s_A"),
                   StateCallbacks{{}, {}, [&](State) { seen_machine = c.co.state(c.machine("C.s_A")); }});
   c.co.on_component(c.comp("C"),
-                    StateCallbacks{{}, {}, [&](State) { seen_component = c.co.extended_state(c.comp("C")); }});
+                    StateCallbacks{{}, {}, [&](State) { seen_component = c.co.extended(c.comp("C")).state; }});
   c.gen("WF", "C.s_A");
   EXPECT_EQ(seen_machine, W);
   EXPECT_EQ(seen_component, W);

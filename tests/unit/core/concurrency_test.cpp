@@ -39,7 +39,7 @@ struct Chain : Gcm {
       test::must(co.connect("C" + std::to_string(k) + ".In", "C" + std::to_string(k - 1) + ".Out"), "connect");
     }
   }
-  MachineId app(int k) const { return co.application_machine(components[static_cast<std::size_t>(k)]); }
+  MachineId app(int k) const { return co.structure().application_machine(components[static_cast<std::size_t>(k)]); }
 };
 
 TEST(Concurrency, OperationsFromSeveralThreadsNeverInterleaveAndRecordsStayInOrder) {
@@ -59,7 +59,7 @@ TEST(Concurrency, OperationsFromSeveralThreadsNeverInterleaveAndRecordsStayInOrd
   }
   for (auto& t : threads) t.join();
   for (int k = 0; k < kThreads; ++k) {
-    EXPECT_EQ(co.extended_state(chain.components[static_cast<std::size_t>(k)]), State::Normal);
+    EXPECT_EQ(co.extended(chain.components[static_cast<std::size_t>(k)]).state, State::Normal);
     EXPECT_TRUE(co.conditions(chain.app(k)).empty());
   }
   ASSERT_FALSE(seqs.empty());

@@ -9,6 +9,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -35,7 +36,8 @@ struct Counts {
   bool operator==(const Counts&) const = default;
 };
 Counts counts(const Coordinator& co) {
-  return Counts{co.component_count(), co.machine_count(), co.event_count(), co.connections().size()};
+  return Counts{co.structure().component_count(), co.structure().machine_count(), co.structure().event_count(),
+                co.structure().connections().size()};
 }
 
 /// Runs a failing configuration call and checks the error names `offending`, has `code`, and
@@ -57,7 +59,7 @@ TEST(BadInput, DuplicateComponentIsRejectedAndChangesNothing) {
   Model m;
   expect_rejected<ComponentId>(
       m, [&] { return m.co.add_component("JR3"); }, ErrorCode::Duplicate, "JR3");
-  EXPECT_EQ(m.co.provided_machines(m.comp("JR3")).size(), 1u);
+  EXPECT_EQ(m.co.structure().provided_machines(m.comp("JR3")).size(), 1u);
 }
 
 TEST(BadInput, InvalidComponentNamesAreRejected) {
@@ -77,11 +79,11 @@ TEST(BadInput, AComponentCannotTakeANameThatAddressesTheWholeSystem) {
 
 TEST(Addresses, TheCoordinatorsNameAddressesTheSystemUnlessAComponentHasThatName) {
   Model m;
-  const auto system = m.co.resolve("robot");
+  const auto system = m.co.structure().resolve("robot");
   ASSERT_TRUE(system);
   EXPECT_EQ(system->kind, Address::Kind::System);
   const ComponentId robot = *m.co.add_component("robot");
-  const auto component = m.co.resolve("robot");
+  const auto component = m.co.structure().resolve("robot");
   ASSERT_TRUE(component);
   EXPECT_EQ(component->kind, Address::Kind::Component);
   EXPECT_EQ(component->component, robot);
@@ -99,14 +101,14 @@ TEST(BadInput, DuplicateInterfaceIsRejectedAndChangesNothing) {
   const auto r = m.co.add_provided(jr3, "ForceData");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("JR3"), std::string::npos);
-  EXPECT_EQ(m.co.provided_machines(jr3).size(), 1u);
-  EXPECT_EQ(m.co.required_machines(control).size(), 1u);
+  EXPECT_EQ(m.co.structure().provided_machines(jr3).size(), 1u);
+  EXPECT_EQ(m.co.structure().required_machines(control).size(), 1u);
 }
 
 TEST(BadInput, AProvidedAndARequiredInterfaceMayShareAName) {
   Model m;
   EXPECT_TRUE(m.co.add_provided(m.comp("CONTROL"), "ForceData"));
-  EXPECT_EQ(m.co.address_of(m.machine("CONTROL.s_P.ForceData")), "CONTROL.s_P.ForceData");
+  EXPECT_EQ(m.co.structure().address_of(m.machine("CONTROL.s_P.ForceData")), "CONTROL.s_P.ForceData");
   EXPECT_NE(m.machine("CONTROL.s_P.ForceData"), m.machine("CONTROL.s_R.ForceData"));
 }
 
@@ -127,7 +129,7 @@ TEST(BadInput, DuplicateEventNameIsRejectedAndChangesNothing) {
   expect_rejected<EventId>(
       m, [&] { return m.co.add_event(onset("EVT_FORCE_ERROR", 60, kToError)); }, ErrorCode::Duplicate,
       "EVT_FORCE_ERROR");
-  EXPECT_EQ(m.co.event(m.id("EVT_FORCE_ERROR")).severity, 50);
+  EXPECT_EQ(m.co.structure().event(m.id("EVT_FORCE_ERROR")).severity, 50);
 }
 
 TEST(BadInput, EventMixingWorseningAndImprovingTransitionsIsRejectedAndChangesNothing) {
@@ -138,7 +140,7 @@ TEST(BadInput, EventMixingWorseningAndImprovingTransitionsIsRejectedAndChangesNo
         return m.co.add_event(onset("EVT_BAD", 10, {Transition::N2E, Transition::E2N}));
       },
       ErrorCode::InvalidArgument, "EVT_BAD");
-  EXPECT_FALSE(m.co.find_event("EVT_BAD"));
+  EXPECT_FALSE(m.co.structure().find_event("EVT_BAD"));
 }
 
 TEST(BadInput, SeverityOutside1To255IsRejectedAndChangesNothing) {
@@ -147,7 +149,7 @@ TEST(BadInput, SeverityOutside1To255IsRejectedAndChangesNothing) {
     expect_rejected<EventId>(
         m, [&] { return m.co.add_event(onset("EVT_SEV", severity, kToError)); }, ErrorCode::InvalidArgument, "EVT_SEV");
   }
-  EXPECT_FALSE(m.co.find_event("EVT_SEV"));
+  EXPECT_FALSE(m.co.structure().find_event("EVT_SEV"));
 }
 
 TEST(BadInput, ACompletionThatFailsDoesNotLinkItselfToItsOnset) {
@@ -157,7 +159,7 @@ TEST(BadInput, ACompletionThatFailsDoesNotLinkItselfToItsOnset) {
   bad.latched = true;
   expect_rejected<EventId>(
       m, [&] { return m.co.add_event(bad); }, ErrorCode::InvalidArgument, "/EVT_ON");
-  EXPECT_EQ(m.co.event(m.id("EVT_ON")).counterpart, kNoEvent);
+  EXPECT_EQ(m.co.structure().event(m.id("EVT_ON")).counterpart, kNoEvent);
 }
 
 TEST(BadInput, ConnectionToAnUnknownComponentIsRejectedAndChangesNothing) {
@@ -212,17 +214,17 @@ TEST(BadInput, ARejectedConnectionDoesNotPropagateAnything) {
 
 TEST(BadInput, GeneratingUnknownEventsOrOnUnknownOrNonMachineTargetsIsAnError) {
   Model m;
-  auto r = m.co.generate("EVT_NOPE", "JR3.s_A");
+  auto r = generate(m.co, "EVT_NOPE", "JR3.s_A");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
   EXPECT_NE(r.error().message.find("EVT_NOPE"), std::string::npos);
 
-  r = m.co.generate("EVT_FORCE_ERROR", "JR3.s_X");
+  r = generate(m.co, "EVT_FORCE_ERROR", "JR3.s_X");
   ASSERT_FALSE(r);
   EXPECT_NE(r.error().message.find("JR3.s_X"), std::string::npos);
 
   for (const char* not_a_machine : {"JR3", "SYSTEM", "JR3.s_S.ForceData"}) {
-    r = m.co.generate("EVT_FORCE_ERROR", not_a_machine);
+    r = generate(m.co, "EVT_FORCE_ERROR", not_a_machine);
     ASSERT_FALSE(r) << not_a_machine;
     EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument) << not_a_machine;
     EXPECT_NE(r.error().message.find(not_a_machine), std::string::npos) << r.error().message;
@@ -235,7 +237,7 @@ TEST(BadInput, GeneratingUnknownEventsOrOnUnknownOrNonMachineTargetsIsAnError) {
 TEST(Address, SystemAndTheCoordinatorsNameResolveToTheSystem) {
   Model m;
   for (const char* a : {"SYSTEM", "robot"}) {
-    const auto r = m.co.resolve(a);
+    const auto r = m.co.structure().resolve(a);
     ASSERT_TRUE(r) << a;
     EXPECT_EQ(r->kind, Address::Kind::System) << a;
   }
@@ -243,7 +245,7 @@ TEST(Address, SystemAndTheCoordinatorsNameResolveToTheSystem) {
 
 TEST(Address, AComponentNameResolvesToItsExtendedState) {
   Model m;
-  const auto r = m.co.resolve("CONTROL");
+  const auto r = m.co.structure().resolve("CONTROL");
   ASSERT_TRUE(r);
   EXPECT_EQ(r->kind, Address::Kind::Component);
   EXPECT_EQ(r->component, m.comp("CONTROL"));
@@ -257,19 +259,19 @@ TEST(Address, EveryMachineAddressResolvesToThatMachine) {
     MachineId expected;
   };
   const Row rows[] = {
-      {"CONTROL.s_F", m.co.framework_machine(control)},
-      {"CONTROL.s_A", m.co.application_machine(control)},
-      {"CONTROL.s_P.Motion", m.co.provided_machines(control)[0]},
-      {"CONTROL.s_R.ForceData", m.co.required_machines(control)[0]},
+      {"CONTROL.s_F", m.co.structure().framework_machine(control)},
+      {"CONTROL.s_A", m.co.structure().application_machine(control)},
+      {"CONTROL.s_P.Motion", m.co.structure().provided_machines(control)[0]},
+      {"CONTROL.s_R.ForceData", m.co.structure().required_machines(control)[0]},
   };
   for (const Row& row : rows) {
-    const auto r = m.co.resolve(row.text);
+    const auto r = m.co.structure().resolve(row.text);
     ASSERT_TRUE(r) << row.text;
     EXPECT_EQ(r->kind, Address::Kind::Machine) << row.text;
     EXPECT_EQ(r->component, control) << row.text;
     EXPECT_EQ(r->machine, row.expected) << row.text;
-    EXPECT_EQ(m.co.address_of(row.expected), row.text) << "address_of round-trips";
-    const auto id = m.co.find_machine(row.text);
+    EXPECT_EQ(m.co.structure().address_of(row.expected), row.text) << "address_of round-trips";
+    const auto id = m.co.structure().find_machine(row.text);
     ASSERT_TRUE(id) << row.text;
     EXPECT_EQ(*id, row.expected);
   }
@@ -277,14 +279,14 @@ TEST(Address, EveryMachineAddressResolvesToThatMachine) {
 
 TEST(Address, AServiceAddressResolvesToTheProvidedInterfacesServiceState) {
   Model m;
-  const auto r = m.co.resolve("CONTROL.s_S.Motion");
+  const auto r = m.co.structure().resolve("CONTROL.s_S.Motion");
   ASSERT_TRUE(r);
   EXPECT_EQ(r->kind, Address::Kind::Service);
   EXPECT_EQ(r->component, m.comp("CONTROL"));
   EXPECT_EQ(r->service, 0u);
   m.gen("EVT_FORCE_ERROR", "CONTROL.s_A");
   EXPECT_EQ(m.co.state_of(*r), State::Error);
-  const auto machine = m.co.find_machine("CONTROL.s_S.Motion");
+  const auto machine = m.co.structure().find_machine("CONTROL.s_S.Motion");
   ASSERT_FALSE(machine);
   EXPECT_EQ(machine.error().code, ErrorCode::InvalidArgument);
   EXPECT_NE(machine.error().message.find("CONTROL.s_S.Motion"), std::string::npos);
@@ -325,7 +327,7 @@ TEST(Address, BadAddressesGiveClearErrors) {
       {"system", ErrorCode::NotFound, "system"},
   };
   for (const Row& row : rows) {
-    const auto r = m.co.resolve(row.text);
+    const auto r = m.co.structure().resolve(row.text);
     ASSERT_FALSE(r) << "'" << row.text << "' resolved";
     EXPECT_EQ(r.error().code, row.code) << row.text << ": " << r.error().message;
     EXPECT_NE(r.error().message.find(row.named), std::string::npos)
@@ -335,11 +337,11 @@ TEST(Address, BadAddressesGiveClearErrors) {
 
 TEST(Address, LookupsByNameFailClearlyForUnknownNames) {
   Model m;
-  const auto c = m.co.find_component("GHOST");
+  const auto c = m.co.structure().find_component("GHOST");
   ASSERT_FALSE(c);
   EXPECT_EQ(c.error().code, ErrorCode::NotFound);
   EXPECT_NE(c.error().message.find("GHOST"), std::string::npos);
-  const auto e = m.co.find_event("EVT_GHOST");
+  const auto e = m.co.structure().find_event("EVT_GHOST");
   ASSERT_FALSE(e);
   EXPECT_NE(e.error().message.find("EVT_GHOST"), std::string::npos);
 }
@@ -348,8 +350,8 @@ TEST(Address, LookupsByNameFailClearlyForUnknownNames) {
 
 TEST(Configuration, ConnectionsRecordClientAndProviderInterfaces) {
   Model m;
-  ASSERT_EQ(m.co.connections().size(), 1u);
-  const Connection& c = m.co.connections()[0];
+  ASSERT_EQ(m.co.structure().connections().size(), 1u);
+  const Connection& c = m.co.structure().connections()[0];
   EXPECT_EQ(c.client, m.comp("CONTROL"));
   EXPECT_EQ(c.required, 0u);
   EXPECT_EQ(c.provider, m.comp("JR3"));
@@ -360,20 +362,20 @@ TEST(Configuration, CountsGrowWithTheModel) {
   Model m;
   const Counts before = counts(m.co);
   const ComponentId id = m.component("NEW", {"a", "b"}, {"c"});
-  EXPECT_EQ(m.co.component_name(id), "NEW");
-  EXPECT_EQ(m.co.component_count(), before.components + 1);
-  EXPECT_EQ(m.co.machine_count(), before.machines + 2 + 2 + 1);
+  EXPECT_EQ(m.co.structure().component_name(id), "NEW");
+  EXPECT_EQ(m.co.structure().component_count(), before.components + 1);
+  EXPECT_EQ(m.co.structure().machine_count(), before.machines + 2 + 2 + 1);
   m.pair("EVT_NEW", 5, State::Warning);
-  EXPECT_EQ(m.co.event_count(), before.events + 2);
+  EXPECT_EQ(m.co.structure().event_count(), before.events + 2);
   m.connect("NEW.c", "CONTROL.Motion");
-  EXPECT_EQ(m.co.connections().size(), before.connections + 1);
+  EXPECT_EQ(m.co.structure().connections().size(), before.connections + 1);
 }
 
 TEST(Configuration, TheCoordinatorReadsTimeFromTheInjectedClock) {
   Model m;
   m.clock.set(seconds_to_time(7.0));
   EXPECT_EQ(m.co.clock().now(), seconds_to_time(7.0));
-  EXPECT_EQ(m.co.name(), "robot");
+  EXPECT_EQ(m.co.structure().name(), "robot");
   Coordinator owned;  // no clock: an owned steady clock
   const Time t0 = owned.clock().now();
   EXPECT_GE(owned.clock().now(), t0);
@@ -402,7 +404,7 @@ TEST(History, AnAddressReturnsAtMostHistoryCapacityOfItsNewestRecordsOldestFirst
   const auto h = g.co.history(g.machine("JR3.s_A"));
   ASSERT_EQ(h.size(), 4u);
   for (std::size_t i = 1; i < h.size(); ++i) EXPECT_LT(h[i - 1].seq, h[i].seq) << "oldest first";
-  EXPECT_EQ(g.co.event(h.back().event).name, "/EVT_X") << "the newest record is last";
+  EXPECT_EQ(g.co.structure().event(h.back().event).name, "/EVT_X") << "the newest record is last";
 }
 
 TEST(History, AQuietAddressKeepsItsRecordsUntilTheCoordinatorHasProducedARingOfNewerOnes) {

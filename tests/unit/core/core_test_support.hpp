@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 // Readable values in test failure messages (found by GoogleTest through argument-dependent lookup).
@@ -84,25 +85,27 @@ struct Gcm {
   void connect(std::string_view client_required, std::string_view provider_provided) {
     must(co.connect(client_required, provider_provided), "connect");
   }
-  MachineId machine(std::string_view address) const { return must(co.find_machine(address), "find_machine"); }
-  ComponentId comp(std::string_view name) const { return must(co.find_component(name), "find_component"); }
-  EventId id(std::string_view event) const { return must(co.find_event(event), "find_event"); }
+  MachineId machine(std::string_view address) const {
+    return must(co.structure().find_machine(address), "find_machine");
+  }
+  ComponentId comp(std::string_view name) const { return must(co.structure().find_component(name), "find_component"); }
+  EventId id(std::string_view event) const { return must(co.structure().find_event(event), "find_event"); }
   void gen(std::string_view event, std::string_view target) {
-    must(co.generate(event, target), "generate " + std::string(event) + " on " + std::string(target));
+    must(generate(co, event, target), "generate " + std::string(event) + " on " + std::string(target));
   }
   void reset(std::string_view target, std::string_view who = "operator", std::string_view why = "test") {
-    must(co.reset(target, who, why), "reset " + std::string(target));
+    must(safecass::reset(co, target, who, why), "reset " + std::string(target));
   }
-  State at(std::string_view address) const { return co.state_of(must(co.resolve(address), "resolve")); }
+  State at(std::string_view address) const { return co.state_of(must(co.structure().resolve(address), "resolve")); }
   /// Name of the outstanding event of a machine, or "" when it has none.
   std::string outstanding(std::string_view address) const {
     const auto c = co.outstanding(machine(address));
-    return c ? co.event(c->event).name : std::string{};
+    return c ? co.structure().event(c->event).name : std::string{};
   }
   /// Name of the outstanding event of a component's extended state, or "".
   std::string component_outstanding(std::string_view name) const {
     const StateSnapshot s = co.extended(comp(name));
-    return s.outstanding == kNoEvent ? std::string{} : co.event(s.outstanding).name;
+    return s.outstanding == kNoEvent ? std::string{} : co.structure().event(s.outstanding).name;
   }
   std::vector<Record> history(std::string_view address) const { return co.history(machine(address)); }
   /// The Event records of a machine's history, oldest first.

@@ -8,6 +8,7 @@
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/event.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -90,33 +91,33 @@ TEST(OnsetLevel, IsUsableInConstantExpressions) {
 TEST(EventDefinition, WorseningTransitionsOnlyMakeAnOnset) {
   Gcm g;
   const EventId id = g.event(onset("EVT_A", 10, {N2W, N2E, W2E}));
-  EXPECT_TRUE(g.co.event(id).is_onset);
-  EXPECT_EQ(g.co.event(id).name, "EVT_A");
-  EXPECT_EQ(g.co.event(id).severity, 10);
-  EXPECT_EQ(g.co.event(id).transitions, (TransitionSet{N2W, N2E, W2E}));
+  EXPECT_TRUE(g.co.structure().event(id).is_onset);
+  EXPECT_EQ(g.co.structure().event(id).name, "EVT_A");
+  EXPECT_EQ(g.co.structure().event(id).severity, 10);
+  EXPECT_EQ(g.co.structure().event(id).transitions, (TransitionSet{N2W, N2E, W2E}));
 }
 
 TEST(EventDefinition, ImprovingTransitionsOnlyMakeACompletion) {
   Gcm g;
   g.event(onset("EVT_A", 10, kToError));
   const EventId id = g.event(completion("/EVT_A", 10, {Transition::W2N, Transition::E2N, Transition::E2W}));
-  EXPECT_FALSE(g.co.event(id).is_onset);
+  EXPECT_FALSE(g.co.structure().event(id).is_onset);
 }
 
 TEST(EventDefinition, MixingWorseningAndImprovingTransitionsIsAnError) {
   Gcm g;
   for (Transition worse : {N2W, N2E, W2E}) {
     for (Transition better : {Transition::W2N, Transition::E2N, Transition::E2W}) {
-      const std::size_t before = g.co.event_count();
+      const std::size_t before = g.co.structure().event_count();
       const auto r = g.co.add_event(onset("EVT_MIXED", 10, {worse, better}));
       ASSERT_FALSE(r) << to_string(worse) << "+" << to_string(better);
       EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
       EXPECT_NE(r.error().message.find("EVT_MIXED"), std::string::npos) << r.error().message;
       EXPECT_NE(r.error().message.find("mixes"), std::string::npos) << r.error().message;
-      EXPECT_EQ(g.co.event_count(), before);
+      EXPECT_EQ(g.co.structure().event_count(), before);
     }
   }
-  EXPECT_FALSE(g.co.find_event("EVT_MIXED"));
+  EXPECT_FALSE(g.co.structure().find_event("EVT_MIXED"));
 }
 
 TEST(EventDefinition, AnEmptyTransitionListIsAnError) {
@@ -130,29 +131,29 @@ TEST(EventDefinition, AnEmptyTransitionListIsAnError) {
 TEST(EventDefinition, SeverityOutsideOneTo255IsAnError) {
   Gcm g;
   for (int severity : {0, 256, -1, 1000, -255}) {
-    const std::size_t before = g.co.event_count();
+    const std::size_t before = g.co.structure().event_count();
     const auto r = g.co.add_event(onset("EVT_S", severity, kToError));
     ASSERT_FALSE(r) << severity;
     EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
     EXPECT_NE(r.error().message.find("EVT_S"), std::string::npos) << r.error().message;
     EXPECT_NE(r.error().message.find(std::to_string(severity)), std::string::npos) << r.error().message;
-    EXPECT_EQ(g.co.event_count(), before);
+    EXPECT_EQ(g.co.structure().event_count(), before);
   }
 }
 
 TEST(EventDefinition, SeverityBoundsOneAnd255AreAccepted) {
   Gcm g;
-  EXPECT_EQ(g.co.event(g.event(onset("EVT_LOW", 1, kToError))).severity, 1);
-  EXPECT_EQ(g.co.event(g.event(onset("EVT_HIGH", 255, kToError))).severity, 255);
+  EXPECT_EQ(g.co.structure().event(g.event(onset("EVT_LOW", 1, kToError))).severity, 1);
+  EXPECT_EQ(g.co.structure().event(g.event(onset("EVT_HIGH", 255, kToError))).severity, 255);
 }
 
 TEST(EventDefinition, Severities251To255AreBroadcastsAndBelowAreNot) {
   Gcm g;
   for (int s : {1, 200, 201, 250}) {
-    EXPECT_FALSE(g.co.event(g.event(onset("EVT_" + std::to_string(s), s, kToError))).is_broadcast()) << s;
+    EXPECT_FALSE(g.co.structure().event(g.event(onset("EVT_" + std::to_string(s), s, kToError))).is_broadcast()) << s;
   }
   for (int s : {251, 255}) {
-    EXPECT_TRUE(g.co.event(g.event(onset("EVT_" + std::to_string(s), s, kToError))).is_broadcast()) << s;
+    EXPECT_TRUE(g.co.structure().event(g.event(onset("EVT_" + std::to_string(s), s, kToError))).is_broadcast()) << s;
   }
 }
 
@@ -160,19 +161,19 @@ TEST(EventDefinition, CompletionNamedSlashXCompletesXByDefault) {
   Gcm g;
   const EventId on = g.event(onset("EVT_FORCE", 50, kToError));
   const EventId off = g.event(completion("/EVT_FORCE", 50, kFromError));
-  EXPECT_EQ(g.co.event(off).completes, "EVT_FORCE");
-  EXPECT_EQ(g.co.event(off).counterpart, on);
-  EXPECT_EQ(g.co.event(on).counterpart, off);
+  EXPECT_EQ(g.co.structure().event(off).completes, "EVT_FORCE");
+  EXPECT_EQ(g.co.structure().event(off).counterpart, on);
+  EXPECT_EQ(g.co.structure().event(on).counterpart, off);
 }
 
 TEST(EventDefinition, ExplicitCompletesNamesTheOnsetItClears) {
   Gcm g;
   const EventId on = g.event(onset("EVT_TOO_HOT", 50, kToError));
   const EventId off = g.event(completion("EVT_COOLED_DOWN", 50, kFromError, "EVT_TOO_HOT"));
-  EXPECT_FALSE(g.co.event(off).is_onset);
-  EXPECT_EQ(g.co.event(off).completes, "EVT_TOO_HOT");
-  EXPECT_EQ(g.co.event(off).counterpart, on);
-  EXPECT_EQ(g.co.event(on).counterpart, off);
+  EXPECT_FALSE(g.co.structure().event(off).is_onset);
+  EXPECT_EQ(g.co.structure().event(off).completes, "EVT_TOO_HOT");
+  EXPECT_EQ(g.co.structure().event(off).counterpart, on);
+  EXPECT_EQ(g.co.structure().event(on).counterpart, off);
   // And it clears it.
   g.component("C");
   g.gen("EVT_TOO_HOT", "C.s_A");
@@ -186,17 +187,17 @@ TEST(EventDefinition, ExplicitCompletesWinsOverTheSlashName) {
   const EventId a = g.event(onset("EVT_A", 50, kToError));
   g.event(onset("EVT_B", 50, kToError));
   const EventId off = g.event(completion("/EVT_B", 50, kFromError, "EVT_A"));
-  EXPECT_EQ(g.co.event(off).completes, "EVT_A");
-  EXPECT_EQ(g.co.event(off).counterpart, a);
+  EXPECT_EQ(g.co.structure().event(off).completes, "EVT_A");
+  EXPECT_EQ(g.co.structure().event(off).counterpart, a);
 }
 
 TEST(EventDefinition, CompletionMayBeDefinedBeforeItsOnset) {
   Gcm g;
   const EventId off = g.event(completion("/EVT_LATE", 50, kFromError));
-  EXPECT_EQ(g.co.event(off).counterpart, kNoEvent);
+  EXPECT_EQ(g.co.structure().event(off).counterpart, kNoEvent);
   const EventId on = g.event(onset("EVT_LATE", 50, kToError));
-  EXPECT_EQ(g.co.event(off).counterpart, on);
-  EXPECT_EQ(g.co.event(on).counterpart, off);
+  EXPECT_EQ(g.co.structure().event(off).counterpart, on);
+  EXPECT_EQ(g.co.structure().event(on).counterpart, off);
   g.component("C");
   g.gen("EVT_LATE", "C.s_A");
   g.gen("/EVT_LATE", "C.s_A");
@@ -207,15 +208,15 @@ TEST(EventDefinition, ExplicitCompletionMayBeDefinedBeforeItsOnset) {
   Gcm g;
   const EventId off = g.event(completion("EVT_OK", 50, kFromError, "EVT_LATER"));
   const EventId on = g.event(onset("EVT_LATER", 50, kToError));
-  EXPECT_EQ(g.co.event(off).counterpart, on);
-  EXPECT_EQ(g.co.event(on).counterpart, off);
+  EXPECT_EQ(g.co.structure().event(off).counterpart, on);
+  EXPECT_EQ(g.co.structure().event(on).counterpart, off);
 }
 
 TEST(EventDefinition, GeneratingACompletionWhoseOnsetWasNeverDefinedIsAnError) {
   Gcm g;
   g.component("C");
   g.event(completion("/EVT_GHOST", 50, kFromError));
-  const auto r = g.co.generate("/EVT_GHOST", "C.s_A");
+  const auto r = generate(g.co, "/EVT_GHOST", "C.s_A");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidState);
   EXPECT_NE(r.error().message.find("EVT_GHOST"), std::string::npos);
@@ -252,8 +253,8 @@ TEST(EventDefinition, AnOnsetCannotSayWhatItCompletes) {
 
 TEST(EventDefinition, LatchedIsAllowedOnOnsets) {
   Gcm g;
-  EXPECT_TRUE(g.co.event(g.event(onset("EVT_L", 50, kToError, true))).latched);
-  EXPECT_FALSE(g.co.event(g.event(onset("EVT_U", 50, kToError, false))).latched);
+  EXPECT_TRUE(g.co.structure().event(g.event(onset("EVT_L", 50, kToError, true))).latched);
+  EXPECT_FALSE(g.co.structure().event(g.event(onset("EVT_U", 50, kToError, false))).latched);
 }
 
 TEST(EventDefinition, LatchedOnACompletionIsAnError) {
@@ -261,27 +262,27 @@ TEST(EventDefinition, LatchedOnACompletionIsAnError) {
   g.event(onset("EVT_L", 50, kToError));
   EventDef d = completion("/EVT_L", 50, kFromError);
   d.latched = true;
-  const std::size_t before = g.co.event_count();
+  const std::size_t before = g.co.structure().event_count();
   const auto r = g.co.add_event(d);
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
   EXPECT_NE(r.error().message.find("/EVT_L"), std::string::npos);
   EXPECT_NE(r.error().message.find("latched"), std::string::npos);
-  EXPECT_EQ(g.co.event_count(), before);
+  EXPECT_EQ(g.co.structure().event_count(), before);
 }
 
 TEST(EventDefinition, DuplicateNamesAreAnErrorAndKeepTheFirstDefinition) {
   Gcm g;
   const EventId first = g.event(onset("EVT_DUP", 50, kToError));
-  const std::size_t before = g.co.event_count();
+  const std::size_t before = g.co.structure().event_count();
   for (const EventDef& again : {onset("EVT_DUP", 60, kToWarning), completion("EVT_DUP", 50, kFromError, "EVT_X")}) {
     const auto r = g.co.add_event(again);
     ASSERT_FALSE(r);
     EXPECT_EQ(r.error().code, ErrorCode::Duplicate);
     EXPECT_NE(r.error().message.find("EVT_DUP"), std::string::npos);
   }
-  EXPECT_EQ(g.co.event_count(), before);
-  EXPECT_EQ(g.co.event(first).severity, 50);
+  EXPECT_EQ(g.co.structure().event_count(), before);
+  EXPECT_EQ(g.co.structure().event(first).severity, 50);
   EXPECT_EQ(g.id("EVT_DUP"), first);
 }
 
@@ -304,13 +305,13 @@ TEST(EventDefinition, HazardAndDescriptionAreKept) {
   EventDef d = onset("EVT_FORCE", 50, kToError, false, "H-3");
   d.description = "force above the limit";
   const EventId id = g.event(d);
-  EXPECT_EQ(g.co.event(id).hazard, "H-3");
-  EXPECT_EQ(g.co.event(id).description, "force above the limit");
+  EXPECT_EQ(g.co.structure().event(id).hazard, "H-3");
+  EXPECT_EQ(g.co.structure().event(id).description, "force above the limit");
 }
 
 TEST(EventDefinition, UnknownEventNamesAreNotFound) {
   Gcm g;
-  const auto r = g.co.find_event("EVT_NOPE");
+  const auto r = g.co.structure().find_event("EVT_NOPE");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
   EXPECT_NE(r.error().message.find("EVT_NOPE"), std::string::npos);

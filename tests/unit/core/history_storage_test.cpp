@@ -11,6 +11,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -76,8 +77,8 @@ struct Chain {
     warn_done = *co.add_event(test::completion("/EVT_WARN", 30, kFromWarning));
     latched = *co.add_event(test::onset("EVT_LATCHED", 60, kToError, true));
     latched_done = *co.add_event(test::completion("/EVT_LATCHED", 60, kFromError));
-    a_app = co.application_machine(*co.find_component("A"));
-    c_fw = co.framework_machine(*co.find_component("C"));
+    a_app = co.structure().application_machine(*co.structure().find_component("A"));
+    c_fw = co.structure().framework_machine(*co.structure().find_component("C"));
     co.subscribe([this](const Record& r) { stream.push_back(r); });
   }
 
@@ -101,11 +102,11 @@ struct Chain {
     injection.kind = RecordKind::Injection;
     injection.machine = a_app;
     injection.time = clock.now();
-    injection.text = co.name_of(co.intern("inject A.force " + std::to_string(k)));
+    injection.text = co.structure().name_of(co.intern("inject A.force " + std::to_string(k)));
     co.publish(injection);
     clock.advance(std::chrono::milliseconds(1));
     co.generate(err_done, a_app);  // cleared at A and every mirror
-    ASSERT_TRUE(co.reset("C", "operator", "round " + std::to_string(k)));
+    ASSERT_TRUE(reset(co, "C", "operator", "round " + std::to_string(k)));
     co.generate(warn_done, a_app);
   }
 
@@ -145,9 +146,11 @@ TEST(HistoryStorage, AfterTheRingWrapsTheNewestRecordsKeepTheirRootCausesAndText
   // And one address's view is the same records, filtered.
   std::vector<Record> of_d;
   for (const Record& r : want) {
-    if (r.machine == chain.co.required_machines(*chain.co.find_component("D"))[0]) of_d.push_back(r);
+    if (r.machine == chain.co.structure().required_machines(*chain.co.structure().find_component("D"))[0])
+      of_d.push_back(r);
   }
-  const std::vector<Record> d = chain.co.history(chain.co.required_machines(*chain.co.find_component("D"))[0]);
+  const std::vector<Record> d =
+      chain.co.history(chain.co.structure().required_machines(*chain.co.structure().find_component("D"))[0]);
   ASSERT_EQ(d.size(), of_d.size());
   for (std::size_t i = 0; i < d.size(); ++i) expect_same(d[i], of_d[i], i);
 }

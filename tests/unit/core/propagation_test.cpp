@@ -9,6 +9,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -51,7 +52,7 @@ struct Net : Gcm {
 };
 
 std::vector<std::string> path_of(const Gcm& g, std::string_view address, std::size_t index = 0) {
-  const auto why = g.co.explain(address);
+  const auto why = explain(g.co, address);
   if (!why || why->size() <= index) {
     ADD_FAILURE() << "no explanation " << index << " at " << address;
     return {};
@@ -96,7 +97,7 @@ TEST(Propagation, TheMirrorIsServiceFailureAtErrorAndKeepsTheRootCause) {
   const Condition& m = conditions[0];
   EXPECT_TRUE(m.mirror);
   EXPECT_EQ(m.event, framework_event::kServiceFailure);
-  EXPECT_EQ(g.co.event(m.event).name, "EVT_SERVICE_FAILURE");
+  EXPECT_EQ(g.co.structure().event(m.event).name, "EVT_SERVICE_FAILURE");
   EXPECT_EQ(m.severity, 220);
   EXPECT_EQ(m.level, E);
   EXPECT_EQ(m.via, ConnectionId{0});
@@ -215,7 +216,7 @@ TEST(Propagation, WarningsCrossAsServiceDegradedWhenTheServicePropagatesWarnings
   const auto conditions = g.co.conditions(g.machine("CONTROL.s_R.ForceData"));
   ASSERT_EQ(conditions.size(), 1u);
   EXPECT_EQ(conditions[0].event, framework_event::kServiceDegraded);
-  EXPECT_EQ(g.co.event(conditions[0].event).name, "EVT_SERVICE_DEGRADED");
+  EXPECT_EQ(g.co.structure().event(conditions[0].event).name, "EVT_SERVICE_DEGRADED");
   EXPECT_EQ(conditions[0].severity, 215);
   EXPECT_EQ(conditions[0].level, W);
   EXPECT_EQ(conditions[0].root.event, g.id("EVT_FORCE_WARNING"));
@@ -350,7 +351,7 @@ TEST(Propagation, TwoRootsReachingTheSameMachineGiveTwoMirrorsAndClearingOneLeav
   g.gen("/EVT_FORCE_ERROR", "JR3.s_A");
   EXPECT_EQ(g.mirrors("CONTROL.s_R.ForceData"), 1u);
   EXPECT_EQ(g.at("CONTROL.s_R.ForceData"), E);
-  const auto why = g.co.explain("CONTROL.s_R.ForceData");
+  const auto why = explain(g.co, "CONTROL.s_R.ForceData");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   EXPECT_EQ((*why)[0].root.event, "EVT_JR3_FAULT");
@@ -422,7 +423,7 @@ TEST(Explain, GivesTheRootCauseAndHopPathOfAClientsError) {
   g.clock.set(seconds_to_time(0.1));
   g.co.generate(g.id("EVT_FORCE_ERROR"), g.machine("JR3.s_A"), cause);
 
-  const auto why = g.co.explain("CONTROL");
+  const auto why = explain(g.co, "CONTROL");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   const Explanation& e = (*why)[0];
@@ -447,7 +448,7 @@ TEST(Explain, WorksForMachinesServicesComponentsAndTheSystem) {
   Robot g;
   g.gen("EVT_FORCE_ERROR", "JR3.s_A");
   auto count = [&](std::string_view a) {
-    const auto why = g.co.explain(a);
+    const auto why = explain(g.co, a);
     EXPECT_TRUE(why) << a;
     return why ? why->size() : 0u;
   };
@@ -458,7 +459,7 @@ TEST(Explain, WorksForMachinesServicesComponentsAndTheSystem) {
   EXPECT_EQ(count("CONTROL.s_R.ForceData"), 1u);
   EXPECT_EQ(count("CONTROL.s_S.Motion"), 1u);
   EXPECT_EQ(count("SYSTEM"), 2u);
-  const auto root = g.co.explain("JR3.s_A");
+  const auto root = explain(g.co, "JR3.s_A");
   ASSERT_TRUE(root);
   ASSERT_EQ(root->size(), 1u);
   EXPECT_FALSE((*root)[0].mirror);
@@ -473,7 +474,7 @@ TEST(Explain, AServiceAddressExplainsOnlyTheMachinesTheServiceDependsOn) {
   test::must(g.co.set_service(g.comp("JR3"), "ForceData", framework_only), "set_service");
   g.gen("EVT_FORCE_ERROR", "JR3.s_A");
   g.gen("EVT_FORCE_WARNING", "JR3.s_F");
-  const auto why = g.co.explain("JR3.s_S.ForceData");
+  const auto why = explain(g.co, "JR3.s_S.ForceData");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   EXPECT_EQ((*why)[0].machine, "JR3.s_F");
@@ -485,7 +486,7 @@ TEST(Explain, ListsTheMostSevereConditionFirstAndMarksTheOutstandingOne) {
   g.gen("EVT_FORCE_WARNING", "CONTROL.s_A");
   g.gen("EVT_JR3_FAULT", "CONTROL.s_A");
   g.gen("EVT_FORCE_ERROR", "CONTROL.s_A");
-  const auto why = g.co.explain("CONTROL.s_A");
+  const auto why = explain(g.co, "CONTROL.s_A");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 3u);
   EXPECT_EQ((*why)[0].event, "EVT_JR3_FAULT");
@@ -498,7 +499,7 @@ TEST(Explain, ListsTheMostSevereConditionFirstAndMarksTheOutstandingOne) {
 
 TEST(Explain, AnUnknownAddressIsAnError) {
   Robot g;
-  const auto why = g.co.explain("NOPE.s_A");
+  const auto why = explain(g.co, "NOPE.s_A");
   ASSERT_FALSE(why);
   EXPECT_EQ(why.error().code, ErrorCode::NotFound);
   EXPECT_NE(why.error().message.find("NOPE"), std::string::npos);
@@ -579,14 +580,14 @@ TEST(Broadcast, AnEventOfSeverity251To255AppliesToTheApplicationMachineOfEveryCo
   g.component("ARM");
   g.event(onset("EVT_ESTOP", 255, kToError));
   g.event(completion("/EVT_ESTOP", 255, kFromError));
-  test::must(g.co.broadcast("EVT_ESTOP"), "broadcast");
+  test::must(broadcast(g.co, "EVT_ESTOP"), "broadcast");
   for (const char* c : {"JR3", "CONTROL", "ARM"}) {
     const std::string a = std::string(c) + ".s_A";
     EXPECT_EQ(g.at(a), E) << a;
     EXPECT_EQ(g.outstanding(a), "EVT_ESTOP") << a;
     EXPECT_EQ(g.at(std::string(c) + ".s_F"), N) << c;
   }
-  test::must(g.co.broadcast("/EVT_ESTOP"), "broadcast");
+  test::must(broadcast(g.co, "/EVT_ESTOP"), "broadcast");
   EXPECT_EQ(g.at("SYSTEM"), N);
 }
 
@@ -605,9 +606,9 @@ TEST(Broadcast, ABroadcastCompletionIsIgnoredWhereItsOnsetIsNotActive) {
   Robot g;
   g.event(onset("EVT_ESTOP", 255, kToError));
   g.event(completion("/EVT_ESTOP", 255, kFromError));
-  test::must(g.co.broadcast("EVT_ESTOP"), "broadcast");
+  test::must(broadcast(g.co, "EVT_ESTOP"), "broadcast");
   g.component("LATE");  // added after the onset: nothing to clear there
-  test::must(g.co.broadcast("/EVT_ESTOP"), "broadcast");
+  test::must(broadcast(g.co, "/EVT_ESTOP"), "broadcast");
   const auto late = g.event_records("LATE.s_A");
   ASSERT_EQ(late.size(), 1u);
   EXPECT_EQ(late[0].outcome, Outcome::Ignored);
@@ -618,12 +619,12 @@ TEST(Broadcast, ABroadcastCompletionIsIgnoredWhereItsOnsetIsNotActive) {
 
 TEST(Broadcast, BroadcastingAnOrdinaryEventIsAnErrorAndChangesNothing) {
   Robot g;
-  const auto r = g.co.broadcast("EVT_FORCE_ERROR");
+  const auto r = broadcast(g.co, "EVT_FORCE_ERROR");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
   EXPECT_NE(r.error().message.find("EVT_FORCE_ERROR"), std::string::npos);
   EXPECT_EQ(g.at("SYSTEM"), N);
-  const auto unknown = g.co.broadcast("EVT_NOPE");
+  const auto unknown = broadcast(g.co, "EVT_NOPE");
   ASSERT_FALSE(unknown);
   EXPECT_EQ(unknown.error().code, ErrorCode::NotFound);
 }
@@ -631,7 +632,7 @@ TEST(Broadcast, BroadcastingAnOrdinaryEventIsAnErrorAndChangesNothing) {
 TEST(Broadcast, ABroadcastErrorStillPropagatesAlongConnections) {
   Robot g;
   g.event(onset("EVT_ESTOP", 252, kToError));
-  test::must(g.co.broadcast("EVT_ESTOP"), "broadcast");
+  test::must(broadcast(g.co, "EVT_ESTOP"), "broadcast");
   EXPECT_EQ(g.at("CONTROL.s_R.ForceData"), E);
   const auto cs = g.co.conditions(g.machine("CONTROL.s_R.ForceData"));
   ASSERT_EQ(cs.size(), 1u);
@@ -657,11 +658,11 @@ TEST(FrameworkEvents, EveryCoordinatorDefinesThemWithTheirSeveritiesAndCompletio
       {"EVT_COORDINATOR_LOST", 240, framework_event::kCoordinatorLost},
       {"EVT_INVALID_SAMPLE", 225, framework_event::kInvalidSample},
   };
-  EXPECT_EQ(g.co.event_count(), framework_event::kCount);
+  EXPECT_EQ(g.co.structure().event_count(), framework_event::kCount);
   for (const Row& row : rows) {
     const EventId on = g.id(row.name);
     EXPECT_EQ(on, row.id) << row.name;
-    const Event& e = g.co.event(on);
+    const Event& e = g.co.structure().event(on);
     EXPECT_TRUE(e.is_onset) << row.name;
     EXPECT_EQ(e.severity, row.severity) << row.name;
     EXPECT_GE(e.severity, 201) << row.name << " is in the framework band";
@@ -669,12 +670,12 @@ TEST(FrameworkEvents, EveryCoordinatorDefinesThemWithTheirSeveritiesAndCompletio
     EXPECT_FALSE(e.description.empty()) << row.name;
     const EventId off = g.id(std::string("/") + row.name);
     EXPECT_EQ(off, framework_event::completion_of(on)) << row.name;
-    EXPECT_FALSE(g.co.event(off).is_onset) << row.name;
-    EXPECT_EQ(g.co.event(off).counterpart, on) << row.name;
+    EXPECT_FALSE(g.co.structure().event(off).is_onset) << row.name;
+    EXPECT_EQ(g.co.structure().event(off).counterpart, on) << row.name;
     EXPECT_EQ(e.counterpart, off) << row.name;
   }
-  EXPECT_EQ(onset_level(g.co.event(framework_event::kServiceFailure).transitions, N), E);
-  EXPECT_EQ(onset_level(g.co.event(framework_event::kServiceDegraded).transitions, N), W);
+  EXPECT_EQ(onset_level(g.co.structure().event(framework_event::kServiceFailure).transitions, N), E);
+  EXPECT_EQ(onset_level(g.co.structure().event(framework_event::kServiceDegraded).transitions, N), W);
 }
 
 TEST(FrameworkEvents, EachCanBeRaisedOnAFrameworkMachineAndClearedByItsCompletion) {

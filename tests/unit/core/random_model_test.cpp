@@ -25,6 +25,7 @@
 #include "safecass/core/id_vector.hpp"
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -247,33 +248,33 @@ struct Hop {
 };
 
 bool depends_on(const Coordinator& co, ComponentId c, std::uint32_t p, MachineId m) {
-  if (co.machine_component(m) != c) return false;
-  const ServiceDependency& d = co.service(c, p);
-  switch (co.machine_kind(m)) {
+  if (co.structure().machine_component(m) != c) return false;
+  const ServiceDependency& d = co.structure().service(c, p);
+  switch (co.structure().machine_kind(m)) {
     case MachineKind::Framework: return d.framework;
     case MachineKind::Application: return d.application;
-    case MachineKind::Provided: return co.provided_machines(c)[p] == m;
+    case MachineKind::Provided: return co.structure().provided_machines(c)[p] == m;
     case MachineKind::Required:
-      return d.all_required ||
-             std::find(d.required.begin(), d.required.end(), std::string(co.interface_name(m))) != d.required.end();
+      return d.all_required || std::find(d.required.begin(), d.required.end(),
+                                         std::string(co.structure().interface_name(m))) != d.required.end();
   }
   return false;
 }
 
 std::vector<MachineId> machines_of(const Coordinator& co, ComponentId c) {
-  std::vector<MachineId> out{co.framework_machine(c), co.application_machine(c)};
-  for (MachineId m : co.provided_machines(c)) out.push_back(m);
-  for (MachineId m : co.required_machines(c)) out.push_back(m);
+  std::vector<MachineId> out{co.structure().framework_machine(c), co.structure().application_machine(c)};
+  for (MachineId m : co.structure().provided_machines(c)) out.push_back(m);
+  for (MachineId m : co.structure().required_machines(c)) out.push_back(m);
   return out;
 }
 
 IdVector<std::vector<Hop>, MachineId> read_hops(const Coordinator& co) {
-  IdVector<std::vector<Hop>, MachineId> hops(co.machine_count());
-  const auto& conns = co.connections();
+  IdVector<std::vector<Hop>, MachineId> hops(co.structure().machine_count());
+  const auto& conns = co.structure().connections();
   for (ConnectionId k : id_range<ConnectionId>(conns.size())) {
     const Connection& conn = conns[to_index(k)];
-    const MachineId client = co.required_machines(conn.client)[conn.required];
-    const State min_level = co.service(conn.provider, conn.provided).propagate;
+    const MachineId client = co.structure().required_machines(conn.client)[conn.required];
+    const State min_level = co.structure().service(conn.provider, conn.provided).propagate;
     for (MachineId m : machines_of(co, conn.provider)) {
       if (depends_on(co, conn.provider, conn.provided, m)) hops[m].push_back(Hop{client, min_level, k});
     }
@@ -351,7 +352,10 @@ bool same_cause(const SampleCause& a, const SampleCause& b) {
 class Oracle {
 public:
   Oracle(const Coordinator& co, std::map<EventId, EventInfo> events)
-      : co_(co), events_(std::move(events)), roots_(co.machine_count()), mirrors_(co.machine_count()) {
+      : co_(co),
+        events_(std::move(events)),
+        roots_(co.structure().machine_count()),
+        mirrors_(co.structure().machine_count()) {
     reread_graph();
   }
 
@@ -375,8 +379,8 @@ public:
   void generate(EventId e, MachineId target, Time now, const SampleCause& cause) {
     const EventInfo& ev = info(e);
     if (ev.broadcast) {
-      for (ComponentId c : id_range<ComponentId>(co_.component_count()))
-        apply(e, co_.application_machine(c), now, cause);
+      for (ComponentId c : id_range<ComponentId>(co_.structure().component_count()))
+        apply(e, co_.structure().application_machine(c), now, cause);
       return;
     }
     apply(e, target, now, cause);
@@ -571,43 +575,43 @@ public:
           .push_back(ids.at(def.name));
     }
     // Framework events (§2.7): every event the spec did not define; their definitions are data.
-    for (EventId id : id_range<EventId>(co_.event_count())) {
+    for (EventId id : id_range<EventId>(co_.structure().event_count())) {
       if (events.count(id) != 0) continue;
-      const Event& ev = co_.event(id);
+      const Event& ev = co_.structure().event(id);
       EventInfo e;
       e.onset = ev.is_onset;
       e.transitions = ev.transitions;
       e.severity = ev.severity;
       if (!e.onset) {
-        const auto onset = co_.find_event(ev.name.substr(1));
+        const auto onset = co_.structure().find_event(ev.name.substr(1));
         if (!onset) return "framework completion without its onset: " + ev.name;
         e.clears = *onset;
       }
       events[id] = e;
       (e.onset ? onsets_ : completions_).push_back(id);
     }
-    service_failure_ = *co_.find_event("EVT_SERVICE_FAILURE");
-    service_degraded_ = *co_.find_event("EVT_SERVICE_DEGRADED");
+    service_failure_ = *co_.structure().find_event("EVT_SERVICE_FAILURE");
+    service_degraded_ = *co_.structure().find_event("EVT_SERVICE_DEGRADED");
     oracle_.emplace(co_, std::move(events));
 
     filter_name_ = co_.intern("random_filter");
     signal_name_ = co_.intern("C0.signal");
-    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
+    for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) {
       co_.on_machine(m, callbacks(false, to_index(m)));
     }
-    for (ComponentId c : id_range<ComponentId>(co_.component_count()))
+    for (ComponentId c : id_range<ComponentId>(co_.structure().component_count()))
       co_.on_component(c, callbacks(true, to_index(c)));
     co_.subscribe([this](const Record& r) { records_.push_back(r); });
-    machine_state_.assign(co_.machine_count(), State::Normal);
-    component_state_.assign(co_.component_count(), State::Normal);
+    machine_state_.assign(co_.structure().machine_count(), State::Normal);
+    component_state_.assign(co_.structure().component_count(), State::Normal);
     return check();
   }
 
   bool cyclic() const { return has_cycle(read_hops(co_)); }
   const Coverage& coverage() const { return coverage_; }
-  std::size_t components() const { return co_.component_count(); }
-  std::size_t machines() const { return co_.machine_count(); }
-  std::size_t connections() const { return co_.connections().size(); }
+  std::size_t components() const { return co_.structure().component_count(); }
+  std::size_t machines() const { return co_.structure().machine_count(); }
+  std::size_t connections() const { return co_.structure().connections().size(); }
 
   /// Runs one random step; returns an error text when an invariant fails.
   std::string step(int n) {
@@ -619,7 +623,7 @@ public:
     if (roll < 430) {
       // An onset on a random machine; a quarter of them with the data of a filter that fired.
       const EventId e = rng_.pick(onsets_);
-      const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
+      const MachineId m = id_at<MachineId>(rng_.below(co_.structure().machine_count()));
       SampleCause cause;
       if (rng_.chance(0.25)) {
         cause.filter = filter_name_;
@@ -628,9 +632,10 @@ public:
         cause.sample_time = now - Time{rng_.between(0, 1000)};
         cause.injected = rng_.chance(0.3);
       }
-      op << "generate " << co_.event(e).name << " on " << co_.address_of(m);
+      op << "generate " << co_.structure().event(e).name << " on " << co_.structure().address_of(m);
       if (!cause.present() && rng_.chance(0.2)) {
-        if (!co_.generate(co_.event(e).name, co_.address_of(m))) return op.str() + ": name-based generate failed";
+        if (!generate(co_, co_.structure().event(e).name, co_.structure().address_of(m)))
+          return op.str() + ": name-based generate failed";
       } else {
         co_.generate(e, m, cause);
       }
@@ -640,7 +645,7 @@ public:
       const auto active = oracle_->active_roots();
       if (active.empty()) return finish("nothing active");
       const auto [m, e] = rng_.pick(active);
-      op << "refresh " << co_.event(e).name << " on " << co_.address_of(m);
+      op << "refresh " << co_.structure().event(e).name << " on " << co_.structure().address_of(m);
       co_.generate(e, m);
       oracle_->generate(e, m, now, {});
     } else if (roll < 850) {
@@ -661,12 +666,12 @@ public:
         m = origin;
       } else {
         e = rng_.pick(completions_);
-        m = id_at<MachineId>(rng_.below(co_.machine_count()));
+        m = id_at<MachineId>(rng_.below(co_.structure().machine_count()));
       }
-      op << "generate " << co_.event(e).name << " on " << co_.address_of(m);
+      op << "generate " << co_.structure().event(e).name << " on " << co_.structure().address_of(m);
       const bool orphan = !oracle_->info(e).clears.has_value();
       if (rng_.chance(0.2)) {
-        const auto result = co_.generate(co_.event(e).name, co_.address_of(m));
+        const auto result = generate(co_, co_.structure().event(e).name, co_.structure().address_of(m));
         if (orphan != !result) return op.str() + ": name-based generate of a completion returned the wrong result";
         if (orphan && result.error().code != ErrorCode::InvalidState) return op.str() + ": expected InvalidState";
         if (!orphan) oracle_->generate(e, m, now, {});  // a refused request is not processed at all
@@ -677,11 +682,12 @@ public:
     } else if (roll < 890) {
       const bool onset = rng_.chance(0.6);
       const EventId e = rng_.pick(onset ? broadcast_onsets_ : broadcast_completions_);
-      op << "broadcast " << co_.event(e).name;
+      op << "broadcast " << co_.structure().event(e).name;
       if (rng_.chance(0.5)) {
-        if (!co_.broadcast(co_.event(e).name)) return op.str() + ": broadcast failed";
+        if (!broadcast(co_, co_.structure().event(e).name)) return op.str() + ": broadcast failed";
       } else {
-        co_.generate(e, id_at<MachineId>(rng_.below(co_.machine_count())));  // the target of a broadcast is ignored
+        co_.generate(
+            e, id_at<MachineId>(rng_.below(co_.structure().machine_count())));  // the target of a broadcast is ignored
       }
       oracle_->generate(e, kNoMachine, now, {});
     } else if (roll < 920) {
@@ -690,19 +696,19 @@ public:
       std::string target;
       std::vector<MachineId> machines;
       if (kind < 8) {
-        const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
-        target = co_.address_of(m);
+        const MachineId m = id_at<MachineId>(rng_.below(co_.structure().machine_count()));
+        target = co_.structure().address_of(m);
         machines = {m};
       } else if (kind < 16) {
-        const ComponentId c = id_at<ComponentId>(rng_.below(co_.component_count()));
-        target = std::string(co_.component_name(c));
+        const ComponentId c = id_at<ComponentId>(rng_.below(co_.structure().component_count()));
+        target = std::string(co_.structure().component_name(c));
         machines = machines_of(co_, c);
       } else {
         target = kind < 19 ? "SYSTEM" : "rand";
-        for (MachineId m : id_range<MachineId>(co_.machine_count())) machines.push_back(m);
+        for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) machines.push_back(m);
       }
       op << "reset " << target;
-      if (!co_.reset(target, "random", "step " + std::to_string(n))) return op.str() + ": reset failed";
+      if (!reset(co_, target, "random", "step " + std::to_string(n))) return op.str() + ": reset failed";
       expected_reset_clears_ = oracle_->reset(machines);
       expected_resets_ = machines;
       reset_text_ = "random: step " + std::to_string(n);
@@ -715,7 +721,7 @@ public:
       if (services.empty()) return finish("no services");
       const std::string target = rng_.pick(services);
       op << "reset " << target << " (refused)";
-      const auto result = co_.reset(target, "random", "service");
+      const auto result = reset(co_, target, "random", "service");
       if (result || result.error().code != ErrorCode::InvalidArgument) return op.str() + ": expected InvalidArgument";
     } else if (roll < 940 && !deferred_.empty()) {
       // A connection made while faults are active carries them at once.
@@ -752,7 +758,7 @@ private:
       calls_.push_back(CallbackCall{Phase::Transition, component, id, State::Normal, State::Normal, info});
     };
     cb.on_entry = [this, component, id](State s) {
-      const State now = component ? co_.extended_state(ComponentId{id}) : co_.state(MachineId{id});
+      const State now = component ? co_.extended(ComponentId{id}).state : co_.state(MachineId{id});
       calls_.push_back(CallbackCall{Phase::Entry, component, id, s, now, {}});
     };
     return cb;
@@ -760,15 +766,16 @@ private:
 
   /// The configuration reads back as the spec wrote it.
   std::string check_read_back() {
-    if (co_.component_count() != spec_.components.size()) return "component count";
+    if (co_.structure().component_count() != spec_.components.size()) return "component count";
     for (ComponentId c : id_range<ComponentId>(spec_.components.size())) {
       const ComponentSpec& cs = spec_.components[to_index(c)];
-      if (co_.component_name(c) != cs.name) return "component name";
-      if (co_.provided_machines(c).size() != cs.provided.size()) return "provided count of " + cs.name;
-      if (co_.required_machines(c).size() != cs.required.size()) return "required count of " + cs.name;
+      if (co_.structure().component_name(c) != cs.name) return "component name";
+      if (co_.structure().provided_machines(c).size() != cs.provided.size()) return "provided count of " + cs.name;
+      if (co_.structure().required_machines(c).size() != cs.required.size()) return "required count of " + cs.name;
       for (std::uint32_t p = 0; p < cs.provided.size(); ++p) {
-        if (co_.interface_name(co_.provided_machines(c)[p]) != cs.provided[p]) return "provided name";
-        const ServiceDependency& got = co_.service(c, p);
+        if (co_.structure().interface_name(co_.structure().provided_machines(c)[p]) != cs.provided[p])
+          return "provided name";
+        const ServiceDependency& got = co_.structure().service(c, p);
         const ServiceDependency want = cs.services[p].value_or(ServiceDependency{});
         if (got.framework != want.framework || got.application != want.application ||
             got.all_required != want.all_required || got.propagate != want.propagate ||
@@ -784,10 +791,10 @@ private:
     const Oracle& o = *oracle_;
     std::set<std::uint64_t> seqs;
     std::size_t total_conditions = 0;
-    IdVector<State, MachineId> states(co_.machine_count());
+    IdVector<State, MachineId> states(co_.structure().machine_count());
 
-    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
-      const std::string& at = co_.address_of(m);
+    for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) {
+      const std::string& at = co_.structure().address_of(m);
       const std::vector<Condition> conds = co_.conditions(m);
       // Roots: exactly the oracle's, with level, count, times, severity and cause.
       std::size_t roots = 0;
@@ -797,20 +804,22 @@ private:
         ++roots;
         const auto& want = o.roots(m);
         const auto it = std::find_if(want.begin(), want.end(), [&](const RootModel& r) { return r.event == c.event; });
-        if (it == want.end()) return at + ": unexpected root condition " + co_.event(c.event).name;
+        if (it == want.end()) return at + ": unexpected root condition " + co_.structure().event(c.event).name;
         if (c.level != it->level) {
-          return at + ": root " + co_.event(c.event).name + " has level " + std::string(to_string(c.level)) +
-                 ", oracle says " + std::string(to_string(it->level));
+          return at + ": root " + co_.structure().event(c.event).name + " has level " +
+                 std::string(to_string(c.level)) + ", oracle says " + std::string(to_string(it->level));
         }
         if (c.count != it->count)
-          return at + ": root " + co_.event(c.event).name + " count " + std::to_string(c.count) + ", oracle says " +
-                 std::to_string(it->count);
-        if (c.first != it->first || c.last != it->last) return at + ": root " + co_.event(c.event).name + " times";
+          return at + ": root " + co_.structure().event(c.event).name + " count " + std::to_string(c.count) +
+                 ", oracle says " + std::to_string(it->count);
+        if (c.first != it->first || c.last != it->last)
+          return at + ": root " + co_.structure().event(c.event).name + " times";
         if (c.severity != o.info(c.event).severity) return at + ": root severity";
         if (c.via != kNoConnection) return at + ": a root condition names a connection";
         if (c.root.event != c.event || c.root.origin != m || c.root.time != it->first)
           return at + ": root cause of a root";
-        if (!same_cause(c.root.sample, it->cause)) return at + ": sample cause of root " + co_.event(c.event).name;
+        if (!same_cause(c.root.sample, it->cause))
+          return at + ": sample cause of root " + co_.structure().event(c.event).name;
       }
       if (roots != o.roots(m).size()) {
         return at + ": " + std::to_string(roots) + " root conditions, oracle says " + std::to_string(o.roots(m).size());
@@ -824,19 +833,20 @@ private:
         const auto it = std::find_if(want.begin(), want.end(), [&](const MirrorModel& x) {
           return x.root_event == c.root.event && x.origin == c.root.origin;
         });
-        const std::string what = "mirror of " + co_.address_of(c.root.origin) + ":" + co_.event(c.root.event).name;
+        const std::string what =
+            "mirror of " + co_.structure().address_of(c.root.origin) + ":" + co_.structure().event(c.root.event).name;
         if (it == want.end()) return at + ": unexpected " + what;
         if (c.root.origin == m) return at + ": holds a mirror of its own root";
         if (c.level != it->level) return at + ": " + what + " has the wrong level";
         const EventId mirror_event = c.level == State::Error ? service_failure_ : service_degraded_;
-        if (c.event != mirror_event) return at + ": " + what + " has event " + co_.event(c.event).name;
+        if (c.event != mirror_event) return at + ": " + what + " has event " + co_.structure().event(c.event).name;
         if (c.severity != (c.level == State::Error ? 220 : 215)) return at + ": " + what + " severity";
         if (c.count != 1) return at + ": " + what + " was refreshed";
         if (c.first != it->first || c.root.time != it->first) return at + ": " + what + " times";
         if (!same_cause(c.root.sample, it->cause)) return at + ": " + what + " lost the sample cause";
-        if (to_index(c.via) >= co_.connections().size()) return at + ": " + what + " names no connection";
-        const Connection& via = co_.connections()[to_index(c.via)];
-        if (co_.required_machines(via.client)[via.required] != m)
+        if (to_index(c.via) >= co_.structure().connections().size()) return at + ": " + what + " names no connection";
+        const Connection& via = co_.structure().connections()[to_index(c.via)];
+        if (co_.structure().required_machines(via.client)[via.required] != m)
           return at + ": " + what + " arrived via another machine's connection";
       }
       total_conditions += conds.size();
@@ -846,7 +856,7 @@ private:
       if (mirrors != o.mirrors(m).size()) {
         std::string missing;
         for (const MirrorModel& x : o.mirrors(m)) {
-          missing += " " + co_.address_of(x.origin) + ":" + co_.event(x.root_event).name + "/" +
+          missing += " " + co_.structure().address_of(x.origin) + ":" + co_.structure().event(x.root_event).name + "/" +
                      std::string(to_string(x.level));
         }
         return at + ": " + std::to_string(mirrors) + " mirrors, oracle expects " + std::to_string(o.mirrors(m).size()) +
@@ -880,8 +890,8 @@ private:
 
     // Components: extended state = product of its machines; outstanding over its machines.
     State all = State::Normal;
-    for (ComponentId c : id_range<ComponentId>(co_.component_count())) {
-      const std::string name(co_.component_name(c));
+    for (ComponentId c : id_range<ComponentId>(co_.structure().component_count())) {
+      const std::string name(co_.structure().component_name(c));
       State ext = State::Normal;
       const Condition* best = nullptr;
       std::vector<std::vector<Condition>> held;
@@ -895,7 +905,7 @@ private:
         }
       }
       const StateSnapshot snap = co_.extended(c);
-      if (snap.state != ext || co_.extended_state(c) != ext)
+      if (snap.state != ext || co_.extended(c).state != ext)
         return name + ": extended state is not the product of its machines";
       if (snap.outstanding != (best == nullptr ? kNoEvent : best->event)) return name + ": extended outstanding event";
       int calls = 0;
@@ -905,29 +915,31 @@ private:
           c, [&] { ++calls; }, [&](const Event& e) { ++calls, dispatched = State::Warning, passed = e.id; },
           [&](const Event& e) { ++calls, dispatched = State::Error, passed = e.id; });
       if (calls != 1 || dispatched != ext || passed != snap.outstanding) return name + ": dispatch";
-      const auto addr = co_.resolve(name);
+      const auto addr = co_.structure().resolve(name);
       if (!addr || co_.state_of(*addr) != ext) return name + ": state_of(component)";
       // Service states: s_P.p ⊗ [s_F] ⊗ [s_A] ⊗ listed (or all) required interfaces.
-      for (std::uint32_t p = 0; p < co_.provided_machines(c).size(); ++p) {
-        const ServiceDependency& d = co_.service(c, p);
-        State s = states[co_.provided_machines(c)[p]];
-        if (d.framework) s = worse(s, states[co_.framework_machine(c)]);
-        if (d.application) s = worse(s, states[co_.application_machine(c)]);
-        for (MachineId r : co_.required_machines(c)) {
-          const std::string rname(co_.interface_name(r));
+      for (std::uint32_t p = 0; p < co_.structure().provided_machines(c).size(); ++p) {
+        const ServiceDependency& d = co_.structure().service(c, p);
+        State s = states[co_.structure().provided_machines(c)[p]];
+        if (d.framework) s = worse(s, states[co_.structure().framework_machine(c)]);
+        if (d.application) s = worse(s, states[co_.structure().application_machine(c)]);
+        for (MachineId r : co_.structure().required_machines(c)) {
+          const std::string rname(co_.structure().interface_name(r));
           if (d.all_required || std::find(d.required.begin(), d.required.end(), rname) != d.required.end()) {
             s = worse(s, states[r]);
           }
         }
         if (co_.service_state(c, p) != s) return name + ": service state of provided interface " + std::to_string(p);
-        const auto sa = co_.resolve(name + ".s_S." + std::string(co_.interface_name(co_.provided_machines(c)[p])));
+        const auto sa = co_.structure().resolve(
+            name + ".s_S." + std::string(co_.structure().interface_name(co_.structure().provided_machines(c)[p])));
         if (!sa || co_.state_of(*sa) != s) return name + ": state_of(service)";
       }
       all = worse(all, ext);
     }
     coverage_.max_conditions = std::max(coverage_.max_conditions, total_conditions);
     if (co_.coordinator_state() != all) return "coordinator state is not the product of the components";
-    if (const auto sys = co_.resolve("SYSTEM"); !sys || co_.state_of(*sys) != all) return "state_of(SYSTEM)";
+    if (const auto sys = co_.structure().resolve("SYSTEM"); !sys || co_.state_of(*sys) != all)
+      return "state_of(SYSTEM)";
 
     // The product is order-independent: fold the machine states in several random orders.
     {
@@ -960,8 +972,8 @@ private:
       const CallbackCall& x = calls_[i];
       const CallbackCall& t = calls_[i + 1];
       const CallbackCall& n = calls_[i + 2];
-      const std::string who =
-          x.component ? std::string(co_.component_name(ComponentId{x.id})) : co_.address_of(MachineId{x.id});
+      const std::string who = x.component ? std::string(co_.structure().component_name(ComponentId{x.id}))
+                                          : co_.structure().address_of(MachineId{x.id});
       if (x.phase != Phase::Exit || t.phase != Phase::Transition || n.phase != Phase::Entry) {
         return who + ": callbacks out of order (want on_exit, on_transition, on_entry)";
       }
@@ -975,9 +987,9 @@ private:
       if (x.state == n.state) return who + ": a transition to the same state";
       if (t.info.transition != expected_transition(x.state, n.state))
         return who + ": on_transition names the wrong transition";
-      if (x.component
-              ? (t.info.component != ComponentId{x.id} || t.info.machine != kNoMachine)
-              : (t.info.machine != MachineId{x.id} || t.info.component != co_.machine_component(MachineId{x.id}))) {
+      if (x.component ? (t.info.component != ComponentId{x.id} || t.info.machine != kNoMachine)
+                      : (t.info.machine != MachineId{x.id} ||
+                         t.info.component != co_.structure().machine_component(MachineId{x.id}))) {
         return who + ": on_transition names the wrong machine or component";
       }
       // Callbacks run once the write that caused them is complete (docs/semantics.md §5.2): on_entry
@@ -993,12 +1005,13 @@ private:
       ++triples[{x.component, x.id}];
     }
     calls_.clear();
-    for (MachineId m : id_range<MachineId>(co_.machine_count())) {
-      if (machine_state_[m] != co_.state(m)) return co_.address_of(m) + ": a state change fired no callbacks";
+    for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) {
+      if (machine_state_[m] != co_.state(m))
+        return co_.structure().address_of(m) + ": a state change fired no callbacks";
     }
-    for (ComponentId c : id_range<ComponentId>(co_.component_count())) {
-      if (component_state_[c] != co_.extended_state(c))
-        return std::string(co_.component_name(c)) + ": a change fired no callbacks";
+    for (ComponentId c : id_range<ComponentId>(co_.structure().component_count())) {
+      if (component_state_[c] != co_.extended(c).state)
+        return std::string(co_.structure().component_name(c)) + ": a change fired no callbacks";
     }
     // The observer stream has one Transition record per machine transition, in seq order.
     std::map<std::pair<bool, std::uint32_t>, int> recorded;
@@ -1021,7 +1034,8 @@ private:
         resets.push_back(r.machine);
       }
       if (r.kind != RecordKind::Event) continue;
-      const std::string at = to_index(r.machine) < co_.machine_count() ? co_.address_of(r.machine) : "?";
+      const std::string at =
+          to_index(r.machine) < co_.structure().machine_count() ? co_.structure().address_of(r.machine) : "?";
       // Every Event record is consistent with its outcome (§2.4).
       bool consistent = true;
       switch (r.outcome) {
@@ -1042,15 +1056,16 @@ private:
         continue;
       }
       // Records of the machines an operation targeted directly: predicted one by one.
-      if (next_expected == expected.size()) return at + ": unexpected Event record for " + co_.event(r.event).name;
+      if (next_expected == expected.size())
+        return at + ": unexpected Event record for " + co_.structure().event(r.event).name;
       const ExpectedRecord& want = expected[next_expected++];
       if (r.machine != want.machine || r.event != want.event || r.outcome != want.outcome || r.from != want.from ||
           r.to != want.to || r.text != want.text) {
-        return at + ": " + co_.event(r.event).name + " recorded " + std::string(to_string(r.outcome)) + " " +
-               std::string(to_string(r.from)) + "->" + std::string(to_string(r.to)) + " '" + std::string(r.text) +
-               "', oracle expects " + co_.address_of(want.machine) + " " + co_.event(want.event).name + " " +
-               std::string(to_string(want.outcome)) + " " + std::string(to_string(want.from)) + "->" +
-               std::string(to_string(want.to)) + " '" + want.text + "'";
+        return at + ": " + co_.structure().event(r.event).name + " recorded " + std::string(to_string(r.outcome)) +
+               " " + std::string(to_string(r.from)) + "->" + std::string(to_string(r.to)) + " '" + std::string(r.text) +
+               "', oracle expects " + co_.structure().address_of(want.machine) + " " +
+               co_.structure().event(want.event).name + " " + std::string(to_string(want.outcome)) + " " +
+               std::string(to_string(want.from)) + "->" + std::string(to_string(want.to)) + " '" + want.text + "'";
       }
     }
     records_.clear();
@@ -1065,9 +1080,9 @@ private:
 
   /// explain() lists every condition with a hop path from its origin that the model allows.
   std::string check_explain() {
-    const MachineId m = id_at<MachineId>(rng_.below(co_.machine_count()));
-    const std::string& at = co_.address_of(m);
-    const auto why = co_.explain(at);
+    const MachineId m = id_at<MachineId>(rng_.below(co_.structure().machine_count()));
+    const std::string& at = co_.structure().address_of(m);
+    const auto why = explain(co_, at);
     if (!why) return at + ": explain failed";
     const auto conds = co_.conditions(m);
     if (why->size() != conds.size()) return at + ": explain lists a different number of conditions";
@@ -1088,15 +1103,15 @@ private:
       if (x.path.size() % 2 == 0) return what + ": hop path does not alternate services and interfaces";
       State level = x.level;
       for (std::size_t i = 1; i + 1 < x.path.size(); i += 2) {
-        const auto from = co_.find_machine(x.path[i - 1]);
-        const auto svc = co_.resolve(x.path[i]);
-        const auto to = co_.find_machine(x.path[i + 1]);
+        const auto from = co_.structure().find_machine(x.path[i - 1]);
+        const auto svc = co_.structure().resolve(x.path[i]);
+        const auto to = co_.structure().find_machine(x.path[i + 1]);
         if (!from || !svc || svc->kind != Address::Kind::Service || !to) return what + ": malformed hop path";
         if (!depends_on(co_, svc->component, svc->service, *from))
           return what + ": hop path leaves through a service that does not depend on " + x.path[i - 1];
         bool ok = false;
         for (const Hop& h : hops[*from]) {
-          const Connection& k = co_.connections()[to_index(h.via)];
+          const Connection& k = co_.structure().connections()[to_index(h.via)];
           if (h.to == *to && k.provider == svc->component && k.provided == svc->service &&
               rank(level) >= rank(h.min_level))
             ok = true;

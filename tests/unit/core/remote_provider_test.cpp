@@ -9,6 +9,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -66,7 +67,7 @@ struct Split {
 
 std::vector<std::string> lines(const Coordinator& co, std::string_view address) {
   std::vector<std::string> out;
-  for (const Explanation& e : must(co.explain(address), "explain")) {
+  for (const Explanation& e : must(explain(co, address), "explain")) {
     out.push_back(e.machine + " " + e.event + " " + std::string(to_string(e.level)) + " <- " + e.root.origin + ":" +
                   e.root.event);
     for (const std::string& hop : e.path) out.back() += " / " + hop;
@@ -190,8 +191,8 @@ TEST(RemoteProvider, RemoteComponentsAreLeftOutOfTheCoordinatorState) {
   Split two;
   two.sensor.gen("EVT_FORCE_WARNING", "JR3.s_A");
   two.sync();
-  EXPECT_TRUE(two.robot.co.is_remote(two.robot.comp("JR3")));
-  EXPECT_FALSE(two.robot.co.is_remote(two.robot.comp("CONTROL")));
+  EXPECT_TRUE(two.robot.co.structure().is_remote(two.robot.comp("JR3")));
+  EXPECT_FALSE(two.robot.co.structure().is_remote(two.robot.comp("CONTROL")));
   EXPECT_EQ(two.robot.at("JR3"), W);
   EXPECT_EQ(two.robot.at("SYSTEM"), N);
 }
@@ -223,7 +224,7 @@ TEST(RemoteProvider, FilterDataOfTheRootCrossesWithIt) {
   cause.value = 42.5;
   two.sensor.co.generate(two.sensor.id("EVT_FORCE_ERROR"), two.sensor.machine("JR3.s_A"), cause);
   two.sync();
-  const auto why = must(two.robot.co.explain("CONTROL.s_R.ForceData"), "explain");
+  const auto why = must(explain(two.robot.co, "CONTROL.s_R.ForceData"), "explain");
   ASSERT_EQ(why.size(), 1u);
   EXPECT_EQ(why[0].root.filter, "force_limit");
   EXPECT_EQ(why[0].root.signal, "JR3.ForceNorm");
@@ -303,7 +304,7 @@ TEST(RemoteProvider, AHistoryRecordKeepsTheRootCauseItWasMadeWithAfterItsRemoteS
   for (const Record& r : two.robot.co.history(two.robot.machine("CONTROL.s_R.ForceData"))) {
     if (r.kind != RecordKind::Transition) continue;
     causes.push_back(std::string(to_string(r.to)) + " <- " + two.robot.co.resolve_root(r.root).origin + ":" +
-                     two.robot.co.event(r.root.event).name);
+                     two.robot.co.structure().event(r.root.event).name);
   }
   EXPECT_EQ(causes, (std::vector<std::string>{"Error <- JR3.s_A:EVT_FORCE_ERROR", "Normal <- JR3.s_A:EVT_FORCE_ERROR",
                                               "Error <- JR3.s_P.ForceData:EVT_FORCE_ERROR"}));

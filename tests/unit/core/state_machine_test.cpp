@@ -10,6 +10,7 @@
 
 #include "core_test_support.hpp"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 
 namespace safecass {
 namespace {
@@ -318,7 +319,7 @@ TEST(ConditionSet, StateEqualsMaxLevelOfActiveConditions) {
     for (const Condition& c : conditions) max = max * c.level;
     ASSERT_EQ(m.co.state(a), max) << "step " << step << " after " << events[pick];
     ASSERT_EQ(m.co.snapshot(a).state, max) << "step " << step;
-    ASSERT_EQ(m.co.extended_state(m.comp("C")), max) << "step " << step;
+    ASSERT_EQ(m.co.extended(m.comp("C")).state, max) << "step " << step;
     // Outstanding: highest severity at the current level, most recent activation on a tie.
     const Condition* best = nullptr;
     for (const Condition& c : conditions) {
@@ -623,20 +624,20 @@ TEST(Reset, AComponentResetGoesStraightToNormalEvenWhenItsMachinesHoldDifferentL
   Machine m;
   m.gen("E50", "C.s_F");
   m.gen("W20", "C.s_A");
-  ASSERT_EQ(m.co.extended_state(m.comp("C")), E);
+  ASSERT_EQ(m.co.extended(m.comp("C")).state, E);
   std::vector<Transition> component_transitions;
   m.co.on_component(
       m.comp("C"),
       StateCallbacks{{}, [&](const TransitionInfo& i) { component_transitions.push_back(i.transition); }, {}});
   m.reset("C");
   EXPECT_EQ(component_transitions, std::vector<Transition>{Transition::E2N});
-  EXPECT_EQ(m.co.extended_state(m.comp("C")), N);
+  EXPECT_EQ(m.co.extended(m.comp("C")).state, N);
 }
 
 TEST(Reset, ResetOfAServiceStateIsRefusedBecauseItIsDerived) {
   Machine m;
   m.gen("E50", "C.s_A");
-  const auto r = m.co.reset("C.s_S.p", "op", "x");
+  const auto r = reset(m.co, "C.s_S.p", "op", "x");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::InvalidArgument);
   EXPECT_NE(r.error().message.find("C.s_S.p"), std::string::npos);
@@ -646,7 +647,7 @@ TEST(Reset, ResetOfAServiceStateIsRefusedBecauseItIsDerived) {
 TEST(Reset, ResetOfAnUnknownTargetIsAnErrorAndChangesNothing) {
   Machine m;
   m.gen("E50", "C.s_A");
-  const auto r = m.co.reset("NOPE", "op", "x");
+  const auto r = reset(m.co, "NOPE", "op", "x");
   ASSERT_FALSE(r);
   EXPECT_EQ(r.error().code, ErrorCode::NotFound);
   EXPECT_NE(r.error().message.find("NOPE"), std::string::npos);
@@ -794,8 +795,8 @@ TEST(History, ARecordCarriesTheRootCauseAndTheFilterSample) {
   EXPECT_EQ(r.root.event, m.id("E50"));
   EXPECT_EQ(r.root.origin, m.machine("C.s_A"));
   EXPECT_EQ(r.root.time, seconds_to_time(0.2));
-  EXPECT_EQ(m.co.name_of(r.root.sample.filter), "force_limit");
-  EXPECT_EQ(m.co.name_of(r.root.sample.signal), "C.ForceNorm");
+  EXPECT_EQ(m.co.structure().name_of(r.root.sample.filter), "force_limit");
+  EXPECT_EQ(m.co.structure().name_of(r.root.sample.signal), "C.ForceNorm");
   EXPECT_DOUBLE_EQ(r.root.sample.value, 35.5);
   EXPECT_EQ(r.root.sample.sample_time, seconds_to_time(0.1));
 }

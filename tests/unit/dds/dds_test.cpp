@@ -90,7 +90,7 @@ protected:
     if (bridge_) bridge_->stop();
   }
   State state(const std::string& address) {
-    auto m = bridge_->coordinator().find_machine(address);
+    auto m = bridge_->coordinator().structure().find_machine(address);
     return m ? bridge_->coordinator().snapshot(*m).state : State::Error;
   }
   bool latest(const std::string& signal, std::vector<double>& out) {
@@ -353,8 +353,9 @@ TEST_F(Ros2Bridge, AnIngestedStatusThatFallsSilentIsStaleNotOk) {
     return state("JR3.s_F") == State::Error;
   }));
   EXPECT_GE(std::chrono::steady_clock::now() - silent, std::chrono::milliseconds(450));
-  auto machine = bridge_->coordinator().find_machine("JR3.s_F");
-  EXPECT_EQ(bridge_->coordinator().event(bridge_->coordinator().snapshot(*machine).outstanding).name, "EVT_STALE");
+  auto machine = bridge_->coordinator().structure().find_machine("JR3.s_F");
+  EXPECT_EQ(bridge_->coordinator().structure().event(bridge_->coordinator().snapshot(*machine).outstanding).name,
+            "EVT_STALE");
   // It speaks again: OK again.
   EXPECT_TRUE(wait_for([&] {
     dds_write(w, &a);
@@ -370,10 +371,10 @@ TEST_F(Ros2Bridge, ATopicPublishedWithAnotherTypeRaisesTheGraphEventOnItsInterfa
   const dds_entity_t w = peer.writer(std_msgs_msg_dds__Float64__desc, "/jr3/wrench");  // not a WrenchStamped
   ASSERT_GT(w, 0);
   ASSERT_TRUE(wait_for([&] { return state("JR3.s_P.ForceData") == State::Error; }));
-  auto m = bridge_->coordinator().find_machine("JR3.s_P.ForceData");
+  auto m = bridge_->coordinator().structure().find_machine("JR3.s_P.ForceData");
   const auto why = bridge_->coordinator().outstanding(*m);
   ASSERT_TRUE(why);
-  const std::string cause(bridge_->coordinator().name_of(why->root.sample.signal));
+  const std::string cause(bridge_->coordinator().structure().name_of(why->root.sample.signal));
   EXPECT_NE(cause.find("/jr3/wrench is published as std_msgs::msg::dds_::Float64_, the mapping expects "
                        "geometry_msgs/WrenchStamped"),
             std::string::npos)
@@ -538,7 +539,7 @@ TEST(Ros2Graph, ARequiredInterfaceNeedsAnotherNodesSubscriptionNotTheBridgesOwnR
   dds::Bridge& bridge = **b;
   ASSERT_TRUE(bridge.start());
   Coordinator& co = bridge.coordinator();
-  const MachineId required = *co.find_machine("CONTROL.s_R.ForceData");
+  const MachineId required = *co.structure().find_machine("CONTROL.s_R.ForceData");
   // The force flows (JR3 stays Normal), so only the graph can fail CONTROL's required interface.
   Peer driver;
   const dds_entity_t w = driver.writer(geometry_msgs_msg_dds__WrenchStamped__desc, "/jr3/wrench");
@@ -547,13 +548,13 @@ TEST(Ros2Graph, ARequiredInterfaceNeedsAnotherNodesSubscriptionNotTheBridgesOwnR
     dds_write(w, &m);
     return co.snapshot(required).state;
   };
-  const MachineId jr3 = *co.find_machine("JR3.s_F");
+  const MachineId jr3 = *co.structure().find_machine("JR3.s_F");
   ASSERT_TRUE(wait_for([&] { return state() != State::Normal && co.snapshot(jr3).state == State::Normal; }))
       << "CONTROL.s_R.ForceData " << to_string(state()) << ", JR3.s_F " << to_string(co.snapshot(jr3).state);
   // Only the bridge reads /jr3/wrench: CONTROL's subscription is missing, and that is the cause.
   auto cause = [&] {
     const auto why = co.outstanding(required);
-    return why ? std::string(co.name_of(why->root.sample.signal)) : std::string();
+    return why ? std::string(co.structure().name_of(why->root.sample.signal)) : std::string();
   };
   EXPECT_TRUE(wait_for([&] {
     return state() == State::Error && cause() == "nobody subscribes to /jr3/wrench (CONTROL.ForceData)";

@@ -80,12 +80,13 @@ private:
   std::string line(const Record& r) const {
     std::string s = std::string(to_string(r.kind)) + " " + std::string(to_string(r.outcome)) +
                     " t=" + std::to_string(r.time.count()) + " m=" + std::to_string(static_cast<int>(r.machine)) + " ";
-    if (r.event != kNoEvent) s += co_.event(r.event).name;
+    if (r.event != kNoEvent) s += co_.structure().event(r.event).name;
     s += " " + std::string(to_string(r.from)) + ">" + std::string(to_string(r.to));
     const SampleCause& c = r.root.sample;
     if (c.present()) {
-      s += " by " + std::string(co_.name_of(c.filter)) + " on " + std::string(co_.name_of(c.signal)) +
-           " v=" + bits(c.value) + " at " + std::to_string(c.sample_time.count()) + (c.injected ? " injected" : "");
+      s += " by " + std::string(co_.structure().name_of(c.filter)) + " on " +
+           std::string(co_.structure().name_of(c.signal)) + " v=" + bits(c.value) + " at " +
+           std::to_string(c.sample_time.count()) + (c.injected ? " injected" : "");
     }
     return s + "\n";
   }
@@ -421,7 +422,7 @@ TEST(FilterBank, ASampleAnObserverWritesDuringTheRunIsJudgedInThatRunAsByTheFilt
         }
         ASSERT_TRUE(w.monitor().add_filter(c));
       }
-      const EventId onset = *w.coordinator().find_event("EVT_0");
+      const EventId onset = *w.coordinator().structure().find_event("EVT_0");
       w.coordinator().subscribe([y, onset](const Record& r) {
         if (r.kind == RecordKind::Event && r.event == onset && r.outcome != Outcome::Ignored) y->push(r.time, 20.0);
       });

@@ -22,7 +22,7 @@ protected:
   BuiltinFixture() {
     co_.subscribe([this](const Record& r) {
       if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored) {
-        machines_.push_back(co_.address_of(r.machine));
+        machines_.push_back(co_.structure().address_of(r.machine));
         times_.push_back(r.time);
       }
     });
@@ -87,8 +87,8 @@ protected:
     monitor_.run_active(component_, seconds_to_time(t));
   }
 
-  MachineId app() const { return co_.application_machine(component_); }
-  MachineId framework() const { return co_.framework_machine(component_); }
+  MachineId app() const { return co_.structure().application_machine(component_); }
+  MachineId framework() const { return co_.structure().framework_machine(component_); }
   /// Event records (not Transition records) in a machine's history.
   std::size_t event_records(MachineId m) const {
     std::size_t n = 0;

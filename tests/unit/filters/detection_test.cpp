@@ -145,7 +145,7 @@ TEST_F(ThresholdFilter, LevelModeRepeatsTheOnsetEverySampleAndTheMachineOnlyRefr
   feed(x, f, 1.3, 13);
   std::vector<Condition> conditions = co_.conditions(app());
   ASSERT_EQ(conditions.size(), 1u);
-  EXPECT_EQ(co_.event(conditions[0].event).name, "EVT_X");
+  EXPECT_EQ(co_.structure().event(conditions[0].event).name, "EVT_X");
   EXPECT_EQ(conditions[0].count, 4u);
   EXPECT_EQ(conditions[0].first, seconds_to_time(1.0));
   EXPECT_EQ(conditions[0].last, seconds_to_time(1.3));

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 
@@ -21,7 +22,7 @@ protected:
     EXPECT_TRUE(co_.add_event(EventDef{"/EVT_X", 50, {Transition::E2N, Transition::E2W}, "", false, "", ""}));
     co_.subscribe([this](const Record& r) {
       if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored) {
-        events_.push_back(co_.event(r.event).name);
+        events_.push_back(co_.structure().event(r.event).name);
         values_.push_back(r.root.sample.value);
       }
     });
@@ -71,7 +72,7 @@ protected:
     EXPECT_TRUE(s->latest(t, v.data())) << name << " has no sample";
     return v[0];
   }
-  State app_state() const { return co_.state(co_.application_machine(component_)); }
+  State app_state() const { return co_.state(co_.structure().application_machine(component_)); }
 
   SimulatedClock clock_;
   Coordinator co_;

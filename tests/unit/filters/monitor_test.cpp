@@ -81,9 +81,9 @@ TEST_F(MonitorTest, MonitorThreadRunsPassiveFiltersInRealTimeAndStops) {
   monitor.start(std::chrono::milliseconds(1));
   EXPECT_TRUE(monitor.running());
   x->push(real.now(), 5.0);
-  for (int i = 0; i < 2000 && co.extended_state(ComponentId{0}) != State::Error; ++i)
+  for (int i = 0; i < 2000 && co.extended(ComponentId{0}).state != State::Error; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  EXPECT_EQ(co.extended_state(ComponentId{0}), State::Error);
+  EXPECT_EQ(co.extended(ComponentId{0}).state, State::Error);
   monitor.stop();
   EXPECT_FALSE(monitor.running());
 }
@@ -105,7 +105,7 @@ TEST_F(MonitorTest, FilterEventsCarryTheirRootCauseIntoExplain) {
   Signal* x = signal("force");
   Filter* f = make("Threshold", threshold("force", 10));
   feed(x, f, 0.25, 12.5);
-  const auto why = co_.explain("C.s_A");
+  const auto why = explain(co_, "C.s_A");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   EXPECT_EQ((*why)[0].root.filter, f->name());
@@ -123,7 +123,7 @@ TEST_F(MonitorTest, FilterRootCausePropagatesToConnectedClients) {
   Signal* x = signal("force");
   Filter* f = make("Threshold", threshold("force", 10));
   feed(x, f, 0.5, 20);
-  const auto why = co.explain("CLIENT");
+  const auto why = explain(co, "CLIENT");
   ASSERT_TRUE(why);
   ASSERT_EQ(why->size(), 1u);
   EXPECT_TRUE((*why)[0].mirror);
@@ -149,9 +149,9 @@ TEST_F(MonitorTest, FiltersCanTargetEachKindOfMachine) {
   }
   x->push(Time{1}, 5.0);
   monitor_.run_active(component_, Time{1});
-  EXPECT_EQ(co_.state(*co_.find_machine("C.s_F")), State::Error);
-  EXPECT_EQ(co_.state(*co_.find_machine("C.s_P.P")), State::Error);
-  EXPECT_EQ(co_.state(*co_.find_machine("C.s_R.R")), State::Error);
+  EXPECT_EQ(co_.state(*co_.structure().find_machine("C.s_F")), State::Error);
+  EXPECT_EQ(co_.state(*co_.structure().find_machine("C.s_P.P")), State::Error);
+  EXPECT_EQ(co_.state(*co_.structure().find_machine("C.s_R.R")), State::Error);
   FilterConfig bad;
   bad.type = "Threshold";
   bad.target = FilterTarget{MachineKind::Provided, "C", "Nope"};

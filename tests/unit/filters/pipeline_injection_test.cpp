@@ -82,7 +82,7 @@ TEST_F(InjectionTest, ShallowInjectionIsSeenByThatFilterAloneAndMarked) {
   EXPECT_DOUBLE_EQ(latest("C.copy"), 1.0) << "the other consumer saw the real sample";
   ASSERT_EQ(injections.size(), 1u);
   EXPECT_NE(std::string(injections[0].text).find("shallow injection into filter target: 50"), std::string::npos);
-  const auto why = co_.explain("C.s_A");
+  const auto why = explain(co_, "C.s_A");
   ASSERT_TRUE(why);
   EXPECT_TRUE((*why)[0].root.injected);
   // After the injected sample is consumed, real samples are judged again.
@@ -131,7 +131,7 @@ TEST_F(InjectionTest, DeepInjectionWritesTheSignalSoEveryConsumerSeesIt) {
   ASSERT_TRUE(x->latest(t, &v, &injected));
   EXPECT_DOUBLE_EQ(v, 42);
   EXPECT_TRUE(injected) << "the signal's history marks injected samples";
-  const auto history = co_.history(co_.application_machine(component_));
+  const auto history = co_.history(co_.structure().application_machine(component_));
   const bool has_injection =
       std::any_of(history.begin(), history.end(), [](const Record& r) { return r.kind == RecordKind::Injection; });
   EXPECT_TRUE(has_injection) << "the injection is in the target machine's history";

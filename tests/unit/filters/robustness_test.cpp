@@ -60,8 +60,9 @@ struct Rig {
     EXPECT_TRUE(co.add_event(EventDef{"/EVT_X", 50, {Transition::E2N, Transition::E2W}, "", false, "", ""}));
     co.subscribe([this](const Record& r) {
       if (r.kind != RecordKind::Event || r.outcome == Outcome::Ignored) return;
-      log.push_back(Entry{co.address_of(r.machine), co.event(r.event).name, r.time, r.root.sample.value,
-                          r.root.sample.signal == kNoName ? "" : std::string(co.name_of(r.root.sample.signal))});
+      log.push_back(
+          Entry{co.structure().address_of(r.machine), co.structure().event(r.event).name, r.time, r.root.sample.value,
+                r.root.sample.signal == kNoName ? "" : std::string(co.structure().name_of(r.root.sample.signal))});
     });
   }
   void create(const Case& k) {
@@ -130,7 +131,7 @@ protected:
       faulty_.push(first, t, bad[i]);
       faulty_.run(t);
       clean_.run(t);
-      states_during_.push_back(faulty_.co.state(faulty_.co.framework_machine(faulty_.c)));
+      states_during_.push_back(faulty_.co.state(faulty_.co.structure().framework_machine(faulty_.c)));
     }
     for (Rig* r : {&faulty_, &clean_}) {
       r->run(1.6);
@@ -159,7 +160,7 @@ TEST_P(EveryBuiltinFilter, NonFiniteSamplesNeverReachTheFilterAndRaiseInvalidSam
   EXPECT_EQ(sf[1].event, "/EVT_INVALID_SAMPLE");
   EXPECT_EQ(sf[1].time, seconds_to_time(1.7));
   EXPECT_EQ(states_during_, (std::vector<State>{State::Error, State::Error, State::Error}));
-  EXPECT_EQ(faulty_.co.state(faulty_.co.framework_machine(faulty_.c)), State::Normal);
+  EXPECT_EQ(faulty_.co.state(faulty_.co.structure().framework_machine(faulty_.c)), State::Normal);
   EXPECT_TRUE(clean_.on("C.s_F").empty());
   // The filter behaved exactly as if the bad samples had never been written: same events on its
   // target, same output samples (so nothing was written for a bad sample).

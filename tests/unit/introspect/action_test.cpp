@@ -96,9 +96,9 @@ TEST_F(ActionPath, AnAppliedActionIsToldOnceWithTheTimeItWasAppliedAt) {
   ASSERT_TRUE(apply(PushSample{"JR3.Fz", {5.0}}, co(), monitor(), t, &told));
   EXPECT_EQ(monitor().signals().find("JR3.Fz")->buffer().end(), 1u);
   ASSERT_TRUE(apply(GenerateEvent{"EVT_FORCE_ERROR", "JR3.s_A"}, co(), monitor(), t, &told));
-  EXPECT_EQ(co().state(*co().find_machine("JR3.s_A")), State::Error);
+  EXPECT_EQ(co().state(*co().structure().find_machine("JR3.s_A")), State::Error);
   ASSERT_TRUE(apply(ResetState{"JR3", "test", "cleared"}, co(), monitor(), t, &told));
-  EXPECT_EQ(co().state(*co().find_machine("JR3.s_A")), State::Normal);
+  EXPECT_EQ(co().state(*co().structure().find_machine("JR3.s_A")), State::Normal);
   ASSERT_TRUE(apply(InjectDeep{"JR3.Fz", {{50.0}}}, co(), monitor(), t, &told));
   ASSERT_TRUE(apply(InjectShallow{"force_limit", {{50.0}}}, co(), monitor(), t, &told));
   ASSERT_EQ(told.actions.size(), 5u);

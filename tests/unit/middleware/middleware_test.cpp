@@ -72,12 +72,12 @@ TEST(RemoteProviders, TheUiCoordinatorGetsCONTROLStatusAsARemoteProvider) {
   Monitor monitor(co, r.registry);
   ASSERT_TRUE(spec::instantiate(*r.load.system, co, monitor, "ui"));
   ASSERT_TRUE(connect_remote_providers(*r.load.system, "ui", co));
-  auto control = co.find_component("CONTROL");
+  auto control = co.structure().find_component("CONTROL");
   ASSERT_TRUE(control);
-  EXPECT_TRUE(co.is_remote(*control));
-  ASSERT_EQ(co.connections().size(), 1u);
-  EXPECT_EQ(co.service(*control, 0).propagate, State::Warning) << "the provider's propagation level";
-  EXPECT_FALSE(co.find_component("JR3")) << "only what the ui's components require";
+  EXPECT_TRUE(co.structure().is_remote(*control));
+  ASSERT_EQ(co.structure().connections().size(), 1u);
+  EXPECT_EQ(co.structure().service(*control, 0).propagate, State::Warning) << "the provider's propagation level";
+  EXPECT_FALSE(co.structure().find_component("JR3")) << "only what the ui's components require";
 }
 
 TEST(RemoteProviders, TheRobotCoordinatorHasNoRemoteProvider) {
@@ -85,10 +85,11 @@ TEST(RemoteProviders, TheRobotCoordinatorHasNoRemoteProvider) {
   Coordinator co("robot");
   Monitor monitor(co, r.registry);
   ASSERT_TRUE(spec::instantiate(*r.load.system, co, monitor, "robot"));
-  const auto before = co.connections().size();
+  const auto before = co.structure().connections().size();
   ASSERT_TRUE(connect_remote_providers(*r.load.system, "robot", co));
-  EXPECT_EQ(co.connections().size(), before);
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) EXPECT_FALSE(co.is_remote(c));
+  EXPECT_EQ(co.structure().connections().size(), before);
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count()))
+    EXPECT_FALSE(co.structure().is_remote(c));
 }
 
 TEST(RemoteProviders, AnUnknownCoordinatorIsNotFound) {
@@ -155,7 +156,7 @@ TEST(Supervisor, BuildsItsViewWithTheApplicationsFilterRegistryAndWithoutItNames
   options.registry = &registry;
   auto supervisor = Supervisor::create(*load.system, options);
   ASSERT_TRUE(supervisor) << supervisor.error().message;
-  EXPECT_TRUE((*supervisor)->model().find_component("ENCODER"));
+  EXPECT_TRUE((*supervisor)->model().structure().find_component("ENCODER"));
 
   options.registry = nullptr;  // the built-in types alone
   auto builtin_only = Supervisor::create(*load.system, options);
@@ -346,12 +347,12 @@ TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
   Monitor monitor(co, registry);
   ASSERT_TRUE(spec::instantiate(*load.system, co, monitor, "right"));
   ASSERT_TRUE(connect_remote_providers(*load.system, "right", co));
-  const MachineId remote = *co.find_machine("S.s_P.out");
+  const MachineId remote = *co.structure().find_machine("S.s_P.out");
   const std::vector<std::string> onsets{"EVT_E", "EVT_F", "EVT_W"};
   const std::vector<std::string> events{"EVT_E", "/EVT_E", "EVT_F", "/EVT_F", "EVT_W", "/EVT_W"};
   std::vector<MachineId> local;
   for (const char* m : {"A.s_F", "A.s_A", "A.s_P.p", "A.s_P.q", "A.s_R.in", "B.s_A", "B.s_P.r", "B.s_R.a"}) {
-    local.push_back(*co.find_machine(m));
+    local.push_back(*co.structure().find_machine(m));
   }
   std::mt19937 random(20261121);
   std::size_t mixed = 0;  // steps where A.p held a remote and a local root together
@@ -381,11 +382,11 @@ TEST(ServiceRoots, TheSnapshotBuiltFromConditionsEqualsTheOneBuiltFromExplain) {
       }
       ASSERT_TRUE(co.apply_remote(remote, roots));
     } else {
-      co.generate(*co.find_event(events[random() % events.size()]), local[random() % local.size()]);
+      co.generate(*co.structure().find_event(events[random() % events.size()]), local[random() % local.size()]);
     }
     for (const char* name : {"A", "B"}) {
-      const ComponentId c = *co.find_component(name);
-      for (std::uint32_t p = 0; p < co.provided_machines(c).size(); ++p) {
+      const ComponentId c = *co.structure().find_component(name);
+      for (std::uint32_t p = 0; p < co.structure().provided_machines(c).size(); ++p) {
         const auto got = co.service_roots(c, p);
         ASSERT_EQ(text_of(got), text_of(roots_from_explain(co, c, p)))
             << "step " << step << ", service " << name << " #" << p;

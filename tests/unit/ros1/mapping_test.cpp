@@ -82,9 +82,9 @@ TEST(Ros1Bridge, TheExampleBuildsTheRobotCoordinatorWithTopicSignalsAndTimingFil
   auto bridge = Bridge::create("examples/ros_robodoc/mapping.json", registry);
   ASSERT_TRUE(bridge) << bridge.error().message;
   Coordinator& co = (*bridge)->coordinator();
-  EXPECT_EQ(co.name(), "robot");
-  EXPECT_TRUE(co.find_component("CONTROL"));
-  EXPECT_FALSE(co.find_component("PENDANT"));  // the "ui" coordinator's
+  EXPECT_EQ(co.structure().name(), "robot");
+  EXPECT_TRUE(co.structure().find_component("CONTROL"));
+  EXPECT_FALSE(co.structure().find_component("PENDANT"));  // the "ui" coordinator's
   Monitor& mon = (*bridge)->monitor();
   ASSERT_NE(mon.signals().find("JR3.Torque"), nullptr);
   EXPECT_EQ(mon.signals().find("JR3.Torque")->size(), 3u);
@@ -96,7 +96,7 @@ TEST(Ros1Bridge, TheExampleBuildsTheRobotCoordinatorWithTopicSignalsAndTimingFil
   ASSERT_NE(mon.find_filter("ros/jr3/wrench:frequency"), nullptr);
   for (const char* e :
        {"EVT_ROS_DIAG_WARN", "/EVT_ROS_DIAG_ERROR", "EVT_ROS_GRAPH_MISSING", "EVT_WRENCH_TOPIC_STALE"}) {
-    EXPECT_TRUE(co.find_event(e)) << e;
+    EXPECT_TRUE(co.structure().find_event(e)) << e;
   }
   EXPECT_EQ((*bridge)->status_name("JR3.s_A"), "safecass: JR3.s_A");
 }

@@ -94,10 +94,10 @@ TEST(GoodSpecs, RobodocInstantiatesEveryComponentMachineAndFilter) {
   Monitor monitor(co, builtin_registry());
   const auto made = instantiate(*r.system, co, monitor);
   ASSERT_TRUE(made) << made.error().message;
-  EXPECT_EQ(co.component_count(), 3u);
-  EXPECT_EQ(co.machine_count(), 10u);  // JR3: F, A, P; CONTROL: F, A, P, R; SERVO: F, A, R
-  EXPECT_EQ(co.event_count(), framework_event::kCount + 9);
-  EXPECT_EQ(co.connections().size(), 2u);
+  EXPECT_EQ(co.structure().component_count(), 3u);
+  EXPECT_EQ(co.structure().machine_count(), 10u);  // JR3: F, A, P; CONTROL: F, A, P, R; SERVO: F, A, R
+  EXPECT_EQ(co.structure().event_count(), framework_event::kCount + 9);
+  EXPECT_EQ(co.structure().connections().size(), 2u);
   EXPECT_EQ(monitor.filters().size(), 10u);
   for (const char* name : {"force_norm", "force_limit", "force_warn", "force_spike.1", "force_spike.2", "force_spike.3",
                            "heartbeat", "tracking.1", "tracking.2", "servo_duty"}) {
@@ -115,14 +115,14 @@ TEST(GoodSpecs, InstantiatedSystemDetectsAndPropagatesAForceError) {
   Coordinator co("robodoc", &clock);
   Monitor monitor(co, builtin_registry());
   ASSERT_TRUE(instantiate(*r.system, co, monitor));
-  const ComponentId jr3 = *co.find_component("JR3");
+  const ComponentId jr3 = *co.structure().find_component("JR3");
   const double force[3] = {0.0, 0.0, 35.0};
   monitor.signals().find("JR3.Force")->push(clock.now(), force);
   monitor.run_active(jr3, clock.now());
-  EXPECT_EQ(co.state(*co.find_machine("JR3.s_A")), State::Error);
-  EXPECT_EQ(co.state(*co.find_machine("CONTROL.s_R.ForceData")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("JR3.s_A")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("CONTROL.s_R.ForceData")), State::Error);
   // CONTROL's Command service passes warnings and errors on to SERVO.
-  EXPECT_EQ(co.state(*co.find_machine("SERVO.s_R.Command")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("SERVO.s_R.Command")), State::Error);
 }
 
 TEST(GoodSpecs, OnlyOneCoordinatorsComponentsAreInstantiated) {
@@ -133,17 +133,17 @@ TEST(GoodSpecs, OnlyOneCoordinatorsComponentsAreInstantiated) {
   Monitor monitor(co, builtin_registry());
   const auto made = instantiate(*r.system, co, monitor, "drive");
   ASSERT_TRUE(made) << made.error().message;
-  EXPECT_EQ(co.component_count(), 1u);
-  EXPECT_EQ(co.machine_count(), 3u);
-  EXPECT_TRUE(co.connections().empty());  // SERVO.Command's provider runs elsewhere
+  EXPECT_EQ(co.structure().component_count(), 1u);
+  EXPECT_EQ(co.structure().machine_count(), 3u);
+  EXPECT_TRUE(co.structure().connections().empty());  // SERVO.Command's provider runs elsewhere
   EXPECT_EQ(monitor.filters().size(), 1u);
-  EXPECT_TRUE(co.find_event("EVT_FORCE_ERROR"));  // events are system-wide
+  EXPECT_TRUE(co.structure().find_event("EVT_FORCE_ERROR"));  // events are system-wide
 
   Coordinator robot("robot", &clock);
   Monitor robot_monitor(robot, builtin_registry());
   ASSERT_TRUE(instantiate(*r.system, robot, robot_monitor, "robot"));
-  EXPECT_EQ(robot.component_count(), 2u);
-  EXPECT_EQ(robot.connections().size(), 1u);
+  EXPECT_EQ(robot.structure().component_count(), 2u);
+  EXPECT_EQ(robot.structure().connections().size(), 1u);
   EXPECT_EQ(robot_monitor.filters().size(), 9u);
 }
 
@@ -192,15 +192,15 @@ TEST(GoodSpecs, A2016SystemInstantiatesAndPropagates) {
   Monitor monitor(co, builtin_registry());
   const auto made = instantiate(*r.system, co, monitor);
   ASSERT_TRUE(made) << made.error().message;
-  EXPECT_EQ(co.machine_count(), 2u + 1u + 2u + 2u);  // JR3: F, A, P; Control: F, A, P, R
-  const ComponentId jr3 = *co.find_component("JR3");
+  EXPECT_EQ(co.structure().machine_count(), 2u + 1u + 2u + 2u);  // JR3: F, A, P; Control: F, A, P, R
+  const ComponentId jr3 = *co.structure().find_component("JR3");
   monitor.signals().find("JR3.DeviceError")->push(clock.now(), 1.0);
   monitor.run_active(jr3, clock.now());
-  EXPECT_EQ(co.state(*co.find_machine("JR3.s_F")), State::Error);
-  EXPECT_EQ(co.state(*co.find_machine("Control.s_R.ReadSensorValue")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("JR3.s_F")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("Control.s_R.ReadSensorValue")), State::Error);
   monitor.signals().find("JR3.DeviceError")->push(clock.now(), 0.0);
   monitor.run_active(jr3, clock.now());
-  EXPECT_EQ(co.state(*co.find_machine("Control.s_R.ReadSensorValue")), State::Normal);
+  EXPECT_EQ(co.state(*co.structure().find_machine("Control.s_R.ReadSensorValue")), State::Normal);
 }
 
 TEST(GoodSpecs, ProvidedInterfaceWithoutServiceEntryGetsTheConservativeDefault) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "safecass/core/clock.hpp"
+#include "safecass/core/named.hpp"
 #include "spec_commands.hpp"
 #include "spec_test_support.hpp"
 
@@ -71,17 +72,19 @@ TEST(Original2016, TheFrameworkFilterTemplateIsInstantiatedForEveryComponentOfTh
   Monitor monitor(co, builtin_registry());
   const auto made = instantiate(*r.system, co, monitor);
   ASSERT_TRUE(made) << made.error().message;
-  const ComponentId arm = *co.find_component("Arm");
+  const ComponentId arm = *co.structure().find_component("Arm");
   Signal* exceptions = monitor.signals().find("Arm.ExceptionCount");
   ASSERT_NE(exceptions, nullptr);
   exceptions->push(clock.now(), 1.0);
   monitor.run_active(arm, clock.now());
-  EXPECT_EQ(co.state(*co.find_machine("Arm.s_F")), State::Error);
-  EXPECT_EQ(co.state(*co.find_machine("Gripper.s_R.ArmMotion")), State::Error) << "the exception fails Arm's service";
-  EXPECT_EQ(co.snapshot(*co.find_machine("Arm.s_F")).outstanding, *co.find_event("EVT_THREAD_EXCEPTION"));
+  EXPECT_EQ(co.state(*co.structure().find_machine("Arm.s_F")), State::Error);
+  EXPECT_EQ(co.state(*co.structure().find_machine("Gripper.s_R.ArmMotion")), State::Error)
+      << "the exception fails Arm's service";
+  EXPECT_EQ(co.snapshot(*co.structure().find_machine("Arm.s_F")).outstanding,
+            *co.structure().find_event("EVT_THREAD_EXCEPTION"));
   exceptions->push(clock.now(), 0.0);
   monitor.run_active(arm, clock.now());
-  EXPECT_EQ(co.state(*co.find_machine("Gripper.s_R.ArmMotion")), State::Normal);
+  EXPECT_EQ(co.state(*co.structure().find_machine("Gripper.s_R.ArmMotion")), State::Normal);
 }
 
 TEST(Original2016, TheKeysAndValuesTheOriginalAcceptedLoad) {
@@ -124,7 +127,7 @@ TEST(Original2016, TheOriginalClassNamesAndArgumentsLoadAsTheirBuiltins) {
   Monitor monitor(co, builtin_registry());
   const auto made = instantiate(*r.system, co, monitor);
   ASSERT_TRUE(made) << made.error().message;
-  const ComponentId id = *co.find_component("Arm");
+  const ComponentId id = *co.structure().find_component("Arm");
   Signal* angle = monitor.signals().find("Arm.JointAngle");
   angle->push(seconds_to_time(0.0), 1.0);
   monitor.run_active(id, seconds_to_time(0.0));
@@ -139,13 +142,14 @@ TEST(Original2016, TheOriginalClassNamesAndArgumentsLoadAsTheirBuiltins) {
   // Bypass with event_on/event_off reports a non-zero input, as the 2016 Bypass did.
   monitor.signals().find("Arm.BrakeFault")->push(seconds_to_time(0.6), 1.0);
   monitor.run_active(id, seconds_to_time(0.6));
-  EXPECT_EQ(co.snapshot(*co.find_machine("Arm.s_A")).outstanding, *co.find_event("EVT_ARM_BRAKE"));
+  EXPECT_EQ(co.snapshot(*co.structure().find_machine("Arm.s_A")).outstanding,
+            *co.structure().find_event("EVT_ARM_BRAKE"));
   // ChangeDetection's 'event'.
   monitor.signals().find("Arm.Mode")->push(seconds_to_time(0.7), 1.0);
   monitor.run_active(id, seconds_to_time(0.7));
   monitor.signals().find("Arm.Mode")->push(seconds_to_time(0.8), 2.0);
   monitor.run_active(id, seconds_to_time(0.8));
-  const auto why = co.explain("Arm.s_A");
+  const auto why = explain(co, "Arm.s_A");
   ASSERT_TRUE(why);
   bool mode = false;
   for (const Explanation& e : *why) mode = mode || e.root.event == "EVT_ARM_MODE";

@@ -37,7 +37,7 @@ TEST(SystemFactory, BuildsAFilterTypeThatOnlyTheApplicationsRegistryKnows) {
   ASSERT_TRUE(built) << to_text(built.error());
   spec::Instance& instance = **built;
   EXPECT_EQ(&instance.registry(), &registry);
-  EXPECT_EQ(instance.coordinator().name(), "encoders");
+  EXPECT_EQ(instance.coordinator().structure().name(), "encoders");
   ASSERT_NE(instance.monitor().find_filter("frozen_angle"), nullptr);
   EXPECT_EQ(instance.monitor().find_filter("frozen_angle")->type(), "Frozen");
 }
@@ -62,9 +62,9 @@ TEST(SystemFactory, AnInstanceIsNamedAfterItsCoordinatorThenTheGivenNameThenTheS
   EXPECT_EQ(spec::coordinator_name(*system, options), "ui");
   auto ui = spec::build_instance(*system, registry, options);
   ASSERT_TRUE(ui) << to_text(ui.error());
-  EXPECT_EQ((*ui)->coordinator().name(), "ui");
-  EXPECT_TRUE((*ui)->coordinator().find_component("PENDANT"));
-  EXPECT_FALSE((*ui)->coordinator().find_component("JR3")) << "another coordinator's component";
+  EXPECT_EQ((*ui)->coordinator().structure().name(), "ui");
+  EXPECT_TRUE((*ui)->coordinator().structure().find_component("PENDANT"));
+  EXPECT_FALSE((*ui)->coordinator().structure().find_component("JR3")) << "another coordinator's component";
 }
 
 TEST(SystemFactory, OpensTheWholeSystemWithOneTaskPerComponentOnItsOwnSimulatedClock) {
@@ -75,7 +75,7 @@ TEST(SystemFactory, OpensTheWholeSystemWithOneTaskPerComponentOnItsOwnSimulatedC
   EXPECT_EQ(system.runtime().task_count(), system.spec().components.size());
   ASSERT_NE(system.simulated_clock(), nullptr);
   for (const char* name : {"JR3", "BMM", "CONTROL", "SERVO", "PENDANT"}) {
-    EXPECT_TRUE(system.coordinator().find_component(name)) << name;
+    EXPECT_TRUE(system.coordinator().structure().find_component(name)) << name;
   }
 }
 
@@ -88,10 +88,10 @@ TEST(SystemFactory, OneCoordinatorOfAMultiProcessSystemBuildsOnlyItsComponentsOn
   auto opened = open_system(kRobodoc, registry, options);
   ASSERT_TRUE(opened) << to_text(opened.error());
   System& system = **opened;
-  EXPECT_EQ(system.coordinator().name(), "ui");
+  EXPECT_EQ(system.coordinator().structure().name(), "ui");
   EXPECT_EQ(system.simulated_clock(), nullptr) << "the system reads the clock it was given";
-  EXPECT_TRUE(system.coordinator().find_component("PENDANT"));
-  EXPECT_FALSE(system.coordinator().find_component("JR3")) << "another coordinator's component";
+  EXPECT_TRUE(system.coordinator().structure().find_component("PENDANT"));
+  EXPECT_FALSE(system.coordinator().structure().find_component("JR3")) << "another coordinator's component";
   EXPECT_EQ(system.runtime().task_count(), 1u);
 }
 

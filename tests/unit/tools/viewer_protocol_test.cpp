@@ -282,7 +282,7 @@ TEST(ViewerProtocol, WritesAreRefusedWhenTheViewerIsReadOnly) {
     EXPECT_THAT(str(reply, "error"), HasSubstr("refused: this viewer is read-only")) << message;
   }
   EXPECT_TRUE(source->take_records().empty());
-  EXPECT_EQ(source->coordinator().state_of(*source->coordinator().resolve("CONTROL.s_A")), State::Normal);
+  EXPECT_EQ(source->coordinator().state_of(*source->coordinator().structure().resolve("CONTROL.s_A")), State::Normal);
 }
 
 TEST(ViewerProtocol, WritesWithoutTheRightTokenAreRefusedAndWithItApplied) {
@@ -298,20 +298,20 @@ TEST(ViewerProtocol, WritesWithoutTheRightTokenAreRefusedAndWithItApplied) {
               HasSubstr("refused: wrong token"));
   EXPECT_THAT(str(parse(protocol.handle(generate + R"(,"token":""})")), "error"), HasSubstr("refused"));
   const Coordinator& co = source->coordinator();
-  EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Normal);
+  EXPECT_EQ(co.state_of(*co.structure().resolve("CONTROL.s_A")), State::Normal);
   EXPECT_TRUE(source->take_records().empty());
 
   const json::JsonValue ok = parse(protocol.handle(generate + R"(,"token":"s3cret","id":3})"));
   EXPECT_EQ(str(ok, "type"), "reply");
   EXPECT_EQ(str(ok, "op"), "generate");
   EXPECT_THAT(str(ok, "text"), HasSubstr("generated EVT_CONTROL_FORCE_FREEZE on CONTROL.s_A"));
-  EXPECT_EQ(co.state_of(*co.resolve("CONTROL.s_A")), State::Error);
-  EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Error);
+  EXPECT_EQ(co.state_of(*co.structure().resolve("CONTROL.s_A")), State::Error);
+  EXPECT_EQ(co.state_of(*co.structure().resolve("SERVO")), State::Error);
 
   const json::JsonValue reset =
       parse(protocol.handle(R"({"op":"reset","target":"CONTROL","reason":"test","token":"s3cret"})"));
   EXPECT_THAT(str(reset, "text"), HasSubstr("reset CONTROL"));
-  EXPECT_EQ(co.state_of(*co.resolve("SERVO")), State::Normal);
+  EXPECT_EQ(co.state_of(*co.structure().resolve("SERVO")), State::Normal);
 }
 
 TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {

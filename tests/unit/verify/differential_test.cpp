@@ -11,6 +11,7 @@
 #include <string>
 
 #include "safecass/core/coordinator.hpp"
+#include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/load.hpp"
@@ -83,16 +84,16 @@ void compare(const spec::SystemSpec& system, unsigned seeds, std::size_t steps, 
     ASSERT_TRUE(spec::instantiate(system, co, monitor));
     std::vector<Address> addresses;
     for (const std::string& a : sim->addresses) {
-      auto resolved = co.resolve(a);
+      auto resolved = co.structure().resolve(a);
       ASSERT_TRUE(resolved) << a;
       addresses.push_back(*resolved);
     }
     for (std::size_t k = 0; k < sim->steps.size(); ++k) {
       const Step& s = sim->steps[k];
       if (s.kind == Step::Kind::Reset) {
-        ASSERT_TRUE(co.reset(s.target, "test", "differential"));
+        ASSERT_TRUE(reset(co, s.target, "test", "differential"));
       } else {
-        ASSERT_TRUE(co.generate(s.event, s.target)) << s.event << " " << s.target;
+        ASSERT_TRUE(generate(co, s.event, s.target)) << s.event << " " << s.target;
       }
       for (std::size_t a = 0; a < addresses.size(); ++a) {
         ASSERT_EQ(co.state_of(addresses[a]), sim->states[k][a])

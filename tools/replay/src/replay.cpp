@@ -353,15 +353,15 @@ namespace {
 /// Every address of a system worth comparing: machines, service states, components, SYSTEM.
 std::vector<std::string> addresses_of(const Coordinator& co) {
   std::vector<std::string> out;
-  for (ComponentId c : id_range<ComponentId>(co.component_count())) {
-    out.emplace_back(co.component_name(c));
-    out.push_back(co.address_of(co.framework_machine(c)));
-    out.push_back(co.address_of(co.application_machine(c)));
-    for (MachineId m : co.provided_machines(c)) {
-      out.push_back(co.address_of(m));
-      out.push_back(address::service(co.component_name(c), co.interface_name(m)));
+  for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
+    out.emplace_back(co.structure().component_name(c));
+    out.push_back(co.structure().address_of(co.structure().framework_machine(c)));
+    out.push_back(co.structure().address_of(co.structure().application_machine(c)));
+    for (MachineId m : co.structure().provided_machines(c)) {
+      out.push_back(co.structure().address_of(m));
+      out.push_back(address::service(co.structure().component_name(c), co.structure().interface_name(m)));
     }
-    for (MachineId m : co.required_machines(c)) out.push_back(co.address_of(m));
+    for (MachineId m : co.structure().required_machines(c)) out.push_back(co.structure().address_of(m));
   }
   out.emplace_back("SYSTEM");
   return out;
@@ -519,15 +519,15 @@ int run_replay_diff(const std::string& system_b, const ReplayOptions& o, const F
   std::vector<Tracked> tracked;
   std::vector<std::string> only;
   for (const std::string& name : addresses_of(b->coordinator())) {
-    auto ab = b->coordinator().resolve(name);
-    auto aa = a->coordinator().resolve(name);
+    auto ab = b->coordinator().structure().resolve(name);
+    auto aa = a->coordinator().structure().resolve(name);
     if (ab && aa)
       tracked.push_back(Tracked{name, *ab, *aa, {}});
     else
       only.push_back(name + " (only in " + system_b + ")");
   }
   for (const std::string& name : addresses_of(a->coordinator())) {
-    if (!b->coordinator().resolve(name)) only.push_back(name + " (only in " + o.system + ")");
+    if (!b->coordinator().structure().resolve(name)) only.push_back(name + " (only in " + o.system + ")");
   }
 
   runner::RunOptions quiet;

@@ -163,7 +163,8 @@ Diagnostics ScenarioRunner::check_names() {
   std::vector<std::string> filter_names;
   for (const auto& f : monitor_->filters()) filter_names.push_back(f->name());
   std::vector<std::string> event_names;
-  for (EventId e : id_range<EventId>(coordinator_.event_count())) event_names.push_back(coordinator_.event(e).name);
+  for (EventId e : id_range<EventId>(coordinator_.structure().event_count()))
+    event_names.push_back(coordinator_.structure().event(e).name);
   const std::vector<std::string> address_names = addresses();
   const auto no_address = [&](const std::string& address, const std::string& message) {
     return message + spec::did_you_mean(address, address_names);
@@ -195,13 +196,13 @@ Diagnostics ScenarioRunner::check_names() {
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
-        auto e = coordinator_.find_event(action->event);
+        auto e = coordinator_.structure().find_event(action->event);
         if (!e) {
           out.push_back(error_at(s, unknown("event", action->event, event_names)));
-        } else if (!coordinator_.event(*e).is_broadcast()) {
+        } else if (!coordinator_.structure().event(*e).is_broadcast()) {
           if (action->target.empty())
             out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
-          else if (auto m = coordinator_.find_machine(action->target); !m) {
+          else if (auto m = coordinator_.structure().find_machine(action->target); !m) {
             out.push_back(error_at(s, no_address(action->target, m.error().message)));
           }
         }
@@ -240,7 +241,7 @@ Diagnostics ScenarioRunner::check_names() {
         // reset of one would do nothing. Refused here, at load, rather than silently at run time.
         if (coordinator_components(action->target) != nullptr) {
           // A coordinator of the system file: all its components are reset (docs/semantics.md §4.5).
-        } else if (auto a = coordinator_.resolve(action->target); !a) {
+        } else if (auto a = coordinator_.structure().resolve(action->target); !a) {
           out.push_back(error_at(s, no_address(action->target, a.error().message)));
         } else if (a->kind == Address::Kind::Service) {
           out.push_back(error_at(s, "cannot reset service state '" + action->target +
@@ -252,7 +253,7 @@ Diagnostics ScenarioRunner::check_names() {
       case spec::ScenarioStep::Kind::ExpectCause:
         for (const auto& [address, expected] : action->expectations) {
           if (coordinator_components(address) != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) continue;
-          auto a = coordinator_.resolve(address);
+          auto a = coordinator_.structure().resolve(address);
           if (!a) {
             out.push_back(error_at(s, no_address(address, a.error().message)));
             continue;
@@ -260,16 +261,16 @@ Diagnostics ScenarioRunner::check_names() {
           if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
             if (a->kind != Address::Kind::Component && a->kind != Address::Kind::Machine) {
               out.push_back(error_at(s, "expect_outstanding needs a component or a machine, not '" + address + "'"));
-            } else if (expected != "none" && !coordinator_.find_event(expected)) {
+            } else if (expected != "none" && !coordinator_.structure().find_event(expected)) {
               out.push_back(error_at(s, unknown("event", expected, event_names)));
             }
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectCause) {
             const auto colon = expected.find(':');
-            if (auto m = coordinator_.find_machine(expected.substr(0, colon)); !m) {
+            if (auto m = coordinator_.structure().find_machine(expected.substr(0, colon)); !m) {
               out.push_back(error_at(s, no_address(expected.substr(0, colon), m.error().message)));
             }
-            if (!coordinator_.find_event(expected.substr(colon + 1))) {
+            if (!coordinator_.structure().find_event(expected.substr(colon + 1))) {
               out.push_back(error_at(s, unknown("event", expected.substr(colon + 1), event_names)));
             }
           }
@@ -336,7 +337,8 @@ std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::st
       components != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) {
     // The state of a coordinator of the system: the product of its components' (DESIGN §2.2).
     State got = State::Normal;
-    for (const std::string& c : *components) got = std::max(got, coordinator_.state_of(*coordinator_.resolve(c)));
+    for (const std::string& c : *components)
+      got = std::max(got, coordinator_.state_of(*coordinator_.structure().resolve(c)));
     const State want = *parse_state(expected);
     if (got == want) return {};
     return address + " is " + std::string(to_string(got)) + ", expected " + std::string(to_string(want));
@@ -346,7 +348,7 @@ std::string ScenarioRunner::check_one(const spec::ScenarioStep& s, const std::st
 
 std::string expectation_problem(const Coordinator& co, const spec::ScenarioStep& s, const std::string& address,
                                 const std::string& expected) {
-  const Address a = *co.resolve(address);
+  const Address a = *co.structure().resolve(address);
   switch (s.kind) {
     case spec::ScenarioStep::Kind::Expect: {
       const State want = *parse_state(expected);
@@ -357,7 +359,7 @@ std::string expectation_problem(const Coordinator& co, const spec::ScenarioStep&
     case spec::ScenarioStep::Kind::ExpectOutstanding: {
       if (a.kind != Address::Kind::Component && a.kind != Address::Kind::Machine) return {};  // refused on load
       const StateSnapshot snap = a.kind == Address::Kind::Component ? co.extended(a.component) : co.snapshot(a.machine);
-      const std::string got = snap.outstanding == kNoEvent ? "none" : co.event(snap.outstanding).name;
+      const std::string got = snap.outstanding == kNoEvent ? "none" : co.structure().event(snap.outstanding).name;
       if (got == expected) return {};
       return "outstanding event of " + address + " is " + got + ", expected " + expected;
     }
@@ -417,11 +419,12 @@ bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
   printer_ = coordinator_.subscribe([this, &result, json = options.json, quiet = options.quiet,
                                      out = options.out](const Record& r) {
     if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent) {
-      result.coverage.events_fired.insert(coordinator_.event(r.event).name);
-      if (r.root.event != kNoEvent) result.coverage.events_fired.insert(coordinator_.event(r.root.event).name);
+      result.coverage.events_fired.insert(coordinator_.structure().event(r.event).name);
+      if (r.root.event != kNoEvent)
+        result.coverage.events_fired.insert(coordinator_.structure().event(r.root.event).name);
     }
     if (r.kind == RecordKind::Transition && r.event != kNoEvent) {
-      result.coverage.taken.emplace(coordinator_.event(r.event).name,
+      result.coverage.taken.emplace(coordinator_.structure().event(r.event).name,
                                     std::string(to_string(transition_between(r.from, r.to))));
     }
     const bool shown = r.kind == RecordKind::Transition || r.kind == RecordKind::Reset ||
@@ -453,8 +456,8 @@ void ScenarioRunner::finish(RunResult& result) {
     recorder_->close();
     result.record = recorder_->status();
   }
-  for (EventId e : id_range(EventId{framework_event::kCount}, coordinator_.event_count())) {
-    const Event& ev = coordinator_.event(e);
+  for (EventId e : id_range(EventId{framework_event::kCount}, coordinator_.structure().event_count())) {
+    const Event& ev = coordinator_.structure().event(e);
     for (Transition t :
          {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (ev.transitions.contains(t)) result.coverage.defined.emplace(ev.name, std::string(to_string(t)));

@@ -92,7 +92,7 @@ std::optional<Time> cleared_at(const RunFacts& run, const Coordinator& co, Event
   }
   for (const auto& [t, c] : run.component_resets) {
     for (MachineId m : machines->second) {
-      if (co.machine_component(m) == c) take(t);
+      if (co.structure().machine_component(m) == c) take(t);
     }
   }
   return best;
@@ -278,8 +278,8 @@ private:
     const FilterConfig& cfg = f.config();
     l.name = cfg.name;
     l.type = cfg.type;
-    l.component = std::string(co().component_name(f.component()));
-    l.target = f.target() == kNoMachine ? std::string() : co().address_of(f.target());
+    l.component = std::string(co().structure().component_name(f.component()));
+    l.target = f.target() == kNoMachine ? std::string() : co().structure().address_of(f.target());
     for (const Signal* s : f.inputs()) l.signals += (l.signals.empty() ? "" : ", ") + s->name();
     l.execution = cfg.execution == ExecutionMode::Active ? "ACTIVE" : "PASSIVE";
     const auto src = stage_source_.find(cfg.name);
@@ -305,13 +305,13 @@ private:
         const auto it = cfg.params.find(p.name);
         if (it != cfg.params.end() && k < 2) {
           if (const std::string* name = std::get_if<std::string>(&it->second)) {
-            if (auto e = co().find_event(*name)) (k == 0 ? ff.onset : ff.completion) = *e;
+            if (auto e = co().structure().find_event(*name)) (k == 0 ? ff.onset : ff.completion) = *e;
           }
         }
         ++k;
       }
     }
-    if (ff.onset != kNoEvent && ff.completion == kNoEvent) ff.completion = co().event(ff.onset).counterpart;
+    if (ff.onset != kNoEvent && ff.completion == kNoEvent) ff.completion = co().structure().event(ff.onset).counterpart;
     for (const auto& [name, value] : cfg.params) {
       if (event_params.count(name) != 0) continue;
       if (name == "threshold") {
@@ -326,7 +326,7 @@ private:
 
   /// An event with where it is written, the filters that generate it and what they target.
   EventLink event_link(EventId id) const {
-    const Event& e = co().event(id);
+    const Event& e = co().structure().event(id);
     EventLink l;
     l.name = e.name;
     l.onset = e.is_onset;
@@ -334,7 +334,7 @@ private:
     l.transitions = transitions_text(e.transitions);
     l.level = e.is_onset ? std::string(to_string(onset_level(e.transitions, State::Normal))) : "Normal";
     l.latched = e.latched;
-    if (e.is_onset && e.counterpart != kNoEvent) l.completion = co().event(e.counterpart).name;
+    if (e.is_onset && e.counterpart != kNoEvent) l.completion = co().structure().event(e.counterpart).name;
     if (const auto src = event_source_.find(e.name); src != event_source_.end()) {
       l.component = src->second.first;
       l.where = src->second.second;
@@ -378,12 +378,13 @@ private:
       if (keep_history) sr.history.push_back(introspect::history_entry(r, rc));
       if (r.kind == RecordKind::Event && r.outcome != Outcome::Ignored && r.event != kNoEvent &&
           to_index(r.event) >= framework_event::kCount) {
-        const Event& e = rc.event(r.event);
+        const Event& e = rc.structure().event(r.event);
         if (e.is_onset) {
           run.first_onset.emplace(r.event, r.time);
           if (!r.mirror && r.machine != kNoMachine) run.onset_machines[r.event].insert(r.machine);
           if (r.machine != kNoMachine)
-            run.onset_components[r.event].insert(std::string(rc.component_name(rc.machine_component(r.machine))));
+            run.onset_components[r.event].insert(
+                std::string(rc.structure().component_name(rc.structure().machine_component(r.machine))));
         } else if (e.counterpart != kNoEvent) {
           run.completions[e.counterpart].push_back(r.time);
         }
@@ -465,8 +466,8 @@ private:
   std::vector<EventId> hazard_events(const spec::HazardSpec& h, HazardTrace& ht) {
     std::vector<EventId> onsets;
     for (const std::string& name : event_order_) {
-      auto id = co().find_event(name);
-      if (!id || !co().event(*id).is_onset || co().event(*id).hazard != h.id) continue;
+      auto id = co().structure().find_event(name);
+      if (!id || !co().structure().event(*id).is_onset || co().structure().event(*id).hazard != h.id) continue;
       onsets.push_back(*id);
       linked_onsets_.insert(*id);
       EventLink onset = event_link(*id);
@@ -478,8 +479,8 @@ private:
         }
       }
       ht.events.push_back(std::move(onset));
-      if (co().event(*id).counterpart != kNoEvent) {
-        EventLink completion = event_link(co().event(*id).counterpart);
+      if (co().structure().event(*id).counterpart != kNoEvent) {
+        EventLink completion = event_link(co().structure().event(*id).counterpart);
         completion.fired_by = uses_of(completion.name);
         ht.events.push_back(std::move(completion));
       }
@@ -606,7 +607,7 @@ private:
   void unclaimed_filters_and_failed_scenarios() {
     for (const FilterFacts& f : filters_) {
       if (f.onset == kNoEvent || linked_onsets_.count(f.onset) != 0) continue;
-      const Event& e = co().event(f.onset);
+      const Event& e = co().structure().event(f.onset);
       if (to_index(e.id) < framework_event::kCount) continue;
       gap(Severity::Info, "filter-without-hazard", "", f.link.name,
           "filter " + f.link.name + " generates " + e.name + ", which is linked to no declared hazard", f.link.where);
@@ -636,8 +637,8 @@ private:
       fired.insert(r.result.coverage.events_fired.begin(), r.result.coverage.events_fired.end());
       taken.insert(r.result.coverage.taken.begin(), r.result.coverage.taken.end());
     }
-    for (EventId e : id_range(EventId{framework_event::kCount}, co().event_count())) {
-      const Event& ev = co().event(e);
+    for (EventId e : id_range(EventId{framework_event::kCount}, co().structure().event_count())) {
+      const Event& ev = co().structure().event(e);
       ++cv.events_defined;
       cv.events_fired += fired.count(ev.name) != 0 ? 1 : 0;
       for (Transition t : kTransitionOrder) {

@@ -13,7 +13,7 @@ Coordinators coordinators_of(const spec::SystemSpec& system, const Coordinator& 
   auto ids_of = [&co](const std::vector<std::string>& names) {
     std::vector<ComponentId> ids;
     for (const std::string& n : names) {
-      if (auto id = co.find_component(n)) ids.push_back(*id);
+      if (auto id = co.structure().find_component(n)) ids.push_back(*id);
     }
     return ids;
   };
@@ -21,7 +21,7 @@ Coordinators coordinators_of(const spec::SystemSpec& system, const Coordinator& 
   if (system.coordinators.empty()) {
     std::vector<std::string> all;
     for (const spec::ComponentSpec& c : system.components) all.push_back(c.name);
-    out.emplace_back(std::string(co.name()), ids_of(all));
+    out.emplace_back(std::string(co.structure().name()), ids_of(all));
   } else {
     for (const auto& [name, components] : system.coordinators) out.emplace_back(name, ids_of(components));
   }
@@ -63,7 +63,7 @@ std::vector<ConnectionView> local_connections(introspect::LocalQuery& query) {
     if (it == coordinators.end()) return fail(ErrorCode::NotFound, "no coordinator '" + std::string(name) + "'");
     std::vector<Explanation> all;
     for (const ComponentId id : it->second) {
-      auto part = query.explain(co.component_name(id));
+      auto part = query.explain(co.structure().component_name(id));
       if (!part) return tl::unexpected(part.error());
       all.insert(all.end(), part->conditions.begin(), part->conditions.end());
     }

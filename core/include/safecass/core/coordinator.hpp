@@ -7,15 +7,21 @@
 /// is ConditionSet (condition_set.hpp), one per machine; the coordinator orchestrates: records,
 /// callbacks, propagation, history.
 ///
+/// The model is read and written through three groups, each in its own header:
+/// - structure.hpp, `structure()`: the shape (components, machines, events, connections, names),
+///   fixed by configuration, every read lock-free;
+/// - this class: configuration, the id-based writes, the lock-free state reads, introspection
+///   (conditions, history, explain: snapshots taken under the lock) and the observer stream;
+/// - named.hpp: the writes and explain by name, for tools and people.
+///
 /// Lifecycle: configure (add components, interfaces, events, services, connections, callbacks),
 /// then run (generate, reset, read). Configuration calls are not safe against concurrent readers:
 /// finish the configuration before other threads start reading or generating. After that:
-/// - state reads (`state()`, `extended()`, `service_state()`, `dispatch()`) are lock-free, wait-free
-///   and never allocate;
-/// - a write (`generate()`, `broadcast()`, `reset()`, `apply_remote()`, `publish()`) takes the
-///   coordinator's lock for the change and its propagation; once the condition vectors have grown
-///   to their working size `generate()` does not allocate. `reset()` may allocate (it records who
-///   and why);
+/// - state reads (`state()`, `snapshot()`, `extended()`, `service_state()`, `dispatch()`) are
+///   lock-free, wait-free and never allocate;
+/// - a write (`generate()`, `reset()`, `apply_remote()`, `publish()`) takes the coordinator's lock
+///   for the change and its propagation; once the condition vectors have grown to their working
+///   size `generate()` does not allocate. `reset()` may allocate (it records who and why);
 /// - callbacks and observers run after the change, with the lock released, on the thread that made
 ///   the change, before its write returns; the records of all writes reach them in the order the
 ///   writes were made (one write's are handed out when the earlier writes' have been). They must not
@@ -29,7 +35,6 @@
 #include <atomic>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -37,7 +42,6 @@
 #include <string>
 #include <string_view>
 #include <thread>
-#include <unordered_map>
 #include <vector>
 
 #include "safecass/core/address.hpp"
@@ -49,45 +53,9 @@
 #include "safecass/core/ids.hpp"
 #include "safecass/core/observer.hpp"
 #include "safecass/core/state.hpp"
-#include "safecass/core/text_map.hpp"
+#include "safecass/core/structure.hpp"
 
 namespace safecass {
-
-/// What the service state of a provided interface depends on (DESIGN §2.2):
-/// s_S.p = s_P.p ⊗ [s_F] ⊗ [s_A] ⊗ (⊗ over the listed required interfaces).
-/// The default-constructed value is the conservative default used when a provided interface has
-/// no `service` entry: s_F, s_A and every required interface.
-struct ServiceDependency {
-  bool framework = true;              ///< include s_F
-  bool application = true;            ///< include s_A
-  bool all_required = true;           ///< include every required interface (ignores `required`)
-  std::vector<std::string> required;  ///< used when all_required is false
-  State propagate = State::Error;     ///< lowest level that crosses connections (Error or Warning)
-
-  /// `"dependency": {}`: the service state is s_P alone.
-  static ServiceDependency provided_only() {
-    ServiceDependency d;
-    d.framework = d.application = d.all_required = false;
-    return d;
-  }
-};
-
-/// A connection from a client's required interface to a provider's provided interface.
-struct Connection {
-  ComponentId client = kNoComponent;
-  std::uint32_t required = kNone;  ///< index into the client's required interfaces
-  ComponentId provider = kNoComponent;
-  std::uint32_t provided = kNone;  ///< index into the provider's provided interfaces
-};
-
-/// A parsed address: `SYSTEM`, `C`, `C.s_F`, `C.s_A`, `C.s_P.p`, `C.s_R.r`, `C.s_S.p`.
-struct Address {
-  enum class Kind : std::uint8_t { System, Component, Machine, Service };
-  Kind kind = Kind::System;
-  ComponentId component = kNoComponent;
-  MachineId machine = kNoMachine;
-  std::uint32_t service = kNone;  ///< Service: index of the provided interface
-};
 
 /// A state and the event that explains it, read atomically together.
 struct StateSnapshot {
@@ -165,38 +133,6 @@ struct CoordinatorOptions {
   std::size_t pending_capacity = 256;  ///< writes made by callbacks and observers, reserved up front per thread
 };
 
-namespace detail {
-/// A growable array whose elements never move: chunks of `kChunk` contiguous elements. Indexing is
-/// a shift, a mask and two loads, without allocation or lock; adding allocates one chunk per
-/// `kChunk` elements. Not thread-safe against a concurrent add. Indexed by the id type `Id`.
-template <class T, class Id>
-class StableVector {
-public:
-  static constexpr std::size_t kChunkBits = 6;
-  static constexpr std::size_t kChunk = std::size_t{1} << kChunkBits;
-
-  std::size_t size() const noexcept { return size_; }
-  bool empty() const noexcept { return size_ == 0; }
-  T& operator[](Id id) noexcept { return at(to_index(id)); }
-  const T& operator[](Id id) const noexcept { return at(to_index(id)); }
-  /// True when `id` names an element.
-  bool contains(Id id) const noexcept { return to_index(id) < size_; }
-  T& back() noexcept { return at(size_ - 1); }
-  /// Appends a default-constructed element and returns it.
-  T& emplace_back() {
-    if ((size_ >> kChunkBits) == chunks_.size()) chunks_.push_back(std::make_unique<T[]>(kChunk));
-    return at(size_++);
-  }
-
-private:
-  T& at(std::size_t i) noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-  const T& at(std::size_t i) const noexcept { return chunks_[i >> kChunkBits][i & (kChunk - 1)]; }
-
-  std::vector<std::unique_ptr<T[]>> chunks_;
-  std::size_t size_ = 0;
-};
-}  // namespace detail
-
 class Coordinator {
 public:
   /// `clock` must outlive the coordinator; null means an owned SteadyClock.
@@ -205,8 +141,9 @@ public:
   Coordinator(const Coordinator&) = delete;
   Coordinator& operator=(const Coordinator&) = delete;
 
-  std::string_view name() const noexcept { return name_; }
   const Clock& clock() const noexcept { return *clock_; }
+  /// The shape of the model: components, machines, events, connections, names (structure.hpp).
+  const Structure& structure() const noexcept { return structure_; }
 
   // ---- configuration -------------------------------------------------------------------------
   /// Errors: Duplicate, InvalidArgument (empty or dotted name).
@@ -232,15 +169,13 @@ public:
   // ---- remote providers (cross-process propagation, DESIGN §2.6 and §4) --------------------
   /// Declares provided interface `provider_provided` ("P.p") of a component that runs in another
   /// process, so that connect() accepts it as a provider. The first call for P adds a *remote
-  /// component* P (is_remote(); left out of coordinator_state()) whose machine P.s_P.p holds the
+  /// component* P (Structure::is_remote(); left out of coordinator_state()) whose machine P.s_P.p holds the
   /// roots the provider reports and whose service state is that machine alone; `propagate` is
   /// the provider's propagation level for the service. Configuration call.
   /// Errors: InvalidArgument (malformed, propagate Normal), Duplicate (P is a local component, or
   /// P.p was declared already).
   [[nodiscard]] Expected<MachineId> add_remote_provided(std::string_view provider_provided,
                                                         State propagate = State::Error);
-  /// True when `id` was added by add_remote_provided().
-  bool is_remote(ComponentId id) const noexcept;
   /// Replaces, as a whole, the set of roots held by remote provided interface `remote_provided`
   /// (a machine returned by add_remote_provided()) with `roots`, then propagates locally exactly
   /// as for a local change: roots no longer reported clear their mirrors, new roots are mirrored
@@ -261,51 +196,18 @@ public:
   /// interned names); safe from observers and callbacks.
   ResolvedRoot resolve_root(const RootCause& root) const;
 
-  // ---- lookup --------------------------------------------------------------------------------
-  [[nodiscard]] Expected<ComponentId> find_component(std::string_view name) const;
-  [[nodiscard]] Expected<EventId> find_event(std::string_view name) const;
-  /// Parses an address (see Address). Errors: Parse, NotFound.
-  [[nodiscard]] Expected<Address> resolve(std::string_view address) const;
-  /// Resolves an address that must name one state machine.
-  [[nodiscard]] Expected<MachineId> find_machine(std::string_view address) const;
-
-  std::size_t component_count() const noexcept { return components_.size(); }
-  std::size_t machine_count() const noexcept { return machines_.size(); }
-  std::size_t event_count() const noexcept { return events_.size(); }
-  const Event& event(EventId id) const noexcept { return events_[to_index(id)]; }
-  const std::vector<Connection>& connections() const noexcept { return connections_; }
-  std::string_view component_name(ComponentId id) const noexcept;
-  MachineId framework_machine(ComponentId id) const noexcept;
-  MachineId application_machine(ComponentId id) const noexcept;
-  const std::vector<MachineId>& provided_machines(ComponentId id) const noexcept;
-  const std::vector<MachineId>& required_machines(ComponentId id) const noexcept;
-  /// Interface name of a provided/required machine; "s_F"/"s_A" otherwise.
-  std::string_view interface_name(MachineId id) const noexcept;
-  MachineKind machine_kind(MachineId id) const noexcept;
-  ComponentId machine_component(MachineId id) const noexcept;
-  /// "C.s_F", "C.s_A", "C.s_P.p", "C.s_R.r".
-  const std::string& address_of(MachineId id) const noexcept;
-  /// The dependency entry of provided interface `provided` (index) of `component`.
-  const ServiceDependency& service(ComponentId component, std::uint32_t provided) const noexcept;
-
-  /// Interns a string (filter, signal or reason name) for use in SampleCause. Thread-safe.
-  NameId intern(std::string_view text);
-  std::string_view name_of(NameId id) const;
+  /// Interns a text (filter, signal or reason name) for use in SampleCause; Structure::name_of()
+  /// reads it back. Thread-safe.
+  NameId intern(std::string_view text) { return structure_.intern(text); }
 
   // ---- events --------------------------------------------------------------------------------
   /// Processes `event` on machine `target` (broadcast events: on s_A of every component) with the
   /// rules of DESIGN §2.4 and propagates the consequences (§2.6). `target` and `event` must be
   /// valid ids. Allocation-free once condition vectors have reached their working size.
   void generate(EventId event, MachineId target, const SampleCause& cause = {}) noexcept;
-  /// Name-based form for tools. Errors: NotFound (event or address), InvalidArgument (address is
-  /// not a machine), InvalidState (completion of an onset that was never defined).
-  [[nodiscard]] Expected<void> generate(std::string_view event, std::string_view target);
-  /// Processes a broadcast event (severity 251–255) on s_A of every component.
-  [[nodiscard]] Expected<void> broadcast(std::string_view event);
-  /// Clears every condition originating in `target` (machine, component, SYSTEM or the
-  /// coordinator's name), latched ones too, and records who and why. Mirrored conditions whose
-  /// root is outside the target and still active stay: the fault they report is still present.
-  [[nodiscard]] Expected<void> reset(std::string_view target, std::string_view who, std::string_view why);
+  /// Clears every condition originating in `target` (machine, component, SYSTEM), latched ones
+  /// too, and records who and why. Mirrored conditions whose root is outside the target and still
+  /// active stay: the fault they report is still present. A service address resets its component.
   void reset(const Address& target, std::string_view who, std::string_view why);
 
   // ---- lock-free reads -----------------------------------------------------------------------
@@ -319,7 +221,6 @@ public:
   StateSnapshot extended(ComponentId id) const noexcept {
     return unpack(components_[id].snapshot.load(std::memory_order_acquire));
   }
-  State extended_state(ComponentId id) const noexcept { return extended(id).state; }
   /// Service state s_S.p of provided interface `provided` (index) of `component`.
   State service_state(ComponentId component, std::uint32_t provided) const noexcept;
   /// Product over every component of this coordinator.
@@ -334,8 +235,8 @@ public:
     const StateSnapshot s = extended(component);
     switch (s.state) {
       case State::Normal: normal(); return;
-      case State::Warning: warning(events_[to_index(s.outstanding)]); return;
-      case State::Error: error(events_[to_index(s.outstanding)]); return;
+      case State::Warning: warning(structure_.event(s.outstanding)); return;
+      case State::Error: error(structure_.event(s.outstanding)); return;
     }
   }
 
@@ -361,8 +262,7 @@ public:
   /// How many records the history can hold (see CoordinatorOptions).
   std::size_t history_size() const noexcept { return history_.items.size(); }
   /// Every active condition at `address` (machine, service, component, SYSTEM) with its root
-  /// cause and hop path. Errors: as resolve().
-  [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const;
+  /// cause and hop path.
   std::vector<Explanation> explain(const Address& address) const;
 
   // ---- callbacks and observers ---------------------------------------------------------------
@@ -435,42 +335,27 @@ private:
   /// The component a stored record is about.
   ComponentId stored_component(const StoredRecord& s) const noexcept;
   History history_;  ///< every machine and component record of this coordinator
+  /// The run-time side of a machine (its shape is Structure's).
   struct MachineData {
-    ComponentId component = kNoComponent;
-    MachineKind kind = MachineKind::Framework;
-    std::uint32_t iface = kNone;  ///< index of the interface for Provided/Required
+    ComponentId component = kNoComponent;  ///< Structure's, copied to the line the hot path reads
     std::atomic<std::uint64_t> snapshot{0};
     std::vector<Edge> fanout;
     ConditionSet conditions;  ///< §2.4: the machine's state and outstanding condition
     std::vector<StateCallbacks> callbacks;
-    std::string address;
   };
-  struct ServiceData {
-    ServiceDependency dependency;
-    std::vector<std::uint32_t> required;  ///< resolved indices of the required interfaces
-  };
+  /// The run-time side of a component (its shape is Structure's).
   struct ComponentData {
     // Read or written on every change of one of its machines (update_component): first.
     std::array<std::uint32_t, 3> machine_state_count{};
     State state = State::Normal;
-    bool remote = false;  ///< a stand-in for a component of another process (add_remote_provided)
     /// Its machines are ids [first_machine, first_machine + machine_count) when `contiguous` (the
-    /// usual case: interfaces are added right after their component); else see the lists below.
+    /// usual case: interfaces are added right after their component); else see Structure's lists.
     bool contiguous = true;
     EventId outstanding = kNoEvent;
     MachineId first_machine = kNoMachine;
     std::uint32_t machine_count = 0;
     std::atomic<std::uint64_t> snapshot{0};
     std::vector<StateCallbacks> callbacks;
-    // Configuration and lookups.
-    MachineId framework = kNoMachine;
-    MachineId application = kNoMachine;
-    std::vector<MachineId> provided;
-    std::vector<MachineId> required;
-    std::vector<ServiceData> services;               ///< one per provided interface
-    std::vector<ConnectionId> required_connection;   ///< one per required interface
-    std::vector<ConnectionId> provider_connections;  ///< connections to its provided interfaces
-    std::string name;
   };
   /// What update_component() reads of each machine, in one dense array by machine id: the
   /// machines of a component are created together, so their summaries share a cache line and a
@@ -526,9 +411,8 @@ private:
   MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
   /// Recomputes the fan-out edges of `provider`'s machines (its connections as a provider).
   void rebuild_fanout(ComponentId provider);
-  /// s_F, s_A, then every s_P and s_R of `c`.
-  static std::vector<MachineId> component_machines(const ComponentData& c);
-  bool depends_on(ComponentId component, std::uint32_t provided, const MachineData& m) const noexcept;
+  /// True when machine `m` feeds the service state of provided interface `provided` of `component`.
+  bool depends_on(ComponentId component, std::uint32_t provided, MachineId m) const noexcept;
 
   // Writes: one operation under the lock, then its records handed out without it.
   /// Makes `op` and hands its records out (finish()); queued instead when called from a callback
@@ -590,21 +474,16 @@ private:
   std::vector<Explanation> explain_machine(MachineId id) const;
   std::vector<std::string> hop_path(MachineId holder, const Condition& c) const;
 
-  std::string name_;
+  Structure structure_;
   std::unique_ptr<Clock> owned_clock_;
   const Clock* clock_;
   CoordinatorOptions options_;
 
-  // Machines and components live in chunks of contiguous elements: a fault that visits thousands
-  // of machines walks memory in order instead of chasing one heap object per machine, and an
-  // element never moves once added (references handed out stay valid while the model grows).
+  // The run-time side of machines and components, by the same ids as the structure's: a fault
+  // that visits thousands of machines walks memory in order instead of chasing one heap object
+  // per machine.
   detail::StableVector<MachineData, MachineId> machines_;
   detail::StableVector<ComponentData, ComponentId> components_;
-  TextMap<ComponentId> component_index_;  ///< by name
-  std::deque<Event> events_;
-  TextMap<EventId> event_index_;           ///< by name
-  std::vector<const Event*> event_table_;  ///< events_ by id; indexing a deque is slow on the hot path
-  std::vector<Connection> connections_;
 
   // ---- lock discipline ------------------------------------------------------------------------
   // - mutex_ guards everything that changes at run time (conditions, history, staged records,
@@ -617,7 +496,8 @@ private:
   //   changes the lists in its own turn, so no list is changed while it is walked. The turn holder
   //   alone touches handing_, deferred_ and requests_, and walks the lists. The thread handing out
   //   records (deliverer_) defers its own registrations and queues its own writes instead.
-  // - Lock order: mutex_, then names_mutex_; never the other way. Waiting for a turn holds no lock.
+  // - Lock order: mutex_, then the structure's names lock; never the other way. Waiting for a turn
+  //   holds no lock.
   mutable std::mutex mutex_;
   std::atomic<std::uint64_t> delivered_{0};   ///< the last ticket whose records were handed out
   std::atomic<std::uint32_t> waiters_{0};     ///< threads waiting for their turn
@@ -647,29 +527,6 @@ private:
   };
   std::vector<RemoteRootData> remote_roots_;  ///< indexed by RootCause::remote; slots are reused
   std::vector<std::uint32_t> free_remote_;
-
-  mutable std::mutex names_mutex_;
-  std::deque<std::string> names_;  ///< by NameId; elements never move
-  /// names_ by text (views of its elements): intern() finds a known text without allocating.
-  std::unordered_map<std::string_view, NameId, TextHash, std::equal_to<>> name_index_;
 };
-
-// ---- the checks of the name-based writes -----------------------------------------------------
-// What Coordinator::generate/broadcast/reset (the name-based forms) would act on, or why they
-// would refuse, changing nothing: a caller that must check a whole batch before applying any of it
-// (a replay, introspect's Action) checks with these, and the writes themselves use them.
-
-/// The event and machine that generate(event, target) processes. A broadcast event ignores
-/// `target` (machine kNoMachine). Errors: as Coordinator::generate.
-struct GenerateTarget {
-  EventId event = kNoEvent;
-  MachineId machine = kNoMachine;
-};
-[[nodiscard]] Expected<GenerateTarget> resolve_generate(const Coordinator& co, std::string_view event,
-                                                        std::string_view target);
-/// The broadcast event broadcast(event) processes. Errors: NotFound, InvalidArgument (not a broadcast).
-[[nodiscard]] Expected<EventId> resolve_broadcast(const Coordinator& co, std::string_view event);
-/// The address reset(target, ...) clears. Errors: as resolve(), InvalidArgument (a service state).
-[[nodiscard]] Expected<Address> resolve_reset(const Coordinator& co, std::string_view target);
 
 }  // namespace safecass

@@ -8,8 +8,8 @@ namespace safecass {
 
 State read(Coordinator& co) {
   const ComponentId component = *co.add_component("C");
-  const MachineId machine = co.application_machine(component);
-  const EventId event = *co.find_event("EVT_STALE");
+  const MachineId machine = co.structure().application_machine(component);
+  const EventId event = *co.structure().find_event("EVT_STALE");
   (void)machine;
   (void)event;
 #if defined(SAFECASS_CASE_RIGHT_IDS)

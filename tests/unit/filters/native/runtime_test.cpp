@@ -64,7 +64,7 @@ TEST(NativeRuntime, FiltersAfterTheBodyJudgeTheSampleItWroteInTheSameCycleAndBef
     Signal* x = s.monitor.signals().find("LOOP.x");
     ASSERT_TRUE(runtime.add_task(
         s.component, 1ms, [x](Time now) { x->push(now, 20.0); }, order));
-    const MachineId app = s.co.application_machine(s.component);
+    const MachineId app = s.co.structure().application_machine(s.component);
     runtime.step(Time{0});
     EXPECT_EQ(s.co.state(app), order == native::FilterOrder::AfterBody ? State::Error : State::Normal)
         << "after the cycle that wrote the sample";
@@ -96,10 +96,10 @@ TEST(NativeRuntime, TheMonitorThreadRunsOnlyWhenThereArePassiveFilters) {
     EXPECT_TRUE(s.monitor.running());
     s.monitor.signals().find("LOOP.x")->push(s.co.clock().now(), 20.0);
     const auto until = std::chrono::steady_clock::now() + 2s;
-    while (s.co.state(s.co.application_machine(s.component)) != State::Error &&
+    while (s.co.state(s.co.structure().application_machine(s.component)) != State::Error &&
            std::chrono::steady_clock::now() < until)
       std::this_thread::sleep_for(5ms);
-    EXPECT_EQ(s.co.state(s.co.application_machine(s.component)), State::Error) << "the PASSIVE filter ran";
+    EXPECT_EQ(s.co.state(s.co.structure().application_machine(s.component)), State::Error) << "the PASSIVE filter ran";
     runtime.stop();
     EXPECT_FALSE(s.monitor.running());
   }
