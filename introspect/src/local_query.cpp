@@ -78,42 +78,41 @@ Expected<ClockInfo> LocalQuery::clock() {
 }
 
 std::vector<StateRow> LocalQuery::component_rows(ComponentId id) const {
+  const Structure& shape = co_.structure();
   std::vector<StateRow> out;
-  const std::string name(co_.structure().component_name(id));
+  const std::string name(shape.component_name(id));
   const StateSnapshot ext = co_.extended(id);
   out.push_back({name, RowKind::Component, ext.state, outstanding_name(co_, ext)});
   auto machine = [&](MachineId m) {
     const StateSnapshot s = co_.snapshot(m);
-    out.push_back(
-        {co_.structure().address_of(m), row_kind(co_.structure().machine_kind(m)), s.state, outstanding_name(co_, s)});
+    out.push_back({shape.address_of(m), row_kind(shape.machine_kind(m)), s.state, outstanding_name(co_, s)});
   };
-  machine(co_.structure().framework_machine(id));
-  machine(co_.structure().application_machine(id));
-  for (const MachineId m : co_.structure().provided_machines(id)) machine(m);
-  for (const MachineId m : co_.structure().required_machines(id)) machine(m);
-  const auto& provided = co_.structure().provided_machines(id);
+  machine(shape.framework_machine(id));
+  machine(shape.application_machine(id));
+  for (const MachineId m : shape.provided_machines(id)) machine(m);
+  for (const MachineId m : shape.required_machines(id)) machine(m);
+  const auto& provided = shape.provided_machines(id);
   for (std::uint32_t p = 0; p < provided.size(); ++p) {
-    out.push_back({address::service(name, co_.structure().interface_name(provided[p])),
-                   RowKind::Service,
-                   co_.service_state(id, p),
-                   {}});
+    out.push_back(
+        {address::service(name, shape.interface_name(provided[p])), RowKind::Service, co_.service_state(id, p), {}});
   }
   return out;
 }
 
 Expected<std::vector<StateRow>> LocalQuery::state_list(std::string_view component) {
+  const Structure& shape = co_.structure();
   std::vector<StateRow> out;
   if (!component.empty()) {
-    auto id = co_.structure().find_component(component);
-    if (!id || co_.structure().is_remote(*id)) {
+    auto id = shape.find_component(component);
+    if (!id || shape.is_remote(*id)) {
       return fail(ErrorCode::NotFound,
                   "no component '" + std::string(component) + "' in coordinator '" + options_.name + "'");
     }
     return component_rows(*id);
   }
   out.push_back({"SYSTEM", RowKind::System, co_.coordinator_state(), {}});
-  for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
-    if (co_.structure().is_remote(id)) continue;
+  for (ComponentId id : id_range<ComponentId>(shape.component_count())) {
+    if (shape.is_remote(id)) continue;
     std::vector<StateRow> rows = component_rows(id);
     out.insert(out.end(), std::make_move_iterator(rows.begin()), std::make_move_iterator(rows.end()));
   }
@@ -199,9 +198,10 @@ Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
 }
 
 Expected<std::vector<EventRow>> LocalQuery::event_list() {
+  const Structure& shape = co_.structure();
   std::vector<EventRow> out;
-  for (EventId id : id_range<EventId>(co_.structure().event_count())) {
-    const Event& e = co_.structure().event(id);
+  for (EventId id : id_range<EventId>(shape.event_count())) {
+    const Event& e = shape.event(id);
     EventRow r;
     r.name = e.name;
     r.severity = e.severity;
@@ -211,7 +211,7 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
          {Transition::N2W, Transition::N2E, Transition::W2E, Transition::W2N, Transition::E2N, Transition::E2W}) {
       if (e.transitions.contains(t)) r.transitions.push_back(t);
     }
-    r.counterpart = e.counterpart == kNoEvent ? std::string() : co_.structure().event(e.counterpart).name;
+    r.counterpart = e.counterpart == kNoEvent ? std::string() : shape.event(e.counterpart).name;
     r.latched = e.latched;
     r.framework = to_index(id) < framework_event::kCount;
     r.hazard = e.hazard;
@@ -222,20 +222,19 @@ Expected<std::vector<EventRow>> LocalQuery::event_list() {
 }
 
 Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
+  const Structure& shape = co_.structure();
   std::vector<ConnectionRow> out;
-  for (const Connection& k : co_.structure().connections()) {
-    const MachineId required = co_.structure().required_machines(k.client)[k.required];
-    const MachineId provided = co_.structure().provided_machines(k.provider)[k.provided];
+  for (const Connection& k : shape.connections()) {
+    const MachineId required = shape.required_machines(k.client)[k.required];
+    const MachineId provided = shape.provided_machines(k.provider)[k.provided];
     ConnectionRow r;
-    r.required = std::string(co_.structure().component_name(k.client)) + "." +
-                 std::string(co_.structure().interface_name(required));
-    r.provided = std::string(co_.structure().component_name(k.provider)) + "." +
-                 std::string(co_.structure().interface_name(provided));
-    r.remote = co_.structure().is_remote(k.provider);
+    r.required = std::string(shape.component_name(k.client)) + "." + std::string(shape.interface_name(required));
+    r.provided = std::string(shape.component_name(k.provider)) + "." + std::string(shape.interface_name(provided));
+    r.remote = shape.is_remote(k.provider);
     r.required_state = co_.state(required);
     if (!r.remote) {
       r.service_state = co_.service_state(k.provider, k.provided);
-      r.propagate = co_.structure().service(k.provider, k.provided).propagate;
+      r.propagate = shape.service(k.provider, k.provided).propagate;
     }
     out.push_back(std::move(r));
   }
@@ -243,23 +242,24 @@ Expected<std::vector<ConnectionRow>> LocalQuery::connection_list() {
 }
 
 Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
+  const Structure& shape = co_.structure();
   std::vector<ServiceRow> out;
-  for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
-    if (co_.structure().is_remote(id)) continue;
-    const auto& provided = co_.structure().provided_machines(id);
+  for (ComponentId id : id_range<ComponentId>(shape.component_count())) {
+    if (shape.is_remote(id)) continue;
+    const auto& provided = shape.provided_machines(id);
     for (std::uint32_t i = 0; i < provided.size(); ++i) {
-      const std::string p(co_.structure().interface_name(provided[i]));
-      const ServiceDependency& d = co_.structure().service(id, i);
+      const std::string p(shape.interface_name(provided[i]));
+      const ServiceDependency& d = shape.service(id, i);
       ServiceRow r;
-      r.address = address::service(co_.structure().component_name(id), p);
+      r.address = address::service(shape.component_name(id), p);
       r.state = co_.service_state(id, i);
       r.propagate = d.propagate;
       r.depends_on.push_back("s_P." + p);
       if (d.framework) r.depends_on.emplace_back("s_F");
       if (d.application) r.depends_on.emplace_back("s_A");
       if (d.all_required) {
-        for (const MachineId m : co_.structure().required_machines(id))
-          r.depends_on.push_back("s_R." + std::string(co_.structure().interface_name(m)));
+        for (const MachineId m : shape.required_machines(id))
+          r.depends_on.push_back("s_R." + std::string(shape.interface_name(m)));
       } else {
         for (const std::string& name : d.required) r.depends_on.push_back("s_R." + name);
       }
@@ -270,19 +270,20 @@ Expected<std::vector<ServiceRow>> LocalQuery::service_list() {
 }
 
 Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
+  const Structure& shape = co_.structure();
   ExplainAnswer a;
   a.address = std::string(address);
   if (address == "SYSTEM") {
     a.state = co_.coordinator_state();
-    for (ComponentId id : id_range<ComponentId>(co_.structure().component_count())) {
-      if (co_.structure().is_remote(id)) continue;
+    for (ComponentId id : id_range<ComponentId>(shape.component_count())) {
+      if (shape.is_remote(id)) continue;
       std::vector<Explanation> part = co_.explain(Address{Address::Kind::Component, id});
       a.conditions.insert(a.conditions.end(), std::make_move_iterator(part.begin()),
                           std::make_move_iterator(part.end()));
     }
     return a;
   }
-  auto resolved = co_.structure().resolve(address);
+  auto resolved = shape.resolve(address);
   if (!resolved) return tl::unexpected(resolved.error());
   a.state = co_.state_of(*resolved);
   a.conditions = co_.explain(*resolved);
@@ -290,22 +291,23 @@ Expected<ExplainAnswer> LocalQuery::explain(std::string_view address) {
 }
 
 Expected<Names> LocalQuery::names() {
+  const Structure& shape = co_.structure();
   Names n;
   n.addresses.emplace_back("SYSTEM");
-  for (ComponentId i : id_range<ComponentId>(co_.structure().component_count())) {
-    if (co_.structure().is_remote(i)) continue;
-    n.components.emplace_back(co_.structure().component_name(i));
-    n.addresses.emplace_back(co_.structure().component_name(i));
-    for (const MachineId p : co_.structure().provided_machines(i)) {
-      n.addresses.push_back(address::service(co_.structure().component_name(i), co_.structure().interface_name(p)));
+  for (ComponentId i : id_range<ComponentId>(shape.component_count())) {
+    if (shape.is_remote(i)) continue;
+    n.components.emplace_back(shape.component_name(i));
+    n.addresses.emplace_back(shape.component_name(i));
+    for (const MachineId p : shape.provided_machines(i)) {
+      n.addresses.push_back(address::service(shape.component_name(i), shape.interface_name(p)));
     }
   }
-  for (MachineId m : id_range<MachineId>(co_.structure().machine_count())) {
-    if (co_.structure().is_remote(co_.structure().machine_component(m))) continue;
-    n.machines.push_back(co_.structure().address_of(m));
-    n.addresses.push_back(co_.structure().address_of(m));
+  for (MachineId m : id_range<MachineId>(shape.machine_count())) {
+    if (shape.is_remote(shape.machine_component(m))) continue;
+    n.machines.push_back(shape.address_of(m));
+    n.addresses.push_back(shape.address_of(m));
   }
-  for (EventId e : id_range<EventId>(co_.structure().event_count())) n.events.push_back(co_.structure().event(e).name);
+  for (EventId e : id_range<EventId>(shape.event_count())) n.events.push_back(shape.event(e).name);
   for (const auto& f : monitor_.filters()) n.filters.push_back(f->name());
   for (const FilterManifest* m : registry_.manifests()) n.filter_types.push_back(m->type);
   for (const auto& s : monitor_.signals().all()) n.signals.push_back(s->name());

@@ -33,24 +33,23 @@ std::string_view HistoryEntry::where() const noexcept {
 }
 
 HistoryEntry history_entry(const Record& r, const Coordinator& co) {
+  const Structure& shape = co.structure();
   HistoryEntry e;
   e.seq = r.seq;
   e.time = r.time;
   e.kind = r.kind;
   e.outcome = r.outcome;
-  if (r.component != kNoComponent && to_index(r.component) < co.structure().component_count())
-    e.component = std::string(co.structure().component_name(r.component));
-  if (r.machine != kNoMachine && to_index(r.machine) < co.structure().machine_count())
-    e.machine = co.structure().address_of(r.machine);
-  if (r.event != kNoEvent && to_index(r.event) < co.structure().event_count())
-    e.event = co.structure().event(r.event).name;
+  if (r.component != kNoComponent && to_index(r.component) < shape.component_count())
+    e.component = std::string(shape.component_name(r.component));
+  if (r.machine != kNoMachine && to_index(r.machine) < shape.machine_count()) e.machine = shape.address_of(r.machine);
+  if (r.event != kNoEvent && to_index(r.event) < shape.event_count()) e.event = shape.event(r.event).name;
   e.from = r.from;
   e.to = r.to;
   e.level = r.level;
   e.severity = r.severity;
   e.mirror = r.mirror;
-  if (r.root.event != kNoEvent && to_index(r.root.event) < co.structure().event_count() &&
-      r.root.origin != kNoMachine && to_index(r.root.origin) < co.structure().machine_count()) {
+  if (r.root.event != kNoEvent && to_index(r.root.event) < shape.event_count() && r.root.origin != kNoMachine &&
+      to_index(r.root.origin) < shape.machine_count()) {
     e.root = co.resolve_root(r.root);
   }
   e.text = std::string(r.text);

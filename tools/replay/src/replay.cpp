@@ -352,16 +352,17 @@ namespace {
 
 /// Every address of a system worth comparing: machines, service states, components, SYSTEM.
 std::vector<std::string> addresses_of(const Coordinator& co) {
+  const Structure& shape = co.structure();
   std::vector<std::string> out;
-  for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
-    out.emplace_back(co.structure().component_name(c));
-    out.push_back(co.structure().address_of(co.structure().framework_machine(c)));
-    out.push_back(co.structure().address_of(co.structure().application_machine(c)));
-    for (MachineId m : co.structure().provided_machines(c)) {
-      out.push_back(co.structure().address_of(m));
-      out.push_back(address::service(co.structure().component_name(c), co.structure().interface_name(m)));
+  for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+    out.emplace_back(shape.component_name(c));
+    out.push_back(shape.address_of(shape.framework_machine(c)));
+    out.push_back(shape.address_of(shape.application_machine(c)));
+    for (MachineId m : shape.provided_machines(c)) {
+      out.push_back(shape.address_of(m));
+      out.push_back(address::service(shape.component_name(c), shape.interface_name(m)));
     }
-    for (MachineId m : co.structure().required_machines(c)) out.push_back(co.structure().address_of(m));
+    for (MachineId m : shape.required_machines(c)) out.push_back(shape.address_of(m));
   }
   out.emplace_back("SYSTEM");
   return out;

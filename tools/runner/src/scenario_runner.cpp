@@ -154,6 +154,7 @@ Opened<std::unique_ptr<ScenarioRunner>> ScenarioRunner::open(const ScenarioSourc
 }
 
 Diagnostics ScenarioRunner::check_names() {
+  const Structure& shape = coordinator_.structure();
   Diagnostics out;
   const auto error_at = [this](const spec::ScenarioStep& s, std::string message) {
     return spec::Diagnostic{spec::Diagnostic::Severity::Error, scenario_.where(s), std::move(message), s.pointer()};
@@ -163,8 +164,7 @@ Diagnostics ScenarioRunner::check_names() {
   std::vector<std::string> filter_names;
   for (const auto& f : monitor_->filters()) filter_names.push_back(f->name());
   std::vector<std::string> event_names;
-  for (EventId e : id_range<EventId>(coordinator_.structure().event_count()))
-    event_names.push_back(coordinator_.structure().event(e).name);
+  for (EventId e : id_range<EventId>(shape.event_count())) event_names.push_back(shape.event(e).name);
   const std::vector<std::string> address_names = addresses();
   const auto no_address = [&](const std::string& address, const std::string& message) {
     return message + spec::did_you_mean(address, address_names);
@@ -196,13 +196,13 @@ Diagnostics ScenarioRunner::check_names() {
         break;
       }
       case spec::ScenarioStep::Kind::Generate: {
-        auto e = coordinator_.structure().find_event(action->event);
+        auto e = shape.find_event(action->event);
         if (!e) {
           out.push_back(error_at(s, unknown("event", action->event, event_names)));
-        } else if (!coordinator_.structure().event(*e).is_broadcast()) {
+        } else if (!shape.event(*e).is_broadcast()) {
           if (action->target.empty())
             out.push_back(error_at(s, "\"generate\" of '" + action->event + "' needs a \"target\" machine"));
-          else if (auto m = coordinator_.structure().find_machine(action->target); !m) {
+          else if (auto m = shape.find_machine(action->target); !m) {
             out.push_back(error_at(s, no_address(action->target, m.error().message)));
           }
         }
@@ -241,7 +241,7 @@ Diagnostics ScenarioRunner::check_names() {
         // reset of one would do nothing. Refused here, at load, rather than silently at run time.
         if (coordinator_components(action->target) != nullptr) {
           // A coordinator of the system file: all its components are reset (docs/semantics.md §4.5).
-        } else if (auto a = coordinator_.structure().resolve(action->target); !a) {
+        } else if (auto a = shape.resolve(action->target); !a) {
           out.push_back(error_at(s, no_address(action->target, a.error().message)));
         } else if (a->kind == Address::Kind::Service) {
           out.push_back(error_at(s, "cannot reset service state '" + action->target +
@@ -253,7 +253,7 @@ Diagnostics ScenarioRunner::check_names() {
       case spec::ScenarioStep::Kind::ExpectCause:
         for (const auto& [address, expected] : action->expectations) {
           if (coordinator_components(address) != nullptr && s.kind == spec::ScenarioStep::Kind::Expect) continue;
-          auto a = coordinator_.structure().resolve(address);
+          auto a = shape.resolve(address);
           if (!a) {
             out.push_back(error_at(s, no_address(address, a.error().message)));
             continue;
@@ -261,16 +261,16 @@ Diagnostics ScenarioRunner::check_names() {
           if (s.kind == spec::ScenarioStep::Kind::ExpectOutstanding) {
             if (a->kind != Address::Kind::Component && a->kind != Address::Kind::Machine) {
               out.push_back(error_at(s, "expect_outstanding needs a component or a machine, not '" + address + "'"));
-            } else if (expected != "none" && !coordinator_.structure().find_event(expected)) {
+            } else if (expected != "none" && !shape.find_event(expected)) {
               out.push_back(error_at(s, unknown("event", expected, event_names)));
             }
           }
           if (s.kind == spec::ScenarioStep::Kind::ExpectCause) {
             const auto colon = expected.find(':');
-            if (auto m = coordinator_.structure().find_machine(expected.substr(0, colon)); !m) {
+            if (auto m = shape.find_machine(expected.substr(0, colon)); !m) {
               out.push_back(error_at(s, no_address(expected.substr(0, colon), m.error().message)));
             }
-            if (!coordinator_.structure().find_event(expected.substr(colon + 1))) {
+            if (!shape.find_event(expected.substr(colon + 1))) {
               out.push_back(error_at(s, unknown("event", expected.substr(colon + 1), event_names)));
             }
           }
@@ -394,6 +394,7 @@ void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& res
 }
 
 bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
+  const Structure& shape = coordinator_.structure();
   if (!options.record_path.empty()) {
     auto r = Recorder::open(coordinator_, options.record_path, 65536, options.limits);
     if (!r) {
