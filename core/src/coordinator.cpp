@@ -276,49 +276,42 @@ MachineId Coordinator::add_machine(ComponentId component, MachineKind kind, std:
   return id;
 }
 
-Expected<std::string> Coordinator::new_interface(ComponentId component, std::string_view name, MachineKind kind) const {
+Expected<MachineId> Coordinator::add_interface(ComponentId component, std::string_view name, MachineKind kind) {
   if (!components_.contains(component))
     return fail(ErrorCode::NotFound, "no component with id " + std::to_string(to_index(component)));
-  const Structure::Component& c = structure_.components_[component];
+  Structure::Component& shape = structure_.components_[component];
   if (!valid_name(name)) {
-    return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + c.name +
+    return fail(ErrorCode::InvalidArgument, "interface name '" + std::string(name) + "' of component '" + shape.name +
                                                 "' must be non-empty, without dots or spaces");
   }
   const bool provided = kind == MachineKind::Provided;
-  std::string address = provided ? address::provided(c.name, name) : address::required(c.name, name);
-  for (MachineId m : provided ? c.provided : c.required) {
+  std::vector<MachineId>& list = provided ? shape.provided : shape.required;
+  std::string address = address::machine(kind, shape.name, name);
+  for (MachineId m : list) {
     if (structure_.machines_[m].address == address) {
       return fail(ErrorCode::Duplicate, std::string("duplicate ") + (provided ? "provided" : "required") +
-                                            " interface '" + std::string(name) + "' in component '" + c.name + "'");
+                                            " interface '" + std::string(name) + "' in component '" + shape.name + "'");
     }
   }
-  return address;
+  const auto iface = static_cast<std::uint32_t>(list.size());
+  const MachineId id = add_machine(component, kind, iface, std::move(address));
+  list.push_back(id);
+  if (provided) {
+    shape.services.emplace_back();
+  } else {
+    shape.required_connection.push_back(kNoConnection);
+  }
+  ++components_[component].machine_state_count[index(State::Normal)];
+  rebuild_fanout(component);
+  return id;
 }
 
 Expected<MachineId> Coordinator::add_provided(ComponentId component, std::string_view name) {
-  auto address = new_interface(component, name, MachineKind::Provided);
-  if (!address) return tl::unexpected(address.error());
-  Structure::Component& shape = structure_.components_[component];
-  const auto iface = static_cast<std::uint32_t>(shape.provided.size());
-  const MachineId id = add_machine(component, MachineKind::Provided, iface, std::move(*address));
-  shape.provided.push_back(id);
-  shape.services.emplace_back();
-  ++components_[component].machine_state_count[index(State::Normal)];
-  rebuild_fanout(component);
-  return id;
+  return add_interface(component, name, MachineKind::Provided);
 }
 
 Expected<MachineId> Coordinator::add_required(ComponentId component, std::string_view name) {
-  auto address = new_interface(component, name, MachineKind::Required);
-  if (!address) return tl::unexpected(address.error());
-  Structure::Component& shape = structure_.components_[component];
-  const auto iface = static_cast<std::uint32_t>(shape.required.size());
-  const MachineId id = add_machine(component, MachineKind::Required, iface, std::move(*address));
-  shape.required.push_back(id);
-  shape.required_connection.push_back(kNoConnection);
-  ++components_[component].machine_state_count[index(State::Normal)];
-  rebuild_fanout(component);
-  return id;
+  return add_interface(component, name, MachineKind::Required);
 }
 
 Expected<EventId> Coordinator::add_event(const EventDef& def) {

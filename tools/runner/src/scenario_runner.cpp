@@ -394,7 +394,6 @@ void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& res
 }
 
 bool ScenarioRunner::begin(const RunOptions& options, RunResult& result) {
-  const Structure& shape = coordinator_.structure();
   if (!options.record_path.empty()) {
     auto r = Recorder::open(coordinator_, options.record_path, 65536, options.limits);
     if (!r) {

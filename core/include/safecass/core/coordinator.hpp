@@ -404,10 +404,8 @@ private:
   }
 
   EventId add_event_unchecked(Event event);
-  /// The address of a new provided or required interface `name` of `component`, or why it
-  /// cannot be added: no such component, a name that is not one, a duplicate.
-  [[nodiscard]] Expected<std::string> new_interface(ComponentId component, std::string_view name,
-                                                    MachineKind kind) const;
+  /// Adds provided or required interface `name` to `component` (add_provided, add_required).
+  [[nodiscard]] Expected<MachineId> add_interface(ComponentId component, std::string_view name, MachineKind kind);
   MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
   /// Recomputes the fan-out edges of `provider`'s machines (its connections as a provider).
   void rebuild_fanout(ComponentId provider);
