@@ -409,8 +409,8 @@ private:
   MachineId add_machine(ComponentId component, MachineKind kind, std::uint32_t iface, std::string address);
   /// Recomputes the fan-out edges of `provider`'s machines (its connections as a provider).
   void rebuild_fanout(ComponentId provider);
-  /// True when machine `m` feeds the service state of provided interface `provided` of `component`.
-  bool depends_on(ComponentId component, std::uint32_t provided, MachineId m) const noexcept;
+  /// True when machine `id` feeds the service state of provided interface `provided` of `component`.
+  bool depends_on(ComponentId component, std::uint32_t provided, MachineId id) const noexcept;
 
   // Writes: one operation under the lock, then its records handed out without it.
   /// Makes `op` and hands its records out (finish()); queued instead when called from a callback
