@@ -1,7 +1,7 @@
 #pragma once
 /// @file address.hpp
 /// The text of an address of the Generic Component Model (DESIGN §2): the one place that spells
-/// `C.s_F`, `C.s_A`, `C.s_P.p`, `C.s_R.r` and `C.s_S.p`. Coordinator::parse_address reads them.
+/// `C.s_F`, `C.s_A`, `C.s_P.p`, `C.s_R.r` and `C.s_S.p`. Structure::resolve (structure.hpp) reads them.
 
 #include <cstdint>
 #include <string>

@@ -6,8 +6,8 @@
 /// coordinator running a scenario, replay, the console and the viewer (through
 /// SystemQuery::apply(), in-process and over the bus).
 ///
-/// apply() checks the action against the system first (the rules of the Coordinator's and the
-/// Monitor's name-based writes), so a refused action changes nothing, then applies it and tells
+/// apply() checks the action against the system first (the rules of the name-based writes of
+/// core/named.hpp and of the Monitor), so a refused action changes nothing, then applies it and tells
 /// the ActionObserver: recording is an observer of applied actions (record's InputRecorder), and
 /// each applied action is told once.
 ///
@@ -73,7 +73,7 @@ public:
 };
 
 /// Why `action` cannot be applied to the system of `co` and `monitor`, changing nothing: the
-/// errors of the Coordinator's resolve_generate/resolve_broadcast/resolve_reset and of the
+/// errors of resolve_generate/resolve_broadcast/resolve_reset (core/named.hpp) and of the
 /// Monitor's check_inject_shallow/check_inject_deep; for a sample, NotFound (no such signal) or
 /// InvalidArgument (a wrong number of values).
 [[nodiscard]] Expected<void> check(const Action& action, const Coordinator& co, const Monitor& monitor);
