@@ -12,11 +12,13 @@ BusLink::BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, 
 
 void BusLink::start() {
   if (running_.exchange(true)) return;
+  sleeper_.restart();
   thread_ = std::thread([this] { loop(); });
 }
 
 void BusLink::stop() noexcept {
   running_.store(false);
+  sleeper_.stop();
   if (thread_.joinable()) thread_.join();
   connected_.store(false);
 }
@@ -26,11 +28,8 @@ std::shared_ptr<Ice::ObjectPrx> BusLink::publisher(std::size_t topic) const {
   return topic < publishers_.size() ? publishers_[topic] : nullptr;
 }
 
-void BusLink::sleep_for(std::chrono::milliseconds d) const {
-  const auto until = std::chrono::steady_clock::now() + d;
-  while (running_.load() && std::chrono::steady_clock::now() < until) {
-    std::this_thread::sleep_for(std::min<std::chrono::milliseconds>(d, std::chrono::milliseconds(20)));
-  }
+void BusLink::sleep_for(std::chrono::milliseconds d) {
+  (void)sleeper_.sleep_until(steady_ns() + std::chrono::nanoseconds(d).count());
 }
 
 bool BusLink::connect() {
@@ -74,7 +73,10 @@ void BusLink::loop() {
       continue;
     }
     try {
-      if (const std::vector<std::string> made = link_.check(); !made.empty()) {
+      // IceStorm is asked whether it is there only when this process's last heartbeat did not
+      // come back round within a period: one that did proves the whole way works.
+      const bool echo_late = steady_ns() - last_own_heartbeat_.load() > std::chrono::nanoseconds(period).count();
+      if (const std::vector<std::string> made = link_.check(echo_late); !made.empty()) {
         // What arrived on those topics meanwhile is lost: every provider republishes its state.
         options_.log(options_.who + ": " + resubscribed_line(made));
         resubscriptions_.fetch_add(made.size());

@@ -21,6 +21,7 @@
 
 #include "ice_util.hpp"
 #include "safecass.h"
+#include "sleeper.hpp"
 
 namespace safecass::middleware {
 
@@ -71,7 +72,8 @@ private:
   void loop();
   /// Connects; false (said, rate-limited) when IceStorm cannot be reached.
   bool connect();
-  void sleep_for(std::chrono::milliseconds d) const;
+  /// Until `d` has passed or stop().
+  void sleep_for(std::chrono::milliseconds d);
 
   std::string where_;  ///< IceStorm's endpoint, as said in the log
   BusLinkOptions options_;
@@ -79,6 +81,7 @@ private:
   mutable std::mutex publishers_mutex_;
   std::vector<std::shared_ptr<Ice::ObjectPrx>> publishers_;
   std::atomic<bool> running_{false};
+  Sleeper sleeper_;  ///< the link thread's waits, ended by stop()
   std::atomic<bool> connected_{false};
   std::atomic<std::int64_t> last_own_heartbeat_{0};
   std::atomic<std::uint64_t> connects_{0};

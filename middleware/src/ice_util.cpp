@@ -242,8 +242,8 @@ std::string resubscribed_line(const std::vector<std::string>& topics) {
          " (dropped as undeliverable, or removed); subscribed again, resynchronising";
 }
 
-std::vector<std::string> Link::check() {
-  ping();
+std::vector<std::string> Link::check(bool ping_broker) {
+  if (ping_broker) ping();
   std::vector<std::string> made;
   bool pending = false;
   for (Subscription& s : subscriptions_) {

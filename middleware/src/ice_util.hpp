@@ -37,7 +37,8 @@ inline std::string heartbeat_topic(std::string_view signer) {
 inline constexpr const char* kResyncTopic = "safecass.resync";
 
 /// Every this many heartbeat periods (1 s at the default 100 ms) a process's link checks that
-/// IceStorm still holds each of its subscriptions (Link::check); in between it only pings IceStorm.
+/// IceStorm still holds each of its subscriptions (Link::check); in between it pings IceStorm
+/// only when the process's own heartbeat did not come back round.
 /// A check is an update at IceStorm (a replicated one forwards it to its master): every 3 periods
 /// it cost the broker half of its CPU at 50 coordinators (docs/scaling.md). A lost subscription
 /// fails toward safe without it (a silent heartbeat or a stream behind counts as lost within the
@@ -108,17 +109,18 @@ public:
   std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
   /// Throws when IceStorm does not answer.
   void ping() const;
-  /// Called once a heartbeat period: pings IceStorm, and every kResubscribeCheckEvery-th call
-  /// also asks IceStorm to make again each subscription it no longer holds. The asking is
-  /// asynchronous (a replicated IceStorm answers it only once its replicas have a master, which
-  /// after the master's death takes seconds, and the caller's heartbeats must not wait for that);
-  /// a later call returns the topics whose subscription was made again (empty: all were there;
-  /// the caller resynchronises otherwise). IceStorm drops a subscriber whose delivery failed or
-  /// timed out (a process starved or stopped for longer than IceStorm's send timeout), and a
-  /// subscription can be removed from outside; without this check such a process would go on
-  /// unaware that nothing reaches it. Throws Ice exceptions when IceStorm cannot be reached or
-  /// refuses the subscription.
-  std::vector<std::string> check();
+  /// Called once a heartbeat period: pings IceStorm when `ping_broker` (the caller's own last
+  /// heartbeat has not come back: one that came back round proved the link), and every
+  /// kResubscribeCheckEvery-th call also asks IceStorm to make again each subscription it no
+  /// longer holds. The asking is asynchronous (a replicated IceStorm answers it only once its
+  /// replicas have a master, which after the master's death takes seconds, and the caller's
+  /// heartbeats must not wait for that); a later call returns the topics whose subscription was
+  /// made again (empty: all were there; the caller resynchronises otherwise). IceStorm drops a
+  /// subscriber whose delivery failed or timed out (a process starved or stopped for longer than
+  /// IceStorm's send timeout), and a subscription can be removed from outside; without this check
+  /// such a process would go on unaware that nothing reaches it. Throws Ice exceptions when
+  /// IceStorm cannot be reached or refuses the subscription.
+  std::vector<std::string> check(bool ping_broker);
 
 private:
   std::shared_ptr<Ice::Communicator> ic_;

@@ -21,6 +21,7 @@
 #include "receiver.hpp"
 #include "safecass/core/id_vector.hpp"
 #include "safecass/middleware/keys.hpp"
+#include "sleeper.hpp"
 
 namespace safecass::middleware {
 
@@ -195,6 +196,7 @@ struct CoordinatorNode::Impl {
   std::shared_ptr<DropLog> drops;
   std::unique_ptr<Prover> prover;  ///< proves peers' processes alive (destroyed after the communicator)
   std::thread watch_thread;
+  Sleeper watch_sleeper;  ///< the watch thread's waits, ended by stop()
   std::thread publisher_thread;
   Coordinator::SubscriptionId subscription = 0;
 
@@ -893,19 +895,23 @@ struct CoordinatorNode::Impl {
     for (MachineId m : peer.feeds) co.generate(framework_event::completion_of(framework_event::kCoordinatorLost), m);
   }
 
+  /// Declares a peer lost once its bound has passed: it sleeps until the earliest peer is due
+  /// (Liveness::due), one loss bound at most, so a loss is said as soon as it is one.
   void watch_loop() {
-    while (running.load()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    const std::chrono::milliseconds bound = lost_after();
+    for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
+      next = now + std::chrono::nanoseconds(bound).count();
       std::lock_guard lock(peer_mutex);
       for (auto& [who, peer] : peers) {
         // A provider is watched from the node's start (never heard of is as bad as gone); the
         // supervisor only once it has been seen (a system may run without one).
         const bool watched = peer.provider || (who == kSupervisorSigner && peer.live.last_beat() != 0);
         if (!watched) continue;
-        if (const std::string why = peer.live.check(now, started, lost_after(), "this node started"); !why.empty()) {
+        if (const std::string why = peer.live.check(now, started, bound, "this node started"); !why.empty()) {
           declare_lost(who, peer, why);
         }
+        next = std::min(next, peer.live.due(started, bound));
       }
     }
   }
@@ -1058,6 +1064,7 @@ Expected<void> CoordinatorNode::start() {
   d.running.store(true);
   d.publisher_thread = std::thread([&d] { d.publisher_loop(); });
   d.link->start();
+  d.watch_sleeper.restart();
   d.watch_thread = std::thread([&d] { d.watch_loop(); });
   return {};
 }
@@ -1069,6 +1076,7 @@ void CoordinatorNode::stop() noexcept {
   d.queue_cv.notify_all();
   if (d.publisher_thread.joinable()) d.publisher_thread.join();
   d.link->stop();
+  d.watch_sleeper.stop();
   if (d.watch_thread.joinable()) d.watch_thread.join();
   try {
     d.ic->shutdown();

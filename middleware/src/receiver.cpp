@@ -4,6 +4,9 @@
 
 #include <sodium.h>
 
+#include <algorithm>
+#include <limits>
+
 #include "ice_util.hpp"
 
 namespace safecass::middleware {
@@ -91,6 +94,17 @@ std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::c
     return "its heartbeats list " + what + " not received for " + bound_text();
   }
   return {};
+}
+
+std::int64_t Liveness::due(std::int64_t watched_since, std::chrono::milliseconds bound) const noexcept {
+  constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
+  if (lost_) return kNever;
+  // check() finds a loss once more than the bound has passed: one nanosecond after it.
+  const std::int64_t after = std::chrono::nanoseconds(bound).count() + 1;
+  const std::int64_t last = last_beat_ != 0 ? last_beat_ : watched_since;
+  std::int64_t due = last != 0 ? last + after : kNever;
+  if (behind_since_ != 0) due = std::min(due, behind_since_ + after);
+  return due;
 }
 
 // ---- PeerFreshness ------------------------------------------------------------------------------

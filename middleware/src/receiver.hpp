@@ -128,7 +128,7 @@ private:
   std::int64_t incarnation_ = 0;
   std::int64_t heartbeat_seq_ = 0;
   bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
-  std::map<std::string, Stream, std::less<>> streams_;
+  TextMap<Stream> streams_;
 };
 
 /// Whether one peer a receiver follows is lost: the loss rule of DESIGN §4 and §7, the same for
@@ -152,6 +152,12 @@ public:
   /// `bound` the loss bound; `since` says what started the watch ("the supervisor connected").
   std::string check(std::int64_t now, std::int64_t watched_since, std::chrono::milliseconds bound,
                     std::string_view since);
+  /// The earliest time (steady ns) at which check() can find the peer lost if nothing comes
+  /// meanwhile; INT64_MAX when it cannot (lost already, or not watched yet). What comes only moves
+  /// it later, and what starts a new duty (a first heartbeat, a stream behind, the watch's start)
+  /// makes one at least `bound` after it: the owner's watch sleeps until the earliest due of its
+  /// peers, `bound` at most, instead of polling.
+  std::int64_t due(std::int64_t watched_since, std::chrono::milliseconds bound) const noexcept;
   bool lost() const noexcept { return lost_; }
   /// When its last heartbeat was believed (0: never).
   std::int64_t last_beat() const noexcept { return last_beat_; }

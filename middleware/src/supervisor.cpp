@@ -25,6 +25,7 @@
 #include "safecass/introspect/model.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/spec/instance.hpp"
+#include "sleeper.hpp"
 
 namespace safecass::middleware {
 
@@ -95,6 +96,7 @@ struct Supervisor::Impl {
   std::atomic<bool> running{false};
   std::atomic<std::int64_t> watching_since{0};  ///< steady_ns() of the first connection to IceStorm
   std::thread watch_thread;
+  Sleeper watch_sleeper;  ///< the watch thread's waits: ended by stop(), cut short when a view must be read again
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
   introspect::HistoryEntry record_scratch;
@@ -206,6 +208,7 @@ struct Supervisor::Impl {
                 "' missed (seq " + seq_range(Gap{heard + 1, joined, 0}) +
                 ", sent before it proved itself alive to the supervisor); its view is read again");
           peer.refresh = true;
+          watch_sleeper.wake();
         }
         peer.unproven_incarnation = 0;
         resync = true;
@@ -284,6 +287,7 @@ struct Supervisor::Impl {
     print("supervisor: " + std::to_string(gap.last - gap.first + 1) + " event record(s) of '" + printable(who) +
           "' missed (seq " + seq_range(gap) + ")");
     peer.refresh = true;  // the missed records may have changed rows: read them again
+    watch_sleeper.wake();
     if (peer.reported.size() >= kMaxGaps) peer.reported.erase(peer.reported.begin());
     peer.reported.push_back(gap);
   }
@@ -655,10 +659,18 @@ struct Supervisor::Impl {
     }
   }
 
+  /// Reports the gaps past their grace, reads again the views of coordinators whose records were
+  /// missed, and declares lost the coordinators past their bound. It sleeps until the next of
+  /// these is due (a loss: Liveness::due; a gap: its grace), at most the shorter of the two
+  /// bounds, since a new duty is due no sooner than that after it starts; a view to read again
+  /// wakes it.
   void watch_loop() {
-    while (running.load()) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    const std::int64_t cap =
+        std::chrono::nanoseconds(std::min<std::chrono::milliseconds>(options.lost_after, kReorderGrace)).count();
+    const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
+    for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
+      next = now + cap;
       report_gaps(now);
       refresh_missed();
       // A coordinator of the system file that was never heard from is lost too, once the bound
@@ -677,6 +689,8 @@ struct Supervisor::Impl {
               !why.empty()) {
             lost_now.push_back(Lost{name, peer.components, std::move(why)});
           }
+          next = std::min(next, peer.live.due(since, options.lost_after));
+          if (!peer.gaps.empty()) next = std::min(next, peer.gaps.front().opened_ns + grace);
         }
       }
       for (const auto& [name, components, why] : lost_now) {
@@ -856,6 +870,7 @@ Expected<void> Supervisor::start() {
   }
   d.running.store(true);
   d.link->start();
+  d.watch_sleeper.restart();
   d.watch_thread = std::thread([&d] { d.watch_loop(); });
   return {};
 }
@@ -864,6 +879,7 @@ void Supervisor::stop() noexcept {
   Impl& d = *impl_;
   if (!d.running.exchange(false)) return;
   d.link->stop();
+  d.watch_sleeper.stop();
   if (d.watch_thread.joinable()) d.watch_thread.join();
   try {
     d.ic->shutdown();

@@ -16,7 +16,6 @@
 
 #include <unistd.h>
 #include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <mutex>
 #include <thread>
@@ -34,13 +33,13 @@
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/spec/scenario.hpp"
+#include "stop_signals.hpp"
 
 namespace safecass::tools {
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop.store(true); }
+std::atomic<bool> g_stop{false};  ///< the end of the run: the scenario's driver stops too
 
 std::mutex g_print;
 void say(const std::string& line) {
@@ -339,6 +338,7 @@ bool close_histories(const RunArgs& args, InputRecorder* inputs, Recorder* recor
 }  // namespace
 
 int run_coordinator(const RunArgs& args) {
+  const StopSignals stop_signals;  // before any thread starts
   const FilterRegistry& registry = builtin_filters();
   std::optional<spec::Scenario> scenario;
   std::string system_path;
@@ -375,8 +375,6 @@ int run_coordinator(const RunArgs& args) {
   BusPart bus;
   if (!join_bus(args, built, registry, inputs.get(), bus)) return 2;
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
   std::size_t local = 0;
   for (ComponentId c : id_range<ComponentId>(co.structure().component_count()))
     local += co.structure().is_remote(c) ? 0 : 1;
@@ -398,9 +396,7 @@ int run_coordinator(const RunArgs& args) {
     d->inputs = inputs.get();
     driver = std::thread([&] { d->run(g_stop); });
   }
-  while (!g_stop.load() && (duration <= 0 || clock.now() - start < seconds_to_time(duration))) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  (void)stop_signals.wait(deadline_after(duration));
   g_stop.store(true);
   if (driver.joinable()) driver.join();
   if (d) {

@@ -7,24 +7,19 @@
 #include <CLI/CLI.hpp>
 
 #include <unistd.h>
-#include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <mutex>
-#include <thread>
 
 #include "middleware_commands.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/supervisor.hpp"
 #include "safecass/spec/load.hpp"
+#include "stop_signals.hpp"
 
 namespace safecass::tools {
 
 namespace {
-
-std::atomic<bool> g_supervisor_stop{false};
-void on_supervisor_signal(int) { g_supervisor_stop.store(true); }
 
 struct SupervisorArgs {
   std::string system;
@@ -39,6 +34,7 @@ struct SupervisorArgs {
 };
 
 int run_supervisor(const SupervisorArgs& args) {
+  const StopSignals stop_signals;  // before any thread starts
   const FilterRegistry& registry = builtin_filters();
   spec::LoadResult load = spec::load_system(args.system, registry);
   for (const auto& d : load.diagnostics) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
@@ -78,13 +74,7 @@ int run_supervisor(const SupervisorArgs& args) {
   }
   options.print("safecass supervisor: system '" + load.system->name + "', IceStorm " + args.ice + ", pid " +
                 std::to_string(::getpid()));
-  std::signal(SIGINT, on_supervisor_signal);
-  std::signal(SIGTERM, on_supervisor_signal);
-  const auto start = std::chrono::steady_clock::now();
-  while (!g_supervisor_stop.load() && (args.duration <= 0 || std::chrono::steady_clock::now() - start <
-                                                                 std::chrono::duration<double>(args.duration))) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
+  (void)stop_signals.wait(deadline_after(args.duration));
   (*supervisor)->stop();
   options.print("safecass supervisor: system-wide view");
   for (const middleware::ViewRow& row : (*supervisor)->view()) {

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -144,6 +145,37 @@ TEST(Liveness, AnUpdateOfTheStreamThatWasBehindCatchesItUpUntilTheNextHeartbeatS
   again.caught_up("state:P.a");
   EXPECT_EQ(again.check(401 * kMs, 1, kBound, "start"), "") << "caught up by the update, before any heartbeat";
   EXPECT_FALSE(again.lost());
+}
+
+TEST(Liveness, TheWatchIsDueOneNanosecondPastTheBoundAfterTheLastHeartbeatAndCheckFindsTheLossExactlyThen) {
+  Liveness live;
+  constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
+  EXPECT_EQ(live.due(0, kBound), kNever) << "not watched yet: nothing is due";
+  EXPECT_EQ(live.due(1000 * kMs, kBound), 1300 * kMs + 1) << "never heard from: the bound after the watch began";
+  EXPECT_FALSE(live.believed(1100 * kMs, ""));
+  const std::int64_t due = live.due(1000 * kMs, kBound);
+  EXPECT_EQ(due, 1400 * kMs + 1);
+  EXPECT_EQ(live.check(due - 1, 1000 * kMs, kBound, "start"), "") << "not a nanosecond before it is due";
+  EXPECT_EQ(live.check(due, 1000 * kMs, kBound, "start"), "no heartbeat for 300 ms");
+  EXPECT_EQ(live.due(1000 * kMs, kBound), kNever) << "lost: nothing more is due until it is back";
+  EXPECT_TRUE(live.believed(1500 * kMs, ""));
+  EXPECT_EQ(live.due(1000 * kMs, kBound), 1800 * kMs + 1);
+}
+
+TEST(Liveness, AStreamBehindIsDueTheBoundAfterItFellBehindAndWhatComesOnlyMovesTheDueTimeLater) {
+  Liveness live;
+  EXPECT_FALSE(live.believed(100 * kMs, ""));
+  const std::int64_t first = live.due(1, kBound);
+  EXPECT_FALSE(live.believed(200 * kMs, "state:P.a"));
+  const std::int64_t behind = live.due(1, kBound);
+  EXPECT_EQ(behind, 500 * kMs + 1) << "behind since 200 ms";
+  EXPECT_GE(behind, first) << "a new duty starts at least one bound after it begins";
+  EXPECT_FALSE(live.believed(400 * kMs, "state:P.a"));
+  EXPECT_EQ(live.due(1, kBound), behind) << "still behind since 200 ms: due then, although beats keep coming";
+  live.caught_up("state:P.a");
+  EXPECT_EQ(live.due(1, kBound), 700 * kMs + 1) << "caught up: due a bound after the last heartbeat";
+  EXPECT_EQ(live.check(700 * kMs, 1, kBound, "start"), "");
+  EXPECT_EQ(live.check(700 * kMs + 1, 1, kBound, "start"), "no heartbeat for 300 ms");
 }
 
 TEST(IncarnationBounds, AnIncarnationNotPositiveOrMoreThanAMinuteAheadOfTheClockIsRefused) {
