@@ -1097,6 +1097,23 @@ void Coordinator::update_component(ComponentId id, EventId event, const RootCaus
 
 // ---- propagation (DESIGN §2.6) ---------------------------------------------------------------
 
+template <class Visit>
+void Coordinator::each_reached(MachineId origin, State level, Visit&& visit) noexcept {
+  const std::uint64_t mark = ++visit_epoch_;
+  work_.clear();
+  work_.push_back(origin);
+  visit_marks_[to_index(origin)] = mark;
+  for (std::size_t head = 0; head < work_.size(); ++head) {
+    const MachineId from = work_[head];
+    for (const Edge& e : machines_[from].fanout) {
+      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
+      visit_marks_[to_index(e.to)] = mark;
+      work_.push_back(e.to);
+      visit(e);
+    }
+  }
+}
+
 void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
   // A machine that feeds no connection (most s_A of a leaf, every s_R) propagates nothing.
   if (machines_[root_condition.root.origin].fanout.empty()) return;
@@ -1105,50 +1122,30 @@ void Coordinator::propagate_onset(const Condition& root_condition) noexcept {
   const Time now = root_condition.first;
   const EventId mirror_event =
       level == State::Error ? framework_event::kServiceFailure : framework_event::kServiceDegraded;
-  const std::uint64_t mark = ++visit_epoch_;
-  work_.clear();
-  work_.push_back(root.origin);
-  visit_marks_[to_index(root.origin)] = mark;
-  for (std::size_t head = 0; head < work_.size(); ++head) {
-    const MachineId from = work_[head];
-    for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
-      visit_marks_[to_index(e.to)] = mark;
-      work_.push_back(e.to);
-      if (machines_[e.to].conditions.find_mirror(root) >= 0) continue;
-      Condition c;
-      c.event = mirror_event;
-      c.level = level;
-      c.severity = structure_.event_table_[to_index(mirror_event)]->severity;
-      c.mirror = true;
-      c.via = e.via;
-      c.first = c.last = now;
-      c.seq = ++condition_seq_;
-      c.root = root;
-      add_condition(e.to, c, now);
-    }
-  }
+  each_reached(root.origin, level, [&](const Edge& e) {
+    if (machines_[e.to].conditions.find_mirror(root) >= 0) return;
+    Condition c;
+    c.event = mirror_event;
+    c.level = level;
+    c.severity = structure_.event_table_[to_index(mirror_event)]->severity;
+    c.mirror = true;
+    c.via = e.via;
+    c.first = c.last = now;
+    c.seq = ++condition_seq_;
+    c.root = root;
+    add_condition(e.to, c, now);
+  });
 }
 
 void Coordinator::propagate_clear(const RootCause& root, State level, Time now) noexcept {
   if (machines_[root.origin].fanout.empty()) return;
-  const std::uint64_t mark = ++visit_epoch_;
-  work_.clear();
-  work_.push_back(root.origin);
-  visit_marks_[to_index(root.origin)] = mark;
-  for (std::size_t head = 0; head < work_.size(); ++head) {
-    const MachineId from = work_[head];
-    for (const Edge& e : machines_[from].fanout) {
-      if (level < e.min_level || visit_marks_[to_index(e.to)] == mark) continue;
-      visit_marks_[to_index(e.to)] = mark;
-      work_.push_back(e.to);
-      const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
-      if (i < 0) continue;
-      const EventId completion =
-          framework_event::completion_of(machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
-      remove_condition(e.to, static_cast<std::size_t>(i), completion, now, kNone);
-    }
-  }
+  each_reached(root.origin, level, [&](const Edge& e) {
+    const std::int32_t i = machines_[e.to].conditions.find_mirror(root);
+    if (i < 0) return;
+    const EventId completion =
+        framework_event::completion_of(machines_[e.to].conditions[static_cast<std::size_t>(i)].event);
+    remove_condition(e.to, static_cast<std::size_t>(i), completion, now, kNone);
+  });
 }
 
 void Coordinator::reset_locked(const Address& target, NameId reason, Time now) noexcept {

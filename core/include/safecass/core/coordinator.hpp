@@ -456,6 +456,10 @@ private:
   void remove_condition(MachineId id, std::size_t index, EventId completion, Time now, std::uint32_t text) noexcept;
   void propagate_onset(const Condition& root) noexcept;
   void propagate_clear(const RootCause& root, State level, Time now) noexcept;
+  /// Calls `visit(edge)` once for every machine an error of `level` at `origin` reaches along the
+  /// connections, breadth first: the walk of an onset's propagation and of its clearing alike.
+  template <class Visit>
+  void each_reached(MachineId origin, State level, Visit&& visit) noexcept;
   /// Writes the event record of a condition just added (change.index) and publishes the machine.
   void record_added(MachineId id, const ConditionChange& change, Time now) noexcept;
   /// Writes the event record of a condition just removed and publishes the machine.
