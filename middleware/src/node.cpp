@@ -604,8 +604,9 @@ struct CoordinatorNode::Impl {
     h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
     for (const auto& s : streams) h.lastSeq[state_stream(s->iface)] = s->seq.load();
     h.lastSeq[std::string(kEventsStream)] = event_seq.load();
-    for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
-      if (!co.structure().is_remote(c)) h.components.emplace_back(co.structure().component_name(c));
+    const Structure& shape = co.structure();
+    for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+      if (!shape.is_remote(c)) h.components.emplace_back(shape.component_name(c));
     }
     {
       std::lock_guard lock(peer_mutex);
@@ -867,9 +868,9 @@ struct CoordinatorNode::Impl {
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is gone (" + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
-      for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
-        if (!co.structure().is_remote(c))
-          co.generate(framework_event::kSupervisorLost, co.structure().framework_machine(c));
+      const Structure& shape = co.structure();
+      for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+        if (!shape.is_remote(c)) co.generate(framework_event::kSupervisorLost, shape.framework_machine(c));
       }
       return;
     }
@@ -883,10 +884,10 @@ struct CoordinatorNode::Impl {
   void recover(const std::string& who, Peer& peer) {
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
-      for (ComponentId c : id_range<ComponentId>(co.structure().component_count())) {
-        if (!co.structure().is_remote(c)) {
-          co.generate(framework_event::completion_of(framework_event::kSupervisorLost),
-                      co.structure().framework_machine(c));
+      const Structure& shape = co.structure();
+      for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+        if (!shape.is_remote(c)) {
+          co.generate(framework_event::completion_of(framework_event::kSupervisorLost), shape.framework_machine(c));
         }
       }
       return;
@@ -952,35 +953,34 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   Impl* d = impl.get();
   impl->drops = std::make_shared<DropLog>([d](const std::string& line) { d->log(line); });
   impl->incarnation = new_incarnation();
-  impl->streams_of.resize(coordinator.structure().component_count());
-  for (ComponentId c : id_range<ComponentId>(coordinator.structure().component_count())) {
-    if (coordinator.structure().is_remote(c)) {
-      for (MachineId m : coordinator.structure().provided_machines(c)) {
-        const std::string iface = std::string(coordinator.structure().component_name(c)) + "." +
-                                  std::string(coordinator.structure().interface_name(m));
-        const std::string provider(impl->members.coordinator_of(coordinator.structure().component_name(c)));
+  const Structure& shape = coordinator.structure();
+  impl->streams_of.resize(shape.component_count());
+  for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+    if (shape.is_remote(c)) {
+      for (MachineId m : shape.provided_machines(c)) {
+        const std::string iface = std::string(shape.component_name(c)) + "." + std::string(shape.interface_name(m));
+        const std::string provider(impl->members.coordinator_of(shape.component_name(c)));
         impl->held.emplace(iface, Impl::Held{m, provider});
         if (!provider.empty()) impl->peers[provider].provider = true;
       }
       continue;
     }
-    const auto& provided = coordinator.structure().provided_machines(c);
+    const auto& provided = shape.provided_machines(c);
     for (std::uint32_t p = 0; p < provided.size(); ++p) {
       auto s = std::make_unique<Impl::Stream>();
       s->component = c;
       s->provided = p;
-      s->iface = std::string(coordinator.structure().component_name(c)) + "." +
-                 std::string(coordinator.structure().interface_name(provided[p]));
+      s->iface = std::string(shape.component_name(c)) + "." + std::string(shape.interface_name(provided[p]));
       impl->streams_of[c].push_back(impl->streams.size());
       impl->streams.push_back(std::move(s));
     }
   }
   // The required interfaces each provider coordinator feeds: where its loss is raised.
-  for (const Connection& k : coordinator.structure().connections()) {
-    if (!coordinator.structure().is_remote(k.provider) || coordinator.structure().is_remote(k.client)) continue;
-    const std::string_view provider = impl->members.coordinator_of(coordinator.structure().component_name(k.provider));
+  for (const Connection& k : shape.connections()) {
+    if (!shape.is_remote(k.provider) || shape.is_remote(k.client)) continue;
+    const std::string_view provider = impl->members.coordinator_of(shape.component_name(k.provider));
     if (provider.empty()) continue;
-    impl->peers[std::string(provider)].feeds.push_back(coordinator.structure().required_machines(k.client)[k.required]);
+    impl->peers[std::string(provider)].feeds.push_back(shape.required_machines(k.client)[k.required]);
   }
   return std::unique_ptr<CoordinatorNode>(new CoordinatorNode(std::move(impl)));
 }
