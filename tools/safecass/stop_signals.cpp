@@ -17,7 +17,14 @@ StopSignals::StopSignals() {
   pthread_sigmask(SIG_BLOCK, &stop_, &before_);
 }
 
-StopSignals::~StopSignals() { pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+StopSignals::~StopSignals() {
+  // A signal that came after the wait (a second Ctrl-C while the run stops) belongs to this run:
+  // taken here, so that restoring the mask does not hand it to the default action (a kill).
+  const timespec none{0, 0};
+  while (sigtimedwait(&stop_, nullptr, &none) > 0) {
+  }
+  pthread_sigmask(SIG_SETMASK, &before_, nullptr);
+}
 
 bool StopSignals::wait(std::optional<std::chrono::steady_clock::time_point> deadline) const {
   using namespace std::chrono;

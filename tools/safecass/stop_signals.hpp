@@ -15,7 +15,7 @@ class StopSignals {
 public:
   /// Blocks SIGINT and SIGTERM in the calling thread (the main one, before it starts any other).
   StopSignals();
-  /// Restores the signal mask found at construction.
+  /// Takes any stop signal still pending, then restores the signal mask found at construction.
   ~StopSignals();
   StopSignals(const StopSignals&) = delete;
   StopSignals& operator=(const StopSignals&) = delete;

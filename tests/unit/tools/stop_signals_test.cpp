@@ -43,6 +43,17 @@ TEST(StopSignals, ASigintSentWhileTheMainThreadWaitsWithoutADeadlineEndsTheWait)
   sender.join();
 }
 
+TEST(StopSignals, ASignalThatComesAfterTheWaitIsTakenWhenTheWaitingEndsAndKillsNobody) {
+  {
+    const StopSignals signals;
+    EXPECT_FALSE(signals.wait(Clock::now()));
+    ASSERT_EQ(std::raise(SIGINT), 0);  // a second Ctrl-C while the run stops
+  }
+  sigset_t pending;
+  ASSERT_EQ(sigpending(&pending), 0);
+  EXPECT_EQ(sigismember(&pending, SIGINT), 0) << "taken before the mask was restored";
+}
+
 TEST(StopSignals, ADurationThatIsNotPositiveMeansUntilASignal) {
   EXPECT_FALSE(deadline_after(0.0).has_value());
   EXPECT_FALSE(deadline_after(-1.0).has_value());
