@@ -13,10 +13,11 @@ struct FilterBench {
   SimulatedClock clock;
   Coordinator co{"bench", &clock};
   FilterRegistry registry;
-  Monitor monitor{co, registry};
+  Monitor monitor;
   ComponentId component{0};
 
-  FilterBench() {
+  /// `banks` false: every filter runs as an object (to measure what a bank saves).
+  explicit FilterBench(bool banks = true) : monitor(co, registry, Monitor::kDefaultSignalHistory, banks) {
     register_builtin_filters(registry);
     component = *co.add_component("C");
     (void)co.add_event(EventDef{"EVT_X", 50, {Transition::N2E}, "", false, "", ""});
@@ -116,6 +117,66 @@ void BM_DetectionCycle(benchmark::State& state) {
   if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
 }
 BENCHMARK(BM_DetectionCycle)->Arg(10)->Arg(100)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
+
+// The floor of BM_DetectionCycle: N signals each get a new sample, and one cursor per signal reads
+// it; nothing is judged. What any detection cycle over N signals costs in memory alone.
+void BM_SignalCycle(benchmark::State& state) {
+  FilterBench b;
+  const auto n = static_cast<std::size_t>(state.range(0));
+  std::vector<Signal*> signals;
+  std::vector<SignalCursor> cursors;
+  for (std::size_t i = 0; i < n; ++i) {
+    signals.push_back(*b.monitor.add_signal("C.s" + std::to_string(i)));
+    cursors.emplace_back(signals.back());
+  }
+  std::int64_t t = 0;
+  double sum = 0.0;
+  for (auto _ : state) {
+    t += 1'000'000;  // 1 ms
+    for (Signal* s : signals) s->push(Time{t}, 1.0);
+    for (SignalCursor& c : cursors) {
+      Time when{};
+      double x = 0.0;
+      if (c.take_single(when, &x)) sum += x;
+    }
+  }
+  benchmark::DoNotOptimize(sum);
+  if (sum != static_cast<double>(state.iterations() * static_cast<std::int64_t>(n))) {
+    state.SkipWithError("a sample was not read");
+  }
+  state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(n));
+}
+BENCHMARK(BM_SignalCycle)->Arg(1000)->Arg(10000)->Unit(benchmark::kMicrosecond);
+
+// One cycle of N timed tasks: each task's start and end checkpoints get a sample (the end 0.2 ms
+// after the start), then one Deadline per task (2 ms) runs; no event. The second argument is 1
+// when the Deadlines run in banks, 0 when they run as objects.
+void BM_DeadlineCycle(benchmark::State& state) {
+  FilterBench b(state.range(1) != 0);
+  const auto n = static_cast<int>(state.range(0));
+  std::vector<Signal*> starts;
+  std::vector<Signal*> ends;
+  for (int i = 0; i < n; ++i) {
+    const std::string task = "task" + std::to_string(i);
+    starts.push_back(*b.monitor.add_signal("C." + task + "_start"));
+    ends.push_back(*b.monitor.add_signal("C." + task + "_end"));
+    b.add("Deadline", {{"input_signals", std::vector<std::string>{task + "_start", task + "_end"}},
+                       {"deadline", 0.002},
+                       {"event_onset", std::string("EVT_X")}});
+  }
+  std::int64_t t = 0;
+  for (auto _ : state) {
+    t += 1'000'000;  // 1 ms
+    for (int i = 0; i < n; ++i) {
+      starts[static_cast<std::size_t>(i)]->push(Time{t}, 1.0);
+      ends[static_cast<std::size_t>(i)]->push(Time{t + 200'000}, 1.0);
+    }
+    b.monitor.run_active(b.component, Time{t + 300'000});
+  }
+  state.SetItemsProcessed(state.iterations() * n);
+  if (b.co.coordinator_state() != State::Normal) state.SkipWithError("unexpected event");
+}
+BENCHMARK(BM_DeadlineCycle)->Args({100, 0})->Args({100, 1})->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace safecass

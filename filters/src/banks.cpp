@@ -1,9 +1,11 @@
 #include "banks.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace safecass::detail {
 
+using builtin::Deadline;
 using builtin::Debounce;
 using builtin::Frequency;
 using builtin::MovingAverage;
@@ -12,7 +14,12 @@ using builtin::Threshold;
 using builtin::Watchdog;
 
 bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
-  if (!banking_ || filter.inputs().size() != 1) return false;
+  if (!banking_) return false;
+  if (dynamic_cast<Deadline*>(&filter) != nullptr) {
+    kind = Kind::Deadline;
+    return filter.inputs().size() == 2;
+  }
+  if (filter.inputs().size() != 1) return false;
   const bool scalar = filter.inputs()[0]->size() == 1;
   if (dynamic_cast<Threshold*>(&filter) != nullptr) {
     kind = Kind::Threshold;
@@ -43,49 +50,87 @@ void Banks::add(Filter* filter) {
   }
   Kind kind{};
   if (!bankable(*filter, kind)) {
-    steps_.push_back(Step{filter, 0});
+    steps_.push_back(Step{filter, 0, false});
     return;
   }
-  const Signal* input = filter->inputs()[0];
-  // A filter joins the reader before it when both read the same signal from the same sample on.
-  const bool join = !steps_.empty() && steps_.back().object == nullptr &&
-                    readers_[steps_.back().reader].cursor.signal() == input &&
-                    filter->first_.level_with(readers_[steps_.back().reader].cursor);
-  if (!join) {
-    Reader reader;
-    reader.cursor = SignalCursor(input);
-    reader.cursor.follow(filter->first_);
-    reader.begin = reader.end = static_cast<std::uint32_t>(members_.size());
-    reader.source = std::find(written_.begin(), written_.end(), input) == written_.end();
-    reader.first = static_cast<std::uint32_t>(readers_.size());
-    for (std::size_t r = 0; r < readers_.size(); ++r) {
-      if (readers_[r].cursor.signal() == input) {
-        reader.first = static_cast<std::uint32_t>(r);
-        break;
-      }
-    }
-    readers_.push_back(std::move(reader));
-    steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1)});
-    const std::size_t samples = 2 * (input->buffer().capacity() + 1);  // written and injected
-    if (times_.size() < samples) {
-      times_.resize(samples);
-      injected_.resize(samples);
-      finite_.resize(samples);
-    }
-    readers_.back().width = static_cast<std::uint32_t>(input->size());
-    values_.resize(std::max(values_.size(), samples * input->size()));
+  // A filter joins the step before it when that step reads the same signals from the same
+  // samples on.
+  const Step* last = steps_.empty() || steps_.back().object != nullptr ? nullptr : &steps_.back();
+  if (kind == Kind::Deadline) {
+    const bool join = last != nullptr && last->pair &&
+                      pairs_[last->reader].cursors[0].signal() == filter->inputs()[0] &&
+                      pairs_[last->reader].cursors[1].signal() == filter->inputs()[1] &&
+                      filter->cursor(0).level_with(pairs_[last->reader].cursors[0]) &&
+                      filter->cursor(1).level_with(pairs_[last->reader].cursors[1]);
+    if (!join) add_pair(*filter);
+  } else {
+    const bool join = last != nullptr && !last->pair && readers_[last->reader].cursor.signal() == filter->inputs()[0] &&
+                      filter->first_.level_with(readers_[last->reader].cursor);
+    if (!join) add_reader(*filter);
   }
   Member m;
   m.filter = filter;
   m.kind = kind;
   m.reader = steps_.back().reader;
-  m.out = filter->detour_.load(std::memory_order_acquire) != 0;
+  m.out = detoured(*filter);
   m.reported = filter->detected();
   m.slow = filter->invalid_count_ != 0;
   members_.push_back(m);
-  readers_[m.reader].end = static_cast<std::uint32_t>(members_.size());
+  const auto end = static_cast<std::uint32_t>(members_.size());
+  if (kind == Kind::Deadline) {
+    pairs_[m.reader].end = end;
+  } else {
+    readers_[m.reader].end = end;
+  }
   adopt(members_.back());
   filter->cold_->bank_changes = &changes_;
+}
+
+void Banks::add_reader(Filter& filter) {
+  const Signal* input = filter.inputs()[0];
+  Reader reader;
+  reader.cursor = SignalCursor(input);
+  reader.cursor.follow(filter.first_);
+  reader.begin = reader.end = static_cast<std::uint32_t>(members_.size());
+  reader.source = std::find(written_.begin(), written_.end(), input) == written_.end();
+  reader.first = static_cast<std::uint32_t>(readers_.size());
+  for (std::size_t r = 0; r < readers_.size(); ++r) {
+    if (readers_[r].cursor.signal() == input) {
+      reader.first = static_cast<std::uint32_t>(r);
+      break;
+    }
+  }
+  reader.width = static_cast<std::uint32_t>(input->size());
+  readers_.push_back(std::move(reader));
+  steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1), false});
+  reserve_read(2 * (input->buffer().capacity() + 1), input->size());  // written and injected
+}
+
+void Banks::add_pair(Filter& filter) {
+  Pair pair;
+  std::size_t samples = 0;
+  std::size_t width = 1;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const Signal* input = filter.inputs()[i];
+    pair.cursors[i] = SignalCursor(input);
+    pair.cursors[i].follow(filter.cursor(i));
+    samples += 2 * (input->buffer().capacity() + 1);  // written and injected
+    width = std::max(width, input->size());
+  }
+  pair.begin = pair.end = static_cast<std::uint32_t>(members_.size());
+  pairs_.push_back(std::move(pair));
+  steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(pairs_.size() - 1), true});
+  reserve_read(samples, width);
+}
+
+void Banks::reserve_read(std::size_t samples, std::size_t width) {
+  if (times_.size() < samples) {
+    times_.resize(samples);
+    injected_.resize(samples);
+    finite_.resize(samples);
+    inputs_.resize(samples);
+  }
+  values_.resize(std::max(values_.size(), samples * width));
 }
 
 template <class State, class Get>
@@ -134,6 +179,7 @@ void Banks::adopt(Member& member) {
       break;
     }
     case Kind::Norm: place(member, norms_, state_of<Norm>); break;
+    case Kind::Deadline: place(member, deadlines_, state_of<Deadline>); break;
   }
 }
 
@@ -187,6 +233,8 @@ void Banks::run(Time now) noexcept {
     if (step.object != nullptr) {
       others_ran_ = true;
       step.object->run(now);
+    } else if (step.pair) {
+      run_pair(pairs_[step.reader], now);
     } else {
       run_reader(readers_[step.reader], now);
     }
@@ -195,7 +243,7 @@ void Banks::run(Time now) noexcept {
 
 void Banks::settle() noexcept {
   for (Member& m : members_) {
-    if (!m.out) m.filter->first_.follow(readers_[m.reader].cursor);
+    if (!m.out) hand_over(m);
   }
 }
 
@@ -203,10 +251,28 @@ void Banks::refresh() noexcept {
   // A member was disabled or injected into: from this run on it runs as an object, from the
   // sample its reader reads next.
   for (Member& m : members_) {
-    if (m.out || m.filter->detour_.load(std::memory_order_acquire) == 0) continue;
+    if (m.out || !detoured(*m.filter)) continue;
     m.out = true;
-    m.filter->first_.follow(readers_[m.reader].cursor);
+    hand_over(m);
   }
+}
+
+bool Banks::level(const Member& m) const noexcept {
+  const Filter& f = *m.filter;
+  if (m.kind != Kind::Deadline) return f.first_.level_with(readers_[m.reader].cursor);
+  const Pair& pair = pairs_[m.reader];
+  return f.cursor(0).level_with(pair.cursors[0]) && f.cursor(1).level_with(pair.cursors[1]);
+}
+
+void Banks::hand_over(Member& m) noexcept {
+  Filter& f = *m.filter;
+  if (m.kind != Kind::Deadline) {
+    f.first_.follow(readers_[m.reader].cursor);
+    return;
+  }
+  const Pair& pair = pairs_[m.reader];
+  f.cursor(0).follow(pair.cursors[0]);
+  f.cursor(1).follow(pair.cursors[1]);
 }
 
 std::size_t Banks::read(Reader& reader) noexcept {
@@ -237,7 +303,14 @@ std::size_t Banks::read(Reader& reader) noexcept {
     return 1;
   }
   const std::uint64_t missed = reader.cursor.missed();
-  reader.cursor.read_new([this, &samples, &plain](const SampleView& s) noexcept {
+  std::uint64_t dropped = 0;
+  reader.cursor.read_new([this, &samples, &plain, &dropped](const SampleView& s) noexcept {
+    // The buffers hold all a run can read (history and injections) unless a writer outran this
+    // read: what does not fit is counted as missed, never written past them.
+    if (samples == times_.size() || (samples + 1) * s.size > values_.size()) {
+      ++dropped;
+      return;
+    }
     times_[samples] = s.time;
     bool finite = true;
     for (std::size_t i = 0; i < s.size; ++i) {
@@ -249,13 +322,82 @@ std::size_t Banks::read(Reader& reader) noexcept {
     plain = plain && !s.injected && finite;
     ++samples;
   });
-  if (const std::uint64_t lost = reader.cursor.missed() - missed; lost != 0) {
-    for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
-      if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
-    }
+  if (const std::uint64_t lost = reader.cursor.missed() - missed + dropped; lost != 0) {
+    this->missed(reader.begin, reader.end, lost);
   }
   plain_ = plain;
   return samples;
+}
+
+void Banks::missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept {
+  for (std::uint32_t i = begin; i < end; ++i) {
+    if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
+  }
+}
+
+std::size_t Banks::read_pair(Pair& pair) noexcept {
+  width_ = std::max(pair.cursors[0].signal()->size(), pair.cursors[1].signal()->size());
+  const std::uint64_t missed = pair.cursors[0].missed() + pair.cursors[1].missed();
+  std::uint64_t dropped = 0;
+  SampleView next[2];
+  bool has[2] = {pair.cursors[0].next(next[0]), pair.cursors[1].next(next[1])};
+  std::size_t samples = 0;
+  bool plain = true;
+  while (has[0] || has[1]) {
+    // The earlier of the two; a tie goes to the start, as in the object's merge.
+    const std::size_t i = has[1] && (!has[0] || next[1].time < next[0].time) ? 1 : 0;
+    const SampleView& s = next[i];
+    if (samples == times_.size() || (samples + 1) * width_ > values_.size()) {
+      ++dropped;  // a writer outran this read (see read())
+    } else {
+      times_[samples] = s.time;
+      bool finite = true;
+      for (std::size_t k = 0; k < s.size; ++k) {
+        values_[samples * width_ + k] = s.data[k];
+        finite = finite && std::isfinite(s.data[k]);
+      }
+      inputs_[samples] = static_cast<char>(i);
+      injected_[samples] = s.injected ? 1 : 0;
+      finite_[samples] = finite ? 1 : 0;
+      plain = plain && !s.injected && finite;
+      ++samples;
+    }
+    has[i] = pair.cursors[i].next(next[i]);
+  }
+  if (const std::uint64_t lost = pair.cursors[0].missed() + pair.cursors[1].missed() - missed + dropped; lost != 0) {
+    this->missed(pair.begin, pair.end, lost);
+  }
+  plain_ = plain;
+  return samples;
+}
+
+void Banks::run_pair(Pair& pair, Time now) noexcept {
+  const std::size_t samples = read_pair(pair);
+  for (std::uint32_t i = pair.begin; i < pair.end; ++i) {
+    Member& m = members_[i];
+    if (m.out) {
+      run_out(m, now);
+      continue;
+    }
+    // Deadline's on_sample() for each sample, then its on_tick().
+    builtin::DeadlineState& s = deadlines_[m.index];
+    for (std::size_t j = 0; j < samples; ++j) {
+      if (!judged_here(m, j)) {
+        deliver(m, j, static_cast<std::size_t>(inputs_[j]));
+        continue;
+      }
+      if (inputs_[j] == 0) {
+        s.on_start(times_[j]);
+        continue;
+      }
+      Time elapsed{};
+      bool late = false;
+      if (!s.on_end(times_[j], elapsed, late)) continue;
+      if (late || m.reported) report(m, late, to_seconds(elapsed), times_[j], 1);
+      if (s.output != nullptr) s.output->push(times_[j], to_seconds(elapsed));
+    }
+    if (s.overdue(now)) report(m, true, to_seconds(now - s.start), now);
+  }
 }
 
 void Banks::run_reader(Reader& reader, Time now) noexcept {
@@ -263,7 +405,7 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
-      run_out(m, reader, now);
+      run_out(m, now);
       continue;
     }
     // Each kind: the step its object's on_sample() takes, then the report and the output write.
@@ -331,24 +473,25 @@ void Banks::run_reader(Reader& reader, Time now) noexcept {
         });
         break;
       }
+      case Kind::Deadline: break;  // never in a reader: a pair's (run_pair)
     }
   }
 }
 
-void Banks::run_out(Member& m, const Reader& reader, Time now) noexcept {
+void Banks::run_out(Member& m, Time now) noexcept {
   Filter& f = *m.filter;
   others_ran_ = true;
   f.run(now);
   m.reported = f.detected();
   m.slow = f.invalid_count_ != 0;
   // Back in the bank once nothing detours it and it has read what its reader read.
-  m.out = f.detour_.load(std::memory_order_acquire) != 0 || !f.first_.level_with(reader.cursor);
+  m.out = detoured(f) || !level(m);
 }
 
-void Banks::deliver(Member& m, std::size_t j) noexcept {
+void Banks::deliver(Member& m, std::size_t j, std::size_t input) noexcept {
   Filter& f = *m.filter;
   others_ran_ = true;
-  f.deliver(0, SampleView{times_[j], sample(j), width_, injected_[j] != 0});
+  f.deliver(input, SampleView{times_[j], sample(j), f.inputs()[input]->size(), injected_[j] != 0});
   f.current_injected_ = false;
   m.slow = f.invalid_count_ != 0;
   m.reported = f.detected();

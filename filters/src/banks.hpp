@@ -5,10 +5,11 @@
 //
 // A group runs its filters in creation order, as steps. A step is either one filter run as an
 // object (Filter::run), or a *reader*: consecutive built-in filters of a bankable type that read
-// one signal. A reader reads each new sample of its signal once and hands it to each of its
-// filters in turn; their state lives in one array per type (the banks), and they are run by a
-// switch over their type, not a virtual call. A filter object is touched only when it has an event
-// to raise, a non-finite or injected sample to judge, or a detour (disabled, shallow injection):
+// one signal, or a *pair*: consecutive Deadlines that read one start and one end signal. A reader
+// reads each new sample of its signal once (a pair merges the new samples of its two in time
+// order once) and hands it to each of its filters in turn; their state lives in one array per
+// type (the banks), and they are run by a switch over their type, not a virtual call. A filter object is touched only
+// when it has an event to raise, a non-finite or injected sample to judge, or a detour (disabled, shallow injection):
 // then that filter runs its samples through the object path until it is level with the reader
 // again. Same filters, same order, same samples: the events, values and times are those of the
 // filters run one by one.
@@ -44,11 +45,11 @@ public:
   std::size_t banked() const noexcept { return members_.size(); }
 
 private:
-  enum class Kind : std::uint8_t { Threshold, Watchdog, Average, VectorAverage, Debounce, Frequency, Norm };
+  enum class Kind : std::uint8_t { Threshold, Watchdog, Average, VectorAverage, Debounce, Frequency, Norm, Deadline };
   struct Member {
     Filter* filter = nullptr;
     std::uint32_t index = 0;   ///< its state in the array of its kind
-    std::uint32_t reader = 0;  ///< the reader of its signal
+    std::uint32_t reader = 0;  ///< the reader of its signal (a Deadline: its pair)
     Kind kind = Kind::Threshold;
     bool out = false;       ///< runs as an object until level with its reader and without a detour
     bool slow = false;      ///< its input is marked invalid: samples go through Filter::deliver
@@ -65,9 +66,18 @@ private:
     Time time{};
     double value = 0.0;
   };
+  /// Consecutive Deadlines of one start and one end signal that read both from the same samples
+  /// on. The new samples of the two are merged in time order (ties: the start first), as a
+  /// Deadline run as an object merges them.
+  struct Pair {
+    SignalCursor cursors[2];  ///< start, end: the Deadline's inputs 0 and 1
+    std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
+    std::uint32_t end = 0;
+  };
   struct Step {
-    Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader]
+    Filter* object = nullptr;  ///< a filter run as an object, or nullptr: readers_[reader] or pairs_[reader]
     std::uint32_t reader = 0;
+    bool pair = false;
   };
   /// The ring of a banked filter's state (MovingAverage's samples, with a vector's sums and means;
   /// Frequency's intervals), kept in rings_ after the others'.
@@ -78,6 +88,20 @@ private:
   };
 
   bool bankable(Filter& filter, Kind& kind) const noexcept;
+  /// Whether something takes `filter` out of its bank: disabled, re-enabled, a shallow injection
+  /// queued or just ended (several inputs is not a detour: a pair merges them).
+  static bool detoured(const Filter& filter) noexcept {
+    return (filter.detour_.load(std::memory_order_acquire) & ~Filter::kSeveralInputs) != 0;
+  }
+  /// A step for a new reader of `filter`'s input, or a new pair of its two; its buffers grown.
+  void add_reader(Filter& filter);
+  void add_pair(Filter& filter);
+  /// Grows the buffers of a read to hold `samples` samples of up to `width` doubles.
+  void reserve_read(std::size_t samples, std::size_t width);
+  /// Whether `filter`'s own cursors stand where its reader's (or pair's) do.
+  bool level(const Member& m) const noexcept;
+  /// Makes `filter`'s own cursors read on from where its reader's (or pair's) stand.
+  void hand_over(Member& m) noexcept;
   void adopt(Member& member);
   /// Moves `member`'s state, `get(filter)`, into `bank`.
   template <class State, class Get>
@@ -88,7 +112,11 @@ private:
   /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_.
   [[gnu::always_inline]] inline std::size_t read(Reader& reader) noexcept;
   [[gnu::always_inline]] inline void run_reader(Reader& reader, Time now) noexcept;
-  [[gnu::cold]] void run_out(Member& m, const Reader& reader, Time now) noexcept;
+  /// This run's new samples of `pair`'s two signals, merged, into times_, values_, inputs_,
+  /// injected_ and finite_.
+  std::size_t read_pair(Pair& pair) noexcept;
+  void run_pair(Pair& pair, Time now) noexcept;
+  [[gnu::cold]] void run_out(Member& m, Time now) noexcept;
   /// Hands each sample of this read that the bank judges to `judge(j)`, the others to the object.
   template <class Judge>
   [[gnu::always_inline]] void each_sample(Member& m, std::size_t samples, Judge&& judge) noexcept {
@@ -100,11 +128,15 @@ private:
       }
     }
   }
-  /// Sample `j` of this read through the object path (non-finite, injected, or the input marked).
-  [[gnu::cold]] void deliver(Member& m, std::size_t j) noexcept;
-  [[gnu::cold]] void report(Member& m, bool detected, double value, Time time) noexcept {
+  /// Sample `j` of this read, of the filter's input `input`, through the object path
+  /// (non-finite, injected, or the input marked).
+  [[gnu::cold]] void deliver(Member& m, std::size_t j, std::size_t input = 0) noexcept;
+  /// Counts samples read but not kept (more than the buffers hold: a writer outran the read) as
+  /// missed by the filters of [begin, end) still in the bank.
+  [[gnu::cold]] void missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept;
+  [[gnu::cold]] void report(Member& m, bool detected, double value, Time time, std::size_t input = 0) noexcept {
     others_ran_ = true;  // the event's observers and callbacks
-    m.filter->report(detected, value, time);
+    m.filter->report(detected, value, time, input);
     m.reported = m.filter->detected();
   }
   bool judged_here(const Member& m, std::size_t j) const noexcept {
@@ -117,6 +149,7 @@ private:
   std::vector<Step> steps_;
   std::vector<const Signal*> written_;  ///< the outputs of the group's filters
   std::vector<Reader> readers_;
+  std::vector<Pair> pairs_;
   std::vector<Member> members_;
   std::vector<builtin::ThresholdState> thresholds_;
   std::vector<builtin::WatchdogState> watchdogs_;
@@ -125,6 +158,7 @@ private:
   std::vector<builtin::DebounceState> debounces_;
   std::vector<builtin::FrequencyState> frequencies_;
   std::vector<builtin::NormState> norms_;
+  std::vector<builtin::DeadlineState> deadlines_;
   std::vector<double> rings_;
   std::vector<Ring> ring_list_;
   // The samples of the current read, for every filter of the reader in turn.
@@ -132,8 +166,9 @@ private:
   std::vector<double> values_;  ///< width_ doubles per sample
   std::vector<char> injected_;
   std::vector<char> finite_;
-  std::size_t width_ = 1;
-  bool plain_ = true;  ///< every sample of the current read is finite and not injected
+  std::vector<char> inputs_;  ///< a pair's read: 0 (start) or 1 (end)
+  std::size_t width_ = 1;     ///< doubles per sample in values_
+  bool plain_ = true;         ///< every sample of the current read is finite and not injected
   /// Code other than the banks' (an object filter, an event's observers and callbacks) ran on
   /// this thread during this run, so it may have written a signal read ahead.
   bool others_ran_ = false;

@@ -1,6 +1,6 @@
 #pragma once
 // The built-in filters that can run in a bank (docs/filters.md, "Filter banks"): Threshold,
-// Watchdog, MovingAverage (scalar and vector), Debounce, Frequency and Norm. Each keeps the state
+// Watchdog, MovingAverage (scalar and vector), Debounce, Frequency, Norm and Deadline. Each keeps the state
 // it judges with in a small struct with the step function that updates it. The filter object
 // points at that struct: at first its own copy, and once a bank adopts it, the bank's element in
 // an array of such structs. Run as an object or in a bank, the filter goes through the same step
@@ -228,6 +228,34 @@ struct NormState {
   void reset() noexcept {}
 };
 
+/// Deadline's state: the start of the open interval, if one is open.
+struct DeadlineState {
+  Time deadline{};
+  Time start{};
+  Signal* output = nullptr;
+  bool open = false;
+
+  /// A start checkpoint at `t`. A start while an interval is open does not restart it: the
+  /// deadline runs from the first unmatched start, so starts that keep coming cannot hide a
+  /// missing end.
+  void on_start(Time t) noexcept {
+    if (!open) start = t;
+    open = true;
+  }
+  /// An end checkpoint at `t`: true when it closes an open interval, with the interval's length
+  /// in `elapsed` and whether it was longer than the deadline in `late`; false when none is open.
+  bool on_end(Time t, Time& elapsed, bool& late) noexcept {
+    if (!open) return false;
+    open = false;
+    elapsed = t - start;
+    late = elapsed > deadline;
+    return true;
+  }
+  /// Once per run, after the samples: the open interval is older than the deadline at `now`.
+  bool overdue(Time now) const noexcept { return open && now - start > deadline; }
+  void reset() noexcept { open = false; }
+};
+
 /// The state a banked filter judges with: its own until a bank adopts it (Banks::add), then the
 /// bank's element, which adopt() fills with a copy of the filter's state so far.
 template <class State>
@@ -394,6 +422,37 @@ protected:
 
 private:
   BankedState<NormState> state_;
+};
+
+/// A sample of the first input opens a checkpoint, one of the second closes it; more than
+/// `deadline` seconds between them (or still open after `deadline`) → onset; a pair within the
+/// deadline → completion.
+class Deadline final : public Filter {
+public:
+  explicit Deadline(FilterInit init);
+  static FilterManifest manifest();
+  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s);
+  BankedState<DeadlineState>& state() noexcept { return state_; }
+
+protected:
+  void on_sample(std::size_t input, const SampleView& s) noexcept override {
+    if (input == 0) {
+      state_->on_start(s.time);
+      return;
+    }
+    Time elapsed{};
+    bool late = false;
+    if (!state_->on_end(s.time, elapsed, late)) return;
+    report(late, to_seconds(elapsed), s.time, 1);
+    write(0, s.time, to_seconds(elapsed));
+  }
+  void on_reset() noexcept override { state_->reset(); }
+
+private:
+  void on_tick(Time now) noexcept override {
+    if (state_->overdue(now)) report(true, to_seconds(now - state_->start), now);
+  }
+  BankedState<DeadlineState> state_;
 };
 
 }  // namespace safecass::builtin

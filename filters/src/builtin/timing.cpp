@@ -147,61 +147,35 @@ private:
   double max_duty_;
 };
 
-/// A sample of the first input opens a checkpoint, one of the second closes it; more than
-/// `deadline` seconds between them (or still open after `deadline`) → onset; a pair within the
-/// deadline → completion.
-class Deadline final : public Filter {
-public:
-  explicit Deadline(FilterInit init) : Filter(std::move(init)), deadline_(seconds_to_time(number("deadline"))) {}
-  static FilterManifest manifest() {
-    FilterManifest m;
-    m.doc = "event when the time from a start checkpoint to an end checkpoint exceeds deadline seconds";
-    m.params = {
-        ParamSpec::signals("input_signals", "two signals: [start checkpoint, end checkpoint]"),
-        ParamSpec::number("deadline", "longest allowed time from start to end, in seconds", std::nullopt, 1e-9, 1e9),
-        ParamSpec::signal("output_signal", "elapsed time of each completed pair", true)};
-    add_event_params(m, true);
-    m.inputs = {"input_signals"};
-    m.outputs = {"output_signal"};
-    return m;
-  }
-  [[nodiscard]] static Expected<std::vector<std::size_t>> output_sizes(const FilterShape& s) {
-    if (s.inputs.size() != 2) {
-      return fail(ErrorCode::InvalidArgument,
-                  "filter '" + s.filter +
-                      "' (Deadline): 'input_signals' must list exactly two signals (start, end), not " +
-                      std::to_string(s.inputs.size()));
-    }
-    return std::vector<std::size_t>{1};
-  }
-
-protected:
-  void on_sample(std::size_t input, const SampleView& s) noexcept override {
-    if (input == 0) {
-      // A start while an interval is open does not restart it: the deadline runs from the first
-      // unmatched start, so starts that keep coming can never hide a missing end.
-      if (!open_) start_ = s.time;
-      open_ = true;
-      return;
-    }
-    if (!open_) return;
-    open_ = false;
-    const Time elapsed = s.time - start_;
-    report(elapsed > deadline_, to_seconds(elapsed), s.time, 1);
-    write(0, s.time, to_seconds(elapsed));
-  }
-  void on_tick(Time now) noexcept override {
-    if (open_ && now - start_ > deadline_) report(true, to_seconds(now - start_), now);
-  }
-  void on_reset() noexcept override { open_ = false; }
-
-private:
-  Time deadline_;
-  Time start_{};
-  bool open_ = false;
-};
-
 }  // namespace
+
+Deadline::Deadline(FilterInit init) : Filter(std::move(init)) {
+  state_.own().deadline = seconds_to_time(number("deadline"));
+  state_.own().output = outputs().empty() ? nullptr : outputs()[0];
+}
+
+FilterManifest Deadline::manifest() {
+  FilterManifest m;
+  m.doc = "event when the time from a start checkpoint to an end checkpoint exceeds deadline seconds";
+  m.params = {
+      ParamSpec::signals("input_signals", "two signals: [start checkpoint, end checkpoint]"),
+      ParamSpec::number("deadline", "longest allowed time from start to end, in seconds", std::nullopt, 1e-9, 1e9),
+      ParamSpec::signal("output_signal", "elapsed time of each completed pair", true)};
+  add_event_params(m, true);
+  m.inputs = {"input_signals"};
+  m.outputs = {"output_signal"};
+  return m;
+}
+
+Expected<std::vector<std::size_t>> Deadline::output_sizes(const FilterShape& s) {
+  if (s.inputs.size() != 2) {
+    return fail(ErrorCode::InvalidArgument,
+                "filter '" + s.filter +
+                    "' (Deadline): 'input_signals' must list exactly two signals (start, end), not " +
+                    std::to_string(s.inputs.size()));
+  }
+  return std::vector<std::size_t>{1};
+}
 
 void register_timing(FilterRegistry& r) {
   (void)r.add<Occurrence>("Occurrence");

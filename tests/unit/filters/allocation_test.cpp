@@ -170,7 +170,8 @@ TEST(FilterAllocation, EdgeEventsAfterWarmUpAllocateNothing) {
 
 TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsAndDetours) {
   // Banks (docs/filters.md): a Threshold, a Watchdog and a MovingAverage per signal, a vector's
-  // Norm → MovingAverage → Threshold and its own MovingAverage, a Debounce and a Frequency, in banks;
+  // Norm → MovingAverage → Threshold and its own MovingAverage, a Debounce, a Frequency, two
+  // Deadlines of one pair of signals and one of a signal with itself, in banks;
   // several samples per run, a NaN now and then, a deep injection, a filter disabled and enabled
   // again: none of it allocates after the warm-up (the deep injection's ring is made by the
   // first injection, in the warm-up).
@@ -192,7 +193,13 @@ TEST(FilterAllocation, BankedFiltersAllocateNothingWithSeveralSamplesInjectionsA
   s.add("MovingAverage", {{"input_signal", std::string("force")}, {"output_signal", std::string("mean_force")}});
   s.add("Debounce", {{"input_signal", std::string("x0")}, {"event_onset", std::string("EVT_X")}});
   s.add("Frequency", {{"input_signal", std::string("x1")}, {"min_rate", 1.0}, {"event_onset", std::string("EVT_X")}});
-  ASSERT_EQ(s.monitor.banked_count(), 156U);
+  for (const char* pair : {"x0 force", "x0 force", "x1 x1"}) {  // overdue at every run, late at every end
+    const std::string p(pair);
+    s.add("Deadline", {{"input_signals", std::vector<std::string>{p.substr(0, 2), p.substr(3)}},
+                       {"deadline", 1e-9},
+                       {"event_onset", std::string("EVT_X")}});
+  }
+  ASSERT_EQ(s.monitor.banked_count(), 159U);
   Filter* toggled = s.monitor.filters()[1].get();
   const double f[] = {1, 2, 3};
   auto cycle = [&](int i) {
