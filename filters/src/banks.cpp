@@ -305,31 +305,33 @@ std::size_t Banks::read(Reader& reader) noexcept {
   const std::uint64_t missed = reader.cursor.missed();
   std::uint64_t dropped = 0;
   reader.cursor.read_new([this, &samples, &plain, &dropped](const SampleView& s) noexcept {
-    // The buffers hold all a run can read (history and injections) unless a writer outran this
-    // read: what does not fit is counted as missed, never written past them.
-    if (samples == times_.size() || (samples + 1) * s.size > values_.size()) {
-      ++dropped;
-      return;
-    }
-    times_[samples] = s.time;
-    bool finite = true;
-    for (std::size_t i = 0; i < s.size; ++i) {
-      values_[samples * s.size + i] = s.data[i];
-      finite = finite && std::isfinite(s.data[i]);
-    }
-    injected_[samples] = s.injected ? 1 : 0;
-    finite_[samples] = finite ? 1 : 0;
-    plain = plain && !s.injected && finite;
-    ++samples;
+    if (!store_sample(samples, s, plain)) ++dropped;
   });
   if (const std::uint64_t lost = reader.cursor.missed() - missed + dropped; lost != 0) {
-    this->missed(reader.begin, reader.end, lost);
+    add_missed(reader.begin, reader.end, lost);
   }
   plain_ = plain;
   return samples;
 }
 
-void Banks::missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept {
+bool Banks::store_sample(std::size_t& samples, const SampleView& s, bool& plain) noexcept {
+  // The buffers hold all a run can read (history and injections) unless a writer outran this
+  // read: what does not fit is counted as missed, never written past them.
+  if (samples == times_.size() || (samples + 1) * width_ > values_.size()) return false;
+  times_[samples] = s.time;
+  bool finite = true;
+  for (std::size_t k = 0; k < s.size; ++k) {
+    values_[samples * width_ + k] = s.data[k];
+    finite = finite && std::isfinite(s.data[k]);
+  }
+  injected_[samples] = s.injected ? 1 : 0;
+  finite_[samples] = finite ? 1 : 0;
+  plain = plain && !s.injected && finite;
+  ++samples;
+  return true;
+}
+
+void Banks::add_missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept {
   for (std::uint32_t i = begin; i < end; ++i) {
     if (!members_[i].out) members_[i].filter->cold_->banked_missed.fetch_add(lost, std::memory_order_relaxed);
   }
@@ -346,26 +348,15 @@ std::size_t Banks::read_pair(Pair& pair) noexcept {
   while (has[0] || has[1]) {
     // The earlier of the two; a tie goes to the start, as in the object's merge.
     const std::size_t i = has[1] && (!has[0] || next[1].time < next[0].time) ? 1 : 0;
-    const SampleView& s = next[i];
-    if (samples == times_.size() || (samples + 1) * width_ > values_.size()) {
-      ++dropped;  // a writer outran this read (see read())
+    if (store_sample(samples, next[i], plain)) {
+      inputs_[samples - 1] = static_cast<char>(i);
     } else {
-      times_[samples] = s.time;
-      bool finite = true;
-      for (std::size_t k = 0; k < s.size; ++k) {
-        values_[samples * width_ + k] = s.data[k];
-        finite = finite && std::isfinite(s.data[k]);
-      }
-      inputs_[samples] = static_cast<char>(i);
-      injected_[samples] = s.injected ? 1 : 0;
-      finite_[samples] = finite ? 1 : 0;
-      plain = plain && !s.injected && finite;
-      ++samples;
+      ++dropped;
     }
     has[i] = pair.cursors[i].next(next[i]);
   }
   if (const std::uint64_t lost = pair.cursors[0].missed() + pair.cursors[1].missed() - missed + dropped; lost != 0) {
-    this->missed(pair.begin, pair.end, lost);
+    add_missed(pair.begin, pair.end, lost);
   }
   plain_ = plain;
   return samples;

@@ -131,9 +131,12 @@ private:
   /// Sample `j` of this read, of the filter's input `input`, through the object path
   /// (non-finite, injected, or the input marked).
   [[gnu::cold]] void deliver(Member& m, std::size_t j, std::size_t input = 0) noexcept;
-  /// Counts samples read but not kept (more than the buffers hold: a writer outran the read) as
-  /// missed by the filters of [begin, end) still in the bank.
-  [[gnu::cold]] void missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept;
+  /// Stores `s` as sample `samples` of this read (width_ doubles apart) and counts it; false, and
+  /// nothing written, when the buffers are full (a writer outran the read).
+  [[gnu::always_inline]] inline bool store_sample(std::size_t& samples, const SampleView& s, bool& plain) noexcept;
+  /// Counts samples lost (overwritten, or not kept) as missed by the filters of [begin, end)
+  /// still in the bank.
+  [[gnu::cold]] void add_missed(std::uint32_t begin, std::uint32_t end, std::uint64_t lost) noexcept;
   [[gnu::cold]] void report(Member& m, bool detected, double value, Time time, std::size_t input = 0) noexcept {
     others_ran_ = true;  // the event's observers and callbacks
     m.filter->report(detected, value, time, input);
