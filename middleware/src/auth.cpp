@@ -453,7 +453,7 @@ wire::Signed Signer::sign(std::string_view kind, Ice::ByteSeq body) const {
   return m;
 }
 
-void DropLog::drop(const std::string& raw_source, const std::string& what) {
+void DropLog::line(const std::string& raw_source, const std::string& what, bool refused) {
   constexpr std::size_t kMaxSource = 64;
   constexpr std::size_t kMaxLine = 1024;
   const std::string source = raw_source.size() <= kMaxSource ? raw_source : printable(raw_source, kMaxSource);
@@ -462,15 +462,29 @@ void DropLog::drop(const std::string& raw_source, const std::string& what) {
   std::string line;
   {
     std::lock_guard lock(mutex_);
-    ++count_;
+    if (refused) ++count_;
     // Sources are signer names taken from messages: bounded, so forged names cannot grow the map.
     Source& s = sources_.size() < 256 || sources_.count(source) != 0 ? sources_[source] : sources_["(other)"];
     if (s.last_logged != 0 && now - s.last_logged < 1'000'000'000) {
       ++s.suppressed;
       return;
     }
+    if (now - second_start_ >= 1'000'000'000) {
+      second_start_ = now;
+      lines_this_second_ = 0;
+    }
+    if (lines_this_second_ >= kLinesPerSecond) {
+      ++over_budget_;  // the source may speak again at its next message
+      return;
+    }
+    ++lines_this_second_;
     line = what.size() <= kMaxLine ? what : what.substr(0, kMaxLine) + "...(cut)";
     if (s.suppressed > 0) line += " (" + std::to_string(s.suppressed) + " more from this source in the last second)";
+    if (over_budget_ > 0) {
+      line += " (" + std::to_string(over_budget_) + " more line(s) of every source suppressed: at most " +
+              std::to_string(kLinesPerSecond) + " a second)";
+      over_budget_ = 0;
+    }
     s.last_logged = now;
     s.suppressed = 0;
   }

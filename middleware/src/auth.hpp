@@ -134,17 +134,25 @@ std::string open_sealed(const Signer& me, const std::shared_ptr<Ice::Communicato
   return {};
 }
 
-/// Counts refused messages and logs them, at most one line per source per second (a flood of
-/// forgeries must not become a flood of log lines), with the number suppressed since. Sources are
+/// Counts refused messages and logs them, and every line that what arrives can repeat: at most
+/// one line per source per second (a flood of forgeries must not become a flood of log lines),
+/// with the number suppressed since, and at most kLinesPerSecond lines a second in all, whatever
+/// the number of sources (the next line says how many were suppressed meanwhile). Sources are
 /// kept capped (printable(source, 64)) and at most 256 of them, lines at most 1,024 bytes: memory
-/// and log growth stay bounded whatever arrives.
+/// stays bounded, and the log grows by at most kLinesPerSecond lines of 1,024 bytes (and their
+/// counts) a second, whatever arrives.
 class DropLog {
 public:
+  static constexpr std::uint64_t kLinesPerSecond = 8;
   explicit DropLog(std::function<void(const std::string&)> log) : log_(std::move(log)) {}
-  void drop(const std::string& source, const std::string& what);
+  /// A refused message: counted (count()) and logged, rate-limited.
+  void drop(const std::string& source, const std::string& what) { line(source, what, true); }
+  /// A line something from outside can make repeat (not a refusal): logged, rate-limited.
+  void note(const std::string& source, const std::string& what) { line(source, what, false); }
   std::uint64_t count() const;
 
 private:
+  void line(const std::string& source, const std::string& what, bool refused);
   struct Source {
     std::int64_t last_logged = 0;
     std::uint64_t suppressed = 0;
@@ -153,6 +161,9 @@ private:
   mutable std::mutex mutex_;
   std::map<std::string, Source, std::less<>> sources_;
   std::uint64_t count_ = 0;
+  std::int64_t second_start_ = 0;         ///< the start of the current second of the total budget
+  std::uint64_t lines_this_second_ = 0;   ///< lines logged since second_start_
+  std::uint64_t over_budget_ = 0;         ///< lines suppressed by the total budget, not said yet
 };
 
 /// An incarnation for a process starting now: its start time in ns since the epoch, so a

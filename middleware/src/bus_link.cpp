@@ -28,6 +28,13 @@ std::shared_ptr<Ice::ObjectPrx> BusLink::publisher(std::size_t topic) const {
   return topic < publishers_.size() ? publishers_[topic] : nullptr;
 }
 
+void BusLink::renew(const std::vector<std::string>& topics) {
+  std::lock_guard lock(renew_mutex_);
+  for (const std::string& t : topics) {
+    if (std::find(renew_.begin(), renew_.end(), t) == renew_.end()) renew_.push_back(t);
+  }
+}
+
 void BusLink::sleep_for(std::chrono::milliseconds d) {
   (void)sleeper_.sleep_until(steady_ns() + std::chrono::nanoseconds(d).count());
 }
@@ -76,6 +83,12 @@ void BusLink::loop() {
       // IceStorm is asked whether it is there only when this process's last heartbeat did not
       // come back round within a period: one that did proves the whole way works.
       const bool echo_late = steady_ns() - last_own_heartbeat_.load() > std::chrono::nanoseconds(period).count();
+      std::vector<std::string> renew;
+      {
+        std::lock_guard lock(renew_mutex_);
+        renew.swap(renew_);
+      }
+      for (const std::string& t : renew) link_.renew(t);
       if (const std::vector<std::string> made = link_.check(echo_late); !made.empty()) {
         // What arrived on those topics meanwhile is lost: every provider republishes its state.
         options_.log(options_.who + ": " + resubscribed_line(made));

@@ -58,6 +58,9 @@ public:
 
   /// The oneway publisher on `publish_on[topic]`; nullptr until connected. Any thread.
   [[nodiscard]] std::shared_ptr<Ice::ObjectPrx> publisher(std::size_t topic) const;
+  /// A stream of `topics` was lost while its heartbeats came (any thread): the link thread
+  /// subscribes to them again under new identities (Link::renew) at its next period.
+  void renew(const std::vector<std::string>& topics);
   /// Sending on the link failed (another thread): the link thread reconnects and resynchronises.
   void reconnect() noexcept { connected_.store(false); }
   /// The process's own heartbeat of this run came back (its dispatch thread): its subscriptions work.
@@ -78,6 +81,8 @@ private:
   std::string where_;  ///< IceStorm's endpoint, as said in the log
   BusLinkOptions options_;
   Link link_;  ///< link thread only
+  std::mutex renew_mutex_;
+  std::vector<std::string> renew_;  ///< topics to subscribe to again (renew())
   mutable std::mutex publishers_mutex_;
   std::vector<std::shared_ptr<Ice::ObjectPrx>> publishers_;
   std::atomic<bool> running_{false};

@@ -88,7 +88,8 @@ private:
 struct RemoteClient::Impl {
   ClientOptions options;
   std::shared_ptr<Ice::Communicator> ic;
-  std::shared_ptr<wire::ControlPrx> control;
+  std::shared_ptr<wire::ControlPrx> control;  ///< bound to the coordinator's own connection (bind_to_member)
+  std::string endpoint;                       ///< where it serves, as its proven heartbeat names it
   std::unique_ptr<Keyring> keys;
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> gaps{0};
@@ -167,15 +168,19 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
                           "without --insecure (requests and the token would cross the network unencrypted)");
         }
       }
-      auto candidate =
-          Ice::uncheckedCast<wire::ControlPrx>(prx)->ice_invocationTimeout(static_cast<int>(o.timeout.count()));
-      auto beat = prove_now(impl->ic, *keys, o.coordinator, candidate);
+      // The connection must be the coordinator's own (its certificate names it), and the proof,
+      // asked over that connection alone, must be of the process at this endpoint.
+      auto bound = bind_to_member(impl->ic, control, o.coordinator, o.timeout);
+      auto candidate = bound ? Ice::uncheckedCast<wire::ControlPrx>(*bound) : nullptr;
+      auto beat = bound ? prove_now(impl->ic, *keys, o.coordinator, control, candidate)
+                        : Expected<wire::Heartbeat>(tl::unexpected(bound.error()));
       if (!beat) {
         unproven = beat.error().message;
         if (beat.error().code == ErrorCode::Io) finder->retry(control);  // no answer: ask again, not a bad proof
         continue;
       }
       impl->incarnation = beat->incarnation;
+      impl->endpoint = control;
       found = candidate;
       break;
     }
@@ -238,7 +243,7 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
 class Follower final {
 public:
   Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
-      : client_(client), sink_(std::move(sink)), last_(last), incarnation_(client.incarnation) {}
+      : client_(client), sink_(std::move(sink)), control_(client.control), last_(last), incarnation_(client.incarnation) {}
 
   void on_records(const wire::Signed& batch);
   /// Subscription::catch_up(): the records after the last delivered, from the history.
@@ -254,8 +259,12 @@ private:
   /// coordinator does not answer.
   [[nodiscard]] Expected<std::size_t> deliver_kept(std::uint64_t below);
 
+  /// The process whose records are followed, at the coordinator's endpoint, bound to it.
+  [[nodiscard]] Expected<wire::Heartbeat> prove_restart();
+
   RemoteClient::Impl& client_;
   introspect::RecordSink sink_;
+  std::shared_ptr<wire::ControlPrx> control_;  ///< the client's, until the coordinator restarts
   std::mutex mutex_;  // stopped_ and the sink's calls
   bool stopped_ = false;
   std::uint64_t last_;        ///< the last record delivered (its coordinator-wide seq)
@@ -314,7 +323,7 @@ void Follower::on_records(const wire::Signed& batch) {
     if (m.incarnation > incarnation_) {
       // A process not proven alive: a restart of the coordinator (followed once the endpoint
       // proves it), or a replay of a run that is over (refused).
-      auto beat = prove_now(client_.ic, *client_.keys, coordinator, client_.control);
+      auto beat = prove_restart();
       if (!beat || beat->incarnation != m.incarnation) {
         ++client_.refused;
         continue;
@@ -332,10 +341,22 @@ void Follower::on_records(const wire::Signed& batch) {
   (void)deliver_kept(0);
 }
 
+Expected<wire::Heartbeat> Follower::prove_restart() {
+  // The connection proven at connect() ends with its process: a restart is reached anew, and
+  // checked as the first one was.
+  const std::string& coordinator = client_.options.coordinator;
+  auto bound = bind_to_member(client_.ic, client_.endpoint, coordinator, client_.options.timeout);
+  if (!bound) return tl::unexpected(bound.error());
+  auto control = Ice::uncheckedCast<wire::ControlPrx>(*bound)->ice_context(client_.control->ice_getContext());
+  auto beat = prove_now(client_.ic, *client_.keys, coordinator, client_.endpoint, control);
+  if (beat) control_ = std::move(control);
+  return beat;
+}
+
 Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {
   try {
     auto kept =
-        entries_from_wire(client_.control->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
+        entries_from_wire(control_->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
     if (!kept) return tl::unexpected(kept.error());
     std::size_t n = 0;
     for (const introspect::HistoryEntry& e : *kept) {

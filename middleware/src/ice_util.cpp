@@ -7,6 +7,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 
 #include "safecass/middleware/keys.hpp"
@@ -31,6 +32,13 @@ TlsOptions tls_from_keys(const std::string& keys_dir, TlsOptions given, std::str
                     std::string(who) + ": TLS: " + file +
                         " is missing (`safecass keys SYSTEM --out DIR` makes the system's certificates)");
       }
+    }
+    // A private key others can read is no longer private: refused, as a member's secret is.
+    const std::string key = tls.dir + "/" + tls.name + ".key";
+    struct stat st {};
+    if (::stat(key.c_str(), &st) == 0 && (st.st_uid != ::geteuid() || (st.st_mode & 077) != 0)) {
+      return fail(ErrorCode::Denied,
+                  std::string(who) + ": TLS: " + key + ": a private key must be owned by its user and have mode 0600");
     }
     return {};
   }
@@ -162,6 +170,12 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
   }
 }
 
+std::shared_ptr<Ice::ObjectPrx> add_subscriber(const std::shared_ptr<Ice::ObjectAdapter>& adapter,
+                                               std::shared_ptr<Ice::Object> servant, const std::string& category) {
+  adapter->addDefaultServant(std::move(servant), category);
+  return adapter->createProxy(Ice::Identity{Ice::generateUUID(), category});
+}
+
 bool subscribe(const std::shared_ptr<IceStorm::TopicPrx>& topic, const std::shared_ptr<Ice::ObjectPrx>& subscriber) {
   try {
     topic->subscribeAndGetPublisher(IceStorm::QoS{}, subscriber->ice_oneway());
@@ -215,7 +229,7 @@ void Link::connect(const std::vector<std::string>& publish_on) {
   for (Subscription& s : subscriptions_) {
     s.check = {};  // a check of the old connection
     s.proxy = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, s.topic)->ice_connectionId(id));
-    (void)subscribe(s.proxy, s.subscriber);
+    renew(s, false);
   }
   publishers_.clear();
   for (const std::string& name : publish_on) {
@@ -239,7 +253,27 @@ std::string resubscribed_line(const std::vector<std::string>& topics) {
   std::string names;
   for (const std::string& t : topics) names += (names.empty() ? "" : ", ") + t;
   return "IceStorm no longer held the subscription to " + names +
-         " (dropped as undeliverable, or removed); subscribed again, resynchronising";
+         " (dropped as undeliverable, or removed), or it no longer delivered here (a stream lost); subscribed again "
+         "under a new identity, resynchronising";
+}
+
+void Link::renew(Subscription& s, bool async) {
+  const std::shared_ptr<Ice::ObjectPrx> old = s.subscriber;
+  s.subscriber = s.servant->ice_identity(Ice::Identity{Ice::generateUUID(), s.servant->ice_getIdentity().category});
+  if (async) {
+    s.check = s.proxy->subscribeAndGetPublisherAsync(IceStorm::QoS{}, s.subscriber->ice_oneway());
+  } else {
+    (void)subscribe(s.proxy, s.subscriber);
+  }
+  // The old identity delivers to someone else's endpoint, or to nobody, or (IceStorm kept it
+  // across a restart of its own) to us, twice: not ours any more either way.
+  if (old != nullptr) s.proxy->unsubscribeAsync(old->ice_oneway(), [] {}, [](std::exception_ptr) {});
+}
+
+void Link::renew(const std::string& topic) {
+  for (Subscription& s : subscriptions_) {
+    if (s.topic == topic && s.proxy != nullptr) renew(s, true);
+  }
 }
 
 std::vector<std::string> Link::check(bool ping_broker) {
@@ -256,6 +290,9 @@ std::vector<std::string> Link::check(bool ping_broker) {
       s.check.get();
       made.push_back(s.topic);  // IceStorm did not hold it: made again now
     } catch (const IceStorm::AlreadySubscribed&) {
+      // The identity is held: by this process, or (IceStorm cannot say: it lists identities, not
+      // where they deliver) by another endpoint that took it. The stream rules tell: a stream
+      // behind is lost within the bound, and its owner asks for a new identity (renew()).
     } catch (const Ice::TimeoutException&) {
       // No answer in time: a replicated IceStorm electing a master answers no subscription until
       // it has one. The ping above answered; the next round asks again.

@@ -70,6 +70,11 @@ std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<I
 /// Retrieves a topic, creating it when it does not exist yet.
 std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicManagerPrx>& manager,
                                           const std::string& name);
+/// A proxy for `servant` under which a Link subscribes it, each subscription with an identity of
+/// its own: the servant is the adapter's default servant of `category` (unique to it), so that an
+/// identity can be replaced (Link::renew) without registering the servant again.
+std::shared_ptr<Ice::ObjectPrx> add_subscriber(const std::shared_ptr<Ice::ObjectAdapter>& adapter,
+                                               std::shared_ptr<Ice::Object> servant, const std::string& category);
 /// Subscribes `subscriber` oneway (IceStorm's default reliability): batched, in order over one
 /// connection. A message the subscriber cannot decode fails there alone: IceStorm never learns of
 /// it, so one bad message drops nobody's subscription (a twoway subscriber whose dispatch fails is
@@ -99,9 +104,9 @@ class Link {
 public:
   Link(std::shared_ptr<Ice::Communicator> ic, IceEndpoint ice, TlsOptions tls = {})
       : ic_(std::move(ic)), ice_(std::move(ice)), tls_(std::move(tls)) {}
-  /// Registers a subscriber of `topic` (used by every connect()).
+  /// Registers a subscriber of `topic` (a proxy of add_subscriber(), used by every connect()).
   void subscribe_to(std::string topic, std::shared_ptr<Ice::ObjectPrx> subscriber) {
-    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), nullptr, {}});
+    subscriptions_.push_back(Subscription{std::move(topic), std::move(subscriber), nullptr, nullptr, {}});
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.
   void connect(const std::vector<std::string>& publish_on);
@@ -109,6 +114,12 @@ public:
   std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
   /// Throws when IceStorm does not answer.
   void ping() const;
+  /// Subscribes again to `topic` under a new identity: IceStorm lists subscriber identities to
+  /// whoever may call the topic (not where they deliver), so another holder of a certificate can
+  /// unsubscribe an identity and subscribe its own endpoint under it, and a subscription IceStorm
+  /// holds is not proof that it reaches this process. The owner asks for it when a stream of the
+  /// topic is lost (Liveness). check() reports it made, as any subscription made again.
+  void renew(const std::string& topic);
   /// Called once a heartbeat period: pings IceStorm when `ping_broker` (the caller's own last
   /// heartbeat has not come back: one that came back round proved the link), and every
   /// kResubscribeCheckEvery-th call also asks IceStorm to make again each subscription it no
@@ -129,10 +140,15 @@ private:
   std::shared_ptr<IceStorm::TopicManagerPrx> manager_;
   struct Subscription {
     std::string topic;
-    std::shared_ptr<Ice::ObjectPrx> subscriber;
-    std::shared_ptr<IceStorm::TopicPrx> proxy;           ///< set by connect()
-    std::future<std::shared_ptr<Ice::ObjectPrx>> check;  ///< check()'s pending subscription, if any
+    std::shared_ptr<Ice::ObjectPrx> servant;    ///< add_subscriber()'s proxy: its category
+    std::shared_ptr<Ice::ObjectPrx> subscriber;  ///< the identity subscribed now (renew())
+    std::shared_ptr<IceStorm::TopicPrx> proxy;   ///< set by connect()
+    std::future<std::shared_ptr<Ice::ObjectPrx>> check;  ///< a pending subscription, if any
   };
+  /// Subscribes `s` under a new identity, and drops the old one from the topic (whoever's
+  /// endpoint it delivers to now). Asynchronous when `async` (the answer is taken by check()),
+  /// else waits (connect()).
+  void renew(Subscription& s, bool async);
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
   std::uint64_t checks_ = 0;

@@ -765,6 +765,8 @@ struct CoordinatorNode::Impl {
       state_stream(stream_scratch, iface);
       const auto s = hb.lastSeq.find(stream_scratch);
       const std::int64_t have = h.incarnation == hb.incarnation ? h.last_seq : 0;
+      // A provider is back only once what it lists as sent is received (a stream it has sent
+      // nothing on yet holds every machine's initial Normal, as this stand-in does).
       const bool behind = s == hb.lastSeq.end() || s->second > have;
       // Two heartbeats in a row: the update may simply be on its way on the other topic. A lost
       // provider is asked at once: its clients stay in Error until they have its state.
@@ -783,7 +785,8 @@ struct CoordinatorNode::Impl {
       pub->resync(resync_request(hb.coordinator));
       resyncs_requested.fetch_add(1);
       if (!proof) {
-        log("middleware: " + name + ": missed state of coordinator '" + hb.coordinator + "'; asked it to republish");
+        drops->note(hb.coordinator + "/republish", "middleware: " + name + ": missed state of coordinator '" +
+                                                       hb.coordinator + "'; asked it to republish");
       }
     } catch (const Ice::Exception&) {
       // The link thread notices and reconnects.
@@ -866,6 +869,10 @@ struct CoordinatorNode::Impl {
   /// Raises the loss of a peer (under peer_mutex; the coordinator write comes after it).
   void declare_lost(const std::string& who, Peer& peer, const std::string& silent) {
     if (who == kSupervisorSigner) {
+      // Two supervisors may watch one system: once the one believed is gone, whichever proves
+      // itself alive next is believed, the older one too. (A coordinator runs once per name: one
+      // that comes back is the same process or a newer one.)
+      peer.fresh.forget();
       log("middleware: " + name + ": the supervisor is gone (" + silent +
           "); EVT_SUPERVISOR_LOST on s_F of every component");
       const Structure& shape = co.structure();
@@ -877,7 +884,25 @@ struct CoordinatorNode::Impl {
     providers_lost.fetch_add(1);
     log("middleware: " + name + ": coordinator '" + who + "' lost (" + silent + "); EVT_COORDINATOR_LOST on the " +
         std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
+    // Its heartbeats or its state may have stopped reaching us only: subscriptions taken by
+    // another endpoint under our identities. New identities bring them back if it is alive.
+    link->renew({state_topic(who), heartbeat_topic(who)});
     for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
+  }
+
+  /// A newcomer starts toward safe (DESIGN §7): until a provider is proven alive and its state is
+  /// received here, the interfaces it feeds are at Error, as after a loss, and they clear the
+  /// same way (recover()).
+  void raise_until_proven() {
+    std::lock_guard lock(peer_mutex);
+    for (auto& [who, peer] : peers) {
+      if (!peer.provider || peer.live.lost()) continue;
+      peer.live.start_lost();
+      log("middleware: " + name + ": coordinator '" + who + "' not proven alive yet (this node just started); " +
+          "EVT_COORDINATOR_LOST on the " + std::to_string(peer.feeds.size()) +
+          " required interface(s) it feeds until it is and its state is received");
+      for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
+    }
   }
 
   /// Clears the loss of a peer that is back and whose state we hold again (under peer_mutex).
@@ -997,7 +1022,6 @@ Expected<void> CoordinatorNode::start() {
     const std::string endpoint = protocol(d.options.tls) + " -h " + d.options.listen_host +
                                  (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);
-    const std::string id = "safecass-" + d.name + "-" + std::to_string(d.incarnation);
     const std::string who = "middleware: " + d.name;
     d.prover = std::make_unique<Prover>(
         d.ic, *d.keyring, [&d](const std::string& signer, const wire::Heartbeat& beat) { d.on_proven(signer, beat); },
@@ -1012,9 +1036,10 @@ Expected<void> CoordinatorNode::start() {
       return std::make_shared<TopicSubscriber>(
           d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops, who);
     };
-    auto state = d.adapter->add(subscriber("updates", &Impl::on_updates), Ice::Identity{"state", id});
-    auto heartbeat = d.adapter->add(subscriber("beat", &Impl::on_beat), Ice::Identity{"heartbeat", id});
-    auto resync = d.adapter->add(subscriber("resync", &Impl::on_resync), Ice::Identity{"resync", id});
+    const std::string id = "safecass-" + d.name + "-" + std::to_string(d.incarnation);
+    auto state = add_subscriber(d.adapter, subscriber("updates", &Impl::on_updates), id + "-state");
+    auto heartbeat = add_subscriber(d.adapter, subscriber("beat", &Impl::on_beat), id + "-heartbeat");
+    auto resync = add_subscriber(d.adapter, subscriber("resync", &Impl::on_resync), id + "-resync");
     ControlContext context{
         d.co,
         d.monitor,
@@ -1061,6 +1086,7 @@ Expected<void> CoordinatorNode::start() {
   }
   d.subscription = d.co.subscribe([&d](const Record& r) { d.on_record(r); });
   d.started = steady_ns();
+  d.raise_until_proven();
   d.running.store(true);
   d.publisher_thread = std::thread([&d] { d.publisher_loop(); });
   d.link->start();

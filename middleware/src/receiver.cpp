@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <limits>
+#include <list>
+
+#include <IceSSL/IceSSL.h>
 
 #include "ice_util.hpp"
 
@@ -209,22 +212,30 @@ std::string fresh_nonce() {
 }
 Ice::ByteSeq bytes_of(const std::string& s) { return Ice::ByteSeq(s.begin(), s.end()); }
 
-/// Why `answer` is not `signer`'s proof of `nonce` (empty: it is, and `beat` is what it proves).
+/// Why `answer` is not `signer`'s proof of `nonce` given at `endpoint` (empty: it is, and `beat` is
+/// what it proves).
 std::string check_proof(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys, const std::string& signer,
-                        const std::string& nonce, const wire::Signed& answer, wire::Heartbeat& beat) {
+                        const std::string& endpoint, const std::string& nonce, const wire::Signed& answer,
+                        wire::Heartbeat& beat) {
   if (answer.signer != signer) return "an answer signed '" + printable(answer.signer) + "', not by '" + signer + "'";
   wire::Proof proof;
   if (std::string why = open_signed(keys, ic, answer, kKindProof, proof); !why.empty()) return why;
   if (proof.nonce != bytes_of(nonce)) return "an answer to another nonce (a recorded proof)";
   if (proof.beat.coordinator != signer) return "a proof naming '" + printable(proof.beat.coordinator) + "'";
   if (std::string why = incarnation_out_of_bounds("a proof", signer, proof.beat.incarnation); !why.empty()) return why;
+  // The process that signed serves the endpoint its heartbeat names; an answer asked at another
+  // one was relayed from it by whoever serves that one.
+  if (proof.beat.control != endpoint) {
+    return "a proof of the process at '" + printable(proof.beat.control) + "' given at '" + printable(endpoint) +
+           "' (relayed)";
+  }
   beat = std::move(proof.beat);
   return {};
 }
 }  // namespace
 
-void Prover::done(const std::string& signer, const std::string& nonce, const wire::Signed* answer,
-                  const std::string& error) {
+void Prover::done(const std::string& signer, const std::string& endpoint, const std::string& nonce,
+                  const wire::Signed* answer, const std::string& error) {
   {
     std::lock_guard lock(mutex_);
     const auto it = questions_.find(signer);
@@ -232,13 +243,29 @@ void Prover::done(const std::string& signer, const std::string& nonce, const wir
     it->second.open = false;
   }
   wire::Heartbeat beat;
-  const std::string why = answer != nullptr ? check_proof(ic_, keys_, signer, nonce, *answer, beat) : error;
+  const std::string why =
+      answer != nullptr ? check_proof(ic_, keys_, signer, endpoint, nonce, *answer, beat) : error;
   if (why.empty()) {
     on_proven_(signer, beat);
   } else if (on_refused_) {
     on_refused_(signer, why);
   }
 }
+
+namespace {
+/// What an Ice failure says, for a log line.
+std::string failure_text(const std::exception_ptr& e) {
+  try {
+    std::rethrow_exception(e);
+  } catch (const Ice::Exception& ex) {
+    return ex.ice_id();
+  } catch (const std::exception& ex) {
+    return ex.what();
+  } catch (...) {
+  }
+  return "unknown";
+}
+}  // namespace
 
 void Prover::ask(const std::string& signer, const std::string& endpoint) {
   if (endpoint.empty()) return;
@@ -260,26 +287,76 @@ void Prover::ask(const std::string& signer, const std::string& endpoint) {
     q.open = true;
     nonce = q.nonce;
   }
+  const auto failed = [this, signer, endpoint, nonce](const std::string& what) {
+    done(signer, endpoint, nonce, nullptr, what);
+  };
+  // First the connection, checked to be the signer's own (not_served_by); then the question, on
+  // that connection only.
+  const auto connected = [this, alive, signer, endpoint, nonce, failed](const std::shared_ptr<Ice::Connection>& con) {
+    if (std::string why = not_served_by(ic_, con, signer); !why.empty()) return failed(why);
+    try {
+      alive->ice_fixed(con)->proveAsync(
+          bytes_of(nonce),
+          [this, signer, endpoint, nonce](const wire::Signed& answer) { done(signer, endpoint, nonce, &answer, {}); },
+          [failed](const std::exception_ptr& e) { failed("its endpoint did not answer (" + failure_text(e) + ")"); });
+    } catch (const Ice::Exception& e) {
+      failed(std::string("cannot ask it (") + e.ice_id() + ")");
+    }
+  };
   try {
-    alive->proveAsync(
-        bytes_of(nonce), [this, signer, nonce](const wire::Signed& answer) { done(signer, nonce, &answer, {}); },
-        [this, signer, nonce](const std::exception_ptr& e) {
-          std::string what = "its endpoint did not answer";
-          try {
-            std::rethrow_exception(e);
-          } catch (const Ice::Exception& ex) {
-            what += std::string(" (") + ex.ice_id() + ")";
-          } catch (...) {
-          }
-          done(signer, nonce, nullptr, what);
-        });
+    alive->ice_getConnectionAsync(connected, [failed](const std::exception_ptr& e) {
+      failed("its endpoint did not answer (" + failure_text(e) + ")");
+    });
   } catch (const Ice::Exception& e) {
-    done(signer, nonce, nullptr, std::string("cannot ask it (") + e.ice_id() + ")");
+    failed(std::string("cannot ask it (") + e.ice_id() + ")");
+  }
+}
+
+std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
+                          const std::shared_ptr<Ice::Connection>& connection, std::string_view member) {
+  if (connection == nullptr) return "no connection";
+  const bool tls = !ic->getProperties()->getProperty("IceSSL.CertFile").empty();
+  if (!tls) return {};
+  std::shared_ptr<Ice::ConnectionInfo> info;
+  try {
+    info = connection->getInfo();
+  } catch (const Ice::Exception& e) {
+    return std::string("its connection closed (") + e.ice_id() + ")";
+  }
+  const auto ssl = std::dynamic_pointer_cast<IceSSL::ConnectionInfo>(info);
+  if (ssl == nullptr) return "its endpoint is not TLS, and this system's bus is";
+  if (!ssl->verified || ssl->certs.empty()) return "its endpoint showed no verified certificate";
+  const IceSSL::DistinguishedName subject = ssl->certs.front()->getSubjectDN();
+  if (!subject.match(IceSSL::DistinguishedName(std::list<std::pair<std::string, std::string>>{
+          {"CN", std::string(member)}}))) {
+    return "its endpoint is served by the certificate of '" + printable(std::string(subject)) + "', not of '" +
+           printable(member) + "'";
+  }
+  return {};
+}
+
+[[nodiscard]] Expected<std::shared_ptr<Ice::ObjectPrx>> bind_to_member(const std::shared_ptr<Ice::Communicator>& ic,
+                                                                       const std::string& endpoint,
+                                                                       std::string_view member,
+                                                                       std::chrono::milliseconds timeout) {
+  const std::string who = printable(member);
+  try {
+    auto prx = ic->stringToProxy(endpoint)->ice_invocationTimeout(static_cast<int>(timeout.count()));
+    auto con = prx->ice_getConnection();
+    if (std::string why = not_served_by(ic, con, member); !why.empty()) {
+      return fail(ErrorCode::Denied, "'" + who + "' not reached at '" + printable(endpoint) + "': " + why);
+    }
+    // The connection is the binding: it must outlive idle times (the other side's idle timer sees
+    // the heartbeats), and when it ends every request fails rather than reaching a newcomer.
+    con->setACM(Ice::nullopt, Ice::ACMClose::CloseOff, Ice::ACMHeartbeat::HeartbeatAlways);
+    return prx->ice_fixed(con);
+  } catch (const Ice::Exception& e) {
+    return fail(ErrorCode::Io, "'" + who + "' not reached at '" + printable(endpoint) + "' (" + e.ice_id() + ")");
   }
 }
 
 [[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
-                                                  const std::string& signer,
+                                                  const std::string& signer, const std::string& endpoint,
                                                   const std::shared_ptr<wire::AlivePrx>& alive) {
   const std::string nonce = fresh_nonce();
   wire::Signed answer;
@@ -289,7 +366,7 @@ void Prover::ask(const std::string& signer, const std::string& endpoint) {
     return fail(ErrorCode::Io, "'" + printable(signer) + "' did not answer a proof of life (" + e.ice_id() + ")");
   }
   wire::Heartbeat beat;
-  if (std::string why = check_proof(ic, keys, signer, nonce, answer, beat); !why.empty()) {
+  if (std::string why = check_proof(ic, keys, signer, endpoint, nonce, answer, beat); !why.empty()) {
     return fail(ErrorCode::Denied, "'" + printable(signer) + "' gave no valid proof of life: " + why);
   }
   return beat;

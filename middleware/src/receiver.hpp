@@ -115,6 +115,10 @@ public:
   /// heartbeat and stream numbers the floor below which everything is a replay. Returns false,
   /// with `why`, when it is older than the believed one.
   bool proven(const wire::Heartbeat& beat, std::string& why);
+  /// The process believed is gone (its peer was declared lost): the next one proven is believed,
+  /// whatever its incarnation. Only a proof of a fresh nonce is: a replay of any process stays
+  /// refused, since it cannot answer one.
+  void forget() noexcept { incarnation_ = 0; }
   /// The believed incarnation (0: none proven yet).
   std::int64_t incarnation() const noexcept { return incarnation_; }
   /// The last number accepted on `stream` (0: none).
@@ -159,6 +163,9 @@ public:
   /// peers, `bound` at most, instead of polling.
   std::int64_t due(std::int64_t watched_since, std::chrono::milliseconds bound) const noexcept;
   bool lost() const noexcept { return lost_; }
+  /// Starts the peer lost (a newcomer starts toward safe): back once a heartbeat is believed
+  /// with every stream caught up, as after a loss.
+  void start_lost() noexcept { lost_ = true; }
   /// When its last heartbeat was believed (0: never).
   std::int64_t last_beat() const noexcept { return last_beat_; }
 
@@ -170,7 +177,8 @@ private:
 };
 
 /// Asks a peer's Alive endpoint (named in its heartbeat) to sign a fresh nonce, and checks the
-/// answer: kind "proof", signed by the peer's key, the nonce ours. At most one question per peer
+/// answer: asked over a connection to the peer's own process (not_served_by), kind "proof", signed
+/// by the peer's key, the nonce ours, the endpoint the one asked. At most one question per peer
 /// at a time, and one per `retry` after a failure. Answers are delivered to `on_proven` on an Ice
 /// thread, outside any lock of the caller.
 class Prover {
@@ -188,7 +196,8 @@ private:
     std::int64_t asked = 0;  ///< steady ns
     bool open = false;
   };
-  void done(const std::string& signer, const std::string& nonce, const wire::Signed* answer, const std::string& error);
+  void done(const std::string& signer, const std::string& endpoint, const std::string& nonce,
+            const wire::Signed* answer, const std::string& error);
 
   std::shared_ptr<Ice::Communicator> ic_;
   const Keyring& keys_;
@@ -199,10 +208,28 @@ private:
   std::map<std::string, Question, std::less<>> questions_;
 };
 
-/// Asks `alive`, which claims to be `signer`'s, to sign a fresh nonce and waits for the answer:
-/// the heartbeat it proves, or why not (Io: no answer; Denied: no valid proof).
+/// Why `connection` is not one to `member`'s own process (empty: it is). A proof names what it
+/// proves (DESIGN §7): with TLS (the communicator holds a certificate of the system), the peer's
+/// verified certificate must carry `member` as its common name, since any certificate of the
+/// system's CA could serve any endpoint. Without TLS (keys of an earlier version, run with a
+/// warning) a connection names nobody and only the proof's endpoint binds it (prove_now).
+std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
+                          const std::shared_ptr<Ice::Connection>& connection, std::string_view member);
+
+/// `endpoint` (a stringified proxy a heartbeat of `member` names) bound to `member`: connected, the
+/// connection checked by not_served_by, and the proxy fixed to that connection, so that every
+/// request goes to the process checked or fails (never to whoever serves the endpoint next).
+/// Errors: Io (no connection within `timeout`), Denied (another process serves it).
+[[nodiscard]] Expected<std::shared_ptr<Ice::ObjectPrx>> bind_to_member(const std::shared_ptr<Ice::Communicator>& ic,
+                                                                       const std::string& endpoint,
+                                                                       std::string_view member,
+                                                                       std::chrono::milliseconds timeout);
+
+/// Asks `alive` (bound to `signer` by bind_to_member, at `endpoint`) to sign a fresh nonce and
+/// waits for the answer: the heartbeat it proves, or why not (Io: no answer; Denied: no valid
+/// proof, or a proof of a process that serves another endpoint: a relayed answer).
 [[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
-                                                  const std::string& signer,
+                                                  const std::string& signer, const std::string& endpoint,
                                                   const std::shared_ptr<wire::AlivePrx>& alive);
 
 /// The signed answer to `nonce` of a process whose current heartbeat is `beat` (Alive::prove).

@@ -284,8 +284,9 @@ struct Supervisor::Impl {
   }
 
   void report_missed(Peer& peer, const std::string& who, const Gap& gap) {
-    print("supervisor: " + std::to_string(gap.last - gap.first + 1) + " event record(s) of '" + printable(who) +
-          "' missed (seq " + seq_range(gap) + ")");
+    drops->note(who + "/records-missed", "supervisor: " + std::to_string(gap.last - gap.first + 1) +
+                                             " event record(s) of '" + printable(who) + "' missed (seq " +
+                                             seq_range(gap) + ")");
     peer.refresh = true;  // the missed records may have changed rows: read them again
     watch_sleeper.wake();
     if (peer.reported.size() >= kMaxGaps) peer.reported.erase(peer.reported.begin());
@@ -546,6 +547,7 @@ struct Supervisor::Impl {
     if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
       if (peer.events_behind) {
         report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
+        link->renew({kEventTopic});  // the records may no longer reach us at all
         peer.last_event_seq = sent->second;
         peer.events_behind = false;
       } else {
@@ -554,15 +556,14 @@ struct Supervisor::Impl {
     } else {
       peer.events_behind = false;
     }
-    // Following states only, the same for the state streams: an update lost with nothing
-    // after it on its interface would leave the view of that service stale. Behind on two
+    // The same for the state streams, whether records are followed or not: an update lost with
+    // nothing after it on its interface would leave the view of that service stale. Behind on two
     // heartbeats in a row: the coordinator is asked to republish its full state; behind for
-    // longer than the loss bound: lost (watch_loop). (Following the records, a gap in them
-    // already has the view refreshed.)
+    // longer than the loss bound: lost (watch_loop), as a receiver whose subscription was taken
+    // from it hears the heartbeats and not the stream.
     std::int64_t states_missed = 0;
     std::string_view behind;  // the first state stream it lists ahead of what the view holds
     for (const auto& [stream, last] : h.lastSeq) {
-      if (options.records) break;
       if (!std::string_view(stream).starts_with(kStateStreamPrefix)) continue;
       const std::int64_t have = peer.fresh.last(stream);
       if (last <= have) continue;
@@ -570,8 +571,9 @@ struct Supervisor::Impl {
       if (behind.empty()) behind = stream;
     }
     if (states_missed > 0 && peer.states_behind) {
-      print("supervisor: " + std::to_string(states_missed) + " state update(s) of '" + printable(h.coordinator) +
-            "' missed; asking for its full state");
+      drops->note(h.coordinator + "/states-missed", "supervisor: " + std::to_string(states_missed) +
+                                                        " state update(s) of '" + printable(h.coordinator) +
+                                                        "' missed; asking for its full state");
       resync = true;
       peer.states_behind = false;
     } else {
@@ -580,6 +582,25 @@ struct Supervisor::Impl {
     if (peer.live.last_beat() == 0) print("supervisor: coordinator '" + h.coordinator + "' is up");
     // Lost if not caught up within the loss bound (watch_loop); back once caught up.
     if (peer.live.believed(steady_ns(), behind)) recovered = peer.components;
+  }
+
+  /// The supervisor starts toward safe (DESIGN §7): every coordinator is lost until it is proven
+  /// alive and its state is received, and comes back as after a loss (announce_recovered).
+  void raise_until_proven() {
+    std::vector<std::pair<std::string, std::vector<std::string>>> unproven;
+    {
+      std::lock_guard lock(mutex);
+      for (auto& [name, peer] : peers) {
+        if (peer.live.lost() || peer.live.last_beat() != 0) continue;
+        peer.live.start_lost();
+        unproven.emplace_back(name, peer.components);
+      }
+    }
+    for (const auto& [name, components] : unproven) {
+      print("supervisor: coordinator '" + name +
+            "' not proven alive yet (the supervisor just started); EVT_COORDINATOR_LOST on its components until it is");
+      for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
+    }
   }
 
   void announce_recovered(const std::string& who, const std::vector<std::string>& recovered) {
@@ -594,28 +615,43 @@ struct Supervisor::Impl {
   void refresh_missed() {
     struct Due {
       std::string name;
-      std::string control;  ///< its Control proxy
-      std::int64_t seq;     ///< the last record received when the read began
+      std::string control;          ///< its Control proxy
+      std::int64_t seq;             ///< the last record received when the read began
+      std::int64_t incarnation;     ///< of its process proven alive
     };
     std::vector<Due> due;
     {
       std::lock_guard lock(mutex);
       for (auto& [name, peer] : peers) {
-        if (!peer.refresh || peer.control.empty()) continue;
+        if (!peer.refresh || peer.control.empty() || peer.fresh.incarnation() == 0) continue;
         peer.refresh = false;
-        due.push_back(Due{name, peer.control, peer.last_event_seq});
+        due.push_back(Due{name, peer.control, peer.last_event_seq, peer.fresh.incarnation()});
       }
     }
-    for (const auto& [name, control, seq_before] : due) {
+    for (const auto& [name, control, seq_before, incarnation_before] : due) {
       const std::string who = printable(name);
       std::vector<introspect::StateRow> rows;
       std::map<std::string, std::string> causes;
+      // Read only from the process proven alive, over a connection to it (its certificate names
+      // it) at the endpoint it proves to serve: a heartbeat of a member names an endpoint, but
+      // whoever serves that endpoint speaks for nobody.
+      auto bound = bind_to_member(ic, control, name, std::chrono::milliseconds(1000));
+      auto prx = bound ? Ice::uncheckedCast<wire::ControlPrx>(*bound) : nullptr;
+      auto beat = bound ? prove_now(ic, *keyring, name, control, prx)
+                        : Expected<wire::Heartbeat>(tl::unexpected(bound.error()));
+      if (!beat || beat->incarnation != incarnation_before) {
+        refuse(name, "the state list of '" + who + "' after missed records: " +
+                         (beat ? "the process at its endpoint is not the one proven alive" : beat.error().message));
+        continue;
+      }
       try {
-        auto prx = Ice::uncheckedCast<wire::ControlPrx>(ic->stringToProxy(control))->ice_invocationTimeout(1000);
         for (const wire::StateEntry& w : prx->stateList("")) {
           introspect::StateRow r;
           if (!from_wire(w, r) || r.kind == introspect::RowKind::System || r.kind == introspect::RowKind::Service)
             continue;
+          // A member speaks only for its own components (a coordinator lists the stand-ins of
+          // its remote providers too: what it believes of them is not theirs to say).
+          if (!members->runs(name, Members::component_of(r.address))) continue;
           if (r.state != State::Normal) {
             const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
             for (const Explanation& e : why.conditions) {
@@ -695,6 +731,9 @@ struct Supervisor::Impl {
       }
       for (const auto& [name, components, why] : lost_now) {
         print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
+        // Its messages may have stopped reaching the supervisor only (subscriptions taken by
+        // another endpoint under its identities): new identities bring them back if it is alive.
+        link->renew({state_topic(name), heartbeat_topic(name)});
         for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
       }
     }
@@ -849,8 +888,11 @@ Expected<void> Supervisor::start() {
       return adapter->addWithUUID(std::make_shared<Guard>(std::move(servant), d.drops, "supervisor"));
     };
     auto subscriber = [&](const char* operation, void (Impl::*handle)(const wire::Signed&)) {
-      return adapter->addWithUUID(std::make_shared<TopicSubscriber>(
-          d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops, "supervisor"));
+      return add_subscriber(adapter,
+                            std::make_shared<TopicSubscriber>(
+                                d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops,
+                                "supervisor"),
+                            "safecass-supervisor-" + std::to_string(d.incarnation) + "-" + operation);
     };
     if (d.options.records) d.link->subscribe_to(kEventTopic, subscriber("records", &Impl::on_events));
     auto state = subscriber("updates", &Impl::on_updates);
@@ -868,6 +910,7 @@ Expected<void> Supervisor::start() {
     d.ic = nullptr;
     return fail(ErrorCode::Io, std::string("supervisor: cannot listen: ") + e.what());
   }
+  d.raise_until_proven();
   d.running.store(true);
   d.link->start();
   d.watch_sleeper.restart();

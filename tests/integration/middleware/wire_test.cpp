@@ -142,6 +142,10 @@ struct Bus {
   std::mutex mutex;
   std::vector<std::string> log;
   Ice::CommunicatorHolder ice;  ///< presents wire-p's certificate (made with the keys, below)
+  /// Presents the supervisor's certificate: the supervisor's Alive object, which a receiver
+  /// believes only from a process whose certificate names it.
+  Ice::CommunicatorHolder supervisor_ice;
+  std::shared_ptr<Ice::ObjectAdapter> supervisor_adapter;
   std::shared_ptr<wire::StateTopicPrx> state_pub;
   /// The publisher of `name`'s heartbeat topic ("safecass.heartbeat.<name>").
   std::shared_ptr<wire::HeartbeatTopicPrx> heartbeat_pub(const std::string& name) {
@@ -170,6 +174,7 @@ struct Bus {
     EXPECT_TRUE(fixture::make_keys(*load.system, keys));
     EXPECT_TRUE(fixture::make_keys(*load.system, attacker_keys));
     ice = Ice::CommunicatorHolder(fixture::communicator(keys, "wire-p"));
+    supervisor_ice = Ice::CommunicatorHolder(fixture::communicator(keys, "supervisor"));
     provider = load_signer(keys, "wire-p");
     other = load_signer(keys, "wire-c");
     supervisor = load_signer(keys, "supervisor");
@@ -181,8 +186,11 @@ struct Bus {
 
     adapter = ice->createObjectAdapterWithEndpoints("ProviderAlive", fixture::kAdapterEndpoint);
     alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "wire-p"))->ice_toString();
-    supervisor_alive_proxy = adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "supervisor"))->ice_toString();
+    supervisor_adapter = supervisor_ice->createObjectAdapterWithEndpoints("SupervisorAlive", fixture::kAdapterEndpoint);
+    supervisor_alive_proxy =
+        supervisor_adapter->addWithUUID(std::make_shared<FakeAlive>(*this, "supervisor"))->ice_toString();
     adapter->activate();
+    supervisor_adapter->activate();
     state_pub = Ice::uncheckedCast<wire::StateTopicPrx>(topic("safecass.state.wire-p")->getPublisher()->ice_oneway());
     beat_thread = std::thread([this] {
       while (running.load()) {
@@ -228,6 +236,7 @@ struct Bus {
     if (beat_thread.joinable()) beat_thread.join();
     if (node) node->stop();
     adapter->destroy();
+    supervisor_adapter->destroy();
   }
 
   /// The IceStorm topic `name` of the fixture (created when it does not exist yet).
@@ -572,7 +581,7 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
   bus.beat(*bus.provider, "wire-p", kIncarnation);
   EXPECT_TRUE(eventually([&] { return output().find("two processes run coordinator 'wire-p'") != std::string::npos; }))
       << output();
-  EXPECT_EQ(output().find("again"), std::string::npos) << "a replayed record is not printed\n" << output();
+  EXPECT_EQ(output().find("reset P (again)"), std::string::npos) << "a replayed record is not printed\n" << output();
   EXPECT_GE((*supervisor)->messages_refused(), 3u);
   (*supervisor)->stop();
 }
@@ -629,7 +638,7 @@ TEST(Wire, ACoordinatorHearsTheHeartbeatsOfItselfItsProvidersAndTheSupervisorAnd
   ASSERT_TRUE(supervisor);
   const auto node_hears = [&](const std::string& topic) {
     for (const Ice::Identity& id : bus.topic(topic)->getSubscribers()) {
-      if (id.name == "heartbeat" && id.category.rfind("safecass-wire-c-", 0) == 0) return true;
+      if (id.category.starts_with("safecass-wire-c-") && id.category.ends_with("-heartbeat")) return true;
     }
     return false;
   };
@@ -667,7 +676,8 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   EXPECT_TRUE(
       eventually([&] { return out.all().find("no longer held the subscription") != std::string::npos; }, 3000ms))
       << out.all();
-  EXPECT_NE(bus.all_log().find("subscribed again, resynchronising"), std::string::npos) << bus.all_log();
+  EXPECT_NE(bus.all_log().find("subscribed again under a new identity, resynchronising"), std::string::npos)
+      << bus.all_log();
 
   // What the provider sends now reaches both views.
   bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
@@ -750,8 +760,8 @@ TEST(Wire, TheSupervisorReportsLostACoordinatorOfTheSystemItNeverHeardFrom) {
   }
   EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; })) << out.all();
   EXPECT_EQ(sup.model().state(*sup.model().structure().find_machine("P.s_F")), State::Error) << out.all();
-  EXPECT_NE(out.all().find("coordinator 'wire-p' lost: no heartbeat for 600 ms (never proven alive since the "
-                           "supervisor connected)"),
+  EXPECT_NE(out.all().find("coordinator 'wire-p' not proven alive yet (the supervisor just started); "
+                           "EVT_COORDINATOR_LOST on its components until it is"),
             std::string::npos)
       << out.all();
   EXPECT_EQ(out.all().find("coordinator 'wire-c' lost"), std::string::npos) << "wire-c beats: " << out.all();
@@ -1542,6 +1552,393 @@ TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) 
   })) << "the real record";
   std::lock_guard lock(mutex);
   for (const std::string& s : shown) EXPECT_EQ(s.find("not this run"), std::string::npos) << s;
+}
+
+}  // namespace
+}  // namespace safecass
+
+// ---- Bus v2.1: the attacks of the second independent review (docs/security.md) -------------------
+
+namespace safecass {
+namespace {
+
+/// An object an attacker serves: every request is handed to `answer` (operation, its in-parameters
+/// encapsulation) which returns the out-parameters encapsulation, or nothing for "not served";
+/// every operation and the request's context are kept, to say what reached it.
+class Relay final : public Ice::BlobjectArray {
+public:
+  using Answer = std::function<std::optional<std::vector<Ice::Byte>>(const std::string& operation,
+                                                                    std::pair<const Ice::Byte*, const Ice::Byte*> in)>;
+  explicit Relay(Answer answer) : answer_(std::move(answer)) {}
+  bool ice_invoke(std::pair<const Ice::Byte*, const Ice::Byte*> in, std::vector<Ice::Byte>& out,
+                  const Ice::Current& current) override {
+    {
+      std::lock_guard lock(mutex_);
+      seen_.push_back(current.operation);
+      for (const auto& [key, value] : current.ctx) seen_.push_back("context " + key);
+    }
+    auto answer = answer_(current.operation, in);
+    if (!answer) throw Ice::OperationNotExistException(__FILE__, __LINE__);
+    out = std::move(*answer);
+    return true;
+  }
+  std::vector<std::string> seen() {
+    std::lock_guard lock(mutex_);
+    return seen_;
+  }
+
+private:
+  Answer answer_;
+  std::mutex mutex_;
+  std::vector<std::string> seen_;
+};
+
+/// Encodes `value` as an operation's out-parameters.
+template <class T>
+std::vector<Ice::Byte> out_params(const std::shared_ptr<Ice::Communicator>& ic, const T& value) {
+  Ice::OutputStream out(ic);
+  out.startEncapsulation();
+  out.write(value);
+  out.endEncapsulation();
+  std::vector<Ice::Byte> bytes;
+  out.finished(bytes);
+  return bytes;
+}
+
+/// Decodes an operation's single in-parameter.
+template <class T>
+T in_param(const std::shared_ptr<Ice::Communicator>& ic, std::pair<const Ice::Byte*, const Ice::Byte*> in) {
+  Ice::InputStream stream(ic, in);
+  stream.startEncapsulation();
+  T value;
+  stream.read(value);
+  stream.endEncapsulation();
+  return value;
+}
+
+/// An impostor's process: a communicator presenting `certificate` of the system's CA and an
+/// object served on loopback.
+struct ImpostorProcess {
+  Ice::CommunicatorHolder ice;
+  std::shared_ptr<Ice::ObjectAdapter> adapter;
+  std::shared_ptr<Relay> servant;
+  std::string proxy;
+  ImpostorProcess(const std::string& keys, const std::string& certificate, Relay::Answer answer)
+      : ice(fixture::communicator(keys, certificate)) {
+    adapter = ice->createObjectAdapterWithEndpoints("Relay", fixture::kAdapterEndpoint);
+    servant = std::make_shared<Relay>(std::move(answer));
+    proxy = adapter->add(servant, Ice::Identity{"control-wire-p", "safecass"})->ice_toString();
+    adapter->activate();
+  }
+  ~ImpostorProcess() { adapter->destroy(); }
+};
+
+// Attack 1 of the review: a fake Control on a dead robot's old port, announced by the robot's
+// replayed heartbeats, forwards the console's nonce to the live robot and returns its genuine
+// signed answer. Whatever certificate of the system's CA the impostor holds (the tools' reader,
+// another member's, even the robot's own), the console sends it nothing: the connection must be
+// the coordinator's own (its certificate names it), and the proof must be of the process that
+// serves the endpoint asked (a relayed proof names the live robot's endpoint).
+TEST(Wire, ARelayedProofGetsNoTokenWhateverCertificateTheRelayHolds) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(false);  // the robot's last heartbeats are what the attacker replays
+  for (const char* certificate : {"reader", "wire-c", "wire-p"}) {
+    SCOPED_TRACE(certificate);
+    std::shared_ptr<Ice::Communicator> relay_ic;
+    ImpostorProcess fake(bus.keys, certificate,
+                         [&](const std::string& operation, std::pair<const Ice::Byte*, const Ice::Byte*> in)
+                             -> std::optional<std::vector<Ice::Byte>> {
+                           if (operation != "prove") return std::nullopt;
+                           // The relay: the console's own nonce, answered by the live robot.
+                           auto live = Ice::uncheckedCast<wire::AlivePrx>(relay_ic->stringToProxy(bus.alive_proxy));
+                           return out_params(relay_ic, live->prove(in_param<Ice::ByteSeq>(relay_ic, in)));
+                         });
+    relay_ic = fake.ice.communicator();
+    std::atomic<bool> replaying{true};
+    std::thread replayer([&] {
+      while (replaying.load()) {
+        bus.beat(*bus.provider, "wire-p", kIncarnation, fake.proxy);  // genuine, naming the old endpoint
+        std::this_thread::sleep_for(50ms);
+      }
+    });
+    middleware::ClientOptions o;
+    o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+    o.coordinator = "wire-p";
+    o.token = std::string(64, 'a');
+    o.read_token = std::string(64, 'b');
+    o.keys_dir = bus.keys;
+    o.timeout = 1000ms;
+    auto lured = middleware::RemoteClient::connect(o);
+    replaying.store(false);
+    replayer.join();
+    ASSERT_FALSE(lured) << "the console believed a relayed proof";
+    const std::string why = lured.error().message;
+    if (std::string(certificate) == "wire-p") {
+      EXPECT_NE(why.find("(relayed)"), std::string::npos) << why;
+    } else {
+      EXPECT_NE(why.find("not of 'wire-p'"), std::string::npos) << why;
+    }
+    // Nothing but the proof question ever reached it: no read, no context, no token.
+    for (const std::string& op : fake.servant->seen()) EXPECT_EQ(op, "prove") << why;
+  }
+}
+
+// Attack 2 of the review: a member (here wire-c, with its own key and certificate) announces a
+// Control of its own that lists wire-p's components as Normal, and heartbeats listing records
+// ahead, so that the supervisor reads that list to refresh its view. The supervisor applies the
+// rule every live update gets: a member speaks only for its own components.
+TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRefresh) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+  auto ic = bus.ice.communicator();
+  // The truth: wire-p's P.s_A goes to Error (a genuine transition record).
+  wire::EventMessage m{};
+  m.coordinator = "wire-p";
+  m.incarnation = kIncarnation;
+  m.seq = 1;
+  m.kind = wire::RecordKind::Transition;
+  m.machine = "P.s_A";
+  m.component = "P";
+  m.event = "EVT_E";
+  m.from = wire::Level::Normal;
+  m.to = wire::Level::Error;
+  m.level = wire::Level::Error;
+  auto events = Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_oneway());
+  events->records(bus.provider->seal(middleware::kKindEvents, encode(ic, wire::EventMessageSeq{m})));
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << out.all();
+
+  // wire-c restarted (a new incarnation it proves with its own key), serving its own Control.
+  const std::int64_t incarnation = middleware::new_incarnation();
+  std::atomic<std::int64_t> seq{0};
+  std::atomic<int> lists{0};
+  std::string endpoint;
+  auto heartbeat = [&] {
+    wire::Heartbeat h;
+    h.coordinator = "wire-c";
+    h.incarnation = incarnation;
+    h.seq = seq.load();
+    h.control = endpoint;
+    h.lastSeq["events"] = 1000 + seq.load();  // always ahead of what the supervisor holds
+    return h;
+  };
+  ImpostorProcess fake(bus.keys, "wire-c",
+                       [&](const std::string& operation, std::pair<const Ice::Byte*, const Ice::Byte*> in)
+                           -> std::optional<std::vector<Ice::Byte>> {
+                         if (operation == "prove") {
+                           return out_params(ic, middleware::make_proof(*bus.other, ic,
+                                                                        in_param<Ice::ByteSeq>(ic, in), heartbeat()));
+                         }
+                         if (operation == "stateList") {
+                           ++lists;
+                           wire::StateEntrySeq rows{{"P", "component", wire::Level::Normal, ""},
+                                                    {"P.s_A", "application", wire::Level::Normal, ""},
+                                                    {"C.s_A", "application", wire::Level::Warning, "EVT_W"}};
+                           return out_params(ic, rows);
+                         }
+                         if (operation == "explain") return out_params(ic, wire::ExplainReply{});
+                         return std::nullopt;
+                       });
+  endpoint = fake.proxy;
+  const auto until = std::chrono::steady_clock::now() + 3000ms;
+  while (std::chrono::steady_clock::now() < until && lists.load() < 2) {
+    ++seq;
+    auto pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(bus.topic("safecass.heartbeat.wire-c")->getPublisher());
+    pub->beat(bus.other->sign(middleware::kKindHeartbeat, encode(ic, heartbeat())));
+    std::this_thread::sleep_for(50ms);
+  }
+  ASSERT_GE(lists.load(), 1) << "the supervisor read the member's list\n" << out.all();
+  // What wire-c says of its own component is taken; of wire-p's, nothing.
+  EXPECT_TRUE(eventually([&] { return view_state(sup, "C.s_A") == State::Warning; })) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << out.all();
+  EXPECT_EQ(out.all().find("[wire-c] P.s_A"), std::string::npos) << out.all();
+  EXPECT_EQ(out.all().find("[wire-c] P Normal"), std::string::npos) << out.all();
+  supervisor->stop();
+}
+
+/// Attacks 3 and 4 of the review: a tool (the reader's certificate) unsubscribes each of
+/// `victim`'s subscriptions to `topic` and subscribes an endpoint of its own under the same
+/// identity. Returns how many it took.
+std::size_t take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic,
+                               const std::string& victim) {
+  auto manager =
+      Ice::uncheckedCast<IceStorm::TopicManagerPrx>(thief.ice->stringToProxy(fixture::topic_manager(bus.port)));
+  auto t = manager->retrieve(topic);
+  std::size_t taken = 0;
+  for (const Ice::Identity& id : t->getSubscribers()) {
+    if (!id.category.starts_with(victim)) continue;
+    t->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
+    t->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
+    ++taken;
+  }
+  return taken;
+}
+
+// Attack 3 of the review: a tool takes a coordinator's subscriber identity on its provider's
+// state topic. The client hears the provider's heartbeats but not its state: when the provider
+// goes to Error, the client is at Error within the loss bound (the stream is lost), never at a
+// stale Normal; it then subscribes under a new identity and holds the provider's true state.
+TEST(Wire, AReceiverWhoseSubscriberIdentityIsTakenIsLostWithinTheBoundAndRecoversUnderANewIdentity) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return bus.node->stats().updates_applied >= 1; })) << bus.all_log();
+  ImpostorProcess thief(bus.keys, "reader", [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> { return std::vector<Ice::Byte>{}; });
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-wire-c-"), 1u);
+
+  // The truth: wire-p's D0 fails. The victim must not stay at Normal past the bound.
+  const auto sent = std::chrono::steady_clock::now();
+  bus.send(*bus.provider, {update("P.D0", 2, "EVT_E", wire::Level::Error)});
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }, 3000ms)) << bus.all_log();
+  const auto in_error = std::chrono::steady_clock::now() - sent;
+  EXPECT_LT(in_error, 1000ms) << "the loss bound is 300 ms\n" << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return !thief.servant->seen().empty(); })) << "the takeover held";
+
+  // A new identity: what the provider sends next (its republish) reaches the victim again.
+  ASSERT_TRUE(eventually([&] { return bus.all_log().find("under a new identity") != std::string::npos; }, 3000ms))
+      << bus.all_log();
+  bus.send(*bus.provider, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; }, 3000ms)) << bus.all_log();
+  EXPECT_EQ(bus.state("C.s_R.D0"), State::Error);
+  EXPECT_TRUE(bus.explains("C.s_R.D0", "EVT_E"));
+  EXPECT_FALSE(bus.explains("C.s_R.D0", "EVT_COORDINATOR_LOST"));
+}
+
+// Attack 4 of the review: the same takeover against the supervisor, which follows records. Its
+// state stream is lost when heartbeats show it behind, whether or not records are followed: no
+// service row stays Normal beside the truth.
+TEST(Wire, ASupervisorFollowingRecordsCountsAStateStreamBehindAsLost) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+  bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
+  ImpostorProcess thief(bus.keys, "reader", [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> { return std::vector<Ice::Byte>{}; });
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-supervisor-"), 1u);
+
+  bus.send(*bus.provider, {update("P.D0", 2, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; }, 2000ms)) << out.all();
+  EXPECT_NE(out.all().find("its heartbeats list state of P.D0 not received"), std::string::npos) << out.all();
+  EXPECT_EQ(sup.model().state(*sup.model().structure().find_machine("P.s_F")), State::Error) << out.all();
+
+  ASSERT_TRUE(eventually([&] { return out.all().find("under a new identity") != std::string::npos; }, 3000ms))
+      << out.all();
+  bus.send(*bus.provider, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
+  EXPECT_TRUE(eventually([&] { return sup.lost().empty(); }, 3000ms)) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
+  supervisor->stop();
+}
+
+// A process that has just started shows nothing it has not been told: until a provider is proven
+// alive and what it lists as sent is received, the interfaces it feeds are at Error.
+TEST(Wire, ANewcomerHoldsTheInterfacesOfAProviderNotYetProvenAliveAtError) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.node->stop();
+  bus.node.reset();
+  bus.proving.store(false);  // wire-p cannot prove itself (yet)
+  middleware::NodeOptions options;
+  options.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  options.keys_dir = bus.keys;
+  options.log = [&bus](const std::string& line) {
+    std::lock_guard lock(bus.mutex);
+    bus.log.push_back(line);
+  };
+  auto node = middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c",
+                                                  options);
+  ASSERT_TRUE(node) << node.error().message;
+  ASSERT_TRUE((*node)->start());
+  // At once, not after a loss bound.
+  for (const char* r : {"C.s_R.D0", "C.s_R.D1", "C.s_R.D2", "C.s_R.D3"}) {
+    EXPECT_EQ(bus.state(r), State::Error) << r;
+    EXPECT_TRUE(bus.explains(r, "EVT_COORDINATOR_LOST")) << r;
+  }
+  EXPECT_NE(bus.all_log().find("coordinator 'wire-p' not proven alive yet (this node just started)"),
+            std::string::npos)
+      << bus.all_log();
+  std::this_thread::sleep_for(500ms);  // heartbeats come, but no proof: still Error
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
+  bus.proving.store(true);
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+  (*node)->stop();
+}
+
+// Two supervisors may watch one system: the second is reported, and when the one the
+// coordinators believe exits, they believe the other within a loss bound, instead of staying in
+// Warning (EVT_SUPERVISOR_LOST) until one is restarted.
+TEST(Wire, WhenEitherOfTwoSupervisorsExitsTheCoordinatorsBelieveTheOther) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  bus.beating.store(true);
+  SupervisorOutput first_out;
+  auto first = start_supervisor(bus, first_out);
+  ASSERT_TRUE(first);
+  SupervisorOutput second_out;
+  auto second = start_supervisor(bus, second_out);
+  ASSERT_TRUE(second);
+  EXPECT_TRUE(eventually([&] {
+    return (first_out.all() + second_out.all()).find("another supervisor runs on this bus") != std::string::npos;
+  })) << first_out.all();
+  std::this_thread::sleep_for(500ms);
+  EXPECT_EQ(bus.state("C.s_F"), State::Normal) << bus.all_log();
+
+  // The newer one exits: the coordinator comes back to the first.
+  second->stop();
+  second.reset();
+  std::this_thread::sleep_for(1000ms);
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 2000ms)) << bus.all_log();
+  // The first exits too: nothing is left to believe, and the coordinator says so.
+  first->stop();
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Warning; }, 2000ms)) << bus.all_log();
+}
+
+// Every private key the system makes is refused when others can read it: a member's TLS key and
+// the tools' reader key, as a member's secret already was.
+TEST(Wire, APrivateKeyOthersCanReadIsRefused) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  const std::string copy = bus.scratch + "/wire-open-keys";
+  std::filesystem::remove_all(copy);
+  std::filesystem::copy(bus.keys, copy);
+  std::filesystem::permissions(copy + "/reader.key", std::filesystem::perms::others_read,
+                               std::filesystem::perm_options::add);
+  middleware::ClientOptions o;
+  o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+  o.coordinator = "wire-c";
+  o.keys_dir = copy;
+  auto console = middleware::RemoteClient::connect(o);
+  ASSERT_FALSE(console);
+  EXPECT_EQ(console.error().code, ErrorCode::Denied);
+  EXPECT_NE(console.error().message.find("reader.key: a private key must be owned by its user and have mode 0600"),
+            std::string::npos)
+      << console.error().message;
+
+  std::filesystem::permissions(copy + "/wire-c.key", std::filesystem::perms::group_read,
+                               std::filesystem::perm_options::add);
+  middleware::NodeOptions options;
+  options.ice = o.ice;
+  options.keys_dir = copy;
+  auto node = middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c",
+                                                  options);
+  ASSERT_FALSE(node);
+  EXPECT_NE(node.error().message.find("wire-c.key: a private key must be owned by its user and have mode 0600"),
+            std::string::npos)
+      << node.error().message;
 }
 
 }  // namespace
