@@ -8,6 +8,8 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "receiver.hpp"
 #include "safecass/middleware/keys.hpp"
@@ -237,6 +239,39 @@ TEST(OpenHeartbeat, AHeartbeatIsOpenedOnlySignedAsAHeartbeatNamingItsSignerAndOf
     EXPECT_NE(far.why.find("incarnation"), std::string::npos) << far.why;
     EXPECT_EQ(far.source, "robot/incarnation");
   }
+}
+
+}  // namespace
+}  // namespace safecass::middleware
+
+namespace safecass::middleware {
+namespace {
+
+// Nothing from outside reaches a log unbounded (DESIGN §7): one line per source per second, and at
+// most DropLog::kLinesPerSecond lines a second in all, however many sources a flood names; the
+// next line says how many were suppressed, and every refusal is counted.
+TEST(DropLogTest, AFloodFromManySourcesLogsAtMostTheTotalBudgetPerSecondAndCountsEveryRefusal) {
+  std::vector<std::string> lines;
+  DropLog log([&](const std::string& line) { lines.push_back(line); });
+  for (int i = 0; i < 1000; ++i) log.drop("source-" + std::to_string(i % 300), "refused message " + std::to_string(i));
+  EXPECT_EQ(log.count(), 1000u);
+  EXPECT_EQ(lines.size(), DropLog::kLinesPerSecond);
+  // A note (not a refusal) is rate-limited the same way and not counted.
+  log.note("peer/republish", "asked it to republish");
+  EXPECT_EQ(log.count(), 1000u);
+  EXPECT_EQ(lines.size(), DropLog::kLinesPerSecond) << "the budget of this second is spent";
+}
+
+TEST(DropLogTest, TheFirstLineAfterTheBudgetSaysHowManyLinesWereSuppressed) {
+  std::vector<std::string> lines;
+  DropLog log([&](const std::string& line) { lines.push_back(line); });
+  for (std::uint64_t i = 0; i < DropLog::kLinesPerSecond + 5; ++i) log.drop("s" + std::to_string(i), "refused");
+  ASSERT_EQ(lines.size(), DropLog::kLinesPerSecond);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));  // the next second of the budget
+  log.drop("another", "refused");
+  ASSERT_EQ(lines.size(), DropLog::kLinesPerSecond + 1);
+  EXPECT_NE(lines.back().find("(5 more line(s) of every source suppressed: at most 8 a second)"), std::string::npos)
+      << lines.back();
 }
 
 }  // namespace
