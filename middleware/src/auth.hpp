@@ -161,9 +161,9 @@ private:
   mutable std::mutex mutex_;
   std::map<std::string, Source, std::less<>> sources_;
   std::uint64_t count_ = 0;
-  std::int64_t second_start_ = 0;         ///< the start of the current second of the total budget
-  std::uint64_t lines_this_second_ = 0;   ///< lines logged since second_start_
-  std::uint64_t over_budget_ = 0;         ///< lines suppressed by the total budget, not said yet
+  std::int64_t second_start_ = 0;        ///< the start of the current second of the total budget
+  std::uint64_t lines_this_second_ = 0;  ///< lines logged since second_start_
+  std::uint64_t over_budget_ = 0;        ///< lines suppressed by the total budget, not said yet
 };
 
 /// An incarnation for a process starting now: its start time in ns since the epoch, so a

@@ -243,7 +243,11 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
 class Follower final {
 public:
   Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
-      : client_(client), sink_(std::move(sink)), control_(client.control), last_(last), incarnation_(client.incarnation) {}
+      : client_(client),
+        sink_(std::move(sink)),
+        control_(client.control),
+        last_(last),
+        incarnation_(client.incarnation) {}
 
   void on_records(const wire::Signed& batch);
   /// Subscription::catch_up(): the records after the last delivered, from the history.
@@ -265,7 +269,7 @@ private:
   RemoteClient::Impl& client_;
   introspect::RecordSink sink_;
   std::shared_ptr<wire::ControlPrx> control_;  ///< the client's, until the coordinator restarts
-  std::mutex mutex_;  // stopped_ and the sink's calls
+  std::mutex mutex_;                           // stopped_ and the sink's calls
   bool stopped_ = false;
   std::uint64_t last_;        ///< the last record delivered (its coordinator-wide seq)
   std::int64_t incarnation_;  ///< of the coordinator process proven alive, whose records are followed

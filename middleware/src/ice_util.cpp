@@ -267,7 +267,9 @@ void Link::renew(Subscription& s, bool async) {
   }
   // The old identity delivers to someone else's endpoint, or to nobody, or (IceStorm kept it
   // across a restart of its own) to us, twice: not ours any more either way.
-  if (old != nullptr) s.proxy->unsubscribeAsync(old->ice_oneway(), [] {}, [](std::exception_ptr) {});
+  if (old != nullptr)
+    s.proxy->unsubscribeAsync(
+        old->ice_oneway(), [] {}, [](std::exception_ptr) {});
 }
 
 void Link::renew(const std::string& topic) {

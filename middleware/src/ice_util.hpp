@@ -140,9 +140,9 @@ private:
   std::shared_ptr<IceStorm::TopicManagerPrx> manager_;
   struct Subscription {
     std::string topic;
-    std::shared_ptr<Ice::ObjectPrx> servant;    ///< add_subscriber()'s proxy: its category
-    std::shared_ptr<Ice::ObjectPrx> subscriber;  ///< the identity subscribed now (renew())
-    std::shared_ptr<IceStorm::TopicPrx> proxy;   ///< set by connect()
+    std::shared_ptr<Ice::ObjectPrx> servant;             ///< add_subscriber()'s proxy: its category
+    std::shared_ptr<Ice::ObjectPrx> subscriber;          ///< the identity subscribed now (renew())
+    std::shared_ptr<IceStorm::TopicPrx> proxy;           ///< set by connect()
     std::future<std::shared_ptr<Ice::ObjectPrx>> check;  ///< a pending subscription, if any
   };
   /// Subscribes `s` under a new identity, and drops the old one from the topic (whoever's

@@ -243,8 +243,7 @@ void Prover::done(const std::string& signer, const std::string& endpoint, const 
     it->second.open = false;
   }
   wire::Heartbeat beat;
-  const std::string why =
-      answer != nullptr ? check_proof(ic_, keys_, signer, endpoint, nonce, *answer, beat) : error;
+  const std::string why = answer != nullptr ? check_proof(ic_, keys_, signer, endpoint, nonce, *answer, beat) : error;
   if (why.empty()) {
     on_proven_(signer, beat);
   } else if (on_refused_) {
@@ -327,8 +326,8 @@ std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
   if (ssl == nullptr) return "its endpoint is not TLS, and this system's bus is";
   if (!ssl->verified || ssl->certs.empty()) return "its endpoint showed no verified certificate";
   const IceSSL::DistinguishedName subject = ssl->certs.front()->getSubjectDN();
-  if (!subject.match(IceSSL::DistinguishedName(std::list<std::pair<std::string, std::string>>{
-          {"CN", std::string(member)}}))) {
+  if (!subject.match(
+          IceSSL::DistinguishedName(std::list<std::pair<std::string, std::string>>{{"CN", std::string(member)}}))) {
     return "its endpoint is served by the certificate of '" + printable(std::string(subject)) + "', not of '" +
            printable(member) + "'";
   }

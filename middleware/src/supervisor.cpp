@@ -615,9 +615,9 @@ struct Supervisor::Impl {
   void refresh_missed() {
     struct Due {
       std::string name;
-      std::string control;          ///< its Control proxy
-      std::int64_t seq;             ///< the last record received when the read began
-      std::int64_t incarnation;     ///< of its process proven alive
+      std::string control;       ///< its Control proxy
+      std::int64_t seq;          ///< the last record received when the read began
+      std::int64_t incarnation;  ///< of its process proven alive
     };
     std::vector<Due> due;
     {
@@ -888,11 +888,11 @@ Expected<void> Supervisor::start() {
       return adapter->addWithUUID(std::make_shared<Guard>(std::move(servant), d.drops, "supervisor"));
     };
     auto subscriber = [&](const char* operation, void (Impl::*handle)(const wire::Signed&)) {
-      return add_subscriber(adapter,
-                            std::make_shared<TopicSubscriber>(
-                                d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops,
-                                "supervisor"),
-                            "safecass-supervisor-" + std::to_string(d.incarnation) + "-" + operation);
+      return add_subscriber(
+          adapter,
+          std::make_shared<TopicSubscriber>(
+              d.ic, operation, [&d, handle](const wire::Signed& m) { (d.*handle)(m); }, d.drops, "supervisor"),
+          "safecass-supervisor-" + std::to_string(d.incarnation) + "-" + operation);
     };
     if (d.options.records) d.link->subscribe_to(kEventTopic, subscriber("records", &Impl::on_events));
     auto state = subscriber("updates", &Impl::on_updates);

@@ -372,7 +372,8 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   }));
   // The start-up lines first: the ui holds PENDANT.s_R.Status at Error until the robot is proven
   // alive and its state received (a newcomer starts toward safe).
-  const auto extra = static_cast<std::ptrdiff_t>(printed.size() - std::min(printed.size(), expected_transitions.size()));
+  const auto extra =
+      static_cast<std::ptrdiff_t>(printed.size() - std::min(printed.size(), expected_transitions.size()));
   for (auto it = printed.begin(); it != printed.begin() + extra; ++it) {
     EXPECT_NE(it->find("EVT_COORDINATOR_LOST"), std::string::npos) << *it << "\n" << supervisor.output();
   }

@@ -1568,7 +1568,7 @@ namespace {
 class Relay final : public Ice::BlobjectArray {
 public:
   using Answer = std::function<std::optional<std::vector<Ice::Byte>>(const std::string& operation,
-                                                                    std::pair<const Ice::Byte*, const Ice::Byte*> in)>;
+                                                                     std::pair<const Ice::Byte*, const Ice::Byte*> in)>;
   explicit Relay(Answer answer) : answer_(std::move(answer)) {}
   bool ice_invoke(std::pair<const Ice::Byte*, const Ice::Byte*> in, std::vector<Ice::Byte>& out,
                   const Ice::Current& current) override {
@@ -1647,14 +1647,15 @@ TEST(Wire, ARelayedProofGetsNoTokenWhateverCertificateTheRelayHolds) {
   for (const char* certificate : {"reader", "wire-c", "wire-p"}) {
     SCOPED_TRACE(certificate);
     std::shared_ptr<Ice::Communicator> relay_ic;
-    ImpostorProcess fake(bus.keys, certificate,
-                         [&](const std::string& operation, std::pair<const Ice::Byte*, const Ice::Byte*> in)
-                             -> std::optional<std::vector<Ice::Byte>> {
-                           if (operation != "prove") return std::nullopt;
-                           // The relay: the console's own nonce, answered by the live robot.
-                           auto live = Ice::uncheckedCast<wire::AlivePrx>(relay_ic->stringToProxy(bus.alive_proxy));
-                           return out_params(relay_ic, live->prove(in_param<Ice::ByteSeq>(relay_ic, in)));
-                         });
+    ImpostorProcess fake(
+        bus.keys, certificate,
+        [&](const std::string& operation,
+            std::pair<const Ice::Byte*, const Ice::Byte*> in) -> std::optional<std::vector<Ice::Byte>> {
+          if (operation != "prove") return std::nullopt;
+          // The relay: the console's own nonce, answered by the live robot.
+          auto live = Ice::uncheckedCast<wire::AlivePrx>(relay_ic->stringToProxy(bus.alive_proxy));
+          return out_params(relay_ic, live->prove(in_param<Ice::ByteSeq>(relay_ic, in)));
+        });
     relay_ic = fake.ice.communicator();
     std::atomic<bool> replaying{true};
     std::thread replayer([&] {
@@ -1729,11 +1730,11 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
     return h;
   };
   ImpostorProcess fake(bus.keys, "wire-c",
-                       [&](const std::string& operation, std::pair<const Ice::Byte*, const Ice::Byte*> in)
-                           -> std::optional<std::vector<Ice::Byte>> {
+                       [&](const std::string& operation,
+                           std::pair<const Ice::Byte*, const Ice::Byte*> in) -> std::optional<std::vector<Ice::Byte>> {
                          if (operation == "prove") {
-                           return out_params(ic, middleware::make_proof(*bus.other, ic,
-                                                                        in_param<Ice::ByteSeq>(ic, in), heartbeat()));
+                           return out_params(
+                               ic, middleware::make_proof(*bus.other, ic, in_param<Ice::ByteSeq>(ic, in), heartbeat()));
                          }
                          if (operation == "stateList") {
                            ++lists;
@@ -1765,8 +1766,7 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
 /// Attacks 3 and 4 of the review: a tool (the reader's certificate) unsubscribes each of
 /// `victim`'s subscriptions to `topic` and subscribes an endpoint of its own under the same
 /// identity. Returns how many it took.
-std::size_t take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic,
-                               const std::string& victim) {
+std::size_t take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic, const std::string& victim) {
   auto manager =
       Ice::uncheckedCast<IceStorm::TopicManagerPrx>(thief.ice->stringToProxy(fixture::topic_manager(bus.port)));
   auto t = manager->retrieve(topic);
@@ -1790,7 +1790,11 @@ TEST(Wire, AReceiverWhoseSubscriberIdentityIsTakenIsLostWithinTheBoundAndRecover
   ASSERT_TRUE(bus.node);
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return bus.node->stats().updates_applied >= 1; })) << bus.all_log();
-  ImpostorProcess thief(bus.keys, "reader", [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> { return std::vector<Ice::Byte>{}; });
+  ImpostorProcess thief(
+      bus.keys, "reader",
+      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+        return std::vector<Ice::Byte>{};
+      });
   ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-wire-c-"), 1u);
 
   // The truth: wire-p's D0 fails. The victim must not stay at Normal past the bound.
@@ -1824,7 +1828,11 @@ TEST(Wire, ASupervisorFollowingRecordsCountsAStateStreamBehindAsLost) {
   const middleware::Supervisor& sup = *supervisor;
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
-  ImpostorProcess thief(bus.keys, "reader", [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> { return std::vector<Ice::Byte>{}; });
+  ImpostorProcess thief(
+      bus.keys, "reader",
+      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+        return std::vector<Ice::Byte>{};
+      });
   ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-supervisor-"), 1u);
 
   bus.send(*bus.provider, {update("P.D0", 2, "EVT_E", wire::Level::Error)});
@@ -1856,8 +1864,8 @@ TEST(Wire, ANewcomerHoldsTheInterfacesOfAProviderNotYetProvenAliveAtError) {
     std::lock_guard lock(bus.mutex);
     bus.log.push_back(line);
   };
-  auto node = middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c",
-                                                  options);
+  auto node =
+      middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c", options);
   ASSERT_TRUE(node) << node.error().message;
   ASSERT_TRUE((*node)->start());
   // At once, not after a loss bound.
@@ -1865,8 +1873,7 @@ TEST(Wire, ANewcomerHoldsTheInterfacesOfAProviderNotYetProvenAliveAtError) {
     EXPECT_EQ(bus.state(r), State::Error) << r;
     EXPECT_TRUE(bus.explains(r, "EVT_COORDINATOR_LOST")) << r;
   }
-  EXPECT_NE(bus.all_log().find("coordinator 'wire-p' not proven alive yet (this node just started)"),
-            std::string::npos)
+  EXPECT_NE(bus.all_log().find("coordinator 'wire-p' not proven alive yet (this node just started)"), std::string::npos)
       << bus.all_log();
   std::this_thread::sleep_for(500ms);  // heartbeats come, but no proof: still Error
   EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
@@ -1933,8 +1940,8 @@ TEST(Wire, APrivateKeyOthersCanReadIsRefused) {
   middleware::NodeOptions options;
   options.ice = o.ice;
   options.keys_dir = copy;
-  auto node = middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c",
-                                                  options);
+  auto node =
+      middleware::CoordinatorNode::create(bus.co, *bus.monitor, bus.registry, *bus.load.system, "wire-c", options);
   ASSERT_FALSE(node);
   EXPECT_NE(node.error().message.find("wire-c.key: a private key must be owned by its user and have mode 0600"),
             std::string::npos)
