@@ -201,6 +201,11 @@ async function test() {
   const ui = await startCoordinator('ui', ice, '');
   await waitStatus(page, 'ui', '', 10000).catch(() => {});
   check(await statusOf(page, 'ui') === '', 'ui answers once its process runs (retried)');
+  // A newcomer starts toward safe: ui holds PENDANT at Error until robot is proven alive and its
+  // state received (docs/semantics.md §7.3), then Normal.
+  await page.waitForFunction(() => ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM'].every(
+    (a) => document.querySelector(`[data-address="${a}"]`)?.getAttribute('data-state') === 'Normal'),
+  null, { timeout: 10000 }).catch(() => {});
   for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal at first`);
 
   // A fault that lasts about a millisecond in another process (a warning raised and cleared by two
