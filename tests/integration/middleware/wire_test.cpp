@@ -21,6 +21,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -1803,6 +1804,8 @@ TEST(Wire, AReceiverWhoseSubscriberIdentityIsTakenIsLostWithinTheBoundAndRecover
   ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }, 3000ms)) << bus.all_log();
   const auto in_error = std::chrono::steady_clock::now() - sent;
   EXPECT_LT(in_error, 1000ms) << "the loss bound is 300 ms\n" << bus.all_log();
+  std::printf("the victim is at Error %.0f ms after the provider's fault\n",
+              std::chrono::duration<double, std::milli>(in_error).count());
   EXPECT_TRUE(eventually([&] { return !thief.servant->seen().empty(); })) << "the takeover held";
 
   // A new identity: what the provider sends next (its republish) reaches the victim again.
@@ -1878,7 +1881,10 @@ TEST(Wire, ANewcomerHoldsTheInterfacesOfAProviderNotYetProvenAliveAtError) {
   std::this_thread::sleep_for(500ms);  // heartbeats come, but no proof: still Error
   EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
   bus.proving.store(true);
+  const auto proving = std::chrono::steady_clock::now();
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  std::printf("Normal %.0f ms after the provider can prove itself\n",
+              std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - proving).count());
   EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
   (*node)->stop();
 }
