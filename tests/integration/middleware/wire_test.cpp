@@ -1215,7 +1215,11 @@ TEST(Wire, ANewcomerBelievesNoReplayedHeartbeatOfAProcessThatCannotProveItselfAl
   EXPECT_TRUE(eventually([&] { return supervisor->lost() == std::vector<std::string>{"wire-p"}; }, 3000ms))
       << out.all();
   EXPECT_EQ(out.all().find("coordinator 'wire-p' is up"), std::string::npos) << out.all();
-  EXPECT_NE(out.all().find("an answer to another nonce (a recorded proof)"), std::string::npos) << out.all();
+  // Refusals are logged at most once a second per source (and 8 a second in all): under load the
+  // first one said may be another (a question that timed out); this one comes.
+  EXPECT_TRUE(eventually(
+      [&] { return out.all().find("an answer to another nonce (a recorded proof)") != std::string::npos; }, 3000ms))
+      << out.all();
   // The node had proven wire-p's earlier process; the replayed later one is not believed either.
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }, 3000ms)) << bus.all_log();
   EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
