@@ -88,7 +88,7 @@ private:
 struct RemoteClient::Impl {
   ClientOptions options;
   std::shared_ptr<Ice::Communicator> ic;
-  std::shared_ptr<wire::ControlPrx> control;  ///< bound to the coordinator's own connection (bind_to_member)
+  std::shared_ptr<wire::ControlPrx> control;  ///< bound to the coordinator's own connection (prove_at)
   std::string endpoint;                       ///< where it serves, as its proven heartbeat names it
   std::unique_ptr<Keyring> keys;
   std::atomic<std::uint64_t> refused{0};
@@ -170,18 +170,15 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
       }
       // The connection must be the coordinator's own (its certificate names it), and the proof,
       // asked over that connection alone, must be of the process at this endpoint.
-      auto bound = bind_to_member(impl->ic, control, o.coordinator, o.timeout);
-      auto candidate = bound ? Ice::uncheckedCast<wire::ControlPrx>(*bound) : nullptr;
-      auto beat = bound ? prove_now(impl->ic, *keys, o.coordinator, control, candidate)
-                        : Expected<wire::Heartbeat>(tl::unexpected(bound.error()));
-      if (!beat) {
-        unproven = beat.error().message;
-        if (beat.error().code == ErrorCode::Io) finder->retry(control);  // no answer: ask again, not a bad proof
+      auto proven = prove_at(impl->ic, *keys, o.coordinator, control, o.timeout);
+      if (!proven) {
+        unproven = proven.error().message;
+        if (proven.error().code == ErrorCode::Io) finder->retry(control);  // no answer: ask again, not a bad proof
         continue;
       }
-      impl->incarnation = beat->incarnation;
+      impl->incarnation = proven->beat.incarnation;
       impl->endpoint = control;
-      found = candidate;
+      found = Ice::uncheckedCast<wire::ControlPrx>(proven->proxy);
       break;
     }
     try {
@@ -348,13 +345,11 @@ void Follower::on_records(const wire::Signed& batch) {
 Expected<wire::Heartbeat> Follower::prove_restart() {
   // The connection proven at connect() ends with its process: a restart is reached anew, and
   // checked as the first one was.
-  const std::string& coordinator = client_.options.coordinator;
-  auto bound = bind_to_member(client_.ic, client_.endpoint, coordinator, client_.options.timeout);
-  if (!bound) return tl::unexpected(bound.error());
-  auto control = Ice::uncheckedCast<wire::ControlPrx>(*bound)->ice_context(client_.control->ice_getContext());
-  auto beat = prove_now(client_.ic, *client_.keys, coordinator, client_.endpoint, control);
-  if (beat) control_ = std::move(control);
-  return beat;
+  auto proven =
+      prove_at(client_.ic, *client_.keys, client_.options.coordinator, client_.endpoint, client_.options.timeout);
+  if (!proven) return tl::unexpected(proven.error());
+  control_ = Ice::uncheckedCast<wire::ControlPrx>(proven->proxy)->ice_context(client_.control->ice_getContext());
+  return proven->beat;
 }
 
 Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {

@@ -673,8 +673,8 @@ struct CoordinatorNode::Impl {
     }
     if (missed > 0 && h.incarnation == u.incarnation) {
       updates_missed.fetch_add(static_cast<std::uint64_t>(missed));
-      log("middleware: " + name + ": " + what() + ": " + std::to_string(missed) +
-          " update(s) missed; this full state supersedes them");
+      drops->note(from + "/missed", "middleware: " + name + ": " + what() + ": " + std::to_string(missed) +
+                                        " update(s) missed; this full state supersedes them");
     }
     std::vector<RemoteRoot> roots;
     roots.reserve(u.roots.size());

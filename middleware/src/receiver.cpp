@@ -334,11 +334,11 @@ std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
   return {};
 }
 
-[[nodiscard]] Expected<std::shared_ptr<Ice::ObjectPrx>> bind_to_member(const std::shared_ptr<Ice::Communicator>& ic,
-                                                                       const std::string& endpoint,
-                                                                       std::string_view member,
-                                                                       std::chrono::milliseconds timeout) {
+[[nodiscard]] Expected<ProvenEndpoint> prove_at(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
+                                                const std::string& member, const std::string& endpoint,
+                                                std::chrono::milliseconds timeout) {
   const std::string who = printable(member);
+  ProvenEndpoint proven;
   try {
     auto prx = ic->stringToProxy(endpoint)->ice_invocationTimeout(static_cast<int>(timeout.count()));
     auto con = prx->ice_getConnection();
@@ -348,27 +348,21 @@ std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
     // The connection is the binding: it must outlive idle times (the other side's idle timer sees
     // the heartbeats), and when it ends every request fails rather than reaching a newcomer.
     con->setACM(Ice::nullopt, Ice::ACMClose::CloseOff, Ice::ACMHeartbeat::HeartbeatAlways);
-    return prx->ice_fixed(con);
+    proven.proxy = prx->ice_fixed(con);
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io, "'" + who + "' not reached at '" + printable(endpoint) + "' (" + e.ice_id() + ")");
   }
-}
-
-[[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
-                                                  const std::string& signer, const std::string& endpoint,
-                                                  const std::shared_ptr<wire::AlivePrx>& alive) {
   const std::string nonce = fresh_nonce();
   wire::Signed answer;
   try {
-    answer = alive->prove(bytes_of(nonce));
+    answer = Ice::uncheckedCast<wire::AlivePrx>(proven.proxy)->prove(bytes_of(nonce));
   } catch (const Ice::Exception& e) {
-    return fail(ErrorCode::Io, "'" + printable(signer) + "' did not answer a proof of life (" + e.ice_id() + ")");
+    return fail(ErrorCode::Io, "'" + who + "' did not answer a proof of life (" + e.ice_id() + ")");
   }
-  wire::Heartbeat beat;
-  if (std::string why = check_proof(ic, keys, signer, endpoint, nonce, answer, beat); !why.empty()) {
-    return fail(ErrorCode::Denied, "'" + printable(signer) + "' gave no valid proof of life: " + why);
+  if (std::string why = check_proof(ic, keys, member, endpoint, nonce, answer, proven.beat); !why.empty()) {
+    return fail(ErrorCode::Denied, "'" + who + "' gave no valid proof of life: " + why);
   }
-  return beat;
+  return proven;
 }
 
 wire::Signed make_proof(const Signer& signer, const std::shared_ptr<Ice::Communicator>& ic, const Ice::ByteSeq& nonce,

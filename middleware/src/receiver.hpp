@@ -212,25 +212,26 @@ private:
 /// proves (DESIGN §7): with TLS (the communicator holds a certificate of the system), the peer's
 /// verified certificate must carry `member` as its common name, since any certificate of the
 /// system's CA could serve any endpoint. Without TLS (keys of an earlier version, run with a
-/// warning) a connection names nobody and only the proof's endpoint binds it (prove_now).
+/// warning) a connection names nobody and only the proof's endpoint binds it (check_proof).
 std::string not_served_by(const std::shared_ptr<Ice::Communicator>& ic,
                           const std::shared_ptr<Ice::Connection>& connection, std::string_view member);
 
-/// `endpoint` (a stringified proxy a heartbeat of `member` names) bound to `member`: connected, the
-/// connection checked by not_served_by, and the proxy fixed to that connection, so that every
-/// request goes to the process checked or fails (never to whoever serves the endpoint next).
-/// Errors: Io (no connection within `timeout`), Denied (another process serves it).
-[[nodiscard]] Expected<std::shared_ptr<Ice::ObjectPrx>> bind_to_member(const std::shared_ptr<Ice::Communicator>& ic,
-                                                                       const std::string& endpoint,
-                                                                       std::string_view member,
-                                                                       std::chrono::milliseconds timeout);
+/// A process proven alive at an endpoint, and the proxy that reaches it.
+struct ProvenEndpoint {
+  std::shared_ptr<Ice::ObjectPrx> proxy;  ///< fixed to the connection checked
+  wire::Heartbeat beat;                   ///< what its proof says of it
+};
 
-/// Asks `alive` (bound to `signer` by bind_to_member, at `endpoint`) to sign a fresh nonce and
-/// waits for the answer: the heartbeat it proves, or why not (Io: no answer; Denied: no valid
-/// proof, or a proof of a process that serves another endpoint: a relayed answer).
-[[nodiscard]] Expected<wire::Heartbeat> prove_now(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
-                                                  const std::string& signer, const std::string& endpoint,
-                                                  const std::shared_ptr<wire::AlivePrx>& alive);
+/// Reaches `member` at `endpoint` (a stringified proxy a heartbeat of `member` names) and proves
+/// it alive there, waiting for the answer: connected, the connection checked by not_served_by,
+/// the proxy fixed to that connection (every later request goes to the process checked or fails,
+/// never to whoever serves the endpoint next), then a fresh nonce signed by `member`'s key and
+/// answered with a proof of the process at `endpoint`.
+/// Errors: Io (no connection or no answer within `timeout`), Denied (another process serves the
+/// endpoint, no valid proof, or a proof of a process at another endpoint: a relayed answer).
+[[nodiscard]] Expected<ProvenEndpoint> prove_at(const std::shared_ptr<Ice::Communicator>& ic, const Keyring& keys,
+                                                const std::string& member, const std::string& endpoint,
+                                                std::chrono::milliseconds timeout);
 
 /// The signed answer to `nonce` of a process whose current heartbeat is `beat` (Alive::prove).
 wire::Signed make_proof(const Signer& signer, const std::shared_ptr<Ice::Communicator>& ic, const Ice::ByteSeq& nonce,

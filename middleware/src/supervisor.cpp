@@ -274,8 +274,8 @@ struct Supervisor::Impl {
     const auto reported = take(peer.reported, seq);
     if (!reported) return false;
     if (!reported->late_said) {
-      print("supervisor: event record(s) of '" + printable(who) + "' reported missed (seq " + seq_range(*reported) +
-            ") arrive late; accepted");
+      drops->note(who + "/late", "supervisor: event record(s) of '" + printable(who) + "' reported missed (seq " +
+                                     seq_range(*reported) + ") arrive late; accepted");
       for (Gap& g : peer.reported) {
         if (g.first >= reported->first && g.last <= reported->last) g.late_said = true;
       }
@@ -635,15 +635,13 @@ struct Supervisor::Impl {
       // Read only from the process proven alive, over a connection to it (its certificate names
       // it) at the endpoint it proves to serve: a heartbeat of a member names an endpoint, but
       // whoever serves that endpoint speaks for nobody.
-      auto bound = bind_to_member(ic, control, name, std::chrono::milliseconds(1000));
-      auto prx = bound ? Ice::uncheckedCast<wire::ControlPrx>(*bound) : nullptr;
-      auto beat = bound ? prove_now(ic, *keyring, name, control, prx)
-                        : Expected<wire::Heartbeat>(tl::unexpected(bound.error()));
-      if (!beat || beat->incarnation != incarnation_before) {
+      auto proven = prove_at(ic, *keyring, name, control, std::chrono::milliseconds(1000));
+      if (!proven || proven->beat.incarnation != incarnation_before) {
         refuse(name, "the state list of '" + who + "' after missed records: " +
-                         (beat ? "the process at its endpoint is not the one proven alive" : beat.error().message));
+                         (proven ? "the process at its endpoint is not the one proven alive" : proven.error().message));
         continue;
       }
+      const auto prx = Ice::uncheckedCast<wire::ControlPrx>(proven->proxy);
       try {
         for (const wire::StateEntry& w : prx->stateList("")) {
           introspect::StateRow r;

@@ -1910,14 +1910,17 @@ TEST(Wire, WhenEitherOfTwoSupervisorsExitsTheCoordinatorsBelieveTheOther) {
   EXPECT_TRUE(eventually([&] {
     return (first_out.all() + second_out.all()).find("another supervisor runs on this bus") != std::string::npos;
   })) << first_out.all();
+  // While both run (an observation window: nothing is to happen in it), nobody is in Warning.
   std::this_thread::sleep_for(500ms);
   EXPECT_EQ(bus.state("C.s_F"), State::Normal) << bus.all_log();
 
-  // The newer one exits: the coordinator comes back to the first.
+  // The newer one exits: the coordinator loses it, then comes back to the first.
   second->stop();
   second.reset();
-  std::this_thread::sleep_for(1000ms);
-  EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 2000ms)) << bus.all_log();
+  const auto said = [&](const char* line) { return bus.all_log().find(line) != std::string::npos; };
+  EXPECT_TRUE(eventually([&] { return said("the supervisor is gone"); }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return said("the supervisor is back") && bus.state("C.s_F") == State::Normal; }, 3000ms))
+      << bus.all_log();
   // The first exits too: nothing is left to believe, and the coordinator says so.
   first->stop();
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Warning; }, 2000ms)) << bus.all_log();
