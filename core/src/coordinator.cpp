@@ -596,21 +596,47 @@ std::vector<Record> Coordinator::history(MachineId id) const {
       [this](const StoredRecord& s) { return decode(s); });
 }
 
-std::vector<Record> Coordinator::component_history(ComponentId id) const {
+std::vector<Record> Coordinator::history(const Address& scope, std::size_t last, std::optional<RecordKind> kind) const {
   const std::lock_guard lock(mutex_);
+  const auto of_kind = [kind](const StoredRecord& s) { return !kind || s.kind == *kind; };
+  if (scope.kind == Address::Kind::Machine) {
+    const std::uint32_t id = to_index(scope.machine);
+    return newest(
+        history_, last == 0 ? options_.history_capacity : std::min(last, options_.history_capacity),
+        [&](const StoredRecord& s) {
+          return s.kind != RecordKind::ComponentTransition && s.subject == id && of_kind(s);
+        },
+        [this](const StoredRecord& s) { return decode(s); });
+  }
+  // An address returns at most history_capacity records; SYSTEM, whatever the ring keeps.
+  const bool system = scope.kind == Address::Kind::System;
+  const std::size_t bound = system ? history_.size : options_.history_capacity;
   return newest(
-      history_, options_.history_capacity,
-      [id](const StoredRecord& s) { return s.kind == RecordKind::ComponentTransition && s.subject == to_index(id); },
+      history_, last == 0 ? bound : std::min(last, bound),
+      [&](const StoredRecord& s) { return (system || stored_component(s) == scope.component) && of_kind(s); },
       [this](const StoredRecord& s) { return decode(s); });
 }
 
-std::vector<Record> Coordinator::history(const Address& scope) const {
-  if (scope.kind == Address::Kind::Machine) return history(scope.machine);
+std::vector<Record> Coordinator::records_since(std::uint64_t seq, std::size_t max) const {
+  max = max == 0 ? options_.history_capacity : std::min(max, options_.history_capacity);
+  std::vector<Record> out;
   const std::lock_guard lock(mutex_);
-  const bool system = scope.kind == Address::Kind::System;
-  return newest(
-      history_, history_.size, [&](const StoredRecord& s) { return system || stored_component(s) == scope.component; },
-      [this](const StoredRecord& s) { return decode(s); });
+  const std::size_t capacity = history_.items.size();
+  const std::size_t oldest = (history_.next + capacity - history_.size) % std::max<std::size_t>(capacity, 1);
+  const auto at = [&](std::size_t k) -> const StoredRecord& { return history_.items[(oldest + k) % capacity]; };
+  // Sequence numbers grow along the ring (record() numbers and stores under this lock).
+  std::size_t lo = 0, hi = history_.size;
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (at(mid).seq <= seq)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  const std::size_t n = std::min(history_.size - lo, max);
+  out.reserve(n);
+  for (std::size_t k = lo; k < lo + n; ++k) out.push_back(decode(at(k)));
+  return out;
 }
 
 // ---- callbacks and observers -----------------------------------------------------------------

@@ -128,17 +128,12 @@ Expected<std::vector<HistoryEntry>> LocalQuery::history(std::string_view scope, 
     a = *r;
     if (a.kind == Address::Kind::Service) a.kind = Address::Kind::Component;
   }
-  std::vector<Record> records = co_.history(a);
-  if (filter == HistoryFilter::Events)
-    std::erase_if(records, [](const Record& r) { return r.kind != RecordKind::Event; });
-  return tail(co_, records, last);
+  const auto kind = filter == HistoryFilter::Events ? std::optional(RecordKind::Event) : std::nullopt;
+  return tail(co_, co_.history(a, last, kind), 0);
 }
 
 Expected<std::vector<HistoryEntry>> LocalQuery::records_since(std::uint64_t seq, std::size_t max) {
-  std::vector<Record> records = co_.history(Address{});
-  std::erase_if(records, [seq](const Record& r) { return r.seq <= seq; });
-  if (max != 0 && records.size() > max) records.resize(max);
-  return tail(co_, records, 0);
+  return tail(co_, co_.records_since(seq, max), 0);
 }
 
 Expected<std::vector<FilterRow>> LocalQuery::filter_list() {

@@ -24,7 +24,14 @@
 //      (a newer full state of the same interface superseded them before they were sent) are
 //      reported as "superseded", and at the end the client must hold exactly the provider's
 //      final state (every Di Normal).
-// Writes {"p50_us", "p99_us", "max_us", "samples", "updates_per_s", ...} to FILE.
+//   3. followers (--follow-seconds F, 0: skipped): does a follower hold up the robot? A third
+//      process ("sensor" again, alone) fires an event every 1 ms (an onset, then its completion)
+//      and times each generate() call; the parent attaches 0, 1, then 3 followers of its records
+//      (RemoteClient::follow: what the viewer, `console --ice watch` and the timeline use) for F
+//      seconds each. Run twice: with a history ring of 8,192 records and of 2^20, each filled
+//      before the process joins the bus.
+// Writes {"p50_us", "p99_us", "max_us", "samples", "updates_per_s", ..., "followers": [...]} to
+// FILE.
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -45,6 +52,7 @@
 
 #include "safecass/filters/monitor.hpp"
 #include "safecass/filters/registry.hpp"
+#include "safecass/middleware/client.hpp"
 #include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
 #include "safecass/spec/load.hpp"
@@ -97,15 +105,22 @@ struct Process {
   std::unique_ptr<Monitor> monitor;
   std::unique_ptr<middleware::CoordinatorNode> node;
 
-  bool build(const std::string& name, const middleware::IceEndpoint& ice, int interfaces) {
+  /// `ring` (not 0): the history holds that many records, and is filled before the node starts.
+  bool build(const std::string& name, const middleware::IceEndpoint& ice, int interfaces, std::size_t ring = 0) {
     register_builtin_filters(registry);
     auto load = spec::load_system_from_text(system_text(interfaces), "bench.json", registry);
     if (!load.ok()) return false;
     system = *load.system;
-    co = std::make_unique<Coordinator>(name, &clock);
+    CoordinatorOptions history;
+    if (ring != 0) {
+      history.history_records = ring;
+      history.history_records_max = std::max(ring, history.history_records_max);
+    }
+    co = std::make_unique<Coordinator>(name, &clock, history);
     monitor = std::make_unique<Monitor>(*co, registry);
     if (!spec::instantiate(system, *co, *monitor, name)) return false;
     if (!middleware::connect_remote_providers(system, name, *co)) return false;
+    if (ring != 0 && !fill_history()) return false;
     middleware::NodeOptions options;
     options.ice = ice;
     options.keys_dir = g_keys;
@@ -114,6 +129,22 @@ struct Process {
     if (!n) return false;
     node = std::move(*n);
     return node->start().has_value();
+  }
+  /// Onsets and completions on JR3.s_A until the history has written over its whole ring: what a
+  /// robot that has run for a while holds (made before the node publishes anything).
+  bool fill_history() {
+    const auto onset = co->structure().find_event("EVT_FORCE_ERROR");
+    const auto completion = co->structure().find_event("/EVT_FORCE_ERROR");
+    const auto target = co->structure().find_machine("JR3.s_A");
+    if (!onset || !completion || !target) return false;
+    const std::uint64_t first = co->history(Address{}, 1).empty() ? 0 : co->history(Address{}, 1).back().seq;
+    while (co->records_since(first, 1).empty() || co->records_since(first, 1).front().seq == first + 1) {
+      for (int i = 0; i < 1024; ++i) {
+        co->generate(*onset, *target);
+        co->generate(*completion, *target);
+      }
+    }
+    return true;
   }
   bool wait_connected() {
     for (int i = 0; i < 500 && !node->stats().connected; ++i) std::this_thread::sleep_for(10ms);
@@ -200,6 +231,110 @@ int provider(const middleware::IceEndpoint& ice, int in, int out, int samples, d
   return 0;
 }
 
+/// Percentiles of the generate() calls timed while followers were attached (µs).
+struct GenerateTimes {
+  double p50 = 0, p99 = 0, p999 = 0, max = 0, samples = 0;
+};
+
+double percentile(std::vector<double> v, double q);
+
+/// The followers phase's provider: fills a history of `ring` records, joins the bus, answers 'r';
+/// then for each 'F' fires an event every 1 ms for `seconds`, timing each generate() call, and
+/// answers 'd' and the GenerateTimes.
+int follower_provider(const middleware::IceEndpoint& ice, int in, int out, std::size_t ring, double seconds) {
+  Process p;
+  if (!p.build("sensor", ice, 1, ring) || !p.wait_connected()) return 2;
+  const EventId events[2] = {*p.co->structure().find_event("EVT_FORCE_ERROR"),
+                             *p.co->structure().find_event("/EVT_FORCE_ERROR")};
+  const MachineId target = *p.co->structure().find_machine("JR3.s_A");
+  write_byte(out, 'r');
+  while (read_byte(in) == 'F') {
+    std::vector<double> us;
+    us.reserve(static_cast<std::size_t>(seconds * 1000) + 1);
+    auto tick = std::chrono::steady_clock::now();
+    const auto until = tick + std::chrono::duration<double>(seconds);
+    for (std::size_t i = 0; tick < until; ++i) {
+      tick += 1ms;
+      std::this_thread::sleep_until(tick);
+      const auto t0 = std::chrono::steady_clock::now();
+      p.co->generate(events[i % 2], target);
+      const auto t1 = std::chrono::steady_clock::now();
+      us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+    }
+    const GenerateTimes t{percentile(us, 0.50), percentile(us, 0.99), percentile(us, 0.999),
+                          *std::max_element(us.begin(), us.end()), static_cast<double>(us.size())};
+    write_byte(out, 'd');
+    (void)!::write(out, &t, sizeof t);
+  }
+  p.node->stop();
+  return 0;
+}
+
+/// The followers phase for one ring: a provider process, and 0, 1 and 3 followers of its records
+/// attached from this one. Appends one JSON object per count to `json`; false when it failed.
+bool followers_phase(const middleware::IceEndpoint& ice, std::size_t ring, double seconds, std::string& json) {
+  int to_child[2], to_parent[2];
+  if (::pipe(to_child) != 0 || ::pipe(to_parent) != 0) return false;
+  const pid_t child = ::fork();
+  if (child == 0) {
+    ::close(to_child[1]);
+    ::close(to_parent[0]);
+    std::_Exit(follower_provider(ice, to_child[0], to_parent[1], ring, seconds));
+  }
+  ::close(to_child[0]);
+  ::close(to_parent[1]);
+  struct Reap {
+    pid_t pid;
+    int in, out;
+    ~Reap() {
+      ::close(out);  // the provider reads end-of-file and stops
+      for (int i = 0; i < 300 && ::waitpid(pid, nullptr, WNOHANG) != pid; ++i) std::this_thread::sleep_for(10ms);
+      ::kill(pid, SIGKILL);
+      ::waitpid(pid, nullptr, WNOHANG);
+      ::close(in);
+    }
+  } reap{child, to_parent[0], to_child[1]};
+  if (read_byte(to_parent[0]) != 'r') {
+    std::fprintf(stderr, "bench_middleware: the followers' provider did not start\n");
+    return false;
+  }
+  middleware::ClientOptions options;
+  options.ice = ice;
+  options.coordinator = "sensor";
+  options.keys_dir = g_keys;
+  std::vector<std::unique_ptr<middleware::RemoteClient>> clients;
+  std::vector<std::unique_ptr<introspect::Subscription>> followers;
+  std::atomic<std::uint64_t> delivered{0};
+  for (const std::size_t count : {0, 1, 3}) {
+    while (followers.size() < count) {
+      std::unique_ptr<middleware::RemoteClient> client;
+      for (int attempt = 0; attempt < 50 && !client; ++attempt) {
+        auto c = middleware::RemoteClient::connect(options);
+        if (c) client = std::move(*c);
+      }
+      if (!client) return false;
+      auto follow = client->follow([&](const introspect::HistoryEntry&) { delivered.fetch_add(1); });
+      if (!follow) return false;
+      followers.push_back(std::move(*follow));
+      clients.push_back(std::move(client));
+    }
+    const std::uint64_t before = delivered.load();
+    write_byte(to_child[1], 'F');
+    GenerateTimes t;
+    if (read_byte(to_parent[0]) != 'd' || ::read(to_parent[0], &t, sizeof t) != sizeof t) return false;
+    std::this_thread::sleep_for(100ms);  // the last records reach the followers
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%s\n    {\"ring\": %zu, \"followers\": %zu, \"generate_p50_us\": %.2f, \"generate_p99_us\": %.2f, "
+                  "\"generate_p999_us\": %.2f, \"generate_max_us\": %.2f, \"samples\": %.0f, "
+                  "\"records_delivered\": %llu}",
+                  json.empty() ? "" : ",", ring, count, t.p50, t.p99, t.p999, t.max, t.samples,
+                  static_cast<unsigned long long>(delivered.load() - before));
+    json += line;
+  }
+  return true;
+}
+
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -233,6 +368,7 @@ int main(int argc, char** argv) {
   double seconds = 2.0;
   int interfaces = 16;
   std::chrono::microseconds pause{50};
+  double follow_seconds = 3.0;
   std::string ca_dir;  // --ca DIR: the key directory whose CA signs the run's keys
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
@@ -246,6 +382,8 @@ int main(int argc, char** argv) {
       seconds = std::max(0.2, std::atof(argv[i + 1]));
     else if (key == "--interfaces")
       interfaces = std::clamp(std::atoi(argv[i + 1]), 1, 1000);
+    else if (key == "--follow-seconds")
+      follow_seconds = std::max(0.0, std::atof(argv[i + 1]));
     else if (key == "--ca")
       ca_dir = argv[i + 1];
     else if (key == "--pause-us")
@@ -268,6 +406,16 @@ int main(int argc, char** argv) {
   struct RemoveKeys {
     ~RemoveKeys() { std::filesystem::remove_all(g_keys); }
   } remove_keys;
+  // The followers phase first: its provider is gone before the other phases' starts.
+  std::string followers;
+  if (follow_seconds > 0) {
+    for (const std::size_t ring : {std::size_t{8192}, std::size_t{1} << 20}) {
+      if (!followers_phase(*ice, ring, follow_seconds, followers)) {
+        std::fprintf(stderr, "bench_middleware: the followers phase failed (ring %zu)\n", ring);
+        return 1;
+      }
+    }
+  }
   int to_child[2], to_parent[2];
   if (::pipe(to_child) != 0 || ::pipe(to_parent) != 0) return 2;
   const pid_t child = ::fork();
@@ -359,8 +507,10 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(changes > published ? changes - published : 0),
                 static_cast<unsigned long long>(messages), static_cast<unsigned long long>(stats.updates_missed),
                 final_ok ? "true" : "false");
-  std::ofstream(out_path) << json;
-  std::printf("%s", json);
+  std::string out = json;
+  if (!followers.empty()) out.insert(out.rfind("\n}"), ",\n  \"followers\": [" + followers + "\n  ]");
+  std::ofstream(out_path) << out;
+  std::printf("%s", out.c_str());
   client.node->stop();
   return copy.size() >= static_cast<std::size_t>(samples) * 9 / 10 && final_ok ? 0 : 1;
 }

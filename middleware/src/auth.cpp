@@ -148,7 +148,12 @@ bool valid_address(std::string_view a) {
 /// The CA of `dir` (ca.pem and ca.key), or NotFound when it holds neither.
 [[nodiscard]] Expected<Pem> read_ca(const std::string& dir) {
   auto certificate = read_small_file(dir + "/ca.pem");
-  auto key = read_small_file(dir + "/ca.key");
+  struct stat st {};
+  auto key = read_small_file(dir + "/ca.key", &st);
+  if (key && (st.st_uid != ::geteuid() || (st.st_mode & 077) != 0)) {
+    // Whoever reads the CA's key can make a member: refused as every other private key is.
+    return fail(ErrorCode::Denied, dir + "/ca.key: a private key must be owned by its user and have mode 0600");
+  }
   if (certificate && key) return Pem{*certificate, *key};
   if (!certificate && certificate.error().code == ErrorCode::NotFound && !key &&
       key.error().code == ErrorCode::NotFound) {

@@ -354,18 +354,23 @@ Expected<wire::Heartbeat> Follower::prove_restart() {
 
 Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {
   try {
-    auto kept =
-        entries_from_wire(control_->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
-    if (!kept) return tl::unexpected(kept.error());
+    // Bounded reads (the coordinator decodes one answer's worth under its lock), from the last
+    // record delivered, until an answer brings nothing new.
     std::size_t n = 0;
-    for (const introspect::HistoryEntry& e : *kept) {
-      if (below != 0 && e.seq >= below) break;
-      if (e.seq <= last_) continue;
-      sink_(e);
-      last_ = e.seq;
-      ++n;
+    for (;;) {
+      auto kept =
+          entries_from_wire(control_->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
+      if (!kept) return tl::unexpected(kept.error());
+      const std::size_t before = n;
+      for (const introspect::HistoryEntry& e : *kept) {
+        if (below != 0 && e.seq >= below) return n;
+        if (e.seq <= last_) continue;
+        sink_(e);
+        last_ = e.seq;
+        ++n;
+      }
+      if (n == before) return n;
     }
-    return n;
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io,
                 "records: coordinator '" + client_.options.coordinator + "' did not answer (" + e.ice_id() + ")");

@@ -879,6 +879,8 @@ struct CoordinatorNode::Impl {
       for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
         if (!shape.is_remote(c)) co.generate(framework_event::kSupervisorLost, shape.framework_machine(c));
       }
+      // As for a provider: its heartbeats may only have stopped reaching us (an identity taken).
+      link->renew({heartbeat_topic(kSupervisorSigner)});
       return;
     }
     providers_lost.fetch_add(1);

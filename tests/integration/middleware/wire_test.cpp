@@ -1926,6 +1926,31 @@ TEST(Wire, WhenEitherOfTwoSupervisorsExitsTheCoordinatorsBelieveTheOther) {
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Warning; }, 2000ms)) << bus.all_log();
 }
 
+// The same takeover against a coordinator's subscription to the supervisor's heartbeats: the
+// coordinator warns (EVT_SUPERVISOR_LOST) within the loss bound, never keeps a supervisor it no
+// longer hears, and believes it again under a new identity.
+TEST(Wire, ACoordinatorWhoseSupervisorSubscriptionIsTakenWarnsAndRecoversUnderANewIdentity) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 3000ms)) << bus.all_log();
+  ImpostorProcess thief(
+      bus.keys, "reader",
+      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+        return std::vector<Ice::Byte>{};
+      });
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.heartbeat.supervisor", "safecass-wire-c-"), 1u);
+  const auto said = [&](const char* line) { return bus.all_log().find(line) != std::string::npos; };
+  EXPECT_TRUE(eventually([&] { return said("the supervisor is gone"); }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return said("under a new identity"); }, 3000ms)) << bus.all_log();
+  EXPECT_TRUE(eventually([&] { return said("the supervisor is back") && bus.state("C.s_F") == State::Normal; }, 3000ms))
+      << bus.all_log();
+  supervisor->stop();
+}
+
 // Every private key the system makes is refused when others can read it: a member's TLS key and
 // the tools' reader key, as a member's secret already was.
 TEST(Wire, APrivateKeyOthersCanReadIsRefused) {

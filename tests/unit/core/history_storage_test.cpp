@@ -176,5 +176,59 @@ TEST(HistoryStorage, GrowingTheRingWhileTheModelIsConfiguredKeepsEveryRecordAndI
   for (std::size_t i = 0; i < after.size(); ++i) expect_same(after[i], want[i], i);
 }
 
+/// Every record records_since() gives after `seq`, read on from the last one until an answer is
+/// empty, as a follower reads.
+std::vector<Record> read_on(const Coordinator& co, std::uint64_t seq, std::size_t max) {
+  std::vector<Record> out;
+  for (;;) {
+    const std::vector<Record> part = co.records_since(seq, max);
+    if (part.empty()) return out;
+    EXPECT_LE(part.size(), max == 0 ? std::size_t{256} : max);
+    seq = part.back().seq;
+    out.insert(out.end(), part.begin(), part.end());
+  }
+}
+
+TEST(HistoryStorage, RecordsSinceGivesTheRecordsAfterASequenceNumberExactlyAsTheStreamPublishedThem) {
+  Chain chain(CoordinatorOptions{});
+  for (int k = 0; k < 5; ++k) chain.round(k);
+  ASSERT_GT(chain.stream.size(), 100u);
+  for (const std::size_t from : {std::size_t{0}, std::size_t{1}, chain.stream.size() / 2, chain.stream.size() - 1}) {
+    SCOPED_TRACE("after the record at " + std::to_string(from));
+    const std::uint64_t seq = from == 0 ? 0 : chain.stream[from - 1].seq;
+    const std::vector<Record> got = read_on(chain.co, seq, 7);
+    const std::vector<Record> want(chain.stream.begin() + static_cast<std::ptrdiff_t>(from), chain.stream.end());
+    ASSERT_EQ(got.size(), want.size());
+    for (std::size_t i = 0; i < got.size(); ++i) expect_same(got[i], want[i], i);
+  }
+  EXPECT_TRUE(chain.co.records_since(chain.stream.back().seq, 10).empty()) << "nothing after the newest";
+}
+
+TEST(HistoryStorage, RecordsSinceReturnsAtMostHistoryCapacityRecordsPerReadWhateverIsAsked) {
+  CoordinatorOptions options;
+  options.history_capacity = 16;
+  Chain chain(options);
+  for (int k = 0; k < 3; ++k) chain.round(k);
+  ASSERT_GT(chain.stream.size(), 16u);
+  EXPECT_EQ(chain.co.records_since(0, 0).size(), 16u) << "0 asks for the bound";
+  EXPECT_EQ(chain.co.records_since(0, 1000000).size(), 16u) << "more than the bound is the bound";
+  EXPECT_EQ(chain.co.records_since(0, 5).size(), 5u);
+  EXPECT_EQ(chain.co.records_since(0, 5).front().seq, chain.stream.front().seq);
+}
+
+TEST(HistoryStorage, AfterTheRingWrapsRecordsSinceStartsAtTheOldestRecordKeptSoTheReaderSeesTheLoss) {
+  CoordinatorOptions options;
+  options.history_records = 64;
+  options.history_per_address = 1;
+  options.history_records_max = 64;
+  Chain chain(options);
+  for (int k = 0; k < 40; ++k) chain.round(k);
+  const std::vector<Record> want = chain.newest(64);
+  const std::vector<Record> got = read_on(chain.co, chain.stream.front().seq, 10);
+  ASSERT_EQ(got.size(), want.size());
+  for (std::size_t i = 0; i < got.size(); ++i) expect_same(got[i], want[i], i);
+  EXPECT_GT(got.front().seq, chain.stream.front().seq + 1) << "the records in between were overwritten";
+}
+
 }  // namespace
 }  // namespace safecass

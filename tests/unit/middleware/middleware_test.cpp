@@ -270,6 +270,24 @@ TEST(BusKeys, AreRefusedWithAClearErrorForAReservedNameABadAddressOrACaWithoutIt
   EXPECT_NE(half.error().message.find("ca.pem and ca.key go together"), std::string::npos) << half.error().message;
 }
 
+TEST(BusKeys, ACaWhoseKeyOthersCanReadSignsNothingAndChangesNothing) {
+  Robodoc r;
+  const std::string keys = ::testing::TempDir() + "safecass-certs-open-ca-" + std::to_string(::getpid());
+  ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
+  const std::string robot = file_text(keys + "/robot.pem");
+  ASSERT_EQ(::chmod((keys + "/ca.key").c_str(), 0640), 0);
+  for (const std::string& dir : {keys, keys + "-shared"}) {
+    SCOPED_TRACE(dir);
+    auto made = create_bus_keys(*r.load.system, dir, dir == keys ? KeyOptions::replacing() : with_ca(keys));
+    ASSERT_FALSE(made) << "a CA key others can read is refused";
+    EXPECT_EQ(made.error().code, ErrorCode::Denied);
+    EXPECT_NE(made.error().message.find("ca.key: a private key must be owned by its user and have mode 0600"),
+              std::string::npos)
+        << made.error().message;
+  }
+  EXPECT_EQ(file_text(keys + "/robot.pem"), robot) << "nothing was made again";
+}
+
 TEST(BusKeys, LoopbackHostsAreRecognised) {
   EXPECT_TRUE(is_loopback_host("127.0.0.1"));
   EXPECT_TRUE(is_loopback_host("127.1.2.3"));

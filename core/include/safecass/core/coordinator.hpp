@@ -121,9 +121,8 @@ struct RemoteApplyResult {
 /// history"): the coordinator keeps the records of all its machines and components in ONE ring,
 /// allocated while the model is configured (never while events are processed). The ring holds
 /// max(`history_records`, `history_per_address` × (machines + components)) records, at most
-/// `history_records_max`; the oldest record of the whole coordinator goes first. history(id) and
-/// component_history(id) return the newest `history_capacity` records of one address that are
-/// still in the ring. A quiet address keeps its records as long as the whole coordinator has not
+/// `history_records_max`; the oldest record of the whole coordinator goes first. history(id)
+/// returns the newest `history_capacity` records of one machine that are still in the ring. A quiet address keeps its records as long as the whole coordinator has not
 /// produced a ring's worth of newer ones (docs/semantics.md §8).
 struct CoordinatorOptions {
   std::size_t history_capacity = 256;                      ///< at most this many records returned per address
@@ -253,12 +252,23 @@ public:
   std::optional<Condition> outstanding(MachineId id) const;
   /// The last records of a machine still in the history (at most history_capacity), oldest first.
   std::vector<Record> history(MachineId id) const;
-  /// The last extended-state transitions of a component still in the history, oldest first.
-  std::vector<Record> component_history(ComponentId id) const;
-  /// Every record in the history about `scope`, oldest first: a machine's records (at most
-  /// history_capacity); for a service, its component and SYSTEM, the records of every machine
-  /// and component transition in scope. One pass over the history.
-  std::vector<Record> history(const Address& scope) const;
+  /// The records in the history about `scope`, oldest first: for a machine, its records; for a
+  /// service, its component and SYSTEM, the records of every machine and component transition in
+  /// scope. At most history_capacity for an address other than SYSTEM (SYSTEM: the whole ring).
+  /// Only the newest `last` of them (0: all kept) and, when
+  /// `kind` is given, only records of that kind (a component's extended-state transitions: its
+  /// scope and RecordKind::ComponentTransition). One backwards pass that stops at the `last`-th
+  /// record found: only what is returned is decoded.
+  std::vector<Record> history(const Address& scope, std::size_t last = 0,
+                              std::optional<RecordKind> kind = std::nullopt) const;
+  /// The records still in the history whose sequence number is above `seq`, oldest first, at most
+  /// `max` and never more than history_capacity (0: history_capacity): how a follower fills a gap,
+  /// reading again from the last record it got until an answer is empty. The ring is ordered by sequence
+  /// number, so the first one is found by bisection and only the records returned are decoded:
+  /// the lock that generate() takes is held for O(log ring + max), however large the ring is
+  /// (docs/semantics.md §8.3). A first record above seq + 1 means the ring has overwritten those
+  /// in between.
+  std::vector<Record> records_since(std::uint64_t seq, std::size_t max) const;
   /// How many records the history can hold (see CoordinatorOptions).
   std::size_t history_size() const noexcept { return history_.items.size(); }
   /// Every active condition at `address` (machine, service, component, SYSTEM) with its root

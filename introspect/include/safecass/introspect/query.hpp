@@ -56,8 +56,10 @@ public:
   /// a service — its component — or a machine), oldest first. Errors: as resolving the address.
   [[nodiscard]] virtual Expected<std::vector<HistoryEntry>> history(std::string_view scope, std::size_t last,
                                                                     HistoryFilter filter = HistoryFilter::All) = 0;
-  /// The records kept whose sequence number is above `seq`, oldest first, at most `max`: how a
-  /// follower fills a gap in the pushed stream.
+  /// The records kept whose sequence number is above `seq`, oldest first, at most `max` and at
+  /// most the coordinator's bound per read (0: that bound; Coordinator::records_since): how a
+  /// follower fills a gap in the pushed stream, reading on from the last record until an answer
+  /// is empty.
   [[nodiscard]] virtual Expected<std::vector<HistoryEntry>> records_since(std::uint64_t seq, std::size_t max) = 0;
   [[nodiscard]] virtual Expected<std::vector<FilterRow>> filter_list() = 0;
   /// A filter (by name) or a filter type. Errors: NotFound.
