@@ -45,7 +45,7 @@ public:
     return z ^ (z >> 31);
   }
   std::uint32_t below(std::size_t n) { return static_cast<std::uint32_t>(next() % n); }
-  int between(int lo, int hi) { return lo + static_cast<int>(below(static_cast<std::size_t>(hi - lo + 1))); }
+  int between(int lo, int hi) { return lo + static_cast<int>(below(static_cast<std::size_t>(hi - lo) + 1)); }
   bool chance(double p) { return static_cast<double>(next() >> 11) * 0x1.0p-53 < p; }
   template <class T>
   const T& pick(const std::vector<T>& v) {

@@ -122,8 +122,8 @@ struct RemoteApplyResult {
 /// allocated while the model is configured (never while events are processed). The ring holds
 /// max(`history_records`, `history_per_address` × (machines + components)) records, at most
 /// `history_records_max`; the oldest record of the whole coordinator goes first. history(id)
-/// returns the newest `history_capacity` records of one machine that are still in the ring. A quiet address keeps its records as long as the whole coordinator has not
-/// produced a ring's worth of newer ones (docs/semantics.md §8).
+/// returns the newest `history_capacity` records of one machine that are still in the ring. A quiet address keeps its
+/// records as long as the whole coordinator has not produced a ring's worth of newer ones (docs/semantics.md §8).
 struct CoordinatorOptions {
   std::size_t history_capacity = 256;                      ///< at most this many records returned per address
   std::size_t history_records = 8192;                      ///< the ring holds at least this many records
