@@ -357,19 +357,20 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   got.erase(got.begin(), got.end() - static_cast<std::ptrdiff_t>(expected.size()));  // the start-up records
   EXPECT_EQ(got, expected);
 
+  // The supervisor prints as the records arrive: wait until its last lines are the transitions
+  // (it may print start-up lines before them, so a count alone says nothing).
   std::vector<std::string> printed;
-  std::istringstream out(supervisor.output());
-  for (std::string line; std::getline(out, line);) {
-    if (line.rfind("[ui] PENDANT.s_R.Status ", 0) == 0) printed.push_back(line);
-  }
-  EXPECT_TRUE(eventually([&] {
+  const auto ends_with_transitions = [&] {
     printed.clear();
-    std::istringstream again(supervisor.output());
-    for (std::string line; std::getline(again, line);) {
+    std::istringstream out(supervisor.output());
+    for (std::string line; std::getline(out, line);) {
       if (line.rfind("[ui] PENDANT.s_R.Status ", 0) == 0) printed.push_back(line);
     }
-    return printed.size() >= expected_transitions.size();
-  }));
+    return printed.size() >= expected_transitions.size() &&
+           std::equal(expected_transitions.begin(), expected_transitions.end(),
+                      printed.end() - static_cast<std::ptrdiff_t>(expected_transitions.size()));
+  };
+  EXPECT_TRUE(eventually(ends_with_transitions)) << supervisor.output();
   // The start-up lines first: the ui holds PENDANT.s_R.Status at Error until the robot is proven
   // alive and its state received (a newcomer starts toward safe).
   const auto extra =
