@@ -332,7 +332,7 @@ void Follower::on_records(const wire::Signed& batch) {
       incarnation_ = m.incarnation;
       last_ = 0;  // a restarted coordinator numbers its records from 1 again
     }
-    const auto seq = static_cast<std::uint64_t>(m.recordSeq);
+    const auto seq = static_cast<std::uint64_t>(m.record.seq);
     newest = std::max(newest, seq);
     if (seq > last_ && (lowest == 0 || seq < lowest)) lowest = seq;
   }

@@ -8,9 +8,7 @@
 #include <mutex>
 
 #include "read_model_wire.hpp"
-#include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
-#include "safecass/introspect/sample_text.hpp"
 #include "safecass/middleware/token.hpp"
 
 namespace safecass::middleware {
@@ -112,13 +110,6 @@ public:
   void filterDinject(std::string token, std::string signal, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter dinject");
     deep(signal, std::move(samples));
-  }
-
-  void filterDinload(std::string token, std::string signal, std::string text, const Ice::Current&) override {
-    check_write(token, "filter dinload");
-    auto samples = introspect::parse_sample_file("filter dinload " + signal + " text", text);
-    if (!samples) raise(samples.error().code, samples.error().message);
-    deep(signal, std::move(*samples));
   }
 
   wire::EventEntrySeq eventList(const Ice::Current& current) override {
@@ -237,40 +228,6 @@ private:
 
 std::shared_ptr<wire::Control> make_control(ControlContext context) {
   return std::make_shared<ControlServant>(std::move(context));
-}
-
-wire::ExplainEntry to_wire(const Explanation& e) {
-  wire::ExplainEntry w{};
-  w.machine = e.machine;
-  w.event = e.event;
-  w.level = to_wire(e.level);
-  w.severity = e.severity;
-  w.mirror = e.mirror;
-  w.outstanding = e.outstanding;
-  w.root = root_to_wire(e.root, to_wire(e.level), e.path);
-  w.hazard = e.hazard;
-  w.line = introspect::explanation_text(e, introspect::TimeFormat{});
-  w.count = static_cast<int>(e.count);
-  w.first = e.first.count();
-  w.last = e.last.count();
-  return w;
-}
-
-Explanation from_wire(const wire::ExplainEntry& w) {
-  Explanation e;
-  e.machine = w.machine;
-  e.event = w.event;
-  from_wire(w.level, e.level);
-  e.severity = w.severity;
-  e.mirror = w.mirror;
-  e.outstanding = w.outstanding;
-  root_from_wire(w.root, e.root);
-  e.hazard = w.hazard;
-  e.path = w.root.path;
-  e.count = static_cast<std::uint32_t>(w.count < 0 ? 0 : w.count);
-  e.first = Time{w.first};
-  e.last = Time{w.last};
-  return e;
 }
 
 }  // namespace safecass::middleware

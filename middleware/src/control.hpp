@@ -31,8 +31,4 @@ inline constexpr const char* kReadCredentialKey = "safecass-read";
 
 std::shared_ptr<wire::Control> make_control(ControlContext context);
 
-/// Explanation <-> wire (shared with the client).
-wire::ExplainEntry to_wire(const Explanation& e);
-Explanation from_wire(const wire::ExplainEntry& w);
-
 }  // namespace safecass::middleware

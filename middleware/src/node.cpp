@@ -265,7 +265,7 @@ struct CoordinatorNode::Impl {
     m.coordinator = name;
     m.incarnation = incarnation;
     m.seq = ++event_seq;
-    fill_message(introspect::history_entry(r, co), m);
+    m.record = to_wire(introspect::history_entry(r, co));
     return m;
   }
 
@@ -390,13 +390,13 @@ struct CoordinatorNode::Impl {
   bool cut_text(wire::EventMessage& m, RecordKind kind, std::size_t size) {
     const std::size_t limit = options.max_message_bytes;
     oversized_messages.fetch_add(1, std::memory_order_relaxed);
-    const std::string what = "middleware: " + name + ": event record seq " + std::to_string(m.seq) + " (" +
-                             std::string(to_string(kind)) + " of " +
-                             printable(m.machine.empty() ? m.component : m.machine) + ") is " + std::to_string(size) +
-                             " bytes, over the " + std::to_string(limit) + "-byte message limit: ";
-    std::string text = std::move(m.text);
+    const std::string what =
+        "middleware: " + name + ": event record seq " + std::to_string(m.seq) + " (" + std::string(to_string(kind)) +
+        " of " + printable(m.record.machine.empty() ? m.record.component : m.record.machine) + ") is " +
+        std::to_string(size) + " bytes, over the " + std::to_string(limit) + "-byte message limit: ";
+    std::string text = std::move(m.record.text);
     const std::string mark = " [cut: " + std::to_string(text.size()) + " bytes]";
-    m.text.clear();
+    m.record.text.clear();
     // One record in a sequence; its text's size prefix may grow from 1 to 5 bytes.
     const std::size_t base = size_prefix(1) + encode(ic, m).size() + 4 + mark.size();
     if (base > limit) {
@@ -407,7 +407,7 @@ struct CoordinatorNode::Impl {
     }
     std::size_t keep = std::min(text.size(), limit - base);
     while (keep > 0 && keep < text.size() && (static_cast<unsigned char>(text[keep]) & 0xC0) == 0x80) --keep;
-    m.text = text.substr(0, keep) + mark;
+    m.record.text = text.substr(0, keep) + mark;
     log_oversize(record_oversize, what + "sent with its text cut from " + std::to_string(text.size()) + " to " +
                                       std::to_string(keep) + " bytes");
     return true;

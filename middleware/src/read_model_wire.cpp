@@ -122,8 +122,7 @@ ParamValue value_from_wire(const wire::ParamValue& w) {
   return w.text;
 }
 
-template <class WireRecord>
-void fill(const in::HistoryEntry& e, WireRecord& w) {
+void fill(const in::HistoryEntry& e, wire::RecordEntry& w) {
   w.time = e.time.count();
   w.kind = kind_to_wire(e.kind);
   w.outcome = outcome_to_wire(e.outcome);
@@ -140,8 +139,7 @@ void fill(const in::HistoryEntry& e, WireRecord& w) {
   if (e.root) w.root = root_to_wire(*e.root);
 }
 
-template <class WireRecord>
-bool read(const WireRecord& w, in::HistoryEntry& e) {
+bool read(const wire::RecordEntry& w, in::HistoryEntry& e) {
   e.time = Time{w.time};
   if (!kind_of(w.kind, e.kind) || !outcome_of(w.outcome, e.outcome)) return false;
   if (!from_wire(w.from, e.from) || !from_wire(w.to, e.to) || !from_wire(w.level, e.level)) return false;
@@ -180,18 +178,8 @@ wire::RecordEntry to_wire(const in::HistoryEntry& e) {
   return w;
 }
 
-void fill_message(const in::HistoryEntry& e, wire::EventMessage& m) {
-  m.recordSeq = static_cast<long long>(e.seq);
-  fill(e, m);
-}
-
 bool from_wire(const wire::RecordEntry& w, in::HistoryEntry& out) {
   out.seq = static_cast<std::uint64_t>(w.seq);
-  return read(w, out);
-}
-
-bool from_wire(const wire::EventMessage& w, in::HistoryEntry& out) {
-  out.seq = static_cast<std::uint64_t>(w.recordSeq);
   return read(w, out);
 }
 
@@ -365,6 +353,38 @@ in::ServiceRow from_wire(const wire::ServiceEntry& w) {
   r.propagate = w.propagate == "Warning" ? State::Warning : State::Error;
   r.depends_on = w.dependsOn;
   return r;
+}
+
+wire::ExplainEntry to_wire(const Explanation& e) {
+  wire::ExplainEntry w{};
+  w.machine = e.machine;
+  w.event = e.event;
+  w.severity = e.severity;
+  w.mirror = e.mirror;
+  w.outstanding = e.outstanding;
+  w.root = root_to_wire(e.root, to_wire(e.level), e.path);
+  w.hazard = e.hazard;
+  w.count = static_cast<int>(e.count);
+  w.first = e.first.count();
+  w.last = e.last.count();
+  return w;
+}
+
+Explanation from_wire(const wire::ExplainEntry& w) {
+  Explanation e;
+  e.machine = w.machine;
+  e.event = w.event;
+  e.level = level_of(w.root.level);
+  e.severity = w.severity;
+  e.mirror = w.mirror;
+  e.outstanding = w.outstanding;
+  root_from_wire(w.root, e.root);
+  e.hazard = w.hazard;
+  e.path = w.root.path;
+  e.count = static_cast<std::uint32_t>(w.count < 0 ? 0 : w.count);
+  e.first = Time{w.first};
+  e.last = Time{w.last};
+  return e;
 }
 
 wire::ExplainReply to_wire(const in::ExplainAnswer& a) {

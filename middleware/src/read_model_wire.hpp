@@ -19,12 +19,13 @@ wire::StateEntry to_wire(const introspect::StateRow& r);
 /// Errors (false): an unknown kind or level (a malformed message).
 bool from_wire(const wire::StateEntry& w, introspect::StateRow& out);
 
+/// A record, in a history answer and in an event-stream message alike.
 wire::RecordEntry to_wire(const introspect::HistoryEntry& e);
-/// Fills the record fields of an event-stream message (its coordinator, incarnation and stream
-/// sequence number are the publisher's).
-void fill_message(const introspect::HistoryEntry& e, wire::EventMessage& m);
 bool from_wire(const wire::RecordEntry& w, introspect::HistoryEntry& out);
-bool from_wire(const wire::EventMessage& w, introspect::HistoryEntry& out);
+
+/// An explanation: its level travels as its root's.
+wire::ExplainEntry to_wire(const Explanation& e);
+Explanation from_wire(const wire::ExplainEntry& w);
 
 wire::FilterEntry to_wire(const introspect::FilterRow& r);
 introspect::FilterRow from_wire(const wire::FilterEntry& w);

@@ -317,27 +317,28 @@ struct Supervisor::Impl {
       return;
     }
     State from = State::Normal, to = State::Normal, level = State::Normal;
-    if (!from_wire(m.from, from) || !from_wire(m.to, to) || !from_wire(m.level, level)) {
+    if (!from_wire(m.record.from, from) || !from_wire(m.record.to, to) || !from_wire(m.record.level, level)) {
       refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an invalid level");
       return;
     }
-    const bool transition = m.kind == wire::RecordKind::Transition || m.kind == wire::RecordKind::ComponentTransition;
-    const bool shown = transition || m.kind == wire::RecordKind::Reset;
+    const bool transition =
+        m.record.kind == wire::RecordKind::Transition || m.record.kind == wire::RecordKind::ComponentTransition;
+    const bool shown = transition || m.record.kind == wire::RecordKind::Reset;
     introspect::HistoryEntry& entry = record_scratch;
     if (shown) {
-      if (!from_wire(m, entry)) {
+      if (!from_wire(m.record, entry)) {
         refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an unknown kind or outcome");
         return;
       }
       // The address a transition's row is kept under: its machine, or its component.
-      if (m.kind == wire::RecordKind::Transition ? m.machine.empty() : m.component.empty()) {
+      if (m.record.kind == wire::RecordKind::Transition ? m.record.machine.empty() : m.record.component.empty()) {
         refuse(sender, "an event record of '" + printable(m.coordinator) + "' that names no " +
-                           (m.kind == wire::RecordKind::Transition ? "machine" : "component"));
+                           (m.record.kind == wire::RecordKind::Transition ? "machine" : "component"));
         return;
       }
     }
     // A member speaks only for the components the system file assigns to it.
-    for (const std::string* named : {&m.component, &m.machine}) {
+    for (const std::string* named : {&m.record.component, &m.record.machine}) {
       if (named->empty() || members->runs(m.coordinator, Members::component_of(*named))) continue;
       refuse(sender, "an event record of '" + printable(m.coordinator) + "' about '" + printable(*named) +
                          "', a component it does not run");
@@ -392,10 +393,10 @@ struct Supervisor::Impl {
           r.address = address;
           r.state = to;
           r.record_seq = m.seq;
-          if (to == State::Normal || !m.hasRoot) {
+          if (to == State::Normal || !m.record.hasRoot) {
             r.cause.clear();
           } else {
-            r.cause.assign(m.root.origin).append(":").append(m.root.event);
+            r.cause.assign(m.record.root.origin).append(":").append(m.record.root.event);
           }
         }
       }

@@ -397,7 +397,7 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
         if (m.coordinator == "over-p") seen.push_back(m);
       }
     }
-    return !seen.empty() && seen.back().kind == wire::RecordKind::Reset;
+    return !seen.empty() && seen.back().record.kind == wire::RecordKind::Reset;
   })) << bus.provider.all_log();
   for (std::size_t i = 0; i < seen.size(); ++i)
     EXPECT_EQ(seen[i].seq, static_cast<std::int64_t>(i + 1)) << "in order, none lost";
@@ -409,8 +409,8 @@ TEST(Oversize, AnEventRecordTooLargeForOneMessageGoesOutWithItsTextCutAndNoRecor
   EXPECT_EQ(stats.oversized_messages, 1u);
 
   const wire::EventMessage& reset = seen.back();
-  EXPECT_THAT(reset.text, MatchesRegex("operator: r+ \\[cut: 10010 bytes\\]"));
-  EXPECT_LT(reset.text.size(), kLimit);
+  EXPECT_THAT(reset.record.text, MatchesRegex("operator: r+ \\[cut: 10010 bytes\\]"));
+  EXPECT_LT(reset.record.text.size(), kLimit);
   EXPECT_THAT(
       bus.provider.all_log(),
       ContainsRegex("middleware: over-p: event record seq [0-9]+ \\(reset of P\\.s_A\\) is [0-9]+ bytes, over the "

@@ -544,13 +544,13 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
     m.coordinator = "wire-p";
     m.incarnation = kIncarnation;
     m.seq = seq;
-    m.kind = kind;
-    (kind == wire::RecordKind::Transition ? m.machine : m.component) = address;
-    m.event = "EVT_E";
-    m.from = wire::Level::Error;
-    m.to = wire::Level::Normal;
-    m.level = wire::Level::Error;
-    m.text = text;
+    m.record.kind = kind;
+    (kind == wire::RecordKind::Transition ? m.record.machine : m.record.component) = address;
+    m.record.event = "EVT_E";
+    m.record.from = wire::Level::Error;
+    m.record.to = wire::Level::Normal;
+    m.record.level = wire::Level::Error;
+    m.record.text = text;
     return m;
   };
   auto ic = bus.ice.communicator();
@@ -834,9 +834,9 @@ TEST(Wire, ASupervisorWatchingStatesOnlyGetsNoRecordsRefusesForgedUpdatesReports
   m.coordinator = "wire-p";
   m.incarnation = kIncarnation;
   m.seq = 1;
-  m.kind = wire::RecordKind::Reset;
-  m.component = "P";
-  m.text = "operator: not followed";
+  m.record.kind = wire::RecordKind::Reset;
+  m.record.component = "P";
+  m.record.text = "operator: not followed";
   events->records(
       bus.provider->seal(middleware::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{m})));
 
@@ -885,13 +885,13 @@ struct RecordSender {
     m.coordinator = "wire-p";
     m.incarnation = kIncarnation;
     m.seq = seq;
-    m.kind = wire::RecordKind::Transition;
-    m.machine = "P.s_A";
-    m.component = "P";
-    m.event = seq % 2 == 1 ? "EVT_E" : "/EVT_E";
-    m.from = seq % 2 == 1 ? wire::Level::Normal : wire::Level::Error;
-    m.to = seq % 2 == 1 ? wire::Level::Error : wire::Level::Normal;
-    m.level = m.to;
+    m.record.kind = wire::RecordKind::Transition;
+    m.record.machine = "P.s_A";
+    m.record.component = "P";
+    m.record.event = seq % 2 == 1 ? "EVT_E" : "/EVT_E";
+    m.record.from = seq % 2 == 1 ? wire::Level::Normal : wire::Level::Error;
+    m.record.to = seq % 2 == 1 ? wire::Level::Error : wire::Level::Normal;
+    m.record.level = m.record.to;
     return m;
   }
 
@@ -1008,11 +1008,11 @@ TEST(Wire, ASupervisorRefusesATransitionRecordThatNamesNoMachineAndItChangesNoth
   const middleware::Supervisor& sup = *r.supervisor;
 
   wire::EventMessage nameless = RecordSender::record(1);
-  nameless.machine.clear();
+  nameless.record.machine.clear();
   wire::EventMessage no_component = RecordSender::record(1);
-  no_component.kind = wire::RecordKind::ComponentTransition;
-  no_component.machine.clear();
-  no_component.component.clear();
+  no_component.record.kind = wire::RecordKind::ComponentTransition;
+  no_component.record.machine.clear();
+  no_component.record.component.clear();
   r.records.send_batch(wire::EventMessageSeq{nameless, no_component});
   ASSERT_TRUE(eventually([&] { return sup.messages_refused() == 2; })) << r.out.all();
   EXPECT_EQ(r.out.records, 0u) << r.out.all();
@@ -1534,11 +1534,11 @@ TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) 
     m.coordinator = "wire-c";
     m.incarnation = incarnation;
     m.seq = seq;
-    m.recordSeq = seq;
-    m.kind = wire::RecordKind::Reset;
-    m.component = "C";
-    m.event = "FAKE";
-    m.text = text;
+    m.record.seq = seq;
+    m.record.kind = wire::RecordKind::Reset;
+    m.record.component = "C";
+    m.record.event = "FAKE";
+    m.record.text = text;
     return m;
   };
   const std::int64_t refused = static_cast<std::int64_t>((*client)->records_refused());
@@ -1709,13 +1709,13 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
   m.coordinator = "wire-p";
   m.incarnation = kIncarnation;
   m.seq = 1;
-  m.kind = wire::RecordKind::Transition;
-  m.machine = "P.s_A";
-  m.component = "P";
-  m.event = "EVT_E";
-  m.from = wire::Level::Normal;
-  m.to = wire::Level::Error;
-  m.level = wire::Level::Error;
+  m.record.kind = wire::RecordKind::Transition;
+  m.record.machine = "P.s_A";
+  m.record.component = "P";
+  m.record.event = "EVT_E";
+  m.record.from = wire::Level::Normal;
+  m.record.to = wire::Level::Error;
+  m.record.level = wire::Level::Error;
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_oneway());
   events->records(bus.provider->seal(middleware::kKindEvents, encode(ic, wire::EventMessageSeq{m})));
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << out.all();
