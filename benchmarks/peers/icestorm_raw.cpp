@@ -1,7 +1,12 @@
 // The transport's floor (`make bench-peers`, item 1): a raw IceStorm publisher and subscriber in
 // two processes, no SAFECASS on either side, carrying one struct per onset and completion.
 //
-//   peer_icestorm_raw --ice HOST:PORT --out FILE [--samples N] [--tls DIR]
+//   peer_icestorm_raw --ice HOST:PORT --out FILE [--samples N] [--tls DIR] [--sender-thread 1]
+//
+// --sender-thread 1: the thread that has the fault stamps it and hands it to a sender thread
+// (a queue and a condition variable), which publishes it: what DESIGN §7 requires of SAFECASS
+// (the control loop never touches the network), and so the fair floor for SAFECASS's
+// visibility. Without it, the faulting thread publishes itself.
 //
 // --tls DIR: over mutual TLS with the certificates of a key directory (`safecass keys`), as a
 // SAFECASS process runs the bus by default; the reader certificate is presented.
@@ -25,10 +30,13 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -134,8 +142,49 @@ char read_byte(int fd) {
   return ::read(fd, &c, 1) == 1 ? c : '\0';
 }
 
+/// Publishes what the faulting thread hands it, in order (--sender-thread).
+class Sender {
+public:
+  explicit Sender(std::shared_ptr<peers::FaultTopicPrx> pub) : pub_(std::move(pub)), thread_([this] { run(); }) {}
+  ~Sender() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    cv_.notify_one();
+    thread_.join();
+  }
+  void send(const peers::Fault& f) {
+    {
+      std::lock_guard lock(mutex_);
+      queue_.push_back(f);
+    }
+    cv_.notify_one();
+  }
+
+private:
+  void run() {
+    std::unique_lock lock(mutex_);
+    for (;;) {
+      cv_.wait(lock, [&] { return stop_ || !queue_.empty(); });
+      if (queue_.empty()) return;
+      peers::Fault f = std::move(queue_.front());
+      queue_.pop_front();
+      lock.unlock();
+      pub_->fault(f);
+      lock.lock();
+    }
+  }
+  std::shared_ptr<peers::FaultTopicPrx> pub_;
+  std::mutex mutex_;
+  std::condition_variable cv_;
+  std::deque<peers::Fault> queue_;
+  bool stop_ = false;
+  std::thread thread_;
+};
+
 int publisher(const std::string& host, int port, const std::string& topic_name, int in, int out, int samples,
-              std::size_t payload) {
+              std::size_t payload, bool sender_thread) {
   auto ic = communicator();
   std::shared_ptr<peers::FaultTopicPrx> pub;
   try {
@@ -145,6 +194,14 @@ int publisher(const std::string& host, int port, const std::string& topic_name, 
     std::fprintf(stderr, "peer_icestorm_raw: publisher: %s\n", e.what());
     return 2;
   }
+  std::optional<Sender> sender;
+  if (sender_thread) sender.emplace(pub);
+  const auto send = [&](const peers::Fault& f) {
+    if (sender)
+      sender->send(f);
+    else
+      pub->fault(f);
+  };
   write_byte(out, 'r');
   if (read_byte(in) != 'L') return 0;
   peers::Fault f;
@@ -153,15 +210,16 @@ int publisher(const std::string& host, int port, const std::string& topic_name, 
     f.seq = 2 * i;
     f.active = true;
     f.time = now_ns();
-    pub->fault(f);
+    send(f);
     std::this_thread::sleep_for(1ms);
     f.seq = 2 * i + 1;
     f.active = false;
     f.time = now_ns();
-    pub->fault(f);
+    send(f);
     std::this_thread::sleep_for(1ms);
   }
   std::this_thread::sleep_for(200ms);
+  sender.reset();
   write_byte(out, 'd');
   (void)read_byte(in);
   ic->destroy();
@@ -195,6 +253,7 @@ double percentile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   std::string ice_text, out_path = "peer-icestorm-raw.json";
   int samples = 2000;
+  bool sender_thread = false;
   for (int i = 1; i + 1 < argc; i += 2) {
     const std::string key = argv[i];
     if (key == "--ice")
@@ -205,6 +264,8 @@ int main(int argc, char** argv) {
       samples = std::max(10, std::atoi(argv[i + 1]));
     else if (key == "--tls")
       g_tls_dir = argv[i + 1];
+    else if (key == "--sender-thread")
+      sender_thread = std::string(argv[i + 1]) == "1";
     else {
       std::fprintf(stderr, "peer_icestorm_raw: unknown option %s\n", key.c_str());
       return 2;
@@ -233,7 +294,7 @@ int main(int argc, char** argv) {
   if (child == 0) {
     ::close(to_child[1]);
     ::close(to_parent[0]);
-    std::_Exit(publisher(host, port, topic_name, to_child[0], to_parent[1], samples, payload));
+    std::_Exit(publisher(host, port, topic_name, to_child[0], to_parent[1], samples, payload, sender_thread));
   }
   ::close(to_child[0]);
   ::close(to_parent[1]);
@@ -286,9 +347,9 @@ int main(int argc, char** argv) {
   char json[512];
   std::snprintf(json, sizeof json,
                 "{\n  \"p50_us\": %.1f,\n  \"p99_us\": %.1f,\n  \"max_us\": %.1f,\n  \"samples\": %zu,\n"
-                "  \"onsets_sent\": %d,\n  \"message_bytes\": %zu,\n"
+                "  \"onsets_sent\": %d,\n  \"message_bytes\": %zu,\n  \"sender_thread\": %s,\n"
                 "  \"transport\": \"raw IceStorm (icebox) on loopback, two processes, SAFECASS's Ice settings\"\n}\n",
-                p50, p99, max, copy.size(), samples, message);
+                p50, p99, max, copy.size(), samples, message, sender_thread ? "true" : "false");
   std::ofstream(out_path) << json;
   std::printf("%s", json);
   return done && copy.size() >= static_cast<std::size_t>(samples) * 9 / 10 ? 0 : 1;
