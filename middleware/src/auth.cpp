@@ -436,6 +436,12 @@ wire::Signed Signer::seal(std::string_view kind, Ice::ByteSeq body) const {
   return m;
 }
 
+Ice::ByteSeq Signer::digest_of(const wire::Signed& m) {
+  Ice::ByteSeq digest(kDigestBytes);
+  seal_digest(digest.data(), m.kind, m.signer, m.body);
+  return digest;
+}
+
 bool Signer::opens(const wire::Signed& m) const noexcept {
   const auto from = members_.find(m.signer);
   if (from == members_.end() || from->second == index_ || m.tags.size() != pair_.size() * kTagBytes) return false;

@@ -73,6 +73,9 @@ public:
   /// True when `m` is sealed by `m.signer` for this member: its tag here is the one computed with
   /// the key this member shares with the signer.
   bool opens(const wire::Signed& m) const noexcept;
+  /// The digest a sealed message's tags authenticate: what a heartbeat lists (Heartbeat::sentEvents)
+  /// to vouch for a batch to the readers that hold only the keyring.
+  static Ice::ByteSeq digest_of(const wire::Signed& m);
 
 private:
   std::string name_;

@@ -93,7 +93,8 @@ struct RemoteClient::Impl {
   std::unique_ptr<Keyring> keys;
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> gaps{0};
-  std::int64_t incarnation = 0;  ///< of the coordinator process proven alive at connect()
+  std::atomic<std::uint64_t> read{0};  ///< records delivered from the history (Follower::deliver_kept)
+  std::int64_t incarnation = 0;        ///< of the coordinator process proven alive at connect()
   /// Counts the bus messages that do not decode (a client logs nothing of its own).
   std::shared_ptr<DropLog> undecodable = std::make_shared<DropLog>(nullptr);
 
@@ -235,7 +236,13 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
   return out;
 }
 
-/// Follows one coordinator's records on the events topic. Runs on the client communicator's one
+/// Follows one coordinator's records on the events topic. A follower holds only the keyring and
+/// cannot check a batch's seal, so it believes a batch once a heartbeat of the process proven
+/// alive, signed with its key, lists the batch's digest (Heartbeat::sentEvents): records travel
+/// once, in the message that carries them, one heartbeat late at most. What no heartbeat vouches
+/// for within two of them is dropped (forged, or of another process); what a heartbeat vouches for
+/// that does not arrive, and what its heartbeats show sent beyond what was vouched for, are read
+/// from the coordinator's history in bounded reads (a gap). Runs on the client communicator's one
 /// dispatch thread, so records reach the sink in order.
 class Follower final {
 public:
@@ -247,6 +254,7 @@ public:
         incarnation_(client.incarnation) {}
 
   void on_records(const wire::Signed& batch);
+  void on_heartbeat(const wire::Signed& beat);
   /// Subscription::catch_up(): the records after the last delivered, from the history.
   [[nodiscard]] Expected<std::size_t> catch_up();
 
@@ -256,6 +264,21 @@ public:
   }
 
 private:
+  /// A batch not vouched for yet (`messages`), or a digest vouched for whose batch has not come
+  /// (no messages); `beats`: heartbeats since.
+  struct Waiting {
+    Ice::ByteSeq digest;
+    wire::EventMessageSeq messages;
+    int beats = 0;
+  };
+  /// How many heartbeats a batch waits for its voucher, and a voucher for its batch.
+  static constexpr int kWaitBeats = 2;
+  /// The most batches held unvouched (a flood of forged ones drops the oldest).
+  static constexpr std::size_t kMaxWaiting = 1024;
+
+  /// Delivers the records of a vouched batch in order and once (a record after one that never
+  /// came: the gap is read from the history first); under mutex_.
+  void deliver(const wire::EventMessageSeq& messages);
   /// Delivers the kept records above last_ and below `below` (0: all); under mutex_. Io when the
   /// coordinator does not answer.
   [[nodiscard]] Expected<std::size_t> deliver_kept(std::uint64_t below);
@@ -266,27 +289,40 @@ private:
   RemoteClient::Impl& client_;
   introspect::RecordSink sink_;
   std::shared_ptr<wire::ControlPrx> control_;  ///< the client's, until the coordinator restarts
-  std::mutex mutex_;                           // stopped_ and the sink's calls
+  std::mutex mutex_;                           // everything below and the sink's calls
   bool stopped_ = false;
-  std::uint64_t last_;        ///< the last record delivered (its coordinator-wide seq)
-  std::int64_t incarnation_;  ///< of the coordinator process proven alive, whose records are followed
+  std::uint64_t last_;                   ///< the last record delivered (its coordinator-wide seq)
+  std::int64_t incarnation_;             ///< of the coordinator process proven alive, whose records are followed
+  std::int64_t beat_seq_ = 0;            ///< the last heartbeat of that process taken
+  std::int64_t stream_seen_ = 0;         ///< the highest event-stream number delivered
+  std::int64_t sent_before_ = 0;         ///< events the heartbeat before the last one listed as sent
+  std::int64_t sent_last_ = 0;           ///< events the last heartbeat listed as sent
+  std::vector<Waiting> unvouched_;       ///< batches received, no heartbeat has listed yet
+  std::vector<Waiting> unreceived_;      ///< digests listed, batches not received yet
+  std::vector<Ice::ByteSeq> delivered_;  ///< digests of the batches delivered lately (listed twice)
+  /// The coordinator's own components, as its heartbeats list them: a read of its history shows
+  /// what its stream carries, not the records of its stand-ins for other processes' components.
+  Ice::StringSeq components_;
 };
 
 class RemoteSubscription final : public introspect::Subscription {
 public:
+  struct Subscribed {
+    std::shared_ptr<IceStorm::TopicPrx> topic;
+    std::shared_ptr<Ice::ObjectPrx> proxy;
+  };
   RemoteSubscription(std::shared_ptr<Follower> follower, std::shared_ptr<Ice::ObjectAdapter> adapter,
-                     std::shared_ptr<IceStorm::TopicPrx> topic, std::shared_ptr<Ice::ObjectPrx> proxy)
-      : follower_(std::move(follower)),
-        adapter_(std::move(adapter)),
-        topic_(std::move(topic)),
-        proxy_(std::move(proxy)) {}
+                     std::vector<Subscribed> subscribed)
+      : follower_(std::move(follower)), adapter_(std::move(adapter)), subscribed_(std::move(subscribed)) {}
   [[nodiscard]] Expected<std::size_t> catch_up() override { return follower_->catch_up(); }
   ~RemoteSubscription() override {
     follower_->stop();
-    try {
-      topic_->unsubscribe(proxy_);
-    } catch (const Ice::Exception&) {
-      // IceStorm is gone: it drops the subscriber by itself.
+    for (const Subscribed& s : subscribed_) {
+      try {
+        s.topic->unsubscribe(s.proxy);
+      } catch (const Ice::Exception&) {
+        // IceStorm is gone: it drops the subscriber by itself.
+      }
     }
     adapter_->destroy();
   }
@@ -294,17 +330,12 @@ public:
 private:
   std::shared_ptr<Follower> follower_;
   std::shared_ptr<Ice::ObjectAdapter> adapter_;
-  std::shared_ptr<IceStorm::TopicPrx> topic_;
-  std::shared_ptr<Ice::ObjectPrx> proxy_;
+  std::vector<Subscribed> subscribed_;
 };
 
 }  // namespace
 
 void Follower::on_records(const wire::Signed& batch) {
-  // Records on the bus are sealed for the members of the system; a follower holds only the
-  // keyring, so it cannot check them. It takes a batch as a doorbell: what the batch says is
-  // not believed, it only says when to read the records, from the coordinator's own history at
-  // the endpoint that proved itself alive (a forged doorbell costs one read that brings nothing).
   const std::string& coordinator = client_.options.coordinator;
   if (batch.signer != coordinator || batch.kind != kKindEvents) return;  // other coordinators' records
   wire::EventMessageSeq messages;
@@ -312,34 +343,118 @@ void Follower::on_records(const wire::Signed& batch) {
     ++client_.refused;
     return;
   }
+  Ice::ByteSeq digest = Signer::digest_of(batch);
   std::lock_guard lock(mutex_);
   if (stopped_) return;
-  std::uint64_t newest = 0;
-  std::uint64_t lowest = 0;  // the lowest record announced that was not delivered yet
+  const auto listed =
+      std::find_if(unreceived_.begin(), unreceived_.end(), [&](const Waiting& w) { return w.digest == digest; });
+  if (listed != unreceived_.end()) {  // vouched for already: the heartbeat came first
+    unreceived_.erase(listed);
+    delivered_.push_back(std::move(digest));
+    deliver(messages);
+    return;
+  }
+  if (unvouched_.size() == kMaxWaiting) {
+    unvouched_.erase(unvouched_.begin());
+    ++client_.refused;
+  }
+  unvouched_.push_back(Waiting{std::move(digest), std::move(messages), 0});
+}
+
+void Follower::on_heartbeat(const wire::Signed& m) {
+  if (m.signer != client_.options.coordinator) return;
+  const OpenedHeartbeat opened = open_heartbeat(*client_.keys, client_.ic, m);
+  std::lock_guard lock(mutex_);
+  if (stopped_) return;
+  if (!opened.why.empty()) {
+    ++client_.refused;
+    return;
+  }
+  const wire::Heartbeat& h = opened.beat;
+  if (h.incarnation < incarnation_) {
+    ++client_.refused;  // a replay from an earlier process
+    return;
+  }
+  if (h.incarnation > incarnation_) {
+    // A process not proven alive: a restart of the coordinator (followed once the endpoint proves
+    // it), or a replay of a run that is over (refused).
+    auto beat = prove_restart();
+    if (!beat || beat->incarnation != h.incarnation) {
+      ++client_.refused;
+      return;
+    }
+    incarnation_ = h.incarnation;
+    last_ = 0;  // a restarted coordinator numbers its records from 1 again
+    beat_seq_ = stream_seen_ = sent_before_ = sent_last_ = 0;
+    unreceived_.clear();
+    delivered_.clear();
+  }
+  if (h.seq <= beat_seq_) return;  // a replay or a duplicate of one taken
+  const bool first = beat_seq_ == 0;
+  beat_seq_ = h.seq;
+  components_ = h.components;
+  std::sort(components_.begin(), components_.end());
+  const auto sent = h.lastSeq.find(std::string(kEventsStream));
+  const std::int64_t sent_now = sent == h.lastSeq.end() ? 0 : sent->second;
+  if (first) {
+    // The first heartbeat of the process followed: what it sent before this follower listened
+    // is read once from its history, and the stream is followed from there.
+    (void)deliver_kept(0);
+    stream_seen_ = std::max(stream_seen_, sent_now);
+  }
+  // What it vouches for: delivered now if here, else awaited.
+  for (const Ice::ByteSeq& digest : h.sentEvents) {
+    if (std::find(delivered_.begin(), delivered_.end(), digest) != delivered_.end()) continue;  // listed twice
+    const auto held =
+        std::find_if(unvouched_.begin(), unvouched_.end(), [&](const Waiting& w) { return w.digest == digest; });
+    if (held != unvouched_.end()) {
+      Waiting batch = std::move(*held);
+      unvouched_.erase(held);
+      delivered_.push_back(std::move(batch.digest));
+      deliver(batch.messages);
+    } else if (std::none_of(unreceived_.begin(), unreceived_.end(),
+                            [&](const Waiting& w) { return w.digest == digest; })) {
+      unreceived_.push_back(Waiting{digest, {}, 0});
+    }
+  }
+  if (delivered_.size() > 4 * SentDigests::kMax)
+    delivered_.erase(delivered_.begin(), delivered_.end() - 2 * SentDigests::kMax);
+  // Batches no heartbeat vouched for in time are dropped (forged, or of another process);
+  // vouchers whose batch did not come, and events listed as sent two heartbeats ago and still
+  // not delivered, are a gap, read from the history.
+  for (Waiting& w : unvouched_) ++w.beats;
+  const auto old =
+      std::remove_if(unvouched_.begin(), unvouched_.end(), [](const Waiting& w) { return w.beats > kWaitBeats; });
+  client_.refused += static_cast<std::uint64_t>(unvouched_.end() - old);
+  unvouched_.erase(old, unvouched_.end());
+  bool gap = false;
+  for (Waiting& w : unreceived_) gap = ++w.beats > kWaitBeats || gap;
+  std::erase_if(unreceived_, [](const Waiting& w) { return w.beats > kWaitBeats; });
+  gap = gap || sent_before_ > stream_seen_;
+  sent_before_ = sent_last_;
+  sent_last_ = sent_now;
+  if (!gap) return;
+  ++client_.gaps;
+  if (deliver_kept(0)) stream_seen_ = std::max(stream_seen_, sent_before_);
+}
+
+void Follower::deliver(const wire::EventMessageSeq& messages) {
+  introspect::HistoryEntry entry;
   for (const wire::EventMessage& m : messages) {
-    if (m.coordinator != coordinator || m.incarnation < incarnation_) {
-      ++client_.refused;  // misattributed, or a replay from an earlier process
+    if (m.coordinator != client_.options.coordinator || m.incarnation != incarnation_ || !from_wire(m.record, entry)) {
+      ++client_.refused;  // misattributed, of another process, or malformed
       continue;
     }
-    if (m.incarnation > incarnation_) {
-      // A process not proven alive: a restart of the coordinator (followed once the endpoint
-      // proves it), or a replay of a run that is over (refused).
-      auto beat = prove_restart();
-      if (!beat || beat->incarnation != m.incarnation) {
-        ++client_.refused;
-        continue;
-      }
-      incarnation_ = m.incarnation;
-      last_ = 0;  // a restarted coordinator numbers its records from 1 again
+    if (entry.seq > last_ + 1 && m.seq != stream_seen_ + 1) {
+      // A message before this one never came: its records are read from the history first.
+      ++client_.gaps;
+      (void)deliver_kept(entry.seq);
     }
-    const auto seq = static_cast<std::uint64_t>(m.record.seq);
-    newest = std::max(newest, seq);
-    if (seq > last_ && (lowest == 0 || seq < lowest)) lowest = seq;
+    stream_seen_ = std::max<std::int64_t>(stream_seen_, m.seq);
+    if (entry.seq <= last_) continue;
+    sink_(entry);
+    last_ = entry.seq;
   }
-  if (newest <= last_) return;  // delivered already
-  // A record announced after one that never was: a message lost on the bus (the history has it).
-  if (lowest > last_ + 1) ++client_.gaps;
-  (void)deliver_kept(0);
 }
 
 Expected<wire::Heartbeat> Follower::prove_restart() {
@@ -361,15 +476,18 @@ Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {
       auto kept =
           entries_from_wire(control_->recordsSince(static_cast<long long>(last_), 0), client_.options.coordinator);
       if (!kept) return tl::unexpected(kept.error());
-      const std::size_t before = n;
+      const std::uint64_t from = last_;
       for (const introspect::HistoryEntry& e : *kept) {
         if (below != 0 && e.seq >= below) return n;
         if (e.seq <= last_) continue;
-        sink_(e);
         last_ = e.seq;
+        if (!components_.empty() && !std::binary_search(components_.begin(), components_.end(), e.component))
+          continue;  // a stand-in's record: its own process publishes that component's records
+        sink_(e);
         ++n;
+        ++client_.read;
       }
-      if (n == before) return n;
+      if (last_ == from) return n;
     }
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io,
@@ -461,8 +579,8 @@ Expected<std::string> RemoteClient::read(std::string_view name, const std::vecto
 }
 
 Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introspect::RecordSink sink) {
-  // Where the stream starts: the last record the coordinator has now; anything after it that
-  // the first message does not carry is a gap, filled from the history.
+  // Where the stream starts: the last record the coordinator has now; what it sends after that
+  // and before this follower listens is read once, at its first heartbeat.
   auto newest = history("SYSTEM", 1);
   if (!newest) return tl::unexpected(newest.error());
   const std::uint64_t last = newest->empty() ? 0 : newest->back().seq;
@@ -471,14 +589,19 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
                                                                protocol(o.tls) + " -h " + o.listen_host);
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
-    auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
+    auto records = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
         impl_->ic, "records", [follower](const wire::Signed& m) { follower->on_records(m); }, impl_->undecodable,
         "console"));
+    auto beats = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
+        impl_->ic, "beat", [follower](const wire::Signed& m) { follower->on_heartbeat(m); }, impl_->undecodable,
+        "console"));
     adapter->activate();
-    auto events = topic(topic_manager(impl_->ic, o.ice, o.tls), kEventTopic);
-    subscribe(events, proxy);
+    const auto manager = topic_manager(impl_->ic, o.ice, o.tls);
+    std::vector<RemoteSubscription::Subscribed> subscribed{{topic(manager, kEventTopic), records},
+                                                           {topic(manager, heartbeat_topic(o.coordinator)), beats}};
+    for (const auto& s : subscribed) subscribe(s.topic, s.proxy);
     return std::unique_ptr<introspect::Subscription>(
-        std::make_unique<RemoteSubscription>(follower, adapter, events, proxy));
+        std::make_unique<RemoteSubscription>(follower, adapter, std::move(subscribed)));
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io,
                 "cannot follow coordinator '" + impl_->options.coordinator + "' on IceStorm: " + e.what());
@@ -513,5 +636,6 @@ Expected<void> RemoteClient::apply(const introspect::Action& action) {
 
 std::uint64_t RemoteClient::records_refused() const { return impl_->refused.load() + impl_->undecodable->count(); }
 std::uint64_t RemoteClient::gaps_filled() const { return impl_->gaps.load(); }
+std::uint64_t RemoteClient::records_read() const { return impl_->read.load(); }
 
 }  // namespace safecass::middleware

@@ -192,6 +192,7 @@ struct CoordinatorNode::Impl {
   std::atomic<std::int64_t> heartbeat_seq{0};  ///< the last heartbeat sent
   std::atomic<std::int64_t> resync_seq{0};
   std::optional<Signer> signer;
+  SentDigests sent_events;  ///< what the next heartbeats vouch for to keyring-only readers
   std::optional<Keyring> keyring;
   std::shared_ptr<DropLog> drops;
   std::unique_ptr<Prover> prover;  ///< proves peers' processes alive (destroyed after the communicator)
@@ -226,9 +227,9 @@ struct CoordinatorNode::Impl {
     bool wake = false;
     {
       std::lock_guard lock(queue_mutex);
-      // Records of stand-ins for remote components are that component's process's to publish.
-      if (r.kind != RecordKind::Event &&
-          !(to_index(r.component) < co.structure().component_count() && co.structure().is_remote(r.component))) {
+      // Every record travels, event records too (a follower shows the stream, never a second
+      // fetch of it); records of stand-ins for remote components are that component's process's.
+      if (!(to_index(r.component) < co.structure().component_count() && co.structure().is_remote(r.component))) {
         if (records.size() < kQueueCapacity) {
           records.push_back(r);
           wake = (records.size() == 1 && !publisher_holds_events) || records.size() == kMaxBatch;
@@ -477,7 +478,10 @@ struct CoordinatorNode::Impl {
           body = encode(ic, part);
         }
         try {
-          pub->records(signer->seal(kKindEvents, std::move(body)));
+          wire::Signed sealed = signer->seal(kKindEvents, std::move(body));
+          Ice::ByteSeq digest = Signer::digest_of(sealed);
+          pub->records(sealed);
+          sent_events.add(std::move(digest));
         } catch (...) {
           event_seq.store(seq_before);  // not sent: the same numbers go out after the reconnection
           throw;
@@ -613,6 +617,7 @@ struct CoordinatorNode::Impl {
       for (const auto& [iface, _] : held) h.clients.push_back(iface);
     }
     h.control = control;
+    if (next) h.sentEvents = sent_events.take();
     return h;
   }
 

@@ -434,4 +434,20 @@ bool Guard::dispatch(Ice::Request& request) {
   }
 }
 
+void SentDigests::add(Ice::ByteSeq digest) {
+  std::lock_guard lock(mutex_);
+  now_.push_back(std::move(digest));
+  if (now_.size() > kMax) now_.erase(now_.begin());
+}
+
+wire::DigestSeq SentDigests::take() {
+  std::lock_guard lock(mutex_);
+  const std::size_t kept = std::min(before_.size(), kMax - now_.size());
+  wire::DigestSeq out(before_.end() - static_cast<std::ptrdiff_t>(kept), before_.end());
+  out.insert(out.end(), now_.begin(), now_.end());
+  before_ = std::move(now_);
+  now_.clear();
+  return out;
+}
+
 }  // namespace safecass::middleware

@@ -61,6 +61,24 @@ struct OpenedHeartbeat {
 OpenedHeartbeat open_heartbeat(const Keyring& keys, const std::shared_ptr<Ice::Communicator>& ic,
                                const wire::Signed& m);
 
+/// The seal digests of the event batches a coordinator sent in its last two heartbeat periods
+/// (Heartbeat::sentEvents): its publisher adds each batch once sent, its heartbeat takes the list.
+/// A reader that holds only the keyring believes a batch once a signed heartbeat lists it; two
+/// periods, so that one heartbeat lost costs no reader a read of the history. Thread-safe.
+class SentDigests {
+public:
+  /// At most this many digests per heartbeat (the newest): the batches of a burst beyond it are
+  /// read from the history by those readers, in bounded reads.
+  static constexpr std::size_t kMax = 256;
+  void add(Ice::ByteSeq digest);
+  /// The digests of the last two periods, oldest first, at most kMax; starts a new period.
+  wire::DigestSeq take();
+
+private:
+  std::mutex mutex_;
+  wire::DigestSeq before_, now_;
+};
+
 /// The names of a peer's streams in its heartbeat's list (wire::Heartbeat::lastSeq): its event
 /// records, and the state of each provided interface "C.p".
 inline constexpr std::string_view kEventsStream = "events";

@@ -1951,6 +1951,127 @@ TEST(Wire, ACoordinatorWhoseSupervisorSubscriptionIsTakenWarnsAndRecoversUnderAN
   supervisor->stop();
 }
 
+/// A RemoteClient of wire-c following its records into `shown` (event and text of each).
+struct WireFollower {
+  std::unique_ptr<middleware::RemoteClient> client;
+  std::unique_ptr<introspect::Subscription> subscription;
+  std::mutex mutex;
+  std::vector<std::string> shown;
+  std::vector<std::uint64_t> seqs;
+
+  explicit WireFollower(Bus& bus) {
+    middleware::ClientOptions o;
+    o.ice = *middleware::parse_ice_endpoint("127.0.0.1:" + bus.port);
+    o.coordinator = "wire-c";
+    o.keys_dir = bus.keys;
+    o.timeout = 3000ms;
+    auto c = middleware::RemoteClient::connect(o);
+    EXPECT_TRUE(c) << (c ? "" : c.error().message);
+    if (!c) return;
+    client = std::move(*c);
+    auto f = client->follow([this](const introspect::HistoryEntry& e) {
+      std::lock_guard lock(mutex);
+      shown.push_back(e.event + " " + e.text);
+      seqs.push_back(e.seq);
+    });
+    EXPECT_TRUE(f) << (f ? "" : f.error().message);
+    if (f) subscription = std::move(*f);
+  }
+  bool shows(const std::string& text) {
+    std::lock_guard lock(mutex);
+    return std::any_of(shown.begin(), shown.end(),
+                       [&](const std::string& s) { return s.find(text) != std::string::npos; });
+  }
+};
+
+// Records travel once: a follower holds only the keyring, and takes each record from the batch
+// that carried it once a heartbeat signed with the coordinator's key lists the batch's digest; it
+// reads the coordinator's history only for what it did not receive.
+TEST(Wire, AFollowerTakesEachRecordFromTheBatchAHeartbeatVouchesForAndReadsNoHistory) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  WireFollower follower(bus);
+  ASSERT_TRUE(follower.subscription);
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "first").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("first"); })) << "the follower is following";
+  const std::uint64_t read = follower.client->records_read();
+  const std::uint64_t gaps = follower.client->gaps_filled();
+  for (int k = 0; k < 10; ++k) ASSERT_TRUE(reset(bus.co, "C", "operator", "round " + std::to_string(k)).has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("round 9"); })) << "every record arrives";
+  {
+    std::lock_guard lock(follower.mutex);
+    std::vector<std::string> rounds;
+    for (const std::string& line : follower.shown) {
+      // A reset writes a record per machine of C, each with its text.
+      const auto at = line.find("round ");
+      if (at != std::string::npos && (rounds.empty() || rounds.back() != line.substr(at)))
+        rounds.push_back(line.substr(at));
+    }
+    std::vector<std::string> want;
+    for (int k = 0; k < 10; ++k) want.push_back("round " + std::to_string(k));
+    EXPECT_EQ(rounds, want) << "in order";
+    EXPECT_TRUE(std::is_sorted(follower.seqs.begin(), follower.seqs.end()) &&
+                std::adjacent_find(follower.seqs.begin(), follower.seqs.end()) == follower.seqs.end())
+        << "each record once, in order";
+  }
+  EXPECT_EQ(follower.client->records_read(), read) << "each record came in the message that carried it";
+  EXPECT_EQ(follower.client->gaps_filled(), gaps);
+}
+
+// A batch that claims a coordinator is believed only when that coordinator's signed heartbeat
+// vouches for it: a member's batch in wire-c's name, with wire-c's incarnation and the next
+// numbers (which a follower cannot tell from wire-c's own, its seal's tags being for members
+// only), is never shown.
+TEST(Wire, ABatchNoHeartbeatOfItsCoordinatorVouchesForIsNeverShown) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  WireFollower follower(bus);
+  ASSERT_TRUE(follower.subscription);
+  // A tool taps the events topic for one genuine record of wire-c (its incarnation and numbers).
+  std::mutex mutex;
+  std::optional<wire::EventMessage> genuine;
+  std::shared_ptr<Ice::Communicator> tap_ic;
+  ImpostorProcess tap(
+      bus.keys, "reader",
+      [&](const std::string& operation,
+          std::pair<const Ice::Byte*, const Ice::Byte*> in) -> std::optional<std::vector<Ice::Byte>> {
+        if (operation != "records") return std::vector<Ice::Byte>{};
+        const auto batch = in_param<wire::Signed>(tap_ic, in);
+        wire::EventMessageSeq messages;
+        if (batch.signer == "wire-c" && middleware::decode(tap_ic, batch.body, messages) && !messages.empty()) {
+          std::lock_guard lock(mutex);
+          genuine = messages.back();
+        }
+        return std::vector<Ice::Byte>{};
+      });
+  tap_ic = tap.ice.communicator();
+  bus.topic("safecass.events")
+      ->subscribeAndGetPublisher(IceStorm::QoS{}, tap.ice->stringToProxy(tap.proxy)->ice_oneway());
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "genuine").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("genuine"); }));
+  ASSERT_TRUE(eventually([&] {
+    std::lock_guard lock(mutex);
+    return genuine.has_value();
+  }));
+  wire::EventMessage forged = *genuine;
+  forged.seq += 1;
+  forged.record.seq += 100;
+  forged.record.text = "operator: FORGED";
+  const std::uint64_t refused = follower.client->records_refused();
+  wire::Signed batch =
+      bus.provider->seal(middleware::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{forged}));
+  batch.signer = "wire-c";  // in wire-c's name, with wire-p's tags: only members could tell
+  Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_twoway())->records(batch);
+  EXPECT_TRUE(eventually([&] { return follower.client->records_refused() > refused; }, 3000ms))
+      << "dropped once no heartbeat vouched for it";
+  // What wire-c really records is still shown, the forgery never.
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "after").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("after"); }));
+  EXPECT_FALSE(follower.shows("FORGED"));
+}
+
 // Every private key the system makes is refused when others can read it: a member's TLS key and
 // the tools' reader key, as a member's secret already was.
 TEST(Wire, APrivateKeyOthersCanReadIsRefused) {

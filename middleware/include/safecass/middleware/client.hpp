@@ -58,10 +58,12 @@ struct ClientOptions {
 /// The SystemQuery of one live coordinator process (the read model's remote implementation):
 /// every read is one request to the coordinator's Control object, answered by the coordinator's
 /// own LocalQuery, so it carries every field an in-process answer has. follow() subscribes to the
-/// coordinator's records on the events topic (pushed, never polled): a client holds only the
-/// keyring and cannot check a sealed batch, so each one is a doorbell: the records it announces
-/// that were not delivered yet are read from the coordinator's history (Control::recordsSince) at
-/// the endpoint proven alive, and delivered in order and once.
+/// coordinator's records on the events topic (pushed, never polled) and to its heartbeats: a
+/// client holds only the keyring and cannot check a sealed batch, so it believes one once a
+/// heartbeat of the process proven alive, signed with its key, lists the batch's digest, and
+/// delivers its records in order and once (records travel once, one heartbeat late at most). What
+/// was sent before it listened, and what was lost on the bus, are read from the coordinator's
+/// history (Control::recordsSince, bounded reads) at the endpoint proven alive.
 class RemoteClient final : public introspect::SystemQuery {
 public:
   /// Errors: Io (IceStorm or the coordinator unreachable; no heartbeat from it within timeout).
@@ -99,6 +101,8 @@ public:
   /// connect(), and gaps filled from the coordinator's history.
   std::uint64_t records_refused() const;
   std::uint64_t gaps_filled() const;
+  /// Records follow() delivered from the coordinator's history rather than from the stream.
+  std::uint64_t records_read() const;
 
   struct Impl;
 
