@@ -118,6 +118,15 @@ struct Chain {
   }
 };
 
+/// A history ring of exactly `n` records, whatever the model's size.
+CoordinatorOptions ring_of(std::size_t n) {
+  CoordinatorOptions options;
+  options.history_records = n;
+  options.history_per_address = 1;
+  options.history_records_max = n;
+  return options;
+}
+
 TEST(HistoryStorage, TheHistoryReturnsExactlyTheRecordsTheStreamPublished) {
   CoordinatorOptions options;  // the defaults: nothing is overwritten in 5 rounds
   Chain chain(options);
@@ -132,11 +141,7 @@ TEST(HistoryStorage, TheHistoryReturnsExactlyTheRecordsTheStreamPublished) {
 TEST(HistoryStorage, AfterTheRingWrapsTheNewestRecordsKeepTheirRootCausesAndTexts) {
   // A ring of 64 records overwritten many times: every root slot a kept record names must still
   // hold its own root (each record writes at most one root into a ring of the same capacity).
-  CoordinatorOptions options;
-  options.history_records = 64;
-  options.history_per_address = 1;
-  options.history_records_max = 64;
-  Chain chain(options);
+  Chain chain(ring_of(64));
   for (int k = 0; k < 40; ++k) chain.round(k);
   ASSERT_EQ(chain.co.history_size(), 64u);
   const std::vector<Record> got = chain.co.history(Address{});
@@ -217,11 +222,7 @@ TEST(HistoryStorage, RecordsSinceReturnsAtMostHistoryCapacityRecordsPerReadWhate
 }
 
 TEST(HistoryStorage, AfterTheRingWrapsRecordsSinceStartsAtTheOldestRecordKeptSoTheReaderSeesTheLoss) {
-  CoordinatorOptions options;
-  options.history_records = 64;
-  options.history_per_address = 1;
-  options.history_records_max = 64;
-  Chain chain(options);
+  Chain chain(ring_of(64));
   for (int k = 0; k < 40; ++k) chain.round(k);
   const std::vector<Record> want = chain.newest(64);
   const std::vector<Record> got = read_on(chain.co, chain.stream.front().seq, 10);
