@@ -270,11 +270,22 @@ private:
     Ice::ByteSeq digest;
     wire::EventMessageSeq messages;
     int beats = 0;
+    std::size_t bytes = 0;  ///< the batch's body
   };
   /// How many heartbeats a batch waits for its voucher, and a voucher for its batch.
   static constexpr int kWaitBeats = 2;
-  /// The most batches held unvouched (a flood of forged ones drops the oldest).
+  /// The most batches, and bytes of them, held unvouched: a flood of forged ones drops the oldest
+  /// (counted as refused), so memory stays bounded; a genuine batch dropped so is read from the
+  /// history once its heartbeat lists it (a gap).
   static constexpr std::size_t kMaxWaiting = 1024;
+  static constexpr std::size_t kMaxWaitingBytes = std::size_t{8} << 20;
+  /// Takes `at` out of unvouched_ (under mutex_).
+  Waiting take_unvouched(std::vector<Waiting>::iterator at) {
+    Waiting w = std::move(*at);
+    unvouched_.erase(at);
+    held_bytes_ -= w.bytes;
+    return w;
+  }
 
   /// Delivers the records of a vouched batch in order and once (a record after one that never
   /// came: the gap is read from the history first); under mutex_.
@@ -298,6 +309,7 @@ private:
   std::int64_t sent_before_ = 0;         ///< events the heartbeat before the last one listed as sent
   std::int64_t sent_last_ = 0;           ///< events the last heartbeat listed as sent
   std::vector<Waiting> unvouched_;       ///< batches received, no heartbeat has listed yet
+  std::size_t held_bytes_ = 0;           ///< of unvouched_
   std::vector<Waiting> unreceived_;      ///< digests listed, batches not received yet
   std::vector<Ice::ByteSeq> delivered_;  ///< digests of the batches delivered lately (listed twice)
   /// The coordinator's own components, as its heartbeats list them: a read of its history shows
@@ -354,11 +366,17 @@ void Follower::on_records(const wire::Signed& batch) {
     deliver(messages);
     return;
   }
-  if (unvouched_.size() == kMaxWaiting) {
-    unvouched_.erase(unvouched_.begin());
+  const std::size_t bytes = batch.body.size();
+  while (!unvouched_.empty() && (unvouched_.size() >= kMaxWaiting || held_bytes_ + bytes > kMaxWaitingBytes)) {
+    (void)take_unvouched(unvouched_.begin());
     ++client_.refused;
   }
-  unvouched_.push_back(Waiting{std::move(digest), std::move(messages), 0});
+  if (bytes > kMaxWaitingBytes) {
+    ++client_.refused;
+    return;
+  }
+  held_bytes_ += bytes;
+  unvouched_.push_back(Waiting{std::move(digest), std::move(messages), 0, bytes});
 }
 
 void Follower::on_heartbeat(const wire::Signed& m) {
@@ -408,8 +426,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
     const auto held =
         std::find_if(unvouched_.begin(), unvouched_.end(), [&](const Waiting& w) { return w.digest == digest; });
     if (held != unvouched_.end()) {
-      Waiting batch = std::move(*held);
-      unvouched_.erase(held);
+      Waiting batch = take_unvouched(held);
       delivered_.push_back(std::move(batch.digest));
       deliver(batch.messages);
     } else if (std::none_of(unreceived_.begin(), unreceived_.end(),
@@ -423,10 +440,10 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   // vouchers whose batch did not come, and events listed as sent two heartbeats ago and still
   // not delivered, are a gap, read from the history.
   for (Waiting& w : unvouched_) ++w.beats;
-  const auto old =
-      std::remove_if(unvouched_.begin(), unvouched_.end(), [](const Waiting& w) { return w.beats > kWaitBeats; });
-  client_.refused += static_cast<std::uint64_t>(unvouched_.end() - old);
-  unvouched_.erase(old, unvouched_.end());
+  while (!unvouched_.empty() && unvouched_.front().beats > kWaitBeats) {  // oldest first: they came in order
+    (void)take_unvouched(unvouched_.begin());
+    ++client_.refused;
+  }
   bool gap = false;
   for (Waiting& w : unreceived_) gap = ++w.beats > kWaitBeats || gap;
   std::erase_if(unreceived_, [](const Waiting& w) { return w.beats > kWaitBeats; });

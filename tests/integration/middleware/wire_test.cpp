@@ -2072,6 +2072,58 @@ TEST(Wire, ABatchNoHeartbeatOfItsCoordinatorVouchesForIsNeverShown) {
   EXPECT_FALSE(follower.shows("FORGED"));
 }
 
+// Batches held for a voucher are bounded in number and bytes: a flood of large batches in a
+// coordinator's name that no heartbeat lists (here the follower hears no heartbeat at all: a tool
+// took its subscription) does not grow a follower's memory with the flood.
+TEST(Wire, AFloodOfBatchesNoHeartbeatVouchesForDoesNotGrowAFollowersMemory) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  WireFollower follower(bus);
+  ASSERT_TRUE(follower.subscription);
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
+  // A tool takes the follower's subscription to wire-c's heartbeats (the nodes' have a category).
+  ImpostorProcess thief(
+      bus.keys, "reader",
+      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+        return std::vector<Ice::Byte>{};
+      });
+  auto beats = bus.topic("safecass.heartbeat.wire-c");
+  std::size_t taken = 0;
+  for (const Ice::Identity& id : beats->getSubscribers()) {
+    if (!id.category.empty()) continue;
+    beats->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
+    beats->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
+    ++taken;
+  }
+  ASSERT_EQ(taken, 1u);
+  wire::EventMessage big{};
+  big.coordinator = "wire-c";
+  big.seq = 1;
+  big.record.kind = wire::RecordKind::Reset;
+  big.record.component = "C";
+  big.record.text = std::string(std::size_t{256} << 10, 'x');
+  auto events = Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_twoway());
+  const long rss_before = rss_kib();
+  const std::uint64_t refused = follower.client->records_refused();
+  constexpr int kBatches = 400;  // 100 MiB in all
+  for (int i = 0; i < kBatches; ++i) {
+    big.seq = 1000 + i;
+    wire::Signed batch =
+        bus.provider->seal(middleware::kKindEvents, encode(bus.ice.communicator(), wire::EventMessageSeq{big}));
+    batch.signer = "wire-c";
+    events->records(batch);
+  }
+  // Each batch is either held or dropped for one held longer: at most 8 MiB stay.
+  EXPECT_TRUE(eventually([&] { return follower.client->records_refused() >= refused + kBatches - 40; }, 10000ms))
+      << follower.client->records_refused() - refused;
+  const long grown = rss_kib() - rss_before;
+  std::printf("[flood] %d batches of 256 KiB to a follower: RSS %+ld KiB\n", kBatches, grown);
+  EXPECT_LT(grown, 48L * 1024L) << "memory does not grow with the flood (100 MiB sent)";
+  EXPECT_FALSE(follower.shows("xxxx"));
+}
+
 // Every private key the system makes is refused when others can read it: a member's TLS key and
 // the tools' reader key, as a member's secret already was.
 TEST(Wire, APrivateKeyOthersCanReadIsRefused) {
