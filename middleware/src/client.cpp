@@ -262,6 +262,16 @@ public:
     std::lock_guard lock(mutex_);
     stopped_ = true;
   }
+  /// True when no heartbeat of the followed process was taken for `at_least` and for three of
+  /// its periods as seen between its last two heartbeats (since the start, or since the last time
+  /// this said true: the subscriptions made again get as long to bring one).
+  bool silent(std::chrono::steady_clock::duration at_least) {
+    std::lock_guard lock(mutex_);
+    const auto now = std::chrono::steady_clock::now();
+    if (now - last_beat_ <= std::max(at_least, 3 * beat_interval_)) return false;
+    last_beat_ = now;
+    return true;
+  }
 
 private:
   /// A batch not vouched for yet (`messages`), or a digest vouched for whose batch has not come
@@ -302,16 +312,18 @@ private:
   std::shared_ptr<wire::ControlPrx> control_;  ///< the client's, until the coordinator restarts
   std::mutex mutex_;                           // everything below and the sink's calls
   bool stopped_ = false;
-  std::uint64_t last_;                   ///< the last record delivered (its coordinator-wide seq)
-  std::int64_t incarnation_;             ///< of the coordinator process proven alive, whose records are followed
-  std::int64_t beat_seq_ = 0;            ///< the last heartbeat of that process taken
-  std::int64_t stream_seen_ = 0;         ///< the highest event-stream number delivered
-  std::int64_t sent_before_ = 0;         ///< events the heartbeat before the last one listed as sent
-  std::int64_t sent_last_ = 0;           ///< events the last heartbeat listed as sent
-  std::vector<Waiting> unvouched_;       ///< batches received, no heartbeat has listed yet
-  std::size_t held_bytes_ = 0;           ///< of unvouched_
-  std::vector<Waiting> unreceived_;      ///< digests listed, batches not received yet
-  std::vector<Ice::ByteSeq> delivered_;  ///< digests of the batches delivered lately (listed twice)
+  std::uint64_t last_;         ///< the last record delivered (its coordinator-wide seq)
+  std::int64_t incarnation_;   ///< of the coordinator process proven alive, whose records are followed
+  std::int64_t beat_seq_ = 0;  ///< the last heartbeat of that process taken
+  std::chrono::steady_clock::time_point last_beat_ = std::chrono::steady_clock::now();  ///< when
+  std::chrono::steady_clock::duration beat_interval_{};  ///< between its last two heartbeats
+  std::int64_t stream_seen_ = 0;                         ///< the highest event-stream number delivered
+  std::int64_t sent_before_ = 0;                         ///< events the heartbeat before the last one listed as sent
+  std::int64_t sent_last_ = 0;                           ///< events the last heartbeat listed as sent
+  std::vector<Waiting> unvouched_;                       ///< batches received, no heartbeat has listed yet
+  std::size_t held_bytes_ = 0;                           ///< of unvouched_
+  std::vector<Waiting> unreceived_;                      ///< digests listed, batches not received yet
+  std::vector<Ice::ByteSeq> delivered_;                  ///< digests of the batches delivered lately (listed twice)
   /// The coordinator's own components, as its heartbeats list them: a read of its history shows
   /// what its stream carries, not the records of its stand-ins for other processes' components.
   Ice::StringSeq components_;
@@ -321,12 +333,37 @@ class RemoteSubscription final : public introspect::Subscription {
 public:
   struct Subscribed {
     std::shared_ptr<IceStorm::TopicPrx> topic;
+    std::shared_ptr<Ice::Object> servant;
     std::shared_ptr<Ice::ObjectPrx> proxy;
   };
+  /// Heard nothing of the followed process for this long: the subscriptions are made again.
+  static constexpr std::chrono::seconds kSilence{1};
   RemoteSubscription(std::shared_ptr<Follower> follower, std::shared_ptr<Ice::ObjectAdapter> adapter,
                      std::vector<Subscribed> subscribed)
       : follower_(std::move(follower)), adapter_(std::move(adapter)), subscribed_(std::move(subscribed)) {}
-  [[nodiscard]] Expected<std::size_t> catch_up() override { return follower_->catch_up(); }
+  /// The records the stream did not bring, from the history; and when no heartbeat of the process
+  /// followed came for kSilence, the subscriptions made again under new identities: IceStorm
+  /// lists subscriber identities to whoever may call a topic, so another holder of a certificate
+  /// can take one (docs/security.md), and a follower would otherwise show no new record from the
+  /// stream until it is restarted.
+  [[nodiscard]] Expected<std::size_t> catch_up() override {
+    auto caught = follower_->catch_up();
+    if (caught && follower_->silent(kSilence)) {
+      for (Subscribed& s : subscribed_) {
+        try {
+          s.topic->unsubscribe(s.proxy);
+          auto renewed = adapter_->addWithUUID(s.servant);
+          subscribe(s.topic, renewed);
+          adapter_->remove(s.proxy->ice_getIdentity());
+          s.proxy = renewed;
+        } catch (const Ice::Exception& e) {
+          return fail(ErrorCode::Io,
+                      std::string("records: IceStorm did not take the subscription again (") + e.ice_id() + ")");
+        }
+      }
+    }
+    return caught;
+  }
   ~RemoteSubscription() override {
     follower_->stop();
     for (const Subscribed& s : subscribed_) {
@@ -410,6 +447,9 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   if (h.seq <= beat_seq_) return;  // a replay or a duplicate of one taken
   const bool first = beat_seq_ == 0;
   beat_seq_ = h.seq;
+  const auto now = std::chrono::steady_clock::now();
+  if (!first) beat_interval_ = now - last_beat_;
+  last_beat_ = now;
   components_ = h.components;
   std::sort(components_.begin(), components_.end());
   const auto sent = h.lastSeq.find(std::string(kEventsStream));
@@ -614,8 +654,9 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
         "console"));
     adapter->activate();
     const auto manager = topic_manager(impl_->ic, o.ice, o.tls);
-    std::vector<RemoteSubscription::Subscribed> subscribed{{topic(manager, kEventTopic), records},
-                                                           {topic(manager, heartbeat_topic(o.coordinator)), beats}};
+    std::vector<RemoteSubscription::Subscribed> subscribed{
+        {topic(manager, kEventTopic), adapter->find(records->ice_getIdentity()), records},
+        {topic(manager, heartbeat_topic(o.coordinator)), adapter->find(beats->ice_getIdentity()), beats}};
     for (const auto& s : subscribed) subscribe(s.topic, s.proxy);
     return std::unique_ptr<introspect::Subscription>(
         std::make_unique<RemoteSubscription>(follower, adapter, std::move(subscribed)));

@@ -2072,6 +2072,59 @@ TEST(Wire, ABatchNoHeartbeatOfItsCoordinatorVouchesForIsNeverShown) {
   EXPECT_FALSE(follower.shows("FORGED"));
 }
 
+/// A tool (`thief`) takes the subscriptions of wire-c's followers to its heartbeats (the nodes'
+/// identities have a category, a follower's none); the identities it took.
+std::vector<Ice::Identity> take_followers_beats(Bus& bus, ImpostorProcess& thief) {
+  auto beats = bus.topic("safecass.heartbeat.wire-c");
+  std::vector<Ice::Identity> taken;
+  for (const Ice::Identity& id : beats->getSubscribers()) {
+    if (!id.category.empty()) continue;
+    beats->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
+    beats->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
+    taken.push_back(id);
+  }
+  return taken;
+}
+
+// A tool's own subscriptions are not kept from it: a follower that hears no heartbeat of the
+// process it follows for a second subscribes again under new identities when it catches up (the
+// viewer does after every 0.5 s of quiet), and takes records from the stream again.
+TEST(Wire, AFollowerWhoseHeartbeatSubscriptionIsTakenSubscribesAgainWhenItCatchesUp) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  WireFollower follower(bus);
+  ASSERT_TRUE(follower.subscription);
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
+  ImpostorProcess thief(
+      bus.keys, "reader",
+      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+        return std::vector<Ice::Byte>{};
+      });
+  const std::vector<Ice::Identity> taken = take_followers_beats(bus, thief);
+  ASSERT_EQ(taken.size(), 1u);
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "while taken").has_value());
+  // Catching up shows what the stream could not vouch for, and after a second of silence the
+  // follower subscribes under a new identity (unsubscribing its old one, which the thief held).
+  const auto subscribed_anew = [&] {
+    for (const Ice::Identity& id : bus.topic("safecass.heartbeat.wire-c")->getSubscribers())
+      if (id.category.empty() && id != taken[0]) return true;
+    return false;
+  };
+  ASSERT_TRUE(eventually(
+      [&] {
+        EXPECT_TRUE(follower.subscription->catch_up());
+        return follower.shows("while taken") && subscribed_anew();
+      },
+      5000ms))
+      << "shown: " << follower.shows("while taken");
+  const std::uint64_t read = follower.client->records_read();
+  ASSERT_TRUE(reset(bus.co, "C", "operator", "after").has_value());
+  ASSERT_TRUE(eventually([&] { return follower.shows("after"); }));
+  EXPECT_EQ(follower.client->records_read(), read) << "from the stream again, vouched for by a heartbeat";
+}
+
 // Batches held for a voucher are bounded in number and bytes: a flood of large batches in a
 // coordinator's name that no heartbeat lists (here the follower hears no heartbeat at all: a tool
 // took its subscription) does not grow a follower's memory with the flood.
@@ -2083,21 +2136,13 @@ TEST(Wire, AFloodOfBatchesNoHeartbeatVouchesForDoesNotGrowAFollowersMemory) {
   ASSERT_TRUE(follower.subscription);
   ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
   ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
-  // A tool takes the follower's subscription to wire-c's heartbeats (the nodes' have a category).
+  // A tool takes the follower's subscription to wire-c's heartbeats.
   ImpostorProcess thief(
       bus.keys, "reader",
       [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
         return std::vector<Ice::Byte>{};
       });
-  auto beats = bus.topic("safecass.heartbeat.wire-c");
-  std::size_t taken = 0;
-  for (const Ice::Identity& id : beats->getSubscribers()) {
-    if (!id.category.empty()) continue;
-    beats->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
-    beats->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
-    ++taken;
-  }
-  ASSERT_EQ(taken, 1u);
+  ASSERT_EQ(take_followers_beats(bus, thief).size(), 1u);
   wire::EventMessage big{};
   big.coordinator = "wire-c";
   big.seq = 1;
