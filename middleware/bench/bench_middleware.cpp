@@ -138,8 +138,14 @@ struct Process {
     const auto completion = co->structure().find_event("/EVT_FORCE_ERROR");
     const auto target = co->structure().find_machine("JR3.s_A");
     if (!onset || !completion || !target) return false;
-    const std::uint64_t first = co->history(Address{}, 1).empty() ? 0 : co->history(Address{}, 1).back().seq;
-    while (co->records_since(first, 1).empty() || co->records_since(first, 1).front().seq == first + 1) {
+    const std::vector<Record> newest = co->history(Address{}, 1);
+    const std::uint64_t first = newest.empty() ? 0 : newest.back().seq;
+    // Written over once the record after `first` is no longer the oldest kept.
+    const auto written_over = [&] {
+      const std::vector<Record> oldest = co->records_since(first, 1);
+      return !oldest.empty() && oldest.front().seq != first + 1;
+    };
+    while (!written_over()) {
       for (int i = 0; i < 1024; ++i) {
         co->generate(*onset, *target);
         co->generate(*completion, *target);

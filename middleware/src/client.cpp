@@ -646,17 +646,17 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
                                                                protocol(o.tls) + " -h " + o.listen_host);
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
-    auto records = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
-        impl_->ic, "records", [follower](const wire::Signed& m) { follower->on_records(m); }, impl_->undecodable,
-        "console"));
-    auto beats = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
-        impl_->ic, "beat", [follower](const wire::Signed& m) { follower->on_heartbeat(m); }, impl_->undecodable,
-        "console"));
-    adapter->activate();
     const auto manager = topic_manager(impl_->ic, o.ice, o.tls);
+    const auto subscriber = [&](const char* operation, std::function<void(const wire::Signed&)> handler) {
+      return std::make_shared<TopicSubscriber>(impl_->ic, operation, std::move(handler), impl_->undecodable, "console");
+    };
     std::vector<RemoteSubscription::Subscribed> subscribed{
-        {topic(manager, kEventTopic), adapter->find(records->ice_getIdentity()), records},
-        {topic(manager, heartbeat_topic(o.coordinator)), adapter->find(beats->ice_getIdentity()), beats}};
+        {topic(manager, kEventTopic),
+         subscriber("records", [follower](const wire::Signed& m) { follower->on_records(m); })},
+        {topic(manager, heartbeat_topic(o.coordinator)),
+         subscriber("beat", [follower](const wire::Signed& m) { follower->on_heartbeat(m); })}};
+    for (auto& s : subscribed) s.proxy = adapter->addWithUUID(s.servant);
+    adapter->activate();
     for (const auto& s : subscribed) subscribe(s.topic, s.proxy);
     return std::unique_ptr<introspect::Subscription>(
         std::make_unique<RemoteSubscription>(follower, adapter, std::move(subscribed)));

@@ -1768,22 +1768,32 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
   supervisor->stop();
 }
 
-/// Attacks 3 and 4 of the review: a tool (the reader's certificate) unsubscribes each of
-/// `victim`'s subscriptions to `topic` and subscribes an endpoint of its own under the same
-/// identity. Returns how many it took.
-std::size_t take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic, const std::string& victim) {
+/// Attacks 3 and 4 of the review: a tool (the reader's certificate) unsubscribes each
+/// subscription to `topic` whose identity `whose` selects and subscribes an endpoint of its own
+/// under the same identity. Returns the identities it took.
+std::vector<Ice::Identity> take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic,
+                                              const std::function<bool(const Ice::Identity&)>& whose) {
   auto manager =
       Ice::uncheckedCast<IceStorm::TopicManagerPrx>(thief.ice->stringToProxy(fixture::topic_manager(bus.port)));
   auto t = manager->retrieve(topic);
-  std::size_t taken = 0;
+  std::vector<Ice::Identity> taken;
   for (const Ice::Identity& id : t->getSubscribers()) {
-    if (!id.category.starts_with(victim)) continue;
+    if (!whose(id)) continue;
     t->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
     t->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
-    ++taken;
+    taken.push_back(id);
   }
   return taken;
 }
+/// The subscriptions of a process whose subscriber categories start with `prefix`.
+std::function<bool(const Ice::Identity&)> of(const std::string& prefix) {
+  return [prefix](const Ice::Identity& id) { return id.category.starts_with(prefix); };
+}
+/// A thief's endpoint: takes every message it is sent and answers nothing.
+const Relay::Answer kKeepsEverything =
+    [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+  return std::vector<Ice::Byte>{};
+};
 
 // Attack 3 of the review: a tool takes a coordinator's subscriber identity on its provider's
 // state topic. The client hears the provider's heartbeats but not its state: when the provider
@@ -1795,12 +1805,8 @@ TEST(Wire, AReceiverWhoseSubscriberIdentityIsTakenIsLostWithinTheBoundAndRecover
   ASSERT_TRUE(bus.node);
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return bus.node->stats().updates_applied >= 1; })) << bus.all_log();
-  ImpostorProcess thief(
-      bus.keys, "reader",
-      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
-        return std::vector<Ice::Byte>{};
-      });
-  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-wire-c-"), 1u);
+  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", of("safecass-wire-c-")).size(), 1u);
 
   // The truth: wire-p's D0 fails. The victim must not stay at Normal past the bound.
   const auto sent = std::chrono::steady_clock::now();
@@ -1835,12 +1841,8 @@ TEST(Wire, ASupervisorFollowingRecordsCountsAStateStreamBehindAsLost) {
   const middleware::Supervisor& sup = *supervisor;
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
-  ImpostorProcess thief(
-      bus.keys, "reader",
-      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
-        return std::vector<Ice::Byte>{};
-      });
-  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", "safecass-supervisor-"), 1u);
+  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", of("safecass-supervisor-")).size(), 1u);
 
   bus.send(*bus.provider, {update("P.D0", 2, "EVT_E", wire::Level::Error)});
   EXPECT_TRUE(eventually([&] { return sup.lost() == std::vector<std::string>{"wire-p"}; }, 2000ms)) << out.all();
@@ -1937,12 +1939,8 @@ TEST(Wire, ACoordinatorWhoseSupervisorSubscriptionIsTakenWarnsAndRecoversUnderAN
   auto supervisor = start_supervisor(bus, out);
   ASSERT_TRUE(supervisor);
   ASSERT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 3000ms)) << bus.all_log();
-  ImpostorProcess thief(
-      bus.keys, "reader",
-      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
-        return std::vector<Ice::Byte>{};
-      });
-  ASSERT_GE(take_subscriptions(bus, thief, "safecass.heartbeat.supervisor", "safecass-wire-c-"), 1u);
+  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ASSERT_GE(take_subscriptions(bus, thief, "safecass.heartbeat.supervisor", of("safecass-wire-c-")).size(), 1u);
   const auto said = [&](const char* line) { return bus.all_log().find(line) != std::string::npos; };
   EXPECT_TRUE(eventually([&] { return said("the supervisor is gone"); }, 3000ms)) << bus.all_log();
   EXPECT_TRUE(eventually([&] { return said("under a new identity"); }, 3000ms)) << bus.all_log();
@@ -2075,15 +2073,8 @@ TEST(Wire, ABatchNoHeartbeatOfItsCoordinatorVouchesForIsNeverShown) {
 /// A tool (`thief`) takes the subscriptions of wire-c's followers to its heartbeats (the nodes'
 /// identities have a category, a follower's none); the identities it took.
 std::vector<Ice::Identity> take_followers_beats(Bus& bus, ImpostorProcess& thief) {
-  auto beats = bus.topic("safecass.heartbeat.wire-c");
-  std::vector<Ice::Identity> taken;
-  for (const Ice::Identity& id : beats->getSubscribers()) {
-    if (!id.category.empty()) continue;
-    beats->unsubscribe(thief.ice->stringToProxy(Ice::identityToString(id)));
-    beats->subscribeAndGetPublisher(IceStorm::QoS{}, thief.adapter->add(thief.servant, id)->ice_oneway());
-    taken.push_back(id);
-  }
-  return taken;
+  return take_subscriptions(bus, thief, "safecass.heartbeat.wire-c",
+                            [](const Ice::Identity& id) { return id.category.empty(); });
 }
 
 // A tool's own subscriptions are not kept from it: a follower that hears no heartbeat of the
@@ -2097,11 +2088,7 @@ TEST(Wire, AFollowerWhoseHeartbeatSubscriptionIsTakenSubscribesAgainWhenItCatche
   ASSERT_TRUE(follower.subscription);
   ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
   ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
-  ImpostorProcess thief(
-      bus.keys, "reader",
-      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
-        return std::vector<Ice::Byte>{};
-      });
+  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
   const std::vector<Ice::Identity> taken = take_followers_beats(bus, thief);
   ASSERT_EQ(taken.size(), 1u);
   ASSERT_TRUE(reset(bus.co, "C", "operator", "while taken").has_value());
@@ -2137,11 +2124,7 @@ TEST(Wire, AFloodOfBatchesNoHeartbeatVouchesForDoesNotGrowAFollowersMemory) {
   ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
   ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
   // A tool takes the follower's subscription to wire-c's heartbeats.
-  ImpostorProcess thief(
-      bus.keys, "reader",
-      [](const std::string&, std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
-        return std::vector<Ice::Byte>{};
-      });
+  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
   ASSERT_EQ(take_followers_beats(bus, thief).size(), 1u);
   wire::EventMessage big{};
   big.coordinator = "wire-c";
