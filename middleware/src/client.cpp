@@ -143,7 +143,15 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     auto proxy = adapter->addWithUUID(std::make_shared<TopicSubscriber>(
         impl->ic, "beat", [finder](const wire::Signed& m) { finder->on_beat(m); }, impl->undecodable, "console"));
     adapter->activate();
-    auto heartbeat = topic(topic_manager(impl->ic, o.ice, o.tls), heartbeat_topic(o.coordinator));
+    std::shared_ptr<IceStorm::TopicPrx> heartbeat;
+    try {
+      heartbeat = topic(topic_manager(impl->ic, tools_broker(o.ice), o.tls), heartbeat_topic(o.coordinator));
+    } catch (const Ice::Exception& e) {
+      return fail(ErrorCode::Io, "cannot reach the tools' broker at " + to_string(tools_broker(o.ice)) +
+                                     " (scripts/start-icestorm runs it beside the members' broker, on the next "
+                                     "port): " +
+                                     e.what());
+    }
     subscribe(heartbeat, proxy);
     // Each endpoint an authentic heartbeat names is asked for a proof of life before anything
     // else is sent to it; one that cannot give one (a replayed heartbeat of a dead process, an
@@ -190,8 +198,8 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
     if (found == nullptr) {
       const std::uint64_t refused = finder->refused();
       return fail(ErrorCode::Io,
-                  "no authenticated heartbeat from coordinator '" + o.coordinator + "' on IceStorm " +
-                      to_string(o.ice) + " within " + std::to_string(o.timeout.count()) + " ms" +
+                  "no authenticated heartbeat from coordinator '" + o.coordinator + "' on the tools' broker " +
+                      to_string(tools_broker(o.ice)) + " within " + std::to_string(o.timeout.count()) + " ms" +
                       (unproven.empty() ? "" : " from a process that proved itself alive (" + unproven + ")") +
                       (refused > 0 ? " (" + std::to_string(refused) + " forged heartbeat(s) naming it refused)" : ""));
     }
@@ -646,7 +654,7 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
                                                                protocol(o.tls) + " -h " + o.listen_host);
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
-    const auto manager = topic_manager(impl_->ic, o.ice, o.tls);
+    const auto manager = topic_manager(impl_->ic, tools_broker(o.ice), o.tls);
     const auto subscriber = [&](const char* operation, std::function<void(const wire::Signed&)> handler) {
       return std::make_shared<TopicSubscriber>(impl_->ic, operation, std::move(handler), impl_->undecodable, "console");
     };

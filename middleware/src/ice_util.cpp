@@ -151,9 +151,10 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls, cons
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls) {
   // Replicated: the topic manager's well-known object, found through the communicator's locator.
-  const std::string text = ice.locator ? std::string(kIceStormInstance) + "/TopicManager"
-                                       : std::string(kIceStormInstance) + "/TopicManager:" + protocol(tls) + " -h " +
-                                             ice.host + " -p " + std::to_string(ice.port) + " -t 2000";
+  const std::string manager = std::string(ice.tools ? kToolStormInstance : kIceStormInstance) + "/TopicManager";
+  const std::string text =
+      ice.locator ? manager
+                  : manager + ":" + protocol(tls) + " -h " + ice.host + " -p " + std::to_string(ice.port) + " -t 2000";
   return Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ic->stringToProxy(text));
 }
 
@@ -214,6 +215,43 @@ std::int64_t steady_ns() noexcept {
 
 namespace safecass::middleware {
 
+void link_for_tools(const std::shared_ptr<IceStorm::TopicPrx>& from,
+                    const std::shared_ptr<IceStorm::TopicManagerPrx>& tools, const std::string& name) {
+  const auto ignore = [](std::exception_ptr) {};
+  const auto link_to = [from, name, ignore](const std::shared_ptr<IceStorm::TopicPrx>& to) {
+    if (to == nullptr) return;
+    from->getLinkInfoSeqAsync(
+        [from, to, name, ignore](const IceStorm::LinkInfoSeq& links) {
+          // A link is kept with the endpoints it was made to: the tools' broker restarted on
+          // another port (its topics are kept) has a topic of the same identity elsewhere.
+          std::shared_ptr<IceStorm::TopicPrx> stale;
+          for (const IceStorm::LinkInfo& l : links) {
+            if (l.theTopic == nullptr || l.name != name) continue;
+            if (l.theTopic->ice_toString() == to->ice_toString()) return;
+            stale = l.theTopic;
+          }
+          const auto link = [from, to, ignore] {
+            from->linkAsync(
+                to, 0, [] {}, ignore);
+          };
+          if (stale != nullptr) {
+            from->unlinkAsync(stale, link, ignore);
+          } else {
+            link();
+          }
+        },
+        ignore);
+  };
+  tools->retrieveAsync(name, link_to, [tools, name, link_to, ignore](std::exception_ptr e) {
+    try {
+      std::rethrow_exception(e);
+    } catch (const IceStorm::NoSuchTopic&) {
+      tools->createAsync(name, link_to, ignore);
+    } catch (...) {
+    }
+  });
+}
+
 void Link::connect(const std::vector<std::string>& publish_on) {
   // Every attempt on connections of its own: after a partition the old ones may look open while
   // their packets wait out TCP's retransmission backoff (minutes), and Ice would keep using them.
@@ -221,6 +259,9 @@ void Link::connect(const std::vector<std::string>& publish_on) {
     if (auto old = manager_->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
     for (const auto& [name, p] : publishers_) {
       if (auto old = p->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
+    }
+    if (tools_ != nullptr) {
+      if (auto old = tools_->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
     }
   }
   const std::string id = "link-" + std::to_string(++generation_);
@@ -232,8 +273,15 @@ void Link::connect(const std::vector<std::string>& publish_on) {
     renew(s, false);
   }
   publishers_.clear();
+  linked_.clear();
+  tools_ =
+      Ice::uncheckedCast<IceStorm::TopicManagerPrx>(topic_manager(ic_, tools_broker(ice_), tls_)->ice_connectionId(id));
   for (const std::string& name : publish_on) {
-    publishers_.emplace_back(name, topic(manager_, name)->getPublisher()->ice_oneway()->ice_connectionId(id));
+    auto t = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, name)->ice_connectionId(id));
+    publishers_.emplace_back(name, t->getPublisher()->ice_oneway()->ice_connectionId(id));
+    if (!tools_hear(name)) continue;
+    linked_.emplace_back(name, t);
+    link_for_tools(t, tools_, name);
   }
 }
 
@@ -307,6 +355,7 @@ std::vector<std::string> Link::check(bool ping_broker) {
             topic(manager_, s.topic)->ice_connectionId(manager_->ice_getConnectionId()));
       s.check = s.proxy->subscribeAndGetPublisherAsync(IceStorm::QoS{}, s.subscriber->ice_oneway());
     }
+    for (const auto& [name, t] : linked_) link_for_tools(t, tools_, name);
   }
   return made;
 }

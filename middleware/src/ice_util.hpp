@@ -35,6 +35,13 @@ inline std::string heartbeat_topic(std::string_view signer) {
   return std::string(kHeartbeatTopic) + "." + std::string(signer);
 }
 inline constexpr const char* kResyncTopic = "safecass.resync";
+/// The topics tools hear: the events and the heartbeats. A tool cannot reach the members' broker
+/// (its certificate is refused there); each member links the topics of these it publishes on to
+/// the topics of the same names at the tools' broker (tools_broker()), which forward what is
+/// published to the tools' subscriptions. The state and resync topics stay among the members.
+inline bool tools_hear(std::string_view topic) {
+  return topic == kEventTopic || topic.starts_with(std::string(kHeartbeatTopic) + ".");
+}
 
 /// Every this many heartbeat periods (1 s at the default 100 ms) a process's link checks that
 /// IceStorm still holds each of its subscriptions (Link::check); in between it pings IceStorm
@@ -75,6 +82,13 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
 /// identity can be replaced (Link::renew) without registering the servant again.
 std::shared_ptr<Ice::ObjectPrx> add_subscriber(const std::shared_ptr<Ice::ObjectAdapter>& adapter,
                                                std::shared_ptr<Ice::Object> servant, const std::string& category);
+/// Makes `from` (a topic of the members' broker) forward to its namesake at the tools' broker
+/// `tools`, created there when missing, unless that link is in place; a link to a topic of that
+/// name elsewhere (the tools' broker restarted on another port) is replaced. Asynchronous,
+/// so that a tools' broker out of reach never holds up a member: what fails is tried again at the
+/// next round of Link::check.
+void link_for_tools(const std::shared_ptr<IceStorm::TopicPrx>& from,
+                    const std::shared_ptr<IceStorm::TopicManagerPrx>& tools, const std::string& name);
 /// Subscribes `subscriber` oneway (IceStorm's default reliability): batched, in order over one
 /// connection. A message the subscriber cannot decode fails there alone: IceStorm never learns of
 /// it, so one bad message drops nobody's subscription (a twoway subscriber whose dispatch fails is
@@ -129,8 +143,9 @@ public:
   /// made again (empty: all were there; the caller resynchronises otherwise). IceStorm drops a
   /// subscriber whose delivery failed or timed out (a process starved or stopped for longer than
   /// IceStorm's send timeout), and a subscription can be removed from outside; without this check
-  /// such a process would go on unaware that nothing reaches it. Throws Ice exceptions when
-  /// IceStorm cannot be reached or refuses the subscription.
+  /// such a process would go on unaware that nothing reaches it. The same rounds make again each
+  /// link to the tools' broker that is missing (a tool may destroy a topic there). Throws Ice
+  /// exceptions when IceStorm cannot be reached or refuses the subscription.
   std::vector<std::string> check(bool ping_broker);
 
 private:
@@ -151,6 +166,10 @@ private:
   void renew(Subscription& s, bool async);
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
+  /// The tools' broker, and the topics this process publishes on that tools hear (tools_hear()):
+  /// each linked to its namesake there, checked with the subscriptions.
+  std::shared_ptr<IceStorm::TopicManagerPrx> tools_;
+  std::vector<std::pair<std::string, std::shared_ptr<IceStorm::TopicPrx>>> linked_;
   std::uint64_t checks_ = 0;
   std::uint64_t generation_ = 0;  ///< connect() attempts: each on connections of its own
 };

@@ -53,6 +53,12 @@ namespace safecass::middleware {
   return e;
 }
 
+IceEndpoint tools_broker(IceEndpoint members) {
+  members.tools = true;
+  if (!members.locator) ++members.port;
+  return members;
+}
+
 std::string to_string(const IceEndpoint& ice) {
   return (ice.locator ? std::string(kLocatorPrefix) : std::string()) + ice.host + ":" + std::to_string(ice.port);
 }

@@ -69,7 +69,7 @@ if [ "$case_name" = across_hosts_a_replicated_broker_keeps_the_views_true_when_i
   wait $registry_started || { echo "start-icestorm --replicas on c failed: $(cat icestorm-start.log)"; exit 1; }
   ice="locator:10.77.0.3:4061"
 else
-  on c "$src/scripts/start-icestorm" --host 10.77.0.3 --port 4061 --publish-port 4062 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" \
+  on c "$src/scripts/start-icestorm" --host 10.77.0.3 --port 4061 --publish-port 4064 --dir "$HOSTS_DIR/ice" --env "$HOSTS_DIR/ice.env" \
     >/dev/null 2>"$HOSTS_DIR/icestorm-start.log" || { echo "start-icestorm on c failed: $(cat icestorm-start.log)"; exit 1; }
 fi
 hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' ice.env)")

@@ -78,10 +78,14 @@ inline std::shared_ptr<Ice::Communicator> communicator(
   return Ice::initialize(init);
 }
 
-/// The endpoint of a test's own object adapter, and of IceStorm's TopicManager on `port`.
+/// The endpoint of a test's own object adapter, and the TopicManager of the fixture's members'
+/// broker on `port` or of its tools' broker (on the next port: docs/security.md).
 inline const char* const kAdapterEndpoint = "ssl -h 127.0.0.1";
-inline std::string topic_manager(const std::string& port) {
-  return "SafecassIceStorm/TopicManager:ssl -h 127.0.0.1 -p " + port;
+enum class Broker { Members, Tools };
+inline std::string topic_manager(const std::string& port, Broker broker = Broker::Members) {
+  return broker == Broker::Members
+             ? "SafecassIceStorm/TopicManager:ssl -h 127.0.0.1 -p " + port
+             : "SafecassToolStorm/TopicManager:ssl -h 127.0.0.1 -p " + std::to_string(std::stoi(port) + 1);
 }
 
 }  // namespace safecass::fixture

@@ -578,6 +578,10 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   ASSERT_TRUE(robot->apply(in::GenerateEvent{"EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}));
   EXPECT_EQ(state_of(*robot, "JR3"), State::Normal);
   EXPECT_EQ(state_of(*robot, "SERVO"), State::Error) << "local propagation does not wait for the network";
+  // A process started while IceStorm is down tries again until it is back (its first connection
+  // failed before any topic was reached).
+  Process supervisor({sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--duration", "40"},
+                     sys.p.scratch + "/restart-supervisor.log");
   std::this_thread::sleep_for(300ms);
 
   ASSERT_EQ(std::system((start + " --port " + port + " --dir " + dir + " --env " + env_file + " >/dev/null").c_str()),
@@ -603,6 +607,14 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   ASSERT_TRUE(robot->apply(in::GenerateEvent{"/EVT_CONTROL_FORCE_FREEZE", "CONTROL.s_A"}));
   EXPECT_TRUE(eventually([&] { return state_of(*ui, "PENDANT") == State::Normal; })) << "propagation works again\n"
                                                                                      << sys.logs();
+  EXPECT_TRUE(eventually([&] {
+    const std::string out = supervisor.output();
+    return out.find("coordinator 'robot' is up") != std::string::npos &&
+           out.find("coordinator 'ui' is up") != std::string::npos;
+  })) << supervisor.output();
+  // A tool that connects now finds the robot through the tools' broker: the links the members made
+  // before the restart still forward (the tools' broker listens where it did).
+  EXPECT_NE(sys.client("robot"), nullptr) << sys.logs();
 }
 
 /// One coordinator of a system on the fixture's IceStorm, in this process.

@@ -201,7 +201,8 @@ struct Bus {
     load = spec::load_system_from_text(system_text(warnings, errors, name_length), "over.json", registry);
     EXPECT_TRUE(load.ok());
     EXPECT_TRUE(fixture::make_keys(*load.system, keys));
-    ice = Ice::CommunicatorHolder(fixture::communicator(keys, "reader", {{"Ice.MessageSizeMax", "4096"}}));
+    // Taps on the members' topics: a member's certificate (the members' broker refuses a tool's).
+    ice = Ice::CommunicatorHolder(fixture::communicator(keys, "supervisor", {{"Ice.MessageSizeMax", "4096"}}));
     states = std::make_shared<StateTap>(ice.communicator());
     events = std::make_shared<EventTap>(ice.communicator());
 

@@ -30,6 +30,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -222,7 +223,7 @@ struct Bus {
     EXPECT_TRUE(eventually(
         [&] {
           for (const char* t : {"safecass.state.wire-p", "safecass.heartbeat.wire-p", "safecass.resync"}) {
-            if (topic(t)->getSubscribers().empty()) return false;
+            if (subscribers(t).empty()) return false;
           }
           return true;
         },
@@ -240,14 +241,38 @@ struct Bus {
     supervisor_adapter->destroy();
   }
 
-  /// The IceStorm topic `name` of the fixture (created when it does not exist yet).
-  std::shared_ptr<IceStorm::TopicPrx> topic(const std::string& name) const {
+  /// The topic `name` of the fixture's members' broker (created when it does not exist yet),
+  /// linked to the tools' broker when tools hear it, as a member that publishes on it links it.
+  std::shared_ptr<IceStorm::TopicPrx> topic(const std::string& name) {
     auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(ice->stringToProxy(fixture::topic_manager(port)));
+    std::shared_ptr<IceStorm::TopicPrx> t;
     try {
-      return manager->retrieve(name);
+      t = manager->retrieve(name);
     } catch (const IceStorm::NoSuchTopic&) {
-      return manager->create(name);
+      t = manager->create(name);
     }
+    if (middleware::tools_hear(name) && linked.insert(name).second) {
+      middleware::link_for_tools(t,
+                                 Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+                                     ice->stringToProxy(fixture::topic_manager(port, fixture::Broker::Tools))),
+                                 name);
+    }
+    return t;
+  }
+  std::set<std::string> linked;  ///< the topics topic() linked to the tools' broker
+  /// Who subscribes to `name` at `broker`: the processes, not the links to the tools' broker.
+  std::vector<Ice::Identity> subscribers(const std::string& name, fixture::Broker broker = fixture::Broker::Members) {
+    std::shared_ptr<IceStorm::TopicPrx> t;
+    if (broker == fixture::Broker::Members) {
+      t = topic(name);
+    } else {
+      t = middleware::topic(Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+                                ice->stringToProxy(fixture::topic_manager(port, fixture::Broker::Tools))),
+                            name);
+    }
+    auto all = t->getSubscribers();
+    std::erase_if(all, [](const Ice::Identity& id) { return id.category == middleware::kToolStormInstance; });
+    return all;
   }
 
   /// wire-p's heartbeat as it stands (under mutex): the streams' last numbers.
@@ -647,7 +672,7 @@ TEST(Wire, ACoordinatorHearsTheHeartbeatsOfItselfItsProvidersAndTheSupervisorAnd
     const std::string topic = std::string("safecass.heartbeat.") + signer;
     EXPECT_TRUE(eventually([&] { return node_hears(topic); })) << topic;
     // The node and the supervisor: nobody else.
-    EXPECT_TRUE(eventually([&] { return bus.topic(topic)->getSubscribers().size() == 2; })) << topic;
+    EXPECT_TRUE(eventually([&] { return bus.subscribers(topic).size() == 2; })) << topic;
   }
 }
 
@@ -667,7 +692,7 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
   std::size_t removed = 0;
   for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat.wire-p"}) {
     auto t = bus.topic(name);
-    for (const Ice::Identity& subscriber : t->getSubscribers()) {
+    for (const Ice::Identity& subscriber : bus.subscribers(name)) {
       t->unsubscribe(bus.ice->stringToProxy(Ice::identityToString(subscriber)));
       ++removed;
     }
@@ -688,10 +713,12 @@ TEST(Wire, ACoordinatorAndTheSupervisorMakeAgainASubscriptionThatIceStormNoLonge
 }
 
 // Members only at the broker (docs/security.md): IceStorm serves mutual TLS only, and admits a
-// process only with a certificate of the system's CA. Without one (plain TCP, or a certificate of
-// another CA) nobody lists, unsubscribes, creates or publishes; the victim keeps its
-// subscriptions and sees the provider's next fault at once, without having to make one again.
-TEST(Wire, ANonMemberCanNeitherListNorUnsubscribeNorCreateATopicAtTheBrokerAndTheVictimsViewStaysTrue) {
+// process only with a certificate of the system's CA; the members' broker refuses the tools'
+// certificate too (tools hear the topics linked to the tools' broker). Without a member's
+// certificate (plain TCP, a certificate of another CA, the tools' reader) nobody lists,
+// unsubscribes, takes an identity, creates or publishes; the victim keeps its subscriptions and
+// sees the provider's next fault at once, without having to make one again.
+TEST(Wire, NeitherANonMemberNorAToolCanListUnsubscribeOrCreateATopicAtTheMembersBrokerAndTheVictimsViewStaysTrue) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
@@ -719,6 +746,9 @@ TEST(Wire, ANonMemberCanNeitherListNorUnsubscribeNorCreateATopicAtTheBrokerAndTh
                        "SafecassIceStorm/TopicManager:tcp -h 127.0.0.1 -p " + bus.port + " -t 1000"});
   outsiders.push_back({"a certificate of another CA",
                        Ice::CommunicatorHolder(fixture::communicator(outsider_keys, "reader", {bounded})),
+                       fixture::topic_manager(bus.port) + " -t 1000"});
+  outsiders.push_back({"the tools' certificate",
+                       Ice::CommunicatorHolder(fixture::communicator(bus.keys, "reader", {bounded})),
                        fixture::topic_manager(bus.port) + " -t 1000"});
   for (Outsider& o : outsiders) {
     auto manager = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(o.ice->stringToProxy(o.manager));
@@ -1294,7 +1324,7 @@ TEST(Wire, UndecodableMessagesDropNoSubscriptionAndAreLoggedAtMostOnceASecond) {
   ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused - refused_before >= 1000; })) << bus.all_log();
   std::this_thread::sleep_for(300ms);
   for (const char* name : {"safecass.state.wire-p", "safecass.heartbeat.wire-p", "safecass.resync"}) {
-    EXPECT_FALSE(bus.topic(name)->getSubscribers().empty()) << name;
+    EXPECT_FALSE(bus.subscribers(name).empty()) << name;
   }
   EXPECT_EQ(bus.node->stats().resubscriptions, 0u) << "nobody was dropped\n" << bus.all_log();
   std::size_t lines = 0;
@@ -1525,7 +1555,7 @@ TEST(Wire, AFollowerShowsNoRecordOfAnotherIncarnationThanTheProcessProvenAlive) 
     shown.push_back(e.event + " " + e.text);
   });
   ASSERT_TRUE(follow) << follow.error().message;
-  ASSERT_TRUE(eventually([&] { return !bus.topic("safecass.events")->getSubscribers().empty(); }));
+  ASSERT_TRUE(eventually([&] { return !bus.subscribers("safecass.events", fixture::Broker::Tools).empty(); }));
 
   // Records "of wire-c", sealed with its key, naming incarnations it does not run.
   auto events = Ice::uncheckedCast<wire::EventTopicPrx>(bus.topic("safecass.events")->getPublisher()->ice_twoway());
@@ -1624,12 +1654,13 @@ T in_param(const std::shared_ptr<Ice::Communicator>& ic, std::pair<const Ice::By
 /// An impostor's process: a communicator presenting `certificate` of the system's CA and an
 /// object served on loopback.
 struct ImpostorProcess {
+  std::string certificate;
   Ice::CommunicatorHolder ice;
   std::shared_ptr<Ice::ObjectAdapter> adapter;
   std::shared_ptr<Relay> servant;
   std::string proxy;
-  ImpostorProcess(const std::string& keys, const std::string& certificate, Relay::Answer answer)
-      : ice(fixture::communicator(keys, certificate)) {
+  ImpostorProcess(const std::string& keys, const std::string& name, Relay::Answer answer)
+      : certificate(name), ice(fixture::communicator(keys, name)) {
     adapter = ice->createObjectAdapterWithEndpoints("Relay", fixture::kAdapterEndpoint);
     servant = std::make_shared<Relay>(std::move(answer));
     proxy = adapter->add(servant, Ice::Identity{"control-wire-p", "safecass"})->ice_toString();
@@ -1768,13 +1799,15 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
   supervisor->stop();
 }
 
-/// Attacks 3 and 4 of the review: a tool (the reader's certificate) unsubscribes each
-/// subscription to `topic` whose identity `whose` selects and subscribes an endpoint of its own
-/// under the same identity. Returns the identities it took.
+/// Attacks 3 and 4 of the review: a thief unsubscribes each subscription to `topic` whose
+/// identity `whose` selects and subscribes an endpoint of its own under the same identity, at the
+/// broker its certificate reaches (a tool's, the reader's: the tools' broker; a member's: the
+/// members'). Returns the identities it took.
 std::vector<Ice::Identity> take_subscriptions(Bus& bus, ImpostorProcess& thief, const std::string& topic,
                                               const std::function<bool(const Ice::Identity&)>& whose) {
+  const auto broker = thief.certificate == "reader" ? fixture::Broker::Tools : fixture::Broker::Members;
   auto manager =
-      Ice::uncheckedCast<IceStorm::TopicManagerPrx>(thief.ice->stringToProxy(fixture::topic_manager(bus.port)));
+      Ice::uncheckedCast<IceStorm::TopicManagerPrx>(thief.ice->stringToProxy(fixture::topic_manager(bus.port, broker)));
   auto t = manager->retrieve(topic);
   std::vector<Ice::Identity> taken;
   for (const Ice::Identity& id : t->getSubscribers()) {
@@ -1795,17 +1828,18 @@ const Relay::Answer kKeepsEverything =
   return std::vector<Ice::Byte>{};
 };
 
-// Attack 3 of the review: a tool takes a coordinator's subscriber identity on its provider's
-// state topic. The client hears the provider's heartbeats but not its state: when the provider
-// goes to Error, the client is at Error within the loss bound (the stream is lost), never at a
-// stale Normal; it then subscribes under a new identity and holds the provider's true state.
+// Attack 3 of the review: a coordinator's subscriber identity on its provider's state topic is
+// taken (by a member now: a tool's certificate no longer reaches the members' broker). The client hears the provider's
+// heartbeats but not its state: when the provider goes to Error, the client is at Error within the loss bound (the
+// stream is lost), never at a stale Normal; it then subscribes under a new identity and holds the provider's true
+// state.
 TEST(Wire, AReceiverWhoseSubscriberIdentityIsTakenIsLostWithinTheBoundAndRecoversUnderANewIdentity) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return bus.node->stats().updates_applied >= 1; })) << bus.all_log();
-  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ImpostorProcess thief(bus.keys, "wire-p", kKeepsEverything);  // a member: tools cannot reach these topics
   ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", of("safecass-wire-c-")).size(), 1u);
 
   // The truth: wire-p's D0 fails. The victim must not stay at Normal past the bound.
@@ -1841,7 +1875,7 @@ TEST(Wire, ASupervisorFollowingRecordsCountsAStateStreamBehindAsLost) {
   const middleware::Supervisor& sup = *supervisor;
   bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Normal; })) << out.all();
-  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ImpostorProcess thief(bus.keys, "wire-p", kKeepsEverything);  // a member: tools cannot reach these topics
   ASSERT_GE(take_subscriptions(bus, thief, "safecass.state.wire-p", of("safecass-supervisor-")).size(), 1u);
 
   bus.send(*bus.provider, {update("P.D0", 2, "EVT_E", wire::Level::Error)});
@@ -1939,7 +1973,7 @@ TEST(Wire, ACoordinatorWhoseSupervisorSubscriptionIsTakenWarnsAndRecoversUnderAN
   auto supervisor = start_supervisor(bus, out);
   ASSERT_TRUE(supervisor);
   ASSERT_TRUE(eventually([&] { return bus.state("C.s_F") == State::Normal; }, 3000ms)) << bus.all_log();
-  ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
+  ImpostorProcess thief(bus.keys, "wire-p", kKeepsEverything);  // a member: tools cannot reach these topics
   ASSERT_GE(take_subscriptions(bus, thief, "safecass.heartbeat.supervisor", of("safecass-wire-c-")).size(), 1u);
   const auto said = [&](const char* line) { return bus.all_log().find(line) != std::string::npos; };
   EXPECT_TRUE(eventually([&] { return said("the supervisor is gone"); }, 3000ms)) << bus.all_log();
@@ -2095,7 +2129,7 @@ TEST(Wire, AFollowerWhoseHeartbeatSubscriptionIsTakenSubscribesAgainWhenItCatche
   // Catching up shows what the stream could not vouch for, and after a second of silence the
   // follower subscribes under a new identity (unsubscribing its old one, which the thief held).
   const auto subscribed_anew = [&] {
-    for (const Ice::Identity& id : bus.topic("safecass.heartbeat.wire-c")->getSubscribers())
+    for (const Ice::Identity& id : bus.subscribers("safecass.heartbeat.wire-c", fixture::Broker::Tools))
       if (id.category.empty() && id != taken[0]) return true;
     return false;
   };

@@ -49,7 +49,13 @@ struct IceEndpoint {
   std::string host = "127.0.0.1";
   int port = 0;
   bool locator = false;  ///< host:port is an IceGrid registry, not an IceStorm
+  bool tools = false;    ///< the tools' broker (tools_broker()), not the members'
 };
+/// The tools' broker of the system whose members' broker is `members`: the second IceStorm that
+/// scripts/start-icestorm runs beside the members' (instance kToolStormInstance, on the next port,
+/// or through the same locator). The members' broker refuses the tools' certificate; the topics
+/// tools hear are linked from it to the tools' broker (docs/security.md "Rights at the broker").
+[[nodiscard]] IceEndpoint tools_broker(IceEndpoint members);
 /// Parses "HOST:PORT", "PORT" or "locator:HOST:PORT". Errors: Parse (with what was wrong).
 [[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
 /// The text parse_ice_endpoint reads: "HOST:PORT" or "locator:HOST:PORT".
@@ -88,6 +94,8 @@ public:
 
 /// The IceStorm instance name scripts/start-icestorm configures.
 inline constexpr std::string_view kIceStormInstance = "SafecassIceStorm";
+/// The instance name of the tools' broker (tools_broker()).
+inline constexpr std::string_view kToolStormInstance = "SafecassToolStorm";
 /// What --ice starts with when it names an IceGrid registry: "locator:HOST:PORT".
 inline constexpr std::string_view kLocatorPrefix = "locator:";
 
