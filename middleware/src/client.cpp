@@ -325,13 +325,13 @@ private:
   std::int64_t beat_seq_ = 0;  ///< the last heartbeat of that process taken
   std::chrono::steady_clock::time_point last_beat_ = std::chrono::steady_clock::now();  ///< when
   std::chrono::steady_clock::duration beat_interval_{};  ///< between its last two heartbeats
-  std::int64_t stream_seen_ = 0;                         ///< the highest event-stream number delivered
-  std::int64_t sent_before_ = 0;                         ///< events the heartbeat before the last one listed as sent
-  std::int64_t sent_last_ = 0;                           ///< events the last heartbeat listed as sent
-  std::vector<Waiting> unvouched_;                       ///< batches received, no heartbeat has listed yet
-  std::size_t held_bytes_ = 0;                           ///< of unvouched_
-  std::vector<Waiting> unreceived_;                      ///< digests listed, batches not received yet
-  std::vector<Ice::ByteSeq> delivered_;                  ///< digests of the batches delivered lately (listed twice)
+  /// The followed process's event stream (receiver.hpp, the supervisor's too): a number skipped,
+  /// or listed sent by a heartbeat two before and not come, is read from the history at once.
+  EventStream stream_;
+  std::vector<Waiting> unvouched_;       ///< batches received, no heartbeat has listed yet
+  std::size_t held_bytes_ = 0;           ///< of unvouched_
+  std::vector<Waiting> unreceived_;      ///< digests listed, batches not received yet
+  std::vector<Ice::ByteSeq> delivered_;  ///< digests of the batches delivered lately (listed twice)
   /// The coordinator's own components, as its heartbeats list them: a read of its history shows
   /// what its stream carries, not the records of its stand-ins for other processes' components.
   Ice::StringSeq components_;
@@ -448,7 +448,8 @@ void Follower::on_heartbeat(const wire::Signed& m) {
     }
     incarnation_ = h.incarnation;
     last_ = 0;  // a restarted coordinator numbers its records from 1 again
-    beat_seq_ = stream_seen_ = sent_before_ = sent_last_ = 0;
+    beat_seq_ = 0;
+    stream_ = EventStream{};
     unreceived_.clear();
     delivered_.clear();
   }
@@ -466,7 +467,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
     // The first heartbeat of the process followed: what it sent before this follower listened
     // is read once from its history, and the stream is followed from there.
     (void)deliver_kept(0);
-    stream_seen_ = std::max(stream_seen_, sent_now);
+    stream_.caught_up(sent_now);
   }
   // What it vouches for: delivered now if here, else awaited.
   for (const Ice::ByteSeq& digest : h.sentEvents) {
@@ -495,12 +496,10 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   bool gap = false;
   for (Waiting& w : unreceived_) gap = ++w.beats > kWaitBeats || gap;
   std::erase_if(unreceived_, [](const Waiting& w) { return w.beats > kWaitBeats; });
-  gap = gap || sent_before_ > stream_seen_;
-  sent_before_ = sent_last_;
-  sent_last_ = sent_now;
+  gap = stream_.heard(sent_now).has_value() || gap;
   if (!gap) return;
   ++client_.gaps;
-  if (deliver_kept(0)) stream_seen_ = std::max(stream_seen_, sent_before_);
+  if (deliver_kept(0)) stream_.caught_up(sent_now);  // the history held everything this heartbeat listed
 }
 
 void Follower::deliver(const wire::EventMessageSeq& messages) {
@@ -510,12 +509,21 @@ void Follower::deliver(const wire::EventMessageSeq& messages) {
       ++client_.refused;  // misattributed, of another process, or malformed
       continue;
     }
-    if (entry.seq > last_ + 1 && m.seq != stream_seen_ + 1) {
-      // A message before this one never came: its records are read from the history first.
-      ++client_.gaps;
-      (void)deliver_kept(entry.seq);
+    const bool skipped = m.seq > stream_.last() + 1;
+    std::optional<EventStream::Range> range;
+    if (stream_.take(m.seq, 0, range) == EventStream::Took::TooFar) {
+      ++client_.refused;
+      continue;
     }
-    stream_seen_ = std::max<std::int64_t>(stream_seen_, m.seq);
+    if (skipped) {
+      // A message before this one never came: its records are read from the history first (a
+      // stand-in's records are not on the stream, so the history may have nothing to add).
+      if (entry.seq > last_ + 1) {
+        ++client_.gaps;
+        (void)deliver_kept(entry.seq);
+      }
+      stream_.caught_up(m.seq - 1);
+    }
     if (entry.seq <= last_) continue;
     sink_(entry);
     last_ = entry.seq;

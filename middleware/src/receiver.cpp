@@ -110,6 +110,102 @@ std::int64_t Liveness::due(std::int64_t watched_since, std::chrono::milliseconds
   return due;
 }
 
+// ---- EventStream --------------------------------------------------------------------------------
+
+namespace {
+/// Takes `seq` out of the range of `gaps` that holds it (splitting it); that gap as it was, or
+/// nothing when no range holds it.
+template <class Gap>
+std::optional<Gap> take_out(std::vector<Gap>& gaps, std::int64_t seq) {
+  for (auto it = gaps.begin(); it != gaps.end(); ++it) {
+    if (seq < it->range.first || seq > it->range.last) continue;
+    const Gap was = *it;
+    if (it->range.first == it->range.last) {
+      gaps.erase(it);
+    } else if (seq == it->range.first) {
+      ++it->range.first;
+    } else if (seq == it->range.last) {
+      --it->range.last;
+    } else {
+      Gap upper = *it;
+      upper.range.first = seq + 1;
+      it->range.last = seq - 1;
+      gaps.insert(std::next(it), upper);
+    }
+    return was;
+  }
+  return std::nullopt;
+}
+}  // namespace
+
+void EventStream::join(std::int64_t sent) {
+  joined_ = last_ = listed_ = listed_before_ = sent;
+  gaps_.clear();
+  missed_.clear();
+}
+
+EventStream::Took EventStream::take(std::int64_t seq, std::int64_t now, std::optional<Range>& range) {
+  range.reset();
+  if (seq - last_ > kMaxSeqJump) return Took::TooFar;
+  if (seq <= joined_) return Took::Early;
+  if (seq <= last_) {
+    if (take_out(gaps_, seq)) return Took::Filled;
+    const auto missed = take_out(missed_, seq);
+    if (!missed) return Took::Again;
+    if (missed->late_said) return Took::LateAgain;
+    for (Gap& g : missed_) {  // the pieces of its range left
+      if (g.range.first >= missed->range.first && g.range.last <= missed->range.last) g.late_said = true;
+    }
+    range = missed->range;
+    return Took::Late;
+  }
+  if (seq != last_ + 1) {
+    if (gaps_.size() >= kMaxGaps) {
+      range = miss(gaps_.front());
+      gaps_.erase(gaps_.begin());
+    }
+    gaps_.push_back(Gap{Range{last_ + 1, seq - 1}, now, false});
+  }
+  last_ = seq;
+  return Took::Next;
+}
+
+std::optional<EventStream::Range> EventStream::heard(std::int64_t sent) {
+  std::optional<Range> out;
+  if (listed_before_ > last_) {
+    out = miss(Gap{Range{last_ + 1, listed_before_}, 0, false});
+    last_ = listed_before_;
+  }
+  listed_before_ = listed_;
+  listed_ = sent;
+  return out;
+}
+
+std::optional<EventStream::Range> EventStream::overdue(std::int64_t now, std::int64_t grace) {
+  if (gaps_.empty() || now - gaps_.front().opened < grace) return std::nullopt;
+  const Range r = miss(gaps_.front());
+  gaps_.erase(gaps_.begin());
+  return r;
+}
+
+void EventStream::caught_up(std::int64_t seq) {
+  for (std::vector<Gap>* list : {&gaps_, &missed_}) {
+    std::erase_if(*list, [&](const Gap& g) { return g.range.last <= seq; });
+    for (Gap& g : *list) g.range.first = std::max(g.range.first, seq + 1);
+  }
+  last_ = std::max(last_, seq);
+}
+
+EventStream::Range EventStream::miss(const Gap& g) {
+  if (missed_.size() >= kMaxGaps) missed_.erase(missed_.begin());
+  missed_.push_back(Gap{g.range, g.opened, false});
+  return g.range;
+}
+
+std::string EventStream::text(const Range& r) {
+  return std::to_string(r.first) + (r.first == r.last ? std::string() : ".." + std::to_string(r.last));
+}
+
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
 PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::string& why) const {

@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -21,6 +22,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <vector>
 
 #include "auth.hpp"
 #include "safecass.h"
@@ -192,6 +194,72 @@ private:
   std::int64_t behind_since_ = 0;  ///< since when its heartbeats show `behind_` ahead (0: caught up)
   std::string behind_;
   bool lost_ = false;
+};
+
+/// One proven process's stream of event records as a receiver follows it, the same for every
+/// receiver (DESIGN §7 "One follower"): the numbers taken, the ranges that did not come (gaps:
+/// IceStorm may deliver a batch after the next one, so a gap is missed only after a grace), and
+/// what the process's heartbeats list as sent that never came. What a receiver does with a missed
+/// range is its own: the supervisor reports it and reads the view again, a tool reads the range
+/// from the coordinator's history. Not thread-safe: the owner holds its own lock.
+class EventStream {
+public:
+  struct Range {
+    std::int64_t first = 0;  ///< first missing number
+    std::int64_t last = 0;   ///< last missing number
+  };
+  enum class Took {
+    Next,       ///< above every number taken: deliver (a skipped range opens a gap)
+    Filled,     ///< fills an open gap (it came after a later one): deliver
+    Late,       ///< comes after its range was missed, the first of that range to: deliver, say so
+    LateAgain,  ///< as Late, said already for its range: deliver
+    Early,      ///< at or below the number the receiver joined at: sent before the process proved
+                ///< itself alive, and indistinguishable from a replay: not taken, without blame
+    Again,      ///< received already: a duplicate or a replay
+    TooFar,     ///< more than kMaxSeqJump above the last number taken: refused
+  };
+  /// More open gaps than this: the oldest is missed at once (take()'s `range`).
+  static constexpr std::size_t kMaxGaps = 64;
+
+  /// A process proven alive whose proof lists `sent` records sent: the stream starts after them.
+  void join(std::int64_t sent);
+  /// Record number `seq`, arrived at `now` (steady ns). `range` is set, for Next, to a gap missed
+  /// at once because more than kMaxGaps are open; for Late, to the missed range it belongs to.
+  Took take(std::int64_t seq, std::int64_t now, std::optional<Range>& range);
+  /// A believed heartbeat listing `sent` records sent: what the heartbeat two before it listed and
+  /// has not come since is missed, once, and the stream goes on after it. Two heartbeats of slack:
+  /// a batch and the heartbeat that lists it travel on different topics, and a reader that waits
+  /// for a heartbeat to vouch for a batch takes it one heartbeat late.
+  std::optional<Range> heard(std::int64_t sent);
+  /// The oldest gap open since at least `grace` ns before `now`, missed now; none when none.
+  std::optional<Range> overdue(std::int64_t now, std::int64_t grace);
+  /// Every record up to `seq` is held (read from the process's history): gaps below it close.
+  void caught_up(std::int64_t seq);
+  /// The highest number taken (or joined at).
+  std::int64_t last() const noexcept { return last_; }
+  /// True while a range below last() has not come.
+  bool has_gaps() const noexcept { return !gaps_.empty(); }
+  /// When overdue() will miss the oldest open gap (steady ns); INT64_MAX when none is open.
+  std::int64_t overdue_at(std::int64_t grace) const noexcept {
+    return gaps_.empty() ? std::numeric_limits<std::int64_t>::max() : gaps_.front().opened + grace;
+  }
+  /// "first" or "first..last".
+  static std::string text(const Range& r);
+
+private:
+  struct Gap {
+    Range range;
+    std::int64_t opened = 0;  ///< steady ns
+    bool late_said = false;   ///< missed ranges: a late record of it was said
+  };
+  /// Moves `g` to the missed ranges (the newest kMaxGaps kept) and returns its range.
+  Range miss(const Gap& g);
+  std::int64_t joined_ = 0;
+  std::int64_t last_ = 0;
+  std::int64_t listed_ = 0;         ///< what the last heartbeat listed as sent
+  std::int64_t listed_before_ = 0;  ///< what the heartbeat before it listed
+  std::vector<Gap> gaps_;           ///< open, oldest first
+  std::vector<Gap> missed_;         ///< missed, oldest first: a record of one that still comes is late
 };
 
 /// Asks a peer's Alive endpoint (named in its heartbeat) to sign a fresh nonce, and checks the

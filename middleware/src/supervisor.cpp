@@ -36,19 +36,10 @@ struct Supervisor::Impl {
   std::unique_ptr<spec::Instance> instance;  ///< the view: every component of the system, named "supervisor"
   Coordinator& model() noexcept { return instance->coordinator(); }
 
-  /// Event records not received between two that were: IceStorm forwards a topic's messages
-  /// without the "ordered" QoS, so a batch can arrive after the next one. A record of an open gap
-  /// is accepted when it comes; what is still missing kReorderGrace after the gap opened is
-  /// reported missed. A reported record that still comes is accepted too (it is authentic and
-  /// was never received), and said to be late once per reported gap.
-  struct Gap {
-    std::int64_t first = 0;      ///< first missing seq
-    std::int64_t last = 0;       ///< last missing seq
-    std::int64_t opened_ns = 0;  ///< steady clock
-    bool late_said = false;      ///< reported gaps: a late record of it was said
-  };
+  /// Event records not received between two that were wait kReorderGrace before they are
+  /// reported missed: IceStorm forwards a topic's messages without the "ordered" QoS, so a batch
+  /// can arrive after the next one (EventStream).
   static constexpr std::chrono::milliseconds kReorderGrace{250};
-  static constexpr std::size_t kMaxGaps = 64;  ///< more open gaps than this: the oldest is reported at once
   /// Between two of the supervisor's heartbeats (coordinators lose it after their loss bound, 3
   /// heartbeat periods by default: 300 ms).
   static constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
@@ -61,16 +52,11 @@ struct Supervisor::Impl {
     /// what it sent above that before its proof was not taken, and is reported missed.
     std::int64_t unproven_incarnation = 0;
     std::int64_t unproven_floor = 0;
-    std::int64_t last_event_seq = 0;  ///< the highest record seq received (or listed when joining)
-    std::vector<Gap> gaps;            ///< below last_event_seq, oldest first
-    std::vector<Gap> reported;        ///< gaps reported missed (the newest kMaxGaps), oldest first
-    /// Where the supervisor joined this incarnation's record stream: at the proof of life of the
-    /// process (which lists the last record sent, so a record lost after it is a gap, even the
-    /// first ones). Records up to joined_at were sent before: any still on their way are not
-    /// taken (they cannot be told from replays); those sent since the supervisor first heard of
-    /// the process were reported missed at the proof.
-    std::int64_t joined_at = 0;
-    bool events_behind = false;  ///< the last heartbeat listed event records not received
+    /// The proven process's records: joined at its proof of life (which lists the last record
+    /// sent, so a record lost after it is a gap, even the first ones). Records up to the join were
+    /// sent before: any still on their way are not taken (they cannot be told from replays);
+    /// those sent since the supervisor first heard of the process were reported missed at the proof.
+    EventStream records;
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool states_behind = false;  ///< the last heartbeat listed state updates not received
@@ -195,17 +181,13 @@ struct Supervisor::Impl {
         }
         const auto sent = beat.lastSeq.find(std::string(kEventsStream));
         const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
-        peer.joined_at = joined;
-        peer.last_event_seq = joined;
-        peer.gaps.clear();
-        peer.reported.clear();
-        peer.events_behind = false;
+        peer.records.join(joined);
         peer.states_behind = false;
         const std::int64_t heard =
             peer.unproven_incarnation == beat.incarnation ? std::min(peer.unproven_floor, joined) : joined;
         if (options.records && heard < joined) {
           print("supervisor: " + std::to_string(joined - heard) + " event record(s) of '" + printable(who) +
-                "' missed (seq " + seq_range(Gap{heard + 1, joined, 0}) +
+                "' missed (seq " + EventStream::text({heard + 1, joined}) +
                 ", sent before it proved itself alive to the supervisor); its view is read again");
           peer.refresh = true;
           watch_sleeper.wake();
@@ -230,67 +212,12 @@ struct Supervisor::Impl {
     }
   }
 
-  /// Records first..last of `peer` did not come: wait kReorderGrace for them (report_gaps()).
-  void open_gap(Peer& peer, const std::string& who, std::int64_t first, std::int64_t last) {
-    if (peer.gaps.size() >= kMaxGaps) {
-      report_missed(peer, who, peer.gaps.front());
-      peer.gaps.erase(peer.gaps.begin());
-    }
-    peer.gaps.push_back(Gap{first, last, steady_ns()});
-  }
-
-  static std::string seq_range(const Gap& gap) {
-    return std::to_string(gap.first) + (gap.first == gap.last ? std::string() : ".." + std::to_string(gap.last));
-  }
-
-  /// Takes `seq` out of the gap of `gaps` that holds it; the gap as it was, or nothing when no gap
-  /// holds it.
-  static std::optional<Gap> take(std::vector<Gap>& gaps, std::int64_t seq) {
-    for (auto it = gaps.begin(); it != gaps.end(); ++it) {
-      if (seq < it->first || seq > it->last) continue;
-      const Gap was = *it;
-      if (it->first == it->last) {
-        gaps.erase(it);
-      } else if (seq == it->first) {
-        ++it->first;
-      } else if (seq == it->last) {
-        --it->last;
-      } else {
-        Gap upper = *it;
-        upper.first = seq + 1;
-        it->last = seq - 1;
-        gaps.insert(std::next(it), upper);
-      }
-      return was;
-    }
-    return std::nullopt;
-  }
-
-  /// A record below the highest received: true when it was never received (it fills an open gap,
-  /// or arrives after its gap was reported missed, which is said once per gap), false when it was
-  /// received already (a replay or a duplicate).
-  bool fill_gap(Peer& peer, const std::string& who, std::int64_t seq) {
-    if (take(peer.gaps, seq)) return true;
-    const auto reported = take(peer.reported, seq);
-    if (!reported) return false;
-    if (!reported->late_said) {
-      drops->note(who + "/late", "supervisor: event record(s) of '" + printable(who) + "' reported missed (seq " +
-                                     seq_range(*reported) + ") arrive late; accepted");
-      for (Gap& g : peer.reported) {
-        if (g.first >= reported->first && g.last <= reported->last) g.late_said = true;
-      }
-    }
-    return true;
-  }
-
-  void report_missed(Peer& peer, const std::string& who, const Gap& gap) {
+  void report_missed(Peer& peer, const std::string& who, const EventStream::Range& gap) {
     drops->note(who + "/records-missed", "supervisor: " + std::to_string(gap.last - gap.first + 1) +
                                              " event record(s) of '" + printable(who) + "' missed (seq " +
-                                             seq_range(gap) + ")");
+                                             EventStream::text(gap) + ")");
     peer.refresh = true;  // the missed records may have changed rows: read them again
     watch_sleeper.wake();
-    if (peer.reported.size() >= kMaxGaps) peer.reported.erase(peer.reported.begin());
-    peer.reported.push_back(gap);
   }
 
   /// Reports the gaps still open kReorderGrace after they opened (watch loop).
@@ -298,10 +225,7 @@ struct Supervisor::Impl {
     const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
     std::lock_guard lock(mutex);
     for (auto& [name, peer] : peers) {
-      while (!peer.gaps.empty() && now - peer.gaps.front().opened_ns >= grace) {
-        report_missed(peer, name, peer.gaps.front());
-        peer.gaps.erase(peer.gaps.begin());
-      }
+      while (const auto gap = peer.records.overdue(now, grace)) report_missed(peer, name, *gap);
     }
   }
 
@@ -358,28 +282,32 @@ struct Supervisor::Impl {
         if (m.incarnation > peer.fresh.incarnation()) heard_unproven(peer, m.incarnation, m.seq - 1);
         return;
       }
-      if (m.seq - peer.last_event_seq > kMaxSeqJump) {
-        refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                           " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
-        return;
-      }
-      if (m.seq <= peer.joined_at) {
-        // Sent before the process proved itself alive to the supervisor, still on its way: it may
-        // as well be a replay of an older record, so it is not taken (reported missed at the
-        // proof when sent since the supervisor first heard of the process).
-        return;
-      } else if (m.seq <= peer.last_event_seq) {
-        late = true;  // it fills a gap below a record received before it
-        if (!fill_gap(peer, m.coordinator, m.seq)) {
-          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                             " not above " + std::to_string(peer.last_event_seq) + " and received already (replayed)");
+      std::optional<EventStream::Range> range;
+      switch (peer.records.take(m.seq, steady_ns(), range)) {
+        case EventStream::Took::Next:
+          if (range) report_missed(peer, m.coordinator, *range);  // pushed out by more open gaps
+          break;
+        case EventStream::Took::Filled: late = true; break;  // it fills a gap below a record received before it
+        case EventStream::Took::Late:
+          drops->note(m.coordinator + "/late", "supervisor: event record(s) of '" + printable(m.coordinator) +
+                                                   "' reported missed (seq " + EventStream::text(*range) +
+                                                   ") arrive late; accepted");
+          late = true;
+          break;
+        case EventStream::Took::LateAgain: late = true; break;
+        case EventStream::Took::Early:
+          // Sent before the process proved itself alive to the supervisor, still on its way: it may
+          // as well be a replay of an older record, so it is not taken (reported missed at the
+          // proof when sent since the supervisor first heard of the process).
           return;
-        }
-      } else {
-        if (m.seq != peer.last_event_seq + 1) {
-          open_gap(peer, m.coordinator, peer.last_event_seq + 1, m.seq - 1);
-        }
-        peer.last_event_seq = m.seq;
+        case EventStream::Took::Again:
+          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                             " not above " + std::to_string(peer.records.last()) + " and received already (replayed)");
+          return;
+        case EventStream::Took::TooFar:
+          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                             " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
+          return;
       }
       if (!shown) return;
       if (transition) {
@@ -545,17 +473,9 @@ struct Supervisor::Impl {
     // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
     // records may be on their way on the other topic): reported as missed.
     const auto sent = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
-    if (sent != h.lastSeq.end() && sent->second > peer.last_event_seq) {
-      if (peer.events_behind) {
-        report_missed(peer, h.coordinator, Gap{peer.last_event_seq + 1, sent->second, 0});
-        link->renew({kEventTopic});  // the records may no longer reach us at all
-        peer.last_event_seq = sent->second;
-        peer.events_behind = false;
-      } else {
-        peer.events_behind = true;
-      }
-    } else {
-      peer.events_behind = false;
+    if (const auto missed = peer.records.heard(sent == h.lastSeq.end() ? 0 : sent->second)) {
+      report_missed(peer, h.coordinator, *missed);
+      link->renew({kEventTopic});  // the records may no longer reach us at all
     }
     // The same for the state streams, whether records are followed or not: an update lost with
     // nothing after it on its interface would leave the view of that service stale. Behind on two
@@ -626,7 +546,7 @@ struct Supervisor::Impl {
       for (auto& [name, peer] : peers) {
         if (!peer.refresh || peer.control.empty() || peer.fresh.incarnation() == 0) continue;
         peer.refresh = false;
-        due.push_back(Due{name, peer.control, peer.last_event_seq, peer.fresh.incarnation()});
+        due.push_back(Due{name, peer.control, peer.records.last(), peer.fresh.incarnation()});
       }
     }
     for (const auto& [name, control, seq_before, incarnation_before] : due) {
@@ -725,7 +645,7 @@ struct Supervisor::Impl {
             lost_now.push_back(Lost{name, peer.components, std::move(why)});
           }
           next = std::min(next, peer.live.due(since, options.lost_after));
-          if (!peer.gaps.empty()) next = std::min(next, peer.gaps.front().opened_ns + grace);
+          next = std::min(next, peer.records.overdue_at(grace));
         }
       }
       for (const auto& [name, components, why] : lost_now) {

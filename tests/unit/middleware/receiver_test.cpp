@@ -180,6 +180,105 @@ TEST(Liveness, AStreamBehindIsDueTheBoundAfterItFellBehindAndWhatComesOnlyMovesT
   EXPECT_EQ(live.check(700 * kMs + 1, 1, kBound, "start"), "no heartbeat for 300 ms");
 }
 
+// ---- EventStream: one follower's bookkeeping, for every receiver --------------------------------
+
+using Took = EventStream::Took;
+using Range = EventStream::Range;
+constexpr std::int64_t kGrace = 250'000'000;  // ns
+
+/// take() without a gap pushed out; a Late record's range is checked by the tests that need it.
+Took take(EventStream& s, std::int64_t seq, std::int64_t now = 0) {
+  std::optional<Range> range;
+  const Took t = s.take(seq, now, range);
+  EXPECT_EQ(range.has_value(), t == Took::Late) << "seq " << seq;
+  return t;
+}
+
+TEST(EventStream, ARecordAfterASkippedRangeOpensAGapThatTheRecordsOfTheRangeFillInAnyOrder) {
+  EventStream s;
+  s.join(10);
+  EXPECT_EQ(take(s, 11), Took::Next);
+  EXPECT_EQ(take(s, 15), Took::Next);  // 12..14 did not come (yet)
+  EXPECT_TRUE(s.has_gaps());
+  EXPECT_EQ(s.last(), 15);
+  EXPECT_EQ(take(s, 13), Took::Filled);
+  EXPECT_EQ(take(s, 14), Took::Filled);
+  EXPECT_EQ(take(s, 12), Took::Filled);
+  EXPECT_FALSE(s.has_gaps());
+  EXPECT_EQ(take(s, 13), Took::Again) << "received already: a duplicate or a replay";
+}
+
+TEST(EventStream, AGapStillOpenAfterTheGraceIsMissedOnceAndARecordOfItThatStillComesIsLateSaidOnce) {
+  EventStream s;
+  s.join(0);
+  EXPECT_EQ(take(s, 5, 1'000), Took::Next);  // 1..4 missing
+  EXPECT_FALSE(s.overdue(1'000 + kGrace - 1, kGrace)) << "within the grace: it may be on its way";
+  const auto missed = s.overdue(1'000 + kGrace, kGrace);
+  ASSERT_TRUE(missed);
+  EXPECT_EQ(EventStream::text(*missed), "1..4");
+  EXPECT_FALSE(s.overdue(1'000 + 2 * kGrace, kGrace)) << "missed once";
+  std::optional<Range> range;
+  EXPECT_EQ(s.take(3, 0, range), Took::Late);
+  ASSERT_TRUE(range);
+  EXPECT_EQ(EventStream::text(*range), "1..4") << "the range said late is the one said missed";
+  EXPECT_EQ(take(s, 4), Took::LateAgain) << "its range was said to be late already";
+  EXPECT_EQ(take(s, 3), Took::Again);
+}
+
+TEST(EventStream, WhatTheHeartbeatTwoBeforeListedAndThatHasNotComeIsMissedOnceAndTheStreamGoesOnAfterIt) {
+  EventStream s;
+  s.join(3);
+  EXPECT_FALSE(s.heard(5));  // lists 4..5: on their way
+  EXPECT_FALSE(s.heard(6)) << "one heartbeat later they may still be on the other topic";
+  EXPECT_EQ(take(s, 4), Took::Next);
+  const auto missed = s.heard(6);  // the heartbeat two before listed 5, which never came
+  ASSERT_TRUE(missed);
+  EXPECT_EQ(EventStream::text(*missed), "5");
+  EXPECT_EQ(s.last(), 5);
+  EXPECT_EQ(take(s, 6), Took::Next);
+  EXPECT_FALSE(s.heard(6)) << "missed once";
+  EXPECT_EQ(take(s, 5), Took::Late) << "what still comes of a missed range is taken, and said late";
+  EXPECT_FALSE(s.heard(6));
+}
+
+TEST(EventStream, WhatWasSentBeforeTheJoinIsNotTakenAndAJumpBeyondTheLimitIsRefused) {
+  EventStream s;
+  s.join(100);
+  EXPECT_EQ(take(s, 100), Took::Early);
+  EXPECT_EQ(take(s, 7), Took::Early);
+  EXPECT_EQ(take(s, 101 + kMaxSeqJump), Took::TooFar);
+  EXPECT_EQ(s.last(), 100) << "a refused number moves nothing";
+  EXPECT_EQ(take(s, 100 + kMaxSeqJump), Took::Next);
+}
+
+TEST(EventStream, MoreOpenGapsThanTheLimitPushTheOldestOutAsMissed) {
+  EventStream s;
+  s.join(0);
+  for (std::size_t i = 0; i < EventStream::kMaxGaps; ++i)
+    EXPECT_EQ(take(s, 2 * static_cast<std::int64_t>(i) + 2), Took::Next);
+  std::optional<Range> pushed_out;
+  EXPECT_EQ(s.take(2 * static_cast<std::int64_t>(EventStream::kMaxGaps) + 2, 0, pushed_out), Took::Next);
+  ASSERT_TRUE(pushed_out);
+  EXPECT_EQ(EventStream::text(*pushed_out), "1") << "the oldest gap, missed at once";
+  EXPECT_EQ(take(s, 1), Took::Late);
+  EXPECT_EQ(take(s, 3), Took::Filled);
+}
+
+TEST(EventStream, RecordsReadFromTheHistoryCloseEveryGapBelowThem) {
+  EventStream s;
+  s.join(0);
+  EXPECT_EQ(take(s, 3), Took::Next);
+  EXPECT_EQ(take(s, 9), Took::Next);  // gaps 1..2 and 4..8
+  s.caught_up(5);
+  EXPECT_TRUE(s.has_gaps()) << "6..8 not read yet";
+  EXPECT_EQ(take(s, 4), Took::Again);
+  EXPECT_EQ(take(s, 7), Took::Filled);
+  s.caught_up(12);
+  EXPECT_FALSE(s.has_gaps());
+  EXPECT_EQ(s.last(), 12);
+  EXPECT_EQ(take(s, 13), Took::Next);
+}
+
 TEST(IncarnationBounds, AnIncarnationNotPositiveOrMoreThanAMinuteAheadOfTheClockIsRefused) {
   EXPECT_TRUE(incarnation_out_of_bounds("a heartbeat", "robot", new_incarnation()).empty());
   EXPECT_FALSE(incarnation_out_of_bounds("a heartbeat", "robot", 0).empty());
