@@ -94,7 +94,7 @@ struct RemoteClient::Impl {
   std::atomic<std::uint64_t> refused{0};
   std::atomic<std::uint64_t> gaps{0};
   std::atomic<std::uint64_t> read{0};  ///< records delivered from the history (Follower::deliver_kept)
-  std::int64_t incarnation = 0;        ///< of the coordinator process proven alive at connect()
+  wire::Heartbeat proven;              ///< the heartbeat the coordinator's proof of life carried at connect()
   /// Counts the bus messages that do not decode (a client logs nothing of its own).
   std::shared_ptr<DropLog> undecodable = std::make_shared<DropLog>(nullptr);
 
@@ -185,7 +185,7 @@ Expected<std::unique_ptr<RemoteClient>> RemoteClient::connect(ClientOptions opti
         if (proven.error().code == ErrorCode::Io) finder->retry(control);  // no answer: ask again, not a bad proof
         continue;
       }
-      impl->incarnation = proven->beat.incarnation;
+      impl->proven = proven->beat;
       impl->endpoint = control;
       found = Ice::uncheckedCast<wire::ControlPrx>(proven->proxy);
       break;
@@ -255,11 +255,10 @@ std::vector<Out> rows_from_wire(const Seq& seq) {
 class Follower final {
 public:
   Follower(RemoteClient::Impl& client, introspect::RecordSink sink, std::uint64_t last)
-      : client_(client),
-        sink_(std::move(sink)),
-        control_(client.control),
-        last_(last),
-        incarnation_(client.incarnation) {}
+      : client_(client), sink_(std::move(sink)), control_(client.control), last_(last) {
+    std::string why;
+    (void)fresh_.proven(client.proven, why);  // the process proven at connect(): a first proof is never refused
+  }
 
   void on_records(const wire::Signed& batch);
   void on_heartbeat(const wire::Signed& beat);
@@ -320,9 +319,11 @@ private:
   std::shared_ptr<wire::ControlPrx> control_;  ///< the client's, until the coordinator restarts
   std::mutex mutex_;                           // everything below and the sink's calls
   bool stopped_ = false;
-  std::uint64_t last_;         ///< the last record delivered (its coordinator-wide seq)
-  std::int64_t incarnation_;   ///< of the coordinator process proven alive, whose records are followed
-  std::int64_t beat_seq_ = 0;  ///< the last heartbeat of that process taken
+  std::uint64_t last_;  ///< the last record delivered (its coordinator-wide seq)
+  /// The coordinator process proven alive, whose records are followed, and its heartbeats' numbers
+  /// (receiver.hpp, every receiver's freshness rules).
+  PeerFreshness fresh_;
+  bool joined_ = false;  ///< a heartbeat of that process was taken (its history read once)
   std::chrono::steady_clock::time_point last_beat_ = std::chrono::steady_clock::now();  ///< when
   std::chrono::steady_clock::duration beat_interval_{};  ///< between its last two heartbeats
   /// The followed process's event stream (receiver.hpp, the supervisor's too): a number skipped,
@@ -434,28 +435,33 @@ void Follower::on_heartbeat(const wire::Signed& m) {
     return;
   }
   const wire::Heartbeat& h = opened.beat;
-  if (h.incarnation < incarnation_) {
-    ++client_.refused;  // a replay from an earlier process
-    return;
-  }
-  if (h.incarnation > incarnation_) {
+  std::string why;
+  PeerFreshness::Verdict v = fresh_.heartbeat(h.incarnation, h.seq, why);
+  bool restarted = false;
+  if (v == PeerFreshness::Verdict::Unproven) {
     // A process not proven alive: a restart of the coordinator (followed once the endpoint proves
     // it), or a replay of a run that is over (refused).
     auto beat = prove_restart();
-    if (!beat || beat->incarnation != h.incarnation) {
+    if (!beat || beat->incarnation != h.incarnation || !fresh_.proven(*beat, why)) {
       ++client_.refused;
       return;
     }
-    incarnation_ = h.incarnation;
     last_ = 0;  // a restarted coordinator numbers its records from 1 again
-    beat_seq_ = 0;
+    joined_ = false;
     stream_ = EventStream{};
     unreceived_.clear();
     delivered_.clear();
+    restarted = true;
+    // Sent with or before the proof (Covered): of the process just proven all the same.
+    v = fresh_.heartbeat(h.incarnation, h.seq, why);
   }
-  if (h.seq <= beat_seq_) return;  // a replay or a duplicate of one taken
-  const bool first = beat_seq_ == 0;
-  beat_seq_ = h.seq;
+  if (v == PeerFreshness::Verdict::Refuse) {
+    ++client_.refused;  // a replay: of an earlier process, or a heartbeat taken already
+    return;
+  }
+  if (v == PeerFreshness::Verdict::Covered && !restarted) return;  // no news: the proof was fresher
+  const bool first = !joined_;
+  joined_ = true;
   const auto now = std::chrono::steady_clock::now();
   if (!first) beat_interval_ = now - last_beat_;
   last_beat_ = now;
@@ -505,7 +511,8 @@ void Follower::on_heartbeat(const wire::Signed& m) {
 void Follower::deliver(const wire::EventMessageSeq& messages) {
   introspect::HistoryEntry entry;
   for (const wire::EventMessage& m : messages) {
-    if (m.coordinator != client_.options.coordinator || m.incarnation != incarnation_ || !from_wire(m.record, entry)) {
+    if (m.coordinator != client_.options.coordinator || m.incarnation != fresh_.incarnation() ||
+        !from_wire(m.record, entry)) {
       ++client_.refused;  // misattributed, of another process, or malformed
       continue;
     }
