@@ -340,55 +340,45 @@ private:
 
 class RemoteSubscription final : public introspect::Subscription {
 public:
-  struct Subscribed {
-    std::shared_ptr<IceStorm::TopicPrx> topic;
-    std::shared_ptr<Ice::Object> servant;
-    std::shared_ptr<Ice::ObjectPrx> proxy;
-  };
   /// Heard nothing of the followed process for this long: the subscriptions are made again.
   static constexpr std::chrono::seconds kSilence{1};
   RemoteSubscription(std::shared_ptr<Follower> follower, std::shared_ptr<Ice::ObjectAdapter> adapter,
-                     std::vector<Subscribed> subscribed)
-      : follower_(std::move(follower)), adapter_(std::move(adapter)), subscribed_(std::move(subscribed)) {}
+                     std::unique_ptr<Link> link, std::vector<std::string> topics)
+      : follower_(std::move(follower)),
+        adapter_(std::move(adapter)),
+        link_(std::move(link)),
+        topics_(std::move(topics)) {}
   /// The records the stream did not bring, from the history; and when no heartbeat of the process
-  /// followed came for kSilence, the subscriptions made again under new identities: IceStorm
-  /// lists subscriber identities to whoever may call a topic, so another holder of a certificate
-  /// can take one (docs/security.md), and a follower would otherwise show no new record from the
-  /// stream until it is restarted.
+  /// followed came for kSilence, the subscriptions made again under new identities (Link::renew,
+  /// as every member does): IceStorm lists subscriber identities to whoever may call a topic, so
+  /// another tool can take one at the tools' broker (docs/security.md), and a follower would
+  /// otherwise show no new record from the stream until it is restarted. Every call also takes
+  /// the answers of earlier renewals, and every tenth makes again a subscription IceStorm dropped
+  /// (Link::check).
   [[nodiscard]] Expected<std::size_t> catch_up() override {
     auto caught = follower_->catch_up();
-    if (caught && follower_->silent(kSilence)) {
-      for (Subscribed& s : subscribed_) {
-        try {
-          s.topic->unsubscribe(s.proxy);
-          auto renewed = adapter_->addWithUUID(s.servant);
-          subscribe(s.topic, renewed);
-          adapter_->remove(s.proxy->ice_getIdentity());
-          s.proxy = renewed;
-        } catch (const Ice::Exception& e) {
-          return fail(ErrorCode::Io,
-                      std::string("records: IceStorm did not take the subscription again (") + e.ice_id() + ")");
-        }
+    try {
+      if (caught && follower_->silent(kSilence)) {
+        for (const std::string& t : topics_) link_->renew(t);
       }
+      (void)link_->check(false);
+    } catch (const Ice::Exception& e) {
+      return fail(ErrorCode::Io,
+                  std::string("records: IceStorm did not take the subscription again (") + e.ice_id() + ")");
     }
     return caught;
   }
   ~RemoteSubscription() override {
     follower_->stop();
-    for (const Subscribed& s : subscribed_) {
-      try {
-        s.topic->unsubscribe(s.proxy);
-      } catch (const Ice::Exception&) {
-        // IceStorm is gone: it drops the subscriber by itself.
-      }
-    }
+    link_->unsubscribe();
     adapter_->destroy();
   }
 
 private:
   std::shared_ptr<Follower> follower_;
   std::shared_ptr<Ice::ObjectAdapter> adapter_;
-  std::vector<Subscribed> subscribed_;
+  std::unique_ptr<Link> link_;
+  std::vector<std::string> topics_;
 };
 
 }  // namespace
@@ -669,20 +659,26 @@ Expected<std::unique_ptr<introspect::Subscription>> RemoteClient::follow(introsp
     auto adapter = impl_->ic->createObjectAdapterWithEndpoints("SafecassFollow-" + Ice::generateUUID(),
                                                                protocol(o.tls) + " -h " + o.listen_host);
     auto follower = std::make_shared<Follower>(*impl_, std::move(sink), last);
-    const auto manager = topic_manager(impl_->ic, tools_broker(o.ice), o.tls);
     const auto subscriber = [&](const char* operation, std::function<void(const wire::Signed&)> handler) {
       return std::make_shared<TopicSubscriber>(impl_->ic, operation, std::move(handler), impl_->undecodable, "console");
     };
-    std::vector<RemoteSubscription::Subscribed> subscribed{
-        {topic(manager, kEventTopic),
-         subscriber("records", [follower](const wire::Signed& m) { follower->on_records(m); })},
-        {topic(manager, heartbeat_topic(o.coordinator)),
-         subscriber("beat", [follower](const wire::Signed& m) { follower->on_heartbeat(m); })}};
-    for (auto& s : subscribed) s.proxy = adapter->addWithUUID(s.servant);
+    // The subscriptions are a Link's, as a member's are: each under an identity of its own, made
+    // again under a new one when taken (RemoteSubscription::catch_up).
+    const std::string category = std::string(kFollowerCategory) + Ice::generateUUID();
+    auto link = std::make_unique<Link>(impl_->ic, tools_broker(o.ice), o.tls);
+    const std::vector<std::string> topics{kEventTopic, heartbeat_topic(o.coordinator)};
+    link->subscribe_to(
+        topics[0],
+        add_subscriber(adapter, subscriber("records", [follower](const wire::Signed& m) { follower->on_records(m); }),
+                       category + "-records"));
+    link->subscribe_to(
+        topics[1],
+        add_subscriber(adapter, subscriber("beat", [follower](const wire::Signed& m) { follower->on_heartbeat(m); }),
+                       category + "-beat"));
     adapter->activate();
-    for (const auto& s : subscribed) subscribe(s.topic, s.proxy);
+    link->connect({});
     return std::unique_ptr<introspect::Subscription>(
-        std::make_unique<RemoteSubscription>(follower, adapter, std::move(subscribed)));
+        std::make_unique<RemoteSubscription>(follower, adapter, std::move(link), topics));
   } catch (const Ice::Exception& e) {
     return fail(ErrorCode::Io,
                 "cannot follow coordinator '" + impl_->options.coordinator + "' on IceStorm: " + e.what());

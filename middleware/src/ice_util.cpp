@@ -274,14 +274,27 @@ void Link::connect(const std::vector<std::string>& publish_on) {
   }
   publishers_.clear();
   linked_.clear();
-  tools_ =
-      Ice::uncheckedCast<IceStorm::TopicManagerPrx>(topic_manager(ic_, tools_broker(ice_), tls_)->ice_connectionId(id));
+  // A tool's link (at the tools' broker already) links nothing.
+  if (!ice_.tools)
+    tools_ = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+        topic_manager(ic_, tools_broker(ice_), tls_)->ice_connectionId(id));
   for (const std::string& name : publish_on) {
     auto t = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, name)->ice_connectionId(id));
     publishers_.emplace_back(name, t->getPublisher()->ice_oneway()->ice_connectionId(id));
-    if (!tools_hear(name)) continue;
+    if (!tools_hear(name) || tools_ == nullptr) continue;
     linked_.emplace_back(name, t);
     link_for_tools(t, tools_, name);
+  }
+}
+
+void Link::unsubscribe() noexcept {
+  for (Subscription& s : subscriptions_) {
+    if (s.proxy == nullptr || s.subscriber == nullptr) continue;
+    try {
+      s.proxy->unsubscribe(s.subscriber->ice_oneway());
+    } catch (const Ice::Exception&) {
+      // IceStorm is gone, or does not answer: it drops the subscriber by itself.
+    }
   }
 }
 

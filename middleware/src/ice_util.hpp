@@ -35,6 +35,8 @@ inline std::string heartbeat_topic(std::string_view signer) {
   return std::string(kHeartbeatTopic) + "." + std::string(signer);
 }
 inline constexpr const char* kResyncTopic = "safecass.resync";
+/// The subscriber categories of a tool's follower start with this (RemoteClient::follow).
+inline constexpr std::string_view kFollowerCategory = "safecass-follow-";
 /// The topics tools hear: the events and the heartbeats. A tool cannot reach the members' broker
 /// (its certificate is refused there); each member links the topics of these it publishes on to
 /// the topics of the same names at the tools' broker (tools_broker()), which forward what is
@@ -124,6 +126,9 @@ public:
   }
   /// Throws Ice exceptions when IceStorm cannot be reached.
   void connect(const std::vector<std::string>& publish_on);
+  /// Removes every subscription of this link from IceStorm (a follower that stops); what IceStorm
+  /// does not answer it drops by itself once delivery fails.
+  void unsubscribe() noexcept;
   /// The oneway publisher of a topic given to connect().
   std::shared_ptr<Ice::ObjectPrx> publisher(const std::string& topic) const;
   /// Throws when IceStorm does not answer.

@@ -2107,8 +2107,7 @@ TEST(Wire, ABatchNoHeartbeatOfItsCoordinatorVouchesForIsNeverShown) {
 /// A tool (`thief`) takes the subscriptions of wire-c's followers to its heartbeats (the nodes'
 /// identities have a category, a follower's none); the identities it took.
 std::vector<Ice::Identity> take_followers_beats(Bus& bus, ImpostorProcess& thief) {
-  return take_subscriptions(bus, thief, "safecass.heartbeat.wire-c",
-                            [](const Ice::Identity& id) { return id.category.empty(); });
+  return take_subscriptions(bus, thief, "safecass.heartbeat.wire-c", of(std::string(middleware::kFollowerCategory)));
 }
 
 // Every gap fails toward completeness: a follower whose records stop coming (its subscription to
@@ -2126,10 +2125,8 @@ TEST(Wire, AFollowerReadsFromTheHistoryTheRecordsItsHeartbeatsListAndThatNeverCa
   const std::uint64_t read = follower.client->records_read();
   const std::uint64_t gaps = follower.client->gaps_filled();
   ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
-  ASSERT_EQ(
-      take_subscriptions(bus, thief, "safecass.events", [](const Ice::Identity& id) { return id.category.empty(); })
-          .size(),
-      1u);
+  ASSERT_EQ(take_subscriptions(bus, thief, "safecass.events", of(std::string(middleware::kFollowerCategory))).size(),
+            1u);
   ASSERT_TRUE(reset(bus.co, "C", "operator", "never came").has_value());
   EXPECT_TRUE(eventually([&] { return follower.shows("never came"); }, 3000ms)) << "read from the history";
   EXPECT_TRUE(eventually([&] { return !thief.servant->seen().empty(); })) << "the stream went to the thief";
@@ -2160,7 +2157,7 @@ TEST(Wire, AFollowerWhoseHeartbeatSubscriptionIsTakenSubscribesAgainWhenItCatche
   // follower subscribes under a new identity (unsubscribing its old one, which the thief held).
   const auto subscribed_anew = [&] {
     for (const Ice::Identity& id : bus.subscribers("safecass.heartbeat.wire-c", fixture::Broker::Tools))
-      if (id.category.empty() && id != taken[0]) return true;
+      if (id.category.starts_with(middleware::kFollowerCategory) && id != taken[0]) return true;
     return false;
   };
   ASSERT_TRUE(eventually(
