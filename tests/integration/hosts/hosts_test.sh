@@ -53,7 +53,12 @@ hosts_up "sc$$" a b c
 ice="10.77.0.3:4061"
 
 # The broker and the supervisor on c, the robot on a, the ui on b.
-if [ "$case_name" = across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another_hosts_replica_dies ]; then
+replicated=0
+case $case_name in
+  across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another_hosts_replica_dies | \
+    across_hosts_a_cut_host_makes_only_its_own_coordinators_lost) replicated=1 ;;
+esac
+if [ $replicated = 1 ]; then
   # IceStorm replicated under IceGrid: the registry on c, a node and a replica on each host
   # (replica i on the i-th host: 1 on a, 2 on b, 3 on c). The registry's host waits for the
   # master's election, which needs the nodes of a and b.
@@ -211,6 +216,28 @@ across_hosts_a_replicated_broker_keeps_the_views_true_when_its_master_or_another
   hosts_heal a
   retry 30 ui_shows Normal
   check "after healing the ui's view is Normal again" test $? -eq 0
+  ;;
+across_hosts_a_cut_host_makes_only_its_own_coordinators_lost)
+  # A known defect (issue "records once", item 6): host a, with the robot and replica 1, is cut
+  # off; the processes on b and c must go on as before, only the robot lost. Today IceStorm's
+  # replicas re-form their group without replica 1 and hold delivery meanwhile, longer than the
+  # loss bound, so the supervisor on c reports the ui on b lost for seconds (docs/deployment.md).
+  has_master() { [ -n "$(hosts_broker_master c "$HOSTS_DIR/ice")" ]; }
+  retry 30 has_master
+  check "the three replicas agree on a master before the cut" test $? -eq 0
+  retry 20 grep -q "coordinator 'ui' is up" supervisor.log
+  check "the supervisor on c hears the ui on b" test $? -eq 0
+  ui_losses=$(grep -c "coordinator 'ui' lost" supervisor.log)
+  robot_losses=$(grep -c "coordinator 'robot' lost" supervisor.log)
+  robot_lost() { [ "$(grep -c "coordinator 'robot' lost" supervisor.log)" -gt "$robot_losses" ]; }
+  hosts_cut a
+  retry 10 robot_lost
+  check "with host a cut off, the supervisor on c reports the robot lost" test $? -eq 0
+  # What must not happen has no condition to wait for: it is watched for 10 s after the cut (the
+  # stall it looks for lasted 4-10 s), then host a comes back.
+  sleep 10
+  check "and never the ui on b, whose host was not cut" test "$(grep -c "coordinator 'ui' lost" supervisor.log)" -eq "$ui_losses"
+  hosts_heal a
   ;;
 across_hosts_no_certificate_another_ca_and_non_members_are_refused)
   mkdir -p no-certs && chmod 700 no-certs && cp keys/keyring no-certs/
