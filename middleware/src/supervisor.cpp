@@ -470,14 +470,15 @@ struct Supervisor::Impl {
   void believe(const wire::Heartbeat& h, Peer& peer, std::vector<std::string>& recovered, bool& resync) {
     peer.control = h.control;
     // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
-    // here: the heartbeat lists the last record sent. Behind on two heartbeats in a row (the
-    // records may be on their way on the other topic): reported as missed.
+    // here: the heartbeat lists the last record sent. What the heartbeat two before this one
+    // listed and has not come (the records may be on their way on the other topic until then):
+    // reported as missed (EventStream::heard).
     const auto sent = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
     if (const auto missed = peer.records.heard(sent == h.lastSeq.end() ? 0 : sent->second)) {
       report_missed(peer, h.coordinator, *missed);
       link->renew({kEventTopic});  // the records may no longer reach us at all
     }
-    // The same for the state streams, whether records are followed or not: an update lost with
+    // The state streams too, whether records are followed or not: an update lost with
     // nothing after it on its interface would leave the view of that service stale. Behind on two
     // heartbeats in a row: the coordinator is asked to republish its full state; behind for
     // longer than the loss bound: lost (watch_loop), as a receiver whose subscription was taken

@@ -2014,6 +2014,10 @@ struct WireFollower {
     return std::any_of(shown.begin(), shown.end(),
                        [&](const std::string& s) { return s.find(text) != std::string::npos; });
   }
+  /// wire-c resets C with `text`, and the follower shows it: it is following.
+  bool shows_reset(Bus& bus, const std::string& text) {
+    return reset(bus.co, "C", "operator", text).has_value() && eventually([&] { return shows(text); });
+  }
 };
 
 // Records travel once: a follower holds only the keyring, and takes each record from the batch
@@ -2025,8 +2029,7 @@ TEST(Wire, AFollowerTakesEachRecordFromTheBatchAHeartbeatVouchesForAndReadsNoHis
   ASSERT_TRUE(bus.node);
   WireFollower follower(bus);
   ASSERT_TRUE(follower.subscription);
-  ASSERT_TRUE(reset(bus.co, "C", "operator", "first").has_value());
-  ASSERT_TRUE(eventually([&] { return follower.shows("first"); })) << "the follower is following";
+  ASSERT_TRUE(follower.shows_reset(bus, "first")) << "the follower is following";
   const std::uint64_t read = follower.client->records_read();
   const std::uint64_t gaps = follower.client->gaps_filled();
   for (int k = 0; k < 10; ++k) ASSERT_TRUE(reset(bus.co, "C", "operator", "round " + std::to_string(k)).has_value());
@@ -2120,8 +2123,7 @@ TEST(Wire, AFollowerReadsFromTheHistoryTheRecordsItsHeartbeatsListAndThatNeverCa
   ASSERT_TRUE(bus.node);
   WireFollower follower(bus);
   ASSERT_TRUE(follower.subscription);
-  ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
-  ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
+  ASSERT_TRUE(follower.shows_reset(bus, "before"));
   const std::uint64_t read = follower.client->records_read();
   const std::uint64_t gaps = follower.client->gaps_filled();
   ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
@@ -2147,8 +2149,7 @@ TEST(Wire, AFollowerWhoseHeartbeatSubscriptionIsTakenSubscribesAgainWhenItCatche
   ASSERT_TRUE(bus.node);
   WireFollower follower(bus);
   ASSERT_TRUE(follower.subscription);
-  ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
-  ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
+  ASSERT_TRUE(follower.shows_reset(bus, "before"));
   ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
   const std::vector<Ice::Identity> taken = take_followers_beats(bus, thief);
   ASSERT_EQ(taken.size(), 1u);
@@ -2182,8 +2183,7 @@ TEST(Wire, AFloodOfBatchesNoHeartbeatVouchesForDoesNotGrowAFollowersMemory) {
   ASSERT_TRUE(bus.node);
   WireFollower follower(bus);
   ASSERT_TRUE(follower.subscription);
-  ASSERT_TRUE(reset(bus.co, "C", "operator", "before").has_value());
-  ASSERT_TRUE(eventually([&] { return follower.shows("before"); }));
+  ASSERT_TRUE(follower.shows_reset(bus, "before"));
   // A tool takes the follower's subscription to wire-c's heartbeats.
   ImpostorProcess thief(bus.keys, "reader", kKeepsEverything);
   ASSERT_EQ(take_followers_beats(bus, thief).size(), 1u);
