@@ -2,6 +2,7 @@
 
 #include "verify_command.hpp"
 
+#include <chrono>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -45,6 +46,10 @@ void add_verify_command(CLI::App& app, int& code) {
     std::string system;
     verify::Options options;
     bool json = false;
+    bool bus = false;
+    bool mutants = false;
+    verify::BusOptions bus_options;
+    long period_ms = 100, lost_after_ms = 0, supervisor_lost_after_ms = 600;
   };
   auto args = std::make_shared<Args>();
   auto* cmd = app.add_subcommand("verify",
@@ -61,7 +66,29 @@ void add_verify_command(CLI::App& app, int& code) {
   cmd->add_flag(
       "--no-merge", [args](std::int64_t) { args->options.merge = false; },
       "track every onset on its own (no counting of interchangeable onsets)");
-  cmd->callback([args, &code] { code = run_verify(args->system, args->options, args->json); });
+  cmd->add_flag("--bus", args->bus,
+                "model-check the bus protocol for this deployment instead (P1-P5, docs/verify.md \"The bus\")");
+  cmd->add_option("--period", args->period_ms, "--bus: the heartbeat period in ms (default 100)");
+  cmd->add_option("--lost-after", args->lost_after_ms, "--bus: the coordinators' loss bound in ms (default 3 periods)");
+  cmd->add_option("--supervisor-lost-after", args->supervisor_lost_after_ms,
+                  "--bus: the supervisor's loss bound in ms (default 600)");
+  cmd->add_flag(
+      "--no-supervisor", [args](std::int64_t) { args->bus_options.supervisor = false; },
+      "--bus: the deployment runs no supervisor");
+  cmd->add_option("--fault-class", args->bus_options.fault_class, "--bus: search only this fault class");
+  cmd->add_option("--mutant", args->bus_options.mutant, "--bus: remove this rule from the model (see --mutants)");
+  cmd->add_flag("--mutants", args->mutants, "--bus: check that each mutant of the protocol is caught by a property");
+  cmd->callback([args, &code] {
+    if (!args->bus) {
+      code = run_verify(args->system, args->options, args->json);
+      return;
+    }
+    args->bus_options.period = std::chrono::milliseconds(args->period_ms);
+    args->bus_options.lost_after = std::chrono::milliseconds(args->lost_after_ms);
+    args->bus_options.supervisor_lost_after = std::chrono::milliseconds(args->supervisor_lost_after_ms);
+    if (args->options.memory_mb != verify::Options{}.memory_mb) args->bus_options.memory_mb = args->options.memory_mb;
+    code = run_verify_bus(args->system, args->bus_options, args->json, args->mutants);
+  });
 }
 
 int run_verify(const std::string& system_path, const verify::Options& options, bool json) {

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "safecass/verify/bus.hpp"
 #include "safecass/verify/verify.hpp"
 
 namespace safecass::tools {
@@ -17,5 +18,11 @@ void add_verify_command(CLI::App& app, int& code);
 /// violated, 2 bad input (errors in the specification, SPIN missing, an unknown property),
 /// 3 one could not be decided within the limits.
 int run_verify(const std::string& system_path, const verify::Options& options, bool json);
+
+/// `safecass verify --bus`: loads `system_path` and model-checks the bus protocol for its
+/// deployment; prints the patterns, each search and each property's verdict, and a violation's
+/// trace. With `mutants`, runs every mutant of bus_mutants() instead and prints which property
+/// catches it. Exit codes as run_verify (a mutant not caught is exit 1).
+int run_verify_bus(const std::string& system_path, const verify::BusOptions& options, bool json, bool mutants);
 
 }  // namespace safecass::tools

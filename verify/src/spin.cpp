@@ -136,8 +136,9 @@ bool write_file(const std::string& path, const std::string& text) {
   // Safety: breadth-first (shortest trail), no cycle detection. LTL: depth-first with cycles.
   // COLLAPSE compresses each state; MEMLIM stops the search at the bound instead of swapping.
   // The verifier is small and runs briefly: no optimisation, the compilation is what costs.
-  std::string flags = "-O0 -w -DMEMLIM=" + std::to_string(options.memory_mb) + " -DCOLLAPSE -DVECTORSZ=4096";
-  if (!options.ltl) flags += " -DSAFETY -DBFS";
+  std::string flags = std::string(options.optimise ? "-O2" : "-O0") +
+                      " -w -DMEMLIM=" + std::to_string(options.memory_mb) + " -DCOLLAPSE -DVECTORSZ=4096";
+  if (!options.ltl) flags += options.shortest ? " -DSAFETY -DBFS" : " -DSAFETY";
   const std::string binary = "pan_" + name;
   auto cc = run_command(dir, shell_quote(options.cc) + " " + flags + " -o " + shell_quote(binary) + " pan.c");
   if (!cc) return tl::unexpected(cc.error());
@@ -152,17 +153,19 @@ bool write_file(const std::string& path, const std::string& text) {
   std::error_code ec;
   const std::string trail = dir + "/" + name + ".pml.trail";
   fs::remove(trail, ec);
-  std::string run =
-      "./" + shell_quote(binary) + " -n -N " + shell_quote(claim) + " -w" + std::to_string(options.hash_bits);
+  const std::string which = claim.empty() ? std::string() : " -N " + shell_quote(claim);
+  std::string run = "./" + shell_quote(binary) + " -n" + which + " -w" + std::to_string(options.hash_bits);
   if (options.ltl) run += " -a -m1000000";
+  if (!options.ltl && !options.shortest) run += " -m200000";
   auto pan = run_command(dir, run);
   if (!pan) return tl::unexpected(pan.error());
   PanResult r;
   r.output = pan->output;
   r.states = number_before(r.output, "states, stored");
   r.memory_mb = double_before(r.output, "total actual memory usage");
-  const bool limit =
-      r.output.find("MEMLIM") != std::string::npos || r.output.find("out of memory") != std::string::npos;
+  const bool limit = r.output.find("MEMLIM") != std::string::npos ||
+                     r.output.find("out of memory") != std::string::npos ||
+                     r.output.find("max search depth too small") != std::string::npos;
   const bool errors = r.output.find("errors: 0") == std::string::npos && r.output.find("errors:") != std::string::npos;
   if (limit) {
     r.outcome = PanResult::Outcome::MemoryLimit;
@@ -175,7 +178,7 @@ bool write_file(const std::string& path, const std::string& text) {
     r.outcome = PanResult::Outcome::Holds;
   }
   if (r.outcome == PanResult::Outcome::Violated && fs::exists(trail, ec)) {
-    auto replay = run_command(dir, "./" + shell_quote(binary) + " -r -S -n -N " + shell_quote(claim));
+    auto replay = run_command(dir, "./" + shell_quote(binary) + " -r -S -n" + which);
     if (!replay) return tl::unexpected(replay.error());
     r.trail = marked_lines(replay->output, &r.cycle, &r.cycle_start);
   }

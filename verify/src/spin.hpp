@@ -42,7 +42,10 @@ private:
 struct PanOptions {
   bool ltl = false;  ///< search for acceptance cycles (-a), depth-first; else safety, breadth-first
   std::size_t memory_mb = 4096;
-  int hash_bits = 20;  ///< -w
+  int hash_bits = 20;     ///< -w
+  bool optimise = false;  ///< compile the verifier with -O2: for searches long enough to repay it
+  bool shortest = true;   ///< safety: breadth-first, so that a trail is a shortest one (else depth-first:
+                          ///< faster, half the memory, any trail)
   std::string spin = "spin";
   std::string cc = "cc";
 };
@@ -63,8 +66,8 @@ struct PanResult {
 [[nodiscard]] Expected<std::string> compile(const std::string& dir, const std::string& name, const std::string& model,
                                             const PanOptions& options);
 
-/// Checks claim `claim` with the verifier `binary` of model `name`; on a violation, replays the
-/// trail (pan -r). Errors: Io.
+/// Checks claim `claim` (empty: the model's assertions only) with the verifier `binary` of model
+/// `name`; on a violation, replays the trail (pan -r). Errors: Io.
 [[nodiscard]] Expected<PanResult> check_claim(const std::string& dir, const std::string& name,
                                               const std::string& binary, const std::string& claim,
                                               const PanOptions& options);
