@@ -35,6 +35,10 @@ demo: configure
 	@echo "Model-checking robodoc's hazard reactions with SPIN (safecass verify):"
 	@./$(BUILD)/bin/safecass verify examples/robodoc/robodoc.json --out $(BUILD)/demo/counterexamples
 	@./$(BUILD)/bin/safecass verify examples/robodoc/robodoc.json --json >$(BUILD)/demo/verify.jsonl 2>/dev/null
+	@echo "Model-checking the bus protocol of robodoc's deployment (safecass verify --bus, about a minute):"
+	@./$(BUILD)/bin/safecass verify --bus examples/robodoc/robodoc.json >$(BUILD)/demo/verify-bus.txt \
+	  || { cat $(BUILD)/demo/verify-bus.txt; exit 1; }
+	@grep -E '^P[1-5] |proved' $(BUILD)/demo/verify-bus.txt | cut -c1-120
 	@./$(BUILD)/bin/safecass trace examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json \
 	  examples/robodoc/injection.json examples/robodoc/warnings.json examples/robodoc/overload.json --verify $(BUILD)/demo/verify.jsonl --csv $(BUILD)/demo/trace.csv \
 	  --html $(BUILD)/demo/trace.html >$(BUILD)/demo/trace.txt 2>/dev/null \
@@ -143,8 +147,9 @@ bench-peers: deps
 bench-scale-out: build
 	@./scripts/bench-scale-out $(BUILD) $(BUILD)/bench-scale-out.json $(BENCH_SCALE_OUT_ARGS)
 
-# `safecass verify` on robodoc and on a generated 50-component tree with hazards: wall-clock time
-# (SPIN and the C compiler included) and memory, written to build/bench-verify.json.
+# `safecass verify` on robodoc and on a generated 50-component tree with hazards, and
+# `safecass verify --bus` on robodoc's deployment: wall-clock time (SPIN and the C compiler
+# included) and memory, written to build/bench-verify.json.
 bench-verify: build
 	@./$(BUILD)/bin/bench_verify $(BUILD)/bench-verify.json
 

@@ -169,6 +169,7 @@ struct CoordinatorNode::Impl {
     bool resync_pending = false;          ///< a request arrived too soon after the last one
     bool provider = false;                ///< it runs a provider of an interface held here
     std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
+    std::size_t behind = 0;               ///< interfaces held of it that a heartbeat showed ahead
   };
   std::map<std::string, Peer, std::less<>> peers;
   std::mutex peer_mutex;       ///< held, peers; taken before a coordinator write, never inside an observer
@@ -708,8 +709,10 @@ struct CoordinatorNode::Impl {
     }
     h.incarnation = u.incarnation;
     h.last_seq = u.seq;
-    h.behind = false;
-    peer.live.caught_up(stream_scratch);
+    if (h.behind) {
+      h.behind = false;
+      if (--peer.behind == 0) peer.live.caught_up();  // every interface held of it, not only this one
+    }
     updates_applied.fetch_add(1);
   }
 
@@ -747,15 +750,16 @@ struct CoordinatorNode::Impl {
         refuse(m.signer, "a heartbeat of '" + printable(hb.coordinator) + "': " + why);
         return;
     }
-    believe(hb, peer, now, false);
+    believe(hb, peer, now, peer.fresh.sent_at(hb.time, now), false);
   }
 
-  /// A proof of life of `who` (Prover, on an Ice thread): its process is believed from now on.
-  void on_proven(const std::string& who, const wire::Heartbeat& beat) {
+  /// A proof of life of `who` (Prover, on an Ice thread), to a question sent at `asked`: its
+  /// process is believed from now on.
+  void on_proven(const std::string& who, const wire::Heartbeat& beat, std::int64_t asked) {
     std::lock_guard lock(peer_mutex);
     Peer& peer = peers[who];
     const std::int64_t before = peer.fresh.incarnation();
-    if (std::string why; !peer.fresh.proven(beat, why)) {
+    if (std::string why; !peer.fresh.proven(beat, why, asked)) {
       refuse(who, "a proof of life of '" + printable(who) + "': " + why);
       return;
     }
@@ -763,12 +767,12 @@ struct CoordinatorNode::Impl {
       log("middleware: " + name + ": coordinator '" + who + "' proved alive (incarnation " +
           std::to_string(beat.incarnation) + ")");
     }
-    believe(beat, peer, steady_ns(), true);
+    believe(beat, peer, steady_ns(), asked, true);
   }
 
-  /// An authentic, fresh heartbeat of `peer` (under peer_mutex): it is alive; what it lists
-  /// sent that is not held here is asked for, and a loss clears once everything is held.
-  void believe(const wire::Heartbeat& hb, Peer& peer, std::int64_t now, bool proof) {
+  /// An authentic, fresh heartbeat of `peer`, sent at `sent` (under peer_mutex): it is alive; what
+  /// it lists sent that is not held here is asked for, and a loss clears once everything is held.
+  void believe(const wire::Heartbeat& hb, Peer& peer, std::int64_t now, std::int64_t sent, bool proof) {
     bool need = proof;          // a process just proven: nothing it sent before is taken, ask for all
     std::string behind_stream;  // the first stream it lists ahead of what is held here
     for (auto& [iface, h] : held) {
@@ -782,11 +786,12 @@ struct CoordinatorNode::Impl {
       // Two heartbeats in a row: the update may simply be on its way on the other topic. A lost
       // provider is asked at once: its clients stay in Error until they have its state.
       if (behind && (h.behind || peer.live.lost())) need = true;
+      if (behind != h.behind) behind ? ++peer.behind : --peer.behind;
       h.behind = behind;
       if (behind && behind_stream.empty()) behind_stream = stream_scratch;
     }
     // Lost if not caught up within the loss bound (watch_loop); back once caught up.
-    if (peer.live.believed(now, behind_stream)) recover(hb.coordinator, peer);
+    if (peer.live.believed(now, sent, behind_stream, lost_after())) recover(hb.coordinator, peer);
     if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
@@ -895,6 +900,7 @@ struct CoordinatorNode::Impl {
       return;
     }
     providers_lost.fetch_add(1);
+    peer.fresh.doubt();  // back only on a new proof of life, never on a recording of it
     log("middleware: " + name + ": coordinator '" + who + "' lost (" + silent + "); EVT_COORDINATOR_LOST on the " +
         std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
     // Its heartbeats or its state may have stopped reaching us only: subscriptions taken by
@@ -1037,7 +1043,10 @@ Expected<void> CoordinatorNode::start() {
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);
     const std::string who = "middleware: " + d.name;
     d.prover = std::make_unique<Prover>(
-        d.ic, *d.keyring, [&d](const std::string& signer, const wire::Heartbeat& beat) { d.on_proven(signer, beat); },
+        d.ic, *d.keyring,
+        [&d](const std::string& signer, const wire::Heartbeat& beat, std::int64_t asked) {
+          d.on_proven(signer, beat, asked);
+        },
         [&d](const std::string& signer, const std::string& why) {
           d.drops->drop(signer, "middleware: " + d.name + ": '" + printable(signer) + "' not proven alive: " + why);
         },

@@ -64,15 +64,16 @@ std::string_view Members::component_of(std::string_view address) { return addres
 
 // ---- Liveness -----------------------------------------------------------------------------------
 
-bool Liveness::believed(std::int64_t now, std::string_view behind) {
-  last_beat_ = now;
+bool Liveness::believed(std::int64_t now, std::int64_t sent, std::string_view behind, std::chrono::milliseconds bound) {
+  const std::int64_t before = last_beat_;
+  if (sent > last_beat_) last_beat_ = sent;
   if (behind.empty()) {
     behind_since_ = 0;
   } else if (behind_since_ == 0) {
-    behind_since_ = now;
+    behind_since_ = before != 0 ? before : last_beat_;
     behind_.assign(behind);
   }
-  if (!lost_ || behind_since_ != 0) return false;
+  if (!lost_ || behind_since_ != 0 || now - last_beat_ > std::chrono::nanoseconds(bound).count()) return false;
   lost_ = false;
   return true;
 }
@@ -221,6 +222,7 @@ PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::str
 
 PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
   if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
+  if (doubt_) return Verdict::Unproven;
   if (seq <= heartbeat_seq_) {
     // The proof carried the heartbeat it was sent with: that one (and older ones still on their
     // way) arrive after it, and are no replay.
@@ -237,6 +239,7 @@ PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64
                                              std::int64_t& missed, std::string& why) {
   missed = 0;
   if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
+  if (doubt_) return Verdict::Unproven;
   auto it = streams_.find(stream);
   if (it == streams_.end()) it = streams_.emplace(std::string(stream), Stream{}).first;
   Stream& s = it->second;
@@ -256,10 +259,11 @@ PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64
   missed = seq - s.last - 1;
   s.last = seq;
   s.from_proof = false;
+  s.taken = seq;
   return Verdict::Accept;
 }
 
-bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why) {
+bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::int64_t asked) {
   if (beat.incarnation < incarnation_) {
     why = "a proof of incarnation " + std::to_string(beat.incarnation) + ", older than " + std::to_string(incarnation_);
     return false;
@@ -279,9 +283,20 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why) {
   // old; what it sends next is above it.
   for (const auto& [stream, last] : beat.lastSeq) {
     Stream& have = streams_[stream];
-    if (last > have.last) have = Stream{last, true};
+    if (last > have.last) {
+      have.last = last;
+      have.from_proof = true;
+    }
   }
+  doubt_ = false;
+  anchor_local_ = asked;
+  anchor_remote_ = beat.time;
   return true;
+}
+
+std::int64_t PeerFreshness::taken(std::string_view stream) const {
+  const auto it = streams_.find(stream);
+  return it == streams_.end() ? 0 : it->second.taken;
 }
 
 std::int64_t PeerFreshness::last(std::string_view stream) const {
@@ -292,7 +307,7 @@ std::int64_t PeerFreshness::last(std::string_view stream) const {
 // ---- Prover -------------------------------------------------------------------------------------
 
 Prover::Prover(std::shared_ptr<Ice::Communicator> ic, const Keyring& keys,
-               std::function<void(const std::string&, const wire::Heartbeat&)> on_proven,
+               std::function<void(const std::string&, const wire::Heartbeat&, std::int64_t)> on_proven,
                std::function<void(const std::string&, const std::string&)> on_refused, std::chrono::milliseconds retry)
     : ic_(std::move(ic)),
       keys_(keys),
@@ -331,7 +346,7 @@ std::string check_proof(const std::shared_ptr<Ice::Communicator>& ic, const Keyr
 }  // namespace
 
 void Prover::done(const std::string& signer, const std::string& endpoint, const std::string& nonce,
-                  const wire::Signed* answer, const std::string& error) {
+                  const wire::Signed* answer, const std::string& error, std::int64_t sent) {
   {
     std::lock_guard lock(mutex_);
     const auto it = questions_.find(signer);
@@ -339,9 +354,13 @@ void Prover::done(const std::string& signer, const std::string& endpoint, const 
     it->second.open = false;
   }
   wire::Heartbeat beat;
-  const std::string why = answer != nullptr ? check_proof(ic_, keys_, signer, endpoint, nonce, *answer, beat) : error;
+  std::string why = answer != nullptr ? check_proof(ic_, keys_, signer, endpoint, nonce, *answer, beat) : error;
+  if (const std::int64_t took = steady_ns() - sent; why.empty() && took > retry_ns_) {
+    why = "its answer came " + std::to_string(took / 1'000'000) + " ms after the question, too late to date its " +
+          "heartbeats by; asked again";
+  }
   if (why.empty()) {
-    on_proven_(signer, beat);
+    on_proven_(signer, beat, sent);
   } else if (on_refused_) {
     on_refused_(signer, why);
   }
@@ -383,16 +402,21 @@ void Prover::ask(const std::string& signer, const std::string& endpoint) {
     nonce = q.nonce;
   }
   const auto failed = [this, signer, endpoint, nonce](const std::string& what) {
-    done(signer, endpoint, nonce, nullptr, what);
+    done(signer, endpoint, nonce, nullptr, what, 0);
   };
   // First the connection, checked to be the signer's own (not_served_by); then the question, on
   // that connection only.
   const auto connected = [this, alive, signer, endpoint, nonce, failed](const std::shared_ptr<Ice::Connection>& con) {
     if (std::string why = not_served_by(ic_, con, signer); !why.empty()) return failed(why);
     try {
+      // The question's time: the nonce leaves now, on a connection already made, so the round trip
+      // is one request (the answer is refused if it is later than a period).
+      const std::int64_t sent = steady_ns();
       alive->ice_fixed(con)->proveAsync(
           bytes_of(nonce),
-          [this, signer, endpoint, nonce](const wire::Signed& answer) { done(signer, endpoint, nonce, &answer, {}); },
+          [this, signer, endpoint, nonce, sent](const wire::Signed& answer) {
+            done(signer, endpoint, nonce, &answer, {}, sent);
+          },
           [failed](const std::exception_ptr& e) { failed("its endpoint did not answer (" + failure_text(e) + ")"); });
     } catch (const Ice::Exception& e) {
       failed(std::string("cannot ask it (") + e.ice_id() + ")");

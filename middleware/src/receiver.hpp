@@ -132,24 +132,50 @@ public:
   Verdict stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed,
                  std::string& why);
   /// A proof of `beat` (checked by the Prover): its incarnation becomes the believed one, and its
-  /// heartbeat and stream numbers the floor below which everything is a replay. Returns false,
-  /// with `why`, when it is older than the believed one.
-  bool proven(const wire::Heartbeat& beat, std::string& why);
+  /// heartbeat and stream numbers the floor below which everything is a replay. `asked` is when
+  /// the nonce it answers was sent (steady ns; 0: not known): the process's heartbeats are dated
+  /// against it from now on (sent_at). Returns false, with `why`, when it is older than the
+  /// believed one.
+  bool proven(const wire::Heartbeat& beat, std::string& why, std::int64_t asked = 0);
   /// The process believed is gone (its peer was declared lost): the next one proven is believed,
   /// whatever its incarnation. Only a proof of a fresh nonce is: a replay of any process stays
   /// refused, since it cannot answer one.
-  void forget() noexcept { incarnation_ = 0; }
+  void forget() noexcept {
+    incarnation_ = 0;
+    doubt_ = false;
+  }
+  /// Its peer was declared lost: the process believed is believed again only on a new proof (its
+  /// heartbeats and state streams are Unproven until then), so that no recording of it (a
+  /// member's replay of heartbeats the receiver never got) ends a loss (verify --bus, P2). Its
+  /// event records are still taken (process()): they end no loss, and none is taken twice. An
+  /// older process stays refused.
+  void doubt() noexcept { doubt_ = true; }
+  /// When the believed process sent what it stamped `remote_time` (Heartbeat::time, its steady
+  /// clock), on this receiver's steady clock: dated against the last proof's question, so at the
+  /// latest by the proof's round trip (never later than `now`). Without a dated proof: `now`.
+  std::int64_t sent_at(std::int64_t remote_time, std::int64_t now) const noexcept {
+    if (anchor_local_ == 0) return now;
+    const std::int64_t sent = anchor_local_ + (remote_time - anchor_remote_);
+    return sent < now ? sent : now;
+  }
   /// The believed incarnation (0: none proven yet).
   std::int64_t incarnation() const noexcept { return incarnation_; }
-  /// The last number accepted on `stream` (0: none).
+  /// The last number accepted on `stream`, or listed by the proof (0: none).
   std::int64_t last(std::string_view stream) const;
+  /// The last number of `stream` taken from a message of the process believed (0: none): what
+  /// the receiver holds of it, whatever a proof listed.
+  std::int64_t taken(std::string_view stream) const;
 
 private:
   struct Stream {
     std::int64_t last = 0;    ///< the last number accepted, or listed by the proof
     bool from_proof = false;  ///< `last` is the proof's: nothing accepted since
+    std::int64_t taken = 0;   ///< the last number accepted from a message
   };
   std::int64_t incarnation_ = 0;
+  bool doubt_ = false;              ///< lost since proven: a new proof is needed
+  std::int64_t anchor_local_ = 0;   ///< when the last proof's question was sent (steady ns here)
+  std::int64_t anchor_remote_ = 0;  ///< the time its heartbeat carried (the sender's steady ns)
   std::int64_t heartbeat_seq_ = 0;
   bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
   TextMap<Stream> streams_;
@@ -163,14 +189,17 @@ private:
 /// stream caught up. Not thread-safe: the owner holds its own lock.
 class Liveness {
 public:
-  /// A heartbeat of the peer believed at `now` (steady ns); `behind` names a stream it lists ahead
-  /// of what is held (empty: none). True when this ends a loss: the owner clears its loss event.
-  bool believed(std::int64_t now, std::string_view behind);
-  /// An update of `stream` was taken: if it is the stream that was behind, it caught up (until
-  /// the next heartbeat says otherwise).
-  void caught_up(std::string_view stream) noexcept {
-    if (stream == behind_) behind_since_ = 0;
-  }
+  /// A heartbeat of the peer, sent at `sent` (PeerFreshness::sent_at) and believed at `now`
+  /// (steady ns); `behind` names a stream it lists ahead of what is held (empty: none). What
+  /// counts is when it was sent: a heartbeat held back (a member relaying it late) buys no time.
+  /// A stream shown ahead for the first time was sent after the heartbeat believed before this
+  /// one: it is behind since then. True when this ends a loss (every stream caught up, and the
+  /// heartbeat younger than `bound`): the owner clears its loss event.
+  bool believed(std::int64_t now, std::int64_t sent, std::string_view behind, std::chrono::milliseconds bound);
+  /// Every stream the last heartbeat showed ahead has caught up (until the next heartbeat says
+  /// otherwise). The owner calls it only when none is behind any more: one stream caught up
+  /// while another is not must not restart the other's clock (verify --bus, two streams).
+  void caught_up() noexcept { behind_since_ = 0; }
   /// Called by the owner's watch at `now`: why the peer is lost from now on (the owner raises its
   /// loss event), or empty. `watched_since` is when the owner started watching it (0: not yet),
   /// `bound` the loss bound; `since` says what started the watch ("the supervisor connected").
@@ -186,7 +215,7 @@ public:
   /// Starts the peer lost (a newcomer starts toward safe): back once a heartbeat is believed
   /// with every stream caught up, as after a loss.
   void start_lost() noexcept { lost_ = true; }
-  /// When its last heartbeat was believed (0: never).
+  /// When the newest heartbeat believed was sent (0: never).
   std::int64_t last_beat() const noexcept { return last_beat_; }
 
 private:
@@ -269,8 +298,11 @@ private:
 /// thread, outside any lock of the caller.
 class Prover {
 public:
+  /// `on_proven` gets the proof's heartbeat and when its question was sent (steady ns); an answer
+  /// that comes more than `retry` after its question is refused: it proves the process alive too
+  /// long ago to date its heartbeats by (PeerFreshness::sent_at), and the question is asked again.
   Prover(std::shared_ptr<Ice::Communicator> ic, const Keyring& keys,
-         std::function<void(const std::string& signer, const wire::Heartbeat& beat)> on_proven,
+         std::function<void(const std::string& signer, const wire::Heartbeat& beat, std::int64_t asked)> on_proven,
          std::function<void(const std::string& signer, const std::string& why)> on_refused,
          std::chrono::milliseconds retry);
   /// Asks `signer`, whose heartbeat names `endpoint`, unless a question is on its way.
@@ -283,11 +315,11 @@ private:
     bool open = false;
   };
   void done(const std::string& signer, const std::string& endpoint, const std::string& nonce,
-            const wire::Signed* answer, const std::string& error);
+            const wire::Signed* answer, const std::string& error, std::int64_t sent);
 
   std::shared_ptr<Ice::Communicator> ic_;
   const Keyring& keys_;
-  std::function<void(const std::string&, const wire::Heartbeat&)> on_proven_;
+  std::function<void(const std::string&, const wire::Heartbeat&, std::int64_t)> on_proven_;
   std::function<void(const std::string&, const std::string&)> on_refused_;
   std::int64_t retry_ns_;
   std::mutex mutex_;

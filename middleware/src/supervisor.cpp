@@ -60,7 +60,10 @@ struct Supervisor::Impl {
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool states_behind = false;  ///< the last heartbeat listed state updates not received
-    Liveness live;               ///< lost or not, and since when it was heard
+    /// The state streams the last heartbeat listed ahead of what the view holds, with the
+    /// numbers it listed: caught up once every one of them has come.
+    std::vector<std::pair<std::string, std::int64_t>> behind;
+    Liveness live;  ///< lost or not, and since when it was heard
   };
   mutable std::mutex mutex;
   std::map<std::string, Peer, std::less<>> peers;
@@ -156,8 +159,8 @@ struct Supervisor::Impl {
     return v == PeerFreshness::Verdict::Accept;
   }
 
-  /// `beat` of `who` was proven by an answer to our nonce (Prover, on an Ice thread).
-  void on_proven(const std::string& who, const wire::Heartbeat& beat) {
+  /// `beat` of `who` was proven by an answer to our nonce sent at `asked` (Prover, on an Ice thread).
+  void on_proven(const std::string& who, const wire::Heartbeat& beat, std::int64_t asked) {
     bool resync = false;
     std::vector<std::string> recovered;
     {
@@ -166,10 +169,12 @@ struct Supervisor::Impl {
       if (p == peers.end()) return;
       Peer& peer = p->second;
       const std::int64_t known = peer.fresh.incarnation();
-      if (std::string why; !peer.fresh.proven(beat, why)) {
+      if (std::string why; !peer.fresh.proven(beat, why, asked)) {
         refuse(who, "a proof of life of '" + printable(who) + "': " + why);
         return;
       }
+      // Proven anew (first, restarted, or after a loss): what it sent meanwhile is asked again.
+      resync = true;
       if (beat.incarnation != known) {
         // A new process: what the view held of an earlier one goes; its records join at what the
         // proof lists as sent, and those it sent before (dropped, unproven) are reported missed.
@@ -195,7 +200,7 @@ struct Supervisor::Impl {
         peer.unproven_incarnation = 0;
         resync = true;
       }
-      believe(beat, peer, recovered, resync);
+      believe(beat, peer, asked, recovered, resync);
     }
     if (resync) request_resync(who);
     announce_recovered(who, recovered);
@@ -396,7 +401,10 @@ struct Supervisor::Impl {
           refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": " + why);
           return;
       }
-      p->second.live.caught_up(stream);
+      if (auto& behind = p->second.behind; !behind.empty()) {
+        std::erase_if(behind, [&](const auto& b) { return b.first == stream && u.seq >= b.second; });
+        if (behind.empty()) p->second.live.caught_up();  // every stream listed ahead has come
+      }
       auto row = view.find(address);
       if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
       ViewRow& r = row->second;
@@ -460,21 +468,22 @@ struct Supervisor::Impl {
           }
           return;
       }
-      believe(h, peer, recovered, resync);
+      believe(h, peer, peer.fresh.sent_at(h.time, steady_ns()), recovered, resync);
     }
     if (resync) request_resync(h.coordinator);
     announce_recovered(h.coordinator, recovered);
   }
 
-  /// An authentic heartbeat of the proven process of `h.coordinator` (under `mutex`).
-  void believe(const wire::Heartbeat& h, Peer& peer, std::vector<std::string>& recovered, bool& resync) {
+  /// An authentic heartbeat of the proven process of `h.coordinator`, sent at `sent` (under `mutex`).
+  void believe(const wire::Heartbeat& h, Peer& peer, std::int64_t sent, std::vector<std::string>& recovered,
+               bool& resync) {
     peer.control = h.control;
     // Records lost with nothing after them (an IceStorm crash at the end of a burst) show only
     // here: the heartbeat lists the last record sent. What the heartbeat two before this one
     // listed and has not come (the records may be on their way on the other topic until then):
     // reported as missed (EventStream::heard).
-    const auto sent = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
-    if (const auto missed = peer.records.heard(sent == h.lastSeq.end() ? 0 : sent->second)) {
+    const auto records = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
+    if (const auto missed = peer.records.heard(records == h.lastSeq.end() ? 0 : records->second)) {
       report_missed(peer, h.coordinator, *missed);
       link->renew({kEventTopic});  // the records may no longer reach us at all
     }
@@ -485,12 +494,14 @@ struct Supervisor::Impl {
     // from it hears the heartbeats and not the stream.
     std::int64_t states_missed = 0;
     std::string_view behind;  // the first state stream it lists ahead of what the view holds
+    peer.behind.clear();
     for (const auto& [stream, last] : h.lastSeq) {
       if (!std::string_view(stream).starts_with(kStateStreamPrefix)) continue;
-      const std::int64_t have = peer.fresh.last(stream);
+      const std::int64_t have = peer.fresh.taken(stream);  // what the view holds, not what a proof listed
       if (last <= have) continue;
       states_missed += last - have;
       if (behind.empty()) behind = stream;
+      peer.behind.emplace_back(stream, last);
     }
     if (states_missed > 0 && peer.states_behind) {
       drops->note(h.coordinator + "/states-missed", "supervisor: " + std::to_string(states_missed) +
@@ -503,7 +514,7 @@ struct Supervisor::Impl {
     }
     if (peer.live.last_beat() == 0) print("supervisor: coordinator '" + h.coordinator + "' is up");
     // Lost if not caught up within the loss bound (watch_loop); back once caught up.
-    if (peer.live.believed(steady_ns(), behind)) recovered = peer.components;
+    if (peer.live.believed(steady_ns(), sent, behind, options.lost_after)) recovered = peer.components;
   }
 
   /// The supervisor starts toward safe (DESIGN §7): every coordinator is lost until it is proven
@@ -643,6 +654,7 @@ struct Supervisor::Impl {
         for (auto& [name, peer] : peers) {
           if (std::string why = peer.live.check(now, since, options.lost_after, "the supervisor connected");
               !why.empty()) {
+            peer.fresh.doubt();  // back only on a new proof of life, never on a recording of it
             lost_now.push_back(Lost{name, peer.components, std::move(why)});
           }
           next = std::min(next, peer.live.due(since, options.lost_after));
@@ -799,7 +811,10 @@ Expected<void> Supervisor::start() {
     bus.log = [&d](const std::string& line) { d.print(line); };
     d.link = std::make_unique<BusLink>(d.ic, d.options.ice, d.options.tls, std::move(bus));
     d.prover = std::make_unique<Prover>(
-        d.ic, *d.keyring, [&d](const std::string& who, const wire::Heartbeat& beat) { d.on_proven(who, beat); },
+        d.ic, *d.keyring,
+        [&d](const std::string& who, const wire::Heartbeat& beat, std::int64_t asked) {
+          d.on_proven(who, beat, asked);
+        },
         [&d](const std::string& who, const std::string& why) {
           d.drops->drop(who, "supervisor: '" + printable(who) + "' not proven alive: " + why);
         },

@@ -98,7 +98,9 @@ bit P1_fail_safe_bound, P2_no_false_recovery, P3_no_false_normal, P4_ownership, 
 #define OLDER(a, b) ((a) == NONE -> (b) : ((b) == NONE -> (a) : ((a) > (b) -> (a) : (b))))
 #define AGE(a, cap) a = ((a) == NONE -> NONE : ((a) < (cap) -> (a) + 1 : (cap)))
 /* heartbeat ages are counted up to CAPH: every comparison of one is with B + HB or less */
+#ifndef CAPH
 #define CAPH (B + HB + 2)
+#endif
 /* the estimated age of what P sent `a` ticks ago: the proof's round trip counted as lateness */
 #define EST(a) ((a) + r_rtt < CAPH -> (a) + r_rtt : CAPH)
 
@@ -316,10 +318,10 @@ inline r_restart() {  /* a newcomer: knows nothing, starts toward safe */
 }
 
 inline p_restart(inc) {  /* a new process: numbers from 0, Normal, its state published at once */
+  printf("@ pstart %d\n", inc);
   p_alive = true; p_inc = inc; p_phase = 0; p_hb = NONE; p_resync = false; p_hon = NONE;
   for (s : 0 .. 1) { p_truth[s] = NORMAL; p_err[s] = NONE }
   for (s : 0 .. S - 1) { publish(s) }
-  printf("@ pstart %d\n", inc)
 }
 
 inline age_all() {

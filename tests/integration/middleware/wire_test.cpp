@@ -281,6 +281,8 @@ struct Bus {
     h.coordinator = "wire-p";
     h.incarnation = incarnation;
     h.seq = seq;
+    h.time = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+                 .count();
     h.control = alive_proxy;
     for (const auto& [iface, last] : last_sent) h.lastSeq["state:" + iface] = last;
     if (events_sent) h.lastSeq["events"] = *events_sent;
@@ -459,11 +461,88 @@ TEST(Wire, AClientRaisesCoordinatorLostWhenItsProviderFallsSilentAndClearsOnceIt
   bus.beating.store(true);
   std::this_thread::sleep_for(400ms);
   EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << "not resynchronised yet";
-  // Resynchronised: the loss clears and the client holds exactly the provider's state.
-  bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
+  // Back only on a new proof of life (verify --bus, P2), which lists seq 2 as sent: the client asks
+  // for a republish, and what wire-p republishes (seq 3) resynchronises it. The loss clears and
+  // the client holds exactly the provider's state.
+  bus.send(*bus.provider, {update("P.D0", 3, "", wire::Level::Normal)});
   EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
   EXPECT_EQ(bus.state("C.s_R.D0"), State::Normal);
   EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+/// A heartbeat of wire-p numbered `seq`, stamped `sent` (wire-p's steady clock), signed with its
+/// key: what a member that took a subscription kept of wire-p's traffic, published again later.
+void relay_heartbeat(Bus& bus, std::int64_t seq, std::int64_t sent) {
+  wire::Heartbeat h;
+  {
+    std::lock_guard lock(bus.mutex);
+    h = bus.provider_heartbeat(kIncarnation, seq);
+  }
+  h.time = sent;
+  bus.heartbeat_pub("wire-p")->beat(bus.provider->sign(middleware::kKindHeartbeat, encode(bus.ice.communicator(), h)));
+}
+
+std::int64_t steady_now() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// verify --bus, mutant no-reproof (P2), at wire level: a member that took the client's heartbeat
+// subscription keeps wire-p's genuine heartbeats; wire-p dies; the member publishes them to the
+// client, each newer than the last it took and each sent within the bound. Without a new proof of
+// life they end no loss: the client stays at Error.
+TEST(Wire, HeartbeatsAMemberKeptAndRelaysAfterTheProviderDiedEndNoLoss) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  bus.beating.store(false);  // wire-p dies
+  bus.proving.store(false);  // and answers no nonce
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; })) << bus.all_log();
+  std::int64_t seq = 0;
+  {
+    std::lock_guard lock(bus.mutex);
+    seq = bus.beat_seq;
+  }
+  // The member publishes what it kept, one a period, each stamped as sent just now (the freshest
+  // a recording could claim): numbers the client never took.
+  const auto until = std::chrono::steady_clock::now() + 1500ms;
+  while (std::chrono::steady_clock::now() < until) {
+    relay_heartbeat(bus, ++seq, steady_now());
+    std::this_thread::sleep_for(100ms);
+    ASSERT_EQ(bus.state("C.s_R.D1"), State::Error) << "a relayed heartbeat ended the loss\n" << bus.all_log();
+  }
+  EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+// verify --bus, mutant arrival-time (P1), at wire level: a member holds wire-p's heartbeats back
+// and relays them late, one a period, so that one arrives whenever the bound would pass. Each
+// counts from when it was sent: the client is lost within the bound after the last one sent in
+// time, although heartbeats keep arriving.
+TEST(Wire, HeartbeatsHeldBackAndRelayedLateBuyNoTime) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  bus.beating.store(false);  // from now on the member holds everything back
+  const std::int64_t held_from = steady_now();
+  std::int64_t seq = 0;
+  {
+    std::lock_guard lock(bus.mutex);
+    seq = bus.beat_seq;
+  }
+  // It relays, every 100 ms, a heartbeat sent 100 ms after the one before, starting from when it
+  // began to hold them back: each arrives later than the one before (250 ms, then more).
+  std::int64_t sent = held_from;
+  const auto start = std::chrono::steady_clock::now();
+  bool lost = false;
+  while (std::chrono::steady_clock::now() - start < 2000ms && !lost) {
+    std::this_thread::sleep_for(150ms);
+    sent += 100'000'000;
+    relay_heartbeat(bus, ++seq, sent);
+    lost = bus.state("C.s_R.D1") == State::Error;
+  }
+  EXPECT_TRUE(lost) << "heartbeats relayed ever later kept the client Normal\n" << bus.all_log();
 }
 
 TEST(Wire, ACoordinatorRaisesAFrameworkWarningWhenTheSupervisorFallsSilent) {
@@ -1288,8 +1367,17 @@ TEST(Wire, AStateStreamItsHeartbeatsShowAheadAndNotCaughtUpWithinTheBoundCountsA
   EXPECT_NE(bus.all_log().find("coordinator 'wire-p' lost (its heartbeats list state of P.D0 not received"),
             std::string::npos)
       << bus.all_log();
-  bus.send(*bus.provider, {update("P.D0", 1, "", wire::Level::Normal)});
-  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; }, 3000ms)) << bus.all_log();
+  // Back on a new proof of life (verify --bus, P2), which lists seq 1 as sent: the client asks for
+  // a republish, and wire-p republishes (seq 2, 3, ... once a period, as a coordinator answers the
+  // requests) until its state reaches the client through the subscription made again.
+  std::int64_t republished = 1;
+  EXPECT_TRUE(eventually(
+      [&] {
+        bus.send(*bus.provider, {update("P.D0", ++republished, "", wire::Level::Normal)});
+        return eventually([&] { return bus.state("C.s_R.D1") == State::Normal; }, 100ms);
+      },
+      3000ms))
+      << bus.all_log();
   EXPECT_FALSE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
 }
 

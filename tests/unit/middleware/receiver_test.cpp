@@ -96,6 +96,42 @@ TEST(PeerFreshness, AStreamCannotJumpMoreThanTwoToTheTwentyAheadEvenFromItsOwnPr
   EXPECT_EQ(peer.stream(stream, kRun, 1, missed, why), Verdict::Accept) << "the stream is not frozen";
 }
 
+TEST(PeerFreshness, AProcessDeclaredLostIsBelievedAgainOnlyOnANewProofOfIt) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  ASSERT_TRUE(peer.proven(proof(kRun, 7, 3), why)) << why;
+  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
+  peer.doubt();
+  EXPECT_EQ(peer.heartbeat(kRun, 9, why), Verdict::Unproven) << "a heartbeat it never sent us may be a recording";
+  EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), kRun, 4, missed, why), Verdict::Unproven);
+  EXPECT_EQ(peer.process(kRun - 1, why), Verdict::Refuse) << "an older process stays refused";
+  ASSERT_TRUE(peer.proven(proof(kRun, 10, 4), why)) << why;
+  EXPECT_EQ(peer.heartbeat(kRun, 11, why), Verdict::Accept) << "proven again";
+}
+
+TEST(PeerFreshness, HeartbeatsAreDatedAgainstTheQuestionOfTheLastProofNeverLaterThanNow) {
+  PeerFreshness peer;
+  std::string why;
+  EXPECT_EQ(peer.sent_at(123, 5000), 5000) << "no proof dated yet: now";
+  wire::Heartbeat beat = proof(kRun, 7, 0);
+  beat.time = 90'000;  // the sender's clock when it answered
+  ASSERT_TRUE(peer.proven(beat, why, 1000)) << why;
+  EXPECT_EQ(peer.sent_at(90'500, 9000), 1500) << "500 after the answer, dated 500 after the question";
+  EXPECT_EQ(peer.sent_at(99'000, 2000), 2000) << "never later than now";
+}
+
+TEST(PeerFreshness, TakenIsWhatCameFromTheProcessNotWhatItsProofListed) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  ASSERT_TRUE(peer.proven(proof(kRun, 7, 5), why)) << why;
+  EXPECT_EQ(peer.last(state_stream("JR3.ForceData")), 5);
+  EXPECT_EQ(peer.taken(state_stream("JR3.ForceData")), 0) << "listed, not received";
+  EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), kRun, 6, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.taken(state_stream("JR3.ForceData")), 6);
+}
+
 constexpr std::int64_t kMs = 1'000'000;  // steady ns
 constexpr std::chrono::milliseconds kBound{300};
 
@@ -109,44 +145,69 @@ TEST(Liveness, APeerNeverHeardFromIsLostOnceTheBoundHasPassedSinceTheWatchBegan)
   EXPECT_EQ(live.check(2000 * kMs, 1000 * kMs, kBound, "start"), "") << "a loss is said once";
 }
 
+/// A heartbeat sent and believed at `t` (no delay on the way).
+bool beat(Liveness& live, std::int64_t t, std::string_view behind = "") { return live.believed(t, t, behind, kBound); }
+
 TEST(Liveness, APeerSilentForLongerThanTheBoundIsLostAndABelievedHeartbeatBringsItBack) {
   Liveness live;
-  EXPECT_FALSE(live.believed(100 * kMs, ""));
+  EXPECT_FALSE(beat(live, 100 * kMs));
   EXPECT_EQ(live.last_beat(), 100 * kMs);
   EXPECT_EQ(live.check(400 * kMs, 1, kBound, "start"), "");
   EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "no heartbeat for 300 ms");
   EXPECT_TRUE(live.lost());
-  EXPECT_TRUE(live.believed(500 * kMs, "")) << "back: the owner clears its loss event";
+  EXPECT_TRUE(beat(live, 500 * kMs)) << "back: the owner clears its loss event";
   EXPECT_FALSE(live.lost());
-  EXPECT_FALSE(live.believed(600 * kMs, "")) << "said once";
+  EXPECT_FALSE(beat(live, 600 * kMs)) << "said once";
+}
+
+TEST(Liveness, AHeartbeatCountsFromWhenItWasSentSoOneHeldBackOnTheWayBuysNoTime) {
+  Liveness live;
+  EXPECT_FALSE(live.believed(350 * kMs, 100 * kMs, "", kBound)) << "sent at 100 ms, held back until 350 ms";
+  EXPECT_EQ(live.last_beat(), 100 * kMs);
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "no heartbeat for 300 ms")
+      << "lost a bound after it was sent, not after it came";
+  EXPECT_FALSE(live.believed(402 * kMs, 90 * kMs, "", kBound)) << "an older one moves nothing";
+  EXPECT_EQ(live.last_beat(), 100 * kMs);
+}
+
+TEST(Liveness, ALossEndsOnlyOnAHeartbeatSentWithinTheBound) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_FALSE(live.check(401 * kMs, 1, kBound, "start").empty());
+  EXPECT_FALSE(live.believed(1000 * kMs, 650 * kMs, "", kBound)) << "sent 350 ms ago: a recording, no sign of life";
+  EXPECT_TRUE(live.lost());
+  EXPECT_TRUE(live.believed(1000 * kMs, 750 * kMs, "", kBound)) << "sent 250 ms ago: back";
 }
 
 TEST(Liveness, AStreamItsHeartbeatsShowAheadNotCaughtUpWithinTheBoundIsLostAsASilentPeerIs) {
   Liveness live;
-  EXPECT_FALSE(live.believed(100 * kMs, "state:P.a"));
-  EXPECT_FALSE(live.believed(200 * kMs, "state:P.a"));
-  EXPECT_FALSE(live.believed(350 * kMs, "state:P.a"));
+  EXPECT_FALSE(beat(live, 100 * kMs, "state:P.a"));
+  EXPECT_FALSE(beat(live, 200 * kMs, "state:P.a"));
+  EXPECT_FALSE(beat(live, 350 * kMs, "state:P.a"));
   EXPECT_EQ(live.check(400 * kMs, 1, kBound, "start"), "") << "behind since 100 ms: not yet past the bound";
   EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "its heartbeats list state of P.a not received for 300 ms")
       << "heartbeats kept coming: behind, not silent, and lost all the same";
-  EXPECT_FALSE(live.believed(450 * kMs, "state:P.a")) << "still behind: still lost";
+  EXPECT_FALSE(beat(live, 450 * kMs, "state:P.a")) << "still behind: still lost";
   EXPECT_TRUE(live.lost());
-  EXPECT_TRUE(live.believed(500 * kMs, "")) << "caught up: back";
+  EXPECT_TRUE(beat(live, 500 * kMs)) << "caught up: back";
 }
 
-TEST(Liveness, AnUpdateOfTheStreamThatWasBehindCatchesItUpUntilTheNextHeartbeatSaysOtherwise) {
+TEST(Liveness, AStreamFirstShownAheadIsBehindSinceTheHeartbeatBelievedBeforeIt) {
   Liveness live;
-  EXPECT_FALSE(live.believed(100 * kMs, "state:P.a"));
-  live.caught_up("state:P.b");
-  EXPECT_FALSE(live.believed(350 * kMs, "state:P.a"));
-  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start").substr(0, 19), "its heartbeats list")
-      << "another stream's update is no catch-up";
-  Liveness again;
-  EXPECT_FALSE(again.believed(100 * kMs, "state:P.a"));
-  EXPECT_FALSE(again.believed(300 * kMs, "state:P.a")) << "behind since 100 ms";
-  again.caught_up("state:P.a");
-  EXPECT_EQ(again.check(401 * kMs, 1, kBound, "start"), "") << "caught up by the update, before any heartbeat";
-  EXPECT_FALSE(again.lost());
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_FALSE(beat(live, 300 * kMs, "state:P.a")) << "the update was sent after 100 ms: behind since then";
+  EXPECT_EQ(live.check(400 * kMs, 1, kBound, "start"), "");
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "its heartbeats list state of P.a not received for 300 ms")
+      << "heartbeats lost on the way do not restart the stream's clock";
+}
+
+TEST(Liveness, CaughtUpClearsTheStreamsBehindUntilTheNextHeartbeatSaysOtherwise) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs, "state:P.a"));
+  EXPECT_FALSE(beat(live, 300 * kMs, "state:P.a")) << "behind since 100 ms";
+  live.caught_up();
+  EXPECT_EQ(live.check(401 * kMs, 1, kBound, "start"), "") << "caught up by the update, before any heartbeat";
+  EXPECT_FALSE(live.lost());
 }
 
 TEST(Liveness, TheWatchIsDueOneNanosecondPastTheBoundAfterTheLastHeartbeatAndCheckFindsTheLossExactlyThen) {
@@ -154,27 +215,27 @@ TEST(Liveness, TheWatchIsDueOneNanosecondPastTheBoundAfterTheLastHeartbeatAndChe
   constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
   EXPECT_EQ(live.due(0, kBound), kNever) << "not watched yet: nothing is due";
   EXPECT_EQ(live.due(1000 * kMs, kBound), 1300 * kMs + 1) << "never heard from: the bound after the watch began";
-  EXPECT_FALSE(live.believed(1100 * kMs, ""));
+  EXPECT_FALSE(beat(live, 1100 * kMs));
   const std::int64_t due = live.due(1000 * kMs, kBound);
   EXPECT_EQ(due, 1400 * kMs + 1);
   EXPECT_EQ(live.check(due - 1, 1000 * kMs, kBound, "start"), "") << "not a nanosecond before it is due";
   EXPECT_EQ(live.check(due, 1000 * kMs, kBound, "start"), "no heartbeat for 300 ms");
   EXPECT_EQ(live.due(1000 * kMs, kBound), kNever) << "lost: nothing more is due until it is back";
-  EXPECT_TRUE(live.believed(1500 * kMs, ""));
+  EXPECT_TRUE(beat(live, 1500 * kMs));
   EXPECT_EQ(live.due(1000 * kMs, kBound), 1800 * kMs + 1);
 }
 
 TEST(Liveness, AStreamBehindIsDueTheBoundAfterItFellBehindAndWhatComesOnlyMovesTheDueTimeLater) {
   Liveness live;
-  EXPECT_FALSE(live.believed(100 * kMs, ""));
+  EXPECT_FALSE(beat(live, 100 * kMs));
   const std::int64_t first = live.due(1, kBound);
-  EXPECT_FALSE(live.believed(200 * kMs, "state:P.a"));
+  EXPECT_FALSE(beat(live, 200 * kMs, "state:P.a"));
   const std::int64_t behind = live.due(1, kBound);
-  EXPECT_EQ(behind, 500 * kMs + 1) << "behind since 200 ms";
-  EXPECT_GE(behind, first) << "a new duty starts at least one bound after it begins";
-  EXPECT_FALSE(live.believed(400 * kMs, "state:P.a"));
-  EXPECT_EQ(live.due(1, kBound), behind) << "still behind since 200 ms: due then, although beats keep coming";
-  live.caught_up("state:P.a");
+  EXPECT_EQ(behind, 400 * kMs + 1) << "behind since the heartbeat before, at 100 ms";
+  EXPECT_GE(behind, first) << "a new duty starts no earlier than the one before it";
+  EXPECT_FALSE(beat(live, 400 * kMs, "state:P.a"));
+  EXPECT_EQ(live.due(1, kBound), behind) << "still behind since 100 ms: due then, although beats keep coming";
+  live.caught_up();
   EXPECT_EQ(live.due(1, kBound), 700 * kMs + 1) << "caught up: due a bound after the last heartbeat";
   EXPECT_EQ(live.check(700 * kMs, 1, kBound, "start"), "");
   EXPECT_EQ(live.check(700 * kMs + 1, 1, kBound, "start"), "no heartbeat for 300 ms");
