@@ -790,8 +790,11 @@ struct CoordinatorNode::Impl {
       h.behind = behind;
       if (behind && behind_stream.empty()) behind_stream = stream_scratch;
     }
-    // Lost if not caught up within the loss bound (watch_loop); back once caught up.
-    if (peer.live.believed(now, sent, behind_stream, lost_after())) recover(hb.coordinator, peer);
+    // Lost if not caught up within the loss bound (watch_loop); back once caught up, and only over a
+    // link that is up: what comes while it reconnects comes through a subscription about to be
+    // replaced, and a loss cleared on it comes back once it is (make cluster-demo, a host rejoining).
+    const bool hold = peer.live.lost() && !link->connected();
+    if (!hold && peer.live.believed(now, sent, behind_stream, lost_after())) recover(hb.coordinator, peer);
     if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;

@@ -514,7 +514,10 @@ struct Supervisor::Impl {
     }
     if (peer.live.last_beat() == 0) print("supervisor: coordinator '" + h.coordinator + "' is up");
     // Lost if not caught up within the loss bound (watch_loop); back once caught up.
-    if (peer.live.believed(steady_ns(), sent, behind, options.lost_after)) recovered = peer.components;
+    // Back only over a link that is up: what comes while it reconnects comes through a subscription
+    // about to be replaced (as for a coordinator, node.cpp).
+    const bool hold = peer.live.lost() && !link->connected();
+    if (!hold && peer.live.believed(steady_ns(), sent, behind, options.lost_after)) recovered = peer.components;
   }
 
   /// The supervisor starts toward safe (DESIGN §7): every coordinator is lost until it is proven
