@@ -515,16 +515,18 @@ TEST(Wire, HeartbeatsAMemberKeptAndRelaysAfterTheProviderDiedEndNoLoss) {
   EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
 }
 
-// verify --bus, mutant arrival-time (P1), at wire level: a member holds wire-p's heartbeats back
-// and relays them late, one a period, so that one arrives whenever the bound would pass. Each
-// counts from when it was sent: the client is lost within the bound after the last one sent in
-// time, although heartbeats keep arriving.
+// verify --bus, mutant arrival-time (P1), at wire level: wire-p is cut off from the client, and a
+// member holds its heartbeats back and relays them late, one a period, so that one arrives
+// whenever the bound would pass. Each counts from when it was sent: the client is lost within the
+// bound after the last one sent in time, although heartbeats keep arriving. (Were wire-p still
+// reachable, it would answer the client's new question and be believed again: alive, rightly.)
 TEST(Wire, HeartbeatsHeldBackAndRelayedLateBuyNoTime) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
   ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
   bus.beating.store(false);  // from now on the member holds everything back
+  bus.proving.store(false);  // and wire-p is cut off from the client: only the member's relays reach it
   const std::int64_t held_from = steady_now();
   std::int64_t seq = 0;
   {
