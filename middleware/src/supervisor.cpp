@@ -198,7 +198,6 @@ struct Supervisor::Impl {
           watch_sleeper.wake();
         }
         peer.unproven_incarnation = 0;
-        resync = true;
       }
       believe(beat, peer, asked, recovered, resync);
     }

@@ -14,14 +14,14 @@
 
 namespace safecass::tools {
 
-namespace {
-
 /// Three decimals: the figures' precision in --json (megabytes, seconds).
 std::string fixed3(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.3f", v);
   return buf;
 }
+
+namespace {
 
 std::string where_text(const spec::Position& p) {
   if (p.file.empty()) return {};
@@ -91,18 +91,25 @@ void add_verify_command(CLI::App& app, int& code) {
   });
 }
 
-int run_verify(const std::string& system_path, const verify::Options& options, bool json) {
-  const FilterRegistry& registry = builtin_filters();
-  const spec::LoadResult loaded = spec::load_system(system_path, registry);
+const spec::SystemSpec* load_to_verify(const std::string& path, std::string_view command, spec::LoadResult& loaded) {
+  loaded = spec::load_system(path, builtin_filters());
   for (const spec::Diagnostic& d : loaded.diagnostics) {
     if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
   }
   if (!loaded.ok()) {
-    std::fprintf(stderr, "verify: %s has %zu error(s); `safecass validate` lists every problem\n", system_path.c_str(),
-                 loaded.errors());
-    return 2;
+    std::fprintf(stderr, "%.*s: %s has %zu error(s); `safecass validate` lists every problem\n",
+                 static_cast<int>(command.size()), command.data(), path.c_str(), loaded.errors());
+    return nullptr;
   }
-  auto report = verify::verify(*loaded.system, registry, options);
+  return &*loaded.system;
+}
+
+int run_verify(const std::string& system_path, const verify::Options& options, bool json) {
+  const FilterRegistry& registry = builtin_filters();
+  spec::LoadResult loaded;
+  const spec::SystemSpec* system = load_to_verify(system_path, "verify", loaded);
+  if (system == nullptr) return 2;
+  auto report = verify::verify(*system, registry, options);
   if (!report) {
     std::fprintf(stderr, "verify: %s\n", report.error().message.c_str());
     return 2;

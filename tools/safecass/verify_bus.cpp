@@ -12,12 +12,6 @@ namespace safecass::tools {
 
 namespace {
 
-std::string fixed(double v, const char* format) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, format, v);
-  return buf;
-}
-
 std::string pairs_text(const verify::BusPattern& p) {
   std::string r;
   for (const std::string& pair : p.pairs) r += (r.empty() ? "" : ", ") + pair;
@@ -63,18 +57,11 @@ int run_mutants(const spec::SystemSpec& system, verify::BusOptions options, bool
 }  // namespace
 
 int run_verify_bus(const std::string& system_path, const verify::BusOptions& options, bool json, bool mutants) {
-  const FilterRegistry& registry = builtin_filters();
-  const spec::LoadResult loaded = spec::load_system(system_path, registry);
-  for (const spec::Diagnostic& d : loaded.diagnostics) {
-    if (d.severity == spec::Diagnostic::Severity::Error) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
-  }
-  if (!loaded.ok()) {
-    std::fprintf(stderr, "verify --bus: %s has %zu error(s); `safecass validate` lists every problem\n",
-                 system_path.c_str(), loaded.errors());
-    return 2;
-  }
-  if (mutants) return run_mutants(*loaded.system, options, json);
-  auto report = verify::verify_bus(*loaded.system, options);
+  spec::LoadResult loaded;
+  const spec::SystemSpec* system = load_to_verify(system_path, "verify --bus", loaded);
+  if (system == nullptr) return 2;
+  if (mutants) return run_mutants(*system, options, json);
+  auto report = verify::verify_bus(*system, options);
   if (!report) {
     std::fprintf(stderr, "verify --bus: %s\n", report.error().message.c_str());
     return 2;
@@ -91,8 +78,8 @@ int run_verify_bus(const std::string& system_path, const verify::BusOptions& opt
           .str("fault_class", s.fault_class)
           .str("result", verify::to_string(s.verdict))
           .integer("states", static_cast<long long>(s.states))
-          .raw("memory_mb", fixed(s.memory_mb, "%.3f"))
-          .raw("seconds", fixed(s.seconds, "%.3f"));
+          .raw("memory_mb", fixed3(s.memory_mb))
+          .raw("seconds", fixed3(s.seconds));
       if (!s.property.empty()) line.str("property", s.property);
       std::printf("%s\n", line.text().c_str());
     }
@@ -103,15 +90,15 @@ int run_verify_bus(const std::string& system_path, const verify::BusOptions& opt
                               .str("result", verify::to_string(p.verdict))
                               .str("checks", p.text)
                               .integer("states", static_cast<long long>(p.states))
-                              .raw("memory_mb", fixed(p.memory_mb, "%.3f"))
-                              .raw("seconds", fixed(p.seconds, "%.3f"))
+                              .raw("memory_mb", fixed3(p.memory_mb))
+                              .raw("seconds", fixed3(p.seconds))
                               .text()
                               .c_str());
     }
     std::printf("%s\n", json::JsonObject()
                             .str("kind", "summary")
                             .str("system", report->system)
-                            .raw("seconds", fixed(report->seconds, "%.3f"))
+                            .raw("seconds", fixed3(report->seconds))
                             .integer("exit", report->exit_code())
                             .text()
                             .c_str());

@@ -4,11 +4,21 @@
 #include <CLI/CLI.hpp>
 
 #include <string>
+#include <string_view>
+
+#include "safecass/spec/load.hpp"
 
 #include "safecass/verify/bus.hpp"
 #include "safecass/verify/verify.hpp"
 
 namespace safecass::tools {
+
+/// Three decimals: the figures' precision in `verify --json` (megabytes, seconds).
+std::string fixed3(double v);
+
+/// Loads `path` into `loaded` for `command` ("verify"): its errors go to stderr, and nullptr
+/// comes back when it has any.
+const spec::SystemSpec* load_to_verify(const std::string& path, std::string_view command, spec::LoadResult& loaded);
 
 /// Adds the `verify` subcommand; its exit code lands in `code`.
 void add_verify_command(CLI::App& app, int& code);

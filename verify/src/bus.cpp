@@ -77,9 +77,8 @@ const char* const kPropertyTokens[] = {"P1_fail_safe_bound", "P2_no_false_recove
                                        "P4_ownership", "P5_convergence"};
 
 std::vector<BusProperty> property_list(const std::vector<BusPattern>& patterns, const BusOptions& options) {
-  int bound = 0, calm = 0;
+  int calm = 0;
   for (const BusPattern& p : patterns) {
-    bound = std::max(bound, p.bound_ticks);
     calm = std::max(calm, calm_periods(p));
   }
   const auto tick = options.period / kTicksPerPeriod;
@@ -226,7 +225,6 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
 
 std::string BusPattern::name() const {
   std::string r = forget ? "the supervisor's heartbeats" : std::to_string(streams_total) + " stream(s)";
-  r += watch_start ? (forget ? "" : "") : "";
   r += ", loss bound " + std::to_string(bound_ticks) + " ticks";
   r += loss_level == State::Warning ? ", lost shows Warning" : ", lost shows Error";
   return r;

@@ -46,7 +46,6 @@ public:
         members_(system),
         bound_(std::chrono::milliseconds(pattern.bound_ticks * kTick / 1'000'000)) {
     restart_receiver();
-    started_[1] = 0;
   }
 
   /// Feeds one "@ ..." line; returns false with `why` on the first decision that differs.
@@ -59,7 +58,6 @@ public:
       ++tick_;
     } else if (k == "pstart") {
       inc_ = std::stoi(w[1]);
-      started_[inc_] = tick_;
       beats_[inc_].clear();
       latest_[inc_] = {0, 0};
     } else if (k == "beat") {
@@ -257,7 +255,6 @@ private:
   std::int64_t watched_since_ = 0;
   int tick_ = 0;
   int inc_ = 1;
-  std::map<int, int> started_;
   std::map<int, std::vector<int>> beats_;
   std::map<int, std::array<std::int64_t, 2>> latest_{{1, {0, 0}}};
   std::vector<std::string> model_, ours_;
