@@ -380,6 +380,11 @@ std::string expectation_problem(const Coordinator& co, const spec::ScenarioStep&
   }
 }
 
+std::string ExpectationFailure::text() const {
+  return where.file + ":" + std::to_string(where.line) + ":" + std::to_string(where.column) +
+         ": expectation failed at t=" + secs(at) + ": " + problem + " [" + pointer + "]";
+}
+
 void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& result) {
   for (const auto& [address, expected] : s.action->expectations) {
     ++result.checks;
@@ -388,8 +393,9 @@ void ScenarioRunner::check(const spec::ScenarioStep& s, Time now, RunResult& res
       result.coverage.states_checked.push_back(StateCheck{address, *parse_state(expected), now, problem.empty()});
     }
     if (problem.empty()) continue;
-    result.failures.push_back(scenario_.path + ":" + std::to_string(s.line) + ":" + std::to_string(s.column) +
-                              ": expectation failed at t=" + secs(now) + ": " + problem + " [" + s.pointer() + "]");
+    const ExpectationFailure failure{scenario_.where(s), s.pointer(), now, address, problem};
+    if (on_failure_) on_failure_(failure);
+    result.failures.push_back(failure.text());
   }
 }
 

@@ -53,6 +53,17 @@ struct StateCheck {
   bool held = false;
 };
 
+/// One expectation that did not hold, when the runner checked it.
+struct ExpectationFailure {
+  spec::Position where;  ///< the step's action value in the scenario file
+  std::string pointer;   ///< its JSON pointer, "/steps/4/expect"
+  Time at{};             ///< the tick at which it was checked
+  std::string address;   ///< the address checked
+  std::string problem;   ///< what was found against what was expected, "JR3 is Normal, expected Error"
+  /// The line RunResult::failures holds: "file:line:col: expectation failed at t=...: problem [pointer]".
+  std::string text() const;
+};
+
 /// What a run did, for `safecass test`'s coverage summary and `safecass trace`'s matrix.
 struct Coverage {
   std::set<std::string> events_fired;                     ///< events processed (not ignored)
@@ -122,6 +133,10 @@ public:
   /// A feed: called at every tick, after the clock is set and before the scenario's steps, to push
   /// samples and apply actions (a replay). Set before the first tick.
   void set_feed(std::function<void(Time now)> feed) { feed_ = std::move(feed); }
+  /// Told of each expectation that fails, at the tick it is checked (the system is then exactly as
+  /// the check found it, so a tool can explain the address), before its line joins
+  /// RunResult::failures. Must not drive the runner.
+  void set_on_failure(std::function<void(const ExpectationFailure&)> told) { on_failure_ = std::move(told); }
   /// The first tick is the first multiple of the period at or after `t` (default 0). Before the
   /// first tick.
   void start_at(Time t);
@@ -171,6 +186,7 @@ private:
   std::size_t next_check_ = 0;
   std::int64_t next_tick_ = 0;
   std::function<void(Time)> feed_;
+  std::function<void(const ExpectationFailure&)> on_failure_;
   std::unique_ptr<Recorder> recorder_;
   std::unique_ptr<InputRecorder> inputs_;
   Coordinator::SubscriptionId printer_ = 0;
