@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <iterator>
 #include <limits>
+#include <optional>
 
+#include "safecass/core/assert.hpp"
 #include "safecass/core/state.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/spec/file.hpp"
@@ -139,9 +142,59 @@ std::string ScenarioStep::pointer() const {
   return "/steps/" + std::to_string(index) + "/" + std::string(step_key(kind));
 }
 
+namespace {
+
+/// Every step kind, in the order of ScenarioStep::Kind.
+constexpr ScenarioStep::Kind kKinds[] = {ScenarioStep::Kind::Sample,
+                                         ScenarioStep::Kind::Ramp,
+                                         ScenarioStep::Kind::Generate,
+                                         ScenarioStep::Kind::Inject,
+                                         ScenarioStep::Kind::Reset,
+                                         ScenarioStep::Kind::Expect,
+                                         ScenarioStep::Kind::ExpectOutstanding,
+                                         ScenarioStep::Kind::ExpectCause};
+static_assert(std::size(kKinds) == static_cast<std::size_t>(ScenarioStep::Kind::ExpectCause) + 1,
+              "a step kind is missing from kKinds");
+
+}  // namespace
+
+const std::vector<ScenarioKeySet>& scenario_keys() {
+  static const std::vector<ScenarioKeySet> table = [] {
+    std::vector<std::string_view> step{"at"};
+    for (const ScenarioStep::Kind k : kKinds) step.push_back(step_key(k));
+    return std::vector<ScenarioKeySet>{
+        {"scenario", {"system", "period", "duration", "steps", "description"}},
+        {"step", std::move(step)},
+        {step_key(ScenarioStep::Kind::Ramp), {"signal", "from", "to", "until"}},
+        {step_key(ScenarioStep::Kind::Generate), {"event", "target"}},
+        {step_key(ScenarioStep::Kind::Inject), {"filter", "signal", "deep", "values"}},
+        {step_key(ScenarioStep::Kind::Reset), {"target", "reason"}},
+    };
+  }();
+  return table;
+}
+
 // ---- reading a scenario ------------------------------------------------------------------------
 
 namespace {
+
+/// The keys of `object` in scenario_keys().
+const std::vector<std::string_view>& keys_of(std::string_view object) {
+  for (const ScenarioKeySet& set : scenario_keys()) {
+    if (set.object == object) return set.keys;
+  }
+  SAFECASS_ASSERT(false && "an object that scenario_keys() does not list");
+  static const std::vector<std::string_view> none;
+  return none;
+}
+
+/// The step kind whose key is `key`, if any.
+std::optional<ScenarioStep::Kind> kind_of(std::string_view key) noexcept {
+  for (const ScenarioStep::Kind k : kKinds) {
+    if (step_key(k) == key) return k;
+  }
+  return std::nullopt;
+}
 
 class Reader {
 public:
@@ -187,10 +240,12 @@ public:
     error(v.position, pointer, "a sample must be a number or a non-empty list of numbers");
     return false;
   }
-  /// Reports the keys of `obj` that are not `known`, with the nearest known one; returns the
-  /// known keys suggested, so that a typo of a required key is not also reported missing.
+  /// Reports the keys of `obj` that are not those of `object` in scenario_keys(), with the
+  /// nearest known one; returns the known keys suggested, so that a typo of a required key is not
+  /// also reported missing.
   std::vector<std::string> unknown_keys(const json::JsonValue& obj, const std::string& pointer,
-                                        std::initializer_list<std::string_view> known) {
+                                        std::string_view object) {
+    const std::vector<std::string_view>& known = keys_of(object);
     std::vector<std::string> suggested;
     for (const json::JsonMember& m : obj.object) {
       if (std::find(known.begin(), known.end(), m.key) == known.end()) {
@@ -255,7 +310,7 @@ bool read_ramp(Reader& r, const json::JsonValue& v, const std::string& p, double
     r.error(v.position, p, "\"ramp\" must be an object {signal, from, to, until}");
     return false;
   }
-  const auto typos = r.unknown_keys(v, p, {"signal", "from", "to", "until"});
+  const auto typos = r.unknown_keys(v, p, step_key(ScenarioStep::Kind::Ramp));
   const json::JsonValue* sig = v.find("signal");
   const json::JsonValue* from = v.find("from");
   const json::JsonValue* to = v.find("to");
@@ -283,7 +338,7 @@ bool read_generate(Reader& r, const json::JsonValue& v, const std::string& p, St
     r.error(v.position, p, "\"generate\" must be an object {event, target}");
     return false;
   }
-  const auto typos = r.unknown_keys(v, p, {"event", "target"});
+  const auto typos = r.unknown_keys(v, p, step_key(ScenarioStep::Kind::Generate));
   const json::JsonValue* e = v.find("event");
   const json::JsonValue* t = v.find("target");
   if (e == nullptr) {
@@ -301,7 +356,7 @@ bool read_inject(Reader& r, const json::JsonValue& v, const std::string& p, Step
     r.error(v.position, p, "\"inject\" must be an object {filter|signal, deep, values}");
     return false;
   }
-  const auto typos = r.unknown_keys(v, p, {"filter", "signal", "deep", "values"});
+  const auto typos = r.unknown_keys(v, p, step_key(ScenarioStep::Kind::Inject));
   const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
   const json::JsonValue* f = v.find("filter");
   const json::JsonValue* sig = v.find("signal");
@@ -348,7 +403,7 @@ bool read_reset(Reader& r, const json::JsonValue& v, const std::string& p, StepA
     r.error(v.position, p, "\"reset\" must be an object {target, reason}");
     return false;
   }
-  const auto typos = r.unknown_keys(v, p, {"target", "reason"});
+  const auto typos = r.unknown_keys(v, p, step_key(ScenarioStep::Kind::Reset));
   const json::JsonValue* t = v.find("target");
   const json::JsonValue* why = v.find("reason");
   if (t == nullptr) {
@@ -393,8 +448,15 @@ bool read_expectations(Reader& r, const json::JsonValue& v, const std::string& p
   return ok;
 }
 
-constexpr std::string_view kActions[] = {"sample", "ramp",   "generate",           "inject",
-                                         "reset",  "expect", "expect_outstanding", "expect_cause"};
+/// The keys of the step kinds, for messages and suggestions.
+const std::vector<std::string>& action_keys() {
+  static const std::vector<std::string> keys = [] {
+    std::vector<std::string> out;
+    for (const ScenarioStep::Kind k : kKinds) out.emplace_back(step_key(k));
+    return out;
+  }();
+  return keys;
+}
 
 /// The step's "at" (seconds, not negative) into `when`; false (reported) when it has none.
 bool read_at(Reader& r, const json::JsonValue& step, const std::string& base, double& when) {
@@ -402,7 +464,7 @@ bool read_at(Reader& r, const json::JsonValue& step, const std::string& base, do
   if (at == nullptr) {
     // A misspelled "at" is one error, the unknown key with its suggestion.
     for (const json::JsonMember& m : step.object) {
-      if (std::find(std::begin(kActions), std::end(kActions), m.key) != std::end(kActions)) continue;
+      if (kind_of(m.key)) continue;
       if (nearest(m.key, {"at"})) {
         r.error(m.key_position, base + "/" + escape_pointer(m.key),
                 "unknown key \"" + m.key + "\"; did you mean 'at'?");
@@ -432,15 +494,12 @@ void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::d
   bool unknown_action = false;
   for (const json::JsonMember& m : step.object) {
     if (m.key == "at") continue;
-    const auto it = std::find(std::begin(kActions), std::end(kActions), m.key);
-    if (it == std::end(kActions)) {
-      const std::string suggestion =
-          did_you_mean(m.key, std::vector<std::string>(std::begin(kActions), std::end(kActions)));
+    const std::optional<ScenarioStep::Kind> kind = kind_of(m.key);
+    if (!kind) {
+      const std::string suggestion = did_you_mean(m.key, action_keys());
       r.error(m.key_position, base + "/" + escape_pointer(m.key),
               "unknown step action \"" + m.key + "\"" +
-                  (suggestion.empty()
-                       ? " (expected sample, ramp, generate, inject, reset, expect, expect_outstanding or expect_cause)"
-                       : suggestion));
+                  (suggestion.empty() ? " (expected " + join_or(action_keys()) + ")" : suggestion));
       unknown_action = true;
       continue;
     }
@@ -452,7 +511,7 @@ void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::d
     s.index = static_cast<std::uint32_t>(index);
     s.line = v.position.line;
     s.column = v.position.column;
-    s.kind = static_cast<ScenarioStep::Kind>(it - std::begin(kActions));
+    s.kind = *kind;
     StepAction a;
     bool ok = true;
     switch (s.kind) {
@@ -504,7 +563,7 @@ ScenarioLoad load_scenario(const std::string& path) {
     r.error(root.position, "", "a scenario must be a JSON object");
     return out;
   }
-  const auto typos = r.unknown_keys(root, "", {"system", "period", "duration", "steps", "description"});
+  const auto typos = r.unknown_keys(root, "", "scenario");
   const auto typo = [&](const char* k) { return std::find(typos.begin(), typos.end(), k) != typos.end(); };
   const json::JsonValue* system = root.find("system");
   if (system == nullptr) {

@@ -138,9 +138,14 @@ def read_history(path: str) -> History:
 
 
 def watch(system: RemoteSystem, timeout: float | None = None) -> Iterator[Record]:
-    """The coordinator's records as they happen, in order and each once, for as long as the
+    """The coordinator's records from this call on, in order and each once, for as long as the
     caller iterates; with a timeout, the iteration ends after that many seconds without a record.
     """
+    system._follow()  # now, not at the first next(): nothing between this call and the loop is missed
+    return _records(system, timeout)
+
+
+def _records(system: RemoteSystem, timeout: float | None) -> Iterator[Record]:
     while True:
         record = system._next_record(timeout if timeout is not None else 1.0)
         if record is not None:

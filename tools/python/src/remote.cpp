@@ -82,9 +82,8 @@ public:
     ask([&](in::SystemQuery& q) { return q.apply(action); });
   }
 
-  /// Starts following the coordinator's records (once), then returns the next one, or None after
-  /// `timeout` seconds without one.
-  std::optional<in::HistoryEntry> next_record(double timeout) {
+  /// Starts following the coordinator's records, once: every record from now on is queued.
+  void follow() {
     open_or_raise();
     if (!following_) {
       auto queue = std::make_shared<RecordQueue>();
@@ -93,6 +92,11 @@ public:
       });
       queue_ = std::move(queue);
     }
+  }
+
+  /// The next record followed, or None after `timeout` seconds without one.
+  std::optional<in::HistoryEntry> next_record(double timeout) {
+    follow();
     const auto wait = std::chrono::milliseconds(static_cast<long long>(std::max(0.0, timeout) * 1000.0));
     py::gil_scoped_release unlocked;
     return queue_->pop(wait);
@@ -128,6 +132,7 @@ std::string token_from(const std::string& file) {
 void bind_remote(py::module_& m) {
   py::class_<RemoteSystem> c(m, "RemoteSystem", "A live coordinator process, reached over the bus.");
   c.def_property_readonly("name", &RemoteSystem::name, "the coordinator's name")
+      .def("_follow", &RemoteSystem::follow)
       .def("_next_record", &RemoteSystem::next_record, py::arg("timeout"))
       .def("close", &RemoteSystem::close, "Leaves the bus (the coordinator is not touched).")
       .def("__enter__", [](RemoteSystem& s) -> RemoteSystem& { return s; })

@@ -1,7 +1,8 @@
 #pragma once
 /// @file scenario.hpp
 /// Scenarios (DESIGN §6): timed signal samples, ramps, events, injections, resets and expected
-/// states that drive a system in simulated time.
+/// states that drive a system in simulated time. The file format, for users:
+/// docs/scenario-format.md.
 
 #include <cstddef>
 #include <cstdint>
@@ -135,6 +136,21 @@ struct ScenarioStep {
 
 /// The key of a step kind in the file ("sample", "expect_outstanding", ...).
 std::string_view step_key(ScenarioStep::Kind kind) noexcept;
+
+/// One object of a scenario file and the keys load_scenario() accepts in it.
+struct ScenarioKeySet {
+  /// "scenario" (the top level), "step" (a member of "steps"), or the key of a step kind whose
+  /// value has fixed keys ("ramp", "generate", "inject", "reset").
+  std::string_view object;
+  std::vector<std::string_view> keys;  ///< in the order of the reader's messages
+};
+
+/// Every key of the scenario format, per object: the top level, a step ("at" and the key of every
+/// step kind, in the order of ScenarioStep::Kind) and the value of each step kind with fixed
+/// keys. The values of `sample` and of the expectations are objects of names (signals,
+/// addresses), not of keys: they have no entry. load_scenario() reports every key that is not
+/// here, and docs/scenario-format.md is tested against this table, so the three agree.
+const std::vector<ScenarioKeySet>& scenario_keys();
 
 struct Scenario {
   std::string path;       ///< the scenario file as given
