@@ -108,6 +108,8 @@ bench: deps
 	  --benchmark_display_aggregates_only=true \
 	  --benchmark_out=$(BUILD)/bench.json --benchmark_out_format=json
 	@./scripts/bench-middleware $(BUILD)/release/bin/bench_middleware $(BUILD)/bench-middleware.json
+	@if [ -d $(BUILD)/release/python/safecass ]; then \
+	  $(PIN) /usr/bin/python3 benchmarks/bench_python.py $(BUILD)/release/python $(BUILD)/bench-python.json; fi
 
 # The hot paths against the committed baseline (benchmarks/baseline.json): each ratio, and a
 # failure beyond its tolerance (docs/benchmarks.md, "bench-check"). Reads build/bench.json; not in CI.

@@ -3,7 +3,10 @@
 #   libsafecass-dev  the install component `dev`: static libraries, headers, CMake package config
 #                    with its Find modules, pkg-config files, and examples/consumer as an example
 #   safecass         the install component `tools`: the `safecass` command (its web pages are
-#                    compiled into it), its man pages, and the example specifications and scenarios
+#                    compiled into it), its man pages, the example specifications and scenarios, and
+#                    start-icestorm (in libexec/safecass: the broker a multi-process system needs)
+#   python3-safecass the install component `python`: `import safecass` for Debian's python3, with
+#                    its pytest plugin (tools/python, docs/python.md)
 #
 # Both install under /usr. The Debian packages the libraries need come from the
 # safecass_install_module() lines; those of the command are found by dpkg-shlibdeps.
@@ -18,6 +21,10 @@ if(TARGET safecass)
             DESTINATION ${CMAKE_INSTALL_DATAROOTDIR}/doc/safecass/examples COMPONENT tools
             FILES_MATCHING PATTERN "*.json")
   endforeach()
+endif()
+
+if(TARGET safecass_python)
+  list(APPEND SAFECASS_PACKAGE_COMPONENTS python)
 endif()
 
 set(CPACK_GENERATOR DEB)
@@ -49,5 +56,17 @@ set(CPACK_COMPONENT_TOOLS_DESCRIPTION
   "the safecass command: validate, run, test, console, viewer, timeline\n"
   "Validates SAFECASS specifications, runs scenarios, and watches live systems in a terminal or a\n"
   "browser. Man pages: safecass(1) and safecass-<subcommand>(1).")
+
+set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-safecass)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SHLIBDEPS ON)
+# The module's own Python needs (its shared libraries are found by dpkg-shlibdeps); pandas and
+# matplotlib are optional (to_pandas(), the plotting example).
+set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3 (>= 3.11), python3 (<< 3.12), python3-numpy")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SUGGESTS "python3-pandas, python3-matplotlib, python3-pytest, safecass")
+set(CPACK_COMPONENT_PYTHON_DESCRIPTION
+  "SAFECASS from Python: import safecass\n"
+  "Loads, runs, injects into, reads and verifies SAFECASS systems from Python 3; recordings as numpy\n"
+  "arrays; a pytest plugin that runs scenario files as tests (docs/python.md).")
 
 include(CPack)

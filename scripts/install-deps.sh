@@ -55,6 +55,11 @@ if [ "$bench_peers" = 1 ]; then
   packages+=(libdiagnostic-updater-dev)
 fi
 
+# `import safecass` (tools/python, docs/python.md): pybind11 for Debian's python3, numpy for the
+# recordings as arrays, pytest for its tests and plugin; pandas (to_pandas()) and matplotlib (the
+# plotting example) are tested where present and installed here so that they are.
+packages+=(pybind11-dev python3-pybind11 python3-numpy python3-pytest python3-pandas python3-matplotlib)
+
 # The trace report's browser test prints it to PDF with chromium and reads it back with pdftotext.
 packages+=(poppler-utils)
 

@@ -235,6 +235,24 @@ EOF
     dpkg-deb -c "$dev" | grep -q "/usr/bin/" && fail "the -dev package holds a command"
     dpkg-deb -c "$tools" | grep -q "\.a$" && fail "the command's package holds a library"
     ;;
+  package.unpacked_python3_safecass_imports_and_runs_robodoc)
+    py=$(ls "$work"/debs/python3-safecass_*.deb)
+    dpkg-deb -f "$py" Depends | grep -q "python3-numpy" || fail "python3-safecass Depends: $(dpkg-deb -f "$py" Depends)"
+    dpkg-deb -f "$py" Depends | grep -q "libc6" || fail "python3-safecass Depends (shlibdeps): $(dpkg-deb -f "$py" Depends)"
+    [ -x "$root/usr/libexec/safecass/start-icestorm" ] || fail "no start-icestorm in the tools package"
+    examples=$root/usr/share/doc/safecass/examples
+    PYTHONPATH=$root/usr/lib/python3/dist-packages /usr/bin/python3 - "$examples/robodoc/robodoc.json" >"$tmp/out" 2>&1 <<'PY' || fail "python3-safecass: $(cat "$tmp/out")"
+import importlib.metadata, sys
+import safecass
+robot = safecass.System(sys.argv[1])
+robot.generate("EVT_FORCE_ERROR", "JR3.s_A")
+assert robot.state("SERVO") == "Error", robot.levels()
+plugins = [e.value for e in importlib.metadata.entry_points(group="pytest11")]
+assert "safecass.pytest_plugin" in plugins, plugins
+print("python3-safecass", safecass.__version__, safecass.__file__)
+PY
+    grep -q "^python3-safecass .*/usr/lib/python3/dist-packages/safecass/__init__.py" "$tmp/out" || fail "imported from elsewhere: $(cat "$tmp/out")"
+    ;;
   *) fail "unknown case $case_name" ;;
 esac
 echo "ok: $case_name"

@@ -47,6 +47,14 @@ def test_every_action_kind_goes_through_the_one_action_path_and_is_recorded(robo
     assert {"event", "transition", "reset", "injection"} <= kinds
 
 
+def test_a_broadcast_reaches_the_application_machine_of_every_component(safecass_system):
+    cell = safecass_system(str(ROOT / "tests/data/verify/broadcast.fixed.json"))
+    cell.broadcast("EVT_ESTOP")
+    assert [cell.state(c + ".s_A") for c in ("PANEL", "AXIS1", "AXIS2")] == ["Error"] * 3
+    with pytest.raises(safecass.Error):
+        cell.broadcast("NOT_AN_EVENT")
+
+
 def test_a_refused_action_raises_and_changes_nothing(robodoc):
     robodoc.generate("EVT_FORCE_HIGH", "JR3.s_A")
     before = (robodoc.levels(), [r.to_dict() for r in robodoc.history()])

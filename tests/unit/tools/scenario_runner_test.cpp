@@ -137,3 +137,39 @@ TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingR
 
 }  // namespace
 }  // namespace safecass::runner
+
+namespace safecass::runner {
+namespace {
+
+TEST(ScenarioRunner, ADeepInjectionOfMoreSamplesThanTheSignalHoldsIsRefusedAtItsStepAndNothingRuns) {
+  // Found by the scenario format's documentation: the runner used to accept the step, and the
+  // injection then refused it at its tick without a word: nothing injected, nothing recorded.
+  const std::string path = ::testing::TempDir() + "deep-overflow-" + std::to_string(::getpid()) + ".json";
+  {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    std::fprintf(f,
+                 "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
+                 "  \"steps\": [\n"
+                 "    { \"at\": 0.0, \"inject\": { \"signal\": \"JR3.Fx\", \"deep\": true, \"values\": [",
+                 SAFECASS_SOURCE_DIR);
+    for (int i = 0; i < 1025; ++i) std::fprintf(f, "%s1", i == 0 ? "" : ",");
+    std::fprintf(f, "] } } ] }\n");
+    std::fclose(f);
+  }
+  FilterRegistry registry;
+  register_builtin_filters(registry);
+  RunOptions options;
+  options.quiet = true;
+  RunResult result;
+  Captured err;
+  const int code = run_scenario_file(path, registry, options, &result, err.file);
+  EXPECT_EQ(code, 2) << err.str();
+  EXPECT_THAT(err.str(), HasSubstr(path + ":3:28: error: deep injection into signal JR3.Fx: 1025 samples would "
+                                          "overflow its history (1023 samples): inject fewer at once [/steps/0/inject]"));
+  EXPECT_EQ(result.checks, 0) << "nothing ran";
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace safecass::runner

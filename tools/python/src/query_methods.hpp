@@ -17,15 +17,15 @@
 
 namespace safecass::python {
 
-namespace detail {
-
-inline std::vector<double> values_of(const py::args& values) {
+/// The values of push(signal, *values): numbers, or one sequence of them.
+inline std::vector<double> sample_values(const py::args& values) {
   if (values.size() == 1 && !py::isinstance<py::float_>(values[0]) && !py::isinstance<py::int_>(values[0]))
     return values[0].cast<std::vector<double>>();
   return values.cast<std::vector<double>>();
 }
 
-inline std::vector<std::vector<double>> rows_of(const py::object& samples) {
+/// The samples of an injection: a sequence of numbers or of sequences of numbers.
+inline std::vector<std::vector<double>> sample_rows(const py::object& samples) {
   std::vector<std::vector<double>> rows;
   for (const py::handle row : samples) {
     if (py::isinstance<py::float_>(row) || py::isinstance<py::int_>(row)) {
@@ -37,15 +37,13 @@ inline std::vector<std::vector<double>> rows_of(const py::object& samples) {
   return rows;
 }
 
-}  // namespace detail
-
 template <class Owner>
 void bind_actions(py::class_<Owner>& c) {
   namespace in = safecass::introspect;
   c.def(
        "push",
        [](Owner& s, const std::string& signal, const py::args& values) {
-         s.apply(in::PushSample{signal, detail::values_of(values)});
+         s.apply(in::PushSample{signal, sample_values(values)});
        },
        py::arg("signal"),
        "Writes one sample of a signal (Component.signal) now: push('JR3.force', 12.5), or a sequence for a vector.")
@@ -54,10 +52,11 @@ void bind_actions(py::class_<Owner>& c) {
           [](Owner& s, const std::string& event, const std::string& target) {
             s.apply(in::GenerateEvent{event, target});
           },
-          py::arg("event"), py::arg("target"), "Processes an event on a machine (\"JR3.s_A\"), as the console's `generate`.")
+          py::arg("event"), py::arg("target"),
+          "Processes an event on a machine (\"JR3.s_A\"), as the console's `generate`.")
       .def(
-          "broadcast", [](Owner& s, const std::string& event) { s.apply(in::BroadcastEvent{event}); },
-          py::arg("event"), "Processes a broadcast event (severity 251-255) on every component's s_A.")
+          "broadcast", [](Owner& s, const std::string& event) { s.apply(in::BroadcastEvent{event}); }, py::arg("event"),
+          "Processes a broadcast event (severity 251-255) on every component's s_A.")
       .def(
           "reset",
           [](Owner& s, const std::string& target, const std::string& why) {
@@ -68,14 +67,14 @@ void bind_actions(py::class_<Owner>& c) {
       .def(
           "inject",
           [](Owner& s, const std::string& filter, const py::object& samples) {
-            s.apply(in::InjectShallow{filter, detail::rows_of(samples)});
+            s.apply(in::InjectShallow{filter, sample_rows(samples)});
           },
           py::arg("filter"), py::arg("samples"),
           "Shallow injection: samples queued into one filter's private input (the console's `filter inject`).")
       .def(
           "inject_deep",
           [](Owner& s, const std::string& signal, const py::object& samples) {
-            s.apply(in::InjectDeep{signal, detail::rows_of(samples)});
+            s.apply(in::InjectDeep{signal, sample_rows(samples)});
           },
           py::arg("signal"), py::arg("samples"),
           "Deep injection: samples written into a signal's history now, seen by every consumer (`filter dinject`).");
@@ -138,8 +137,7 @@ void bind_reads(py::class_<Owner>& c) {
       .def(
           "connections",
           [](Owner& s) {
-            return result_list(
-                in::connection_list_json(s.ask([](in::SystemQuery& q) { return q.connection_list(); })));
+            return result_list(in::connection_list_json(s.ask([](in::SystemQuery& q) { return q.connection_list(); })));
           },
           "`connection list`: each connection and its states.")
       .def(

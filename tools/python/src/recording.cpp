@@ -117,11 +117,9 @@ py::dict read_inputs(const std::string& path) {
   py::dict out;
   out["header"] = py::dict(py::arg("period") = to_seconds(h.period), py::arg("start") = to_seconds(h.start),
                            py::arg("clock") = h.clock, py::arg("system") = h.system);
-  out["inputs"] = structured({{"time", column(times)},
-                              {"signal", text_column(names)},
-                              {"index", column(index)},
-                              {"value", column(values)}},
-                             times.size());
+  out["inputs"] = structured(
+      {{"time", column(times)}, {"signal", text_column(names)}, {"index", column(index)}, {"value", column(values)}},
+      times.size());
   out["actions"] = actions;
   out["losses"] = losses;
   out["end"] = end;

@@ -87,9 +87,8 @@ public:
     open_or_raise();
     if (!following_) {
       auto queue = std::make_shared<RecordQueue>();
-      following_ = ask([&](in::SystemQuery& q) {
-        return q.follow([queue](const in::HistoryEntry& e) { queue->push(e); });
-      });
+      following_ =
+          ask([&](in::SystemQuery& q) { return q.follow([queue](const in::HistoryEntry& e) { queue->push(e); }); });
       queue_ = std::move(queue);
     }
   }
@@ -155,8 +154,8 @@ void bind_remote(py::module_& m) {
         o.timeout = std::chrono::milliseconds(static_cast<long long>(timeout * 1000.0));
         return RemoteSystem::connect(std::move(o));
       },
-      py::arg("ice"), py::arg("coordinator"), py::arg("keys") = "", py::arg("read_token") = "",
-      py::arg("token") = "", py::arg("tls") = "", py::arg("timeout") = 2.0,
+      py::arg("ice"), py::arg("coordinator"), py::arg("keys") = "", py::arg("read_token") = "", py::arg("token") = "",
+      py::arg("tls") = "", py::arg("timeout") = 2.0,
       "Connects to a live coordinator as `safecass console --ice HOST:PORT --coordinator NAME` does: found by its "
       "signed heartbeat on IceStorm and proven alive before anything is sent. keys: the system's bus keys "
       "(default $SAFECASS_KEYS); read_token, token: the read and write token files (token: writes allowed).");
@@ -165,10 +164,9 @@ void bind_remote(py::module_& m) {
 #else
 
 void bind_remote(py::module_& m) {
-  m.def(
-      "connect", [](const py::args&, const py::kwargs&) {
-        raise(Error{ErrorCode::InvalidState, "this build has no middleware (SAFECASS_WITH_ICE=OFF)"});
-      });
+  m.def("connect", [](const py::args&, const py::kwargs&) {
+    raise(Error{ErrorCode::InvalidState, "this build has no middleware (SAFECASS_WITH_ICE=OFF)"});
+  });
 }
 
 #endif

@@ -53,8 +53,8 @@ struct Subscriber {
 class System {
 public:
   /// A system file (and a scenario to drive it, and files to record to).
-  static std::unique_ptr<System> open(const std::string& path, const std::string& scenario,
-                                      const std::string& record, const std::string& inputs) {
+  static std::unique_ptr<System> open(const std::string& path, const std::string& scenario, const std::string& record,
+                                      const std::string& inputs) {
     auto opened = runner::ScenarioRunner::open(runner::ScenarioSource{scenario, path}, builtin_filters());
     if (!opened) raise(opened.error());
     auto system = std::unique_ptr<System>(new System());
@@ -138,8 +138,8 @@ public:
     open_or_raise();
     Signal* target = runner_->monitor().signals().find(signal);
     const std::size_t width = target != nullptr ? target->size() : 1;
-    value_or_raise(in::check(in::PushSample{signal, std::vector<double>(width)}, runner_->coordinator(),
-                             runner_->monitor()));
+    value_or_raise(
+        in::check(in::PushSample{signal, std::vector<double>(width)}, runner_->coordinator(), runner_->monitor()));
     const std::size_t n = check_feed(times, values, width);
     const double* t = times.data();
     const double* v = values.data();
@@ -238,8 +238,8 @@ private:
 
   Time time_or_raise(double t, const char* what) const {
     if (!std::isfinite(t) || t < 0.0 || t > 1e9) {
-      raise(Error{ErrorCode::InvalidArgument, std::string(what) + ": " + std::to_string(t) +
-                                                  " is not a time in seconds (finite, 0 to 1e9)"});
+      raise(Error{ErrorCode::InvalidArgument,
+                  std::string(what) + ": " + std::to_string(t) + " is not a time in seconds (finite, 0 to 1e9)"});
     }
     return seconds_to_time(t);
   }
@@ -316,7 +316,6 @@ private:
 
 }  // namespace
 
-
 namespace {
 
 /// What load() answers: the loaded system's outline, as a Result.
@@ -369,7 +368,8 @@ void bind_system(py::module_& m) {
         return loaded.diagnostics;
       },
       py::arg("path"),
-      "Every problem of a system or component file (errors and warnings), each with file:line:col; [] when it is valid.");
+      "Every problem of a system or component file (errors and warnings), each with file:line:col; [] when it is "
+      "valid.");
   py::class_<System> c(m, "System",
                        "A system built in this process and run in simulated time, as the console runs it in-process.");
   c.def(py::init(&System::open), py::arg("path"), py::arg("scenario") = "", py::arg("record") = "",
@@ -399,9 +399,8 @@ void bind_system(py::module_& m) {
   bind_reads(c);
   m.def(
       "replay",
-      [](const std::string& system, const std::string& recording, const std::string& format,
-         const std::string& mapping, std::optional<double> period, std::optional<double> start,
-         std::optional<double> end) {
+      [](const std::string& system, const std::string& recording, const std::string& format, const std::string& mapping,
+         std::optional<double> period, std::optional<double> start, std::optional<double> end) {
         replay::ReplayOptions options;
         options.system = system;
         options.input = recording;

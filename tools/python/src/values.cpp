@@ -80,7 +80,8 @@ void bind_record(py::module_& m) {
   py::class_<in::HistoryEntry>(m, "Record",
                                "One record of the observer stream: an event, a transition, a reset or an injection.")
       .def_readonly("seq", &in::HistoryEntry::seq)
-      .def_property_readonly("time", [](const in::HistoryEntry& e) { return to_seconds(e.time); }, "seconds")
+      .def_property_readonly(
+          "time", [](const in::HistoryEntry& e) { return to_seconds(e.time); }, "seconds")
       .def_property_readonly("kind", [](const in::HistoryEntry& e) { return std::string(to_string(e.kind)); })
       .def_property_readonly("outcome",
                              [](const in::HistoryEntry& e) {
@@ -97,8 +98,9 @@ void bind_record(py::module_& m) {
       .def_readonly("root", &in::HistoryEntry::root)
       .def_readonly("text", &in::HistoryEntry::text, "why an event was ignored; who and why of a reset")
       .def_property_readonly("where", [](const in::HistoryEntry& e) { return std::string(e.where()); })
-      .def("to_dict", [](const in::HistoryEntry& e) { return from_json(in::history_json(e)); },
-           "the record as the history file writes it (docs/record-format.md)")
+      .def(
+          "to_dict", [](const in::HistoryEntry& e) { return from_json(in::history_json(e)); },
+          "the record as the history file writes it (docs/record-format.md)")
       .def("__str__", [](const in::HistoryEntry& e) { return in::live_line(e); })
       .def("__repr__", [](const in::HistoryEntry& e) { return "<Record " + in::history_json(e) + ">"; });
 }
@@ -109,8 +111,7 @@ void bind_state_row(py::module_& m) {
       .def_property_readonly("kind", [](const in::StateRow& r) { return std::string(to_string(r.kind)); })
       .def_property_readonly("state", [](const in::StateRow& r) { return level(r.state); })
       .def_readonly("outstanding", &in::StateRow::outstanding)
-      .def("to_dict",
-           [](const in::StateRow& r) { return from_json(in::state_list_json({r})); })
+      .def("to_dict", [](const in::StateRow& r) { return from_json(in::state_list_json({r})); })
       .def("__repr__", [](const in::StateRow& r) { return "<StateRow " + r.address + " " + level(r.state) + ">"; });
 }
 
@@ -134,11 +135,10 @@ void bind_explain(py::module_& m) {
       .def_readonly("conditions", &in::ExplainAnswer::conditions)
       .def("to_dict", [](const in::ExplainAnswer& a) { return from_json(in::explain_json(a)); })
       .def("__str__", [](const in::ExplainAnswer& a) { return in::explain_text(a, in::TimeFormat()); })
-      .def("__repr__",
-           [](const in::ExplainAnswer& a) {
-             return "<Explain " + a.address + " " + level(a.state) + ", " + std::to_string(a.conditions.size()) +
-                    " condition(s)>";
-           });
+      .def("__repr__", [](const in::ExplainAnswer& a) {
+        return "<Explain " + a.address + " " + level(a.state) + ", " + std::to_string(a.conditions.size()) +
+               " condition(s)>";
+      });
 }
 
 }  // namespace
@@ -160,9 +160,7 @@ py::object from_json(std::string_view text) {
   return py::module_::import("json").attr("loads")(py::str(text.data(), text.size()));
 }
 
-py::object result_from_json(std::string_view text) {
-  return values_module().attr("Result")(from_json(text));
-}
+py::object result_from_json(std::string_view text) { return values_module().attr("Result")(from_json(text)); }
 
 py::list result_list(std::string_view lines) {
   const py::object result = values_module().attr("Result");

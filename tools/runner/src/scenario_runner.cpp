@@ -171,6 +171,7 @@ Diagnostics ScenarioRunner::check_names() {
   };
   for (const spec::ScenarioStep& s : scenario_.steps) {
     const spec::StepAction* action = s.action.get();  // null for a sample step
+    const std::size_t before = out.size();
     switch (s.kind) {
       case spec::ScenarioStep::Kind::Sample:
         for (const auto& [name, values] : s.samples) {
@@ -234,6 +235,16 @@ Diagnostics ScenarioRunner::check_names() {
           }
         } else if (Signal* sig = monitor_->signals().find(action->signal); sig == nullptr) {
           out.push_back(error_at(s, unknown("signal", action->signal, signal_names)));
+        }
+        if (out.size() == before) {
+          // What the injection itself refuses (more samples than the history holds, a deep sample of
+          // the wrong size), said here rather than applied to nothing at its tick.
+          for (const introspect::Action& a : step_actions(s, *monitor_, system_->spec())) {
+            if (auto ok = introspect::check(a, coordinator_, *monitor_); !ok) {
+              out.push_back(error_at(s, ok.error().message));
+              break;
+            }
+          }
         }
         break;
       case spec::ScenarioStep::Kind::Reset:
