@@ -65,7 +65,7 @@ public:
   }
 
   /// A recording replayed through a system (replay::ReplaySession: every input checked first).
-  static std::unique_ptr<System> replay(replay::ReplayOptions options) {
+  static std::unique_ptr<System> replay(const replay::ReplayOptions& options) {
     Expected<std::unique_ptr<replay::ReplaySession>> opened = fail(ErrorCode::InvalidState, "not opened");
     {
       py::gil_scoped_release unlocked;
