@@ -106,69 +106,60 @@ TEST(ScenarioRunner, AnInjectionOfANonFiniteValueBuiltInCppIsAnErrorAtItsStep) {
 namespace safecass::runner {
 namespace {
 
-TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingRuns) {
-  // A service state is derived (DESIGN §2.2): the coordinator and the console refuse to reset
-  // one. The runner used to accept the step and then do nothing.
-  const std::string path = ::testing::TempDir() + "reset-service-" + std::to_string(::getpid()) + ".json";
-  {
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    ASSERT_NE(f, nullptr);
-    std::fprintf(
-        f,
-        "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
-        "  \"steps\": [\n"
-        "    { \"at\": 0.0, \"reset\": { \"target\": \"JR3.s_S.ForceData\", \"reason\": \"operator\" } } ] }\n",
-        SAFECASS_SOURCE_DIR);
+/// A scenario of robodoc (period 1 ms, 10 ms) with `steps`, run by run_scenario_file(): its exit
+/// code, what it printed on `err`, its result; the file is written under `name` and removed.
+struct RobodocRun {
+  std::string path;
+  int code = 0;
+  std::string err;
+  RunResult result;
+};
+RobodocRun run_robodoc_steps(const std::string& name, const std::string& steps) {
+  RobodocRun run;
+  run.path = ::testing::TempDir() + name + "-" + std::to_string(::getpid()) + ".json";
+  if (std::FILE* f = std::fopen(run.path.c_str(), "w"); f != nullptr) {
+    std::fprintf(f,
+                 "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
+                 "  \"steps\": [\n%s ] }\n",
+                 SAFECASS_SOURCE_DIR, steps.c_str());
     std::fclose(f);
   }
   FilterRegistry registry;
   register_builtin_filters(registry);
   RunOptions options;
   options.quiet = true;
-  RunResult result;
   Captured err;
-  const int code = run_scenario_file(path, registry, options, &result, err.file);
-  EXPECT_EQ(code, 2) << err.str();
-  EXPECT_THAT(err.str(), HasSubstr(path + ":3:27: error: cannot reset service state 'JR3.s_S.ForceData': it is "
-                                          "derived; reset its component or a machine [/steps/0/reset]"));
-  EXPECT_EQ(result.checks, 0) << "nothing ran";
-  std::remove(path.c_str());
+  run.code = run_scenario_file(run.path, registry, options, &run.result, err.file);
+  run.err = err.str();
+  std::remove(run.path.c_str());
+  return run;
 }
 
-}  // namespace
-}  // namespace safecass::runner
-
-namespace safecass::runner {
-namespace {
+TEST(ScenarioRunner, AResetOfAServiceStateIsRefusedAtLoadWithItsPlaceAndNothingRuns) {
+  // A service state is derived (DESIGN §2.2): the coordinator and the console refuse to reset
+  // one. The runner used to accept the step and then do nothing.
+  const RobodocRun run = run_robodoc_steps(
+      "reset-service",
+      "    { \"at\": 0.0, \"reset\": { \"target\": \"JR3.s_S.ForceData\", \"reason\": \"operator\" } }");
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_THAT(run.err, HasSubstr(run.path + ":3:27: error: cannot reset service state 'JR3.s_S.ForceData': it is "
+                                            "derived; reset its component or a machine [/steps/0/reset]"));
+  EXPECT_EQ(run.result.checks, 0) << "nothing ran";
+}
 
 TEST(ScenarioRunner, ADeepInjectionOfMoreSamplesThanTheSignalHoldsIsRefusedAtItsStepAndNothingRuns) {
   // Found by the scenario format's documentation: the runner used to accept the step, and the
   // injection then refused it at its tick without a word: nothing injected, nothing recorded.
-  const std::string path = ::testing::TempDir() + "deep-overflow-" + std::to_string(::getpid()) + ".json";
-  {
-    std::FILE* f = std::fopen(path.c_str(), "w");
-    ASSERT_NE(f, nullptr);
-    std::fprintf(f,
-                 "{ \"system\": \"%s/examples/robodoc/robodoc.json\", \"period\": 0.001, \"duration\": 0.01,\n"
-                 "  \"steps\": [\n"
-                 "    { \"at\": 0.0, \"inject\": { \"signal\": \"JR3.Fx\", \"deep\": true, \"values\": [",
-                 SAFECASS_SOURCE_DIR);
-    for (int i = 0; i < 1025; ++i) std::fprintf(f, "%s1", i == 0 ? "" : ",");
-    std::fprintf(f, "] } } ] }\n");
-    std::fclose(f);
-  }
-  FilterRegistry registry;
-  register_builtin_filters(registry);
-  RunOptions options;
-  options.quiet = true;
-  RunResult result;
-  Captured err;
-  const int code = run_scenario_file(path, registry, options, &result, err.file);
-  EXPECT_EQ(code, 2) << err.str();
-  EXPECT_THAT(err.str(), HasSubstr(path + ":3:28: error: deep injection into signal JR3.Fx: 1025 samples would "
-                                          "overflow its history (1023 samples): inject fewer at once [/steps/0/inject]"));
-  EXPECT_EQ(result.checks, 0) << "nothing ran";
-  std::remove(path.c_str());
+  std::string values = "1";
+  for (int i = 1; i < 1025; ++i) values += ",1";
+  const RobodocRun run = run_robodoc_steps(
+      "deep-overflow",
+      "    { \"at\": 0.0, \"inject\": { \"signal\": \"JR3.Fx\", \"deep\": true, \"values\": [" + values + "] } }");
+  EXPECT_EQ(run.code, 2) << run.err;
+  EXPECT_THAT(run.err, HasSubstr(run.path + ":3:28: error: deep injection into signal JR3.Fx: 1025 samples would "
+                                            "overflow its history (1023 samples): inject fewer at once "
+                                            "[/steps/0/inject]"));
+  EXPECT_EQ(run.result.checks, 0) << "nothing ran";
 }
 
 }  // namespace
