@@ -381,6 +381,9 @@ InputLogReader::Item InputLogReader::next() {
         if (!whole(19)) return error_.empty() ? Item::Eof : fail_at(error_);
         mark_time_ = Time{get<std::int64_t>(buffer_.data() + pos_ + 1)};
         loss_signal_ = get<std::uint16_t>(buffer_.data() + pos_ + 9);
+        if (loss_signal_ != 0xffff && loss_signal_ >= widths_.size()) {
+          return fail_at("loss of signal id " + std::to_string(loss_signal_) + ", which was never declared");
+        }
         lost_ = get<std::uint64_t>(buffer_.data() + pos_ + 11);
         pos_ += 19;
         ++index_;

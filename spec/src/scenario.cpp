@@ -536,14 +536,18 @@ void read_step(Reader& r, const json::JsonValue& step, std::size_t index, std::d
 }  // namespace
 
 ScenarioLoad load_scenario(const std::string& path) {
-  ScenarioLoad out;
-  Reader r(path, out.diagnostics);
   auto read = read_regular_file(path);
   if (!read) {
+    ScenarioLoad out;
     out.diagnostics.push_back(Diagnostic{Diagnostic::Severity::Error, Position{path, 1, 1}, read.error().message, ""});
     return out;
   }
-  std::string text = std::move(*read);
+  return load_scenario_text(std::move(*read), path);
+}
+
+ScenarioLoad load_scenario_text(std::string text, const std::string& path) {
+  ScenarioLoad out;
+  Reader r(path, out.diagnostics);
   // The steps are read one by one as the parser reaches them and their JSON is dropped at once:
   // a tree of the whole file took ten times its size (docs/spec-format.md, "Memory"). Their
   // diagnostics come after those of the scenario's other members, as they always did.

@@ -8,6 +8,7 @@
 #include <string>
 #include <string_view>
 
+#include "fuzz_text.hpp"
 #include "safecass/spec/spec.hpp"
 
 namespace {
@@ -19,22 +20,6 @@ const safecass::FilterRegistry& registry() {
     return x;
   }();
   return r;
-}
-
-bool inside(std::string_view text, int line, int column) {
-  if (line < 1 || column < 1) return false;
-  int current = 1;
-  std::size_t start = 0;
-  for (std::size_t i = 0; i < text.size() && current < line; ++i) {
-    if (text[i] == '\n') {
-      ++current;
-      start = i + 1;
-    }
-  }
-  if (current != line) return false;
-  const std::size_t end = text.find('\n', start);
-  const std::size_t length = (end == std::string_view::npos ? text.size() : end) - start;
-  return static_cast<std::size_t>(column) <= length + 1;
 }
 
 }  // namespace

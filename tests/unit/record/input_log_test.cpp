@@ -259,6 +259,21 @@ TEST(InputLogReader, ASampleOfAnUndeclaredSignalIsAnError) {
   EXPECT_THAT(error, HasSubstr("sample of signal id 3, which was never declared"));
 }
 
+TEST(InputLogReader, ALossOfAnUndeclaredSignalIsAnError) {
+  // Found by input_log_fuzz: the reader handed out a loss naming signal id 7 of a file that
+  // declares none, and a reader of its name (signal_name(7)) read past the table.
+  std::string bytes;
+  input_log::put_header(bytes, InputLogHeader{});
+  input_log::put_loss(bytes, Time{0}, 7, 3);
+  input_log::put_loss(bytes, Time{0}, 0xffff, 2);
+  const std::string path = scratch("undeclared-loss.inputs");
+  spit(path, bytes);
+  std::string error;
+  read_all(path, &error);
+  EXPECT_THAT(error, HasSubstr(": record 1 (byte "));
+  EXPECT_THAT(error, HasSubstr("loss of signal id 7, which was never declared"));
+}
+
 TEST_F(InputRecording, SamplesOverwrittenBeforeTheRecorderReadThemAreCountedMarkedAndSaid) {
   const std::string path = scratch("lost.inputs");
   auto rec = InputRecorder::open(monitor_, path);

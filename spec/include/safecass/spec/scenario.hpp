@@ -178,6 +178,9 @@ struct ScenarioLoad {
 /// runs, or all at once by runner::check_scenario). An expectation after the duration is an
 /// error: it would never be checked.
 ScenarioLoad load_scenario(const std::string& path);
+/// The same for a scenario's bytes already read: `path` names it in diagnostics and is what
+/// "system" is relative to (the fuzzer, tools that hold the text). Consumes `text`.
+ScenarioLoad load_scenario_text(std::string text, const std::string& path);
 
 /// read_regular_file() (file.hpp) with its default limit, for callers that want a flag and a
 /// message: false with the message ("cannot read file 'PATH': why") when it cannot be read.
