@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-build fuzz fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
 
 all: build
 
@@ -55,7 +55,7 @@ ros-demo: configure
 # Every test; a test that fails is run once more alone and named in the summary as retried
 # (scripts/run-tests), which ends with what ran: ctest's count and the fuzz smoke run's executions.
 test: build fuzz-smoke
-	@JOBS=$(JOBS) ./scripts/run-tests $(BUILD) --fuzz-log $(FUZZ)/smoke.log $(CTEST_ARGS)
+	@JOBS=$(JOBS) ./scripts/run-tests $(BUILD) --fuzz-log $(FUZZ)/spec_loader.log $(CTEST_ARGS)
 
 # The tests that start processes (label `processes`), STRESS_RUNS times (default 5) beside two busy
 # loops with ctest -j2 and no retry: every run must pass (scripts/stress-test).
@@ -66,37 +66,26 @@ stress-test: build
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
-# Short libFuzzer runs of the spec loader, the ROS inputs and the named reads' answers (clang,
-# ASan + UBSan); the long runs are in docs/spec-format.md.
+# The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, their own tree): the spec loader, the
+# ROS inputs, the named reads' answers, scenarios, history lines and inputs recordings
+# (docs/contributing.md, "Fuzzing"). scripts/fuzz runs them with their seed corpora.
 FUZZ := $(BUILD)/fuzz
-fuzz-smoke: deps
+FUZZ_TARGETS := spec_loader ros_input read_answer scenario history input_log
+FUZZ_SECONDS ?= 60
+fuzz-build: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
 	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
 	  -DSAFECASS_BUILD_TOOLS=OFF -DSAFECASS_BUILD_EXAMPLES=OFF -DSAFECASS_BUILD_BENCHMARKS=OFF >/dev/null
-	@cmake --build $(FUZZ) -j $(JOBS) --target spec_loader_fuzz >/dev/null
-	@mkdir -p $(FUZZ)/corpus
-	@for f in tests/data/good_specs/*.json tests/data/good_specs/*/*.json tests/data/bad_specs/*.json; do \
-	  cp "$$f" "$(FUZZ)/corpus/$$(echo "$$f" | tr / _)"; done
-	@$(FUZZ)/bin/spec_loader_fuzz -dict=tests/fuzz/spec.dict -max_len=8192 -max_total_time=20 -print_final_stats=1 \
-	  -artifact_prefix=$(FUZZ)/ $(FUZZ)/corpus >$(FUZZ)/smoke.log 2>&1 \
-	  || { tail -40 $(FUZZ)/smoke.log; echo "fuzz-smoke: the spec loader fuzzer found a failure"; exit 1; }
-	@echo "fuzz-smoke: no failure in 20 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/smoke.log | tail -1))"
-	@cmake --build $(FUZZ) -j $(JOBS) --target ros_input_fuzz >/dev/null
-	@mkdir -p $(FUZZ)/ros-corpus
-	@for f in examples/ros_robodoc/mapping.json examples/dds_robodoc/mapping.json tests/unit/dds/data/*.json tests/integration/dds/*.json; do \
-	  { printf '\003'; cat "$$f"; } >"$(FUZZ)/ros-corpus/$$(echo "$$f" | tr / _)"; done
-	@$(FUZZ)/bin/ros_input_fuzz -max_len=4096 -max_total_time=10 -print_final_stats=1 \
-	  -artifact_prefix=$(FUZZ)/ros- $(FUZZ)/ros-corpus >$(FUZZ)/ros-smoke.log 2>&1 \
-	  || { tail -40 $(FUZZ)/ros-smoke.log; echo "fuzz-smoke: the ROS input fuzzer found a failure"; exit 1; }
-	@echo "fuzz-smoke: ROS inputs (CDR, mapping files): no failure in 10 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/ros-smoke.log | tail -1))"
-	@cmake --build $(FUZZ) -j $(JOBS) --target read_answer_fuzz >/dev/null
-	@mkdir -p $(FUZZ)/read-corpus
-	@printf '%s\n' '{"system":"Error","normal":3,"warning":1,"error":1,"not_normal":[{"component":"BMM","state":"Warning","outstanding":"EVT_BONE_MOTION"},{"component":"JR3","state":"Error","outstanding":null}]}' \
-	  >$(FUZZ)/read-corpus/state_summary.json
-	@$(FUZZ)/bin/read_answer_fuzz -max_len=1024 -max_total_time=5 -print_final_stats=1 \
-	  -artifact_prefix=$(FUZZ)/read- $(FUZZ)/read-corpus >$(FUZZ)/read-smoke.log 2>&1 \
-	  || { tail -40 $(FUZZ)/read-smoke.log; echo "fuzz-smoke: the named-read answer fuzzer found a failure"; exit 1; }
-	@echo "fuzz-smoke: named-read answers: no failure in 5 s ($$(grep -o 'stat::number_of_executed_units: *[0-9]*' $(FUZZ)/read-smoke.log | tail -1))"
+	@cmake --build $(FUZZ) -j $(JOBS) --target $(addsuffix _fuzz,$(FUZZ_TARGETS)) >/dev/null
+
+# Every target for FUZZ_SECONDS (default 60) each: executions, edges and findings per target.
+fuzz: fuzz-build
+	@./scripts/fuzz $(FUZZ) $(FUZZ_SECONDS)
+
+# The short runs of `make test`: the spec loader 20 s, every other target 4 s.
+fuzz-smoke: fuzz-build
+	@./scripts/fuzz $(FUZZ) 20 spec_loader
+	@./scripts/fuzz $(FUZZ) 4 $(filter-out spec_loader,$(FUZZ_TARGETS))
 
 # Benchmarks are built in Release in their own tree; results land in build/bench.json (every
 # repetition and the aggregates), run on one core (the last) when taskset is there.

@@ -61,18 +61,20 @@ class Recording:
     ("Component.signal"), ``index`` (the value's place in a vector sample, 0 for a scalar) and
     ``value``. ``actions`` lists the operator's actions as dicts, ``losses`` the samples the
     recorder could not keep, ``end`` the last tick of a cleanly closed recording (None when it was
-    cut), ``truncated`` whether the file ended inside a record (a killed recorder).
+    cut), ``truncated`` whether the file ended inside a record (a killed recorder) and
+    ``cut_bytes`` how many bytes after its last whole record were left out.
     """
 
     def __init__(self, path: str) -> None:
-        parts = _read_inputs(str(path))
         self.path = str(path)
+        parts = _read_inputs(self.path)
         self.header: dict = parts["header"]
         self.inputs = parts["inputs"]
         self.actions: list = parts["actions"]
         self.losses: list = parts["losses"]
         self.end = parts["end"]
         self.truncated: bool = parts["truncated"]
+        self.cut_bytes: int = parts["cut_bytes"]
 
     def signal(self, name: str, index: int = 0) -> tuple:
         """The (times, values) numpy arrays of one signal's element, ready to plot or to feed."""
@@ -97,15 +99,17 @@ class History:
     ``kind`` ("event", "transition", ...), ``address`` (the machine, else the component),
     ``event``, ``level`` (a transition's new level, an event's level) and ``root``
     ("JR3.s_A:EVT_FORCE_ERROR", or ""). ``dropped`` counts records the recorder dropped; ``torn``
-    is the line number of a torn last line (a killed recorder), or None.
+    is the line number of a torn last line (a killed recorder), or None, and ``cut_bytes`` its
+    length.
     """
 
     def __init__(self, path: str) -> None:
-        parts = _read_history(str(path))
         self.path = str(path)
+        parts = _read_history(self.path)
         self.records = parts["records"]
         self.dropped: int = parts["dropped"]
         self.torn = parts["torn"]
+        self.cut_bytes: int = parts["cut_bytes"]
 
     def levels(self, address: str) -> tuple:
         """The (times, levels) of one address's transitions, levels as 0 Normal, 1 Warning, 2 Error."""

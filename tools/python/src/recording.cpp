@@ -3,6 +3,7 @@
 // the one history reader, timeline's parse_history). The arrays are built column by column; the
 // Python classes around them (safecass.Recording, safecass.History) are in safecass/__init__.py.
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -124,6 +125,10 @@ py::dict read_inputs(const std::string& path) {
   out["losses"] = losses;
   out["end"] = end;
   out["truncated"] = reader->truncated();
+  // What a killed recorder left after its last whole record: the bytes the reader did not take.
+  std::error_code size_error;
+  const auto size = std::filesystem::file_size(path, size_error);
+  out["cut_bytes"] = reader->truncated() && !size_error && size > reader->offset() ? size - reader->offset() : 0;
   return out;
 }
 
@@ -138,7 +143,8 @@ py::dict read_history(const std::string& path) {
   if (!file) raise(Error{ErrorCode::Io, path + ": cannot be read"});
   std::stringstream text;
   text << file.rdbuf();
-  const timeline::HistoryParse parsed = timeline::parse_history(text.str());
+  const std::string all = text.str();
+  const timeline::HistoryParse parsed = timeline::parse_history(all);
   if (!parsed.errors.empty()) {
     spec::Diagnostics problems;
     for (const timeline::HistoryError& e : parsed.errors) {
@@ -176,6 +182,8 @@ py::dict read_history(const std::string& path) {
   for (const std::uint64_t d : dropped) lost += d;
   out["dropped"] = lost;
   out["torn"] = parsed.torn ? py::object(py::int_(parsed.torn->line)) : py::object(py::none());
+  const std::size_t last_newline = all.rfind('\n');
+  out["cut_bytes"] = parsed.torn ? all.size() - (last_newline == std::string::npos ? 0 : last_newline + 1) : 0;
   return out;
 }
 
