@@ -14,6 +14,10 @@ namespace {
 
 using json::JsonValue;
 
+/// The largest time a history line may hold, in seconds: 2^32 (136 years) rounded down, so that a
+/// double keeps a time's microseconds and writing it back (history_json) gives the same text.
+constexpr double kMaxSeconds = 4e9;
+
 /// Reads the fields of one object; the first problem is kept as the message.
 class FieldReader {
 public:
@@ -39,6 +43,18 @@ public:
       return std::nullopt;
     }
     return v->number;
+  }
+
+  /// A time in seconds: a number of at most kMaxSeconds in magnitude, where the file's
+  /// microseconds still read back as they were written (beyond, a double cannot hold them).
+  std::optional<Time> time(std::string_view key, bool required) {
+    const std::optional<double> seconds = number(key, required);
+    if (!seconds) return std::nullopt;
+    if (!(std::fabs(*seconds) <= kMaxSeconds)) {
+      fail("\"" + std::string(key) + "\" must be a time in seconds of at most 4e9 in magnitude (about 126 years)");
+      return std::nullopt;
+    }
+    return seconds_to_time(*seconds);
   }
 
   bool boolean(std::string_view key) {
@@ -102,11 +118,11 @@ void read_root(const JsonValue& v, HistoryEntry& e, FieldReader& f) {
   ResolvedRoot& r = e.root.emplace();
   r.event = rf.string("event", true);
   r.origin = rf.string("origin", true);
-  r.time = seconds_to_time(rf.number("t", false).value_or(0.0));
+  r.time = rf.time("t", false).value_or(Time{0});
   r.filter = rf.string("filter", false);
   r.signal = rf.string("signal", false);
   r.value = sample_value(*root, rf);
-  r.sample_time = seconds_to_time(rf.number("sample_t", false).value_or(0.0));
+  r.sample_time = rf.time("sample_t", false).value_or(Time{0});
   r.injected = rf.boolean("injected");
   if (rf.error()) f.fail("in \"root\": " + *rf.error());
 }
@@ -151,7 +167,7 @@ std::string missing_names(const HistoryEntry& e) {
   if (const auto seq = f.number("seq", false); seq && *seq >= 0 && *seq <= 9.0e15) {
     e.seq = static_cast<std::uint64_t>(*seq);
   }
-  e.time = seconds_to_time(f.number("t", true).value_or(0.0));
+  e.time = f.time("t", true).value_or(Time{0});
   e.component = f.string("component", false);
   e.machine = f.string("machine", false);
   e.event = f.string("event", false);

@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,7 +66,7 @@ std::vector<Item> read_all(const std::string& path, std::string* out, bool& erro
   InputLogReader& r = **reader;
   if (out != nullptr) input_log::put_header(*out, r.header());
   std::size_t declared = 0;
-  std::int64_t last_time = -1;
+  std::optional<std::int64_t> last_time;  // of the last time record written
   for (std::size_t n = 0; n < 100000; ++n) {
     const InputLogReader::Item kind = r.next();
     Item item;
@@ -80,7 +81,7 @@ std::vector<Item> read_all(const std::string& path, std::string* out, bool& erro
       }
       if (out != nullptr) {
         declare(r, *out, declared);
-        if (item.time != last_time) input_log::put_time(*out, r.time());
+        if (last_time != item.time) input_log::put_time(*out, r.time());
         last_time = item.time;
         input_log::put_sample(*out, r.signal(), r.values(), r.width());
       }

@@ -173,5 +173,26 @@ TEST(HistoryRead, ALineWithAWrongFieldSaysWhichAndWhy) {
   EXPECT_EQ(error_of(R"([1])"), "expected a JSON object (one record per line), not array");
 }
 
+TEST(HistoryRead, ATimeBeyondWhatADoubleKeepsToTheMicrosecondIsRefused) {
+  // Found by history_fuzz: a root cause at t = 5555555550.5000055 s read back, but written and read
+  // again it moved by a microsecond: a double holds no microseconds that far. A line's times
+  // (the record's, its root's and its sample's) are refused beyond 4e9 s; nothing is lost below.
+  const auto error_of = [](std::string_view line) {
+    const json::JsonParse parsed = json::parse_json(line);
+    auto e = history_entry_from_json(*parsed.value);
+    return e ? std::string("(read)") : e.error().message;
+  };
+  const std::string head = R"({"kind":"reset","machine":"A.s_A","from":"Error","to":"Normal",)";
+  EXPECT_EQ(error_of(head + R"("t":5555555550.500005})"),
+            R"("t" must be a time in seconds of at most 4e9 in magnitude (about 126 years))");
+  EXPECT_EQ(error_of(head + R"("t":1e300})"),
+            R"("t" must be a time in seconds of at most 4e9 in magnitude (about 126 years))");
+  EXPECT_EQ(error_of(head + R"("t":1,"root":{"event":"E","origin":"A.s_A","t":5555555550.500005555550}})"),
+            R"(in "root": "t" must be a time in seconds of at most 4e9 in magnitude (about 126 years))");
+  EXPECT_EQ(error_of(head + R"("t":1,"root":{"event":"E","origin":"A.s_A","t":1,"sample_t":-4e10}})"),
+            R"(in "root": "sample_t" must be a time in seconds of at most 4e9 in magnitude (about 126 years))");
+  EXPECT_EQ(error_of(head + R"("t":3999999999.999999})"), "(read)");
+}
+
 }  // namespace
 }  // namespace safecass::introspect
