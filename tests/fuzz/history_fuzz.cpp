@@ -14,7 +14,7 @@
 
 namespace {
 
-safecass::Expected<safecass::introspect::HistoryEntry> read_line(std::string_view line) {
+[[nodiscard]] safecass::Expected<safecass::introspect::HistoryEntry> read_line(std::string_view line) {
   const safecass::json::JsonParse parsed = safecass::json::parse_json(line, 8);
   if (!parsed.value) return safecass::fail(safecass::ErrorCode::Parse, "not JSON");
   return safecass::introspect::history_entry_from_json(*parsed.value);
