@@ -116,7 +116,8 @@ TEST_P(BadCsv, IsRefusedWithWhereAndWhyAndNothingRuns) {
 INSTANTIATE_TEST_SUITE_P(GoldenDiagnostics, BadCsv,
                          ::testing::Values("missing_time.csv", "missing_element.csv", "unknown_signal.csv",
                                            "computed_signal.csv", "non_monotonic.csv", "malformed_number.csv",
-                                           "extra_cell.csv", "partial_vector.csv", "not_finite.csv"),
+                                           "extra_cell.csv", "partial_vector.csv", "not_finite.csv",
+                                           "time_out_of_range.csv"),
                          [](const auto& param_info) {
                            std::string n = param_info.param;
                            return n.substr(0, n.find('.'));
