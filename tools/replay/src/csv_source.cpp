@@ -18,7 +18,6 @@ namespace {
 /// The largest time of a row, in seconds (about 126 years): nanoseconds of it fit a 64-bit clock.
 constexpr double kMaxSeconds = 4e9;
 
-
 constexpr std::size_t kBuffer = 256 * 1024;
 constexpr std::size_t kMaxLine = 1 << 20;
 
