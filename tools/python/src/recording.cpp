@@ -89,27 +89,25 @@ py::dict read_inputs(const std::string& path) {
   std::vector<std::uint16_t> ids, index;
   py::list actions, losses;
   py::object end = py::none();
-  {
-    for (InputLogReader::Item item = reader->next(); item != InputLogReader::Item::Eof; item = reader->next()) {
-      if (item == InputLogReader::Item::Error) raise(Error{ErrorCode::Parse, reader->error()});
-      if (item == InputLogReader::Item::Sample) {
-        const double t = to_seconds(reader->time());
-        for (std::size_t k = 0; k < reader->width(); ++k) {
-          times.push_back(t);
-          ids.push_back(reader->signal());
-          index.push_back(static_cast<std::uint16_t>(k));
-          values.push_back(reader->values()[k]);
-        }
-      } else if (item == InputLogReader::Item::Action) {
-        actions.append(action_dict(reader->action(), to_seconds(reader->mark_time())));
-      } else if (item == InputLogReader::Item::Loss) {
-        const std::uint16_t id = reader->loss_signal();
-        losses.append(py::dict(py::arg("time") = to_seconds(reader->mark_time()),
-                               py::arg("signal") = id == 0xffff ? std::string() : reader->signal_name(id),
-                               py::arg("lost") = reader->lost()));
-      } else if (item == InputLogReader::Item::End) {
-        end = py::float_(to_seconds(reader->mark_time()));
+  for (InputLogReader::Item item = reader->next(); item != InputLogReader::Item::Eof; item = reader->next()) {
+    if (item == InputLogReader::Item::Error) raise(Error{ErrorCode::Parse, reader->error()});
+    if (item == InputLogReader::Item::Sample) {
+      const double t = to_seconds(reader->time());
+      for (std::size_t k = 0; k < reader->width(); ++k) {
+        times.push_back(t);
+        ids.push_back(reader->signal());
+        index.push_back(static_cast<std::uint16_t>(k));
+        values.push_back(reader->values()[k]);
       }
+    } else if (item == InputLogReader::Item::Action) {
+      actions.append(action_dict(reader->action(), to_seconds(reader->mark_time())));
+    } else if (item == InputLogReader::Item::Loss) {
+      const std::uint16_t id = reader->loss_signal();
+      losses.append(py::dict(py::arg("time") = to_seconds(reader->mark_time()),
+                             py::arg("signal") = id == 0xffff ? std::string() : reader->signal_name(id),
+                             py::arg("lost") = reader->lost()));
+    } else if (item == InputLogReader::Item::End) {
+      end = py::float_(to_seconds(reader->mark_time()));
     }
   }
   std::vector<std::string> names(ids.size());
