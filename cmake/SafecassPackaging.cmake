@@ -52,6 +52,8 @@ list(JOIN SAFECASS_DEBIAN_DEPENDS ", " CPACK_DEBIAN_DEV_PACKAGE_DEPENDS)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_NAME safecass)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_SECTION devel)
 set(CPACK_DEBIAN_TOOLS_PACKAGE_SHLIBDEPS ON)
+# Found at run time: SPIN (and a C compiler) by `safecass verify`, SCRAM by `safecass analyze`.
+set(CPACK_DEBIAN_TOOLS_PACKAGE_RECOMMENDS "spin, gcc, scram")
 set(CPACK_COMPONENT_TOOLS_DESCRIPTION
   "the safecass command: validate, run, test, console, viewer, timeline\n"
   "Validates SAFECASS specifications, runs scenarios, and watches live systems in a terminal or a\n"

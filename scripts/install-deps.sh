@@ -48,6 +48,9 @@ packages+=(libssl-dev)
 # `safecass verify` translates a system into Promela and model-checks it with SPIN (the verifier
 # it generates is compiled with the system's gcc, from build-essential).
 packages+=(spin)
+# `safecass analyze` writes fault trees in the Open-PSA MEF and has SCRAM compute their minimal cut
+# sets; it reads SCRAM's XML report with TinyXML-2.
+packages+=(scram libtinyxml2-dev)
 
 # `make bench-peers` (benchmarks/peers): diagnostic_updater for the ROS diagnostics peer; roscpp,
 # diagnostic_aggregator, IceStorm and Boost (MSM, Statechart: header-only) are listed above.

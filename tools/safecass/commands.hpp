@@ -48,6 +48,10 @@ int run_test(const TestArgs& args);
 /// Adds `safecass replay` (replay_command.cpp); its callback stores the exit code in `code`.
 void add_replay_command(CLI::App& app, int& code);
 
+/// Adds `safecass analyze` (analyze.cpp, docs/analyze.md): exit 0 no error-severity gap, 1 one
+/// exists (with --strict: or a warning), 2 invalid input.
+void add_analyze_command(CLI::App& app, int& code);
+
 struct TraceArgs {
   std::string system;
   std::vector<std::string> scenarios;

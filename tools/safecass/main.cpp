@@ -70,6 +70,7 @@ int main(int argc, char** argv) {
   test->callback([&] { code = safecass::tools::run_test(test_args); });
 
   safecass::tools::add_replay_command(app, code);
+  safecass::tools::add_analyze_command(app, code);
 
   safecass::tools::TraceArgs trace_args;
   auto* trace = app.add_subcommand(

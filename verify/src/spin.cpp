@@ -34,7 +34,7 @@ std::string shell_quote(const std::string& word) {
   return r;
 }
 
-Expected<WorkDir> WorkDir::create(const std::string& given) {
+Expected<WorkDir> WorkDir::create(const std::string& given, const std::string& prefix) {
   std::error_code ec;
   if (!given.empty()) {
     fs::create_directories(given, ec);
@@ -42,8 +42,9 @@ Expected<WorkDir> WorkDir::create(const std::string& given) {
     return WorkDir(given, false);
   }
   const char* tmp = std::getenv("TMPDIR");
-  std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/safecass-verify-XXXXXX";
-  if (::mkdtemp(pattern.data()) == nullptr) return fail(ErrorCode::Io, "cannot create a temporary directory for SPIN");
+  std::string pattern = std::string(tmp != nullptr && *tmp != '\0' ? tmp : "/tmp") + "/" + prefix + "XXXXXX";
+  if (::mkdtemp(pattern.data()) == nullptr)
+    return fail(ErrorCode::Io, "cannot create a temporary directory in " + pattern);
   return WorkDir(pattern, true);
 }
 

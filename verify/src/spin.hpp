@@ -7,37 +7,9 @@
 #include <vector>
 
 #include "safecass/core/expected.hpp"
+#include "safecass/verify/command.hpp"
 
 namespace safecass::verify {
-
-/// A command's output (stdout and stderr together) and exit status.
-struct CommandResult {
-  int status = -1;
-  std::string output;
-};
-
-/// Runs `command` with /bin/sh in `dir`. Errors: Io (cannot start it).
-[[nodiscard]] Expected<CommandResult> run_command(const std::string& dir, const std::string& command);
-
-/// Single-quotes a word for /bin/sh.
-std::string shell_quote(const std::string& word);
-
-/// A fresh private directory for SPIN's files (mkdtemp under $TMPDIR or /tmp); removed by the
-/// destructor unless `keep`.
-class WorkDir {
-public:
-  [[nodiscard]] static Expected<WorkDir> create(const std::string& given);
-  WorkDir(WorkDir&& other) noexcept;
-  WorkDir& operator=(WorkDir&&) = delete;
-  WorkDir(const WorkDir&) = delete;
-  ~WorkDir();
-  const std::string& path() const { return path_; }
-
-private:
-  WorkDir(std::string path, bool owned) : path_(std::move(path)), owned_(owned) {}
-  std::string path_;
-  bool owned_ = false;
-};
 
 struct PanOptions {
   bool ltl = false;  ///< search for acceptance cycles (-a), depth-first; else safety, breadth-first

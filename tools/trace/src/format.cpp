@@ -91,17 +91,6 @@ std::string json_event(const EventLink& e) {
       .text();
 }
 
-/// RFC 4180: a field with a comma, a quote, CR or LF is quoted, its quotes doubled.
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string out = "\"";
-  for (char c : s) {
-    out += c;
-    if (c == '"') out += '"';
-  }
-  return out + "\"";
-}
-
 std::string gaps_of(const Trace& t, const std::string& hazard, const std::string& event, const std::string& filter) {
   std::vector<std::string> out;
   for (const Gap& g : t.gaps) {
@@ -247,6 +236,23 @@ std::string trace_json(const Trace& t) {
          "\n";
 }
 
+/// RFC 4180: a field with a comma, a quote, CR or LF is quoted, its quotes doubled.
+static std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
+  std::string out = "\"";
+  for (char c : s) {
+    out += c;
+    if (c == '"') out += '"';
+  }
+  return out + "\"";
+}
+
+std::string csv_row(const std::vector<std::string>& fields) {
+  std::string out;
+  for (std::size_t k = 0; k < fields.size(); ++k) out += (k == 0 ? "" : ",") + csv_field(fields[k]);
+  return out + "\r\n";
+}
+
 std::string trace_csv(const Trace& t) {
   static const char* const kHeader[] = {"hazard",      "hazard_description",
                                         "reaction",    "reaction_checked_by",
@@ -260,13 +266,8 @@ std::string trace_csv(const Trace& t) {
                                         "parameters",  "execution",
                                         "period",      "fired_by",
                                         "cleared_by",  "gaps"};
-  std::string out;
-  for (std::size_t k = 0; k < std::size(kHeader); ++k) out += std::string(k == 0 ? "" : ",") + kHeader[k];
-  out += "\r\n";
-  const auto row = [&](const std::vector<std::string>& fields) {
-    for (std::size_t k = 0; k < fields.size(); ++k) out += (k == 0 ? "" : ",") + csv_field(fields[k]);
-    out += "\r\n";
-  };
+  std::string out = csv_row(std::vector<std::string>(std::begin(kHeader), std::end(kHeader)));
+  const auto row = [&](const std::vector<std::string>& fields) { out += csv_row(fields); };
   const auto rows_of = [&](const HazardTrace* h, const EventLink* e) {
     std::vector<std::string> head;
     if (h != nullptr) {

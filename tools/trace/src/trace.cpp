@@ -190,6 +190,7 @@ public:
     if (Diagnostics errors = run_scenarios(); !errors.empty()) return tl::unexpected(std::move(errors));
     for (const spec::HazardSpec& h : sys().hazards) trace_.hazards.push_back(trace_hazard(h));
     unclaimed_filters_and_failed_scenarios();
+    collect_onsets();
     std::stable_sort(gaps_.begin(), gaps_.end(), [](const Gap& a, const Gap& b) { return a.severity < b.severity; });
     trace_.gaps = std::move(gaps_);
     summarize_coverage();
@@ -281,6 +282,9 @@ private:
     l.component = std::string(co().structure().component_name(f.component()));
     l.target = f.target() == kNoMachine ? std::string() : co().structure().address_of(f.target());
     for (const Signal* s : f.inputs()) l.signals += (l.signals.empty() ? "" : ", ") + s->name();
+    for (const Signal* s : f.outputs()) {
+      if (s != nullptr) l.outputs += (l.outputs.empty() ? "" : ", ") + s->name();  // an optional output not used
+    }
     l.execution = cfg.execution == ExecutionMode::Active ? "ACTIVE" : "PASSIVE";
     const auto src = stage_source_.find(cfg.name);
     if (src != stage_source_.end()) {
@@ -409,6 +413,39 @@ private:
     runs_.push_back(std::move(run));
   }
 
+  /// The scenarios in which onset `id` fired and was then cleared (completed or reset).
+  std::vector<std::string> clearing_runs(EventId id) const {
+    std::vector<std::string> out;
+    for (std::size_t k = 0; k < runs_.size(); ++k) {
+      const auto first = runs_[k].first_onset.find(id);
+      if (first != runs_[k].first_onset.end() && cleared_at(runs_[k], co(), id, first->second))
+        out.push_back(trace_.scenarios[k].path);
+    }
+    return out;
+  }
+
+  /// Trace::onsets: every onset a component declares, in the system's order, then the framework
+  /// onsets some filter generates, each with its filters and scenarios.
+  void collect_onsets() {
+    std::vector<EventId> ids;
+    for (const std::string& name : event_order_) {
+      auto id = co().structure().find_event(name);
+      if (id && co().structure().event(*id).is_onset) ids.push_back(*id);
+    }
+    for (const FilterFacts& f : filters_) {
+      if (f.onset != kNoEvent && to_index(f.onset) < framework_event::kCount &&
+          std::find(ids.begin(), ids.end(), f.onset) == ids.end())
+        ids.push_back(f.onset);
+    }
+    for (const FilterFacts& f : filters_) trace_.filters.push_back(f.link);
+    for (EventId id : ids) {
+      EventLink l = event_link(id);
+      l.fired_by = uses_of(l.name);
+      l.cleared_by = clearing_runs(id);
+      trace_.onsets.push_back(std::move(l));
+    }
+  }
+
   /// The scenarios that fired event `name`, with the transitions it took in each. Event ids agree
   /// between the trace's system and every run's: the same spec, built the same way.
   std::vector<ScenarioUse> uses_of(const std::string& name) const {
@@ -472,12 +509,7 @@ private:
       linked_onsets_.insert(*id);
       EventLink onset = event_link(*id);
       onset.fired_by = uses_of(onset.name);
-      for (std::size_t k = 0; k < runs_.size(); ++k) {
-        const auto first = runs_[k].first_onset.find(*id);
-        if (first != runs_[k].first_onset.end() && cleared_at(runs_[k], co(), *id, first->second)) {
-          onset.cleared_by.push_back(trace_.scenarios[k].path);
-        }
-      }
+      onset.cleared_by = clearing_runs(*id);
       ht.events.push_back(std::move(onset));
       if (co().structure().event(*id).counterpart != kNoEvent) {
         EventLink completion = event_link(co().structure().event(*id).counterpart);

@@ -1,0 +1,92 @@
+// `safecass analyze SYSTEM [--fmea] [--fault-trees] [--gsn] [--format text|csv|json] ...`
+// (docs/analyze.md).
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <fstream>
+
+#include "commands.hpp"
+#include "safecass/analyze/analyze.hpp"
+#include "safecass/filters/registry.hpp"
+
+namespace safecass::tools {
+
+namespace {
+
+struct AnalyzeArgs {
+  analyze::AnalyzeOptions options;
+  std::vector<std::string> tops;
+  bool fmea = false, trees = false, gsn = false, strict = false;
+  std::string format = "text";
+  std::string mef;  ///< --mef FILE: the fault trees as given to SCRAM
+};
+
+bool write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (out) out.write(text.data(), static_cast<std::streamsize>(text.size()));
+  if (out) out.close();
+  if (!out) std::fprintf(stderr, "safecass analyze: cannot write '%s'\n", path.c_str());
+  return static_cast<bool>(out);
+}
+
+int run_analyze(AnalyzeArgs& args) {
+  for (const std::string& t : args.tops) {
+    auto top = analyze::parse_top(t);
+    if (!top) {
+      std::fprintf(stderr, "safecass analyze: --top %s\n", top.error().message.c_str());
+      return 2;
+    }
+    args.options.tops.push_back(*top);
+  }
+  const bool all = !args.fmea && !args.trees && !args.gsn;
+  args.options.fault_trees = all || args.trees || !args.mef.empty();
+  auto built = analyze::build_analysis(args.options, builtin_filters());
+  if (!built) {
+    for (const spec::Diagnostic& d : built.error()) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+    std::fprintf(stderr, "safecass analyze: nothing analysed (%zu error%s)\n", built.error().size(),
+                 built.error().size() == 1 ? "" : "s");
+    return 2;
+  }
+  const analyze::Analysis& a = *built;
+  for (const spec::Diagnostic& d : a.trace.notes) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
+  std::string text;
+  if (args.format == "json") {
+    text = analyze::analysis_json(a);
+  } else if (args.format == "csv") {
+    text = analyze::fmea_csv(a);
+  } else {
+    if (all || args.fmea) text += analyze::fmea_text(a);
+    if (all || args.trees) text += analyze::fault_trees_text(a);
+    if (all || args.gsn) text += analyze::safety_case_text(a);
+  }
+  std::fwrite(text.data(), 1, text.size(), stdout);
+  if (!args.mef.empty() && !write_file(args.mef, a.trees.mef)) return 2;
+  if (a.has_error_gap()) return 1;
+  if (args.strict && a.gap_count(trace::Severity::Warning) != 0) return 1;
+  return 0;
+}
+
+}  // namespace
+
+void add_analyze_command(CLI::App& app, int& code) {
+  auto args = std::make_shared<AnalyzeArgs>();
+  auto* cmd = app.add_subcommand(
+      "analyze", "The FMEA, the fault trees (SCRAM) and the GSN safety case, derived from the specification");
+  cmd->add_option("SYSTEM", args->options.system, "system file")->required();
+  cmd->add_flag("--fmea", args->fmea, "the FMEA (default: all three)");
+  cmd->add_flag("--fault-trees", args->trees, "the fault trees and their minimal cut sets (default: all three)");
+  cmd->add_flag("--gsn", args->gsn, "the GSN safety case (default: all three)");
+  cmd->add_option("--format", args->format, "text (default), csv (the FMEA's rows) or json (everything)")
+      ->check(CLI::IsMember({"text", "csv", "json"}));
+  cmd->add_option("--scenarios,-s", args->options.scenarios, "scenarios to run as test evidence");
+  cmd->add_option("--verify", args->options.verify_json, "the output of `safecass verify --json`: what is proved");
+  cmd->add_option("--top", args->tops, "another top event, ADDRESS=LEVEL (e.g. SERVO=Error)");
+  cmd->add_option("--order", args->options.order, "the largest cut set computed, 1 to 6 (default 3)")
+      ->check(CLI::Range(1, 6));
+  cmd->add_option("--mef", args->mef, "write the fault trees in the Open-PSA MEF to this file");
+  cmd->add_option("--scram", args->options.scram, "SCRAM's executable (default: scram)");
+  cmd->add_flag("--strict", args->strict, "exit 1 on a gap of warning severity too");
+  cmd->callback([args, &code] { code = run_analyze(*args); });
+}
+
+}  // namespace safecass::tools
