@@ -118,7 +118,9 @@ const ObjectKind& system_kind() {
        objects("connections", "connections from a required interface to a provided interface", "connection"),
        object("coordinators", "coordinator (process) name -> the components it runs", "coordinators"),
        objects("hazards", "the hazards of the hazard analysis and the reaction each requires", "hazard"),
-       objects("invariants", "named LTL formulas over addresses and levels, checked by safecass verify", "invariant")}};
+       objects("invariants", "named LTL formulas over addresses and levels, checked by safecass verify", "invariant"),
+       object("reliability", "failure rates or probabilities of the failure modes, for safecass analyze's fault trees",
+              "reliability")}};
   return kind;
 }
 
@@ -308,10 +310,52 @@ const ObjectKind& invariant_kind() {
   return kind;
 }
 
+const ObjectKind& reliability_kind() {
+  static const ObjectKind kind{
+      "reliability",
+      "failure rates or probabilities of the failure modes (docs/analyze.md): SCRAM then computes each top "
+      "event's probability and the importance of each mode",
+      {[] {
+         Key k = text("mission_time", "hours over which rates become probabilities (default 8760, a year)");
+         k.shape = Shape::Number;
+         k.min = 0;
+         k.exclusive_min = true;
+         return k;
+       }(),
+       object("modes",
+              "failure mode name (EVT_X@C.s_A, EVT_X for every machine it is raised at, C.s_F, C.s_A, "
+              "stale:C.signal, fault:filter, lost:coordinator, lost:supervisor) -> its rate or probability",
+              "mode_rates", true),
+       kDescriptionKey}};
+  return kind;
+}
+
+const ObjectKind& mode_rate_kind() {
+  static const ObjectKind kind{"mode_rate",
+                               "one failure mode's rate or probability (exactly one of the two)",
+                               {[] {
+                                  Key k =
+                                      text("rate", "failures per hour (exponential: 1 - exp(-rate * mission_time))");
+                                  k.shape = Shape::Number;
+                                  k.min = 0;
+                                  k.exclusive_min = true;
+                                  return k;
+                                }(),
+                                [] {
+                                  Key k = text("probability", "the probability that it happens within the mission");
+                                  k.shape = Shape::Number;
+                                  k.min = 0;
+                                  k.max = 1;
+                                  return k;
+                                }()}};
+  return kind;
+}
+
 std::vector<const ObjectKind*> all_kinds() {
-  return {&system_kind(),     &include_kind(),    &component_kind(), &interfaces_kind(), &signal_kind(),
-          &event_kind(),      &filter_kind(),     &pipeline_kind(),  &target_kind(),     &service_kind(),
-          &dependency_kind(), &connection_kind(), &hazard_kind(),    &invariant_kind()};
+  return {&system_kind(), &include_kind(),   &component_kind(),   &interfaces_kind(),
+          &signal_kind(), &event_kind(),     &filter_kind(),      &pipeline_kind(),
+          &target_kind(), &service_kind(),   &dependency_kind(),  &connection_kind(),
+          &hazard_kind(), &invariant_kind(), &reliability_kind(), &mode_rate_kind()};
 }
 
 }  // namespace safecass::spec

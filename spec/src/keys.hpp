@@ -73,6 +73,8 @@ const ObjectKind& dependency_kind();
 const ObjectKind& connection_kind();
 const ObjectKind& hazard_kind();
 const ObjectKind& invariant_kind();
+const ObjectKind& reliability_kind();
+const ObjectKind& mode_rate_kind();
 
 /// Every kind, in schema order.
 std::vector<const ObjectKind*> all_kinds();

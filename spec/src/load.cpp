@@ -137,6 +137,14 @@ SystemSpec to_system(const Model& model, const Sink& sink) {
   for (const InvariantItem& i : model.invariants) {
     system.invariants.push_back(InvariantSpec{i.name, i.formula, i.description, sink.position(i.name_site)});
   }
+  if (model.reliability) {
+    ReliabilitySpec r;
+    r.mission_time = model.reliability->mission_time.value_or(ReliabilitySpec::kDefaultMissionTime);
+    r.where = sink.position(model.reliability->site);
+    for (const ReliabilityItem::Mode& m : model.reliability->modes)
+      r.modes.push_back(ReliabilitySpec::Mode{m.name, m.rate, m.probability, sink.position(m.key_site)});
+    system.reliability = std::move(r);
+  }
   return system;
 }
 

@@ -192,6 +192,20 @@ struct InvariantItem {
   bool has_formula = false;
 };
 
+/// The system file's "reliability" section, as written; checked by the validator.
+struct ReliabilityItem {
+  struct Mode {
+    std::string name;
+    std::optional<double> rate, probability;  ///< when given and valid
+    int given = 0;                            ///< how many of "rate" and "probability" are written
+    Site key_site;
+    Site value_site;
+  };
+  std::optional<double> mission_time;
+  std::vector<Mode> modes;
+  Site site;
+};
+
 struct Model {
   std::string name;
   std::string path;
@@ -205,6 +219,7 @@ struct Model {
   std::vector<HazardItem> hazards;
   bool has_hazards = false;  ///< a "hazards" section exists: events' hazard ids are checked against it
   std::vector<InvariantItem> invariants;
+  std::optional<ReliabilityItem> reliability;
 };
 
 /// Reads the top-level file (from disk when `text` is null) and everything it includes into

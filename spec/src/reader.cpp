@@ -552,6 +552,8 @@ private:
                         model_.invariants.push_back(std::move(item));
                       });
     }
+    if (const json::JsonValue* reliability = f.get("reliability"))
+      read_reliability(doc, *reliability, f.pointer("reliability"));
     if (const json::JsonValue* coordinators = f.get("coordinators")) {
       const std::string base = f.pointer("coordinators");
       std::set<std::string_view> seen;
@@ -684,6 +686,44 @@ private:
                       });
     }
     return entry;
+  }
+
+  /// The "reliability" section: the mission time, and per failure mode name its rate or
+  /// probability (the names and the one-of rule are checked by the validator).
+  void read_reliability(int doc, const json::JsonValue& e, const std::string& pointer) {
+    Fields f(sink_, doc, e, pointer, reliability_kind(), "reliability");
+    if (model_.reliability) {
+      sink_.error(f.object_site(), "reliability: a second \"reliability\" section (a system has one)");
+      return;
+    }
+    ReliabilityItem item;
+    item.site = f.object_site();
+    if (const json::JsonValue* t = f.get("mission_time")) item.mission_time = t->number;
+    if (const json::JsonValue* modes = f.get("modes")) {
+      const std::string base = f.pointer("modes");
+      std::set<std::string_view> seen;
+      for (const json::JsonMember& m : modes->object) {
+        const Site key_site{doc, m.key_position, pointer_join(base, m.key)};
+        if (!seen.insert(m.key).second) {
+          sink_.error(key_site, "reliability: duplicate failure mode " + quote_name(m.key));
+          continue;
+        }
+        const Site value_site{doc, m.value.position, key_site.pointer};
+        if (!m.value.is_object()) {
+          sink_.error(value_site, "reliability: failure mode " + quote_name(m.key) +
+                                      " must be an object {\"rate\": per hour} or {\"probability\": p}, not " +
+                                      a_type(m.value.type));
+          continue;
+        }
+        Fields r(sink_, doc, m.value, key_site.pointer, mode_rate_kind(), "reliability of " + quote_name(m.key));
+        ReliabilityItem::Mode mode{m.key, {}, {}, 0, key_site, value_site};
+        mode.given = (m.value.find("rate") != nullptr ? 1 : 0) + (m.value.find("probability") != nullptr ? 1 : 0);
+        if (const json::JsonValue* rate = r.get("rate")) mode.rate = rate->number;
+        if (const json::JsonValue* p = r.get("probability")) mode.probability = p->number;
+        item.modes.push_back(std::move(mode));
+      }
+    }
+    model_.reliability = std::move(item);
   }
 
   HazardItem read_hazard(int doc, const json::JsonValue& e, const std::string& pointer) {

@@ -408,6 +408,13 @@ std::string json_schema(const FilterRegistry& registry) {
     choices.push(Node::text("Error"));
     defs.set("reaction", std::move(r));
   }
+  {
+    Node m;
+    m.set("type", Node::text("object"));
+    m.set("description", Node::text("failure mode name -> its rate or probability"));
+    m.set("additionalProperties", Node::ref("mode_rate"));
+    defs.set("mode_rates", std::move(m));
+  }
   for (const FilterManifest* m : manifests) defs.set("argument_" + m->type, argument_schema(*m));
 
   std::string out;

@@ -117,6 +117,7 @@ public:
     check_unconnected();
     check_hazards();
     check_invariants();
+    check_reliability();
   }
 
 private:
@@ -1290,6 +1291,73 @@ private:
                     "hazard " + quote_name(h.id) +
                         " has no linked event: no onset names it in its \"hazard\" field, so nothing detects it");
     }
+  }
+
+  /// Each rate or probability names a failure mode of the system (docs/analyze.md), and gives
+  /// exactly one of the two.
+  void check_reliability() {
+    if (!m_.reliability) return;
+    for (const ReliabilityItem::Mode& mode : m_.reliability->modes) {
+      if (mode.given != 1) {
+        sink_.error(mode.value_site, "reliability of " + quote_name(mode.name) +
+                                         ": give exactly one of \"rate\" (per hour) and \"probability\"");
+      }
+      if (const std::string problem = mode_problem(mode.name); !problem.empty())
+        sink_.error(mode.key_site, "reliability: " + quote_name(mode.name) + " is not a failure mode: " + problem);
+    }
+  }
+
+  /// Why `name` names no failure mode ("" when it does).
+  std::string mode_problem(const std::string& name) const {
+    const auto colon = name.find(':');
+    if (colon != std::string::npos) {
+      const std::string kind = name.substr(0, colon), what = name.substr(colon + 1);
+      if (kind == "lost") {
+        if (!m_.has_coordinators) return "the system declares no \"coordinators\": no process to lose";
+        if (what == "supervisor") return {};
+        std::vector<std::string> names{"supervisor"};
+        for (const CoordinatorItem& c : m_.coordinators) names.push_back(c.name.text);
+        return contains_text(names, what) ? "" : "no coordinator " + quote_name(what) + did_you_mean(what, names);
+      }
+      if (kind == "stale") {
+        std::vector<std::string> signals;
+        for (const ComponentItem& c : m_.components) {
+          for (const SignalItem& sig : c.signals) signals.push_back(sig.name);
+        }
+        return contains_text(signals, what) ? "" : "no signal " + quote_name(what) + did_you_mean(what, signals);
+      }
+      if (kind == "fault") {
+        std::vector<std::string> filters;
+        for (const ComponentItem& c : m_.components) {
+          for (const FilterEntryItem& f : c.filters) {
+            for (const FilterItem& stage : f.stages) filters.push_back(stage.config.name);
+          }
+        }
+        return contains_text(filters, what) ? "" : "no filter " + quote_name(what) + did_you_mean(what, filters);
+      }
+      return "expected EVT, EVT@C.s_A, C.s_F, C.s_A, stale:C.signal, fault:filter, lost:coordinator or lost:supervisor";
+    }
+    const auto at = name.find('@');
+    const std::string event = name.substr(0, at);
+    const auto info = events_.find(event);
+    if (info == events_.end()) {
+      if (at != std::string::npos || name.find('.') == std::string::npos) return "no event " + quote_name(event);
+      if (!name.ends_with(".s_F") && !name.ends_with(".s_A"))
+        return "a machine failure is C.s_F or C.s_A, not " + quote_name(name);
+      return address_problem(name);
+    }
+    if (info->second.kind_known && !info->second.onset) return quote_name(event) + " is a completion, not an onset";
+    if (at == std::string::npos) return {};
+    const std::string machine = name.substr(at + 1);
+    if (machine == "every s_A") return {};
+    if (const std::string problem = address_problem(machine); !problem.empty()) return problem;
+    const auto dots = std::count(machine.begin(), machine.end(), '.');
+    if (dots == 0 || machine.find(".s_S.") != std::string::npos) return quote_name(machine) + " is not a state machine";
+    return {};
+  }
+
+  static bool contains_text(const std::vector<std::string>& list, const std::string& s) {
+    return std::find(list.begin(), list.end(), s) != list.end();
   }
 
   void check_invariants() {

@@ -38,6 +38,7 @@ const char* const kSystems[] = {
     "tests/data/good_specs/original_2016/system.json",
     "tests/data/good_specs/legacy_2016/system.json",
     "tests/data/analyze/escalation.json",
+    "tests/data/analyze/rates.json",
 };
 
 class Analyze : public ::testing::Test {
@@ -299,6 +300,53 @@ TEST_F(Analyze, ScramsMinimalCutSetsAreWhatTheEngineDoesOnEverySystem) {
       }
     }
   }
+}
+
+TEST_F(Analyze, AReliabilitySectionGivesScramsTopEventProbabilityAndImportances) {
+  const Analysis a = analyze("tests/data/analyze/rates.json");
+  EXPECT_EQ(a.trees.unquantified, "");
+  EXPECT_DOUBLE_EQ(a.trees.mission_time, 1000.0);
+  ASSERT_EQ(a.trees.tops.size(), 1U);
+  const TopEvent& t = a.trees.tops[0];
+  ASSERT_TRUE(t.probability.has_value());
+  // Worked by hand in the file's comment: the BDD's answer is exact.
+  EXPECT_NEAR(*t.probability, 0.0110540, 1e-7);
+  EXPECT_EQ(t.importance.size(), 9U);
+  for (const CutSet& c : t.cut_sets) EXPECT_TRUE(c.probability.has_value());
+  EXPECT_THAT(a.trees.mef, HasSubstr("<exponential><float value=\"1.0005e-06\"/><system-mission-time/>"));
+}
+
+TEST_F(Analyze, AnEntryNamingAnEventAppliesToEachOfItsModesAndAnEntryNamingOneModeWins) {
+  const Analysis a = analyze("examples/robodoc/robodoc.json");
+  std::vector<FailureMode> modes = a.modes;
+  spec::ReliabilitySpec r;
+  r.modes.push_back({"EVT_FORCE_ERROR", 1e-5, std::nullopt, {}});
+  r.modes.push_back({"JR3.s_F", std::nullopt, 0.01, {}});
+  ASSERT_TRUE(apply_reliability(r, modes).has_value());
+  for (const FailureMode& m : modes) {
+    if (m.event == "EVT_FORCE_ERROR" && m.kind == ModeKind::Onset) {
+      EXPECT_EQ(m.rate, 1e-5);
+    }
+    if (m.name == "JR3.s_F") {
+      EXPECT_EQ(m.probability, 0.01);
+    }
+  }
+  // Not every mode has one: the trees are not quantified, and the text says which are missing.
+  const FaultTrees trees = fault_trees(modes, {}, {}, 3, r);
+  EXPECT_THAT(trees.unquantified, HasSubstr("have no rate or probability: FM1 (EVT_FORCE_HIGH@JR3.s_A)"));
+}
+
+TEST_F(Analyze, AReliabilityEntryThatIsNoFailureModeOfTheAnalysisIsAnErrorAtItsPosition) {
+  // The validator accepts it (the event and the machine exist), but nothing raises it there.
+  const Analysis a = analyze("examples/robodoc/robodoc.json");
+  std::vector<FailureMode> modes = a.modes;
+  spec::ReliabilitySpec r;
+  r.modes.push_back({"EVT_FORCE_ERROR@SERVO.s_A", 1e-5, std::nullopt, {"robodoc.json", 12, 7}});
+  auto applied = apply_reliability(r, modes);
+  ASSERT_FALSE(applied.has_value());
+  EXPECT_EQ(applied.error()[0].where.line, 12);
+  EXPECT_THAT(applied.error()[0].message, HasSubstr("'EVT_FORCE_ERROR@SERVO.s_A' is no failure mode"));
+  EXPECT_FALSE(modes[1].rate.has_value());  // nothing changed
 }
 
 TEST_F(Analyze, ATopThatIsNotAnAddressOrLevelIsRefusedAndNothingIsAnalysed) {

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <random>
 
@@ -22,6 +23,27 @@
 
 namespace safecass::middleware {
 namespace {
+
+/// A directory of this test's own under the test temp dir, removed before (a PID is reused: a
+/// run killed before its end leaves one) and after the test.
+class FreshDir {
+public:
+  explicit FreshDir(const std::string& name) : path_(::testing::TempDir() + name + "-" + std::to_string(::getpid())) {
+    remove();
+  }
+  FreshDir(const FreshDir&) = delete;
+  FreshDir& operator=(const FreshDir&) = delete;
+  ~FreshDir() { remove(); }
+  operator const std::string&() const { return path_; }  // NOLINT(google-explicit-constructor): a path
+
+private:
+  void remove() const {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+    std::filesystem::remove_all(path_ + "-shared", ec);
+  }
+  std::string path_;
+};
 
 TEST(IceEndpoint, HostAndPortAreParsed) {
   auto e = parse_ice_endpoint("127.0.0.1:24061");
@@ -112,7 +134,8 @@ TEST(CoordinatorNode, CreationChecksItsOptionsWithoutTouchingTheNetwork) {
   ASSERT_FALSE(unknown);
   EXPECT_EQ(unknown.error().code, ErrorCode::NotFound);
 
-  const std::string keys = ::testing::TempDir() + "safecass-node-keys-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-node-keys");
+  const std::string& keys = keys_dir;
   options.keys_dir = keys + "-missing";
   auto no_keys = CoordinatorNode::create(co, monitor, r.registry, *r.load.system, "robot", options);
   ASSERT_FALSE(no_keys) << "the bus is authenticated: no keys, no node";
@@ -147,7 +170,8 @@ TEST(Supervisor, BuildsItsViewWithTheApplicationsFilterRegistryAndWithoutItNames
   ASSERT_TRUE(registry.add<Frozen>("Frozen"));
   auto load = spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/tests/data/custom_filter/encoders.json", registry);
   ASSERT_TRUE(load.ok()) << spec::to_text(load.diagnostics);
-  const std::string keys = ::testing::TempDir() + "safecass-supervisor-keys-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-supervisor-keys");
+  const std::string& keys = keys_dir;
   ASSERT_TRUE(create_bus_keys(*load.system, keys, KeyOptions::replacing()));
   SupervisorOptions options;
   options.ice = *parse_ice_endpoint("127.0.0.1:1");  // never reached: create() touches no network
@@ -166,7 +190,8 @@ TEST(Supervisor, BuildsItsViewWithTheApplicationsFilterRegistryAndWithoutItNames
 
 TEST(BusKeys, AreCreatedPrivateOncePerSignerAndNeverOverwriteAForeignFile) {
   Robodoc r;
-  const std::string keys = ::testing::TempDir() + "safecass-keys-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-keys");
+  const std::string& keys = keys_dir;
   auto names = create_bus_keys(*r.load.system, keys, KeyOptions::replacing());
   ASSERT_TRUE(names) << names.error().message;
   EXPECT_EQ(*names, (std::vector<std::string>{"robot", "ui", "supervisor"}));
@@ -215,7 +240,8 @@ mode_t file_mode(const std::string& path) {
 // certificate signed by it for every member, IceStorm and the tools' reader; private keys 0600.
 TEST(BusKeys, MakeTheSystemsCaAndACertificateSignedByItForEveryMemberIceStormAndTheReader) {
   Robodoc r;
-  const std::string keys = ::testing::TempDir() + "safecass-certs-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-certs");
+  const std::string& keys = keys_dir;
   ASSERT_TRUE(create_bus_keys(*r.load.system, keys, with_addresses({"IP:10.0.0.5", "DNS:robot.local"})));
   const std::string ca = file_text(keys + "/ca.pem");
   ASSERT_EQ(ca.rfind("-----BEGIN CERTIFICATE-----", 0), 0u);
@@ -249,7 +275,8 @@ TEST(BusKeys, MakeTheSystemsCaAndACertificateSignedByItForEveryMemberIceStormAnd
 
 TEST(BusKeys, AreRefusedWithAClearErrorForAReservedNameABadAddressOrACaWithoutItsKey) {
   Robodoc r;
-  const std::string keys = ::testing::TempDir() + "safecass-certs-bad-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-certs-bad");
+  const std::string& keys = keys_dir;
   auto address = create_bus_keys(*r.load.system, keys, with_addresses({"10.0.0.5"}));
   ASSERT_FALSE(address);
   EXPECT_EQ(address.error().code, ErrorCode::InvalidArgument);
@@ -272,7 +299,8 @@ TEST(BusKeys, AreRefusedWithAClearErrorForAReservedNameABadAddressOrACaWithoutIt
 
 TEST(BusKeys, ACaWhoseKeyOthersCanReadSignsNothingAndChangesNothing) {
   Robodoc r;
-  const std::string keys = ::testing::TempDir() + "safecass-certs-open-ca-" + std::to_string(::getpid());
+  const FreshDir keys_dir("safecass-certs-open-ca");
+  const std::string& keys = keys_dir;
   ASSERT_TRUE(create_bus_keys(*r.load.system, keys, KeyOptions::replacing()));
   const std::string robot = file_text(keys + "/robot.pem");
   ASSERT_EQ(::chmod((keys + "/ca.key").c_str(), 0640), 0);

@@ -130,7 +130,7 @@ private:
   /// G<k>: the hazard is mitigated, by S<k>: detection, reaction and test.
   std::string hazard(const trace::HazardTrace& h, std::size_t k) {
     const std::string n = std::to_string(k);
-    const std::string goal = "G1." + n;
+    std::string goal = "G1." + n;
     node(goal, "goal", h.id + " (" + h.description + ") is mitigated");
     node("S1." + n, "strategy", "Argument over the detection, the reaction and the tests of " + h.id);
     find(goal).parts.push_back("S1." + n);
@@ -140,7 +140,7 @@ private:
   }
 
   std::string detection(const trace::HazardTrace& h, const std::string& n) {
-    const std::string id = "G1." + n + ".1";
+    std::string id = "G1." + n + ".1";
     std::vector<std::string> solutions;
     int s = 0;
     for (const trace::EventLink& e : h.events) {
@@ -159,7 +159,7 @@ private:
   }
 
   std::string reaction(const trace::HazardTrace& h, const std::string& n) {
-    const std::string id = "G1." + n + ".2";
+    std::string id = "G1." + n + ".2";
     std::string required;
     for (const trace::ReactionLink& r : h.reaction)
       required += (required.empty() ? "" : ", ") + r.address + " at " + r.level;
@@ -188,7 +188,7 @@ private:
   }
 
   std::string tests(const trace::HazardTrace& h, const std::string& n) {
-    const std::string id = "G1." + n + ".3";
+    std::string id = "G1." + n + ".3";
     std::vector<std::string> solutions;
     std::vector<std::string> seen;
     bool failed = false;
@@ -219,6 +219,38 @@ private:
 
 SafetyCase safety_case(const Analysis& a) { return CaseBuilder(a).build(); }
 
+[[nodiscard]] spec::Opened<bool> apply_reliability(const spec::ReliabilitySpec& reliability,
+                                                   std::vector<FailureMode>& modes) {
+  const auto by_event = [](const FailureMode& m, const std::string& name) {
+    return m.kind == ModeKind::Onset && m.event == name;
+  };
+  spec::Diagnostics errors;
+  for (const spec::ReliabilitySpec::Mode& r : reliability.modes) {
+    const bool known = std::any_of(modes.begin(), modes.end(),
+                                   [&](const FailureMode& m) { return m.name == r.name || by_event(m, r.name); });
+    if (!known)
+      errors.push_back(spec::Diagnostic{spec::Diagnostic::Severity::Error,
+                                        r.where,
+                                        "reliability: '" + r.name +
+                                            "' is no failure mode of the analysis (an event raised nowhere there, or a "
+                                            "signal no Watchdog watches): safecass analyze --fmea lists them",
+                                        {}});
+  }
+  if (!errors.empty()) return tl::unexpected(std::move(errors));
+  // Entries naming an event alone first, so that an entry naming one of its modes wins.
+  for (const bool general : {true, false}) {
+    for (const spec::ReliabilitySpec::Mode& r : reliability.modes) {
+      for (FailureMode& m : modes) {
+        if (general ? by_event(m, r.name) : m.name == r.name) {
+          m.rate = r.rate;
+          m.probability = r.probability;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 [[nodiscard]] tl::expected<Analysis, std::vector<spec::Diagnostic>> build_analysis(const AnalyzeOptions& options,
                                                                                    const FilterRegistry& registry) {
   if (options.order < 1 || options.order > 6)
@@ -241,7 +273,11 @@ SafetyCase safety_case(const Analysis& a) { return CaseBuilder(a).build(); }
   a.modes = std::move(modes->modes);
   auto tops = top_events(sys, options, engine);
   if (!tops) return tl::unexpected(std::move(tops.error()));
-  a.trees = fault_trees(a.modes, modes->raises, std::move(*tops), options.order);
+  if (sys.reliability) {
+    if (auto applied = apply_reliability(*sys.reliability, a.modes); !applied)
+      return tl::unexpected(std::move(applied.error()));
+  }
+  a.trees = fault_trees(a.modes, modes->raises, std::move(*tops), options.order, sys.reliability);
   if (options.fault_trees) {
     if (auto ran = run_scram(sys.name, a.modes, a.trees, options.scram, options.work_dir); !ran)
       return tl::unexpected(spec::Diagnostics{error_at(options.system, ran.error().message)});

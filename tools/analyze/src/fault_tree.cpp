@@ -7,6 +7,7 @@
 #include <tinyxml2.h>
 
 #include <algorithm>
+#include <charconv>
 #include <fstream>
 #include <map>
 #include <set>
@@ -107,6 +108,29 @@ void write_formula(std::string& out, const Gate& g) {
     out += std::string(g.all ? "<and>" : "<or>") + args + (g.all ? "</and>" : "</or>");
 }
 
+/// A double as MEF and SCRAM read it: the shortest text that reads back as the same double.
+std::string number(double v) {
+  char buf[32];
+  const auto [end, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  return ec == std::errc{} ? std::string(buf, end) : std::string("0");
+}
+
+double attribute(const tinyxml2::XMLElement* e, const char* name) { return e->DoubleAttribute(name, 0.0); }
+
+/// Why the trees cannot be quantified ("" when every mode has a rate or a probability).
+std::string unquantified(const std::vector<FailureMode>& modes, bool has_section) {
+  if (!has_section) return "the system file has no \"reliability\" section";
+  std::vector<std::string> missing;
+  for (const FailureMode& m : modes) {
+    if (!m.rate && !m.probability) missing.push_back(m.id + " (" + m.name + ")");
+  }
+  if (missing.empty()) return {};
+  std::string out = std::to_string(missing.size()) + " failure mode" + (missing.size() == 1 ? " has" : "s have") +
+                    " no rate or probability: ";
+  for (std::size_t k = 0; k < missing.size() && k < 5; ++k) out += (k == 0 ? "" : ", ") + missing[k];
+  return out + (missing.size() > 5 ? ", …" : "");
+}
+
 const tinyxml2::XMLElement* child(const tinyxml2::XMLElement* e, const char* name) {
   return e == nullptr ? nullptr : e->FirstChildElement(name);
 }
@@ -114,9 +138,11 @@ const tinyxml2::XMLElement* child(const tinyxml2::XMLElement* e, const char* nam
 }  // namespace
 
 FaultTrees fault_trees(const std::vector<FailureMode>& modes, const std::vector<std::vector<Raise>>& raises,
-                       std::vector<TopEvent> tops, int order) {
+                       std::vector<TopEvent> tops, int order, const std::optional<spec::ReliabilitySpec>& reliability) {
   FaultTrees trees;
   trees.order = order;
+  if (reliability) trees.mission_time = reliability->mission_time;
+  trees.unquantified = unquantified(modes, reliability.has_value());
   TreeBuilder builder(modes, raises);
   for (std::size_t k = 0; k < tops.size(); ++k) {
     tops[k].gate = "TOP" + std::to_string(k + 1);
@@ -138,7 +164,12 @@ std::string mef_document(const std::string& system, const std::vector<FailureMod
   out += "  </define-fault-tree>\n  <model-data>\n";
   for (const FailureMode& m : modes) {
     out += "    <define-basic-event name=\"" + m.id + "\">\n      <label>" + xml_escape(m.name + ": " + m.description) +
-           "</label>\n    </define-basic-event>\n";
+           "</label>\n";
+    if (m.probability)
+      out += "      <float value=\"" + number(*m.probability) + "\"/>\n";
+    else if (m.rate)
+      out += "      <exponential><float value=\"" + number(*m.rate) + "\"/><system-mission-time/></exponential>\n";
+    out += "    </define-basic-event>\n";
   }
   return out + "  </model-data>\n</opsa-mef>\n";
 }
@@ -161,8 +192,10 @@ std::string mef_document(const std::string& system, const std::vector<FailureMod
     f << trees.mef;
     if (!f) return fail(ErrorCode::Io, "cannot write " + dir->path() + "/trees.xml");
   }
-  auto run = verify::run_command(dir->path(), verify::shell_quote(scram) + " trees.xml --limit-order " +
-                                                  std::to_string(trees.order) + " -o report.xml");
+  std::string command = verify::shell_quote(scram) + " trees.xml --limit-order " + std::to_string(trees.order);
+  if (trees.unquantified.empty())
+    command += " --probability 1 --importance 1 --mission-time " + number(trees.mission_time);
+  auto run = verify::run_command(dir->path(), command + " -o report.xml");
   if (!run) return tl::unexpected(run.error());
   if (run->status != 0)
     return fail(ErrorCode::Io, "SCRAM failed (status " + std::to_string(run->status) + "): " + run->output);
@@ -177,9 +210,11 @@ std::string mef_document(const std::string& system, const std::vector<FailureMod
     const char* name = sop->Attribute("name");
     const auto it = by_gate.find(name == nullptr ? "" : name);
     if (it == by_gate.end()) continue;
+    if (trees.unquantified.empty()) it->second->probability = attribute(sop, "probability");
     for (const tinyxml2::XMLElement* p = sop->FirstChildElement("product"); p != nullptr;
          p = p->NextSiblingElement("product")) {
       CutSet cs;
+      if (trees.unquantified.empty()) cs.probability = attribute(p, "probability");
       for (const tinyxml2::XMLElement* b = p->FirstChildElement("basic-event"); b != nullptr;
            b = b->NextSiblingElement("basic-event"))
         cs.modes.emplace_back(b->Attribute("name") == nullptr ? "" : b->Attribute("name"));
@@ -194,6 +229,18 @@ std::string mef_document(const std::string& system, const std::vector<FailureMod
           a.modes.begin(), a.modes.end(), b.modes.begin(), b.modes.end(),
           [](const std::string& x, const std::string& y) { return mode_number(x) < mode_number(y); });
     });
+  }
+  for (const tinyxml2::XMLElement* imp = child(results, "importance"); imp != nullptr;
+       imp = imp->NextSiblingElement("importance")) {
+    const char* name = imp->Attribute("name");
+    const auto it = by_gate.find(name == nullptr ? "" : name);
+    if (it == by_gate.end()) continue;
+    for (const tinyxml2::XMLElement* b = imp->FirstChildElement("basic-event"); b != nullptr;
+         b = b->NextSiblingElement("basic-event")) {
+      it->second->importance.push_back(Importance{b->Attribute("name") == nullptr ? "" : b->Attribute("name"),
+                                                  attribute(b, "probability"), attribute(b, "MIF"), attribute(b, "CIF"),
+                                                  attribute(b, "DIF"), attribute(b, "RAW"), attribute(b, "RRW")});
+    }
   }
   return trees.scram;
 }

@@ -1,5 +1,6 @@
 // The analysis as text, CSV and JSON. One formatter per format; every format shows the same facts.
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 
@@ -61,6 +62,13 @@ std::string where_text(const spec::Position& p) {
 
 std::string level_text(State s) { return std::string(to_string(s)); }
 
+/// A probability or factor to six significant digits.
+std::string probability_text(double p) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", p);
+  return buf;
+}
+
 /// "FM3 (EVT_X@C.s_A)": a mode as a cut set names it.
 std::string mode_label(const Analysis& a, const std::string& id) {
   for (const FailureMode& m : a.modes) {
@@ -83,6 +91,8 @@ std::string fmea_text(const Analysis& a) {
     out += "  system:     " + (m.effects.empty() ? std::string("nothing") : effects_text(m.effects)) + "\n";
     if (m.escalates) out += "  escalated:  " + effects_text(m.escalated) + "\n";
     out += "  detection:  " + m.detection + "\n";
+    if (m.rate) out += "  rate:       " + probability_text(*m.rate) + " per hour\n";
+    if (m.probability) out += "  probability: " + probability_text(*m.probability) + "\n";
     out += "  hazards:    " + (m.hazards.empty() ? std::string("none") : join(hazards_of(m), "; ")) + "\n";
     out += "  tests:      " + (m.tests.empty() ? std::string("none") : join(tests_of(m), "; ")) + "\n";
     for (const std::string& g : gaps_of(m)) out += "  GAP " + g + "\n";
@@ -96,13 +106,26 @@ std::string fmea_text(const Analysis& a) {
 std::string fault_trees_text(const Analysis& a) {
   std::string out = "\nFault trees (" + (a.trees.scram.empty() ? std::string("SCRAM not run") : a.trees.scram) +
                     ", cut sets up to order " + std::to_string(a.trees.order) + ")\n";
+  out += a.trees.unquantified.empty()
+             ? "Probabilities over a mission of " + probability_text(a.trees.mission_time) + " h\n"
+             : "Not quantified: " + a.trees.unquantified + "\n";
   for (const TopEvent& t : a.trees.tops) {
     out += "\n" + t.gate + "  " + t.address + " at " + level_text(t.level) + " or worse  (" + t.why +
-           "): " + std::to_string(t.cut_sets.size()) + " minimal cut set" + (t.cut_sets.size() == 1 ? "" : "s") + "\n";
+           "): " + std::to_string(t.cut_sets.size()) + " minimal cut set" + (t.cut_sets.size() == 1 ? "" : "s");
+    if (t.probability) out += ", probability " + probability_text(*t.probability);
+    out += "\n";
     for (const CutSet& c : t.cut_sets) {
       std::vector<std::string> names;
       for (const std::string& id : c.modes) names.push_back(mode_label(a, id));
-      out += "  {" + join(names, ", ") + "}\n";
+      out += "  {" + join(names, ", ") + "}" + (c.probability ? "  p=" + probability_text(*c.probability) : "") + "\n";
+    }
+    std::vector<Importance> ranked = t.importance;
+    std::stable_sort(ranked.begin(), ranked.end(),
+                     [](const Importance& x, const Importance& y) { return x.cif > y.cif; });
+    if (!ranked.empty()) out += "  importance (criticality CIF, Birnbaum MIF, RAW, RRW):\n";
+    for (const Importance& i : ranked) {
+      out += "    " + mode_label(a, i.mode) + "  CIF " + probability_text(i.cif) + "  MIF " + probability_text(i.mif) +
+             "  RAW " + probability_text(i.raw) + "  RRW " + probability_text(i.rrw) + "\n";
     }
   }
   return out;
@@ -188,6 +211,8 @@ std::string json_mode(const FailureMode& m) {
       .raw("hazards", hazards.text())
       .raw("tests", tests.text())
       .raw("gaps", gaps.text())
+      .raw("rate", m.rate ? json::json_number(*m.rate) : "null")
+      .raw("probability", m.probability ? json::json_number(*m.probability) : "null")
       .str("where", where_text(m.where))
       .text();
 }
@@ -195,17 +220,41 @@ std::string json_mode(const FailureMode& m) {
 std::string json_trees(const FaultTrees& trees) {
   JsonArray tops(JsonArray::Layout::OnePerLine);
   for (const TopEvent& t : trees.tops) {
-    JsonArray cuts;
-    for (const CutSet& c : t.cut_sets) cuts.raw(json::json_string_array(c.modes));
+    JsonArray cuts, importance;
+    for (const CutSet& c : t.cut_sets) {
+      cuts.raw(JsonObject()
+                   .raw("modes", json::json_string_array(c.modes))
+                   .raw("probability", c.probability ? json::json_number(*c.probability) : "null")
+                   .text());
+    }
+    for (const Importance& i : t.importance) {
+      importance.raw(JsonObject()
+                         .str("mode", i.mode)
+                         .num("probability", i.probability)
+                         .num("mif", i.mif)
+                         .num("cif", i.cif)
+                         .num("dif", i.dif)
+                         .num("raw", i.raw)
+                         .num("rrw", i.rrw)
+                         .text());
+    }
     tops.raw(JsonObject()
                  .str("gate", t.gate)
                  .str("address", t.address)
                  .str("level", level_text(t.level))
                  .str("why", t.why)
                  .raw("cut_sets", cuts.text())
+                 .raw("probability", t.probability ? json::json_number(*t.probability) : "null")
+                 .raw("importance", importance.text())
                  .text());
   }
-  return JsonObject().integer("order", trees.order).str("scram", trees.scram).raw("tops", tops.text()).text();
+  return JsonObject()
+      .integer("order", trees.order)
+      .str("scram", trees.scram)
+      .num("mission_time", trees.mission_time)
+      .opt("unquantified", trees.unquantified)
+      .raw("tops", tops.text())
+      .text();
 }
 
 std::string json_case(const SafetyCase& c) {

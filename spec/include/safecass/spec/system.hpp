@@ -57,6 +57,21 @@ struct InvariantSpec {
   Position where;  ///< its name
 };
 
+/// The system file's `"reliability"` section (docs/analyze.md): a rate or a probability per
+/// failure mode, named as `safecass analyze` names them; at most one of the two is set.
+struct ReliabilitySpec {
+  static constexpr double kDefaultMissionTime = 8760.0;  ///< hours: a year
+  struct Mode {
+    std::string name;                   ///< "EVT_X@C.s_A", "EVT_X", "C.s_F", "stale:C.sig", "fault:f", "lost:c", …
+    std::optional<double> rate;         ///< failures per hour
+    std::optional<double> probability;  ///< within the mission
+    Position where;                     ///< its name
+  };
+  double mission_time = kDefaultMissionTime;  ///< hours
+  std::vector<Mode> modes;
+  Position where;
+};
+
 struct ComponentSpec {
   std::string name;
   std::vector<std::string> provided, required;
@@ -87,6 +102,7 @@ struct SystemSpec {
   std::vector<std::pair<std::string, std::vector<std::string>>> coordinators;
   std::vector<HazardSpec> hazards;  ///< empty when the system declares none
   std::vector<InvariantSpec> invariants;
+  std::optional<ReliabilitySpec> reliability;  ///< absent when the system file has no such section
 
   /// The hazard of that id, or null.
   const HazardSpec* hazard(std::string_view id) const noexcept {

@@ -94,6 +94,8 @@ struct FailureMode {
   std::vector<HazardLink> hazards;
   std::vector<Evidence> tests;
   std::vector<Gap> gaps;
+  std::optional<double> rate;         ///< failures per hour, from the system's "reliability"
+  std::optional<double> probability;  ///< within the mission, from the system's "reliability"
   spec::Position where;
 };
 
@@ -130,10 +132,14 @@ struct TopEvent {
 
 struct FaultTrees {
   std::vector<TopEvent> tops;
-  std::vector<Gate> gates;  ///< every gate, tops first
-  int order = 3;            ///< the largest cut set computed (SCRAM's --limit-order)
-  std::string mef;          ///< the MEF document given to SCRAM
-  std::string scram;        ///< "SCRAM 0.16.2"
+  std::vector<Gate> gates;       ///< every gate, tops first
+  int order = 3;                 ///< the largest cut set computed (SCRAM's --limit-order)
+  double mission_time = 8760.0;  ///< hours (the "reliability" section's, or SCRAM's default)
+  /// Empty when SCRAM computed probabilities and importances; else why not ("no \"reliability\"
+  /// section", "3 modes have no rate or probability: FM2, …").
+  std::string unquantified;
+  std::string mef;    ///< the MEF document given to SCRAM
+  std::string scram;  ///< "SCRAM 0.16.2"
 };
 
 /// One node of the GSN goal structure (GSN Community Standard v3 element types).
