@@ -47,10 +47,11 @@ demo: configure
 	@echo "Hazard trace report (open in a browser, prints to PDF): $(BUILD)/demo/trace.html (matrix: $(BUILD)/demo/trace.txt, CSV: $(BUILD)/demo/trace.csv)"
 	@./$(BUILD)/bin/safecass analyze examples/robodoc/robodoc.json --scenarios examples/robodoc/story.json \
 	  examples/robodoc/injection.json examples/robodoc/warnings.json examples/robodoc/overload.json \
-	  --verify $(BUILD)/demo/verify.jsonl --mef $(BUILD)/demo/fault-trees.xml >$(BUILD)/demo/analysis.txt 2>/dev/null \
+	  --verify $(BUILD)/demo/verify.jsonl --mef $(BUILD)/demo/fault-trees.xml --html $(BUILD)/demo/analysis.html \
+	  >$(BUILD)/demo/analysis.txt 2>/dev/null \
 	  || { cat $(BUILD)/demo/analysis.txt; echo "analyze: a gap of error severity (above)"; exit 1; }
 	@grep -E '^(FMEA of|Gaps:)' $(BUILD)/demo/analysis.txt
-	@echo "FMEA, fault trees and safety case (safecass analyze): $(BUILD)/demo/analysis.txt (MEF: $(BUILD)/demo/fault-trees.xml)"
+	@echo "FMEA, fault trees and safety case (safecass analyze; open in a browser, prints to PDF): $(BUILD)/demo/analysis.html (text: $(BUILD)/demo/analysis.txt, MEF: $(BUILD)/demo/fault-trees.xml)"
 
 # ROBODOC on ROS 1 (examples/ros_robodoc): roscore, diagnostic_aggregator, the nodes, rosdiagnostic.
 ros-demo: configure

@@ -18,7 +18,10 @@ struct AnalyzeArgs {
   std::vector<std::string> tops;
   bool fmea = false, trees = false, gsn = false, strict = false;
   std::string format = "text";
-  std::string mef;  ///< --mef FILE: the fault trees as given to SCRAM
+  std::string mef;   ///< --mef FILE: the fault trees as given to SCRAM
+  std::string html;  ///< --html FILE: the report
+  std::string pdf;   ///< --pdf FILE: the report printed by Chromium
+  std::string chromium = "chromium";
 };
 
 bool write_file(const std::string& path, const std::string& text) {
@@ -61,6 +64,20 @@ int run_analyze(AnalyzeArgs& args) {
   }
   std::fwrite(text.data(), 1, text.size(), stdout);
   if (!args.mef.empty() && !write_file(args.mef, a.trees.mef)) return 2;
+  if (!args.html.empty() || !args.pdf.empty()) {
+    const std::string html = args.html.empty() ? args.pdf + ".html" : args.html;
+    if (!write_file(html, analyze::render_analysis_page(a, report_date()))) return 2;
+    if (!args.pdf.empty()) {
+      auto printed = analyze::print_pdf(html, args.pdf, args.chromium);
+      if (args.html.empty()) std::remove(html.c_str());
+      if (!printed) {
+        std::fprintf(stderr, "safecass analyze: %s\n", printed.error().message.c_str());
+        return 2;
+      }
+      std::fprintf(stderr, "safecass analyze: report printed to %s\n", args.pdf.c_str());
+    }
+    if (!args.html.empty()) std::fprintf(stderr, "safecass analyze: report written to %s\n", args.html.c_str());
+  }
   if (a.has_error_gap()) return 1;
   if (args.strict && a.gap_count(trace::Severity::Warning) != 0) return 1;
   return 0;
@@ -84,6 +101,9 @@ void add_analyze_command(CLI::App& app, int& code) {
   cmd->add_option("--order", args->options.order, "the largest cut set computed, 1 to 6 (default 3)")
       ->check(CLI::Range(1, 6));
   cmd->add_option("--mef", args->mef, "write the fault trees in the Open-PSA MEF to this file");
+  cmd->add_option("--html", args->html, "write the report (one self-contained page, printable to PDF) to this file");
+  cmd->add_option("--pdf", args->pdf, "print the report to this PDF file with headless Chromium");
+  cmd->add_option("--chromium", args->chromium, "Chromium's executable for --pdf (default: chromium)");
   cmd->add_option("--scram", args->options.scram, "SCRAM's executable (default: scram)");
   cmd->add_flag("--strict", args->strict, "exit 1 on a gap of warning severity too");
   cmd->callback([args, &code] { code = run_analyze(*args); });

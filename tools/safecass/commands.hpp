@@ -61,6 +61,9 @@ struct TraceArgs {
   bool json = false;    ///< the matrix as JSON on stdout instead of text
   bool strict = false;  ///< a gap of warning severity fails too
 };
+/// A report's date: now in UTC, or SOURCE_DATE_EPOCH when set (reproducible builds).
+std::string report_date();
+
 /// `safecass trace` (docs/trace.md): 0 no error-severity gap, 1 one exists (with --strict: or a
 /// warning), 2 invalid input or a file that cannot be written.
 int run_trace(const TraceArgs& args);

@@ -25,6 +25,8 @@ bool write_file(const std::string& path, const std::string& text) {
   return true;
 }
 
+}  // namespace
+
 /// The report's date: now in UTC, or SOURCE_DATE_EPOCH when set (reproducible builds).
 std::string report_date() {
   std::time_t now = std::time(nullptr);
@@ -39,8 +41,6 @@ std::string report_date() {
   std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S UTC", &tm);
   return buf;
 }
-
-}  // namespace
 
 int run_trace(const TraceArgs& args) {
   const FilterRegistry& registry = builtin_filters();

@@ -257,7 +257,9 @@ std::string json_trees(const FaultTrees& trees) {
       .text();
 }
 
-std::string json_case(const SafetyCase& c) {
+}  // namespace
+
+std::string safety_case_json(const SafetyCase& c) {
   JsonArray nodes(JsonArray::Layout::OnePerLine);
   for (const GsnNode& n : c.nodes) {
     nodes.raw(JsonObject()
@@ -272,8 +274,6 @@ std::string json_case(const SafetyCase& c) {
   return JsonObject().str("notation", "GSN Community Standard v3").raw("nodes", nodes.text()).text();
 }
 
-}  // namespace
-
 std::string analysis_json(const Analysis& a) {
   JsonArray modes(JsonArray::Layout::OnePerLine);
   for (const FailureMode& m : a.modes) modes.raw(json_mode(m));
@@ -283,7 +283,7 @@ std::string analysis_json(const Analysis& a) {
              .str("version", trace::tool_version())
              .raw("fmea", modes.text())
              .raw("fault_trees", json_trees(a.trees))
-             .raw("safety_case", json_case(a.safety_case))
+             .raw("safety_case", safety_case_json(a.safety_case))
              .raw("gaps", JsonObject()
                               .integer("error", static_cast<long long>(a.gap_count(trace::Severity::Error)))
                               .integer("warning", static_cast<long long>(a.gap_count(trace::Severity::Warning)))

@@ -305,7 +305,11 @@ std::string coverage_table(const Trace& t) {
   return out + "</tbody></table>\n";
 }
 
-std::string fill(std::string_view tmpl, const std::map<std::string, std::string, std::less<>>& values) {
+}  // namespace
+
+std::string_view tool_version() noexcept { return SAFECASS_VERSION; }
+
+std::string fill_template(std::string_view tmpl, const std::map<std::string, std::string, std::less<>>& values) {
   std::string out;
   std::size_t pos = 0;
   while (true) {
@@ -324,10 +328,6 @@ std::string fill(std::string_view tmpl, const std::map<std::string, std::string,
   out.append(tmpl.substr(pos));
   return out;
 }
-
-}  // namespace
-
-std::string_view tool_version() noexcept { return SAFECASS_VERSION; }
 
 std::string sha256_hex(std::string_view bytes) {
   unsigned char digest[crypto_hash_sha256_BYTES];
@@ -379,7 +379,7 @@ std::string render_trace_page(const Trace& t, const std::string& date) {
       {"CSS", std::string(web::kTraceCss)},           {"BODY", body},
       {"TIMELINE_JS", std::string(web::kTimelineJs)}, {"JS", std::string(web::kTraceJs)},
   };
-  return fill(web::kTraceHtml, values);
+  return fill_template(web::kTraceHtml, values);
 }
 
 }  // namespace safecass::trace

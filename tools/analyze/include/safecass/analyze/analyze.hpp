@@ -202,5 +202,16 @@ std::string safety_case_text(const Analysis& a);
 std::string fmea_csv(const Analysis& a);
 /// The whole analysis as one JSON document (docs/analyze.md, "JSON").
 std::string analysis_json(const Analysis& a);
+/// The goal structure alone, as analysis_json() has it: {"notation": ..., "nodes": [...]}.
+std::string safety_case_json(const SafetyCase& c);
+
+/// The report: one self-contained HTML page (no network) with a header (system, SHA-256 of every
+/// spec file, tool version, `date`), the FMEA with its gaps marked, the fault trees with their cut
+/// sets, and the safety case drawn as a GSN diagram; printable to PDF.
+std::string render_analysis_page(const Analysis& a, const std::string& date);
+
+/// Prints the report `html_path` to `pdf_path` with headless Chromium (`chromium`). Errors: Io.
+[[nodiscard]] Expected<void> print_pdf(const std::string& html_path, const std::string& pdf_path,
+                                       const std::string& chromium);
 
 }  // namespace safecass::analyze

@@ -15,6 +15,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -193,6 +194,10 @@ std::string sha256_hex(std::string_view bytes);
 /// every spec file, tool version, `date`), the matrix with the gaps highlighted, per hazard a
 /// timeline excerpt drawn by the timeline page's renderer, and the coverage summary.
 std::string render_trace_page(const Trace& trace, const std::string& date);
+
+/// A page template with every "{{NAME}}" replaced by `values`' text for NAME (a name without a
+/// value is left as it is): how the reports put their parts into their pages.
+std::string fill_template(std::string_view tmpl, const std::map<std::string, std::string, std::less<>>& values);
 
 /// The version of the tool, as `safecass --version` prints it.
 std::string_view tool_version() noexcept;
