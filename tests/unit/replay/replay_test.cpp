@@ -97,6 +97,18 @@ TEST(ReplayCsv, ReplayingFromAndToFeedsOnlyTheWindow) {
   EXPECT_EQ(early.out, "");
 }
 
+// Found by the csv fuzz target (its time property assumed times of zero or more): field data may
+// start before zero (a pre-trigger window); such rows replay in their order, from their first time.
+TEST(ReplayCsv, RowsBeforeTimeZeroReplayInOrderFromTheFirstRowsTime) {
+  const std::string path = ::testing::TempDir() + "safecass-negative-times-" + std::to_string(::getpid()) + ".csv";
+  std::ofstream(path) << "time,ARM.Temperature\n-01,20\n0,10\n1,22\n";
+  const Ran r = replay(options(kData + "arm.json", path));
+  std::remove(path.c_str());
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("replayed 3 samples and 0 actions"));
+  EXPECT_THAT(r.err, HasSubstr("-1.000000 s to 1.000000 s"));
+}
+
 class BadCsv : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(BadCsv, IsRefusedWithWhereAndWhyAndNothingRuns) {
