@@ -203,25 +203,15 @@ private:
     for (const trace::EventLink& e : trace_.onsets) {
       const Event* ev = engine_.event(e.name);
       if (ev == nullptr) continue;
-      std::vector<std::string> machines;
-      for (const std::string& t : e.targets) {
-        if (t.rfind("every s_A", 0) == 0) {
-          for (const spec::ComponentSpec& c : sys_.components) machines.push_back(address::application(c.name));
-        } else {
-          machines.push_back(target_machine(t));
-        }
-      }
+      // A broadcast applies to every component's s_A at once (DESIGN §2.7): one mode. Any other
+      // onset: one mode per machine it is raised at.
       const bool broadcast = ev->is_broadcast();
-      if (broadcast) {  // one mode: a broadcast reaches every s_A at once
-        machines.erase(std::remove_if(machines.begin(), machines.end(),
-                                      [](const std::string& m) { return m.find(".s_A") == std::string::npos; }),
-                       machines.end());
-      }
       std::vector<std::vector<std::string>> groups;
       if (broadcast) {
-        groups.push_back(machines);
+        groups.emplace_back();
+        for (const spec::ComponentSpec& c : sys_.components) groups.back().push_back(address::application(c.name));
       } else {
-        for (const std::string& m : machines) groups.push_back({m});
+        for (const std::string& t : e.targets) groups.push_back({target_machine(t)});
       }
       for (const std::vector<std::string>& group : groups) {
         FailureMode m;
