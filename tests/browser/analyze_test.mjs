@@ -74,6 +74,9 @@ async function testRobodoc() {
   check(await page.locator('#gsn-figure svg g.node.undeveloped polygon.diamond').count() === undeveloped,
     `a diamond under each undeveloped goal (${undeveloped})`);
   check(await page.locator('#gsn-figure svg polyline.edge').count() > 0, 'the diagram draws its links');
+  const stroke = await page.locator('#gsn-figure svg g.node rect').first().evaluate((r) => getComputedStyle(r).stroke);
+  check(stroke !== 'none' && stroke !== '', `its shapes are outlined (stroke ${stroke})`);
+  check(!(await page.content()).includes('{{'), 'every part of the page template is filled');
   check(errors.length === 0, `no script error (${errors.join('; ')})`);
   await page.locator('#gsn-figure').screenshot({ path: path.join(out, 'analysis-gsn.png') })
     .catch((e) => console.log(`note: no screenshot (${e.message.split('\n')[0]})`));

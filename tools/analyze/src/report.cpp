@@ -192,6 +192,8 @@ std::string render_analysis_page(const Analysis& a, const std::string& date) {
   const std::string gsn = safety_case_json(a.safety_case);
   const std::map<std::string, std::string, std::less<>> values{
       {"TITLE", markup_text(a.trace.system)},
+      {"TIMELINE_CSS", std::string(web::kTimelineCss)},
+      {"TRACE_CSS", std::string(web::kTraceCss)},
       {"CSS", std::string(web::kAnalyzeCss)},
       {"BODY", body},
       {"GSN", script_safe(gsn)},
