@@ -34,7 +34,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   auto second = read_line(written);
   if (!second) __builtin_trap();  // what the writer wrote, the reader reads
   const std::string again = introspect::history_json(*second);
+  // Compared as written, not with ==: a root's value may be NaN (a non-finite sample judged), and
+  // NaN equals nothing.
   auto third = read_line(again);
-  if (!third || !(*third == *second) || introspect::history_json(*third) != again) __builtin_trap();
+  if (!third || introspect::history_json(*third) != again) __builtin_trap();
   return 0;
 }
