@@ -237,6 +237,28 @@ case $case_name in
     "$safecass" trace tests/data/trace/arm.json --scenarios tests/data/trace/covered.scenario.json --html "$tmp/no/such/dir.html" \
       >/dev/null 2>"$tmp/err"; expect_code 2 $? "unwritable report"
     ;;
+  analyze_exit_codes_tops_and_outputs)
+    "$safecass" analyze examples/robodoc/robodoc.json --mef "$tmp/trees.xml" --format csv >"$tmp/fmea.csv" 2>/dev/null
+    expect_code 0 $? "robodoc: no error-severity gap"
+    head -1 "$tmp/fmea.csv" | grep -q "^id,name,kind,failure," || fail "csv header: $(head -1 "$tmp/fmea.csv")"
+    grep -q "<opsa-mef>" "$tmp/trees.xml" || fail "no MEF written"
+    "$safecass" analyze tests/data/verify/level_rule.json >"$tmp/out" 2>/dev/null
+    expect_code 1 $? "an onset that misses its reaction"
+    grep -q "GAP error reaction-missed" "$tmp/out" || fail "the gap is not named: $(grep GAP "$tmp/out")"
+    # --top repeats, one value each, before or after SYSTEM.
+    "$safecass" analyze --top SERVO=Error --top BMM.s_A=Warning examples/robodoc/robodoc.json --fault-trees \
+      >"$tmp/out" 2>/dev/null; expect_code 0 $? "two --top before SYSTEM"
+    grep -q "BMM.s_A at Warning or worse  (--top)" "$tmp/out" || fail "--top not a top: $(grep TOP "$tmp/out")"
+    "$safecass" analyze examples/robodoc/robodoc.json --top SERVO=Normal >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "a top at Normal"
+    grep -q "Warning or Error" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    "$safecass" analyze examples/robodoc/robodoc.json --scram "$tmp/no-scram" >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "SCRAM missing"
+    grep -q "does not run" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    "$safecass" analyze tests/data/bad_specs/unknown_event.json >/dev/null 2>"$tmp/err"
+    expect_code 2 $? "a bad system"
+    grep -q "unknown_event.json:[0-9]*:[0-9]*: error" "$tmp/err" || fail "message: $(cat "$tmp/err")"
+    ;;
   *) fail "unknown case $case_name" ;;
 esac
 echo "ok: $case_name"

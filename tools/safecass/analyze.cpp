@@ -97,7 +97,8 @@ void add_analyze_command(CLI::App& app, int& code) {
       ->check(CLI::IsMember({"text", "csv", "json"}));
   cmd->add_option("--scenarios,-s", args->options.scenarios, "scenarios to run as test evidence");
   cmd->add_option("--verify", args->options.verify_json, "the output of `safecass verify --json`: what is proved");
-  cmd->add_option("--top", args->tops, "another top event, ADDRESS=LEVEL (e.g. SERVO=Error)");
+  cmd->add_option("--top", args->tops, "another top event, ADDRESS=LEVEL (e.g. SERVO=Error); repeatable")
+      ->allow_extra_args(false);
   cmd->add_option("--order", args->options.order, "the largest cut set computed, 1 to 6 (default 3)")
       ->check(CLI::Range(1, 6));
   cmd->add_option("--mef", args->mef, "write the fault trees in the Open-PSA MEF to this file");
