@@ -81,7 +81,7 @@ known-defects: build
 # they run in `make fuzz` only.
 FUZZ := $(BUILD)/fuzz
 FUZZ_SMOKE_TARGETS := spec_loader ros_input read_answer scenario history input_log
-FUZZ_TARGETS := $(FUZZ_SMOKE_TARGETS) csv viewer_message console_command
+FUZZ_TARGETS := $(FUZZ_SMOKE_TARGETS) csv viewer_message console_command wire_events
 FUZZ_SECONDS ?= 60
 fuzz-tree: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \

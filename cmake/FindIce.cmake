@@ -52,7 +52,11 @@ if(Ice_FOUND AND NOT TARGET Ice::Ice++11)
 endif()
 
 function(ice_slice2cpp)
-  cmake_parse_arguments(S "" "OUTPUT_VAR;OUTPUT_DIR" "SLICE" ${ARGN})
+  cmake_parse_arguments(S "" "OUTPUT_VAR;OUTPUT_DIR;ADD_HEADER" "SLICE" ${ARGN})
+  set(add_header)
+  if(S_ADD_HEADER)
+    set(add_header --add-header ${S_ADD_HEADER})
+  endif()
   if(NOT S_OUTPUT_DIR)
     set(S_OUTPUT_DIR ${CMAKE_CURRENT_BINARY_DIR}/generated)
   endif()
@@ -63,8 +67,8 @@ function(ice_slice2cpp)
     get_filename_component(dir ${slice} DIRECTORY)
     add_custom_command(
       OUTPUT ${S_OUTPUT_DIR}/${base}.cpp ${S_OUTPUT_DIR}/${base}.h
-      COMMAND ${Ice_SLICE2CPP_EXECUTABLE} -I${Ice_SLICE_DIR} -I${dir} --output-dir ${S_OUTPUT_DIR} ${slice}
-      DEPENDS ${slice}
+      COMMAND ${Ice_SLICE2CPP_EXECUTABLE} -I${Ice_SLICE_DIR} -I${dir} ${add_header} --output-dir ${S_OUTPUT_DIR} ${slice}
+      DEPENDS ${slice} ${S_ADD_HEADER}
       COMMENT "slice2cpp ${base}.ice"
       VERBATIM)
     list(APPEND outputs ${S_OUTPUT_DIR}/${base}.cpp ${S_OUTPUT_DIR}/${base}.h)

@@ -27,6 +27,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ice_sequences.hpp"  // before the generated header: its sequences' reader
 #include "safecass.h"
 #include "safecass/core/expected.hpp"
 

@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "ice_sequences.hpp"  // before the generated header: its sequences' reader
 #include "ice_util.hpp"
 #include "safecass.h"
 #include "sleeper.hpp"

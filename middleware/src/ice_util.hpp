@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "ice_sequences.hpp"  // before the generated header: its sequences' reader
 #include "safecass.h"
 #include "safecass/core/coordinator.hpp"
 #include "safecass/middleware/node.hpp"

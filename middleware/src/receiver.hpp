@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "ice_sequences.hpp"  // before the generated header: its sequences' reader
 #include "safecass.h"
 #include "safecass/core/text_map.hpp"
 #include "safecass/spec/system.hpp"

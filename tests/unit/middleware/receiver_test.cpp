@@ -11,6 +11,7 @@
 #include <thread>
 #include <vector>
 
+#include "auth.hpp"
 #include "receiver.hpp"
 #include "safecass/middleware/keys.hpp"
 
@@ -432,6 +433,35 @@ TEST(DropLogTest, TheFirstLineAfterTheBudgetSaysHowManyLinesWereSuppressed) {
   ASSERT_EQ(lines.size(), DropLog::kLinesPerSecond + 1);
   EXPECT_NE(lines.back().find("(5 more line(s) of every source suppressed: at most 8 a second)"), std::string::npos)
       << lines.back();
+}
+
+}  // namespace
+}  // namespace safecass::middleware
+
+namespace safecass::middleware {
+namespace {
+
+// Found by tests/fuzz/wire_events_fuzz.cpp: a member's sealed event batch of 31 bytes declared
+// 33,554,431 messages; Ice 3.7's 32-bit check of size x minimum size wrapped, and the receiver
+// built a vector of 13 GB before reading the first message. A sequence of structs declaring more
+// elements than the bytes left can hold is now refused (ice_sequences.hpp), allocating nothing.
+TEST(Decode, ABatchDeclaringMoreMessagesThanItsBytesCanHoldIsRefusedWithoutBuildingThem) {
+  const std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
+  const Ice::ByteSeq body{0xff, 0xff, 0xff, 0xff, 0x01, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x02, 0xff, 0x09, 0x00, 0x73,
+                          0x61, 0x76, 0x65, 0x2d, 0xff, 0xff, 0x60, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0x05};
+  wire::EventMessageSeq batch;
+  EXPECT_FALSE(decode(ice, body, batch));
+  EXPECT_TRUE(batch.empty());
+  // A genuine batch still decodes.
+  wire::EventMessage m;
+  m.coordinator = "robot";
+  m.seq = 1;
+  const wire::EventMessageSeq sent{m, m};
+  wire::EventMessageSeq received;
+  ASSERT_TRUE(decode(ice, encode(ice, sent), received));
+  EXPECT_EQ(received.size(), 2U);
+  EXPECT_EQ(received[1].coordinator, "robot");
+  ice->destroy();
 }
 
 }  // namespace
