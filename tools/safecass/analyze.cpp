@@ -3,7 +3,6 @@
 
 #include <CLI/CLI.hpp>
 #include <cstdio>
-#include <fstream>
 
 #include "commands.hpp"
 #include "safecass/analyze/analyze.hpp"
@@ -23,14 +22,6 @@ struct AnalyzeArgs {
   std::string pdf;   ///< --pdf FILE: the report printed by Chromium
   std::string chromium = "chromium";
 };
-
-bool write_file(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
-  if (out) out.write(text.data(), static_cast<std::streamsize>(text.size()));
-  if (out) out.close();
-  if (!out) std::fprintf(stderr, "safecass analyze: cannot write '%s'\n", path.c_str());
-  return static_cast<bool>(out);
-}
 
 int run_analyze(AnalyzeArgs& args) {
   for (const std::string& t : args.tops) {
@@ -63,10 +54,10 @@ int run_analyze(AnalyzeArgs& args) {
     if (all || args.gsn) text += analyze::safety_case_text(a);
   }
   std::fwrite(text.data(), 1, text.size(), stdout);
-  if (!args.mef.empty() && !write_file(args.mef, a.trees.mef)) return 2;
+  if (!args.mef.empty() && !write_output("analyze", args.mef, a.trees.mef)) return 2;
   if (!args.html.empty() || !args.pdf.empty()) {
     const std::string html = args.html.empty() ? args.pdf + ".html" : args.html;
-    if (!write_file(html, analyze::render_analysis_page(a, report_date()))) return 2;
+    if (!write_output("analyze", html, analyze::render_analysis_page(a, report_date()))) return 2;
     if (!args.pdf.empty()) {
       auto printed = analyze::print_pdf(html, args.pdf, args.chromium);
       if (args.html.empty()) std::remove(html.c_str());

@@ -61,6 +61,10 @@ struct TraceArgs {
   bool json = false;    ///< the matrix as JSON on stdout instead of text
   bool strict = false;  ///< a gap of warning severity fails too
 };
+/// Writes `text` to `path` (replacing it); false, with "safecass COMMAND: cannot write 'PATH'" on
+/// stderr, when it cannot.
+bool write_output(const char* command, const std::string& path, const std::string& text);
+
 /// A report's date: now in UTC, or SOURCE_DATE_EPOCH when set (reproducible builds).
 std::string report_date();
 

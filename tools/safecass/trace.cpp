@@ -12,20 +12,13 @@
 
 namespace safecass::tools {
 
-namespace {
-
-bool write_file(const std::string& path, const std::string& text) {
+bool write_output(const char* command, const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (out) out.write(text.data(), static_cast<std::streamsize>(text.size()));
   if (out) out.close();
-  if (!out) {
-    std::fprintf(stderr, "safecass trace: cannot write '%s'\n", path.c_str());
-    return false;
-  }
-  return true;
+  if (!out) std::fprintf(stderr, "safecass %s: cannot write '%s'\n", command, path.c_str());
+  return static_cast<bool>(out);
 }
-
-}  // namespace
 
 /// The report's date: now in UTC, or SOURCE_DATE_EPOCH when set (reproducible builds).
 std::string report_date() {
@@ -60,9 +53,9 @@ int run_trace(const TraceArgs& args) {
   for (const spec::Diagnostic& d : t.notes) std::fprintf(stderr, "%s\n", spec::format(d).c_str());
   const std::string text = args.json ? trace::trace_json(t) : trace::trace_text(t);
   std::fwrite(text.data(), 1, text.size(), stdout);
-  if (!args.csv.empty() && !write_file(args.csv, trace::trace_csv(t))) return 2;
+  if (!args.csv.empty() && !write_output("trace", args.csv, trace::trace_csv(t))) return 2;
   if (!args.html.empty()) {
-    if (!write_file(args.html, trace::render_trace_page(t, report_date()))) return 2;
+    if (!write_output("trace", args.html, trace::render_trace_page(t, report_date()))) return 2;
     std::fprintf(stderr, "safecass trace: report written to %s\n", args.html.c_str());
   }
   if (t.has_error_gap()) return 1;
