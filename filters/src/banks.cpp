@@ -42,6 +42,14 @@ bool Banks::bankable(Filter& filter, Kind& kind) const noexcept {
 
 void Banks::add(Filter* filter) {
   ++size_;
+  filter->change_facts([&] {
+    Filter::Cold& c = *filter->cold_;
+    // It counts this group's runs from now on (an earlier group's were kept by settle()).
+    c.runs_at_join.store(runs() - (c.group_runs != nullptr ? c.group_runs->load() - c.runs_at_join.load() : 0));
+    c.group_runs = &runs_;
+    c.seat = nullptr;
+    c.bank_changes = nullptr;
+  });
   // A signal this filter writes cannot be read ahead of the run: it changes during it.
   for (const Signal* output : filter->outputs()) {
     if (output == nullptr) continue;
@@ -75,6 +83,8 @@ void Banks::add(Filter* filter) {
   m.out = detoured(*filter);
   m.reported = filter->detected();
   m.slow = filter->invalid_count_ != 0;
+  BankSeat& seat = seats_.emplace_back();
+  seat.reader = read_facts(m);
   members_.push_back(m);
   const auto end = static_cast<std::uint32_t>(members_.size());
   if (kind == Kind::Deadline) {
@@ -84,6 +94,8 @@ void Banks::add(Filter* filter) {
   }
   adopt(members_.back());
   filter->cold_->bank_changes = &changes_;
+  filter->cold_->seat = &seat;
+  if (!members_.back().out) enter(members_.back());
 }
 
 void Banks::add_reader(Filter& filter) {
@@ -102,6 +114,7 @@ void Banks::add_reader(Filter& filter) {
   }
   reader.width = static_cast<std::uint32_t>(input->size());
   readers_.push_back(std::move(reader));
+  reader_facts_.emplace_back();
   steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1), false});
   reserve_read(2 * (input->buffer().capacity() + 1), input->size());  // written and injected
 }
@@ -119,6 +132,7 @@ void Banks::add_pair(Filter& filter) {
   }
   pair.begin = pair.end = static_cast<std::uint32_t>(members_.size());
   pairs_.push_back(std::move(pair));
+  pair_facts_.emplace_back();
   steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(pairs_.size() - 1), true});
   reserve_read(samples, width);
 }
@@ -205,6 +219,7 @@ double*& Banks::ring_of(const Ring& ring) noexcept {
 }
 
 void Banks::run(Time now) noexcept {
+  runs_.store(runs_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // one writer
   if (const std::uint32_t changes = changes_.load(std::memory_order_acquire); changes != seen_) {
     seen_ = changes;
     refresh();
@@ -243,8 +258,30 @@ void Banks::run(Time now) noexcept {
 
 void Banks::settle() noexcept {
   for (Member& m : members_) {
-    if (!m.out) hand_over(m);
+    if (m.out) continue;
+    hand_over(m);
+    leave(m);  // the filter keeps its newest sample: the group goes
   }
+}
+
+void Banks::enter(Member& m) noexcept {
+  m.filter->change_facts([&] {
+    BankSeat& seat = seat_of(m);
+    seat.entry_reads.store(seat.reader->reads.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    seat.in.store(true, std::memory_order_relaxed);
+  });
+}
+
+void Banks::leave(Member& m) noexcept {
+  Filter& f = *m.filter;
+  f.change_facts([&] {
+    // The last sample it judged in the bank becomes the object's own (facts()).
+    BankSeat& seat = seat_of(m);
+    if (seat.reader->reads.load(std::memory_order_relaxed) != seat.entry_reads.load(std::memory_order_relaxed)) {
+      f.last_judged_.store(seat.reader->last.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    }
+    seat.in.store(false, std::memory_order_relaxed);
+  });
 }
 
 void Banks::refresh() noexcept {
@@ -254,6 +291,7 @@ void Banks::refresh() noexcept {
     if (m.out || !detoured(*m.filter)) continue;
     m.out = true;
     hand_over(m);
+    leave(m);
   }
 }
 
@@ -364,6 +402,7 @@ std::size_t Banks::read_pair(Pair& pair) noexcept {
 
 void Banks::run_pair(Pair& pair, Time now) noexcept {
   const std::size_t samples = read_pair(pair);
+  publish(pair_facts_[static_cast<std::size_t>(&pair - pairs_.data())], samples);
   for (std::uint32_t i = pair.begin; i < pair.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
@@ -393,6 +432,7 @@ void Banks::run_pair(Pair& pair, Time now) noexcept {
 
 void Banks::run_reader(Reader& reader, Time now) noexcept {
   const std::size_t samples = read(reader);
+  publish(reader_facts_[static_cast<std::size_t>(&reader - readers_.data())], samples);
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
@@ -477,6 +517,7 @@ void Banks::run_out(Member& m, Time now) noexcept {
   m.slow = f.invalid_count_ != 0;
   // Back in the bank once nothing detours it and it has read what its reader read.
   m.out = detoured(f) || !level(m);
+  if (!m.out) enter(m);
 }
 
 void Banks::deliver(Member& m, std::size_t j, std::size_t input) noexcept {

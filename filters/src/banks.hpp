@@ -16,6 +16,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 #include "builtin/banked.hpp"
@@ -26,8 +27,8 @@ namespace safecass::detail {
 class Banks {
 public:
   /// `banking` false: every filter runs as an object (the reference the differential test
-  /// compares the banks with).
-  explicit Banks(bool banking) : banking_(banking) {}
+  /// compares the banks with). `runs`: the runs a group it replaces had begun (Monitor::regroup).
+  explicit Banks(bool banking, std::uint64_t runs = 0) : banking_(banking), runs_(runs) {}
   Banks(const Banks&) = delete;
   Banks& operator=(const Banks&) = delete;
 
@@ -41,6 +42,8 @@ public:
   /// filters join another group).
   void settle() noexcept;
   std::size_t size() const noexcept { return size_; }
+  /// The runs begun: every filter of the group runs in each (Filter::facts()).
+  std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
   /// Filters whose state is in a bank (for tests and docs).
   std::size_t banked() const noexcept { return members_.size(); }
 
@@ -109,6 +112,21 @@ private:
   void keep_ring(const Member& member, double* ring, std::size_t length);
   double*& ring_of(const Ring& ring) noexcept;
   [[gnu::cold]] void refresh() noexcept;
+  /// Its seat (in seats_), through the filter: members_ stays small, the run reads it.
+  static BankSeat& seat_of(const Member& m) noexcept { return *m.filter->cold_->seat; }
+  const ReadFacts* read_facts(const Member& m) const noexcept {
+    return m.kind == Kind::Deadline ? &pair_facts_[m.reader] : &reader_facts_[m.reader];
+  }
+  /// `m` enters (or leaves) its bank: where its newest sample is read changes (Filter::facts()).
+  void enter(Member& m) noexcept;
+  void leave(Member& m) noexcept;
+  /// Publishes the last sample of this read (Filter::facts()), before the filters of the read run:
+  /// one that enters the bank in this run has dealt with this read itself.
+  void publish(ReadFacts& facts, std::size_t samples) noexcept {
+    if (samples == 0) return;
+    facts.last.store(ReadFacts::word(times_[samples - 1], injected_[samples - 1] != 0), std::memory_order_relaxed);
+    facts.reads.store(facts.reads.load(std::memory_order_relaxed) + 1, std::memory_order_release);  // one writer
+  }
   /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_.
   [[gnu::always_inline]] inline std::size_t read(Reader& reader) noexcept;
   [[gnu::always_inline]] inline void run_reader(Reader& reader, Time now) noexcept;
@@ -154,6 +172,12 @@ private:
   std::vector<Reader> readers_;
   std::vector<Pair> pairs_;
   std::vector<Member> members_;
+  // What Filter::facts() reads, apart from what the run reads most: per member (a deque: they never
+  // move), and per reader and pair (what each publishes of its reads; by index).
+  std::deque<BankSeat> seats_;
+  std::deque<ReadFacts> reader_facts_;
+  std::deque<ReadFacts> pair_facts_;
+  std::atomic<std::uint64_t> runs_{0};  ///< runs begun
   std::vector<builtin::ThresholdState> thresholds_;
   std::vector<builtin::WatchdogState> watchdogs_;
   std::vector<builtin::AverageState> averages_;

@@ -36,15 +36,63 @@ std::uint64_t Filter::missed_samples() const noexcept {
   return n + cold_->banked_missed.load(std::memory_order_relaxed);
 }
 
+FilterFacts Filter::facts() const noexcept {
+  const Cold& c = *cold_;
+  FilterFacts f;
+  for (;;) {
+    const std::uint32_t version = c.facts_version.load(std::memory_order_acquire);
+    if ((version & 1U) != 0) continue;  // being changed: a few stores
+    const std::uint8_t detour = detour_.load(std::memory_order_acquire);
+    f.enabled = (detour & kDisabled) == 0;
+    std::int64_t last = last_judged_.load(std::memory_order_relaxed);
+    if (const detail::BankSeat* seat = c.seat; seat != nullptr && seat->in.load(std::memory_order_relaxed)) {
+      // In its bank, the filter has judged what its reader read since it entered.
+      if (seat->reader->reads.load(std::memory_order_acquire) != seat->entry_reads.load(std::memory_order_relaxed)) {
+        last = seat->reader->last.load(std::memory_order_relaxed);
+      }
+    }
+    const bool sampled = last != detail::kNoSample;
+    f.injected = (detour & kInjection) != 0 || (sampled && detail::ReadFacts::injected_in(last));
+    f.last_sample.reset();
+    if (sampled) f.last_sample = detail::ReadFacts::time_of(last);
+    f.evaluations = 0;
+    if (c.group_runs != nullptr) {
+      // The runs begun since it joined, less those it spent disabled.
+      const std::uint64_t runs = c.group_runs->load(std::memory_order_relaxed);
+      const std::int64_t disabled_at = c.disabled_at.load(std::memory_order_relaxed);
+      std::uint64_t off = c.runs_at_join.load(std::memory_order_relaxed) + c.skipped.load(std::memory_order_relaxed);
+      if (disabled_at >= 0) off += runs - static_cast<std::uint64_t>(disabled_at) + 1;
+      f.evaluations = runs >= off ? runs - off : 0;
+    }
+    std::atomic_thread_fence(std::memory_order_acquire);
+    if (c.facts_version.load(std::memory_order_relaxed) == version) return f;
+  }
+}
+
 void Filter::run_general(Time now) noexcept {
   const std::uint8_t detour = detour_.load(std::memory_order_acquire);
   if ((detour & kDisabled) != 0) {
-    if ((detour & kReenabled) == 0) detour_.fetch_or(kReenabled, std::memory_order_acq_rel);
+    if ((detour & kReenabled) == 0) {
+      detour_.fetch_or(kReenabled, std::memory_order_acq_rel);
+      // The first run it skips: from this one on, its group's runs are not its evaluations.
+      if (const auto* runs = cold_->group_runs) {
+        change_facts(
+            [&] { cold_->disabled_at.store(static_cast<std::int64_t>(runs->load(std::memory_order_relaxed))); });
+      }
+    }
     return;
   }
   if ((detour & kReenabled) != 0) {
     for (std::size_t i = 0; i < cold_->inputs.size(); ++i) cursor(i).skip_to_end();
     detour_.fetch_and(static_cast<std::uint8_t>(~kReenabled), std::memory_order_acq_rel);
+    if (const auto* runs = cold_->group_runs; runs != nullptr && cold_->disabled_at.load() >= 0) {
+      change_facts([&] {
+        const auto skipped =
+            runs->load(std::memory_order_relaxed) - static_cast<std::uint64_t>(cold_->disabled_at.load());
+        cold_->skipped.store(cold_->skipped.load() + skipped);
+        cold_->disabled_at.store(-1);
+      });
+    }
   }
   const bool injected_run = (detour & kInjection) != 0 && run_injection(now);
   // The first run after a shallow injection ran out (DESIGN §3): the injection stood in for

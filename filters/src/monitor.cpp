@@ -211,7 +211,9 @@ void Monitor::regroup(std::size_t count) {
   auto old_active = std::move(active_);
   auto old_passive = std::move(passive_);
   active_.clear();
-  passive_ = std::make_unique<detail::Banks>(banks_);
+  // The groups count on from the old ones' runs (Filter::facts()).
+  for (const auto& g : old_active) active_.push_back(std::make_unique<detail::Banks>(banks_, g->runs()));
+  passive_ = std::make_unique<detail::Banks>(banks_, old_passive->runs());
   for (std::size_t i = 0; i < count && i < filters_.size(); ++i) group(*filters_[i]).add(filters_[i].get());
 }
 

@@ -27,15 +27,6 @@ std::string sample_json(double v) {
   return json::json_number(v);
 }
 
-std::string joined(const std::vector<std::string>& items, std::string_view separator) {
-  std::string out;
-  for (const std::string& s : items) {
-    if (!out.empty()) out += separator;
-    out += s;
-  }
-  return out;
-}
-
 std::vector<std::string> names_of(const std::vector<SignalRef>& signals) {
   std::vector<std::string> out;
   for (const SignalRef& s : signals) out.push_back(s.name);
@@ -62,6 +53,15 @@ std::string default_text(const ParamRow& p) {
 std::string event_kind(const EventRow& e) { return e.broadcast ? "broadcast" : e.onset ? "onset" : "completion"; }
 
 }  // namespace
+
+std::string joined(const std::vector<std::string>& items, std::string_view separator) {
+  std::string out;
+  for (const std::string& s : items) {
+    if (!out.empty()) out += separator;
+    out += s;
+  }
+  return out;
+}
 
 // ---- times and numbers ------------------------------------------------------------------------
 
@@ -412,6 +412,83 @@ std::string state_summary_json(const StateSummary& s) {
   return s;
 }
 
+std::string coverage_now_text(const CoverageNow& c) {
+  if (c.hazards.empty()) return "no onset names a hazard: nothing to judge\n";
+  std::string out;
+  for (const HazardCoverage& h : c.hazards) {
+    if (h.covered()) {
+      out += "hazard " + h.hazard + ": covered (" + joined(h.onsets, ", ") + ")\n";
+      continue;
+    }
+    out += "hazard " + h.hazard + ": UNCOVERED\n";
+    for (const CoverageGap& g : h.gaps) out += "  " + g.onset + ": " + g.reason + "\n";
+  }
+  return out + std::to_string(c.hazards.size()) + " hazards, " + std::to_string(c.uncovered()) + " uncovered now\n";
+}
+
+std::string coverage_now_json(const CoverageNow& c) {
+  std::string hazards = "[";
+  for (const HazardCoverage& h : c.hazards) {
+    std::string gaps = "[";
+    for (const CoverageGap& g : h.gaps) {
+      gaps += (gaps.size() > 1 ? "," : "") + json::JsonObject().str("onset", g.onset).str("reason", g.reason).text();
+    }
+    hazards += (hazards.size() > 1 ? "," : "") + json::JsonObject()
+                                                     .str("hazard", h.hazard)
+                                                     .boolean("covered", h.covered())
+                                                     .strings("onsets", h.onsets)
+                                                     .raw("gaps", gaps + "]")
+                                                     .text();
+  }
+  return json::JsonObject()
+             .seconds("t", c.now)
+             .integer("uncovered", static_cast<long long>(c.uncovered()))
+             .raw("hazards", hazards + "]")
+             .text() +
+         "\n";
+}
+
+[[nodiscard]] Expected<CoverageNow> coverage_now_from_json(std::string_view text) {
+  const json::JsonParse parsed = json::parse_json(text, 8);
+  if (!parsed.value || !parsed.value->is_object()) return fail(ErrorCode::Parse, "analyze now: not a JSON object");
+  const json::JsonValue& v = *parsed.value;
+  const auto strings_of = [](const json::JsonValue* field, std::vector<std::string>& out) {
+    if (field == nullptr || !field->is_array()) return false;
+    for (const json::JsonValue& item : field->array) {
+      if (!item.is_string()) return false;
+      out.push_back(item.string);
+    }
+    return true;
+  };
+  const json::JsonValue* t = v.find("t");
+  const json::JsonValue* hazards = v.find("hazards");
+  if (t == nullptr || !t->is_number() || hazards == nullptr || !hazards->is_array()) {
+    return fail(ErrorCode::Parse, "analyze now: t or hazards missing or wrong");
+  }
+  CoverageNow c;
+  c.now = seconds_to_time(t->number);
+  for (const json::JsonValue& item : hazards->array) {
+    HazardCoverage h;
+    const json::JsonValue* name = item.find("hazard");
+    const json::JsonValue* gaps = item.find("gaps");
+    if (name == nullptr || !name->is_string() || !strings_of(item.find("onsets"), h.onsets) || gaps == nullptr ||
+        !gaps->is_array()) {
+      return fail(ErrorCode::Parse, "analyze now: a hazard without its name, onsets or gaps");
+    }
+    h.hazard = name->string;
+    for (const json::JsonValue& g : gaps->array) {
+      const json::JsonValue* onset = g.find("onset");
+      const json::JsonValue* reason = g.find("reason");
+      if (onset == nullptr || !onset->is_string() || reason == nullptr || !reason->is_string()) {
+        return fail(ErrorCode::Parse, "analyze now: hazard " + h.hazard + ": a gap without its onset or reason");
+      }
+      h.gaps.push_back(CoverageGap{onset->string, reason->string});
+    }
+    c.hazards.push_back(std::move(h));
+  }
+  return c;
+}
+
 std::string filter_list_text(const std::vector<FilterRow>& rows) {
   if (rows.empty()) return "no filters\n";
   std::vector<std::vector<std::string>> table;
@@ -419,8 +496,9 @@ std::string filter_list_text(const std::vector<FilterRow>& rows) {
     std::string signals = joined(names_of(f.inputs), ",");
     if (!f.outputs.empty()) signals += " -> " + joined(names_of(f.outputs), ",");
     table.push_back({f.name, f.type, f.target.empty() ? "-" : f.target, f.active ? "ACTIVE" : "PASSIVE",
-                     f.edge ? "EDGE" : "LEVEL", f.enabled ? "enabled" : "disabled", f.detected ? "DETECTED" : "-",
-                     signals});
+                     f.edge ? "EDGE" : "LEVEL",
+                     std::string(f.enabled ? "enabled" : "disabled") + (f.injected ? ",injected" : ""),
+                     f.detected ? "DETECTED" : "-", signals, std::to_string(f.evaluations) + " runs"});
   }
   return columns(table);
 }
@@ -438,6 +516,10 @@ std::string filter_list_json(const std::vector<FilterRow>& rows) {
                .boolean("detected", f.detected)
                .strings("inputs", names_of(f.inputs))
                .strings("outputs", names_of(f.outputs))
+               .opt("onset", f.onset)
+               .boolean("injected", f.injected)
+               .raw("last_sample", f.last_sample ? json::json_seconds(*f.last_sample) : "null")
+               .integer("evaluations", static_cast<long long>(f.evaluations))
                .text() +
            "\n";
   }
@@ -457,9 +539,11 @@ std::string filter_info_text(const FilterInfo& info) {
     line("filter " + f.name + ": " + info.type + " - " + info.doc);
     line("  target " + (f.target.empty() ? std::string("-") : f.target) + ", " + (f.active ? "ACTIVE" : "PASSIVE") +
          ", " + (f.edge ? "EDGE" : "LEVEL"));
-    line(std::string("  ") + (f.enabled ? "enabled" : "disabled") + ", " +
+    line(std::string("  ") + (f.enabled ? "enabled" : "disabled") + (f.injected ? ", injected" : "") + ", " +
          (f.detected ? "detected (onset sent, no completion yet)" : "not detected") + ", " +
          std::to_string(info.missed_samples) + " missed samples");
+    line("  onset " + (f.onset.empty() ? std::string("-") : f.onset) + "; " + std::to_string(f.evaluations) +
+         " runs; newest sample judged " + (f.last_sample ? seconds_text(*f.last_sample) + " s" : std::string("none")));
     line("  inputs:  " + sized(f.inputs));
     line("  outputs: " + sized(f.outputs));
   } else {

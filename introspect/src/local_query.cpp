@@ -1,5 +1,7 @@
 #include "safecass/introspect/local_query.hpp"
+
 #include "safecass/core/address.hpp"
+#include "safecass/introspect/coverage.hpp"
 #include "safecass/introspect/format.hpp"
 
 #include <algorithm>
@@ -145,13 +147,43 @@ Expected<std::vector<FilterRow>> LocalQuery::filter_list() {
     r.target = f->target() == kNoMachine ? std::string() : co_.structure().address_of(f->target());
     r.active = f->execution() == ExecutionMode::Active;
     r.edge = f->detection() == DetectionMode::Edge;
-    r.enabled = f->enabled();
     r.detected = f->detected();
     r.inputs = signal_refs(f->inputs());
     r.outputs = signal_refs(f->outputs());
+    if (f->onset() != kNoEvent) r.onset = co_.structure().event(f->onset()).name;
+    const FilterFacts facts = f->facts();
+    r.enabled = facts.enabled;
+    r.injected = facts.injected;
+    r.last_sample = facts.last_sample;
+    r.evaluations = facts.evaluations;
     out.push_back(std::move(r));
   }
   return out;
+}
+
+std::vector<std::string> LocalQuery::lost_components() const {
+  std::vector<std::string> lost;
+  const Structure& shape = co_.structure();
+  for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+    if (!shape.is_remote(c)) continue;
+    for (const Condition& condition : co_.conditions(shape.framework_machine(c))) {
+      if (condition.event == framework_event::kCoordinatorLost) {
+        lost.emplace_back(shape.component_name(c));
+        break;
+      }
+    }
+  }
+  return lost;
+}
+
+Expected<CoverageNow> LocalQuery::coverage() {
+  auto events = event_list();
+  if (!events) return tl::unexpected(events.error());
+  auto filters = filter_list();
+  if (!filters) return tl::unexpected(filters.error());
+  auto now = clock();
+  if (!now) return tl::unexpected(now.error());
+  return coverage_now(*events, {ProcessFilters{name(), false, std::move(*filters)}}, lost_components(), now->now);
 }
 
 Expected<FilterInfo> LocalQuery::filter_info(std::string_view name) {
@@ -338,6 +370,8 @@ namespace {
   return s;
 }
 
+[[nodiscard]] Expected<CoverageNow> analyze_now(LocalQuery& query) { return query.coverage(); }
+
 /// A read whose answer is `Value`: produced by `Produce`, written by `Json`, read back by `Parse`
 /// and shown by `Text`.
 template <class Value, Expected<Value> (*Produce)(LocalQuery&), std::string (*Json)(const Value&),
@@ -359,6 +393,8 @@ constexpr NamedRead read_without_arguments(std::string_view name) {
 constexpr NamedRead kReads[] = {
     read_without_arguments<StateSummary, state_summary, state_summary_json, state_summary_from_json,
                            state_summary_text>("state summary"),
+    read_without_arguments<CoverageNow, analyze_now, coverage_now_json, coverage_now_from_json, coverage_now_text>(
+        "analyze now"),
 };
 
 }  // namespace

@@ -200,6 +200,11 @@ wire::FilterEntry to_wire(const in::FilterRow& r) {
     w.outputs.push_back(s.name);
     w.outputSizes.push_back(static_cast<int>(s.size));
   }
+  w.onset = r.onset;
+  w.injected = r.injected;
+  w.sampled = r.last_sample.has_value();
+  w.lastSampleNs = r.last_sample ? r.last_sample->count() : 0;
+  w.evaluations = static_cast<std::int64_t>(r.evaluations);
   return w;
 }
 
@@ -218,6 +223,10 @@ in::FilterRow from_wire(const wire::FilterEntry& w) {
   for (std::size_t i = 0; i < w.outputs.size(); ++i) {
     r.outputs.push_back({w.outputs[i], i < w.outputSizes.size() ? static_cast<std::size_t>(w.outputSizes[i]) : 1});
   }
+  r.onset = w.onset;
+  r.injected = w.injected;
+  if (w.sampled) r.last_sample = Time{w.lastSampleNs};
+  r.evaluations = w.evaluations < 0 ? 0 : static_cast<std::uint64_t>(w.evaluations);
   return r;
 }
 

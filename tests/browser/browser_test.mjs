@@ -168,6 +168,16 @@ async function testViewer() {
   check(/EVT_CONTROL_FORCE_FREEZE/.test(await page.textContent('[data-address="CONTROL.s_A"]')),
     'the generated event shows on CONTROL.s_A');
 
+  // The hazards panel: a shallow injection into the filter that detects excessive force leaves
+  // H-3 uncovered, marked with why (`analyze now`).
+  check(await page.isVisible('#hazards li.hazard[data-hazard="H-3"]'), 'the hazards panel lists H-3');
+  await page.fill('#inject-target', 'force_limit');
+  await page.fill('#inject-samples', Array(200).fill('5').join('; '));
+  await page.click('#inject-form button');
+  await page.waitForSelector('#hazards li.hazard.uncovered[data-hazard="H-3"]', { timeout: 5000 });
+  check(/filter force_limit judges injected samples/.test(await page.textContent('#hazards li.hazard[data-hazard="H-3"]')),
+    'an uncovered hazard is marked with what leaves it undetected');
+
   // Stop the viewer by PID: it exits 0 and removes its token file.
   const exited = new Promise((resolve) => viewer.on('exit', (code, signal) => resolve({ code, signal })));
   process.kill(viewer.pid, 'SIGTERM');

@@ -79,6 +79,10 @@ const std::vector<CommandSpec>& commands() {
        "the system at a glance: its state, how many components are Normal, Warning and Error, and those that "
        "are not Normal with their outstanding event",
        false, 0, 0, {}},
+      {Id::Read, "analyze now", "analyze now",
+       "which hazards the system cannot detect now: an onset whose every filter is disabled, injected, without a "
+       "sample yet or fed by a stale signal, or raised in a process whose coordinator is lost (docs/analyze.md)",
+       false, 0, 0, {}},
       {Id::StateHistory, "state history", "state history [ADDRESS] [N]",
        "the last N records (default 20) of a machine, a component or the whole system",
        false, 0, 2, {Arg::Address, Arg::None}},
@@ -154,7 +158,7 @@ const CommandSpec* find_command(std::string_view name) {
 
 namespace {
 
-constexpr std::string_view kGroups[] = {"state", "filter", "event", "connection", "service"};
+constexpr std::string_view kGroups[] = {"state", "filter", "event", "connection", "service", "analyze"};
 
 bool is_group(std::string_view word) {
   return std::find(std::begin(kGroups), std::end(kGroups), word) != std::end(kGroups);

@@ -28,6 +28,8 @@ void add_replay_command(CLI::App& app, int& code) {
   cmd->add_flag(
       "--diff", args->diff,
       "replay through SYSTEM_B and SYSTEM_A and print, per address, where their states differ (exit 1 if they do)");
+  cmd->add_flag("--coverage", args->options.coverage,
+                "after the replay, print when each hazard was uncovered (`analyze now` at every tick)");
   auto* from = cmd->add_option("--from", args->from, "seconds: start the replay here (inputs before it are not fed)");
   auto* to = cmd->add_option("--to", args->to, "seconds: end the replay here");
   auto* period =

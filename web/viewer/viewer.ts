@@ -103,8 +103,13 @@ interface Condition {
   path: string[];
 }
 
-interface Hello { type: 'hello'; write: boolean; max_message: number; view: SystemView; recent: HistoryRecord[] }
-interface Update { type: 'update'; t: number; running: boolean; states: Record<string, [StateName, string]>; records: HistoryRecord[]; replay?: ReplayView }
+/** `analyze now` (coverage_now_json): each hazard and why it cannot be detected now. */
+interface CoverageGap { onset: string; reason: string }
+interface HazardCoverage { hazard: string; covered: boolean; onsets: string[]; gaps: CoverageGap[] }
+interface Coverage { t: number; uncovered: number; hazards: HazardCoverage[] }
+
+interface Hello { type: 'hello'; write: boolean; max_message: number; view: SystemView; coverage: Coverage; recent: HistoryRecord[] }
+interface Update { type: 'update'; t: number; running: boolean; states: Record<string, [StateName, string]>; records: HistoryRecord[]; coverage?: Coverage; replay?: ReplayView }
 interface TimeMessage { type: 'time'; t: number; running: boolean; replay?: ReplayView }
 interface Reply {
   type: 'reply';
@@ -332,6 +337,7 @@ class Viewer {
     if (m.view.replay !== undefined) byId('connection').textContent = 'replay';
     if (m.view.replay !== undefined) this.setReplay(m.view.replay, m.view.t);
     byId('write-panel').hidden = !m.write;
+    this.showCoverage(m.coverage);
     const list = byId('transitions');
     list.replaceChildren();
     for (const r of m.recent) this.addTransition(r);
@@ -349,7 +355,24 @@ class Viewer {
       if (address === this.selected) selectedChanged = true;
     }
     for (const r of m.records) this.addTransition(r);
+    if (m.coverage !== undefined) this.showCoverage(m.coverage);
     if (selectedChanged) this.select(this.selected);
+  }
+
+  /** Each hazard, an uncovered one marked with what leaves it undetected now. */
+  private showCoverage(c: Coverage): void {
+    const list = byId('hazards');
+    list.replaceChildren();
+    if (c.hazards.length === 0) list.append(element('li', 'hint', 'no onset names a hazard'));
+    for (const h of c.hazards) {
+      const item = element('li', h.covered ? 'hazard covered' : 'hazard uncovered');
+      item.dataset.hazard = h.hazard;
+      item.append(element('span', 'hazard-name', h.hazard), element('span', 'hazard-verdict', h.covered ? 'covered' : 'UNCOVERED'));
+      item.title = `onsets: ${h.onsets.join(', ')}`;
+      for (const g of h.gaps) item.append(element('div', 'hazard-gap', `${g.onset}: ${g.reason}`));
+      list.append(item);
+    }
+    byId('hazards-summary').textContent = c.hazards.length === 0 ? '' : `${c.uncovered} of ${c.hazards.length} uncovered now`;
   }
 
   private onReply(m: Reply): void {

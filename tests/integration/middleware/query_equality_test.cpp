@@ -192,7 +192,8 @@ INSTANTIATE_TEST_SUITE_P(
     Robodoc, ConsoleReadCommand,
     ::testing::Values(
         ReadCommand{"state_list", "state list"}, ReadCommand{"state_list_component", "state list CONTROL"},
-        ReadCommand{"state_summary", "state summary"}, ReadCommand{"state_history", "state history 200"},
+        ReadCommand{"state_summary", "state summary"}, ReadCommand{"analyze_now", "analyze now"},
+        ReadCommand{"state_history", "state history 200"},
         ReadCommand{"state_history_component", "state history CONTROL 100"},
         ReadCommand{"state_history_machine", "state history JR3.s_A 100"},
         ReadCommand{"state_history_service", "state history CONTROL.s_S.Command 100"},

@@ -70,7 +70,12 @@ public:
       v += ";";
     }
     for (const auto& f : monitor_.filters()) {
-      v += f->name() + (f->detected() ? "!" : ".") + std::to_string(f->missed_samples()) + ";";
+      // The run-time facts too (Filter::facts(): what `analyze now` reads), kept by either path.
+      const FilterFacts facts = f->facts();
+      v += f->name() + (f->detected() ? "!" : ".") + std::to_string(f->missed_samples()) +
+           (facts.enabled ? " on" : " off") + (facts.injected ? " injected" : "") +
+           " last=" + (facts.last_sample ? std::to_string(facts.last_sample->count()) : "-") +
+           " runs=" + std::to_string(facts.evaluations) + ";";
     }
     return v;
   }

@@ -109,6 +109,28 @@ TEST(ReplayCsv, RowsBeforeTimeZeroReplayInOrderFromTheFirstRowsTime) {
   EXPECT_THAT(r.err, HasSubstr("-1.000000 s to 1.000000 s"));
 }
 
+TEST(ReplayCoverage, ReplaySaysWhenEachHazardWasUncoveredAndWhy) {
+  // The force stops at 0.004 s: once the Watchdog fires, the force limit reads a stale norm and
+  // H-1 cannot be detected until the end of the log.
+  ReplayOptions o = options(kData + "arm_watched.json", kData + "arm_silent.csv");
+  o.coverage = true;
+  const Ran r = replay(o);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("ARM.s_F  Normal -> Warning  EVT_FORCE_STALE")) << r.out;
+  EXPECT_THAT(r.out, HasSubstr("coverage: hazard H-1 uncovered 0.007000 .. 0.010000 (the end) s: EVT_FORCE_ERROR: "
+                               "filter force_limit reads ARM.ForceNorm, which is stale\n"))
+      << r.out;
+  o.json = true;
+  const Ran json = replay(o);
+  ASSERT_EQ(json.code, 0) << json.err;
+  EXPECT_THAT(json.out, HasSubstr(R"({"kind":"uncovered","hazard":"H-1","from":0.007000,"to":null,)")) << json.out;
+
+  // Without a hazard, the replay says there was nothing to judge.
+  ReplayOptions plain = options(kData + "arm.json", kData + "arm_ok.csv");
+  plain.coverage = true;
+  EXPECT_THAT(replay(plain).out, HasSubstr("coverage: no onset names a hazard\n"));
+}
+
 class BadCsv : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(BadCsv, IsRefusedWithWhereAndWhyAndNothingRuns) {

@@ -108,6 +108,19 @@ TEST_F(ConsoleTest, StateSummaryCountsTheComponentsByStateAndListsThoseNotNormal
   EXPECT_FALSE(extra.ok) << "state summary takes no argument";
 }
 
+TEST_F(ConsoleTest, AnalyzeNowSaysEveryHazardIsUncoveredWhileNoFilterHasJudgedASample) {
+  // The console's system has not run: no filter has a sample to judge, so nothing can be detected.
+  const std::string out = run("analyze now").out;
+  EXPECT_TRUE(contains(out, "hazard H-3: UNCOVERED\n  EVT_FORCE_ERROR: filter force_limit has judged no sample yet\n"))
+      << out << "(EVT_CONTROL_FORCE_FREEZE, raised by CONTROL's code, is no gap)";
+  EXPECT_TRUE(contains(out, " hazards, ")) << out;
+  auto json = open_console(true, true);
+  ASSERT_NE(json, nullptr);
+  const std::string answer = json->execute("analyze now").out;
+  EXPECT_TRUE(contains(answer, R"("hazard":"H-3","covered":false)")) << answer;
+  EXPECT_FALSE(console->execute("analyze now H-3").ok) << "analyze now takes no argument";
+}
+
 TEST_F(ConsoleTest, StateHistoryShowsTheRecordsOfAnAddressOrOfTheSystem) {
   run("event generate EVT_CONTROL_FORCE_FREEZE CONTROL.s_A");
   const std::string machine = run("state history CONTROL.s_A").out;
@@ -146,7 +159,7 @@ TEST_F(ConsoleTest, FilterInfoShowsTheManifestAndTheFiltersCurrentState) {
   EXPECT_TRUE(contains(out, "[0, +inf]")) << out;
   run("filter inject force_limit 50");
   run("watch 0.002");
-  EXPECT_TRUE(contains(run("filter info force_limit").out, "enabled, detected"));
+  EXPECT_TRUE(contains(run("filter info force_limit").out, "enabled, injected, detected"));
 
   const std::string type = run("filter info Watchdog").out;
   EXPECT_TRUE(contains(type, "filter type Watchdog")) << type;

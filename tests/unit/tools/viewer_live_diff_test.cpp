@@ -155,6 +155,7 @@ public:
     out.swap(records);
     return out;
   }
+  introspect::CoverageNow coverage() const override { return {}; }  // a system without hazards
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view) const override {
     return std::vector<Explanation>{};
   }

@@ -334,6 +334,42 @@ TEST(ViewerProtocol, InjectionWithTheTokenReachesTheFilters) {
   EXPECT_THAT(str(shallow, "text"), HasSubstr("queued 2 samples into filter force_limit"));
 }
 
+/// Hazard `name` of a coverage message (`analyze now`), or nullptr.
+const json::JsonValue* hazard(const json::JsonValue& coverage, std::string_view name) {
+  for (const json::JsonValue& h : coverage.find("hazards")->array) {
+    if (str(h, "hazard") == name) return &h;
+  }
+  return nullptr;
+}
+
+TEST(ViewerProtocol, TheHazardsCoverageIsInHelloAndPushedWhenItChangesMarkingAnUncoveredHazard) {
+  auto source = open_story();
+  ASSERT_NE(source, nullptr);
+  Protocol protocol(*source, writable("k"));
+  source->advance_to(0.1);
+  const json::JsonValue hello = parse(protocol.hello());
+  const json::JsonValue* h3 = hazard(*hello.find("coverage"), "H-3");
+  ASSERT_NE(h3, nullptr);
+  EXPECT_TRUE(h3->find("covered")->boolean);
+  (void)protocol.update(0);  // the coverage the pages have (protocol.update pushes it once)
+
+  // A shallow injection into the filter that detects excessive force: H-3 is uncovered until the
+  // injected samples are spent and reality is judged again.
+  (void)protocol.handle(R"({"op":"inject","filter":"force_limit","samples":[[5],[5]],"token":"k"})");
+  const json::JsonValue injected = parse(protocol.update(300));
+  ASSERT_NE(injected.find("coverage"), nullptr);
+  h3 = hazard(*injected.find("coverage"), "H-3");
+  EXPECT_FALSE(h3->find("covered")->boolean);
+  EXPECT_EQ(str(h3->find("gaps")->array.at(0), "reason"), "filter force_limit judges injected samples");
+  EXPECT_EQ(str(h3->find("gaps")->array.at(0), "onset"), "EVT_FORCE_ERROR");
+  EXPECT_EQ(protocol.update(400).find("coverage"), std::string::npos) << "unchanged: not pushed again";
+
+  source->advance_to(0.2);
+  const json::JsonValue restored = parse(protocol.update(700));
+  ASSERT_NE(restored.find("coverage"), nullptr);
+  EXPECT_TRUE(hazard(*restored.find("coverage"), "H-3")->find("covered")->boolean);
+}
+
 TEST(ViewerProtocol, ViewCarriesTheConnectionsForTheGraphAndScenarioSecondsAsItsClock) {
   auto source = open_story();
   ASSERT_NE(source, nullptr);

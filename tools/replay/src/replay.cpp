@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "safecass/introspect/format.hpp"
+#include "safecass/introspect/local_query.hpp"
 #include "safecass/json/write.hpp"
 #include "safecass/record/recorder.hpp"
 #include "safecass/replay/source.hpp"
@@ -299,6 +300,59 @@ std::optional<Prepared> prepare(const ReplayOptions& o, const FilterRegistry& re
 
 }  // namespace
 
+/// When each hazard was uncovered during a replay: `analyze now` judged after every tick, each
+/// interval kept with the gaps that opened it.
+class CoverageTimeline {
+public:
+  void observe(const introspect::CoverageNow& c) {
+    for (const introspect::HazardCoverage& h : c.hazards) {
+      auto open = std::find_if(intervals_.begin(), intervals_.end(),
+                               [&](const Interval& i) { return i.hazard == h.hazard && !i.to; });
+      if (h.covered()) {
+        if (open != intervals_.end()) open->to = c.now;
+        continue;
+      }
+      if (open != intervals_.end()) continue;
+      std::vector<std::string> gaps;
+      for (const introspect::CoverageGap& g : h.gaps) gaps.push_back(g.onset + ": " + g.reason);
+      intervals_.push_back(Interval{h.hazard, c.now, std::nullopt, introspect::joined(gaps, "; ")});
+    }
+    if (!c.hazards.empty()) judged_ = true;
+  }
+
+  void print(Time end, bool json, std::FILE* out) const {
+    if (!json && !judged_) std::fprintf(out, "coverage: no onset names a hazard\n");
+    if (!json && judged_ && intervals_.empty()) std::fprintf(out, "coverage: every hazard covered throughout\n");
+    for (const Interval& i : intervals_) {
+      const std::string until = i.to ? secs(*i.to) : secs(end) + " (the end)";
+      if (json) {
+        std::fprintf(out, "%s\n",
+                     json::JsonObject()
+                         .str("kind", "uncovered")
+                         .str("hazard", i.hazard)
+                         .raw("from", secs(i.from))
+                         .raw("to", i.to ? secs(*i.to) : "null")
+                         .str("gaps", i.gaps)
+                         .text()
+                         .c_str());
+      } else {
+        std::fprintf(out, "coverage: hazard %s uncovered %s .. %s s: %s\n", i.hazard.c_str(), secs(i.from).c_str(),
+                     until.c_str(), i.gaps.c_str());
+      }
+    }
+  }
+
+private:
+  struct Interval {
+    std::string hazard;
+    Time from{};
+    std::optional<Time> to;  ///< none: still uncovered at the end
+    std::string gaps;        ///< what opened it
+  };
+  std::vector<Interval> intervals_;
+  bool judged_ = false;  ///< some onset names a hazard
+};
+
 int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
   std::optional<Prepared> prepared = prepare(o, registry);
   if (!prepared) return 2;
@@ -323,10 +377,17 @@ int run_replay(const ReplayOptions& o, const FilterRegistry& registry) {
   ScenarioRunner& sys = *r;
   r->set_feed([&](Time now) { feeder.feed(now, sys, nullptr, nullptr); });
   const Time tick = seconds_to_time(r->scenario().period);
-  while (!feeder.done()) r->advance_to(r->now() + tick, result);
+  introspect::LocalQuery query(r->coordinator(), r->monitor(), registry);
+  CoverageTimeline coverage;
+  auto step = [&](Time to) {
+    r->advance_to(to, result);
+    if (o.coverage) coverage.observe(query.coverage().value_or(introspect::CoverageNow{}));  // in-process: never fails
+  };
+  while (!feeder.done()) step(r->now() + tick);
   const Time end = end_of(*src, feeder, w, r->now());
-  if (r->now() < end) r->advance_to(end, result);
+  if (r->now() < end) step(end);
   r->finish(result);
+  if (o.coverage) coverage.print(r->now(), o.json, o.out);
   if (feeder.failed()) {
     std::fprintf(o.err, "%s\n", src->error().c_str());  // the log changed between the two passes
     return 2;

@@ -143,6 +143,10 @@ double InProcessSource::now() const { return to_seconds(impl_->now()); }
 
 bool InProcessSource::running() const { return impl_->now() < impl_->duration; }
 
+introspect::CoverageNow InProcessSource::coverage() const {
+  return impl_->query->coverage().value_or(introspect::CoverageNow{});  // in-process: never fails
+}
+
 SystemView InProcessSource::view() const {
   SystemView v = local_view(*impl_->query, impl_->coordinators, impl_->connections);
   v.system = impl_->system_name;

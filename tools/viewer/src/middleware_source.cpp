@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 
 #include "safecass/filters/registry.hpp"
+#include "safecass/introspect/coverage.hpp"
 #include "safecass/introspect/format.hpp"
 #include "safecass/introspect/local_query.hpp"
 #include "safecass/introspect/sample_text.hpp"
@@ -65,7 +66,8 @@ struct MiddlewareLink {
 
   // Shared with the thread; guarded by Impl::mutex.
   std::vector<introspect::StateRow> rows;
-  bool stale = true;  ///< records arrived since the rows were fetched: fetch them again
+  std::vector<introspect::FilterRow> filters;  ///< as last read (the system file's until it answers)
+  bool stale = true;                           ///< records arrived since the rows were fetched: fetch them again
   std::string status = "connecting";
   bool tried = false;
   std::shared_ptr<RemoteClient> requests;
@@ -81,7 +83,8 @@ struct MiddlewareSource::Impl {
   const FilterRegistry* registry = nullptr;  // outlives the local monitors
   std::string system_name;
   std::string description;
-  std::vector<ConnectionView> connections;  ///< from the system file
+  std::vector<ConnectionView> connections;   ///< from the system file
+  std::vector<introspect::EventRow> events;  ///< from the system file: the onsets' hazards
   std::vector<std::unique_ptr<MiddlewareLink>> links;
 
   mutable std::mutex mutex;
@@ -200,8 +203,9 @@ struct MiddlewareSource::Impl {
         l.stale = false;
       }
       auto answer = reader->state_list();
-      if (!answer) {
-        lose(answer.error().message);
+      auto filters = answer ? reader->filter_list() : Expected<std::vector<introspect::FilterRow>>();
+      if (!answer || !filters) {
+        lose((!answer ? answer.error() : filters.error()).message);
         continue;
       }
       answered = true;
@@ -212,6 +216,7 @@ struct MiddlewareSource::Impl {
           l.rows = std::move(*answer);
           ++version;
         }
+        l.filters = std::move(*filters);
         l.tried = true;
       }
       wake.notify_all();
@@ -315,6 +320,8 @@ Expected<std::unique_ptr<MiddlewareSource>> MiddlewareSource::open(const Middlew
     introspect::LocalQuery skeleton(l->local->coordinator(), l->local->monitor(), *impl->registry);
     l->rows = *skeleton.state_list();
     l->shown_rows = l->rows;
+    l->filters = *skeleton.filter_list();
+    if (impl->events.empty()) impl->events = *skeleton.event_list();
     names += (names.empty() ? "" : ", ") + name;
     impl->links.push_back(std::move(l));
   }
@@ -378,6 +385,19 @@ void MiddlewareSource::poll() {
     l->shown_status = l->status;
   }
   m.shown_version = m.version;
+}
+
+introspect::CoverageNow MiddlewareSource::coverage() const {
+  // Each coordinator answers for its own filters; one that is lost, or has not answered yet, can
+  // vouch for none of them.
+  std::vector<introspect::ProcessFilters> processes;
+  {
+    std::lock_guard lock(impl_->mutex);
+    for (const auto& l : impl_->links) processes.push_back({l->name, !l->status.empty(), l->filters});
+  }
+  return introspect::coverage_now(
+      impl_->events, processes, {},
+      std::chrono::duration_cast<Time>(std::chrono::steady_clock::now().time_since_epoch()));
 }
 
 SystemView MiddlewareSource::view() const {

@@ -18,10 +18,11 @@ namespace safecass::viewer {
 
 namespace {
 
-constexpr std::size_t kMaxString = 256;     ///< longest name, address or reason accepted
-constexpr std::size_t kMaxSamples = 1000;   ///< samples in one injection
-constexpr std::size_t kMaxSampleSize = 64;  ///< doubles in one sample
-constexpr long long kTimeIntervalMs = 250;  ///< clock-only messages at most this often
+constexpr std::size_t kMaxString = 256;         ///< longest name, address or reason accepted
+constexpr std::size_t kMaxSamples = 1000;       ///< samples in one injection
+constexpr std::size_t kMaxSampleSize = 64;      ///< doubles in one sample
+constexpr long long kTimeIntervalMs = 250;      ///< clock-only messages at most this often
+constexpr long long kCoverageIntervalMs = 250;  ///< the hazards' coverage judged at most this often, but on records
 
 std::string quote(std::string_view s) { return json::json_string(s); }
 
@@ -228,6 +229,7 @@ std::string Protocol::hello() const {
       .boolean("write", options_.allow_write)
       .integer("max_message", static_cast<long long>(options_.max_message))
       .raw("view", view_json())
+      .raw("coverage", introspect::coverage_now_json(source_.coverage()))
       .raw("recent", array(recent_, [](const std::string& r) { return r; }))
       .text();
 }
@@ -272,7 +274,18 @@ std::string Protocol::update(long long now_ms) {
     }
     sent_ = std::move(now);
   }
-  if (changes > 0 || !listed.empty()) {
+  // The hazards' coverage, judged a few times a second (a filter's facts change without a record:
+  // its first sample, a signal going stale) and pushed when it changed.
+  std::string coverage;
+  if (now_ms - coverage_ms_ >= kCoverageIntervalMs || !records.empty()) {
+    coverage_ms_ = now_ms;
+    introspect::CoverageNow c = source_.coverage();
+    if (c.hazards != sent_coverage_) {
+      coverage = introspect::coverage_now_json(c);
+      sent_coverage_ = std::move(c.hazards);
+    }
+  }
+  if (changes > 0 || !listed.empty() || !coverage.empty()) {
     last_time_ms_ = now_ms;
     last_replay_ = replay ? replay_json(*replay) : std::string();
     Object o;
@@ -281,6 +294,7 @@ std::string Protocol::update(long long now_ms) {
         .boolean("running", source_.running())
         .raw("states", changed.text())
         .raw("records", listed.text());
+    if (!coverage.empty()) o.raw("coverage", coverage);
     if (replay) o.raw("replay", last_replay_);
     return o.text();
   }

@@ -163,6 +163,10 @@ void ReplaySource::settle() {
   while (impl_->seek || impl_->next) impl_->poll();
 }
 
+introspect::CoverageNow ReplaySource::coverage() const {
+  return impl_->query->coverage().value_or(introspect::CoverageNow{});  // in-process: never fails
+}
+
 SystemView ReplaySource::view() const {
   SystemView v = local_view(*impl_->query, impl_->coordinators, impl_->connections);
   v.system = impl_->system_name;

@@ -24,8 +24,10 @@
 #include <cmath>
 #include <cstddef>
 #include <deque>
+#include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -72,9 +74,57 @@ struct FilterInit {
   NameId name_id = kNoName;
 };
 
+/// What a filter has done so far, read from any thread while it runs (docs/filters.md, "Run-time
+/// facts"): what `safecass analyze now` judges a hazard's coverage by.
+struct FilterFacts {
+  bool enabled = true;
+  /// A shallow injection is queued, or the newest sample the filter judged was injected.
+  bool injected = false;
+  /// The time of the newest sample the filter judged, the last in its input's order (none: none).
+  std::optional<Time> last_sample;
+  /// The runs of its monitor's group (its component's ACTIVE filters, or the PASSIVE ones) in which it
+  /// judged its inputs: a run while disabled is none.
+  std::uint64_t evaluations = 0;
+};
+
 namespace detail {
 class Banks;
-}
+
+inline constexpr std::int64_t kNoSample = std::numeric_limits<std::int64_t>::min();
+
+/// What a bank's reader (or pair) publishes of its reads: the last sample of the last read that had
+/// one, and how many such reads it made. Written by the bank's thread once per read with samples.
+/// Copied only while the bank is configured (its reader moves with the bank's array).
+struct ReadFacts {
+  ReadFacts() = default;
+  ReadFacts(const ReadFacts& other) noexcept
+      : last(other.last.load(std::memory_order_relaxed)), reads(other.reads.load(std::memory_order_relaxed)) {}
+  ReadFacts& operator=(const ReadFacts& other) noexcept {
+    last.store(other.last.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    reads.store(other.reads.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    return *this;
+  }
+
+  /// The last sample in one word, read at once: its time (ns) times two, plus one when it was
+  /// injected; kNoSample before any.
+  static constexpr std::int64_t word(Time time, bool injected) noexcept {
+    return time.count() * 2 + (injected ? 1 : 0);
+  }
+  static constexpr Time time_of(std::int64_t word) noexcept { return Time{word >> 1}; }
+  static constexpr bool injected_in(std::int64_t word) noexcept { return (word & 1) != 0; }
+
+  std::atomic<std::int64_t> last{kNoSample};
+  std::atomic<std::uint64_t> reads{0};
+};
+
+/// Where a banked filter's newest sample is while it is in its bank: its reader's, once the reader
+/// has read since the filter entered. Written by the filter's thread when it enters or leaves.
+struct BankSeat {
+  const ReadFacts* reader = nullptr;
+  std::atomic<bool> in{false};
+  std::atomic<std::uint64_t> entry_reads{0};  ///< the reader's reads when it entered
+};
+}  // namespace detail
 
 class Filter {
 public:
@@ -89,6 +139,8 @@ public:
   DetectionMode detection() const noexcept { return cold_->config.detection; }
   ComponentId component() const noexcept { return cold_->component; }
   MachineId target() const noexcept { return cold_->target; }
+  /// The onset it raises, or kNoEvent (a filter that only writes outputs).
+  EventId onset() const noexcept { return cold_->onset; }
   const std::vector<Signal*>& inputs() const noexcept { return cold_->inputs; }
   const std::vector<Signal*>& outputs() const noexcept { return cold_->outputs; }
 
@@ -106,6 +158,9 @@ public:
   bool detected() const noexcept { return detected_.load(std::memory_order_acquire); }
   /// Samples lost to history-buffer overflow since creation.
   std::uint64_t missed_samples() const noexcept;
+  /// Enabled, injected, the newest sample judged and the runs so far, whether it runs as an object
+  /// or in a bank. Any thread; lock-free (it retries while the filter's thread changes them).
+  FilterFacts facts() const noexcept;
 
   /// Processes the new samples of every input, then on_tick(now). Call from one thread only. A
   /// filter of a monitor is run by it (Monitor::run_active, Monitor::tick), which may run it in a
@@ -178,6 +233,7 @@ private:
   /// sample raises EVT_INVALID_SAMPLE and is not passed on), held, then handed to on_sample().
   void deliver(std::size_t input, const SampleView& sample) noexcept {
     current_injected_ = sample.injected;  // also marks an EVT_INVALID_SAMPLE raised by this sample
+    last_judged_.store(detail::ReadFacts::word(sample.time, sample.injected), std::memory_order_relaxed);  // facts()
     bool finite;
     if (sample.size == 1) {  // scalars: no loop
       finite = std::isfinite(sample.data[0]);
@@ -196,6 +252,17 @@ private:
     if (invalid_count_ != 0 && cold_->invalid[input] != 0) invalid_sample(input, sample, false);
     cursor(input).keep();
     on_sample(input, sample);
+  }
+  /// Changes facts that facts() reads together: a reader that overlaps `change` reads them again
+  /// (a sequence lock; only the filter's thread writes them).
+  template <class Change>
+  void change_facts(Change&& change) noexcept {
+    std::atomic<std::uint32_t>& version = cold_->facts_version;
+    const std::uint32_t v = version.load(std::memory_order_relaxed);
+    version.store(v + 1, std::memory_order_relaxed);
+    std::atomic_thread_fence(std::memory_order_release);
+    change();
+    version.store(v + 2, std::memory_order_release);
   }
   /// A bank that runs this filter learns that it must look at detour_ again.
   void tell_bank() noexcept {
@@ -234,7 +301,8 @@ private:
   bool ticks_ = true;                ///< on_tick is overridden (cleared by the default on its first call)
   std::uint32_t invalid_count_ = 0;  ///< inputs marked in cold_->invalid
   Signal* output0_ = nullptr;        ///< the first output, or nullptr
-  SignalCursor first_;               ///< the first input's cursor; it keeps the newest finite sample
+  std::atomic<std::int64_t> last_judged_{detail::kNoSample};  ///< the last sample judged as an object (a word)
+  SignalCursor first_;  ///< the first input's cursor; it keeps the newest finite sample
 
   /// What the hot path does not read: configuration, the other inputs, injections.
   struct Cold {
@@ -254,7 +322,14 @@ private:
     std::mutex injection_mutex;  ///< guards injections and kInjection
     std::deque<std::vector<double>> injections;
     std::atomic<std::uint32_t>* bank_changes = nullptr;  ///< the bank's change count, when banked
-    std::atomic<std::uint64_t> banked_missed{0};         ///< samples its bank's reader missed
+    // The facts kept where they change, not per run (facts()): runs are counted by the group.
+    std::atomic<std::uint32_t> facts_version{0};             ///< odd while the filter's thread changes them
+    const std::atomic<std::uint64_t>* group_runs = nullptr;  ///< the runs its group has begun
+    std::atomic<std::uint64_t> runs_at_join{0};              ///< group_runs when it joined the group
+    std::atomic<std::uint64_t> skipped{0};                   ///< runs while disabled, before the last
+    std::atomic<std::int64_t> disabled_at{-1};               ///< the run it was first disabled in; -1
+    detail::BankSeat* seat = nullptr;                        ///< in its bank, when banked
+    std::atomic<std::uint64_t> banked_missed{0};             ///< samples its bank's reader missed
   };
   std::unique_ptr<Cold> cold_;
 };

@@ -19,6 +19,9 @@
 
 namespace safecass::introspect {
 
+/// `items` with `separator` between them: joined({"a", "b"}, ", ") == "a, b".
+std::string joined(const std::vector<std::string>& items, std::string_view separator);
+
 /// How the times of one system are written.
 class TimeFormat {
 public:
@@ -104,6 +107,13 @@ std::string state_summary_text(const StateSummary& summary);
 std::string state_summary_json(const StateSummary& summary);
 /// The inverse of state_summary_json(). Errors: Parse (what is missing or wrong).
 [[nodiscard]] Expected<StateSummary> state_summary_from_json(std::string_view json);
+/// `analyze now`: each hazard, covered or UNCOVERED with each gap, and a last line that counts them.
+std::string coverage_now_text(const CoverageNow& coverage);
+/// {"t":...,"uncovered":N,"hazards":[{"hazard":...,"covered":...,"onsets":[...],"gaps":[{"onset":...,"reason":...}]}]}
+std::string coverage_now_json(const CoverageNow& coverage);
+/// The inverse of coverage_now_json(). Errors: Parse (what is missing or wrong).
+[[nodiscard]] Expected<CoverageNow> coverage_now_from_json(std::string_view json);
+
 std::string filter_list_text(const std::vector<FilterRow>& rows);
 std::string filter_list_json(const std::vector<FilterRow>& rows);
 std::string filter_info_text(const FilterInfo& info);

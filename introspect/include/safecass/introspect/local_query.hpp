@@ -52,6 +52,12 @@ public:
   /// LocalOptions::actions.
   [[nodiscard]] Expected<void> apply(const Action& action) override;
 
+  /// The components of other processes whose coordinator is lost (EVT_COORDINATOR_LOST on their
+  /// s_F), in declaration order.
+  std::vector<std::string> lost_components() const;
+  /// `analyze now`: the hazards this process cannot detect now (coverage.hpp), its filters judged
+  /// by their run-time facts.
+  [[nodiscard]] Expected<CoverageNow> coverage();
   /// The rows of one component (its extended state, s_F, s_A, each s_P, s_R and s_S), in the
   /// order of state_list(). For tools that show a coordinator before it answers.
   std::vector<StateRow> component_rows(ComponentId id) const;

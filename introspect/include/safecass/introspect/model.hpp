@@ -134,6 +134,37 @@ struct FilterRow {
   bool detected = false;
   std::vector<SignalRef> inputs;
   std::vector<SignalRef> outputs;
+  std::string onset;  ///< the onset it raises, empty when none
+  // Its run-time facts (safecass::FilterFacts): what `analyze now` judges coverage by.
+  bool injected = false;            ///< a shallow injection queued, or the newest sample judged injected
+  std::optional<Time> last_sample;  ///< the newest sample judged (system clock), none yet
+  std::uint64_t evaluations = 0;    ///< runs that judged its inputs
+};
+
+/// A hazard-linked onset the system cannot raise now, and why (`analyze now`).
+struct CoverageGap {
+  std::string onset;
+  std::string reason;  ///< "filter force_limit is disabled; ..." (every filter that raises it)
+  friend bool operator==(const CoverageGap&, const CoverageGap&) = default;
+};
+
+/// A hazard of the running system (an id that events name in "hazard") and what leaves it
+/// undetected now: covered when it has no gap.
+struct HazardCoverage {
+  std::string hazard;
+  std::vector<std::string> onsets;  ///< the onsets linked to it, in event-list order
+  std::vector<CoverageGap> gaps;
+  bool covered() const noexcept { return gaps.empty(); }
+  friend bool operator==(const HazardCoverage&, const HazardCoverage&) = default;
+};
+
+/// The answer to `analyze now` (docs/analyze.md, "At run time"): each hazard, in the order its
+/// first onset is declared, at the system's time `now`.
+struct CoverageNow {
+  Time now{};
+  std::vector<HazardCoverage> hazards;
+  std::size_t uncovered() const noexcept;
+  friend bool operator==(const CoverageNow&, const CoverageNow&) = default;
 };
 
 /// One parameter of a filter type's manifest, with this filter's value.

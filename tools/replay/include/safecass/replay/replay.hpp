@@ -34,6 +34,9 @@ struct ReplayOptions {
   std::optional<double>
       period;  ///< seconds per tick (default: the recording's, else the smallest component period, else 1 ms)
   bool json = false;
+  /// After the replay, when each hazard was uncovered (`analyze now` judged at every tick:
+  /// docs/analyze.md, "At run time").
+  bool coverage = false;
   std::string record;         ///< the replay's own history (and inputs next to it)
   std::string record_inputs;  ///< the replay's own inputs recording ("-": none)
   FileLimits limits;

@@ -74,6 +74,7 @@ public:
   std::vector<std::string> take_records() override;
   /// Changes when poll() took new state lists or statuses: they arrive after their records.
   std::uint64_t view_version() const override;
+  introspect::CoverageNow coverage() const override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
   /// Sent to the coordinator that owns the action's target (a broadcast and a reset of SYSTEM: to
   /// every coordinator), with that coordinator's token.

@@ -88,6 +88,9 @@ private:
   std::uint64_t generation_ = 0;    ///< the source's generation the pages were last greeted with
   std::uint64_t view_version_ = 0;  ///< the source's view_version() when the states were last compared
   std::string last_replay_;         ///< the replay status last pushed
+  /// The hazards' coverage last pushed (ViewSource::coverage()), and when it was last judged.
+  std::vector<introspect::HazardCoverage> sent_coverage_;
+  long long coverage_ms_ = -1000000;
 };
 
 }  // namespace safecass::viewer

@@ -48,6 +48,7 @@ public:
   double now() const override;
   bool running() const override;
   std::vector<std::string> take_records() override;
+  introspect::CoverageNow coverage() const override;
   [[nodiscard]] Expected<std::vector<Explanation>> explain(std::string_view address) const override;
   /// Refused: a replay is read-only.
   [[nodiscard]] Expected<std::string> apply(const introspect::Action& action) override;

@@ -20,6 +20,7 @@
 #include "safecass/core/expected.hpp"
 #include "safecass/core/state.hpp"
 #include "safecass/introspect/action.hpp"
+#include "safecass/introspect/model.hpp"
 
 namespace safecass::viewer {
 
@@ -110,6 +111,11 @@ public:
   /// The observer-stream records since the last call, oldest first, each one JSON object in the
   /// format of record_to_json() (the history-file format).
   virtual std::vector<std::string> take_records() = 0;
+  /// Which hazards the system cannot detect now (`analyze now`, docs/analyze.md "At run time"):
+  /// judged from every coordinator's filters as last read, a lost or not yet answering
+  /// coordinator's filters counting as unable to detect. Costs a read of the filter list: the
+  /// server asks a few times a second.
+  virtual introspect::CoverageNow coverage() const = 0;
   /// Every active condition at `address` (SYSTEM, a coordinator name, C, C.s_F, …) with its
   /// root cause and hop path. Errors: NotFound / Parse for an unknown or malformed address.
   [[nodiscard]] virtual Expected<std::vector<Explanation>> explain(std::string_view address) const = 0;
