@@ -113,8 +113,9 @@ void Banks::add_reader(Filter& filter) {
     }
   }
   reader.width = static_cast<std::uint32_t>(input->size());
+  const Reader* before = readers_.data();
   readers_.push_back(std::move(reader));
-  reader_facts_.emplace_back();
+  if (readers_.data() != before) reseat();
   steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(readers_.size() - 1), false});
   reserve_read(2 * (input->buffer().capacity() + 1), input->size());  // written and injected
 }
@@ -131,8 +132,9 @@ void Banks::add_pair(Filter& filter) {
     width = std::max(width, input->size());
   }
   pair.begin = pair.end = static_cast<std::uint32_t>(members_.size());
+  const Pair* before = pairs_.data();
   pairs_.push_back(std::move(pair));
-  pair_facts_.emplace_back();
+  if (pairs_.data() != before) reseat();
   steps_.push_back(Step{nullptr, static_cast<std::uint32_t>(pairs_.size() - 1), true});
   reserve_read(samples, width);
 }
@@ -219,7 +221,6 @@ double*& Banks::ring_of(const Ring& ring) noexcept {
 }
 
 void Banks::run(Time now) noexcept {
-  runs_.store(runs_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // one writer
   if (const std::uint32_t changes = changes_.load(std::memory_order_acquire); changes != seen_) {
     seen_ = changes;
     refresh();
@@ -254,6 +255,8 @@ void Banks::run(Time now) noexcept {
       run_reader(readers_[step.reader], now);
     }
   }
+  // Counted when done: a filter that finds itself disabled in this run never counted it.
+  runs_.store(runs_.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);  // one writer
 }
 
 void Banks::settle() noexcept {
@@ -261,6 +264,12 @@ void Banks::settle() noexcept {
     if (m.out) continue;
     hand_over(m);
     leave(m);  // the filter keeps its newest sample: the group goes
+  }
+}
+
+void Banks::reseat() noexcept {
+  for (Member& m : members_) {
+    m.filter->change_facts([&] { seat_of(m).reader = read_facts(m); });
   }
 }
 
@@ -402,7 +411,7 @@ std::size_t Banks::read_pair(Pair& pair) noexcept {
 
 void Banks::run_pair(Pair& pair, Time now) noexcept {
   const std::size_t samples = read_pair(pair);
-  publish(pair_facts_[static_cast<std::size_t>(&pair - pairs_.data())], samples);
+  publish(pair.facts, samples);
   for (std::uint32_t i = pair.begin; i < pair.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
@@ -432,7 +441,7 @@ void Banks::run_pair(Pair& pair, Time now) noexcept {
 
 void Banks::run_reader(Reader& reader, Time now) noexcept {
   const std::size_t samples = read(reader);
-  publish(reader_facts_[static_cast<std::size_t>(&reader - readers_.data())], samples);
+  publish(reader.facts, samples);
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {

@@ -42,7 +42,7 @@ public:
   /// filters join another group).
   void settle() noexcept;
   std::size_t size() const noexcept { return size_; }
-  /// The runs begun: every filter of the group runs in each (Filter::facts()).
+  /// The runs done: every filter of the group runs in each (Filter::facts()).
   std::uint64_t runs() const noexcept { return runs_.load(std::memory_order_relaxed); }
   /// Filters whose state is in a bank (for tests and docs).
   std::size_t banked() const noexcept { return members_.size(); }
@@ -60,6 +60,7 @@ private:
   };
   struct Reader {
     SignalCursor cursor;
+    ReadFacts facts;          ///< what it publishes of its reads (Filter::facts()), next to what a read touches
     std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
     std::uint32_t end = 0;
     std::uint32_t width = 1;  ///< doubles per sample
@@ -74,6 +75,7 @@ private:
   /// Deadline run as an object merges them.
   struct Pair {
     SignalCursor cursors[2];  ///< start, end: the Deadline's inputs 0 and 1
+    ReadFacts facts;          ///< what it publishes of its reads
     std::uint32_t begin = 0;  ///< its members: [begin, end) of members_
     std::uint32_t end = 0;
   };
@@ -114,8 +116,11 @@ private:
   [[gnu::cold]] void refresh() noexcept;
   /// Its seat (in seats_), through the filter: members_ stays small, the run reads it.
   static BankSeat& seat_of(const Member& m) noexcept { return *m.filter->cold_->seat; }
+  /// Points each member's seat at its reader's (or pair's) facts again: they moved with readers_
+  /// or pairs_ (configuration only).
+  void reseat() noexcept;
   const ReadFacts* read_facts(const Member& m) const noexcept {
-    return m.kind == Kind::Deadline ? &pair_facts_[m.reader] : &reader_facts_[m.reader];
+    return m.kind == Kind::Deadline ? &pairs_[m.reader].facts : &readers_[m.reader].facts;
   }
   /// `m` enters (or leaves) its bank: where its newest sample is read changes (Filter::facts()).
   void enter(Member& m) noexcept;
@@ -172,12 +177,8 @@ private:
   std::vector<Reader> readers_;
   std::vector<Pair> pairs_;
   std::vector<Member> members_;
-  // What Filter::facts() reads, apart from what the run reads most: per member (a deque: they never
-  // move), and per reader and pair (what each publishes of its reads; by index).
-  std::deque<BankSeat> seats_;
-  std::deque<ReadFacts> reader_facts_;
-  std::deque<ReadFacts> pair_facts_;
-  std::atomic<std::uint64_t> runs_{0};  ///< runs begun
+  std::deque<BankSeat> seats_;          ///< per member, read by Filter::facts() (a deque: they never move)
+  std::atomic<std::uint64_t> runs_{0};  ///< runs done
   std::vector<builtin::ThresholdState> thresholds_;
   std::vector<builtin::WatchdogState> watchdogs_;
   std::vector<builtin::AverageState> averages_;

@@ -57,11 +57,11 @@ FilterFacts Filter::facts() const noexcept {
     if (sampled) f.last_sample = detail::ReadFacts::time_of(last);
     f.evaluations = 0;
     if (c.group_runs != nullptr) {
-      // The runs begun since it joined, less those it spent disabled.
+      // The runs done since it joined, less those it spent disabled.
       const std::uint64_t runs = c.group_runs->load(std::memory_order_relaxed);
       const std::int64_t disabled_at = c.disabled_at.load(std::memory_order_relaxed);
       std::uint64_t off = c.runs_at_join.load(std::memory_order_relaxed) + c.skipped.load(std::memory_order_relaxed);
-      if (disabled_at >= 0) off += runs - static_cast<std::uint64_t>(disabled_at) + 1;
+      if (disabled_at >= 0) off += runs - static_cast<std::uint64_t>(disabled_at);
       f.evaluations = runs >= off ? runs - off : 0;
     }
     std::atomic_thread_fence(std::memory_order_acquire);

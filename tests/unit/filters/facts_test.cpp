@@ -2,6 +2,10 @@
 // sample judged and the runs so far, the same whether the filter runs as an object or in a bank
 // (the bank's differential test compares them over random systems too: bank_test.cpp).
 
+#include <atomic>
+#include <limits>
+#include <thread>
+
 #include "filter_fixture.hpp"
 
 namespace safecass::test {
@@ -93,6 +97,32 @@ TEST_P(FilterFactsTest, ANonFiniteSampleIsJudgedAndIsTheNewestSample) {
   EXPECT_EQ(filter_->facts().last_sample, std::chrono::milliseconds(2));
   cycle(3, 3.0);
   EXPECT_EQ(text(filter_->facts()), text(true, false, std::chrono::milliseconds(3), 3));
+}
+
+TEST_P(FilterFactsTest, AnotherThreadReadsFactsThatNeverGoBackWhileTheFilterRunsEntersAndLeavesItsBank) {
+  // The filter is disabled and enabled again now and then (it leaves its bank and comes back):
+  // a reader on another thread sees its runs and its newest sample only ever grow.
+  std::atomic<bool> done{false};
+  std::atomic<int> backwards{0};
+  std::thread reader([&] {
+    std::uint64_t runs = 0;
+    std::int64_t last = std::numeric_limits<std::int64_t>::min();
+    while (!done.load()) {
+      const FilterFacts f = filter_->facts();
+      const std::int64_t t = f.last_sample ? f.last_sample->count() : std::numeric_limits<std::int64_t>::min();
+      if (f.evaluations < runs || t < last) backwards.fetch_add(1);
+      runs = f.evaluations;
+      last = t;
+    }
+  });
+  for (std::int64_t ms = 1; ms <= 2990; ++ms) {
+    if (ms % 50 == 0) filter_->set_enabled(ms % 100 != 0);
+    cycle(ms, 1.0);
+  }
+  done.store(true);
+  reader.join();
+  EXPECT_EQ(backwards.load(), 0);
+  EXPECT_EQ(filter_->facts().last_sample, std::chrono::milliseconds(2990));
 }
 
 INSTANTIATE_TEST_SUITE_P(ObjectAndBank, FilterFactsTest, ::testing::Values(false, true),

@@ -324,12 +324,12 @@ private:
     std::atomic<std::uint32_t>* bank_changes = nullptr;  ///< the bank's change count, when banked
     // The facts kept where they change, not per run (facts()): runs are counted by the group.
     std::atomic<std::uint32_t> facts_version{0};             ///< odd while the filter's thread changes them
-    const std::atomic<std::uint64_t>* group_runs = nullptr;  ///< the runs its group has begun
+    const std::atomic<std::uint64_t>* group_runs = nullptr;  ///< the runs its group has done
     std::atomic<std::uint64_t> runs_at_join{0};              ///< group_runs when it joined the group
     std::atomic<std::uint64_t> skipped{0};                   ///< runs while disabled, before the last
-    std::atomic<std::int64_t> disabled_at{-1};               ///< the run it was first disabled in; -1
-    detail::BankSeat* seat = nullptr;                        ///< in its bank, when banked
-    std::atomic<std::uint64_t> banked_missed{0};             ///< samples its bank's reader missed
+    std::atomic<std::int64_t> disabled_at{-1};    ///< group_runs before the first run it skipped; -1: enabled
+    detail::BankSeat* seat = nullptr;             ///< in its bank, when banked
+    std::atomic<std::uint64_t> banked_missed{0};  ///< samples its bank's reader missed
   };
   std::unique_ptr<Cold> cold_;
 };
