@@ -54,6 +54,9 @@ std::string component_of(std::string_view address) { return std::string(address.
 
 /// One coordinator of the system: its shape (built locally), what its thread last learnt, and
 /// the connection the server thread uses for explain and writes.
+/// How often a live coordinator's filter list (its filters' run-time facts) is read at most.
+constexpr std::chrono::milliseconds kFiltersPeriod{500};
+
 struct MiddlewareLink {
   std::string name;
   std::string token;       ///< empty without --token-file for it
@@ -157,6 +160,7 @@ struct MiddlewareSource::Impl {
     std::unique_ptr<RemoteClient> reader;
     std::unique_ptr<introspect::Subscription> records;
     bool answered = false;
+    std::chrono::steady_clock::time_point filters_read{};
     auto lose = [&](const std::string& why) {
       records.reset();  // before the client it belongs to
       reader.reset();
@@ -203,11 +207,16 @@ struct MiddlewareSource::Impl {
         l.stale = false;
       }
       auto answer = reader->state_list();
-      auto filters = answer ? reader->filter_list() : Expected<std::vector<introspect::FilterRow>>();
+      // The filters' facts (the hazards' coverage) at most every kFiltersPeriod: a second request
+      // per state list would double the coordinator's load of a busy page.
+      const auto now = std::chrono::steady_clock::now();
+      const bool refilter = !answered || now - filters_read >= kFiltersPeriod;
+      auto filters = answer && refilter ? reader->filter_list() : Expected<std::vector<introspect::FilterRow>>();
       if (!answer || !filters) {
         lose((!answer ? answer.error() : filters.error()).message);
         continue;
       }
+      if (refilter) filters_read = now;
       answered = true;
       {
         std::lock_guard lock(mutex);
@@ -216,7 +225,7 @@ struct MiddlewareSource::Impl {
           l.rows = std::move(*answer);
           ++version;
         }
-        l.filters = std::move(*filters);
+        if (refilter) l.filters = std::move(*filters);
         l.tried = true;
       }
       wake.notify_all();
