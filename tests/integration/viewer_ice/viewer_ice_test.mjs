@@ -37,11 +37,15 @@ let userDataDir = '';
 let failures = 0;
 const scratch = path.join(out, 'viewer_ice_scratch');
 
+const testStart = Date.now();
+/** Seconds since the test started: each line says when, so a run near its deadline shows where the time went. */
+const at = () => `[${((Date.now() - testStart) / 1000).toFixed(1)} s]`;
+
 function check(condition, what) {
   if (condition) {
-    console.log(`ok: ${what}`);
+    console.log(`ok: ${what} ${at()}`);
   } else {
-    console.log(`FAILED: ${what}`);
+    console.log(`FAILED: ${what} ${at()}`);
     failures += 1;
   }
 }
