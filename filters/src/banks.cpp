@@ -339,6 +339,7 @@ std::size_t Banks::read(Reader& reader) noexcept {
     // another thread writes meanwhile may as well come after the run (and is read by the next).
     if (!others_ran_ || !reader.cursor.unread()) {
       plain_ = plain;
+      reader.facts.note(reader.time, false);
       return 1;
     }
   } else if (reader.cursor.take_single(times_[0], values_.data())) {  // one new sample: the common case
@@ -347,6 +348,7 @@ std::size_t Banks::read(Reader& reader) noexcept {
     injected_[0] = 0;
     finite_[0] = finite ? 1 : 0;
     plain_ = finite;
+    reader.facts.note(times_[0], false);
     return 1;
   }
   const std::uint64_t missed = reader.cursor.missed();
@@ -358,6 +360,7 @@ std::size_t Banks::read(Reader& reader) noexcept {
     add_missed(reader.begin, reader.end, lost);
   }
   plain_ = plain;
+  if (samples != 0) reader.facts.note(times_[samples - 1], injected_[samples - 1] != 0);
   return samples;
 }
 
@@ -406,12 +409,12 @@ std::size_t Banks::read_pair(Pair& pair) noexcept {
     add_missed(pair.begin, pair.end, lost);
   }
   plain_ = plain;
+  if (samples != 0) pair.facts.note(times_[samples - 1], injected_[samples - 1] != 0);
   return samples;
 }
 
 void Banks::run_pair(Pair& pair, Time now) noexcept {
   const std::size_t samples = read_pair(pair);
-  publish(pair.facts, samples);
   for (std::uint32_t i = pair.begin; i < pair.end; ++i) {
     Member& m = members_[i];
     if (m.out) {
@@ -441,7 +444,6 @@ void Banks::run_pair(Pair& pair, Time now) noexcept {
 
 void Banks::run_reader(Reader& reader, Time now) noexcept {
   const std::size_t samples = read(reader);
-  publish(reader.facts, samples);
   for (std::uint32_t i = reader.begin; i < reader.end; ++i) {
     Member& m = members_[i];
     if (m.out) {

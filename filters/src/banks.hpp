@@ -125,18 +125,13 @@ private:
   /// `m` enters (or leaves) its bank: where its newest sample is read changes (Filter::facts()).
   void enter(Member& m) noexcept;
   void leave(Member& m) noexcept;
-  /// Publishes the last sample of this read (Filter::facts()), before the filters of the read run:
-  /// one that enters the bank in this run has dealt with this read itself.
-  void publish(ReadFacts& facts, std::size_t samples) noexcept {
-    if (samples == 0) return;
-    facts.last.store(ReadFacts::word(times_[samples - 1], injected_[samples - 1] != 0), std::memory_order_relaxed);
-    facts.reads.store(facts.reads.load(std::memory_order_relaxed) + 1, std::memory_order_release);  // one writer
-  }
-  /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_.
+  /// This run's new samples of `reader`'s signal into times_, values_, injected_ and finite_; the
+  /// last noted in the reader's facts, before the filters of the read run (one that enters the
+  /// bank in this run has judged this read itself).
   [[gnu::always_inline]] inline std::size_t read(Reader& reader) noexcept;
   [[gnu::always_inline]] inline void run_reader(Reader& reader, Time now) noexcept;
   /// This run's new samples of `pair`'s two signals, merged, into times_, values_, inputs_,
-  /// injected_ and finite_.
+  /// injected_ and finite_; the last noted in the pair's facts.
   std::size_t read_pair(Pair& pair) noexcept;
   void run_pair(Pair& pair, Time now) noexcept;
   [[gnu::cold]] void run_out(Member& m, Time now) noexcept;

@@ -49,6 +49,9 @@ Filter* Monitor::find_filter(std::string_view name) const noexcept {
 Expected<FilterInit> Monitor::prepare(FilterConfig config,
                                       std::vector<std::pair<std::string, std::size_t>>& new_outputs) {
   const FilterRegistry::Entry* entry = registry_.find(config.type);
+  // A filter is of its type, not of the alias it was asked for by ("Heartbeat" is a Watchdog), as a
+  // specification's filters are: what reads its type (filter list, analyze) then knows it.
+  if (entry != nullptr) config.type = entry->manifest.type;
   if (config.name.empty()) config.name = config.type + "_" + std::to_string(filters_.size() + 1);
   const std::string where = "filter '" + config.name + "'";
   if (entry == nullptr) {

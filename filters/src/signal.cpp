@@ -1,6 +1,7 @@
 #include "safecass/filters/signal.hpp"
 
 #include <algorithm>
+#include <new>
 
 namespace safecass {
 
@@ -12,15 +13,52 @@ std::size_t round_up_pow2(std::size_t n) {
 }
 }  // namespace
 
+void* Arena::allocate(std::size_t bytes) {
+  bytes = (bytes + kLine - 1) / kLine * kLine;
+  if (blocks_.empty() || blocks_.back().size - blocks_.back().used < bytes) {
+    const std::size_t size = std::max(bytes, block_bytes_);
+    blocks_.push_back(Block{
+        std::unique_ptr<std::byte[], Free>(static_cast<std::byte*>(::operator new[](size, std::align_val_t{kLine}))),
+        size, 0});
+  }
+  Block& b = blocks_.back();
+  void* p = b.memory.get() + b.used;
+  b.used += bytes;
+  return p;
+}
+
+void Arena::release(Mark mark) noexcept {
+  while (blocks_.size() > mark.blocks) blocks_.pop_back();
+  if (!blocks_.empty()) blocks_.back().used = mark.used;
+}
+
 HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity, bool keyed)
     : width_(width),
       header_(keyed ? 2 : 1),
       stride_(width + header_),
       mask_(round_up_pow2(capacity < 2 ? 2 : capacity) - 1),
-      words_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * stride_)) {}
+      words_(nullptr),
+      own_(std::make_unique<std::atomic<std::uint64_t>[]>((mask_ + 1) * stride_)) {
+  words_ = own_.get();
+}
+
+HistoryBuffer::HistoryBuffer(std::size_t width, std::size_t capacity, Arena& memory)
+    : width_(width), header_(1), stride_(width + header_), mask_(round_up_pow2(capacity < 2 ? 2 : capacity) - 1) {
+  const std::size_t words = (mask_ + 1) * stride_;
+  // A line more than the ring: the rings of a registry then lie one line apart modulo a page, so
+  // the slots that every ring writes in one cycle (the same index in each) fall into different
+  // cache sets instead of all into one (docs/filters.md, "Memory layout").
+  constexpr std::size_t kStagger = 64;
+  words_ =
+      static_cast<std::atomic<std::uint64_t>*>(memory.allocate(words * sizeof(std::atomic<std::uint64_t>) + kStagger));
+  for (std::size_t i = 0; i < words; ++i) new (&words_[i]) std::atomic<std::uint64_t>(0);
+}
 
 Signal::Signal(std::string name, ComponentId component, std::size_t size, std::size_t history)
     : buffer_(size, history), name_(std::move(name)), component_(component) {}
+
+Signal::Signal(std::string name, ComponentId component, std::size_t size, std::size_t history, Arena& rings)
+    : buffer_(size, history, rings), name_(std::move(name)), component_(component) {}
 
 void Signal::inject(Time time, const double* values) {
   std::lock_guard lock(inject_mutex_);
@@ -131,10 +169,25 @@ Expected<Signal*> SignalRegistry::add(std::string_view name, ComponentId compone
     }
     return s;
   }
-  signals_.push_back(std::make_unique<Signal>(std::string(name), component, size, default_history_));
-  by_name_.emplace(signals_.back()->name(), signals_.back().get());
-  return signals_.back().get();
+  signals_.reserve(signals_.size() + 1);
+  marks_.reserve(signals_.size() + 1);
+  const auto before = std::make_pair(headers_.mark(), rings_.mark());
+  Signal* s = nullptr;
+  try {
+    s = new (headers_.allocate(sizeof(Signal))) Signal(std::string(name), component, size, default_history_, rings_);
+    by_name_.emplace(s->name(), s);
+  } catch (...) {
+    if (s != nullptr) s->~Signal();
+    headers_.release(before.first);
+    rings_.release(before.second);
+    throw;
+  }
+  signals_.push_back(s);
+  marks_.push_back(before);
+  return s;
 }
+
+SignalRegistry::~SignalRegistry() { truncate(0); }
 
 Signal* SignalRegistry::find(std::string_view name) const noexcept {
   const auto it = by_name_.find(name);
@@ -142,10 +195,15 @@ Signal* SignalRegistry::find(std::string_view name) const noexcept {
 }
 
 void SignalRegistry::truncate(std::size_t count) {
-  while (signals_.size() > count) {
-    by_name_.erase(signals_.back()->name());
-    signals_.pop_back();
+  if (signals_.size() <= count) return;
+  for (std::size_t i = signals_.size(); i-- > count;) {
+    by_name_.erase(signals_[i]->name());
+    signals_[i]->~Signal();
   }
+  headers_.release(marks_[count].first);
+  rings_.release(marks_[count].second);
+  signals_.resize(count);
+  marks_.resize(count);
 }
 
 }  // namespace safecass

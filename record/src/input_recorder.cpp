@@ -99,9 +99,9 @@ InputRecorder::InputRecorder(Monitor& monitor, std::unique_ptr<detail::Segmented
   std::set<const Signal*> outputs;
   for (const auto& f : monitor_.filters()) outputs.insert(f->outputs().begin(), f->outputs().end());
   const std::set<std::string> only(options_.signals.begin(), options_.signals.end());
-  for (const auto& s : monitor_.signals().all()) {
-    if (outputs.count(s.get()) != 0 || (!only.empty() && only.count(s->name()) == 0)) continue;
-    inputs_.push_back(Input{s.get(), SignalCursor(s.get()), 0});
+  for (Signal* s : monitor_.signals().all()) {
+    if (outputs.count(s) != 0 || (!only.empty() && only.count(s->name()) == 0)) continue;
+    inputs_.push_back(Input{s, SignalCursor(s), 0});
   }
 }
 

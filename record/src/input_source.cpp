@@ -10,8 +10,8 @@ std::vector<std::string> input_signal_names(const Monitor& monitor) {
   std::set<const Signal*> outputs;
   for (const auto& f : monitor.filters()) outputs.insert(f->outputs().begin(), f->outputs().end());
   std::vector<std::string> out;
-  for (const auto& s : monitor.signals().all()) {
-    if (outputs.count(s.get()) == 0) out.push_back(s->name());
+  for (const Signal* s : monitor.signals().all()) {
+    if (outputs.count(s) == 0) out.push_back(s->name());
   }
   return out;
 }

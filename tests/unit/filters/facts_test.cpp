@@ -126,7 +126,7 @@ TEST_P(FilterFactsTest, AnotherThreadReadsFactsThatNeverGoBackWhileTheFilterRuns
 }
 
 INSTANTIATE_TEST_SUITE_P(ObjectAndBank, FilterFactsTest, ::testing::Values(false, true),
-                         [](const auto& info) { return info.param ? "InABank" : "AsAnObject"; });
+                         [](const auto& p) { return p.param ? "InABank" : "AsAnObject"; });
 
 }  // namespace
 }  // namespace safecass::test

@@ -38,6 +38,21 @@ TEST_F(MonitorTest, The2016FilterNamesAreAliasesOfTheBuiltins) {
   EXPECT_EQ(registry_.manifests().size(), 17u);
 }
 
+TEST_F(MonitorTest, AFilterAddedByAnAliasIsOfTheTypeTheAliasNames) {
+  signal("x");
+  Filter* f = make("Heartbeat", {{"input_signal", std::string("x")}, {"timeout", 1.0}});
+  EXPECT_EQ(f->type(), "Watchdog");
+  EXPECT_EQ(f->config().type, "Watchdog");
+  FilterConfig c;
+  c.type = "FilterThreshold";
+  c.target.component = "C";
+  c.params = threshold("x", 1);
+  auto added = monitor_.add_filter(c);
+  ASSERT_TRUE(added);
+  EXPECT_EQ((*added)->type(), "Threshold");
+  EXPECT_EQ((*added)->name().rfind("Threshold_", 0), 0u) << (*added)->name();
+}
+
 TEST_F(MonitorTest, ActiveFiltersRunOnlyFromTheirComponentsLoop) {
   Signal* x = signal("x");
   Filter* f = make("Threshold", threshold("x", 1));

@@ -1,6 +1,8 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdint>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -258,6 +260,60 @@ TEST(SignalRegistry, RejectsMalformedNamesZeroSizeAndSizeConflicts) {
   ASSERT_FALSE(conflict);
   EXPECT_NE(conflict.error().message.find("size 3"), std::string::npos);
   EXPECT_EQ(reg.all().size(), 1u);
+}
+
+// The registry keeps its signals and their rings in arenas (docs/filters.md, "Memory layout"):
+// each signal on a cache line of its own, each ring whole, across the arenas' blocks.
+TEST(SignalRegistry, SignalsInItsArenasStartOnACacheLineAndEachRingKeepsItsOwnSamples) {
+  SignalRegistry reg(64);
+  std::vector<Signal*> signals;
+  for (int i = 0; i < 600; ++i) {  // more than one block of each arena
+    auto s = reg.add("C.s" + std::to_string(i), ComponentId{0}, 1 + static_cast<std::size_t>(i % 3));
+    ASSERT_TRUE(s);
+    EXPECT_EQ(reinterpret_cast<std::uintptr_t>(*s) % 64, 0u);
+    signals.push_back(*s);
+  }
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    std::vector<double> v(signals[i]->size(), static_cast<double>(i));
+    for (int k = 0; k < 100; ++k) signals[i]->push(Time{k}, v.data());  // wraps each ring
+  }
+  for (std::size_t i = 0; i < signals.size(); ++i) {
+    EXPECT_EQ(reg.find(signals[i]->name()), signals[i]);
+    for (std::uint64_t k = 100 - signals[i]->buffer().capacity(); k < 100; ++k) {
+      Time t{};
+      std::vector<double> out(signals[i]->size(), -1.0);
+      ASSERT_TRUE(signals[i]->buffer().read(k, t, out.data()));
+      EXPECT_EQ(t, Time{static_cast<Time::rep>(k)});
+      EXPECT_EQ(out, std::vector<double>(signals[i]->size(), static_cast<double>(i))) << signals[i]->name();
+    }
+  }
+}
+
+TEST(SignalRegistry, TruncateForgetsTheLaterSignalsAndTheirNamesCanBeCreatedAgain) {
+  SignalRegistry reg(16);
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(reg.add("C.a" + std::to_string(i), ComponentId{0}, 1));
+  Signal* kept = reg.find("C.a7");
+  kept->push(Time{1}, 7.0);
+  const Signal* first_b = nullptr;
+  for (int round = 0; round < 3; ++round) {  // a configuration step that fails, again and again
+    for (int i = 0; i < 500; ++i) ASSERT_TRUE(reg.add("C.b" + std::to_string(i), ComponentId{0}, 2));
+    // The arenas went back: each round's signals take the memory of the round before.
+    if (round == 0) first_b = reg.find("C.b0");
+    EXPECT_EQ(reg.find("C.b0"), first_b);
+    reg.truncate(300);
+    EXPECT_EQ(reg.all().size(), 300u);
+    EXPECT_EQ(reg.find("C.b0"), nullptr);
+    EXPECT_EQ(reg.find("C.b499"), nullptr);
+  }
+  auto again = reg.add("C.b0", ComponentId{0}, 1);  // another size than before: a new signal
+  ASSERT_TRUE(again);
+  EXPECT_EQ((*again)->size(), 1u);
+  EXPECT_EQ((*again)->buffer().end(), 0u);
+  EXPECT_EQ(reg.find("C.a7"), kept);
+  Time t{};
+  double x = 0.0;
+  ASSERT_TRUE(kept->latest(t, &x));
+  EXPECT_EQ(x, 7.0);
 }
 
 }  // namespace

@@ -112,6 +112,11 @@ struct ReadFacts {
   }
   static constexpr Time time_of(std::int64_t word) noexcept { return Time{word >> 1}; }
   static constexpr bool injected_in(std::int64_t word) noexcept { return (word & 1) != 0; }
+  /// A read whose last sample is `time` (the bank's thread, the one writer).
+  void note(Time time, bool injected) noexcept {
+    last.store(word(time, injected), std::memory_order_relaxed);
+    reads.store(reads.load(std::memory_order_relaxed) + 1, std::memory_order_release);
+  }
 
   std::atomic<std::int64_t> last{kNoSample};
   std::atomic<std::uint64_t> reads{0};

@@ -22,6 +22,7 @@
 #include <cstring>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -44,6 +45,43 @@ struct SampleView {
   double scalar() const noexcept { return data[0]; }
 };
 
+/// Memory handed out in creation order from a few large blocks, each piece on a cache line of its
+/// own, freed all at once or back to a mark. A registry keeps its signals in one and their
+/// history buffers in another: what a cycle touches of N signals (each signal's first line, each
+/// ring's current slot) then lies in a few dense blocks, wherever the heap puts the filters
+/// created between them (docs/filters.md, "Memory layout"). Configuration time only.
+class Arena {
+public:
+  /// What was allocated up to a point, to go back to.
+  struct Mark {
+    std::size_t blocks = 0;
+    std::size_t used = 0;  ///< bytes used of the last block
+  };
+  /// New blocks hold `block_bytes`, or one piece larger than that.
+  explicit Arena(std::size_t block_bytes) noexcept : block_bytes_(block_bytes) {}
+  Arena(const Arena&) = delete;
+  Arena& operator=(const Arena&) = delete;
+
+  /// `bytes` of uninitialised memory, aligned to a cache line.
+  void* allocate(std::size_t bytes);
+  Mark mark() const noexcept { return Mark{blocks_.size(), blocks_.empty() ? 0 : blocks_.back().used}; }
+  /// Frees what was allocated after `mark` (its objects already destroyed).
+  void release(Mark mark) noexcept;
+
+private:
+  static constexpr std::size_t kLine = 64;
+  struct Free {
+    void operator()(std::byte* p) const noexcept { ::operator delete[](p, std::align_val_t{kLine}); }
+  };
+  struct Block {
+    std::unique_ptr<std::byte[], Free> memory;
+    std::size_t size = 0;
+    std::size_t used = 0;
+  };
+  std::size_t block_bytes_;
+  std::vector<Block> blocks_;
+};
+
 /// A ring of timestamped samples with one writer at a time and any number of lock-free readers.
 /// Each slot holds the time, in a keyed ring an order key (see Signal), and width() doubles, stored as bit
 /// patterns in relaxed atomics so that a reader racing the writer is well defined (the head check
@@ -53,6 +91,8 @@ public:
   /// `width` doubles per sample; the ring has `capacity` rounded up to a power of two slots.
   /// `keyed`: each slot also keeps an order key (the injection ring; see Signal).
   HistoryBuffer(std::size_t width, std::size_t capacity, bool keyed = false);
+  /// The same, its ring in `memory` (a registry's signals: SignalRegistry).
+  HistoryBuffer(std::size_t width, std::size_t capacity, Arena& memory);
   HistoryBuffer(const HistoryBuffer&) = delete;
   HistoryBuffer& operator=(const HistoryBuffer&) = delete;
 
@@ -139,8 +179,9 @@ private:
   std::size_t header_;  ///< words before the values: 1 (time) or 2 (time, key)
   std::size_t stride_;  ///< words per slot
   std::size_t mask_;
-  std::unique_ptr<std::atomic<std::uint64_t>[]> words_;
+  std::atomic<std::uint64_t>* words_;  ///< the ring: in own_, or in an arena
   std::atomic<std::uint64_t> head_{0};
+  std::unique_ptr<std::atomic<std::uint64_t>[]> own_;
 };
 
 /// A named signal with its history buffer and, after the first deep injection, its injection ring.
@@ -149,6 +190,8 @@ private:
 class alignas(64) Signal {
 public:
   Signal(std::string name, ComponentId component, std::size_t size, std::size_t history);
+  /// The same, its history buffer's ring in `rings` (SignalRegistry).
+  Signal(std::string name, ComponentId component, std::size_t size, std::size_t history, Arena& rings);
 
   /// "Component.signal".
   const std::string& name() const noexcept { return name_; }
@@ -340,23 +383,30 @@ private:
 };
 
 /// The signals of one coordinator, by name. Signals are created during configuration; their
-/// addresses are stable for the registry's lifetime.
+/// addresses are stable for the registry's lifetime. The signals and their history buffers are
+/// kept in two arenas, in creation order (see Arena).
 class SignalRegistry {
 public:
   explicit SignalRegistry(std::size_t default_history = 1024) : default_history_(default_history) {}
+  SignalRegistry(const SignalRegistry&) = delete;
+  SignalRegistry& operator=(const SignalRegistry&) = delete;
+  ~SignalRegistry();
   /// Creates `name` ("Component.signal") of `size` doubles. Errors: Duplicate (with a different
   /// size), InvalidArgument (size 0, malformed name). Creating an existing signal with the same
   /// size returns it.
   [[nodiscard]] Expected<Signal*> add(std::string_view name, ComponentId component, std::size_t size);
   Signal* find(std::string_view name) const noexcept;
-  const std::vector<std::unique_ptr<Signal>>& all() const noexcept { return signals_; }
+  const std::vector<Signal*>& all() const noexcept { return signals_; }
   /// Removes the signals created after the first `count` (undoing a failed configuration step).
   void truncate(std::size_t count);
 
 private:
   std::size_t default_history_;
-  std::vector<std::unique_ptr<Signal>> signals_;
-  std::unordered_map<std::string_view, Signal*> by_name_;  ///< keys: the signals' own names
+  Arena headers_{std::size_t{64} << 10};                    ///< the Signal objects
+  Arena rings_{std::size_t{1} << 20};                       ///< their history buffers' rings
+  std::vector<Signal*> signals_;                            ///< in headers_, in creation order
+  std::vector<std::pair<Arena::Mark, Arena::Mark>> marks_;  ///< before each signal: headers_, rings_
+  std::unordered_map<std::string_view, Signal*> by_name_;   ///< keys: the signals' own names
 };
 
 }  // namespace safecass
