@@ -702,10 +702,14 @@ Expected<void> RemoteClient::apply(const introspect::Action& action) {
         } else if constexpr (std::is_same_v<A, introspect::ResetState>) {
           return impl_->call("reset", [&] { control->reset(token, a.target, a.who, a.why); });
         } else if constexpr (std::is_same_v<A, introspect::InjectShallow>) {
-          return impl_->call("filter inject", [&] { control->filterInject(token, a.filter, a.samples); });
+          return impl_->call("filter inject", [&] {
+            control->filterInject(token, a.filter, wire::SampleSeq(a.samples.begin(), a.samples.end()));
+          });
         } else {
           static_assert(std::is_same_v<A, introspect::InjectDeep>, "an Action alternative the client does not send");
-          return impl_->call("filter dinject", [&] { control->filterDinject(token, a.signal, a.samples); });
+          return impl_->call("filter dinject", [&] {
+            control->filterDinject(token, a.signal, wire::SampleSeq(a.samples.begin(), a.samples.end()));
+          });
         }
       },
       action);

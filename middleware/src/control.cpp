@@ -46,6 +46,11 @@ void ok_or_raise(const Expected<void>& r) {
   if (!r) raise(r.error());
 }
 
+/// Injected samples as the read model takes them.
+std::vector<std::vector<double>> plain(wire::SampleSeq samples) {
+  return {std::make_move_iterator(samples.begin()), std::make_move_iterator(samples.end())};
+}
+
 template <class Row>
 auto rows_to_wire(const std::vector<Row>& rows) {
   std::vector<decltype(to_wire(rows.front()))> out;
@@ -61,7 +66,7 @@ public:
   explicit ControlServant(ControlContext c)
       : c_(std::move(c)), query_(c_.co, c_.monitor, c_.registry, with_name(c_.clock, c_.name)) {}
 
-  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override { return c_.prove(nonce); }
+  wire::Signed prove(wire::Bytes nonce, const Ice::Current&) override { return c_.prove(nonce); }
 
   std::string coordinator(const Ice::Current& current) override {
     check_read(current);
@@ -103,7 +108,7 @@ public:
   void filterInject(std::string token, std::string filter, wire::SampleSeq samples, const Ice::Current&) override {
     check_write(token, "filter inject");
     const std::size_t n = samples.size();
-    apply(introspect::InjectShallow{filter, std::move(samples)});
+    apply(introspect::InjectShallow{filter, plain(std::move(samples))});
     c_.log("middleware: " + c_.name + ": filter inject " + filter + " (" + std::to_string(n) + " samples)");
   }
 
@@ -169,7 +174,7 @@ public:
     return to_wire(value_or_raise(locked([&] { return query_.names(); })));
   }
 
-  std::string read(std::string name, Ice::StringSeq args, const Ice::Current& current) override {
+  std::string read(std::string name, wire::Strings args, const Ice::Current& current) override {
     check_read(current);
     return value_or_raise(locked([&] { return query_.read(name, args); }));
   }
@@ -208,7 +213,7 @@ private:
 
   void deep(const std::string& signal, wire::SampleSeq samples) {
     const std::size_t n = samples.size();
-    apply(introspect::InjectDeep{signal, std::move(samples)});
+    apply(introspect::InjectDeep{signal, plain(std::move(samples))});
     c_.log("middleware: " + c_.name + ": deep injection into " + signal + " (" + std::to_string(n) + " samples)");
   }
 

@@ -1,7 +1,7 @@
 #pragma once
-// Internal: how a sequence of structs or strings is read from a bus message. Included before the
-// generated Slice header by every file that decodes one, and by the generated source itself
-// (slice2cpp --add-header), so that one reader serves them all.
+// Internal: how a sequence is read from a bus message. Included by the generated Slice header
+// (cpp:include) and source (slice2cpp --add-header), and before the generated header by every file
+// that decodes one, so that one reader serves them all.
 //
 // Ice 3.7 checks a sequence's declared size against the bytes left as `size * minWireSize` in 32
 // bits: a size near 2^31 / minWireSize wraps the product and passes, and the vector of that many
@@ -10,14 +10,70 @@
 // Here the bound is checked in 64 bits: a sequence of more elements than the bytes left can hold
 // is refused (UnmarshalOutOfBoundsException, which decode() turns into a refusal), so what a
 // message makes us allocate is bounded by its size.
+//
+// Sequences of bytes, ints, doubles and strings are read by libIce's own functions, which a
+// template cannot replace, and the same wrap there is worse: a byte sequence declaring nearly 2^31
+// bytes passes the check and is copied from far past the message (a crash, before any signature
+// is checked). So the Slice file declares those sequences as `bounded::List`s of ours
+// (cpp:type), read here with the bound in 64 bits too.
 
 #include <Ice/Ice.h>
 
 #include <cstdint>
+#include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
+namespace safecass::bounded {
+
+/// A std::vector that the bus reads with its size bounded by the bytes left (see above); it
+/// converts to and from std::vector freely.
+template <class E>
+struct List : std::vector<E> {
+  using std::vector<E>::vector;
+  List() = default;
+  List(const std::vector<E>& v) : std::vector<E>(v) {}                 // NOLINT(google-explicit-constructor)
+  List(std::vector<E>&& v) noexcept : std::vector<E>(std::move(v)) {}  // NOLINT(google-explicit-constructor)
+};
+using Bytes = List<Ice::Byte>;
+using Ints = List<Ice::Int>;
+using Doubles = List<Ice::Double>;
+using Strings = List<std::string>;
+
+/// The fewest bytes an element takes on the wire.
+template <class E>
+constexpr std::int64_t wire_bytes() {
+  return std::is_arithmetic_v<E> ? static_cast<std::int64_t>(sizeof(E)) : 1;  // a string: its size
+}
+
+}  // namespace safecass::bounded
+
 namespace Ice {
+
+template <typename E>
+struct StreamHelper<safecass::bounded::List<E>, StreamHelperCategorySequence> {
+  template <class S>
+  static void write(S* stream, const safecass::bounded::List<E>& v) {
+    stream->write(static_cast<const std::vector<E>&>(v));
+  }
+
+  template <class S>
+  static void read(S* stream, safecass::bounded::List<E>& v) {
+    const Int size = stream->readSize();
+    const std::int64_t left = stream->b.end() - stream->i;
+    if (static_cast<std::int64_t>(size) * safecass::bounded::wire_bytes<E>() > left) {
+      throw UnmarshalOutOfBoundsException(__FILE__, __LINE__);
+    }
+    if constexpr (std::is_same_v<E, Ice::Byte>) {
+      v.assign(stream->i, stream->i + size);
+      stream->i += size;
+    } else {
+      v.assign(static_cast<std::size_t>(size), E{});
+      for (E& e : v) stream->read(e);
+    }
+  }
+};
 
 template <typename E>
 requires std::is_class_v<E>

@@ -698,7 +698,7 @@ namespace {
 class AliveServant final : public wire::Alive {
 public:
   explicit AliveServant(Supervisor::Impl& d) : d_(d) {}
-  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override {
+  wire::Signed prove(wire::Bytes nonce, const Ice::Current&) override {
     return make_proof(*d_.signer, d_.ic, nonce, d_.heartbeat(false));
   }
 

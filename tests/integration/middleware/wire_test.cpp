@@ -121,7 +121,7 @@ struct Bus;
 class FakeAlive final : public wire::Alive {
 public:
   FakeAlive(Bus& bus, std::string name) : bus_(bus), name_(std::move(name)) {}
-  wire::Signed prove(Ice::ByteSeq nonce, const Ice::Current&) override;
+  wire::Signed prove(wire::Bytes nonce, const Ice::Current&) override;
 
 private:
   Bus& bus_;
@@ -334,7 +334,7 @@ struct Bus {
   }
 };
 
-wire::Signed FakeAlive::prove(Ice::ByteSeq nonce, const Ice::Current&) {
+wire::Signed FakeAlive::prove(wire::Bytes nonce, const Ice::Current&) {
   std::lock_guard lock(bus_.mutex);
   if (name_ == "wire-p" && !bus_.proving.load()) return {};
   if (name_ == "wire-p") {
@@ -1286,7 +1286,7 @@ TEST(Wire, StringsFromMessagesArePrintedOnOneLine) {
 class ReplayingAlive final : public wire::Alive {
 public:
   explicit ReplayingAlive(wire::Signed recorded) : recorded_(std::move(recorded)) {}
-  wire::Signed prove(Ice::ByteSeq, const Ice::Current&) override {
+  wire::Signed prove(wire::Bytes, const Ice::Current&) override {
     ++asked;
     return recorded_;
   }

@@ -454,7 +454,7 @@ TEST(Decode, ABatchDeclaringMoreMessagesThanItsBytesCanHoldIsRefusedWithoutBuild
   EXPECT_FALSE(decode(ice, body, batch));
   EXPECT_TRUE(batch.empty());
   // A genuine batch still decodes.
-  wire::EventMessage m;
+  wire::EventMessage m{};  // every field set: an enum left undefined does not encode
   m.coordinator = "robot";
   m.seq = 1;
   const wire::EventMessageSeq sent{m, m};
@@ -462,6 +462,46 @@ TEST(Decode, ABatchDeclaringMoreMessagesThanItsBytesCanHoldIsRefusedWithoutBuild
   ASSERT_TRUE(decode(ice, encode(ice, sent), received));
   EXPECT_EQ(received.size(), 2U);
   EXPECT_EQ(received[1].coordinator, "robot");
+  ice->destroy();
+}
+
+}  // namespace
+}  // namespace safecass::middleware
+
+namespace safecass::middleware {
+namespace {
+
+// Ice 3.7 checks a sequence's declared size as start + size x minimum size in 32 bits, which wraps
+// for a size near 2^31: a byte, double or string sequence declaring that many elements must be
+// refused, not read past the message or allocated.
+Ice::ByteSeq with_huge_size(Ice::ByteSeq prefix, std::int32_t size) {
+  prefix.push_back(0xff);
+  for (int k = 0; k < 4; ++k)
+    prefix.push_back(static_cast<Ice::Byte>((static_cast<std::uint32_t>(size) >> (8 * k)) & 0xff));
+  for (int k = 0; k < 16; ++k) prefix.push_back(0x41);
+  return prefix;
+}
+
+TEST(Decode, ASignedMessageWhoseBodyDeclaresNearlyTwoGigabytesIsRefused) {
+  const std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
+  for (std::int32_t size : {0x7fffffff, 0x7ffffff0, 0x7fffff00}) {
+    wire::Signed m;
+    EXPECT_FALSE(decode(ice, with_huge_size({0x01, 0x61, 0x01, 0x62}, size), m)) << size;
+  }
+  ice->destroy();
+}
+
+TEST(Decode, AParameterWhoseNumbersOrTextsDeclareTooManyIsRefused) {
+  const std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
+  for (std::int32_t size : {0x20000000, 0x40000000, 0x60000000, 0x7fffffff, 0x7ffffff0}) {
+    // kind "a", number 0.0, flag false, text "", then the texts' size
+    Ice::ByteSeq texts{0x01, 0x61, 0, 0, 0, 0, 0, 0, 0, 0, 0x00, 0x00};
+    wire::ParamValue v;
+    EXPECT_FALSE(decode(ice, with_huge_size(texts, size), v)) << size;
+    Ice::ByteSeq numbers = texts;
+    numbers.push_back(0x00);  // no texts, then the numbers' size
+    EXPECT_FALSE(decode(ice, with_huge_size(numbers, size), v)) << size;
+  }
   ice->destroy();
 }
 
