@@ -47,6 +47,16 @@ constexpr std::int64_t wire_bytes() {
   return std::is_arithmetic_v<E> ? static_cast<std::int64_t>(sizeof(E)) : 1;  // a string: its size
 }
 
+/// Reads a sequence's size; refuses one of more elements, of at least `min_bytes` each, than the
+/// bytes left can hold (the bound in 64 bits).
+template <class S>
+Ice::Int read_count(S* stream, std::int64_t min_bytes) {
+  const Ice::Int size = stream->readSize();
+  const std::int64_t left = stream->b.end() - stream->i;
+  if (static_cast<std::int64_t>(size) * min_bytes > left) throw Ice::UnmarshalOutOfBoundsException(__FILE__, __LINE__);
+  return size;
+}
+
 }  // namespace safecass::bounded
 
 namespace Ice {
@@ -60,11 +70,7 @@ struct StreamHelper<safecass::bounded::List<E>, StreamHelperCategorySequence> {
 
   template <class S>
   static void read(S* stream, safecass::bounded::List<E>& v) {
-    const Int size = stream->readSize();
-    const std::int64_t left = stream->b.end() - stream->i;
-    if (static_cast<std::int64_t>(size) * safecass::bounded::wire_bytes<E>() > left) {
-      throw UnmarshalOutOfBoundsException(__FILE__, __LINE__);
-    }
+    const Int size = safecass::bounded::read_count(stream, safecass::bounded::wire_bytes<E>());
     if constexpr (std::is_same_v<E, Ice::Byte>) {
       v.assign(stream->i, stream->i + size);
       stream->i += size;
@@ -86,11 +92,7 @@ struct StreamHelper<std::vector<E>, StreamHelperCategorySequence> {
 
   template <class S>
   static void read(S* stream, std::vector<E>& v) {
-    const Int size = stream->readSize();
-    const std::int64_t left = stream->b.end() - stream->i;
-    if (static_cast<std::int64_t>(size) * StreamableTraits<E>::minWireSize > left) {
-      throw UnmarshalOutOfBoundsException(__FILE__, __LINE__);
-    }
+    const Int size = safecass::bounded::read_count(stream, StreamableTraits<E>::minWireSize);
     std::vector<E>(static_cast<std::size_t>(size)).swap(v);
     for (E& e : v) stream->read(e);
   }
