@@ -169,21 +169,22 @@ Expected<Signal*> SignalRegistry::add(std::string_view name, ComponentId compone
     }
     return s;
   }
-  signals_.reserve(signals_.size() + 1);
-  marks_.reserve(signals_.size() + 1);
-  const auto before = std::make_pair(headers_.mark(), rings_.mark());
+  // Its places first (amortised growth), so that nothing can fail once it is built.
+  marks_.emplace_back(headers_.mark(), rings_.mark());
+  signals_.push_back(nullptr);
   Signal* s = nullptr;
   try {
     s = new (headers_.allocate(sizeof(Signal))) Signal(std::string(name), component, size, default_history_, rings_);
     by_name_.emplace(s->name(), s);
   } catch (...) {
     if (s != nullptr) s->~Signal();
-    headers_.release(before.first);
-    rings_.release(before.second);
+    headers_.release(marks_.back().first);
+    rings_.release(marks_.back().second);
+    signals_.pop_back();
+    marks_.pop_back();
     throw;
   }
-  signals_.push_back(s);
-  marks_.push_back(before);
+  signals_.back() = s;
   return s;
 }
 

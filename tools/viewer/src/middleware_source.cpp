@@ -52,11 +52,11 @@ std::string component_of(std::string_view address) { return std::string(address.
 
 }  // namespace
 
-/// One coordinator of the system: its shape (built locally), what its thread last learnt, and
-/// the connection the server thread uses for explain and writes.
 /// How often a live coordinator's filter list (its filters' run-time facts) is read at most.
 constexpr std::chrono::milliseconds kFiltersPeriod{500};
 
+/// One coordinator of the system: its shape (built locally), what its thread last learnt, and
+/// the connection the server thread uses for explain and writes.
 struct MiddlewareLink {
   std::string name;
   std::string token;       ///< empty without --token-file for it
