@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-tree fuzz fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-tree fuzz fuzz-coverage fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
 
 all: build
 
@@ -73,15 +73,14 @@ stress-test: build
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
-# The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, their own tree): the spec loader, the
-# ROS inputs, the named reads' answers, scenarios, history lines, inputs recordings, CSV logs and
-# the viewer's messages (docs/contributing.md, "Fuzzing"). scripts/fuzz runs them with their seeds.
-# `make test` runs a smoke of the library targets; csv and viewer_message need the tools built
-# with the fuzzer's instrumentation (the middleware among them), minutes more of a cold CI run, so
-# they run in `make fuzz` only.
+# The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, their own tree), one per input that
+# crosses a boundary: the spec loader, the ROS inputs, the named reads' answers, scenarios, history
+# lines, input recordings, CSV logs, ROS 1 and ROS 2 bags, the viewer's messages, the console's
+# command lines and the bus's authenticated messages (docs/contributing.md, "Fuzzing").
+# scripts/fuzz runs them with their seeds; `make test` runs a smoke of each.
 FUZZ := $(BUILD)/fuzz
-FUZZ_SMOKE_TARGETS := spec_loader ros_input read_answer scenario history input_log
-FUZZ_TARGETS := $(FUZZ_SMOKE_TARGETS) csv viewer_message console_command wire_events
+FUZZ_TARGETS := spec_loader ros_input read_answer scenario history input_log csv rosbag1 rosbag2 viewer_message \
+  console_command wire_events
 FUZZ_SECONDS ?= 60
 fuzz-tree: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
@@ -93,11 +92,15 @@ fuzz: fuzz-tree
 	@cmake --build $(FUZZ) -j $(JOBS) --target $(addsuffix _fuzz,$(FUZZ_TARGETS)) >/dev/null
 	@./scripts/fuzz $(FUZZ) $(FUZZ_SECONDS) $(FUZZ_TARGETS)
 
-# The short runs of `make test`: the spec loader 20 s, every other library target 4 s.
+# The source coverage of each parser that its target's kept corpus reaches (llvm-cov, its own tree).
+fuzz-coverage: fuzz-tree
+	@./scripts/fuzz-coverage $(FUZZ) $(BUILD)/fuzz-coverage $(FUZZ_TARGETS)
+
+# The short runs of `make test`: the spec loader 20 s, every other target 4 s.
 fuzz-smoke: fuzz-tree
-	@cmake --build $(FUZZ) -j $(JOBS) --target $(addsuffix _fuzz,$(FUZZ_SMOKE_TARGETS)) >/dev/null
+	@cmake --build $(FUZZ) -j $(JOBS) --target $(addsuffix _fuzz,$(FUZZ_TARGETS)) >/dev/null
 	@./scripts/fuzz $(FUZZ) 20 spec_loader
-	@./scripts/fuzz $(FUZZ) 4 $(filter-out spec_loader,$(FUZZ_SMOKE_TARGETS))
+	@./scripts/fuzz $(FUZZ) 4 $(filter-out spec_loader,$(FUZZ_TARGETS))
 
 # Benchmarks are built in Release in their own tree; results land in build/bench.json (every
 # repetition and the aggregates), run on one core (the last) when taskset is there.

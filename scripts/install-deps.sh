@@ -22,10 +22,11 @@ packages+=(clang-format clang-tidy universal-ctags)
 # ROS 2 over DDS (extensions/dds, examples/dds_robodoc, `make ros2-demo`): Eclipse Cyclone DDS's C
 # library and its IDL compiler (idlc) and tools (ddsperf).
 packages+=(cyclonedds-dev cyclonedds-tools libcycloneddsidl0)
-# `safecass replay` of a ROS 2 bag (rosbag2's sqlite3 store).
-packages+=(libsqlite3-dev)
-# ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (`safecass
-# replay` of a bag), the messages,
+# `safecass replay` of a ROS 2 bag (rosbag2's sqlite3 store) and of a ROS 1 bag (chunks compressed
+# with bzip2 or LZ4).
+packages+=(libsqlite3-dev libbz2-dev liblz4-dev)
+# ROS 1 (extensions/ros1, examples/ros_robodoc, `make ros-demo`): roscore, roscpp, rosbag (the bag
+# replay tests write their bags with rosbag's own writer), the messages,
 # diagnostic_aggregator and rosdiagnostic; unshare/ip for the loopback-only test namespace.
 packages+=(
   ros-core libroscpp-dev librosbag-dev libstd-msgs-dev libgeometry-msgs-dev libsensor-msgs-dev

@@ -8,12 +8,17 @@ namespace {
 
 constexpr std::size_t kHeader = 4;
 
-/// Reads CDR members in order; the first failure is kept and every later read fails.
+/// Reads members in order, as CDR (aligned, after the encapsulation header) or as ROS 1 packs them
+/// (no header, no alignment, little endian); the first failure is kept and every later read fails.
 class CdrReader {
 public:
-  CdrReader(const std::uint8_t* data, std::size_t size, std::string& error) : data_(data), size_(size), error_(error) {}
+  enum class Encoding : std::uint8_t { Cdr, Ros1 };
+
+  CdrReader(Encoding encoding, const std::uint8_t* data, std::size_t size, std::string& error)
+      : encoding_(encoding), data_(data), size_(size), error_(error) {}
 
   bool header() {
+    if (encoding_ == Encoding::Ros1) return true;
     if (size_ < kHeader) return fail(0, "fewer than the 4 bytes of the CDR encapsulation header");
     // 00 00: CDR big endian; 00 01: CDR little endian (plain CDR, not XCDR2 or parameter lists).
     if (data_[0] != 0 || data_[1] > 1)
@@ -21,6 +26,12 @@ public:
     little_ = data_[1] == 1;
     at_ = kHeader;
     return true;
+  }
+  /// std_msgs/Header: (ROS 1: uint32 seq,) the stamp's int32 sec and uint32 nanosec, string frame_id.
+  bool message_header() {
+    std::uint32_t seq = 0, nanosec = 0;
+    std::int32_t sec = 0;
+    return (encoding_ == Encoding::Cdr || u32(seq)) && i32(sec) && u32(nanosec) && skip_string();
   }
   bool u32(std::uint32_t& v) { return scalar(v); }
   bool i32(std::int32_t& v) { return scalar(v); }
@@ -67,7 +78,9 @@ private:
     static const char digits[] = "0123456789abcdef";
     return std::string{digits[b >> 4], digits[b & 15]};
   }
-  void align(std::size_t n) { at_ = kHeader + (at_ - kHeader + n - 1) / n * n; }
+  void align(std::size_t n) {
+    if (encoding_ == Encoding::Cdr) at_ = kHeader + (at_ - kHeader + n - 1) / n * n;
+  }
   template <class T>
   bool scalar(T& v) {
     if (!ok_) return false;
@@ -91,6 +104,7 @@ private:
     return false;
   }
 
+  Encoding encoding_;
   const std::uint8_t* data_;
   std::size_t size_;
   std::string& error_;
@@ -99,18 +113,11 @@ private:
   bool ok_ = true;
 };
 
-}  // namespace
-
-bool decode_cdr(MessageType type, const std::uint8_t* data, std::size_t size, DecodedMessage& out, std::string& error) {
-  CdrReader r(data, size, error);
+/// The numbers of a `type` message that `r` reads.
+bool decode(CdrReader& r, MessageType type, DecodedMessage& out, std::string& error) {
   if (!r.header()) return false;
   out.numbers = MessageNumbers{};
-  // std_msgs/Header: builtin_interfaces/Time stamp (int32 sec, uint32 nanosec), string frame_id.
-  auto header = [&r] {
-    std::int32_t sec = 0;
-    std::uint32_t nanosec = 0;
-    return r.i32(sec) && r.u32(nanosec) && r.skip_string();
-  };
+  auto header = [&r] { return r.message_header(); };
   switch (type) {
     case MessageType::Float64: return r.f64(out.numbers.data);
     case MessageType::WrenchStamped: {
@@ -135,6 +142,19 @@ bool decode_cdr(MessageType type, const std::uint8_t* data, std::size_t size, De
   }
   error = "unsupported message type";
   return false;
+}
+
+}  // namespace
+
+bool decode_cdr(MessageType type, const std::uint8_t* data, std::size_t size, DecodedMessage& out, std::string& error) {
+  CdrReader r(CdrReader::Encoding::Cdr, data, size, error);
+  return decode(r, type, out, error);
+}
+
+bool decode_ros1(MessageType type, const std::uint8_t* data, std::size_t size, DecodedMessage& out,
+                 std::string& error) {
+  CdrReader r(CdrReader::Encoding::Ros1, data, size, error);
+  return decode(r, type, out, error);
 }
 
 }  // namespace safecass::ros_common

@@ -47,8 +47,8 @@ case $case_name in
     "$write_bag" "$tmp/wrong.bag" wrong_type || fail "write_bag"
     replay "$tmp/wrong.bag" >"$tmp/out" 2>"$tmp/err"; code=$?
     [ $code = 2 ] || fail "exit code $code: $(cat "$tmp/err")"
-    # (rosbag files the Float64 under the topic's WrenchStamped connection: it cannot be read as one.)
-    grep -q "^$tmp/wrong.bag: message 1[0-9][0-9] (/jr3/wrench): cannot be read as geometry_msgs/WrenchStamped (rosbag: " "$tmp/err" \
+    # (rosbag files the Float64 under the topic's WrenchStamped connection: its 8 bytes cannot be read as one.)
+    grep -q "^$tmp/wrong.bag: message 1[0-9][0-9] (/jr3/wrench): cannot be read as geometry_msgs/WrenchStamped: byte 8: " "$tmp/err" \
       || fail "message: $(cat "$tmp/err")"
     [ -s "$tmp/out" ] && fail "something ran: $(cat "$tmp/out")"
     "$write_bag" "$tmp/short.bag" short_joint_state || fail "write_bag"

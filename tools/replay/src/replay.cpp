@@ -20,9 +20,7 @@
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/spec/instance.hpp"
 
-#ifdef SAFECASS_REPLAY_WITH_ROSBAG
-#include "safecass/ros1/bag_source.hpp"
-#endif
+#include "safecass/replay/rosbag1_source.hpp"
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG2
 #include "safecass/replay/rosbag2_source.hpp"
 #endif
@@ -66,17 +64,11 @@ std::string sniff(const std::string& path) {
   }
   if (format == "csv") return open_csv(o.input);
   if (format == "bag") {
-#ifdef SAFECASS_REPLAY_WITH_ROSBAG
     if (o.mapping.empty()) {
       return fail(ErrorCode::InvalidArgument,
                   o.input + ": a ROS bag needs the ROS extension's mapping file (--mapping FILE)");
     }
-    return ros1::open_bag(o.input, o.mapping);
-#else
-    return fail(
-        ErrorCode::InvalidArgument,
-        o.input + ": a ROS bag needs the ROS 1 extension, and this safecass was built without it (SAFECASS_WITH_ROS1)");
-#endif
+    return open_rosbag1(o.input, o.mapping);
   }
   if (format == "rosbag2") {
 #ifdef SAFECASS_REPLAY_WITH_ROSBAG2

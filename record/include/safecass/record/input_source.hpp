@@ -1,9 +1,9 @@
 #pragma once
 /// @file input_source.hpp
 /// A log of a system's inputs read back as a stream (what `safecass replay` feeds through a
-/// system): a SAFECASS input recording (input_log.hpp), a CSV file, a ROS 1 bag (the ROS 1
-/// extension, safecass/ros1/bag_source.hpp) or a ROS 2 bag. Each is read as a stream of items in
-/// time order, in constant memory, whatever the file's size.
+/// system): a SAFECASS input recording (input_log.hpp), a CSV file, a ROS 1 bag or a ROS 2 bag
+/// (safecass/replay/). Each is read as a stream of items in time order; memory does not grow with
+/// the file's data (a ROS 1 bag holds the index of its mapped topics' messages, 24 bytes each).
 ///
 /// bind() resolves the names the log uses against the replayed system first; then next() yields
 /// samples (already bound to their Signal) and actions. A problem in the log ends the stream with

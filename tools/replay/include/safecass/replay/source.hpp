@@ -1,8 +1,7 @@
 #pragma once
 /// @file source.hpp
 /// The replay's own input sources (the interface is record/input_source.hpp): a SAFECASS input
-/// recording, a CSV file and a ROS 2 bag (rosbag2_source.hpp); a ROS 1 bag is the ROS 1
-/// extension's (safecass/ros1/bag_source.hpp).
+/// recording, a CSV file, a ROS 1 bag (rosbag1_source.hpp) and a ROS 2 bag (rosbag2_source.hpp).
 
 #include <memory>
 #include <string>
