@@ -383,11 +383,7 @@ private:
 }  // namespace
 
 [[nodiscard]] Expected<std::unique_ptr<InputSource>> open_rosbag1(const std::string& bag, const std::string& mapping) {
-  auto m = ros_common::load_log_mapping(mapping);
-  if (!m) return tl::unexpected(m.error());
-  auto source = std::make_unique<Rosbag1Source>(bag, std::move(*m));
-  if (auto opened = source->open(); !opened) return tl::unexpected(opened.error());
-  return std::unique_ptr<InputSource>(std::move(source));
+  return ros_common::open_message_source<Rosbag1Source>(bag, mapping);
 }
 
 }  // namespace safecass::replay

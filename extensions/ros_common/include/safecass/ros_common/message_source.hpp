@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <memory>
 #include <set>
 #include <string>
 #include <string_view>
@@ -81,5 +82,17 @@ private:
   bool failed_ = false;
   std::string error_;
 };
+
+/// A `Source` (a MessageSource with `Expected<void> open()`) of the log at `log`, with the mapping
+/// file at `mapping`. Errors: the mapping's (Parse), then open()'s.
+template <class Source>
+[[nodiscard]] Expected<std::unique_ptr<InputSource>> open_message_source(const std::string& log,
+                                                                         const std::string& mapping) {
+  auto m = load_log_mapping(mapping);
+  if (!m) return tl::unexpected(m.error());
+  auto source = std::make_unique<Source>(log, std::move(*m));
+  if (auto opened = source->open(); !opened) return tl::unexpected(opened.error());
+  return std::unique_ptr<InputSource>(std::move(source));
+}
 
 }  // namespace safecass::ros_common
