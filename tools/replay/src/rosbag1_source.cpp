@@ -40,7 +40,7 @@ std::uint64_t little(std::string_view bytes) {
 class Fields {
 public:
   /// The fields of `header`, or why it is not one.
-  static Expected<Fields> parse(std::string_view header) {
+  [[nodiscard]] static Expected<Fields> parse(std::string_view header) {
     Fields f;
     for (std::size_t pos = 0; pos < header.size();) {
       if (header.size() - pos < 4) return fail(ErrorCode::Parse, "a header field's length is cut off");
@@ -151,9 +151,9 @@ private:
   };
 
   /// What the record of `op` at `at` tells, checked.
-  Expected<void> take(std::uint64_t op, const Fields& fields, std::uint64_t at, std::uint64_t data_at,
-                      std::uint32_t data_len, std::optional<std::uint64_t>& index_pos,
-                      std::vector<std::pair<std::uint64_t, std::uint64_t>>& chunk_refs) {
+  [[nodiscard]] Expected<void> take(std::uint64_t op, const Fields& fields, std::uint64_t at, std::uint64_t data_at,
+                                    std::uint32_t data_len, std::optional<std::uint64_t>& index_pos,
+                                    std::vector<std::pair<std::uint64_t, std::uint64_t>>& chunk_refs) {
     switch (op) {
       case kBagHeader:
         index_pos = fields.number("index_pos", 8);
