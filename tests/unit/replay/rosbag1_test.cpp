@@ -71,7 +71,7 @@ std::vector<Record> records(const std::string& bag) {
   return out;
 }
 
-const Record& first(const std::vector<Record>& rs, std::uint8_t op) {
+Record first(const std::vector<Record>& rs, std::uint8_t op) {
   for (const Record& r : rs) {
     if (r.op == op) return r;
   }
@@ -120,7 +120,7 @@ TEST(Rosbag1, EveryCompressionOfTheSameBagReplaysTheSameSamplesInTimeOrder) {
 TEST(Rosbag1, ARecordHeaderLongerThanTheFileIsRefusedBeforeAnythingIsAllocated) {
   // Found by the fuzz target with librosbag, which allocated the 4 GiB it was told before reading.
   std::string bag = read_bytes(kSeeds + "ros1_plain.bag");
-  const Record& connection = first(records(bag), 0x07);
+  const Record connection = first(records(bag), 0x07);
   put_u32(bag, connection.at, 0xFFFFFF00u);
   const std::string path = write_bag("long_header", bag);
   EXPECT_EQ(replay(path), std::vector<std::string>{"refused: " + path + ": byte " + std::to_string(connection.at) +
@@ -132,7 +132,7 @@ TEST(Rosbag1, AnIndexEntryPointingOutsideItsChunkIsRefusedWithItsMessage) {
   // Found by the fuzz target with librosbag, which read the message at any offset it was told (SEGV).
   std::string bag = read_bytes(kSeeds + "ros1_plain.bag");
   const std::vector<Record> rs = records(bag);
-  const Record& index = first(rs, 0x04);
+  const Record index = first(rs, 0x04);
   put_u32(bag, index.data_at + 8, 0x7FFFFFF0u);  // the first entry's offset in its chunk
   const std::string path = write_bag("index_outside", bag);
   const std::vector<std::string> out = replay(path);
@@ -145,7 +145,7 @@ TEST(Rosbag1, AnIndexEntryPointingOutsideItsChunkIsRefusedWithItsMessage) {
 TEST(Rosbag1, AChunkThatDecompressesToOtherThanItDeclaresIsRefused) {
   for (const char* compression : {"bz2", "lz4"}) {
     std::string bag = read_bytes(kSeeds + "ros1_" + compression + ".bag");
-    const Record& chunk = first(records(bag), 0x05);
+    const Record chunk = first(records(bag), 0x05);
     const std::uint32_t declared = u32_at(bag, chunk.value_at.at("size"));
     put_u32(bag, chunk.value_at.at("size"), declared + 100);
     const std::string path = write_bag(std::string("chunk_size_") + compression, bag);
@@ -159,7 +159,7 @@ TEST(Rosbag1, AChunkThatDecompressesToOtherThanItDeclaresIsRefused) {
 
 TEST(Rosbag1, ABagWithoutAnIndexIsRefusedWithTheCommandThatWritesOne) {
   std::string bag = read_bytes(kSeeds + "ros1_plain.bag");
-  const Record& header = first(records(bag), 0x03);
+  const Record header = first(records(bag), 0x03);
   put_u32(bag, header.value_at.at("index_pos"), 0);
   put_u32(bag, header.value_at.at("index_pos") + 4, 0);
   const std::string path = write_bag("unindexed", bag);
