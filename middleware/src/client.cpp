@@ -459,13 +459,14 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   std::sort(components_.begin(), components_.end());
   const auto sent = h.lastSeq.find(std::string(kEventsStream));
   const std::int64_t sent_now = sent == h.lastSeq.end() ? 0 : sent->second;
-  if (first) {
-    // The first heartbeat of the process followed: what it sent before this follower listened
-    // is read once from its history, and the stream is followed from there.
-    (void)deliver_kept(0);
-    stream_.caught_up(sent_now);
-  }
-  // What it vouches for: delivered now if here, else awaited.
+  // The first heartbeat of the process followed: what it sent before this follower listened is
+  // read once from its history, and the stream is followed from there (a read that fails leaves
+  // the stream behind: a gap, read again at the next heartbeat).
+  const bool covered = first && deliver_kept(0).has_value();
+  if (covered) stream_.caught_up(sent_now);
+  // What it vouches for: delivered now if here, else awaited. After the first heartbeat's read, a
+  // batch not here was sent before this follower listened (a heartbeat lists two periods): its
+  // records were in that read, so it is not awaited, and listed again it is no gap.
   for (const Ice::ByteSeq& digest : h.sentEvents) {
     if (std::find(delivered_.begin(), delivered_.end(), digest) != delivered_.end()) continue;  // listed twice
     const auto held =
@@ -474,6 +475,8 @@ void Follower::on_heartbeat(const wire::Signed& m) {
       Waiting batch = take_unvouched(held);
       delivered_.push_back(std::move(batch.digest));
       deliver(batch.messages);
+    } else if (covered) {
+      delivered_.push_back(digest);
     } else if (std::none_of(unreceived_.begin(), unreceived_.end(),
                             [&](const Waiting& w) { return w.digest == digest; })) {
       unreceived_.push_back(Waiting{digest, {}, 0});
@@ -553,9 +556,9 @@ Expected<std::size_t> Follower::deliver_kept(std::uint64_t below) {
         last_ = e.seq;
         if (!components_.empty() && !std::binary_search(components_.begin(), components_.end(), e.component))
           continue;  // a stand-in's record: its own process publishes that component's records
-        sink_(e);
         ++n;
-        ++client_.read;
+        ++client_.read;  // counted before it is shown: whoever sees it shown sees it counted
+        sink_(e);
       }
       if (last_ == from) return n;
     }
