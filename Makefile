@@ -7,7 +7,7 @@ BUILD := build
 # design until it is, so `make test` leaves them out and `make known-defects` runs them.
 CTEST_ARGS ?= -LE known-defect
 
-.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-tree fuzz fuzz-coverage fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
+.PHONY: all deps configure build demo ros-demo ros2-demo cluster-demo test stress-test known-defects fuzz-tree fuzz fuzz-coverage fuzz-keep fuzz-smoke bench bench-check bench-peers bench-scale-out bench-verify asan tsan package lint clean
 
 all: build
 
@@ -80,7 +80,7 @@ known-defects: build
 # scripts/fuzz runs them with their seeds; `make test` runs a smoke of each.
 FUZZ := $(BUILD)/fuzz
 FUZZ_TARGETS := spec_loader ros_input read_answer scenario history input_log csv rosbag1 rosbag2 viewer_message \
-  console_command wire_events
+  console_command wire_events wire_messages
 FUZZ_SECONDS ?= 60
 fuzz-tree: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
@@ -95,6 +95,11 @@ fuzz: fuzz-tree
 # The source coverage of each parser that its target's kept corpus reaches (llvm-cov, its own tree).
 fuzz-coverage: fuzz-tree
 	@./scripts/fuzz-coverage $(FUZZ) $(BUILD)/fuzz-coverage $(FUZZ_TARGETS)
+
+# A campaign's corpora, each merged to its smallest subset of the same coverage, into
+# tests/fuzz/corpus/TARGET.tar.xz: every later run starts from them.
+fuzz-keep: fuzz-tree
+	@./scripts/fuzz-keep $(FUZZ) $(FUZZ_TARGETS)
 
 # The short runs of `make test`: the spec loader 20 s, every other target 4 s.
 fuzz-smoke: fuzz-tree

@@ -465,6 +465,9 @@ std::string coverage_now_json(const CoverageNow& c) {
   if (t == nullptr || !t->is_number() || hazards == nullptr || !hazards->is_array()) {
     return fail(ErrorCode::Parse, "analyze now: t or hazards missing or wrong");
   }
+  if (!readable_seconds(t->number)) {
+    return fail(ErrorCode::Parse, "analyze now: t must be a time in seconds of at most 4e9 in magnitude");
+  }
   CoverageNow c;
   c.now = seconds_to_time(t->number);
   for (const json::JsonValue& item : hazards->array) {

@@ -14,10 +14,6 @@ namespace {
 
 using json::JsonValue;
 
-/// The largest time a history line may hold, in seconds: 2^32 (136 years) rounded down, so that a
-/// double keeps a time's microseconds and writing it back (history_json) gives the same text.
-constexpr double kMaxSeconds = 4e9;
-
 /// Reads the fields of one object; the first problem is kept as the message.
 class FieldReader {
 public:
@@ -45,12 +41,12 @@ public:
     return v->number;
   }
 
-  /// A time in seconds: a number of at most kMaxSeconds in magnitude, where the file's
+  /// A time in seconds: a number of at most kMaxReadSeconds in magnitude, where the file's
   /// microseconds still read back as they were written (beyond, a double cannot hold them).
   std::optional<Time> time(std::string_view key, bool required) {
     const std::optional<double> seconds = number(key, required);
     if (!seconds) return std::nullopt;
-    if (!(std::fabs(*seconds) <= kMaxSeconds)) {
+    if (!readable_seconds(*seconds)) {
       fail("\"" + std::string(key) + "\" must be a time in seconds of at most 4e9 in magnitude (about 126 years)");
       return std::nullopt;
     }

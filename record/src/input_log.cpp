@@ -266,7 +266,7 @@ std::optional<introspect::Action> decode_action(InputActionKind kind, const char
     p += 2;
     if (stop - p < 8 * static_cast<std::ptrdiff_t>(w)) return std::nullopt;
     std::vector<double> v(w);
-    std::memcpy(v.data(), p, std::size_t{8} * w);
+    if (w != 0) std::memcpy(v.data(), p, std::size_t{8} * w);  // an empty vector's data() may be null
     p += std::size_t{8} * w;
     values.push_back(std::move(v));
   }

@@ -23,43 +23,13 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "fuzz_bus.hpp"
 #include "read_model_wire.hpp"
-#include "safecass/filters/registry.hpp"
 #include "safecass/introspect/format.hpp"
-#include "safecass/middleware/keys.hpp"
-#include "safecass/spec/load.hpp"
 
 namespace {
 
 using namespace safecass;
-
-struct Members {
-  std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
-  std::optional<middleware::Signer> robot, supervisor;
-};
-
-Members& members() {
-  static Members* m = [] {
-    auto* made = new Members;
-    const FilterRegistry& registry = builtin_filters();
-    const spec::LoadResult loaded = spec::load_system(SAFECASS_SOURCE_DIR "/examples/robodoc/robodoc.json", registry);
-    if (!loaded.system) __builtin_trap();
-    const std::string dir =
-        (std::filesystem::temp_directory_path() / ("safecass-wire-fuzz-" + std::to_string(::getpid()))).string();
-    if (!middleware::create_bus_keys(*loaded.system, dir, middleware::KeyOptions::replacing())) __builtin_trap();
-    auto keyring = middleware::Keyring::load(dir);
-    if (!keyring) __builtin_trap();
-    auto robot = middleware::Signer::load(dir, "robot", *keyring);
-    auto supervisor = middleware::Signer::load(dir, "supervisor", *keyring);
-    if (!robot || !supervisor) __builtin_trap();
-    made->robot.emplace(std::move(*robot));
-    made->supervisor.emplace(std::move(*supervisor));
-    std::error_code ec;
-    std::filesystem::remove_all(dir, ec);
-    return made;
-  }();
-  return *m;
-}
 
 /// A record of robodoc as a coordinator publishes one: a transition with its root.
 wire::EventMessage record(long long seq, const std::string& machine, wire::Level to) {
@@ -83,7 +53,7 @@ wire::EventMessage record(long long seq, const std::string& machine, wire::Level
 }
 
 void write_seeds(const std::string& dir) {
-  Members& m = members();
+  fuzz::BusMembers& m = fuzz::bus_members();
   const std::vector<wire::EventMessageSeq> seeds{
       {record(1, "JR3.s_A", wire::Level::Error)},
       {record(2, "JR3.s_A", wire::Level::Error), record(3, "CONTROL.s_R.ForceData", wire::Level::Error)},
@@ -107,7 +77,7 @@ extern "C" int LLVMFuzzerInitialize(int* /*argc*/, char*** /*argv*/) {
 }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-  Members& m = members();
+  fuzz::BusMembers& m = fuzz::bus_members();
   const wire::Signed sealed = m.robot->seal(middleware::kKindEvents, Ice::ByteSeq(data, data + size));
   wire::EventMessageSeq batch;
   const std::string why = middleware::open_sealed(*m.supervisor, m.ice, sealed, middleware::kKindEvents, batch);

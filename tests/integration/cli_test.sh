@@ -148,6 +148,17 @@ case $case_name in
     "$safecass" replay --diff examples/robodoc/robodoc.json examples/robodoc/robodoc.json --input "$tmp/s.inputs" >"$tmp/out" 2>"$tmp/err"
     expect_code 0 $? "diff of a system with itself"
     ;;
+  replay_refuses_a_time_its_clock_cannot_hold)
+    # --from, --to and --period become nanoseconds in 64 bits: beyond 4e9 s, or NaN, they are
+    # refused with the option and the value, before the log is opened (it does not exist here).
+    for option in "--from 1e300" "--to nan" "--period 5e9" "--period -1" "--from -inf"; do
+      # shellcheck disable=SC2086
+      "$safecass" replay examples/robodoc/robodoc.json --input "$tmp/none.inputs" $option >"$tmp/out" 2>"$tmp/err"
+      expect_code 2 $? "replay $option: $(cat "$tmp/err")"
+      grep -q -- "${option%% *}" "$tmp/err" || fail "replay $option: the option is not named: $(cat "$tmp/err")"
+    done
+    grep -q "at most 4e9" "$tmp/err" || fail "no bound said: $(cat "$tmp/err")"
+    ;;
   run_records_history_as_json_lines)
     "$safecass" run --scenario examples/force_sensor/scenario.json --record "$tmp/h.jsonl" >/dev/null; expect_code 0 $? "run"
     [ -s "$tmp/h.jsonl" ] || fail "empty history"

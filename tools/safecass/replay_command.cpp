@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "safecass/core/clock.hpp"
 #include "safecass/filters/registry.hpp"
 #include "safecass/replay/replay.hpp"
 
@@ -16,6 +17,17 @@ struct ReplayArgs {
   double from = 0, to = 0, period = 0;
   std::uint64_t max_bytes = 0;
 };
+
+/// A number of seconds the replay's clock holds (core/clock.hpp, readable_seconds): finite and at
+/// most 4e9 in magnitude. CLI11's own ranges let NaN through.
+const CLI::Validator kSeconds(
+    [](std::string& text) {
+      double seconds = 0;
+      if (!CLI::detail::lexical_cast(text, seconds) || !readable_seconds(seconds))
+        return std::string("must be a number of seconds of at most 4e9 in magnitude, not ") + text;
+      return std::string();
+    },
+    "SECONDS");
 }  // namespace
 
 void add_replay_command(CLI::App& app, int& code) {
@@ -30,11 +42,13 @@ void add_replay_command(CLI::App& app, int& code) {
       "replay through SYSTEM_B and SYSTEM_A and print, per address, where their states differ (exit 1 if they do)");
   cmd->add_flag("--coverage", args->options.coverage,
                 "after the replay, print when each hazard was uncovered (`analyze now` at every tick)");
-  auto* from = cmd->add_option("--from", args->from, "seconds: start the replay here (inputs before it are not fed)");
-  auto* to = cmd->add_option("--to", args->to, "seconds: end the replay here");
+  auto* from = cmd->add_option("--from", args->from, "seconds: start the replay here (inputs before it are not fed)")
+                   ->check(kSeconds);
+  auto* to = cmd->add_option("--to", args->to, "seconds: end the replay here")->check(kSeconds);
   auto* period =
       cmd->add_option("--period", args->period,
                       "seconds per tick (default: the recording's, else the smallest component period, else 0.001)")
+          ->check(kSeconds)
           ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", args->options.json, "one JSON object per line");
   cmd->add_option("--record", args->options.record,

@@ -184,5 +184,19 @@ TEST(CoverageNowFormat, AnAnswerThatIsNotACoverageIsAParseErrorThatSaysSo) {
   }
 }
 
+TEST(CoverageNowFormat, AnAnswerWhoseTimeTheClockCannotHoldIsAParseError) {
+  // Found while extending read_answer_fuzz to every named read: "t" of 1e300 s was converted to
+  // nanoseconds with undefined behaviour (a double beyond 64 bits; float-cast-overflow).
+  for (const char* bad : {R"({"t":1e300,"hazards":[]})", R"({"t":-5e9,"hazards":[]})"}) {
+    auto parsed = coverage_now_from_json(bad);
+    ASSERT_FALSE(parsed) << bad;
+    EXPECT_EQ(parsed.error().code, ErrorCode::Parse) << bad;
+    EXPECT_EQ(parsed.error().message, "analyze now: t must be a time in seconds of at most 4e9 in magnitude") << bad;
+  }
+  auto edge = coverage_now_from_json(R"({"t":4e9,"hazards":[]})");
+  ASSERT_TRUE(edge) << edge.error().message;
+  EXPECT_EQ(edge->now, seconds_to_time(4e9));
+}
+
 }  // namespace
 }  // namespace safecass::introspect

@@ -274,6 +274,20 @@ TEST(InputLogReader, ALossOfAnUndeclaredSignalIsAnError) {
   EXPECT_THAT(error, HasSubstr("loss of signal id 7, which was never declared"));
 }
 
+TEST(InputLogReader, AnInjectionHoldingAnEmptySampleReadsBack) {
+  // Found by input_log_fuzz once UBSan's reports stopped the run: an injected sample of no values
+  // was copied from a null pointer (memcpy of 0 bytes into an empty vector's data()).
+  std::string bytes;
+  input_log::put_header(bytes, InputLogHeader{});
+  input_log::put_action(bytes, introspect::InjectShallow{"f", {{}, {1.0}}}, Time{0});
+  input_log::put_end(bytes, Time{0});
+  const std::string path = scratch("empty-sample.inputs");
+  spit(path, bytes);
+  std::string error;
+  EXPECT_EQ(read_all(path, &error), "A inject 0 f|||2\nE 0\n");
+  EXPECT_EQ(error, "");
+}
+
 TEST_F(InputRecording, SamplesOverwrittenBeforeTheRecorderReadThemAreCountedMarkedAndSaid) {
   const std::string path = scratch("lost.inputs");
   auto rec = InputRecorder::open(monitor_, path);

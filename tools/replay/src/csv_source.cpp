@@ -15,9 +15,6 @@ namespace safecass::replay {
 
 namespace {
 
-/// The largest time of a row, in seconds (about 126 years): nanoseconds of it fit a 64-bit clock.
-constexpr double kMaxSeconds = 4e9;
-
 constexpr std::size_t kBuffer = 256 * 1024;
 constexpr std::size_t kMaxLine = 1 << 20;
 
@@ -289,7 +286,7 @@ private:
     if (!have_time) return fail_line(0, "the row has no time");
     // A time the replay's clock holds (nanoseconds in 64 bits): field data in seconds since the Unix
     // epoch fits, with room; 1e72 s does not convert at all.
-    if (!(std::fabs(t) <= kMaxSeconds)) {
+    if (!readable_seconds(t)) {
       char buf[96];
       std::snprintf(buf, sizeof buf, "time %.9g s is out of range (at most 4e9 s in magnitude)", t);
       return fail_line(0, buf);

@@ -17,6 +17,16 @@ constexpr Time seconds_to_time(double seconds) noexcept {
 }
 constexpr double to_seconds(Time t) noexcept { return static_cast<double>(t.count()) * 1e-9; }
 
+/// The largest magnitude of a time read from outside (a recording, a log, an answer), in seconds:
+/// 2^32 (136 years) rounded down. Its nanoseconds fit Time, and a double still holds its
+/// microseconds, so what is written back as text reads back the same.
+inline constexpr double kMaxReadSeconds = 4e9;
+/// True when `seconds` (read from outside) converts to a Time: finite and at most kMaxReadSeconds
+/// in magnitude. Beyond, seconds_to_time() would overflow (undefined behaviour).
+constexpr bool readable_seconds(double seconds) noexcept {
+  return seconds <= kMaxReadSeconds && seconds >= -kMaxReadSeconds;
+}
+
 /// Source of time. now() is thread-safe, lock-free and never allocates.
 class Clock {
 public:
