@@ -521,7 +521,8 @@ int run_interactive(Console& console) {
   return 0;
 }
 
-/// "a; b\nc" -> {"a", "b", "c"}.
+}  // namespace
+
 std::vector<std::string> split_commands(const std::string& text) {
   std::vector<std::string> out;
   std::string current;
@@ -536,8 +537,6 @@ std::vector<std::string> split_commands(const std::string& text) {
   out.push_back(current);
   return out;
 }
-
-}  // namespace
 
 int run_console(const ConsoleArgs& args) {
   std::vector<std::string> script;

@@ -101,6 +101,9 @@ private:
   ConsoleOptions options_;
 };
 
+/// The commands of `-c TEXT`: TEXT split at each ';' and line end ("a; b\nc" -> {"a", " b", "c"}).
+[[nodiscard]] std::vector<std::string> split_commands(const std::string& text);
+
 /// Runs the console; returns the exit code: 0, or 2 when the system cannot be loaded (or the
 /// coordinator cannot be reached) or (with -c, --script or a non-terminal stdin) when any
 /// command failed.

@@ -626,5 +626,13 @@ TEST_F(ConsoleTest, CompletionOffersCommandWordsThenTheNamesEachCommandTakes) {
   EXPECT_FALSE(console->completes_file("filter dinject JR3.Force "));
 }
 
+TEST(ConsoleBatch, DashCTextIsCutAtEverySemicolonAndLineEndAndKeepsEmptyCommands) {
+  EXPECT_EQ(split_commands("state list; filter list\nevent list"),
+            (std::vector<std::string>{"state list", " filter list", "event list"}));
+  EXPECT_EQ(split_commands(";;"), (std::vector<std::string>{"", "", ""}))
+      << "each an empty command, which does nothing";
+  EXPECT_EQ(split_commands("time"), (std::vector<std::string>{"time"}));
+}
+
 }  // namespace
 }  // namespace safecass::tools

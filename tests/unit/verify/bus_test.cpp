@@ -71,12 +71,17 @@ TEST(BusVerify, RobodocsDeploymentMeetsP1ToP5InEveryFaultClassExhaustively) {
 }
 
 TEST(BusVerify, ASecondDeploymentWithTwoStreamsBetweenCoordinatorsMeetsP1ToP5) {
+  // Its one-stream classes are the very models of robodoc's robot -> ui (proved above; `verify
+  // --bus` searches a model once): the two-stream class is what this deployment adds.
   BusOptions options;
   options.supervisor = false;
+  options.fault_class = "two-streams";
   auto r = verify_bus(load_bus("tests/data/bus/cell.json"), options);
   ASSERT_TRUE(r) << r.error().message;
   ASSERT_EQ(r->patterns.size(), 2u);
   EXPECT_EQ(r->patterns[0].streams, 2u) << "sensing feeds control two interfaces";
+  ASSERT_EQ(r->searches.size(), 1u) << "control -> hmi holds one stream: no two-stream search";
+  EXPECT_EQ(r->searches.front().fault_class, "two-streams");
   expect_proved(*r);
 }
 
