@@ -61,13 +61,8 @@ ros-demo: configure
 
 # Every test; a test that fails is run once more alone and named in the summary as retried
 # (scripts/run-tests), which ends with what ran: ctest's count and the fuzz smoke run's executions.
-# The fuzz targets build at the lowest priority while the tests run (they leave much of the CPU
-# idle, waiting on heartbeats and timeouts); their smoke runs after the tests.
-test: build fuzz-tree
-	@JOBS=$(JOBS) ./scripts/run-tests $(BUILD) \
-	  --beside "cmake --build $(FUZZ) -j $(JOBS) --target $(addsuffix _fuzz,$(FUZZ_TARGETS))" \
-	  --then "FUZZ_PARALLEL=$(JOBS) ./scripts/fuzz $(FUZZ) 5 $(FUZZ_TARGETS)" \
-	  --fuzz-log $(FUZZ)/spec_loader.log $(CTEST_ARGS)
+test: build fuzz-smoke
+	@JOBS=$(JOBS) ./scripts/run-tests $(BUILD) --fuzz-log $(FUZZ)/spec_loader.log $(CTEST_ARGS)
 
 # The tests that start processes (label `processes`), STRESS_RUNS times (default 5) beside two busy
 # loops with ctest -j2 and no retry: every run must pass (scripts/stress-test).
