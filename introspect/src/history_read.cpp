@@ -1,7 +1,6 @@
 // history_entry_from_json(): a history-file line (history_json()'s) read back into a HistoryEntry.
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
