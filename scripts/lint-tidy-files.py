@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """The sources clang-tidy checks (scripts/lint --tidy, --tidy-all), one absolute path per line.
 
-  lint-tidy-files.py COMPILE_COMMANDS [--changed-since-baseline]
+  lint-tidy-files.py COMPILE_COMMANDS DB_DIR [--changed-since-baseline]
 
-Every source of the project's own targets in COMPILE_COMMANDS (under the source tree, not under a
+Writes DB_DIR/compile_commands.json, the database clang-tidy reads: COMPILE_COMMANDS with each of
+CMake's unity sources (a test program's batch of files, tests/CMakeLists.txt) replaced by the files
+it includes, each compiled by the batch's command. Then prints every source of the project's own targets in COMPILE_COMMANDS (under the source tree, not under a
 build tree, not generated). With --changed-since-baseline, only those that changed since the
 tidied baseline commit named in .ci/tidy-baseline (committed, staged, unstaged or untracked), and
 those that include a changed header by the path written in their #include; every source when
@@ -19,6 +21,7 @@ import sys
 
 BASELINE_FILE = ".ci/tidy-baseline"
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]', re.M)
+UNITY_SOURCE = re.compile(r"/CMakeFiles/[^/]+\.dir/Unity/unity_[0-9]+_cxx\.cxx$")
 
 
 def git(*args):
@@ -66,15 +69,36 @@ def includes_changed_header(rel, path, headers):
     return False
 
 
+def without_unity_sources(entries):
+    """The entries, each unity source's replaced by one per file that it includes."""
+    out = []
+    for entry in entries:
+        path = os.path.normpath(os.path.join(entry["directory"], entry["file"]))
+        if not UNITY_SOURCE.search(path):
+            out.append(entry)
+            continue
+        for source in INCLUDE.findall(open(path, encoding="utf-8").read()):
+            one = dict(entry, file=source)
+            if "command" in one:
+                one["command"] = one["command"].replace(path, source)
+            if "arguments" in one:
+                one["arguments"] = [source if a == path else a for a in one["arguments"]]
+            out.append(one)
+    return out
+
+
 def main():
-    if len(sys.argv) not in (2, 3) or (len(sys.argv) == 3 and sys.argv[2] != "--changed-since-baseline"):
+    if len(sys.argv) not in (3, 4) or (len(sys.argv) == 4 and sys.argv[3] != "--changed-since-baseline"):
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
     root = os.getcwd()
-    changed = changed_files() if len(sys.argv) == 3 else None
+    changed = changed_files() if len(sys.argv) == 4 else None
     headers = [c for c in changed or () if c.endswith((".hpp", ".h"))]
+    entries = without_unity_sources(json.load(open(sys.argv[1], encoding="utf-8")))
+    with open(os.path.join(sys.argv[2], "compile_commands.json"), "w", encoding="utf-8") as db:
+        json.dump(entries, db, indent=1)
     seen = set()
-    for entry in json.load(open(sys.argv[1], encoding="utf-8")):
+    for entry in entries:
         path = os.path.normpath(os.path.join(entry["directory"], entry["file"]))
         rel = os.path.relpath(path, root)
         if rel.startswith("..") or rel.startswith("build") or "/generated/" in rel or path in seen:

@@ -16,9 +16,9 @@ namespace {
 
 using test::Gcm;
 
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::W;
 
 /// Component C provides p and q, requires r1 and r2; events EF (error) and WF (warning).
 struct Comp : Gcm {

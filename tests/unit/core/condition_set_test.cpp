@@ -26,9 +26,9 @@
 namespace safecass {
 namespace {
 
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::W;
 
 constexpr EventId kX{100};
 constexpr EventId kB{200};

@@ -26,6 +26,15 @@ inline void PrintTo(RecordKind k, std::ostream* os) { *os << to_string(k); }
 
 namespace safecass::test {
 
+// Terse states for the tables of expected levels.
+inline constexpr State N = State::Normal;
+inline constexpr State W = State::Warning;
+inline constexpr State E = State::Error;
+// Terse onset transitions for the same tables.
+inline constexpr Transition N2W = Transition::N2W;
+inline constexpr Transition N2E = Transition::N2E;
+inline constexpr Transition W2E = Transition::W2E;
+
 inline constexpr TransitionSet kToWarning{Transition::N2W};
 inline constexpr TransitionSet kToError{Transition::N2E, Transition::W2E};
 inline constexpr TransitionSet kFromWarning{Transition::W2N};

@@ -21,12 +21,12 @@ using test::kToError;
 using test::kToWarning;
 using test::onset;
 
-constexpr Transition N2W = Transition::N2W;
-constexpr Transition N2E = Transition::N2E;
-constexpr Transition W2E = Transition::W2E;
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::N2E;
+using test::N2W;
+using test::W;
+using test::W2E;
 
 // ---- the onset-level rule, exhaustively ---------------------------------------------------------
 

@@ -53,7 +53,7 @@ void expect_same(const Record& a, const Record& b, std::size_t i) {
 
 /// A chain A ← B ← C ← D (each X.in connected to the previous one's out), with a warning and an
 /// error onset (the error one latched in a second pair), driven through every kind of record.
-struct Chain {
+struct HistoryChain {
   SimulatedClock clock;
   Coordinator co;
   std::vector<Record> stream;
@@ -61,7 +61,7 @@ struct Chain {
   MachineId a_app{};
   MachineId c_fw{};
 
-  explicit Chain(CoordinatorOptions options) : co("history", &clock, options) {
+  explicit HistoryChain(CoordinatorOptions options) : co("history", &clock, options) {
     for (const char* name : {"A", "B", "C", "D"}) {
       const ComponentId c = *co.add_component(name);
       (void)*co.add_provided(c, "out");
@@ -129,7 +129,7 @@ CoordinatorOptions ring_of(std::size_t n) {
 
 TEST(HistoryStorage, TheHistoryReturnsExactlyTheRecordsTheStreamPublished) {
   CoordinatorOptions options;  // the defaults: nothing is overwritten in 5 rounds
-  Chain chain(options);
+  HistoryChain chain(options);
   for (int k = 0; k < 5; ++k) chain.round(k);
   const std::vector<Record> got = chain.co.history(Address{});
   const std::vector<Record> want = chain.newest(chain.co.history_size());
@@ -141,7 +141,7 @@ TEST(HistoryStorage, TheHistoryReturnsExactlyTheRecordsTheStreamPublished) {
 TEST(HistoryStorage, AfterTheRingWrapsTheNewestRecordsKeepTheirRootCausesAndTexts) {
   // A ring of 64 records overwritten many times: every root slot a kept record names must still
   // hold its own root (each record writes at most one root into a ring of the same capacity).
-  Chain chain(ring_of(64));
+  HistoryChain chain(ring_of(64));
   for (int k = 0; k < 40; ++k) chain.round(k);
   ASSERT_EQ(chain.co.history_size(), 64u);
   const std::vector<Record> got = chain.co.history(Address{});
@@ -165,7 +165,7 @@ TEST(HistoryStorage, GrowingTheRingWhileTheModelIsConfiguredKeepsEveryRecordAndI
   CoordinatorOptions options;
   options.history_records = 8;
   options.history_per_address = 4;
-  Chain chain(options);
+  HistoryChain chain(options);
   chain.round(0);
   const std::size_t before = chain.co.history_size();
   const std::vector<Record> kept = chain.co.history(Address{});
@@ -195,7 +195,7 @@ std::vector<Record> read_on(const Coordinator& co, std::uint64_t seq, std::size_
 }
 
 TEST(HistoryStorage, RecordsSinceGivesTheRecordsAfterASequenceNumberExactlyAsTheStreamPublishedThem) {
-  Chain chain(CoordinatorOptions{});
+  HistoryChain chain(CoordinatorOptions{});
   for (int k = 0; k < 5; ++k) chain.round(k);
   ASSERT_GT(chain.stream.size(), 100u);
   for (const std::size_t from : {std::size_t{0}, std::size_t{1}, chain.stream.size() / 2, chain.stream.size() - 1}) {
@@ -212,7 +212,7 @@ TEST(HistoryStorage, RecordsSinceGivesTheRecordsAfterASequenceNumberExactlyAsThe
 TEST(HistoryStorage, RecordsSinceReturnsAtMostHistoryCapacityRecordsPerReadWhateverIsAsked) {
   CoordinatorOptions options;
   options.history_capacity = 16;
-  Chain chain(options);
+  HistoryChain chain(options);
   for (int k = 0; k < 3; ++k) chain.round(k);
   ASSERT_GT(chain.stream.size(), 16u);
   EXPECT_EQ(chain.co.records_since(0, 0).size(), 16u) << "0 asks for the bound";
@@ -222,7 +222,7 @@ TEST(HistoryStorage, RecordsSinceReturnsAtMostHistoryCapacityRecordsPerReadWhate
 }
 
 TEST(HistoryStorage, AfterTheRingWrapsRecordsSinceStartsAtTheOldestRecordKeptSoTheReaderSeesTheLoss) {
-  Chain chain(ring_of(64));
+  HistoryChain chain(ring_of(64));
   for (int k = 0; k < 40; ++k) chain.round(k);
   const std::vector<Record> want = chain.newest(64);
   const std::vector<Record> got = read_on(chain.co, chain.stream.front().seq, 10);

@@ -20,9 +20,9 @@ using test::kFromError;
 using test::kToError;
 using test::onset;
 
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::W;
 
 /// The paper's example: JR3 provides ForceData, CONTROL requires it.
 struct Robot : Gcm {

@@ -17,9 +17,9 @@ namespace {
 using test::Gcm;
 using test::must;
 
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::W;
 
 /// The events every "process" of these tests defines (events are system-wide names).
 void define_events(Gcm& g) {

@@ -23,9 +23,9 @@ using test::kToError;
 using test::kToWarning;
 using test::onset;
 
-constexpr State N = State::Normal;
-constexpr State W = State::Warning;
-constexpr State E = State::Error;
+using test::E;
+using test::N;
+using test::W;
 
 /// One component C with a catalogue of onsets (name = level + severity) and their completions.
 struct Machine : Gcm {
@@ -357,9 +357,9 @@ TEST(ConditionSet, OutstandingIsHighestSeverityAtCurrentLevelMostRecentOnTie) {
 
 // ---- exhaustive tables ----------------------------------------------------------------------------
 
-constexpr Transition N2W = Transition::N2W;
-constexpr Transition N2E = Transition::N2E;
-constexpr Transition W2E = Transition::W2E;
+using test::N2E;
+using test::N2W;
+using test::W2E;
 
 struct OnsetRow {
   const char* transitions_text;

@@ -16,14 +16,14 @@
 namespace safecass::middleware {
 namespace {
 
-constexpr std::int64_t kMs = 1'000'000;
+constexpr std::int64_t kMillisecond = 1'000'000;
 
 TEST(Sleeper, ASleepEndsAtItsDeadlineAndNeverBefore) {
   Sleeper sleeper;
-  const std::int64_t deadline = steady_ns() + 30 * kMs;
+  const std::int64_t deadline = steady_ns() + 30 * kMillisecond;
   EXPECT_TRUE(sleeper.sleep_until(deadline));
   EXPECT_GE(steady_ns(), deadline);
-  EXPECT_TRUE(sleeper.sleep_until(deadline - 1000 * kMs)) << "a deadline already past: at once";
+  EXPECT_TRUE(sleeper.sleep_until(deadline - 1000 * kMillisecond)) << "a deadline already past: at once";
 }
 
 TEST(Sleeper, AWakeEndsTheSleepEarlyAndAWakeBeforeTheSleepEndsTheNextOne) {
@@ -33,11 +33,11 @@ TEST(Sleeper, AWakeEndsTheSleepEarlyAndAWakeBeforeTheSleepEndsTheNextOne) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
     sleeper.wake();
   });
-  EXPECT_TRUE(sleeper.sleep_until(start + 60'000 * kMs)) << "woken, not stopped";
+  EXPECT_TRUE(sleeper.sleep_until(start + 60'000 * kMillisecond)) << "woken, not stopped";
   waker.join();
-  EXPECT_LT(steady_ns() - start, 30'000 * kMs) << "the wake, not the minute, ended it";
+  EXPECT_LT(steady_ns() - start, 30'000 * kMillisecond) << "the wake, not the minute, ended it";
   sleeper.wake();  // a duty that came up while the thread was busy is not lost
-  EXPECT_TRUE(sleeper.sleep_until(steady_ns() + 60'000 * kMs));
+  EXPECT_TRUE(sleeper.sleep_until(steady_ns() + 60'000 * kMillisecond));
 }
 
 TEST(Sleeper, AStopEndsTheSleepAndEverySleepAfterItUntilRestarted) {
@@ -48,9 +48,9 @@ TEST(Sleeper, AStopEndsTheSleepAndEverySleepAfterItUntilRestarted) {
   sleeper.stop();
   sleeping.join();  // a sleep "forever" ends at the stop
   EXPECT_FALSE(returned_true.load());
-  EXPECT_FALSE(sleeper.sleep_until(steady_ns() + 60'000 * kMs)) << "stopped: at once";
+  EXPECT_FALSE(sleeper.sleep_until(steady_ns() + 60'000 * kMillisecond)) << "stopped: at once";
   sleeper.restart();
-  EXPECT_TRUE(sleeper.sleep_until(steady_ns() + kMs));
+  EXPECT_TRUE(sleeper.sleep_until(steady_ns() + kMillisecond));
 }
 
 }  // namespace

@@ -14,8 +14,6 @@
 namespace safecass::spec {
 namespace {
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 constexpr const char* kCorpus = "tests/data/bad_specs";
 
 /// The cases: every *.json directly in the corpus directory (included/ holds helpers).

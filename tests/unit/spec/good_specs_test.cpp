@@ -9,8 +9,6 @@
 namespace safecass::spec {
 namespace {
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 constexpr const char* kRobodoc = "tests/data/good_specs/robodoc.json";
 constexpr const char* kLegacy = "tests/data/good_specs/legacy_2016/system.json";
 

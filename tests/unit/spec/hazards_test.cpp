@@ -13,8 +13,6 @@
 namespace safecass::spec {
 namespace {
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 std::string arm_system(const std::string& sections, const std::string& hazard = "H-3") {
   return R"({"safecass": 1, "system": "arm", )" + sections + R"(
   "components": [{"component": "ARM", "interfaces": {"provided": ["Motion"]}, "signals": [{"name": "Force"}],

@@ -15,8 +15,6 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 constexpr const char* kDir = "tests/data/good_specs/original_2016/";
 
 const ComponentSpec& component(const SystemSpec& s, const std::string& name) {

@@ -12,8 +12,6 @@
 namespace safecass::spec {
 namespace {
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 TEST(SpecSchema, CheckedInFileEqualsTheGeneratedSchema) {
   const std::string schema = json_schema(builtin_registry());
   const char* update = std::getenv("SAFECASS_UPDATE_GOLDEN");

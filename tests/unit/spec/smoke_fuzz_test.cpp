@@ -16,8 +16,6 @@
 namespace safecass::spec {
 namespace {
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 const std::vector<std::string> kSeeds = {
     "tests/data/good_specs/robodoc.json", "tests/data/good_specs/jr3.json", "tests/data/good_specs/parts/control.json",
     "tests/data/good_specs/legacy_2016/jr3.json", "tests/data/good_specs/legacy_2016/system.json"};

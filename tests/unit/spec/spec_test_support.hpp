@@ -20,6 +20,8 @@ class SourceRoot : public ::testing::Environment {
 public:
   void SetUp() override { std::filesystem::current_path(SAFECASS_SOURCE_DIR); }
 };
+/// Registered once for the whole program (an inline variable), whichever of its files include this.
+inline const auto* const kSourceRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 
 inline const FilterRegistry& builtin_registry() {
   static const FilterRegistry registry = [] {

@@ -12,8 +12,6 @@ namespace {
 
 using ::testing::HasSubstr;
 
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
 TEST(SpecValidateCommand, GoodSystemExitsZero) {
   ::testing::internal::CaptureStdout();
   const int code = run_validate({"tests/data/good_specs/robodoc.json"}, false);

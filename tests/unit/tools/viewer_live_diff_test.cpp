@@ -18,15 +18,18 @@
 #include "safecass/viewer/in_process_source.hpp"
 #include "safecass/viewer/live_diff.hpp"
 #include "safecass/viewer/protocol.hpp"
+#include "viewer_test_support.hpp"
 
 namespace safecass::viewer {
 namespace {
 
+using test::kSystem;
+using test::parse;
+using test::str;
+
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using ::testing::Not;
-
-const std::string kSystem = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
 
 /// One coordinator of robodoc built locally, as MiddlewareSource builds its skeleton.
 struct LocalCoordinator {
@@ -43,17 +46,6 @@ struct LocalCoordinator {
   Coordinator co;
   Monitor monitor;
 };
-
-json::JsonValue parse(const std::string& text) {
-  json::JsonParse p = json::parse_json(text, 64);
-  EXPECT_TRUE(p.value.has_value()) << text;
-  return p.value ? *p.value : json::JsonValue{};
-}
-
-std::string str(const json::JsonValue& object, std::string_view key) {
-  const json::JsonValue* v = object.find(key);
-  return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
-}
 
 /// The read model's rows of a locally built coordinator (what a live one answers to state list).
 std::vector<introspect::StateRow> rows_of(LocalCoordinator& local) {

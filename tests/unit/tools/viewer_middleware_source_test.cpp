@@ -24,13 +24,14 @@
 
 #include "safecass/viewer/middleware_source.hpp"
 #include "safecass/viewer/protocol.hpp"
+#include "viewer_test_support.hpp"
 
 namespace safecass::viewer {
 namespace {
 
-using ::testing::HasSubstr;
+using test::kSystem;
 
-const std::string kSystem = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
+using ::testing::HasSubstr;
 
 /// A TCP port on 127.0.0.1 that nobody listens on (bound, then released).
 int closed_port() {

@@ -14,14 +14,17 @@
 #include "safecass/viewer/protocol.hpp"
 
 #include "../../../examples/custom_filter/frozen_filter.hpp"
+#include "viewer_test_support.hpp"
 
 namespace safecass::viewer {
 namespace {
 
-using ::testing::HasSubstr;
+using test::kStory;
+using test::kSystem;
+using test::parse;
+using test::str;
 
-const std::string kStory = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/story.json";
-const std::string kSystem = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
+using ::testing::HasSubstr;
 
 /// The robodoc story, driven by hand (advance_to): the wall clock barely moves it (speed 0.001).
 std::unique_ptr<InProcessSource> open_story() {
@@ -32,17 +35,6 @@ std::unique_ptr<InProcessSource> open_story() {
   auto source = InProcessSource::open(o);
   EXPECT_TRUE(source.has_value()) << (source ? "" : source.error().message);
   return source ? std::move(*source) : nullptr;
-}
-
-json::JsonValue parse(const std::string& text) {
-  json::JsonParse p = json::parse_json(text, 64);
-  EXPECT_TRUE(p.value.has_value()) << text;
-  return p.value ? *p.value : json::JsonValue{};
-}
-
-std::string str(const json::JsonValue& object, std::string_view key) {
-  const json::JsonValue* v = object.find(key);
-  return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
 }
 
 /// The component `name` of the view, or nullptr.

@@ -24,15 +24,17 @@
 #include "safecass/runner/scenario_runner.hpp"
 #include "safecass/viewer/protocol.hpp"
 #include "safecass/viewer/replay_source.hpp"
+#include "viewer_test_support.hpp"
 
 namespace safecass::viewer {
 namespace {
 
+using test::kStory;
+using test::kSystem;
+
 using ::testing::HasSubstr;
 
 const std::string kSource = SAFECASS_SOURCE_DIR;
-const std::string kStory = kSource + "/examples/robodoc/story.json";
-const std::string kSystem = kSource + "/examples/robodoc/robodoc.json";
 
 /// The robodoc story run once, recorded: its history and its inputs, in a fresh directory.
 class RecordedStory : public ::testing::Test {

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <filesystem>
 #include <string>
 
 #include "safecass/core/coordinator.hpp"
@@ -16,24 +15,12 @@
 #include "safecass/filters/registry.hpp"
 #include "safecass/spec/load.hpp"
 #include "safecass/verify/verify.hpp"
+#include "verify_test_support.hpp"
 
 namespace safecass::verify {
 namespace {
 
-class SourceRoot : public ::testing::Environment {
-public:
-  void SetUp() override { std::filesystem::current_path(SAFECASS_SOURCE_DIR); }
-};
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
-const FilterRegistry& registry() {
-  static const FilterRegistry r = [] {
-    FilterRegistry x;
-    register_builtin_filters(x);
-    return x;
-  }();
-  return r;
-}
+using test::registry;
 
 /// A tree of `n` components (Ck requires the Out of C((k-1)/3)), each with an Error onset, a
 /// Warning onset that turns into an Error from Warning ({N2W, W2E}), a latched onset on every

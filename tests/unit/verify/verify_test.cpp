@@ -18,6 +18,7 @@
 #include "safecass/spec/load.hpp"
 #include "safecass/verify/verify.hpp"
 #include "verify_command.hpp"
+#include "verify_test_support.hpp"
 
 namespace safecass::verify {
 namespace {
@@ -27,25 +28,17 @@ namespace fs = std::filesystem;
 
 fs::path test_root() { return fs::temp_directory_path() / ("safecass-verify-test-" + std::to_string(::getpid())); }
 
-/// Runs in the source root; removes the counterexamples written under the temporary directory.
-class SourceRoot : public ::testing::Environment {
+/// Removes the counterexamples written under the temporary directory once every test has run.
+class CounterexampleFiles : public ::testing::Environment {
 public:
-  void SetUp() override { fs::current_path(SAFECASS_SOURCE_DIR); }
   void TearDown() override {
     std::error_code ec;
     fs::remove_all(test_root(), ec);
   }
 };
-const auto* const kRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
+const auto* const kCounterexampleFiles = ::testing::AddGlobalTestEnvironment(new CounterexampleFiles);
 
-const FilterRegistry& registry() {
-  static const FilterRegistry r = [] {
-    FilterRegistry x;
-    register_builtin_filters(x);
-    return x;
-  }();
-  return r;
-}
+using test::registry;
 
 spec::SystemSpec load(const std::string& path) {
   spec::LoadResult r = spec::load_system(path, registry());
