@@ -29,12 +29,17 @@ if (!safecass || !root || !out) {
 // About 15 s idle; beside two busy loops some runs took 57 s (Chromium, six processes and the
 // loops on two cores): the deadline and the coordinators' run leave room for that.
 const kDeadlineMs = 115000;
+// How long a condition may take to show in the page: well under a second idle, but beside two busy
+// loops Chromium once took 24 s to show a write's result. Waits end as soon as the condition holds.
+const kWaitMs = 20000;
 const kSystem = path.join(root, 'examples/robodoc/robodoc.json');
 const kQuiet = path.join(root, 'tests/integration/console_ice/robot_quiet.json');
 
 const children = [];       // every process started, stopped by PID in cleanup()
 let icestormPid = 0;       // IceBox (started detached by scripts/start-icestorm)
 let context = null;
+let shown = null;          // the page, for what a failure needs
+const frames = [];         // every WebSocket frame the page received but updates: hello, replies, errors
 let userDataDir = '';
 let failures = 0;
 const scratch = path.join(out, 'viewer_ice_scratch');
@@ -189,15 +194,17 @@ async function test() {
 
   ({ context, userDataDir } = await launchChromium(root));
   const page = await context.newPage();
+  shown = page;
   const updates = [];
   page.on('websocket', (ws) => ws.on('framereceived', (frame) => {
     try {
       const m = JSON.parse(frame.payload);
       if (m.type === 'update') updates.push(m);
+      else frames.push(`${at()} ${frame.payload.slice(0, 600)}`);
     } catch { /* not ours */ }
   }));
   await page.goto(url);
-  await page.waitForSelector('#connection.online', { timeout: 10000 });
+  await page.waitForSelector('#connection.online', { timeout: kWaitMs });
   check(await statusOf(page, 'robot') === '', 'the page shows robot answering');
   check(await statusOf(page, 'ui') === 'unreachable', 'the page shows ui unreachable');
   check(await page.isVisible('[data-address="PENDANT.s_A"]'),
@@ -205,39 +212,48 @@ async function test() {
 
   // ui starts: it is tried again and shows as answering.
   const ui = await startCoordinator('ui', ice, '');
-  await waitStatus(page, 'ui', '', 10000).catch(() => {});
+  await waitStatus(page, 'ui', '', kWaitMs).catch(() => {});
   check(await statusOf(page, 'ui') === '', 'ui answers once its process runs (retried)');
   // A newcomer starts toward safe: ui holds PENDANT at Error until robot is proven alive and its
   // state received (docs/semantics.md §7.3), then Normal.
   await page.waitForFunction(() => ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM'].every(
     (a) => document.querySelector(`[data-address="${a}"]`)?.getAttribute('data-state') === 'Normal'),
-  null, { timeout: 10000 }).catch(() => {});
+  null, { timeout: kWaitMs }).catch(() => {});
   for (const a of ['CONTROL', 'PENDANT', 'JR3.s_A', 'SYSTEM']) check(await stateOf(page, a) === 'Normal', `${a} is Normal at first`);
 
   // A fault that lasts about a millisecond in another process (a warning raised and cleared by two
   // requests back to back): the robot pushes both records, so both reach the transition list,
-  // although no state list fetched between them would have seen the warning.
-  const glitch = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--allow-write', '--token-file', robotToken,
-    '-c', 'event generate EVT_FORCE_HIGH JR3.s_A; event generate /EVT_FORCE_HIGH JR3.s_A']);
-  check(glitch.code === 0, `console: the glitch EVT_FORCE_HIGH then /EVT_FORCE_HIGH on JR3.s_A (exit ${glitch.code}) ${glitch.stderr}`);
-  const listedNow = (what) => page.waitForFunction((w) => [...document.querySelectorAll('#transitions li')]
-    .some((li) => li.textContent.includes('JR3.s_A') && li.textContent.includes(w)), what, { timeout: 5000 })
+  // although no state list fetched between them would have seen the warning. That proof needs the
+  // glitch shorter than the 20 ms the states were once polled at: on a loaded machine the two
+  // requests may be further apart, and the glitch is raised again (at most three times).
+  const listedTimes = (what, n) => page.waitForFunction(([w, count]) => [...document.querySelectorAll('#transitions li')]
+    .filter((li) => li.textContent.includes('JR3.s_A') && li.textContent.includes(w)).length >= count, [what, n], { timeout: kWaitMs })
     .then(() => true).catch(() => false);
-  const onsetListed = await listedNow('Normal → Warning EVT_FORCE_HIGH');
-  const completionListed = await listedNow('Warning → Normal /EVT_FORCE_HIGH');
+  let width = null;
+  let onsetListed = false;
+  let completionListed = false;
+  for (let glitches = 1; glitches <= 3; glitches += 1) {
+    const glitch = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--allow-write', '--token-file', robotToken,
+      '-c', 'event generate EVT_FORCE_HIGH JR3.s_A; event generate /EVT_FORCE_HIGH JR3.s_A']);
+    check(glitch.code === 0, `console: the glitch EVT_FORCE_HIGH then /EVT_FORCE_HIGH on JR3.s_A (exit ${glitch.code}) ${glitch.stderr}`);
+    onsetListed = await listedTimes('Normal → Warning EVT_FORCE_HIGH', glitches);
+    completionListed = await listedTimes('Warning → Normal /EVT_FORCE_HIGH', glitches);
+    const lasted = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--json', '-c', 'state history JR3.s_A 10']);
+    const edges = lasted.stdout.split('\n').filter((l) => l.trim() !== '').map((l) => JSON.parse(l))
+      .filter((r) => r.kind === 'transition' && /EVT_FORCE_HIGH$/.test(r.event ?? ''));
+    width = edges.length >= 2 ? edges[edges.length - 1].t - edges[edges.length - 2].t : null;
+    if (!onsetListed || !completionListed || (width !== null && width < 0.02)) break;
+    console.log(`note: glitch ${glitches} lasted ${(width * 1000).toFixed(2)} ms, not under 20 ms (a loaded machine): raised again`);
+  }
   check(onsetListed, 'the glitch\'s onset is in the transition list');
   check(completionListed, 'the glitch\'s completion is in the transition list');
   if (!onsetListed || !completionListed) {
     // What a failure needs: what the page lists, what it received, and what the viewer said.
-    const listed = await page.$$eval('#transitions li', (items) => items.map((li) => li.textContent));
-    console.log(`--- the transition list (newest first):\n${listed.join('\n')}`);
+    const items = await page.$$eval('#transitions li', (all) => all.map((li) => li.textContent));
+    console.log(`--- the transition list (newest first):\n${items.join('\n')}`);
     console.log(`--- records received in updates:\n${updates.flatMap((u) => u.records.map((r) => JSON.stringify(r))).join('\n')}`);
     console.log(`--- viewer log:\n${logOf('viewer')}`);
   }
-  const lasted = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--json', '-c', 'state history JR3.s_A 10']);
-  const edges = lasted.stdout.split('\n').filter((l) => l.trim() !== '').map((l) => JSON.parse(l))
-    .filter((r) => r.kind === 'transition' && /EVT_FORCE_HIGH$/.test(r.event ?? ''));
-  const width = edges.length >= 2 ? edges[edges.length - 1].t - edges[edges.length - 2].t : null;
   check(width !== null && width < 0.02, `the glitch lasted less than the 20 ms the states were once polled at (${width === null ? '?' : (width * 1000).toFixed(2)} ms)`);
   check(await stateOf(page, 'JR3.s_A') === 'Normal', 'after the glitch JR3.s_A is Normal again');
 
@@ -246,8 +262,8 @@ async function test() {
   const generated = await run(safecass, ['console', '--ice', ice, '--coordinator', 'robot', '--allow-write', '--token-file', robotToken,
     '-c', 'event generate EVT_FORCE_ERROR JR3.s_A']);
   check(generated.code === 0, `console event generate EVT_FORCE_ERROR JR3.s_A (exit ${generated.code}) ${generated.stderr}`);
-  await page.waitForSelector('.component-name[data-address="CONTROL"].state-Error', { timeout: 5000 }).catch(() => {});
-  await page.waitForSelector('.component-name[data-address="PENDANT"].state-Error', { timeout: 5000 }).catch(() => {});
+  await page.waitForSelector('.component-name[data-address="CONTROL"].state-Error', { timeout: kWaitMs }).catch(() => {});
+  await page.waitForSelector('.component-name[data-address="PENDANT"].state-Error', { timeout: kWaitMs }).catch(() => {});
   check(await stateOf(page, 'CONTROL') === 'Error', 'CONTROL (robot process) is Error');
   check(await stateOf(page, 'PENDANT') === 'Error', 'PENDANT (ui process) is Error');
   check(await stateOf(page, 'JR3.s_A') === 'Error', 'JR3.s_A is Error');
@@ -258,7 +274,7 @@ async function test() {
 
   // The cause of PENDANT, asked from the ui process: the root is JR3.s_A EVT_FORCE_ERROR on robot.
   await page.click('.component-name[data-address="PENDANT"]');
-  await page.waitForFunction(() => /root cause/.test(document.getElementById('cause').textContent), null, { timeout: 5000 }).catch(() => {});
+  await page.waitForFunction(() => /root cause/.test(document.getElementById('cause').textContent), null, { timeout: kWaitMs }).catch(() => {});
   const cause = await page.textContent('#cause');
   check(/root cause: EVT_FORCE_ERROR at JR3\.s_A/.test(cause), `the cause of PENDANT names JR3.s_A EVT_FORCE_ERROR (${cause.slice(0, 200)})`);
 
@@ -318,7 +334,7 @@ async function test() {
   await page.fill('#generate-event', '/EVT_FORCE_ERROR');
   await page.fill('#generate-target', 'JR3.s_A');
   await page.click('#generate-form button');
-  await page.waitForSelector('#write-result.ok, #write-result.error', { timeout: 5000 });
+  await page.waitForSelector('#write-result.ok, #write-result.error', { timeout: kWaitMs });
   const result = await page.textContent('#write-result');
   check(/generated \/EVT_FORCE_ERROR on JR3\.s_A \(coordinator robot\)/.test(result), `the page's write goes to robot (${result})`);
   check(near(result), `the write says when in wall-clock time (${result})`);
@@ -328,7 +344,7 @@ async function test() {
   await page.waitForFunction((addresses) => addresses.every((a) => {
     const el = document.querySelector(`[data-address="${a}"]`);
     return el !== null && el.getAttribute('data-state') === 'Normal';
-  }), cleared, { timeout: 5000 }).catch(() => {});
+  }), cleared, { timeout: kWaitMs }).catch(() => {});
   for (const a of cleared) check(await stateOf(page, a) === 'Normal', `${a} is Normal again`);
   const late = [];
   for (const a of cleared) if (await stateOf(page, a) !== 'Normal') late.push(a);
@@ -347,7 +363,7 @@ async function test() {
 
   // ui stops: the page shows it lost.
   await stopPid(ui.pid);
-  await waitStatus(page, 'ui', 'lost', 10000).catch(() => {});
+  await waitStatus(page, 'ui', 'lost', kWaitMs).catch(() => {});
   check(await statusOf(page, 'ui') === 'lost', 'ui shows as lost when its process stops');
   check(await statusOf(page, 'robot') === '', 'robot still answers');
 
@@ -361,6 +377,12 @@ try {
   await test();
 } catch (e) {
   console.log(`FAILED: ${e.stack ?? e}`);
+  if (shown !== null) {
+    const addresses = await shown.$$eval('[data-address]', (all) => all.map((el) => `${el.dataset.address}=${el.dataset.state ?? ''}`))
+      .catch((x) => [`(page unreadable: ${x.message.split('\n')[0]})`]);
+    console.log(`--- the page's addresses now ${at()}:\n${addresses.join(' ')}`);
+    console.log(`--- the page's other frames:\n${frames.join('\n')}`);
+  }
   for (const name of ['viewer', 'robot', 'ui']) console.log(`--- ${name} log:\n${logOf(name)}`);
   failures += 1;
 } finally {
