@@ -63,7 +63,7 @@ constexpr Op kAllOps[] = {Op::WarningOnset,
 enum class Subject { Absent, Active, Latched, Mirrored };
 constexpr Subject kAllSubjects[] = {Subject::Absent, Subject::Active, Subject::Latched, Subject::Mirrored};
 
-struct Row {
+struct RuleRow {
   const char* rule;  ///< the test's name: state, event, subject, what happens
   Subject subject;
   Op op;
@@ -75,7 +75,7 @@ struct Row {
   const char* reason;       ///< ignored completions: the recorded reason
 };
 
-void PrintTo(const Row& row, std::ostream* os) { *os << row.rule; }
+void PrintTo(const RuleRow& row, std::ostream* os) { *os << row.rule; }
 
 constexpr Outcome Raised = Outcome::Raised;
 constexpr Outcome Override = Outcome::Override;
@@ -93,7 +93,7 @@ using S = Subject;
 using O = Op;
 
 // clang-format off
-const Row kRows[] = {
+const RuleRow kRows[] = {
   // ---- onset of a Warning-level event (X {N2W}, severity 60) -------------------------------------
   {"Normal_WarningOnset_Absent_RaisesToWarning",                S::Absent,   O::WarningOnset, "",        Raised,    W, "X:W",     "X", ""},
   {"Warning_WarningOnset_Absent_HigherSeverityOverrides",       S::Absent,   O::WarningOnset, "B:W",     Override,  W, "B:W X:W", "X", ""},
@@ -300,10 +300,10 @@ State highest_level(const ConditionSet& set) {
   return s;
 }
 
-class ConditionSetTable : public ::testing::TestWithParam<Row> {};
+class ConditionSetTable : public ::testing::TestWithParam<RuleRow> {};
 
 TEST_P(ConditionSetTable, FollowsTheSeverityPolicy) {
-  const Row& row = GetParam();
+  const RuleRow& row = GetParam();
   const Event onset = onset_event(row.op, row.subject == Subject::Latched);
   std::uint64_t activations = 0;
   ConditionSet set = build(row.before, onset.severity, activations);
@@ -380,7 +380,7 @@ TEST_P(ConditionSetTable, FollowsTheSeverityPolicy) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Rule, ConditionSetTable, ::testing::ValuesIn(kRows),
-                         [](const ::testing::TestParamInfo<Row>& row_info) {
+                         [](const ::testing::TestParamInfo<RuleRow>& row_info) {
                            return std::string(row_info.param.rule);
                          });
 
@@ -389,7 +389,7 @@ INSTANTIATE_TEST_SUITE_P(Rule, ConditionSetTable, ::testing::ValuesIn(kRows),
 // a state other than Normal).
 TEST(ConditionSetTableCoverage, EveryStateEventAndSubjectCombinationHasARow) {
   std::multiset<std::tuple<State, Op, Subject>> seen;
-  for (const Row& row : kRows) {
+  for (const RuleRow& row : kRows) {
     std::uint64_t activations = 0;
     seen.emplace(build(row.before, 60, activations).state(), row.op, row.subject);
   }
@@ -409,7 +409,7 @@ TEST(ConditionSetTableCoverage, EveryStateEventAndSubjectCombinationHasARow) {
 }
 
 TEST(ConditionSetTableCoverage, EveryRowStartsFromAConsistentSet) {
-  for (const Row& row : kRows) {
+  for (const RuleRow& row : kRows) {
     std::uint64_t activations = 0;
     const ConditionSet set = build(row.before, 60, activations);
     const bool has_x = set.find_root(kX) >= 0;

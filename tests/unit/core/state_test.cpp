@@ -12,6 +12,10 @@
 namespace safecass {
 namespace {
 
+using test::E;
+using test::N;
+using test::W;
+
 constexpr std::array<State, 3> kStates{State::Normal, State::Warning, State::Error};
 constexpr std::array<Transition, 6> kTransitions{Transition::N2W, Transition::N2E, Transition::W2E,
                                                  Transition::W2N, Transition::E2N, Transition::E2W};
@@ -24,7 +28,6 @@ TEST(StateOrder, NormalIsLessSevereThanWarningWhichIsLessSevereThanError) {
 
 TEST(StateProduct, IsTheMoreSevereOfTheTwoForEveryPair) {
   // Written out by hand: row = a, column = b.
-  const State N = State::Normal, W = State::Warning, E = State::Error;
   const std::array<std::array<State, 3>, 3> expected{{{N, W, E}, {W, W, E}, {E, E, E}}};
   for (std::size_t a = 0; a < 3; ++a) {
     for (std::size_t b = 0; b < 3; ++b) {
@@ -91,7 +94,6 @@ TEST(StateProduct, IsUsableInConstantExpressions) {
 }
 
 TEST(Transitions, TransitionBetweenNamesEveryOrderedPairOfDifferentStates) {
-  const State N = State::Normal, W = State::Warning, E = State::Error;
   EXPECT_EQ(transition_between(N, W), Transition::N2W);
   EXPECT_EQ(transition_between(N, E), Transition::N2E);
   EXPECT_EQ(transition_between(W, E), Transition::W2E);
@@ -101,7 +103,6 @@ TEST(Transitions, TransitionBetweenNamesEveryOrderedPairOfDifferentStates) {
 }
 
 TEST(Transitions, SourceAndTargetAreTheStatesTheTransitionConnects) {
-  const State N = State::Normal, W = State::Warning, E = State::Error;
   struct Row {
     Transition t;
     State from;

@@ -10,7 +10,8 @@
 // samples per cycle, none, bursts that overflow the history, deep and shallow injection, enabling and disabling
 // filters, and a pipeline that fails half-built and is undone.
 //
-// SAFECASS_BANK_SEEDS=N runs N seeds (the long run in docs/filters.md); `make test` runs 2,000.
+// SAFECASS_BANK_SEEDS=N runs N seeds (the long run in docs/filters.md); `make test` runs 2,000, the
+// CI's ASan subset 400 (Makefile, ASAN_CI_ENV).
 
 #include <gtest/gtest.h>
 

@@ -8,7 +8,7 @@
 
 #include "safecass/json/read.hpp"
 
-namespace safecass::viewer::test {
+namespace safecass::test {
 
 inline const std::string kSystem = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/robodoc.json";
 inline const std::string kStory = std::string(SAFECASS_SOURCE_DIR) + "/examples/robodoc/story.json";
@@ -26,4 +26,4 @@ inline std::string str(const json::JsonValue& object, std::string_view key) {
   return v != nullptr && v->is_string() ? v->string : "<" + std::string(key) + " missing>";
 }
 
-}  // namespace safecass::viewer::test
+}  // namespace safecass::test

@@ -7,7 +7,7 @@
 
 #include "safecass/filters/registry.hpp"
 
-namespace safecass::verify::test {
+namespace safecass::test {
 
 /// Moves to the source root before any test runs (ctest does too; this covers running the binary
 /// by hand).
@@ -28,4 +28,4 @@ inline const FilterRegistry& registry() {
   return r;
 }
 
-}  // namespace safecass::verify::test
+}  // namespace safecass::test
