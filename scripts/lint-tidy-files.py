@@ -5,13 +5,14 @@
 
 Writes DB_DIR/compile_commands.json, the database clang-tidy reads: COMPILE_COMMANDS with each of
 CMake's unity sources (a test program's batch of files, tests/CMakeLists.txt) replaced by the files
-it includes, each compiled by the batch's command. Then prints every source of the project's own targets in COMPILE_COMMANDS (under the source tree, not under a
-build tree, not generated). With --changed-since-baseline, only those that changed since the
-tidied baseline commit named in .ci/tidy-baseline (committed, staged, unstaged or untracked), and
-those that include a changed header by the path written in their #include; every source when
-.clang-tidy changed since then, or when the baseline commit is not in this clone's history. The
-baseline moves only after a clean whole-tree run (scripts/lint --tidy-all). Says on stderr which
-scope it chose and why. Standard library only.
+it includes, each compiled by the batch's command. Then prints every source of the project's own
+targets in that database (under the source tree, not under a build tree, not generated). With
+--changed-since-baseline, only those that changed since the tidied baseline commit named in
+.ci/tidy-baseline (committed, staged, unstaged or untracked), and those that include a changed
+header by the path written in their #include; every source when .clang-tidy changed since then, or
+when the baseline commit is not in this clone's history. The baseline moves only after a clean
+whole-tree run (scripts/lint --tidy-all), or a clean incremental run on top of one. Says on stderr
+which scope it chose and why. Standard library only.
 """
 import json
 import os
