@@ -23,14 +23,7 @@ public:
 /// Registered once for the whole program (an inline variable), whichever of its files include this.
 inline const auto* const kSourceRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
 
-inline const FilterRegistry& builtin_registry() {
-  static const FilterRegistry registry = [] {
-    FilterRegistry r;
-    register_builtin_filters(r);
-    return r;
-  }();
-  return registry;
-}
+inline const FilterRegistry& builtin_registry() { return builtin_filters(); }
 
 inline std::string read_text(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

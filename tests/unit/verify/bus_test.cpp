@@ -19,12 +19,7 @@ namespace {
 using ::testing::HasSubstr;
 
 spec::SystemSpec load_bus(const std::string& path) {
-  static const FilterRegistry registry = [] {
-    FilterRegistry x;
-    register_builtin_filters(x);
-    return x;
-  }();
-  spec::LoadResult r = spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/" + path, registry);
+  spec::LoadResult r = spec::load_system(std::string(SAFECASS_SOURCE_DIR) + "/" + path, builtin_filters());
   EXPECT_TRUE(r.ok()) << path;
   return r.system ? *r.system : spec::SystemSpec{};
 }

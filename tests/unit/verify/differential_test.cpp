@@ -20,8 +20,6 @@
 namespace safecass::verify {
 namespace {
 
-using test::registry;
-
 /// A tree of `n` components (Ck requires the Out of C((k-1)/3)), each with an Error onset, a
 /// Warning onset that turns into an Error from Warning ({N2W, W2E}), a latched onset on every
 /// third component, services passing warnings on every other one, and a connection back from
@@ -63,11 +61,11 @@ std::string tree(int n) {
 /// Runs `seeds` random simulations of `steps` steps and replays each on a fresh coordinator.
 void compare(const spec::SystemSpec& system, unsigned seeds, std::size_t steps, std::size_t& total) {
   for (unsigned seed = 1; seed <= seeds; ++seed) {
-    auto sim = simulate(system, registry(), seed, steps);
+    auto sim = simulate(system, builtin_filters(), seed, steps);
     ASSERT_TRUE(sim) << sim.error().message;
     ASSERT_FALSE(sim->steps.empty());
     Coordinator co(system.name);
-    Monitor monitor(co, registry());
+    Monitor monitor(co, builtin_filters());
     ASSERT_TRUE(spec::instantiate(system, co, monitor));
     std::vector<Address> addresses;
     for (const std::string& a : sim->addresses) {
@@ -97,11 +95,11 @@ TEST(ModelIsTheEngine, RandomRunsOfTheModelAndTheCoordinatorAgreeOnEveryAddressA
   for (const char* path : {"examples/robodoc/robodoc.json", "tests/data/verify/missing_dependency.fixed.json",
                            "tests/data/verify/propagation_level.json", "tests/data/verify/level_rule.json",
                            "tests/data/verify/broadcast.fixed.json", "tests/data/verify/invariant.json"}) {
-    const spec::LoadResult r = spec::load_system(path, registry());
+    const spec::LoadResult r = spec::load_system(path, builtin_filters());
     ASSERT_TRUE(r.ok()) << path;
     compare(*r.system, 3, 250, total);
   }
-  const spec::LoadResult t = spec::load_system_from_text(tree(13), "tree.json", registry());
+  const spec::LoadResult t = spec::load_system_from_text(tree(13), "tree.json", builtin_filters());
   ASSERT_TRUE(t.ok()) << spec::format(t.diagnostics.at(0));
   compare(*t.system, 4, 300, total);
   EXPECT_GE(total, 5000u) << "thousands of steps";

@@ -38,16 +38,14 @@ public:
 };
 const auto* const kCounterexampleFiles = ::testing::AddGlobalTestEnvironment(new CounterexampleFiles);
 
-using test::registry;
-
 spec::SystemSpec load(const std::string& path) {
-  spec::LoadResult r = spec::load_system(path, registry());
+  spec::LoadResult r = spec::load_system(path, builtin_filters());
   EXPECT_TRUE(r.ok()) << path << ": " << (r.diagnostics.empty() ? "" : spec::format(r.diagnostics[0]));
   return r.system ? *r.system : spec::SystemSpec{};
 }
 
 spec::SystemSpec load_text(const std::string& text) {
-  spec::LoadResult r = spec::load_system_from_text(text, "generated.json", registry());
+  spec::LoadResult r = spec::load_system_from_text(text, "generated.json", builtin_filters());
   EXPECT_TRUE(r.ok()) << (r.diagnostics.empty() ? "" : spec::format(r.diagnostics[0]));
   return r.system ? *r.system : spec::SystemSpec{};
 }
@@ -69,7 +67,7 @@ const PropertyResult* find(const Report& r, PropertyResult::Kind kind, const std
 
 TEST(Verify, RobodocProvesEveryHazardReactionAndItsInvariant) {
   const spec::SystemSpec system = load("examples/robodoc/robodoc.json");
-  auto report = verify(system, registry(), Options{});
+  auto report = verify(system, builtin_filters(), Options{});
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->exit_code(), 0);
   for (const char* h : {"H-2", "H-3", "H-4", "H-5", "H-6"}) {
@@ -96,7 +94,7 @@ TEST(Verify, AHazardWhoseReactionIsTooStrongIsViolatedWithAShortestCounterexampl
   Options options;
   options.out_dir = out_dir("robodoc-force-high");
   options.property = "H-3";
-  auto report = verify(system, registry(), options);
+  auto report = verify(system, builtin_filters(), options);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->exit_code(), 1);
   ASSERT_EQ(report->properties.size(), 1u) << "--property checks that property only";
@@ -108,7 +106,7 @@ TEST(Verify, AHazardWhoseReactionIsTooStrongIsViolatedWithAShortestCounterexampl
   run.quiet = true;
   runner::RunResult result;
   std::FILE* sink = std::tmpfile();
-  EXPECT_EQ(runner::run_scenario_file(p.scenario, registry(), run, &result, sink), 1);
+  EXPECT_EQ(runner::run_scenario_file(p.scenario, builtin_filters(), run, &result, sink), 1);
   ASSERT_FALSE(result.failures.empty());
   EXPECT_THAT(result.failures[0], HasSubstr("CONTROL is Normal, expected Error"));
   std::ifstream in(p.scenario);
@@ -128,7 +126,7 @@ TEST_P(BrokenSpec, VerifyFailsTheScenarioReproducesItAndTheFixedSpecPassesBoth) 
   const std::string fixed_path = "tests/data/verify/" + name + ".fixed.json";
   Options options;
   options.out_dir = out_dir(name);
-  auto broken = verify(load(broken_path), registry(), options);
+  auto broken = verify(load(broken_path), builtin_filters(), options);
   ASSERT_TRUE(broken) << broken.error().message;
   EXPECT_EQ(broken->exit_code(), 1);
   const PropertyResult* violated = nullptr;
@@ -147,7 +145,8 @@ TEST_P(BrokenSpec, VerifyFailsTheScenarioReproducesItAndTheFixedSpecPassesBoth) 
   runner::RunOptions run;
   run.quiet = true;
   runner::RunResult result;
-  EXPECT_EQ(runner::run_scenario_file(violated->scenario, registry(), run, &result, sink), 1) << violated->scenario;
+  EXPECT_EQ(runner::run_scenario_file(violated->scenario, builtin_filters(), run, &result, sink), 1)
+      << violated->scenario;
   ASSERT_FALSE(result.failures.empty());
   const std::string failure = result.failures.front();
   const std::string address = failure.substr(failure.find(": ", failure.find("expectation failed")) + 2,
@@ -156,7 +155,7 @@ TEST_P(BrokenSpec, VerifyFailsTheScenarioReproducesItAndTheFixedSpecPassesBoth) 
   EXPECT_THAT(violated->message, HasSubstr(address + " is ")) << failure;
 
   // Fixed: verify passes, and the same scenario passes against the fixed system.
-  auto fixed = verify(load(fixed_path), registry(), Options{});
+  auto fixed = verify(load(fixed_path), builtin_filters(), Options{});
   ASSERT_TRUE(fixed) << fixed.error().message;
   for (const PropertyResult& p : fixed->properties) {
     if (p.kind == PropertyResult::Kind::Reaction || p.kind == PropertyResult::Kind::Invariant) {
@@ -166,7 +165,7 @@ TEST_P(BrokenSpec, VerifyFailsTheScenarioReproducesItAndTheFixedSpecPassesBoth) 
   EXPECT_EQ(fixed->exit_code(), 0);
   run.system_override = fixed_path;
   runner::RunResult again;
-  EXPECT_EQ(runner::run_scenario_file(violated->scenario, registry(), run, &again, sink), 0);
+  EXPECT_EQ(runner::run_scenario_file(violated->scenario, builtin_filters(), run, &again, sink), 0);
   EXPECT_TRUE(again.failures.empty()) << again.failures.front();
   std::fclose(sink);
 }
@@ -183,7 +182,7 @@ TEST(Verify, TheLevelRuleDependsOnTheStateWhenTheOnsetArrives) {
   Options options;
   options.property = "never_error";
   options.out_dir = out_dir("level-rule-state");
-  auto report = verify(system, registry(), options);
+  auto report = verify(system, builtin_filters(), options);
   ASSERT_TRUE(report) << report.error().message;
   ASSERT_EQ(report->properties.size(), 1u);
   const PropertyResult& p = report->properties[0];
@@ -204,7 +203,7 @@ TEST(Verify, LatchedConditionsClearOnlyByReset) {
       spec::InvariantSpec{"freeze_stays", "[] (CTRL.s_A == Error -> [] (CTRL.s_A == Error))", "", {}});
   Options options;
   options.property = "freeze_stays";
-  auto report = verify(system, registry(), options);
+  auto report = verify(system, builtin_filters(), options);
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->properties.at(0).verdict, PropertyResult::Verdict::Violated)
       << "a reset clears a latched condition";
@@ -212,7 +211,7 @@ TEST(Verify, LatchedConditionsClearOnlyByReset) {
 }
 
 TEST(Verify, ReportsTheSpecificationsOwnPropertiesWithTheirPositions) {
-  auto report = verify(load("tests/data/verify/findings.json"), registry(), Options{});
+  auto report = verify(load("tests/data/verify/findings.json"), builtin_filters(), Options{});
   ASSERT_TRUE(report) << report.error().message;
   EXPECT_EQ(report->exit_code(), 0) << "findings about the specification are warnings";
   const PropertyResult* needs_reset = find(*report, PropertyResult::Kind::NeedsReset, "EVT_JAM@GRIPPER.s_A");
@@ -233,7 +232,7 @@ TEST(Verify, ReportsTheSpecificationsOwnPropertiesWithTheirPositions) {
 TEST(Verify, AnUnknownPropertyIsBadInput) {
   Options options;
   options.property = "H-99";
-  auto report = verify(load("examples/robodoc/robodoc.json"), registry(), options);
+  auto report = verify(load("examples/robodoc/robodoc.json"), builtin_filters(), options);
   ASSERT_FALSE(report);
   EXPECT_EQ(report.error().code, ErrorCode::NotFound);
   EXPECT_THAT(report.error().message, HasSubstr("H-3"));
@@ -264,7 +263,7 @@ TEST(Verify, PastTheMemoryBoundAPropertyIsUndecidedWithAdviceNotACrash) {
   Options options;
   options.property = "everything";
   options.memory_mb = 64;
-  auto report = verify(load_text(wide_system(12)), registry(), options);
+  auto report = verify(load_text(wide_system(12)), builtin_filters(), options);
   ASSERT_TRUE(report) << report.error().message;
   ASSERT_EQ(report->properties.size(), 1u);
   const PropertyResult& p = report->properties[0];
@@ -286,11 +285,11 @@ TEST(Verify, InterchangeableOnsetsAreCountedNotTracked) {
   }
   s += "]}]}";
   const spec::SystemSpec system = load_text(s);
-  auto merged = verify(system, registry(), Options{});
+  auto merged = verify(system, builtin_filters(), Options{});
   ASSERT_TRUE(merged);
   Options separate;
   separate.merge = false;
-  auto tracked = verify(system, registry(), separate);
+  auto tracked = verify(system, builtin_filters(), separate);
   ASSERT_TRUE(tracked);
   const PropertyResult* m = find(*merged, PropertyResult::Kind::Reaction, "H-1");
   const PropertyResult* t = find(*tracked, PropertyResult::Kind::Reaction, "H-1");
@@ -306,13 +305,13 @@ TEST(Verify, WithoutSpinOrACompilerItSaysWhatToInstall) {
   const spec::SystemSpec system = load("examples/robodoc/robodoc.json");
   Options no_spin;
   no_spin.spin = "/nonexistent/spin";
-  auto a = verify(system, registry(), no_spin);
+  auto a = verify(system, builtin_filters(), no_spin);
   ASSERT_FALSE(a);
   EXPECT_EQ(a.error().code, ErrorCode::Io);
   EXPECT_THAT(a.error().message, HasSubstr("install the Debian package 'spin'"));
   Options no_cc;
   no_cc.cc = "/nonexistent/cc";
-  auto b = verify(system, registry(), no_cc);
+  auto b = verify(system, builtin_filters(), no_cc);
   ASSERT_FALSE(b);
   EXPECT_THAT(b.error().message, HasSubstr("C compiler"));
 }

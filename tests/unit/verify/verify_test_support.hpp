@@ -1,11 +1,9 @@
 #pragma once
-// What the verify tests share: every test runs in the source root, and the built-in filters.
+// What the verify tests share: every test runs in the source root.
 
 #include <gtest/gtest.h>
 
 #include <filesystem>
-
-#include "safecass/filters/registry.hpp"
 
 namespace safecass::test {
 
@@ -17,15 +15,5 @@ public:
 };
 /// Registered once for the whole program (an inline variable), whichever of its files include this.
 inline const auto* const kSourceRoot = ::testing::AddGlobalTestEnvironment(new SourceRoot);
-
-/// The built-in filters.
-inline const FilterRegistry& registry() {
-  static const FilterRegistry r = [] {
-    FilterRegistry x;
-    register_builtin_filters(x);
-    return x;
-  }();
-  return r;
-}
 
 }  // namespace safecass::test
