@@ -137,7 +137,7 @@ bool write_file(const std::string& path, const std::string& text) {
   // Safety: breadth-first (shortest trail), no cycle detection. LTL: depth-first with cycles.
   // COLLAPSE compresses each state; MEMLIM stops the search at the bound instead of swapping.
   // The verifier is small and runs briefly: no optimisation, the compilation is what costs.
-  std::string flags = std::string(options.optimise ? "-O2" : "-O0") +
+  std::string flags = std::string(options.optimise ? "-O1" : "-O0") +
                       " -w -DMEMLIM=" + std::to_string(options.memory_mb) + " -DCOLLAPSE -DVECTORSZ=4096";
   if (!options.ltl) flags += options.shortest ? " -DSAFETY -DBFS" : " -DSAFETY";
   const std::string binary = "pan_" + name;
