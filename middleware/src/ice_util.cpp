@@ -151,7 +151,7 @@ std::shared_ptr<Ice::Communicator> make_communicator(const TlsOptions& tls, cons
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls) {
   // Replicated: the topic manager's well-known object, found through the communicator's locator.
-  const std::string manager = std::string(ice.tools ? kToolStormInstance : kIceStormInstance) + "/TopicManager";
+  const std::string manager = instance_name(ice) + "/TopicManager";
   const std::string text =
       ice.locator ? manager
                   : manager + ":" + protocol(tls) + " -h " + ice.host + " -p " + std::to_string(ice.port) + " -t 2000";
@@ -215,24 +215,25 @@ std::int64_t steady_ns() noexcept {
 
 namespace safecass::middleware {
 
-void link_for_tools(const std::shared_ptr<IceStorm::TopicPrx>& from,
-                    const std::shared_ptr<IceStorm::TopicManagerPrx>& tools, const std::string& name) {
+void link_topic(const std::shared_ptr<IceStorm::TopicPrx>& from, const std::shared_ptr<IceStorm::TopicManagerPrx>& to,
+                const std::string& name) {
   const auto ignore = [](std::exception_ptr) {};
-  const auto link_to = [from, name, ignore](const std::shared_ptr<IceStorm::TopicPrx>& to) {
-    if (to == nullptr) return;
+  const auto link_to = [from, name, ignore](const std::shared_ptr<IceStorm::TopicPrx>& target) {
+    if (target == nullptr) return;
     from->getLinkInfoSeqAsync(
-        [from, to, name, ignore](const IceStorm::LinkInfoSeq& links) {
-          // A link is kept with the endpoints it was made to: the tools' broker restarted on
-          // another port (its topics are kept) has a topic of the same identity elsewhere.
+        [from, target, name, ignore](const IceStorm::LinkInfoSeq& links) {
+          // A link is kept with the endpoints it was made to: a broker restarted on another port
+          // (its topics are kept) has a topic of the same identity elsewhere. (Each broker's
+          // topics have identities of their own: its instance name, IceEndpoint::name.)
           std::shared_ptr<IceStorm::TopicPrx> stale;
           for (const IceStorm::LinkInfo& l : links) {
             if (l.theTopic == nullptr || l.name != name) continue;
-            if (l.theTopic->ice_toString() == to->ice_toString()) return;
-            stale = l.theTopic;
+            if (l.theTopic->ice_toString() == target->ice_toString()) return;
+            if (l.theTopic->ice_getIdentity() == target->ice_getIdentity()) stale = l.theTopic;
           }
-          const auto link = [from, to, ignore] {
+          const auto link = [from, target, ignore] {
             from->linkAsync(
-                to, 0, [] {}, ignore);
+                target, 0, [] {}, ignore);
           };
           if (stale != nullptr) {
             from->unlinkAsync(stale, link, ignore);
@@ -242,11 +243,11 @@ void link_for_tools(const std::shared_ptr<IceStorm::TopicPrx>& from,
         },
         ignore);
   };
-  tools->retrieveAsync(name, link_to, [tools, name, link_to, ignore](std::exception_ptr e) {
+  to->retrieveAsync(name, link_to, [to, name, link_to, ignore](std::exception_ptr e) {
     try {
       std::rethrow_exception(e);
     } catch (const IceStorm::NoSuchTopic&) {
-      tools->createAsync(name, link_to, ignore);
+      to->createAsync(name, link_to, ignore);
     } catch (...) {
     }
   });
@@ -260,8 +261,8 @@ void Link::connect(const std::vector<std::string>& publish_on) {
     for (const auto& [name, p] : publishers_) {
       if (auto old = p->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
     }
-    if (tools_ != nullptr) {
-      if (auto old = tools_->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
+    for (const LinkTarget& target : targets_) {
+      if (auto old = target.manager->ice_getCachedConnection()) old->close(Ice::ConnectionClose::Forcefully);
     }
   }
   const std::string id = "link-" + std::to_string(++generation_);
@@ -274,16 +275,34 @@ void Link::connect(const std::vector<std::string>& publish_on) {
   }
   publishers_.clear();
   linked_.clear();
-  // A tool's link (at the tools' broker already) links nothing.
-  if (!ice_.tools)
-    tools_ = Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-        topic_manager(ic_, tools_broker(ice_), tls_)->ice_connectionId(id));
+  targets_.clear();
+  // A tool's link (at the tools' broker already) links nothing. A member's links: to its own
+  // tools' broker, and with one broker per host to each other host's members' and tools' brokers.
+  if (!ice_.tools) {
+    const auto target = [&](const IceEndpoint& broker, bool tools_only) {
+      targets_.push_back(LinkTarget{
+          Ice::uncheckedCast<IceStorm::TopicManagerPrx>(topic_manager(ic_, broker, tls_)->ice_connectionId(id)),
+          tools_only});
+    };
+    target(tools_broker(ice_), true);
+    for (const IceEndpoint& peer : ice_.peers) {
+      target(peer, false);
+      target(tools_broker(peer), true);
+    }
+  }
   for (const std::string& name : publish_on) {
     auto t = Ice::uncheckedCast<IceStorm::TopicPrx>(topic(manager_, name)->ice_connectionId(id));
     publishers_.emplace_back(name, t->getPublisher()->ice_oneway()->ice_connectionId(id));
-    if (!tools_hear(name) || tools_ == nullptr) continue;
     linked_.emplace_back(name, t);
-    link_for_tools(t, tools_, name);
+  }
+  make_links();
+}
+
+void Link::make_links() {
+  for (const auto& [name, t] : linked_) {
+    for (const LinkTarget& target : targets_) {
+      if (!target.tools_only || tools_hear(name)) link_topic(t, target.manager, name);
+    }
   }
 }
 
@@ -368,7 +387,7 @@ std::vector<std::string> Link::check(bool ping_broker) {
             topic(manager_, s.topic)->ice_connectionId(manager_->ice_getConnectionId()));
       s.check = s.proxy->subscribeAndGetPublisherAsync(IceStorm::QoS{}, s.subscriber->ice_oneway());
     }
-    for (const auto& [name, t] : linked_) link_for_tools(t, tools_, name);
+    make_links();
   }
   return made;
 }

@@ -74,7 +74,8 @@ std::string listen_host_towards(const IceEndpoint& ice);
 
 /// "ssl" with TLS, else "tcp": the protocol of every endpoint the process creates or names.
 inline std::string protocol(const TlsOptions& tls) { return tls.enabled() ? "ssl" : "tcp"; }
-/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS), or through the locator.
+/// "SafecassIceStorm/TopicManager:tcp -h HOST -p PORT" (ssl with TLS; the instance_name() of a
+/// named broker), or through the locator.
 std::shared_ptr<IceStorm::TopicManagerPrx> topic_manager(const std::shared_ptr<Ice::Communicator>& ic,
                                                          const IceEndpoint& ice, const TlsOptions& tls = {});
 /// Retrieves a topic, creating it when it does not exist yet.
@@ -85,13 +86,13 @@ std::shared_ptr<IceStorm::TopicPrx> topic(const std::shared_ptr<IceStorm::TopicM
 /// identity can be replaced (Link::renew) without registering the servant again.
 std::shared_ptr<Ice::ObjectPrx> add_subscriber(const std::shared_ptr<Ice::ObjectAdapter>& adapter,
                                                std::shared_ptr<Ice::Object> servant, const std::string& category);
-/// Makes `from` (a topic of the members' broker) forward to its namesake at the tools' broker
-/// `tools`, created there when missing, unless that link is in place; a link to a topic of that
-/// name elsewhere (the tools' broker restarted on another port) is replaced. Asynchronous,
-/// so that a tools' broker out of reach never holds up a member: what fails is tried again at the
-/// next round of Link::check.
-void link_for_tools(const std::shared_ptr<IceStorm::TopicPrx>& from,
-                    const std::shared_ptr<IceStorm::TopicManagerPrx>& tools, const std::string& name);
+/// Makes `from` (a topic of the members' broker) forward to its namesake at the broker `to` (the
+/// tools' broker, or another host's broker), created there when missing, unless that link is in
+/// place; a link to that topic elsewhere (its broker restarted on another port) is replaced.
+/// Asynchronous, so that a broker out of reach never holds up a member: what fails is tried again
+/// at the next round of Link::check.
+void link_topic(const std::shared_ptr<IceStorm::TopicPrx>& from, const std::shared_ptr<IceStorm::TopicManagerPrx>& to,
+                const std::string& name);
 /// Subscribes `subscriber` oneway (IceStorm's default reliability): batched, in order over one
 /// connection. A message the subscriber cannot decode fails there alone: IceStorm never learns of
 /// it, so one bad message drops nobody's subscription (a twoway subscriber whose dispatch fails is
@@ -150,7 +151,8 @@ public:
   /// subscriber whose delivery failed or timed out (a process starved or stopped for longer than
   /// IceStorm's send timeout), and a subscription can be removed from outside; without this check
   /// such a process would go on unaware that nothing reaches it. The same rounds make again each
-  /// link to the tools' broker that is missing (a tool may destroy a topic there). Throws Ice
+  /// link to the tools' broker and to the other hosts' brokers that is missing (a tool may destroy
+  /// a topic at the tools' broker; a broker restarted empty holds no topic). Throws Ice
   /// exceptions when IceStorm cannot be reached or refuses the subscription.
   std::vector<std::string> check(bool ping_broker);
 
@@ -172,10 +174,16 @@ private:
   void renew(Subscription& s, bool async);
   std::vector<Subscription> subscriptions_;
   std::vector<std::pair<std::string, std::shared_ptr<Ice::ObjectPrx>>> publishers_;
-  /// The tools' broker, and the topics this process publishes on that tools hear (tools_hear()):
-  /// each linked to its namesake there, checked with the subscriptions.
-  std::shared_ptr<IceStorm::TopicManagerPrx> tools_;
-  std::vector<std::pair<std::string, std::shared_ptr<IceStorm::TopicPrx>>> linked_;
+  /// A broker the topics this process publishes on are linked to (link_topic()): its tools'
+  /// broker, for the topics tools hear (tools_hear()); with one broker per host, each other host's
+  /// members' broker (every topic) and tools' broker. Made again with the subscriptions' checks.
+  struct LinkTarget {
+    std::shared_ptr<IceStorm::TopicManagerPrx> manager;
+    bool tools_only = false;  ///< only the topics tools hear
+  };
+  void make_links();
+  std::vector<LinkTarget> targets_;
+  std::vector<std::pair<std::string, std::shared_ptr<IceStorm::TopicPrx>>> linked_;  ///< published on
   std::uint64_t checks_ = 0;
   std::uint64_t generation_ = 0;  ///< connect() attempts: each on connections of its own
 };

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <condition_variable>
 #include <cstdio>
 #include <deque>
@@ -25,9 +26,24 @@
 
 namespace safecass::middleware {
 
-[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view whole) {
+namespace {
+
+/// One broker's "HOST:PORT", "PORT", "locator:HOST:PORT" or "NAME=HOST:PORT"; `whole` is the
+/// option's text, for errors.
+Expected<IceEndpoint> parse_one_broker(std::string_view text, std::string_view whole) {
   IceEndpoint e;
-  std::string_view text = whole;
+  if (const auto eq = text.find('='); eq != std::string_view::npos) {
+    e.name = std::string(text.substr(0, eq));
+    text.remove_prefix(eq + 1);
+    const bool valid = !e.name.empty() && std::all_of(e.name.begin(), e.name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) != 0 || c == '-' || c == '_';
+    });
+    if (!valid)
+      return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': broker name '" + e.name +
+                                        "' (write NAME=HOST:PORT; a name is letters, digits, '-' and '_')");
+    if (text.starts_with(kLocatorPrefix))
+      return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': a replicated broker (locator:) is not named");
+  }
   if (text.starts_with(kLocatorPrefix)) {
     e.locator = true;
     text.remove_prefix(kLocatorPrefix.size());
@@ -53,14 +69,59 @@ namespace safecass::middleware {
   return e;
 }
 
+}  // namespace
+
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view whole) {
+  const auto comma = whole.find(',');
+  auto e = parse_one_broker(whole.substr(0, comma), whole);
+  if (!e || comma == std::string_view::npos) return e;
+  if (e->locator)
+    return fail(ErrorCode::Parse, "--ice '" + std::string(whole) +
+                                      "': a replicated broker (locator:) and one broker per host (a list) exclude "
+                                      "each other");
+  std::string_view rest = whole.substr(comma + 1);
+  while (true) {
+    const auto next = rest.find(',');
+    const std::string_view text = rest.substr(0, next);
+    auto peer = parse_one_broker(text, whole);
+    if (!peer) return peer;
+    if (peer->locator)
+      return fail(ErrorCode::Parse, "--ice '" + std::string(whole) + "': peer '" + std::string(text) +
+                                        "' is a locator; one broker per host names each host's IceStorm as "
+                                        "NAME=HOST:PORT");
+    const auto same = [&](const IceEndpoint& other) { return other.host == peer->host && other.port == peer->port; };
+    if (same(*e) || std::any_of(e->peers.begin(), e->peers.end(), same))
+      return fail(ErrorCode::Parse,
+                  "--ice '" + std::string(whole) + "': broker '" + std::string(text) + "' is given twice");
+    const auto same_name = [&](const IceEndpoint& other) { return other.name == peer->name; };
+    if (e->name.empty() || peer->name.empty() || same_name(*e) ||
+        std::any_of(e->peers.begin(), e->peers.end(), same_name))
+      return fail(ErrorCode::Parse, "--ice '" + std::string(whole) +
+                                        "': with one broker per host, name each broker once (NAME=HOST:PORT, as "
+                                        "scripts/start-icestorm --name NAME runs it): IceStorm tells the brokers' "
+                                        "topics apart by their names");
+    e->peers.push_back(std::move(*peer));
+    if (next == std::string_view::npos) return e;
+    rest.remove_prefix(next + 1);
+  }
+}
+
 IceEndpoint tools_broker(IceEndpoint members) {
   members.tools = true;
   if (!members.locator) ++members.port;
   return members;
 }
 
+std::string instance_name(const IceEndpoint& ice) {
+  const std::string instance(ice.tools ? kToolStormInstance : kIceStormInstance);
+  return ice.name.empty() ? instance : instance + "." + ice.name;
+}
+
 std::string to_string(const IceEndpoint& ice) {
-  return (ice.locator ? std::string(kLocatorPrefix) : std::string()) + ice.host + ":" + std::to_string(ice.port);
+  std::string text = (ice.locator ? std::string(kLocatorPrefix) : std::string()) +
+                     (ice.name.empty() ? std::string() : ice.name + "=") + ice.host + ":" + std::to_string(ice.port);
+  for (const IceEndpoint& peer : ice.peers) text += "," + to_string(peer);
+  return text;
 }
 
 namespace {

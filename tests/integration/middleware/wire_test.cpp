@@ -252,10 +252,10 @@ struct Bus {
       t = manager->create(name);
     }
     if (middleware::tools_hear(name) && linked.insert(name).second) {
-      middleware::link_for_tools(t,
-                                 Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
-                                     ice->stringToProxy(fixture::topic_manager(port, fixture::Broker::Tools))),
-                                 name);
+      middleware::link_topic(t,
+                             Ice::uncheckedCast<IceStorm::TopicManagerPrx>(
+                                 ice->stringToProxy(fixture::topic_manager(port, fixture::Broker::Tools))),
+                             name);
     }
     return t;
   }

@@ -68,9 +68,57 @@ TEST(IceEndpoint, ALocatorPrefixNamesTheIceGridRegistryOfAReplicatedIceStormAndP
   EXPECT_EQ(to_string(*direct), "127.0.0.1:4061");
 }
 
+TEST(IceEndpoint, AListNamesThisHostsBrokerFirstThenTheOtherHostsBrokersAndPrintsBackAsWritten) {
+  auto e = parse_ice_endpoint("a=10.77.0.1:4061,b=10.77.0.2:4061,host-c=10.77.0.3:5061");
+  ASSERT_TRUE(e) << e.error().message;
+  EXPECT_EQ(e->host, "10.77.0.1");
+  EXPECT_EQ(e->port, 4061);
+  EXPECT_EQ(e->name, "a");
+  ASSERT_EQ(e->peers.size(), 2u);
+  EXPECT_EQ(e->peers[0].host, "10.77.0.2");
+  EXPECT_EQ(e->peers[1].port, 5061);
+  EXPECT_FALSE(e->peers[1].locator);
+  EXPECT_EQ(to_string(*e), "a=10.77.0.1:4061,b=10.77.0.2:4061,host-c=10.77.0.3:5061");
+  EXPECT_TRUE(parse_ice_endpoint("127.0.0.1:4061")->peers.empty());
+}
+
+TEST(IceEndpoint, EachBrokerOfAHostHasAnInstanceNameOfItsOwnSoThatItsTopicsCanBeLinkedApart) {
+  auto e = parse_ice_endpoint("a=10.77.0.1:4061,b=10.77.0.2:4061");
+  ASSERT_TRUE(e);
+  EXPECT_EQ(instance_name(*e), "SafecassIceStorm.a");
+  EXPECT_EQ(instance_name(tools_broker(e->peers[0])), "SafecassToolStorm.b");
+  EXPECT_EQ(tools_broker(e->peers[0]).port, 4062);
+  EXPECT_EQ(instance_name(*parse_ice_endpoint("127.0.0.1:4061")), "SafecassIceStorm");
+  EXPECT_EQ(instance_name(*parse_ice_endpoint("b=127.0.0.1:4061")), "SafecassIceStorm.b") << "a named broker alone";
+}
+
 TEST(IceEndpoint, MalformedEndpointsAreParseErrorsThatSayWhy) {
-  for (const char* bad : {"", "host:", ":4061", "host:port", "host:70000", "host:0", "host:-1", "host:123456",
-                          "locator:", "locator:4061", "locator::4061", "locator:host:port"}) {
+  for (const char* bad : {"",
+                          "host:",
+                          ":4061",
+                          "host:port",
+                          "host:70000",
+                          "host:0",
+                          "host:-1",
+                          "host:123456",
+                          "locator:",
+                          "locator:4061",
+                          "locator::4061",
+                          "locator:host:port",
+                          "x=a:4061,",
+                          "x=a:4061,,y=b:4061",
+                          "x=a:4061,y=b:port",
+                          "x=a:4061,locator:b:4061",
+                          "locator:a:4061,y=b:4061",
+                          "x=a:4061,y=a:4061",
+                          "x=a:4061,y=b:4061,z=b:4061",
+                          "a:4061,b:4061",
+                          "x=a:4061,b:4061",
+                          "x=a:4061,x=b:4061",
+                          "=a:4061",
+                          "x y=a:4061",
+                          "x=locator:a:4061",
+                          "x=a:4061,y=locator:b:4061"}) {
     auto e = parse_ice_endpoint(bad);
     ASSERT_FALSE(e) << bad;
     EXPECT_EQ(e.error().code, ErrorCode::Parse);

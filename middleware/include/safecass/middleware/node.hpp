@@ -31,6 +31,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "safecass/core/coordinator.hpp"
 #include "safecass/core/expected.hpp"
@@ -43,22 +44,37 @@ namespace safecass::middleware {
 
 /// Where a process finds IceStorm: "HOST:PORT", the TopicManager endpoint of one IceStorm, or
 /// "locator:HOST:PORT", the locator of the IceGrid registry of a replicated IceStorm
-/// (`scripts/start-icestorm --replicas N`, docs/deployment.md "A replicated broker"). Host
-/// defaults to 127.0.0.1.
+/// (`scripts/start-icestorm --replicas N`, docs/deployment.md "A replicated broker"), or
+/// "NAME=HOST:PORT", a broker named for its host (`scripts/start-icestorm --name NAME`), and
+/// "NAME=HOST:PORT,PEER=HOST:PORT,...", one broker per host: this host's first, then the other
+/// hosts' (docs/deployment.md "One broker per host"). Host defaults to 127.0.0.1.
 struct IceEndpoint {
   std::string host = "127.0.0.1";
   int port = 0;
   bool locator = false;  ///< host:port is an IceGrid registry, not an IceStorm
   bool tools = false;    ///< the tools' broker (tools_broker()), not the members'
+  /// A named broker's name: its instance is kIceStormInstance + "." + name (its tools' broker's
+  /// kToolStormInstance + "." + name). Empty: the one broker, kIceStormInstance. With one broker
+  /// per host each broker is named, differently: IceStorm tells topics (and links between them)
+  /// apart by identity, which is the instance name and the topic's name.
+  std::string name;
+  /// One broker per host: the other hosts' members' brokers. A member links each topic it
+  /// publishes on at its own broker to the topic of that name at each of them (and, for the topics
+  /// tools hear, at their tools' brokers), so that a host cut off holds up no other host's messages.
+  std::vector<IceEndpoint> peers;
 };
+/// The instance name of the broker `ice` names (a members' or a tools' broker).
+[[nodiscard]] std::string instance_name(const IceEndpoint& ice);
 /// The tools' broker of the system whose members' broker is `members`: the second IceStorm that
 /// scripts/start-icestorm runs beside the members' (instance kToolStormInstance, on the next port,
 /// or through the same locator). The members' broker refuses the tools' certificate; the topics
 /// tools hear are linked from it to the tools' broker (docs/security.md "Rights at the broker").
 [[nodiscard]] IceEndpoint tools_broker(IceEndpoint members);
-/// Parses "HOST:PORT", "PORT" or "locator:HOST:PORT". Errors: Parse (with what was wrong).
+/// Parses "HOST:PORT", "PORT", "locator:HOST:PORT", "NAME=HOST:PORT" or
+/// "NAME=HOST:PORT,PEER=HOST:PORT,..." (with peers every broker is named, each name and address
+/// once; a name is letters, digits, '-' and '_'). Errors: Parse (with what was wrong).
 [[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
-/// The text parse_ice_endpoint reads: "HOST:PORT" or "locator:HOST:PORT".
+/// The text parse_ice_endpoint reads: "HOST:PORT", "locator:HOST:PORT" or "NAME=HOST:PORT,...".
 std::string to_string(const IceEndpoint& ice);
 
 /// Mutual TLS (IceSSL) on every connection of a process: to IceStorm, from IceStorm to its
