@@ -73,7 +73,8 @@ stress-test: build
 known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
-# The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, their own tree), one per input that
+# The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, their own tree, unity sources as the
+# presets' builds: docs/contributing.md, "Continuous integration"), one per input that
 # crosses a boundary: the spec loader, the ROS inputs, the named reads' answers, scenarios, history
 # lines, input recordings, CSV logs, ROS 1 and ROS 2 bags, the viewer's messages, the console's
 # command lines and the bus's authenticated messages (docs/contributing.md, "Fuzzing").
@@ -84,7 +85,7 @@ FUZZ_TARGETS := spec_loader ros_input read_answer scenario history input_log csv
 FUZZ_SECONDS ?= 60
 fuzz-tree: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
-	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
 	  -DSAFECASS_BUILD_TOOLS=ON -DSAFECASS_BUILD_EXAMPLES=OFF -DSAFECASS_BUILD_BENCHMARKS=OFF >/dev/null
 
 # Every target for FUZZ_SECONDS (default 60) each: executions, edges and findings per target.

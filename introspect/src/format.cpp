@@ -469,7 +469,7 @@ std::string coverage_now_json(const CoverageNow& c) {
     return fail(ErrorCode::Parse, "analyze now: t must be a time in seconds of at most 4e9 in magnitude");
   }
   CoverageNow c;
-  c.now = seconds_to_time(t->number);
+  c.now = read_seconds(t->number);
   for (const json::JsonValue& item : hazards->array) {
     HazardCoverage h;
     const json::JsonValue* name = item.find("hazard");

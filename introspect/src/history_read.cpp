@@ -49,7 +49,7 @@ public:
       fail("\"" + std::string(key) + "\" must be a time in seconds of at most 4e9 in magnitude (about 126 years)");
       return std::nullopt;
     }
-    return seconds_to_time(*seconds);
+    return read_seconds(*seconds);
   }
 
   bool boolean(std::string_view key) {

@@ -24,9 +24,6 @@ constexpr std::size_t kMaxIncludeDepth = 16;
 constexpr std::size_t kMaxFiles = 100000;
 constexpr int kMaxJsonDepth = 64;
 
-/// "a number", "an object": the type of a value in a message.
-std::string a_type(json::JsonValue::Type t) { return std::string(json::a_type_name(t)); }
-
 std::vector<std::string> to_strings(const std::vector<std::string_view>& views) { return {views.begin(), views.end()}; }
 
 bool whole(double d) noexcept { return std::isfinite(d) && std::floor(d) == d; }

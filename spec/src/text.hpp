@@ -34,6 +34,9 @@ std::optional<Utf8Error> check_utf8(std::string_view text);
 /// %g-like, shortest form that reads back the same ("30", "0.001", "1e+300").
 std::string number_text(double value);
 
+/// "an object", "a string", ...: a JSON value's type as an error names it (json::a_type_name).
+inline std::string a_type(json::JsonValue::Type t) { return std::string(json::a_type_name(t)); }
+
 /// "a", "b" and "c" -> "a, b or c".
 std::string join_or(const std::vector<std::string>& words);
 /// "a", "b" and "c" -> "a, b, c".

@@ -16,9 +16,6 @@ namespace safecass::spec {
 
 namespace {
 
-/// "a number", "an object": the type of a value in a message.
-std::string a_type(json::JsonValue::Type t) { return std::string(json::a_type_name(t)); }
-
 std::vector<std::string> names_of(const std::vector<Name>& names) {
   std::vector<std::string> out;
   for (const Name& n : names) out.push_back(n.text);

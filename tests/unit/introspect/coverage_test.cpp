@@ -173,6 +173,20 @@ TEST(CoverageNowFormat, ItsJsonIsOneLineThatReadsBackToTheSameValue) {
   EXPECT_EQ(*text, coverage_now_text(one_uncovered()));
 }
 
+// Found by the read_answer fuzz target: a time finer than the microsecond (written with six
+// decimals) read back as another time once written again.
+TEST(CoverageNowFormat, ATimeFinerThanAMicrosecondIsReadToTheMicrosecondSoItReadsBackTheSameWrittenAgain) {
+  auto first = coverage_now_from_json(R"({"t":12.58888888888888888888,"uncovered":0,"hazards":[]})");
+  ASSERT_TRUE(first) << first.error().message;
+  EXPECT_EQ(first->now, std::chrono::microseconds(12'588'889));
+  auto again = coverage_now_from_json(coverage_now_json(*first));
+  ASSERT_TRUE(again) << again.error().message;
+  EXPECT_EQ(*again, *first);
+  auto negative = coverage_now_from_json(R"({"t":-0.0000015,"uncovered":0,"hazards":[]})");
+  ASSERT_TRUE(negative);
+  EXPECT_EQ(negative->now, std::chrono::microseconds(-2)) << "half a microsecond rounds away from zero";
+}
+
 TEST(CoverageNowFormat, AnAnswerThatIsNotACoverageIsAParseErrorThatSaysSo) {
   for (const char* bad : {"", "[]", R"({"hazards":[]})", R"({"t":1,"hazards":[{"hazard":"H1","onsets":[]}]})",
                           R"({"t":1,"hazards":[{"hazard":"H1","onsets":[3],"gaps":[]}]})",

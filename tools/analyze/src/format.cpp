@@ -5,6 +5,7 @@
 #include <map>
 
 #include "safecass/analyze/analyze.hpp"
+#include "safecass/introspect/format.hpp"
 #include "safecass/json/write.hpp"
 
 namespace safecass::analyze {
@@ -14,22 +15,16 @@ namespace {
 using json::JsonArray;
 using json::JsonObject;
 
-std::string join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k) out += (k == 0 ? "" : sep) + items[k];
-  return out;
-}
-
 std::string effects_text(const std::vector<Reached>& effects) {
   std::vector<std::string> out;
   for (const Reached& r : effects) out.push_back(r.address + "=" + std::string(to_string(r.level)));
-  return join(out, " ");
+  return introspect::joined(out, " ");
 }
 
 std::string hazard_text(const HazardLink& l) {
   std::string s = l.id + " (" + l.role;
   if (l.role == "detected") {
-    s += l.missed.empty() ? ", reaction reached" : ", reaction MISSED: " + join(l.missed, "; ");
+    s += l.missed.empty() ? ", reaction reached" : ", reaction MISSED: " + introspect::joined(l.missed, "; ");
     s += ", verify: " + std::string(trace::to_string(l.verified));
   }
   return s + ")";
@@ -60,8 +55,6 @@ std::string where_text(const spec::Position& p) {
   return p.file + ":" + std::to_string(p.line) + ":" + std::to_string(p.column);
 }
 
-std::string level_text(State s) { return std::string(to_string(s)); }
-
 /// A probability or factor to six significant digits.
 std::string probability_text(double p) {
   char buf[32];
@@ -85,16 +78,17 @@ std::string fmea_text(const Analysis& a) {
   for (const FailureMode& m : a.modes) {
     out += "\n" + m.id + "  " + m.name + "  [" + std::string(to_string(m.kind)) + "]\n";
     out += "  failure:    " + m.description + "\n";
-    out += "  raises:     " + m.event + " (severity " + std::to_string(m.severity) + ", " + level_text(m.level) +
-           (m.escalates ? "; Error on a machine already at Warning" : "") + ")\n";
+    out += "  raises:     " + m.event + " (severity " + std::to_string(m.severity) + ", " +
+           std::string(to_string(m.level)) + (m.escalates ? "; Error on a machine already at Warning" : "") + ")\n";
     out += "  local:      " + m.local_effect + "\n";
     out += "  system:     " + (m.effects.empty() ? std::string("nothing") : effects_text(m.effects)) + "\n";
     if (m.escalates) out += "  escalated:  " + effects_text(m.escalated) + "\n";
     out += "  detection:  " + m.detection + "\n";
     if (m.rate) out += "  rate:       " + probability_text(*m.rate) + " per hour\n";
     if (m.probability) out += "  probability: " + probability_text(*m.probability) + "\n";
-    out += "  hazards:    " + (m.hazards.empty() ? std::string("none") : join(hazards_of(m), "; ")) + "\n";
-    out += "  tests:      " + (m.tests.empty() ? std::string("none") : join(tests_of(m), "; ")) + "\n";
+    out +=
+        "  hazards:    " + (m.hazards.empty() ? std::string("none") : introspect::joined(hazards_of(m), "; ")) + "\n";
+    out += "  tests:      " + (m.tests.empty() ? std::string("none") : introspect::joined(tests_of(m), "; ")) + "\n";
     for (const std::string& g : gaps_of(m)) out += "  GAP " + g + "\n";
   }
   out += "\nGaps: " + std::to_string(a.gap_count(trace::Severity::Error)) + " error, " +
@@ -110,14 +104,15 @@ std::string fault_trees_text(const Analysis& a) {
              ? "Probabilities over a mission of " + probability_text(a.trees.mission_time) + " h\n"
              : "Not quantified: " + a.trees.unquantified + "\n";
   for (const TopEvent& t : a.trees.tops) {
-    out += "\n" + t.gate + "  " + t.address + " at " + level_text(t.level) + " or worse  (" + t.why +
+    out += "\n" + t.gate + "  " + t.address + " at " + std::string(to_string(t.level)) + " or worse  (" + t.why +
            "): " + std::to_string(t.cut_sets.size()) + " minimal cut set" + (t.cut_sets.size() == 1 ? "" : "s");
     if (t.probability) out += ", probability " + probability_text(*t.probability);
     out += "\n";
     for (const CutSet& c : t.cut_sets) {
       std::vector<std::string> names;
       for (const std::string& id : c.modes) names.push_back(mode_label(a, id));
-      out += "  {" + join(names, ", ") + "}" + (c.probability ? "  p=" + probability_text(*c.probability) : "") + "\n";
+      out += "  {" + introspect::joined(names, ", ") + "}" +
+             (c.probability ? "  p=" + probability_text(*c.probability) : "") + "\n";
     }
     std::vector<Importance> ranked = t.importance;
     std::stable_sort(ranked.begin(), ranked.end(),
@@ -158,9 +153,10 @@ std::string fmea_csv(const Analysis& a) {
                       "system_effect", "escalated_effect", "detection", "hazards", "tests", "gaps", "where"});
   for (const FailureMode& m : a.modes) {
     out += trace::csv_row({m.id, m.name, std::string(to_string(m.kind)), m.description, m.event,
-                           std::to_string(m.severity), level_text(m.level), m.escalates ? "yes" : "no", m.local_effect,
-                           effects_text(m.effects), effects_text(m.escalated), m.detection, join(hazards_of(m), "; "),
-                           join(tests_of(m), "; "), join(gaps_of(m), "; "), where_text(m.where)});
+                           std::to_string(m.severity), std::string(to_string(m.level)), m.escalates ? "yes" : "no",
+                           m.local_effect, effects_text(m.effects), effects_text(m.escalated), m.detection,
+                           introspect::joined(hazards_of(m), "; "), introspect::joined(tests_of(m), "; "),
+                           introspect::joined(gaps_of(m), "; "), where_text(m.where)});
   }
   return out;
 }
@@ -170,7 +166,7 @@ namespace {
 std::string json_effects(const std::vector<Reached>& effects) {
   JsonArray arr;
   for (const Reached& r : effects)
-    arr.raw(JsonObject().str("address", r.address).str("level", level_text(r.level)).text());
+    arr.raw(JsonObject().str("address", r.address).str("level", std::string(to_string(r.level))).text());
   return arr.text();
 }
 
@@ -201,7 +197,7 @@ std::string json_mode(const FailureMode& m) {
       .str("failure", m.description)
       .str("event", m.event)
       .integer("severity", m.severity)
-      .str("level", level_text(m.level))
+      .str("level", std::string(to_string(m.level)))
       .boolean("escalates", m.escalates)
       .str("local_effect", m.local_effect)
       .raw("effects", json_effects(m.effects))
@@ -241,7 +237,7 @@ std::string json_trees(const FaultTrees& trees) {
     tops.raw(JsonObject()
                  .str("gate", t.gate)
                  .str("address", t.address)
-                 .str("level", level_text(t.level))
+                 .str("level", std::string(to_string(t.level)))
                  .str("why", t.why)
                  .raw("cut_sets", cuts.text())
                  .raw("probability", t.probability ? json::json_number(*t.probability) : "null")

@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "safecass/introspect/format.hpp"
 #include "safecass/json/read.hpp"
 #include "safecass/json/write.hpp"
 #include "safecass/trace/trace.hpp"
@@ -9,12 +10,6 @@
 namespace safecass::trace {
 
 namespace {
-
-std::string join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k) out += (k == 0 ? "" : sep) + items[k];
-  return out;
-}
 
 std::string where_text(const spec::Position& p) {
   if (p.file.empty()) return {};
@@ -25,16 +20,16 @@ std::string where_text(const spec::Position& p) {
 std::string uses_text(const std::vector<ScenarioUse>& uses) {
   std::vector<std::string> out;
   for (const ScenarioUse& u : uses)
-    out.push_back(u.scenario + (u.transitions.empty() ? "" : " (" + join(u.transitions, " ") + ")"));
-  return join(out, "; ");
+    out.push_back(u.scenario + (u.transitions.empty() ? "" : " (" + introspect::joined(u.transitions, " ") + ")"));
+  return introspect::joined(out, "; ");
 }
 
 std::string filter_text(const FilterLink& f) {
   std::string out = f.name + " [" + f.type + ", " + f.execution + ", every " + f.period + "] on " + f.target;
   if (!f.signals.empty()) out += ", reads " + f.signals;
   if (!f.threshold.empty()) out += ", threshold " + f.threshold;
-  if (!f.parameters.empty()) out += ", " + join(f.parameters, ", ");
-  if (!f.pipeline.empty()) out += ", pipeline " + f.pipeline + ": " + join(f.chain, " -> ");
+  if (!f.parameters.empty()) out += ", " + introspect::joined(f.parameters, ", ");
+  if (!f.pipeline.empty()) out += ", pipeline " + f.pipeline + ": " + introspect::joined(f.chain, " -> ");
   return out;
 }
 
@@ -100,7 +95,7 @@ std::string gaps_of(const Trace& t, const std::string& hazard, const std::string
         (hazard.empty() && !filter.empty() && g.subject == filter);
     if (mine) out.push_back(std::string(to_string(g.severity)) + " " + g.kind + ": " + g.subject);
   }
-  return join(out, "; ");
+  return introspect::joined(out, "; ");
 }
 
 }  // namespace
@@ -111,24 +106,24 @@ std::string trace_text(const Trace& t) {
     out += "\n" + h.id + ": " + h.description + "\n";
     std::vector<std::string> reaction;
     for (const ReactionLink& r : h.reaction) {
-      reaction.push_back(
-          r.address + " >= " + r.level +
-          (r.checked_by.empty() ? " (checked by no scenario)" : " (checked by " + join(r.checked_by, ", ") + ")"));
+      reaction.push_back(r.address + " >= " + r.level +
+                         (r.checked_by.empty() ? " (checked by no scenario)"
+                                               : " (checked by " + introspect::joined(r.checked_by, ", ") + ")"));
     }
-    out += "  reaction: " + (reaction.empty() ? std::string("none") : join(reaction, "; ")) + "\n";
+    out += "  reaction: " + (reaction.empty() ? std::string("none") : introspect::joined(reaction, "; ")) + "\n";
     out += "  verify: " + std::string(to_string(h.verified)) +
            (h.verify_detail.empty() ? "" : " (" + h.verify_detail + ")") + "\n";
     if (h.events.empty()) out += "  no linked event\n";
     for (const EventLink& e : h.events) {
       out += "  " + std::string(e.onset ? "onset " : "completion ") + e.name + " (" + e.component + ", severity " +
              std::to_string(e.severity) + (e.onset ? ", " + e.level + ", " + e.transitions : ", " + e.transitions) +
-             (e.latched ? ", latched" : "") + ") -> " + join(e.targets, ", ") + "\n";
+             (e.latched ? ", latched" : "") + ") -> " + introspect::joined(e.targets, ", ") + "\n";
       for (const FilterLink& f : e.filters) out += "    filter " + filter_text(f) + "\n";
       if (e.filters.empty()) out += "    no filter generates it\n";
       out += "    fired by: " + (e.fired_by.empty() ? std::string("no scenario") : uses_text(e.fired_by)) + "\n";
       if (e.onset)
-        out +=
-            "    cleared by: " + (e.cleared_by.empty() ? std::string("no scenario") : join(e.cleared_by, ", ")) + "\n";
+        out += "    cleared by: " +
+               (e.cleared_by.empty() ? std::string("no scenario") : introspect::joined(e.cleared_by, ", ")) + "\n";
     }
   }
   if (!t.unlinked.empty()) {
@@ -274,9 +269,11 @@ std::string trace_csv(const Trace& t) {
       std::vector<std::string> reaction, checked;
       for (const ReactionLink& r : h->reaction) {
         reaction.push_back(r.address + ">=" + r.level);
-        checked.push_back(r.address + ": " + (r.checked_by.empty() ? std::string("none") : join(r.checked_by, " ")));
+        checked.push_back(r.address + ": " +
+                          (r.checked_by.empty() ? std::string("none") : introspect::joined(r.checked_by, " ")));
       }
-      head = {h->id, h->description, join(reaction, "; "), join(checked, "; "), std::string(to_string(h->verified))};
+      head = {h->id, h->description, introspect::joined(reaction, "; "), introspect::joined(checked, "; "),
+              std::string(to_string(h->verified))};
     } else {
       head = {"", "", "", "", ""};
     }
@@ -293,20 +290,21 @@ std::string trace_csv(const Trace& t) {
                                             std::to_string(e->severity),
                                             e->level,
                                             e->transitions,
-                                            join(e->targets, "; "),
+                                            introspect::joined(e->targets, "; "),
                                             e->latched ? "yes" : "no"};
     const auto emit = [&](const FilterLink* f) {
       std::vector<std::string> fields = head;
       fields.insert(fields.end(), event.begin(), event.end());
       if (f != nullptr) {
-        fields.insert(fields.end(),
-                      {f->name, f->pipeline.empty() ? "" : f->pipeline + ": " + join(f->chain, " -> "), f->type,
-                       f->signals, f->threshold, join(f->parameters, " "), f->execution, f->period});
+        fields.insert(
+            fields.end(),
+            {f->name, f->pipeline.empty() ? "" : f->pipeline + ": " + introspect::joined(f->chain, " -> "), f->type,
+             f->signals, f->threshold, introspect::joined(f->parameters, " "), f->execution, f->period});
       } else {
         fields.insert(fields.end(), 8, "");
       }
       fields.push_back(uses_text(e->fired_by));
-      fields.push_back(join(e->cleared_by, "; "));
+      fields.push_back(introspect::joined(e->cleared_by, "; "));
       fields.push_back(gaps_of(t, h != nullptr ? h->id : "", e->name, f != nullptr ? f->name : ""));
       row(fields);
     };

@@ -20,12 +20,6 @@ namespace safecass::trace {
 
 namespace {
 
-std::string join(const std::vector<std::string>& items, const std::string& sep) {
-  std::string out;
-  for (std::size_t k = 0; k < items.size(); ++k) out += (k == 0 ? "" : sep) + items[k];
-  return out;
-}
-
 std::string marker(Severity s, const std::string& kind, const std::string& text) {
   const std::string sev(to_string(s));
   std::string label = sev;
@@ -78,10 +72,10 @@ std::string filter_cell(const FilterLink& f) {
   if (!f.signals.empty()) out += "<br>reads " + introspect::markup_text(f.signals);
   if (!f.threshold.empty()) out += "<br>threshold <b>" + introspect::markup_text(f.threshold) + "</b>";
   if (!f.parameters.empty())
-    out += "<br><span class=\"small\">" + introspect::markup_text(join(f.parameters, ", ")) + "</span>";
+    out += "<br><span class=\"small\">" + introspect::markup_text(introspect::joined(f.parameters, ", ")) + "</span>";
   if (!f.pipeline.empty())
     out += "<br><span class=\"small\">pipeline " + introspect::markup_text(f.pipeline) + ": " +
-           introspect::markup_text(join(f.chain, " → ")) + "</span>";
+           introspect::markup_text(introspect::joined(f.chain, " → ")) + "</span>";
   return out;
 }
 
@@ -91,7 +85,7 @@ std::string event_cell(const EventLink& e) {
                     ", severity " + std::to_string(e.severity) + "<br>" + introspect::markup_text(e.transitions);
   if (e.onset) out += " → " + introspect::markup_text(e.level);
   if (e.latched) out += "<br><b>latched</b> (cleared by reset)";
-  out += "<br>to " + introspect::markup_text(join(e.targets, ", "));
+  out += "<br>to " + introspect::markup_text(introspect::joined(e.targets, ", "));
   return out;
 }
 
@@ -100,15 +94,17 @@ std::string scenarios_cell(const EventLink& e) {
   std::string out = "<ul class=\"plain\">";
   for (const ScenarioUse& u : e.fired_by) {
     out += "<li>" + introspect::markup_text(u.scenario) +
-           (u.transitions.empty()
-                ? ""
-                : " <span class=\"small\">(" + introspect::markup_text(join(u.transitions, " ")) + ")</span>") +
+           (u.transitions.empty() ? ""
+                                  : " <span class=\"small\">(" +
+                                        introspect::markup_text(introspect::joined(u.transitions, " ")) + ")</span>") +
            "</li>";
   }
   out += "</ul>";
   if (e.onset) {
-    out += "<span class=\"small\">cleared by: " +
-           (e.cleared_by.empty() ? std::string("none") : introspect::markup_text(join(e.cleared_by, ", "))) + "</span>";
+    out +=
+        "<span class=\"small\">cleared by: " +
+        (e.cleared_by.empty() ? std::string("none") : introspect::markup_text(introspect::joined(e.cleared_by, ", "))) +
+        "</span>";
   }
   return out;
 }
@@ -120,7 +116,7 @@ std::string reaction_cell(const Trace& t, const HazardTrace& h) {
     out += "<li data-address=\"" + introspect::markup_text(r.address) + "\"><b>" + introspect::markup_text(r.address) +
            "</b> ≥ " + introspect::markup_text(r.level) + "<br><span class=\"small\">" +
            (r.checked_by.empty() ? std::string("checked by no expect")
-                                 : "expect in " + introspect::markup_text(join(r.checked_by, ", "))) +
+                                 : "expect in " + introspect::markup_text(introspect::joined(r.checked_by, ", "))) +
            "</span>" + markers(gaps_about(t, h.id, r.address)) + "</li>";
   }
   return out + "</ul>";
@@ -272,7 +268,8 @@ std::string excerpts(const Trace& t) {
            introspect::markup_text(run->path) + "\" data-from=\"" + number_text(h.excerpt_from) + "\" data-to=\"" +
            number_text(h.excerpt_to) + "\">\n<figcaption>" + introspect::markup_text(h.id) + " in " +
            introspect::markup_text(run->path) + ", t = " + number_text(h.excerpt_from) + " s to " +
-           number_text(h.excerpt_to) + " s; " + introspect::markup_text(join(h.excerpt_components, ", ")) +
+           number_text(h.excerpt_to) + " s; " +
+           introspect::markup_text(introspect::joined(h.excerpt_components, ", ")) +
            "</figcaption>\n<div class=\"excerpt-box\"><svg class=\"timeline-axis\" role=\"img\" aria-label=\"Time axis "
            "in seconds\"></svg>"
            "<svg class=\"timeline-lanes\" role=\"img\" aria-label=\"States during " +

@@ -31,14 +31,6 @@ std::string_view to_string(NodeKind kind) noexcept {
   return "?";
 }
 
-namespace {
-
-/// At most this many ticks are processed per poll, so that a poll never holds the event loop
-/// for long; the clock catches up over the next polls.
-constexpr std::int64_t kMaxTicksPerPoll = 5000;
-
-}  // namespace
-
 struct InProcessSource::Impl {
   const FilterRegistry* registry = nullptr;  // outlives the runner's monitor
   std::unique_ptr<runner::ScenarioRunner> runner;

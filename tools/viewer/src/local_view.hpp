@@ -16,6 +16,11 @@
 
 namespace safecass::viewer {
 
+/// At most this many ticks are processed per poll of an in-process source (a scenario run, a
+/// replay), so that a poll never holds the event loop for long; the clock catches up over the
+/// next polls.
+inline constexpr std::int64_t kMaxTicksPerPoll = 5000;
+
 /// The coordinators of a system file with their components (one named after the coordinator
 /// holding every component when the file names none).
 using Coordinators = std::vector<std::pair<std::string, std::vector<ComponentId>>>;

@@ -18,9 +18,6 @@ namespace safecass::viewer {
 
 namespace {
 
-/// At most this many ticks per poll, so that a poll never holds the event loop for long.
-constexpr std::int64_t kMaxTicksPerPoll = 5000;
-
 [[nodiscard]] Expected<void> check_speed(double speed) {
   if (!std::isfinite(speed) || speed <= 0.0 || speed > 1000.0) {
     return fail(ErrorCode::InvalidArgument,

@@ -27,6 +27,14 @@ constexpr bool readable_seconds(double seconds) noexcept {
   return seconds <= kMaxReadSeconds && seconds >= -kMaxReadSeconds;
 }
 
+/// A time read from text (a recording, a log, an answer; check readable_seconds() first), to the
+/// microsecond: SAFECASS writes times with six decimals (seconds_text()), so what is read, written
+/// and read again is the same time. Half a microsecond rounds away from zero.
+constexpr Time read_seconds(double seconds) noexcept {
+  const double micros = seconds * 1e6;
+  return Time{static_cast<Time::rep>(micros + (micros < 0 ? -0.5 : 0.5)) * 1000};
+}
+
 /// Source of time. now() is thread-safe, lock-free and never allocates.
 class Clock {
 public:
