@@ -30,7 +30,7 @@ namespace {
 
 /// One broker's "HOST:PORT", "PORT", "locator:HOST:PORT" or "NAME=HOST:PORT"; `whole` is the
 /// option's text, for errors.
-Expected<IceEndpoint> parse_one_broker(std::string_view text, std::string_view whole) {
+[[nodiscard]] Expected<IceEndpoint> parse_one_broker(std::string_view text, std::string_view whole) {
   IceEndpoint e;
   if (const auto eq = text.find('='); eq != std::string_view::npos) {
     e.name = std::string(text.substr(0, eq));
