@@ -436,8 +436,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   PanOptions pan_base;
   pan_base.memory_mb = options.memory_mb;
   pan_base.hash_bits = 24;
-  pan_base.shortest =
-      false;  // depth-first finds the verdict fastest; a violation is searched again for its shortest trail
+  // Depth-first finds the verdict fastest; a violation is searched again for its shortest trail.
+  pan_base.shortest = false;
   pan_base.spin = options.spin;
   pan_base.cc = options.cc;
   struct Job {
