@@ -67,6 +67,8 @@ hosts_start robot a "$bin/safecass" run "$system" --coordinator robot --ice "$(i
 echo "== ROBODOC on three hosts: robot on a (10.77.0.1), ui on b (10.77.0.2), the supervisor on c (10.77.0.3)"
 echo "   a broker on each host: IceStorm, each topic linked to its namesake at the other hosts' brokers"
 echo "   every link mutual TLS with the system's keys; below, the component states the supervisor on c reports"
+echo "   (a row marked \"while 'X' is lost\" is what X did out of reach: the supervisor shows X lost until it"
+echo "   recovers, once X has heard its own peers again, and then each row changes once)"
 say "the robot's force is 5 N; everything Normal"
 until_line "coordinator 'robot' is up" 20
 say "the force rises to 40 N (the scenario, from 6 s), over JR3's 30 N limit"

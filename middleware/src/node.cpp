@@ -233,6 +233,7 @@ struct CoordinatorNode::Impl {
     std::size_t behind = 0;               ///< interfaces held of it that a heartbeat showed ahead
   };
   std::map<std::string, Peer, std::less<>> peers;
+  std::vector<std::string> cleared_since_heartbeat;  ///< under peer_mutex: losses cleared since (Heartbeat::settling)
   std::mutex peer_mutex;       ///< held, peers; taken before a coordinator write, never inside an observer
   std::string stream_scratch;  ///< under peer_mutex: a stream's name, its storage reused per update
   std::int64_t started = 0;
@@ -683,6 +684,17 @@ struct CoordinatorNode::Impl {
     {
       std::lock_guard lock(peer_mutex);
       for (const auto& [iface, _] : held) h.clients.push_back(iface);
+      // Its receivers keep its loss until it has cleared its own (Liveness::believed): those it
+      // holds now, and those cleared since the last heartbeat, whose state may not be sent yet. A
+      // peer never heard (a supervisor not started) is not coming back after a partition: not
+      // listed, or every receiver would wait the whole limit.
+      for (const auto& [who, peer] : peers) {
+        if (peer.live.lost() && peer.live.last_beat() != 0) h.settling.push_back(who);
+      }
+      for (const std::string& who : cleared_since_heartbeat) {
+        if (std::find(h.settling.begin(), h.settling.end(), who) == h.settling.end()) h.settling.push_back(who);
+      }
+      if (next) cleared_since_heartbeat.clear();
     }
     h.control = control;
     if (next) h.sentEvents = sent_events.take();
@@ -855,7 +867,10 @@ struct CoordinatorNode::Impl {
     // link that is up: what comes while it reconnects comes through a subscription about to be
     // replaced, and a loss cleared on it comes back once it is (make cluster-demo, a host rejoining).
     const bool hold = peer.live.lost() && !link->connected();
-    if (!hold && peer.live.believed(now, sent, behind_stream, lost_after())) recover(hb.coordinator, peer);
+    // Its state, shown here, is about to change while it clears losses of its own: its loss
+    // clears once that is done, so the view changes once (Liveness::believed).
+    const bool settling = peer.provider && !hb.settling.empty();
+    if (!hold && peer.live.believed(now, sent, behind_stream, lost_after(), settling)) recover(hb.coordinator, peer);
     if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
@@ -990,6 +1005,7 @@ struct CoordinatorNode::Impl {
 
   /// Clears the loss of a peer that is back and whose state we hold again (under peer_mutex).
   void recover(const std::string& who, Peer& peer) {
+    cleared_since_heartbeat.push_back(who);
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
       const Structure& shape = co.structure();

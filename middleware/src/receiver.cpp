@@ -64,7 +64,8 @@ std::string_view Members::component_of(std::string_view address) { return addres
 
 // ---- Liveness -----------------------------------------------------------------------------------
 
-bool Liveness::believed(std::int64_t now, std::int64_t sent, std::string_view behind, std::chrono::milliseconds bound) {
+bool Liveness::believed(std::int64_t now, std::int64_t sent, std::string_view behind, std::chrono::milliseconds bound,
+                        bool settling) {
   const std::int64_t before = last_beat_;
   if (sent > last_beat_) last_beat_ = sent;
   if (behind.empty()) {
@@ -74,7 +75,12 @@ bool Liveness::believed(std::int64_t now, std::int64_t sent, std::string_view be
     behind_.assign(behind);
   }
   if (!lost_ || behind_since_ != 0 || now - last_beat_ > std::chrono::nanoseconds(bound).count()) return false;
+  if (settling) {
+    if (settling_since_ == 0) settling_since_ = now;
+    if (now - settling_since_ <= std::chrono::nanoseconds(settle_limit_).count()) return false;
+  }
   lost_ = false;
+  settling_since_ = 0;
   return true;
 }
 

@@ -60,6 +60,8 @@ struct Supervisor::Impl {
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool states_behind = false;  ///< the last heartbeat listed state updates not received
+    /// The records the last heartbeat believed listed sent (0 when not followed); none since a loss.
+    std::optional<std::int64_t> records_listed;
     /// The state streams the last heartbeat listed ahead of what the view holds, with the
     /// numbers it listed: caught up once every one of them has come.
     std::vector<std::pair<std::string, std::int64_t>> behind;
@@ -89,7 +91,7 @@ struct Supervisor::Impl {
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
   introspect::HistoryEntry record_scratch;
-  std::string late_note;  ///< dispatch thread: the note of a record printed late
+  std::string record_note;  ///< dispatch thread: the note printed with a record (late, taken while lost)
   std::string address_scratch;
   std::string note_scratch;
   std::string stream_scratch;
@@ -187,6 +189,7 @@ struct Supervisor::Impl {
         const auto sent = beat.lastSeq.find(std::string(kEventsStream));
         const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
         peer.records.join(joined);
+        peer.records_listed = joined;
         peer.states_behind = false;
         const std::int64_t heard =
             peer.unproven_incarnation == beat.incarnation ? std::min(peer.unproven_floor, joined) : joined;
@@ -272,7 +275,8 @@ struct Supervisor::Impl {
                          "', a component it does not run");
       return;
     }
-    bool late = false;  // below a record received before it: printed as late
+    bool late = false;    // below a record received before it: printed as late
+    bool masked = false;  // taken while the coordinator is lost, which its rows are shown as
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(m.coordinator);
@@ -314,6 +318,7 @@ struct Supervisor::Impl {
           return;
       }
       if (!shown) return;
+      masked = peer.live.lost();
       if (transition) {
         const std::string_view address = entry.where();  // checked above: a machine, or a component
         auto row = view.find(address);
@@ -333,10 +338,14 @@ struct Supervisor::Impl {
         }
       }
     }
-    if (late) {
-      late_note.assign("late: seq ").append(std::to_string(m.seq)).append(" arrived after newer records");
+    record_note.clear();
+    if (late) record_note.assign("late: seq ").append(std::to_string(m.seq)).append(" arrived after newer records");
+    if (masked) {
+      // What it did while out of reach, or while it settles its own losses (Liveness::believed):
+      // the view shows it lost until it recovers, and then changes once.
+      record_note.append(late ? "; " : "").append("while '").append(m.coordinator).append("' is lost");
     }
-    emit(SupervisorLine::of_record(m.coordinator, entry, late ? std::string_view(late_note) : std::string_view()));
+    emit(SupervisorLine::of_record(m.coordinator, entry, std::string_view(record_note)));
   }
 
   void on_updates(const wire::Signed& signed_batch) {
@@ -516,7 +525,17 @@ struct Supervisor::Impl {
     // Back only over a link that is up: what comes while it reconnects comes through a subscription
     // about to be replaced (as for a coordinator, node.cpp).
     const bool hold = peer.live.lost() && !link->connected();
-    if (!hold && peer.live.believed(steady_ns(), sent, behind, options.lost_after)) recovered = peer.components;
+    // Its state is about to change while it clears losses of its own (the supervisor, a provider),
+    // or its records of what it did are still on their way (each topic's link between brokers comes
+    // back on its own after a partition): its loss clears once that is done, so each row changes
+    // once (Liveness::believed).
+    // (Records listed by the heartbeat before this one, believed since the loss: those sent since
+    // may be on their way. The first one believed after a loss is its proof: one more is waited for.)
+    const std::int64_t records_sent = records == h.lastSeq.end() ? 0 : records->second;
+    const bool settling = !h.settling.empty() || !peer.records_listed || *peer.records_listed > peer.records.last();
+    peer.records_listed = records_sent;
+    if (!hold && peer.live.believed(steady_ns(), sent, behind, options.lost_after, settling))
+      recovered = peer.components;
   }
 
   /// The supervisor starts toward safe (DESIGN §7): every coordinator is lost until it is proven
@@ -656,7 +675,8 @@ struct Supervisor::Impl {
         for (auto& [name, peer] : peers) {
           if (std::string why = peer.live.check(now, since, options.lost_after, "the supervisor connected");
               !why.empty()) {
-            peer.fresh.doubt();  // back only on a new proof of life, never on a recording of it
+            peer.fresh.doubt();           // back only on a new proof of life, never on a recording of it
+            peer.records_listed.reset();  // what it sent while out of reach is not known yet
             lost_now.push_back(Lost{name, peer.components, std::move(why)});
           }
           next = std::min(next, peer.live.due(since, options.lost_after));

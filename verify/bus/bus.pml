@@ -22,7 +22,9 @@
  * (periods of calm after which R must show the truth, P5); WATCH_START (R watches P from its own
  * start: a provider; else once heard: the supervisor); FORGET (R forgets P's process on a loss:
  * the supervisor's heartbeats at a coordinator); LOSS_LEVEL (what R shows while P is lost); the
- * budgets B_* (faults and attacks per run: they bound the search, not time) and the mutants M_*.
+ * budgets B_* (faults and attacks per run: they bound the search, not time) and the mutants M_*;
+ * PS (P settles its own losses within PS ticks of the heal) and SL (R keeps a loss for a settling
+ * P at most SL ticks: Liveness::kSettleLimit, scaled down; see docs/verify.md).
  */
 
 #define NONE 255
@@ -42,6 +44,9 @@ byte p_truth[2];       /* NORMAL or ERROR */
 byte p_err[2];         /* ghost: age of its Error (NONE: Normal) */
 byte p_levels[2];      /* ghost, P4: the levels it sent on each stream (bit mask) */
 bool p_resync = false; /* a resync request to honour */
+bool p_set = false;    /* P holds a peer of its own lost (cut off, it lost them too): its Normal streams
+                          show Warning until it hears them again (Heartbeat::settling) */
+byte p_seta = NONE;    /* ticks since the heal while P settles (NONE: not settling, or still cut off) */
 byte p_hon = NONE;     /* age of its last republish for a request */
 
 /* ---- the network and the attacker ---- */
@@ -55,17 +60,17 @@ byte calm = 0;         /* ghost, P5: ticks since anything disturbed the pair */
 bool disturbed = false;
 /* heartbeats in flight: incarnation, age, listed stream numbers, ticks until delivered */
 byte hq_n = 0;
-byte hq_inc[QN]; byte hq_age[QN]; byte hq_l0[QN]; byte hq_l1[QN]; byte hq_due[QN];
+byte hq_inc[QN]; byte hq_age[QN]; byte hq_l0[QN]; byte hq_l1[QN]; byte hq_due[QN]; bool hq_set[QN];
 /* state updates in flight: signer (0 P, 1 another member), incarnation, stream, number, level, due */
 byte sq_n = 0;
 byte sq_who[QN]; byte sq_inc[QN]; byte sq_s[QN]; byte sq_seq[QN]; byte sq_lvl[QN]; byte sq_due[QN];
 byte rs_due = NONE;    /* R's resync request on its way to P */
 /* what a member at the broker recorded, to replay */
-bool rh = false; byte rh_inc; byte rh_age; byte rh_l0; byte rh_l1;
+bool rh = false; byte rh_inc; byte rh_age; byte rh_l0; byte rh_l1; bool rh_set;
 bool rst = false; byte rst_inc; byte rst_seq; byte rst_lvl;
 byte b_crash = B_CRASH; byte b_cut = B_CUT; byte b_unsub = B_UNSUB; byte b_broker = B_BROKER;
 byte b_flip = B_FLIP; byte b_replay = B_REPLAY; byte b_forge = B_FORGE; byte b_wild = B_WILD;
-byte b_rrestart = B_RRESTART; byte b_drop = B_DROP;
+byte b_rrestart = B_RRESTART; byte b_drop = B_DROP; byte b_settle = B_SETTLE;
 
 /* ---- the receiver R ---- */
 byte r_age = 0;        /* ticks since it started */
@@ -80,6 +85,7 @@ byte r_rtt = 0;        /* the last proof's round trip: heartbeats' ages are read
 byte l_beat = NONE;    /* age (estimated) of the newest heartbeat believed; NONE: never */
 byte l_behind = NONE;  /* age (estimated) of the first heartbeat that showed a stream ahead */
 bool lost = false;
+byte l_hold = NONE;    /* ticks a loss has been kept for P settling (NONE: not kept) */
 bool g_proof = false;  /* ghost, P2: a proof came since the loss began */
 /* the stand-ins of P's streams */
 byte h_inc[2]; byte h_seq[2]; bool h_behind[2]; byte view[2];
@@ -88,10 +94,14 @@ byte r_resync = NONE;  /* age of its last request to P to republish */
 bool q_open = false; byte q_age = NONE;
 /* what R shows, and P5's count of its changes since calm */
 byte shown[2]; byte shown_any;
-byte flips[2];         /* ghost, P5: changes of each stream's level taken since calm */
+byte flips[2];         /* ghost, P5: changes of each stream's level shown since calm (a loss aside) */
 byte flips_any;        /* ghost, P5: losses since calm */
+bit was_lost;          /* ghost, P5: R was holding P lost when it last showed its view */
+bit g_seen;            /* ghost, P5: P began settling while R held it, and R has not lost it since */
+bit g_allow;           /* ghost, P5: P settled so: its state changed once more, and R, holding it
+                          all along, must show that too (a true change, not a flap) */
 
-byte i, s, need, bf, have, beh, fate, est;
+byte i, s, need, bf, have, beh, fate, est, nv;
 /* always false: each names its property in the text SPIN prints for a violated assertion */
 bit P1_fail_safe_bound, P2_no_false_recovery, P3_no_false_normal, P4_ownership, P5_convergence;
 
@@ -104,9 +114,16 @@ bit P1_fail_safe_bound, P2_no_false_recovery, P3_no_false_normal, P4_ownership, 
 /* the estimated age of what P sent `a` ticks ago: the proof's round trip counted as lateness */
 #define EST(a) ((a) + r_rtt < CAPH -> (a) + r_rtt : CAPH)
 
+/* What R shows, and P5's count of its changes: a loss and the recovery from a loss that began since
+   calm are the one loss P5 allows (flips_any); a recovery from a loss older than calm is a change */
 inline show_view() {
-  for (s : 0 .. S - 1) { shown[s] = (lost -> LOSS_LEVEL : view[s]) }
-  shown_any = (lost -> LOSS_LEVEL : NORMAL)
+  for (s : 0 .. S - 1) {
+    nv = (lost -> LOSS_LEVEL : view[s]);
+    if :: nv != shown[s] && !lost && !(was_lost && flips_any > 0) -> flips[s]++ :: else -> skip fi;
+    shown[s] = nv
+  }
+  shown_any = (lost -> LOSS_LEVEL : NORMAL);
+  was_lost = lost
 }
 
 inline ask() {  /* Prover::ask: one question at a time; again a period after the last */
@@ -117,7 +134,7 @@ inline ask() {  /* Prover::ask: one question at a time; again a period after the
 }
 
 /* A heartbeat, or a proof's, of incarnation inc sent `age` ticks ago is believed (node.cpp believe). */
-inline believe(inc, age, l0, l1, proof) {
+inline believe(inc, age, l0, l1, proof, set) {
   need = proof; bf = NONE;
   for (s : 0 .. S - 1) {
     have = (h_inc[s] == inc -> h_seq[s] : NONE);
@@ -144,9 +161,14 @@ inline believe(inc, age, l0, l1, proof) {
   fi;
   if :: l_beat == NONE || est < l_beat -> l_beat = est :: else -> skip fi;
   if
+#ifndef M_NOSETTLE
+  /* P settles its own losses: its state is about to change; kept lost until it has (at most SL) */
+  :: lost && l_behind == NONE && l_beat <= B && set && (l_hold == NONE || l_hold < SL) ->
+     if :: l_hold == NONE -> l_hold = 0 :: else -> skip fi
+#endif
   :: lost && l_behind == NONE && l_beat <= B ->
      assert(P2_no_false_recovery || g_proof);  /* a loss ends only on a proof taken since it began */
-     lost = false; printf("@ recovered\n")
+     lost = false; l_hold = NONE; printf("@ recovered\n")
   :: else -> skip
   fi;
   if
@@ -156,8 +178,8 @@ inline believe(inc, age, l0, l1, proof) {
 }
 
 /* A heartbeat arrives (node.cpp on_beat: open_heartbeat, PeerFreshness::heartbeat). */
-inline on_hb(inc, age, l0, l1) {
-  printf("@ hb %d %d %d %d\n", inc, age, l0, l1);
+inline on_hb(inc, age, l0, l1, set) {
+  printf("@ hb %d %d %d %d %d\n", inc, age, l0, l1, set);
   if
 #ifndef M_NOINCBOUND
   :: inc == WILDINC -> printf("@ v refuse\n")
@@ -171,7 +193,7 @@ inline on_hb(inc, age, l0, l1) {
         :: else -> skip
         fi;
         r_doubt = false; r_hb = age; r_hbp = false; r_rtt = 0; printf("@ v accept\n");
-        believe(inc, age, l0, l1, false)
+        believe(inc, age, l0, l1, false, set)
 #else
         printf("@ v unproven\n"); ask()
 #endif
@@ -179,7 +201,7 @@ inline on_hb(inc, age, l0, l1) {
      :: inc == r_inc && !r_doubt && age >= r_hb && r_hbp -> printf("@ v covered\n")
      :: inc == r_inc && !r_doubt && age >= r_hb && !r_hbp -> printf("@ v refuse\n")
      :: inc == r_inc && !r_doubt && age < r_hb ->
-        r_hb = age; r_hbp = false; printf("@ v accept\n"); believe(inc, age, l0, l1, false)
+        r_hb = age; r_hbp = false; printf("@ v accept\n"); believe(inc, age, l0, l1, false, set)
      fi
   fi
 }
@@ -202,7 +224,6 @@ inline on_st(who, inc, st, seq, lvl) {
 #endif
      :: else ->
         r_last[st] = seq; r_lastp[st] = false; printf("@ v accept\n");
-        if :: view[st] != lvl -> flips[st]++ :: else -> skip fi;
         view[st] = lvl; h_inc[st] = inc; h_seq[st] = seq; h_behind[st] = false;
         if :: !h_behind[0] && !h_behind[1] -> l_behind = NONE :: else -> skip fi   /* Liveness::caught_up: every stream */
      fi
@@ -211,7 +232,7 @@ inline on_st(who, inc, st, seq, lvl) {
 
 /* P answers R's question with its heartbeat of now (Prover, PeerFreshness::proven). */
 inline on_proof() {
-  printf("@ proof %d %d %d\n", p_inc, p_hb, q_age);
+  printf("@ proof %d %d %d %d\n", p_inc, p_hb, q_age, p_set);
   q_open = false;
   if
   :: q_age > HB -> printf("@ v late\n")              /* answered too late to date P's heartbeats: asked again */
@@ -231,7 +252,7 @@ inline on_proof() {
           if :: r_last[s] > 1 -> r_last[s] = 1; r_lastp[s] = true :: else -> skip fi
         }
         r_doubt = false; g_proof = true; r_rtt = q_age; down = 0; printf("@ v accept\n");   /* P reached R */
-        believe(p_inc, 0, 1, 1, true)
+        believe(p_inc, 0, 1, 1, true, p_set)
      fi
   fi
 }
@@ -241,7 +262,7 @@ inline watch() {
   if
   :: !lost && (WATCH_START || l_beat != NONE) &&
      ((l_beat == NONE && r_age > B) || (l_beat != NONE && l_beat > B) || (l_behind != NONE && l_behind > B)) ->
-     lost = true; g_proof = false; flips_any++; printf("@ lost\n");
+     lost = true; l_hold = NONE; g_proof = false; g_seen = 0; flips_any++; printf("@ lost\n");
 #ifndef M_NORESUB
      sub_hb = true; sub_st = true; sub_gone = NONE;  /* subscribed again under new identities */
 #endif
@@ -258,19 +279,19 @@ inline watch() {
   fi
 }
 
-inline hpush(inc, age, l0, l1, due) {
+inline hpush(inc, age, l0, l1, set, due) {
   if
   :: hq_n < QN -> hq_inc[hq_n] = inc; hq_age[hq_n] = age; hq_l0[hq_n] = l0; hq_l1[hq_n] = l1;
-     hq_due[hq_n] = due; hq_n++
+     hq_set[hq_n] = set; hq_due[hq_n] = due; hq_n++
   :: else -> skip   /* the topic's queue is full: lost */
   fi
 }
 inline hpop() {
   for (i : 1 .. QN - 1) {
     hq_inc[i - 1] = hq_inc[i]; hq_age[i - 1] = hq_age[i]; hq_l0[i - 1] = hq_l0[i]; hq_l1[i - 1] = hq_l1[i];
-    hq_due[i - 1] = hq_due[i]
+    hq_set[i - 1] = hq_set[i]; hq_due[i - 1] = hq_due[i]
   }
-  hq_n--; hq_inc[hq_n] = 0; hq_age[hq_n] = 0; hq_l0[hq_n] = 0; hq_l1[hq_n] = 0; hq_due[hq_n] = 0
+  hq_n--; hq_inc[hq_n] = 0; hq_age[hq_n] = 0; hq_l0[hq_n] = 0; hq_l1[hq_n] = 0; hq_set[hq_n] = 0; hq_due[hq_n] = 0
 }
 inline spush(who, inc, st, seq, lvl, due) {
   if
@@ -311,7 +332,7 @@ inline publish(st) {
 
 inline r_restart() {  /* a newcomer: knows nothing, starts toward safe */
   r_age = 0; sub_gone = NONE; r_inc = 0; r_doubt = false; r_hb = NONE; r_hbp = false; r_rtt = 0;
-  l_beat = NONE; l_behind = NONE; lost = WATCH_START; g_proof = false;
+  l_beat = NONE; l_behind = NONE; lost = WATCH_START; l_hold = NONE; g_proof = false;
   for (s : 0 .. 1) { r_last[s] = NONE; r_lastp[s] = false; h_inc[s] = 0; h_seq[s] = NONE; h_behind[s] = false; view[s] = NORMAL }
   r_resync = NONE; q_open = false; q_age = NONE; sub_hb = true; sub_st = true; sub_gone = NONE; flush();
   printf("@ rstart\n")
@@ -319,7 +340,7 @@ inline r_restart() {  /* a newcomer: knows nothing, starts toward safe */
 
 inline p_restart(inc) {  /* a new process: numbers from 0, Normal, its state published at once */
   printf("@ pstart %d\n", inc);
-  p_alive = true; p_inc = inc; p_phase = 0; p_hb = NONE; p_resync = false; p_hon = NONE;
+  p_alive = true; p_inc = inc; p_phase = 0; p_hb = NONE; p_resync = false; p_hon = NONE; p_set = false; p_seta = NONE;
   for (s : 0 .. 1) { p_truth[s] = NORMAL; p_err[s] = NONE }
   for (s : 0 .. S - 1) { publish(s) }
 }
@@ -328,7 +349,8 @@ inline age_all() {
   AGE(p_hb, CAPH); AGE(r_hb, CAPH); AGE(l_beat, CAPH); AGE(l_behind, CAPH); AGE(rh_age, CAPH);
   for (i : 0 .. QN - 1) { if :: i < hq_n -> AGE(hq_age[i], CAPH) :: else -> skip fi }
   AGE(down, B + HB + 1); for (s : 0 .. 1) { AGE(p_err[s], B + HB + 1) }
-  AGE(p_hon, HB); AGE(r_resync, RS); AGE(q_age, (q_open -> QT : HB)); AGE(r_age, B + 1);
+  AGE(p_hon, HB); AGE(r_resync, RS); AGE(l_hold, SL);
+  if :: p_set && !cut -> p_seta = (p_seta == NONE -> 0 : (p_seta < PS -> p_seta + 1 : PS)) :: else -> p_seta = NONE fi; AGE(q_age, (q_open -> QT : HB)); AGE(r_age, B + 1);
   if :: l_beat != NONE -> r_age = B + 1 :: else -> skip fi;   /* only read before a first heartbeat */ AGE(calm, K * HB); AGE(sub_gone, RESUB);
   for (i : 0 .. QN - 1) {
     if :: i < hq_n && hq_due[i] > 0 -> hq_due[i]-- :: else -> skip fi;
@@ -357,15 +379,17 @@ active proctype bus() {
         disturbed = true; if :: p_inc != WILDINC -> b_crash-- :: else -> skip fi; p_alive = false; printf("@ crash\n")
      :: !p_alive -> disturbed = true; p_sane++; fs = 0
      :: b_wild > 0 && !p_alive -> disturbed = true; b_wild--; fs = 1
-     :: b_flip > 0 && p_alive && p_inc != WILDINC && S > 0 -> disturbed = true; b_flip--; d = 0; fs = 2
-     :: b_flip > 0 && p_alive && p_inc != WILDINC && S > 1 -> disturbed = true; b_flip--; d = 1; fs = 2
+     :: b_flip > 0 && p_alive && p_inc != WILDINC && !p_set && S > 0 -> disturbed = true; b_flip--; d = 0; fs = 2
+     :: b_flip > 0 && p_alive && p_inc != WILDINC && !p_set && S > 1 -> disturbed = true; b_flip--; d = 1; fs = 2
+     :: b_settle > 0 && cut && p_alive && p_inc != WILDINC && !p_set -> disturbed = true; b_settle--; fs = 4
+     :: p_set && p_seta != NONE && p_alive -> fs = 5   /* P hears its own peers again: its own doing, not a fault */
      :: b_wild > 0 && p_alive && S > 0 -> disturbed = true; b_wild--; fs = 3   /* P's own fault: a number far ahead */
      :: b_cut > 0 && !cut -> disturbed = true; b_cut--; cut = true; printf("@ cut\n")
      :: cut -> disturbed = true; cut = false; printf("@ heal\n")
      :: b_unsub > 0 && sub_hb -> disturbed = true; b_unsub--; sub_hb = false; printf("@ unsub hb\n")
      :: b_unsub > 0 && sub_st && S > 0 -> disturbed = true; b_unsub--; sub_st = false; printf("@ unsub st\n")
      :: b_broker > 0 -> disturbed = true; b_broker--; d_step { flush(); sub_hb = false; sub_st = false; rs_due = NONE; printf("@ broker\n") }
-     :: b_replay > 0 && rh -> disturbed = true; b_replay--; d_step { printf("@ replay hb\n"); hpush(rh_inc, rh_age, rh_l0, rh_l1, 0); if :: p_alive && rh_inc == p_inc && rh_age < down -> down = rh_age :: else -> skip fi }
+     :: b_replay > 0 && rh -> disturbed = true; b_replay--; d_step { printf("@ replay hb\n"); hpush(rh_inc, rh_age, rh_l0, rh_l1, rh_set, 0); if :: p_alive && rh_inc == p_inc && rh_age < down -> down = rh_age :: else -> skip fi }
      :: b_replay > 0 && rst && sub_st -> disturbed = true; b_replay--; d_step { printf("@ replay st\n"); spush(0, rst_inc, 0, rst_seq, rst_lvl, 0) }
      :: b_forge > 0 && S > 0 && sub_st -> disturbed = true; b_forge--; d_step { printf("@ forge\n"); spush(1, p_inc, 0, 1, WARNING, 0) }
      :: b_rrestart > 0 -> disturbed = true; b_rrestart--; d_step { r_restart() }
@@ -392,6 +416,15 @@ active proctype bus() {
        :: fs == 2 -> printf("@ flip %d\n", d); p_truth[d] = ERROR - p_truth[d]; p_err[d] = (p_truth[d] == ERROR -> 0 : NONE); publish(d)
        :: fs == 3 -> printf("@ wild\n"); p_levels[0] = p_levels[0] | (1 << p_truth[0]);
                      if :: !cut && sub_st && fate <= D -> spush(0, p_inc, 0, 0, p_truth[0], fate) :: else -> skip fi
+       :: fs == 4 -> printf("@ settling\n"); p_set = true; g_seen = !lost;
+                     for (s : 0 .. S - 1) { if :: p_truth[s] == NORMAL -> p_truth[s] = WARNING; publish(s) :: else -> skip fi }
+       :: else -> skip
+       fi;
+       /* P has heard its own peers again (within PS ticks of the heal at the latest) */
+       if
+       :: fs == 5 || (p_set && p_alive && p_seta == PS) ->
+          printf("@ settled\n"); p_set = false; p_seta = NONE; g_allow = g_seen; g_seen = 0;
+          for (s : 0 .. S - 1) { if :: p_truth[s] == WARNING -> p_truth[s] = NORMAL; publish(s) :: else -> skip fi }
        :: else -> skip
        fi;
        fs = NONE;
@@ -404,10 +437,10 @@ active proctype bus() {
        if
        :: p_alive && p_phase == 0 ->
           p_hb = 0; printf("@ beat\n");
-          if :: !cut && sub_hb && fate <= D -> hpush(p_inc, 0, 1, 1, fate) :: else -> skip fi;
+          if :: !cut && sub_hb && fate <= D -> hpush(p_inc, 0, 1, 1, p_set, fate) :: else -> skip fi;
           /* a member at the broker keeps the newest heartbeat and update it saw, to replay them */
           if
-          :: b_replay > 0 && !cut -> rh = true; rh_inc = p_inc; rh_age = 0; rh_l0 = 1; rh_l1 = 1;
+          :: b_replay > 0 && !cut -> rh = true; rh_inc = p_inc; rh_age = 0; rh_l0 = 1; rh_l1 = 1; rh_set = p_set;
              if :: S > 0 -> rst = true; rst_inc = p_inc; rst_seq = 1; rst_lvl = p_truth[0] :: else -> skip fi
           :: else -> skip
           fi
@@ -425,11 +458,11 @@ active proctype bus() {
        /* 5. the network delivers what is due, in each topic's order */
        if
        :: ord == 0 ->
-          do :: hq_n > 0 && hq_due[0] == 0 -> on_hb(hq_inc[0], hq_age[0], hq_l0[0], hq_l1[0]); hpop() :: else -> break od;
+          do :: hq_n > 0 && hq_due[0] == 0 -> on_hb(hq_inc[0], hq_age[0], hq_l0[0], hq_l1[0], hq_set[0]); hpop() :: else -> break od;
           do :: sq_n > 0 && sq_due[0] == 0 -> on_st(sq_who[0], sq_inc[0], sq_s[0], sq_seq[0], sq_lvl[0]); spop() :: else -> break od
        :: else ->
           do :: sq_n > 0 && sq_due[0] == 0 -> on_st(sq_who[0], sq_inc[0], sq_s[0], sq_seq[0], sq_lvl[0]); spop() :: else -> break od;
-          do :: hq_n > 0 && hq_due[0] == 0 -> on_hb(hq_inc[0], hq_age[0], hq_l0[0], hq_l1[0]); hpop() :: else -> break od
+          do :: hq_n > 0 && hq_due[0] == 0 -> on_hb(hq_inc[0], hq_age[0], hq_l0[0], hq_l1[0], hq_set[0]); hpop() :: else -> break od
        fi;
        /* 6. a resync request reaches P */
        if
@@ -450,15 +483,15 @@ active proctype bus() {
        watch();
        /* the ghosts: since when P is out of reach; calm; what R shows, and how often it changed */
        if :: p_alive && !cut && sub_hb -> down = 0 :: else -> skip fi;
-       if :: b_replay == 0 -> rh = false; rh_inc = 0; rh_age = 0; rh_l0 = 0; rh_l1 = 0; rst = false; rst_inc = 0; rst_seq = 0; rst_lvl = 0
+       if :: b_replay == 0 -> rh = false; rh_inc = 0; rh_age = 0; rh_l0 = 0; rh_l1 = 0; rh_set = 0; rst = false; rst_inc = 0; rst_seq = 0; rst_lvl = 0
           :: else -> skip fi;
        if :: disturbed || fate > D || !p_alive || cut -> calm = 0 :: else -> skip fi;   /* a lost subscription is for R to repair */
        disturbed = false;
-       if
-       :: calm == 0 -> for (s : 0 .. 1) { flips[s] = 0 }; flips_any = 0
+       show_view();
+       if   /* what changed in a tick that disturbed the pair is not counted */
+       :: calm == 0 -> for (s : 0 .. 1) { flips[s] = 0 }; flips_any = 0; g_allow = 0
        :: else -> skip
        fi;
-       show_view();
 
        /* P1 (fail-safe bound): out of reach for longer than the bound and a period: lost */
        assert(P1_fail_safe_bound || !(down > B + HB && (WATCH_START || l_beat != NONE)) || lost);
@@ -470,12 +503,12 @@ active proctype bus() {
           truth; on its way there it loses P at most once, and takes each stream's level at most once */
        assert(P5_convergence || flips_any <= 1);
        for (s : 0 .. S - 1) {
-         assert(P5_convergence || flips[s] <= 1);
+         assert(P5_convergence || flips[s] <= 1 + g_allow);
          assert(P5_convergence || !(calm >= K * HB && p_inc != WILDINC) || shown[s] == p_truth[s])
        }
        assert(P5_convergence || !(calm >= K * HB && p_inc != WILDINC) || !lost);
        /* the scratch variables back to one value, so that equal states are stored once */
-       i = 0; s = 0; need = 0; bf = 0; have = 0; beh = 0; est = 0; fate = 0; ord = 0; d = 0;
+       i = 0; s = 0; need = 0; bf = 0; have = 0; beh = 0; est = 0; nv = 0; fate = 0; ord = 0; d = 0;
        age_all()
      }
   od

@@ -34,6 +34,8 @@ constexpr std::chrono::milliseconds kProofTimeout{1000};
 constexpr int kTicksPerPeriod = 2;
 /// Stream numbers this far behind P's latest compare equal (docs/verify.md "The bus").
 constexpr int kStreamCap = 4;
+constexpr int kSettleTicks = kBusSettleTicks;
+static_assert(kBusSettleLimitTicks >= kSettleTicks + 3 * kTicksPerPeriod, "a provider that settles in time is held");
 /// The largest loss bound the model takes, in ticks: beyond it the search outgrows its memory.
 constexpr int kMaxBoundTicks = 24;
 
@@ -66,9 +68,10 @@ int proof_ticks(std::chrono::milliseconds period) {
 }
 
 /// Periods of calm after which every view must equal the truth (P5): a subscription round, a
-/// loss bound and three periods (a proof, a resync, a heartbeat).
+/// loss bound, the provider's settling and three periods (a proof, a resync, a heartbeat).
 int calm_periods(const BusPattern& p) {
-  return (kResubscribePeriods * kTicksPerPeriod + p.bound_ticks + 3 * kTicksPerPeriod + kTicksPerPeriod - 1) /
+  return (kResubscribePeriods * kTicksPerPeriod + p.bound_ticks + kSettleTicks + 3 * kTicksPerPeriod + kTicksPerPeriod -
+          1) /
          kTicksPerPeriod;
 }
 
@@ -116,7 +119,8 @@ std::vector<BusProperty> property_list(const std::vector<BusPattern>& patterns, 
       {"P5",
        "convergence without flapping: " + std::to_string(calm) + " periods (" + ms_text(calm * 2 * tick) +
            ") after the last fault, every view equals the provider's state; on the way a receiver loses the "
-           "provider at most once and takes each stream's level at most once",
+           "provider at most once and shows each stream change level at most once (once more only when the "
+           "provider, held all along, settled losses of its own)",
        {},
        0,
        0.0,
@@ -166,14 +170,15 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
       say(pending + " -> " + w[1]);
     } else if (k == "hb" && w.size() >= 5) {
       pending = "R receives a heartbeat of P's incarnation " + w[1] + " sent " +
-                std::to_string(std::stol(w[2]) * tick_ms) + " ms ago, listing stream 0 at " + number_text(w[3]);
+                std::to_string(std::stol(w[2]) * tick_ms) + " ms ago, listing stream 0 at " + number_text(w[3]) +
+                (w.size() >= 6 && w[5] == "1" ? ", P settling" : "");
     } else if (k == "st" && w.size() >= 6) {
       pending = std::string("R receives a state update signed by ") + (w[1] == "0" ? "P" : "another member") +
                 " for P's incarnation " + w[2] + ", stream " + w[3] + " at " + number_text(w[4]) + ": " +
                 level_text(w[5]);
     } else if (k == "proof" && w.size() >= 4) {
       pending = "P (incarnation " + w[1] + ") answers R's question asked " + std::to_string(std::stol(w[3]) * tick_ms) +
-                " ms ago";
+                " ms ago" + (w.size() >= 5 && w[4] == "1" ? ", P settling" : "");
     } else if (k == "pub" && w.size() >= 3) {
       say("P publishes stream " + w[1] + ": " + level_text(w[2]));
     } else if (k == "beat") {
@@ -194,6 +199,10 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
       say("P is cut off the network");
     } else if (k == "heal") {
       say("the network heals");
+    } else if (k == "settling") {
+      say("P, cut off, loses its own peers: it is settling (Heartbeat::settling), its Normal streams at Warning");
+    } else if (k == "settled") {
+      say("P hears its own peers again: settled, its streams back to Normal");
     } else if (k == "unsub" && w.size() >= 2) {
       say(std::string("a member unsubscribes R from P's ") + (w[1] == "hb" ? "heartbeats" : "state"));
     } else if (k == "broker") {
@@ -253,7 +262,7 @@ const std::vector<BusFaultClass>& bus_fault_classes() {
   // network delaying anything by up to half a period. The classes are chosen so that every
   // property meets every attack that could break it (docs/verify.md "The bus").
   static const std::vector<BusFaultClass> classes = [] {
-    std::vector<BusFaultClass> c(7);
+    std::vector<BusFaultClass> c(8);
     c[0].name = "restarts";
     c[0].text = "the provider crashes and restarts, the receiver restarts, a level changes, a message is lost";
     c[0].crash = c[0].flip = c[0].receiver_restart = c[0].drop = 1;
@@ -279,6 +288,11 @@ const std::vector<BusFaultClass>& bus_fault_classes() {
     c[6].text = "two streams change level, two messages are lost";
     c[6].flip = c[6].drop = 2;
     c[6].two_streams = true;
+    c[7].name = "settle";
+    c[7].text =
+        "the provider is cut off and loses its own peers (its state at Warning), the network heals and it "
+        "hears them again, a message is lost";
+    c[7].cut = c[7].settle = c[7].drop = 1;
     return c;
   }();
   return classes;
@@ -294,6 +308,8 @@ const std::vector<BusMutant>& bus_mutants() {
       {"no-ownership", "take a state update from any member", "M_NOOWNER"},
       {"no-reproof", "clear a loss on heartbeats of the process believed, without a new proof", "M_NOREPROOF"},
       {"arrival-time", "count a heartbeat as fresh when it arrives, not when it was sent", "M_ARRIVAL"},
+      {"no-settle-hold", "clear a loss while the provider still settles its own (Heartbeat::settling ignored)",
+       "M_NOSETTLE"},
   };
   return mutants;
 }
@@ -382,6 +398,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   def("QT", proof_ticks(options.period));
   def("CAPS", kStreamCap);
   def("K", calm_periods(pattern));
+  def("PS", kSettleTicks);
+  def("SL", kBusSettleLimitTicks);
   def("WATCH_START", pattern.watch_start ? 1 : 0);
   def("FORGET", pattern.forget ? 1 : 0);
   def("LOSS_LEVEL", static_cast<int>(pattern.loss_level));
@@ -395,6 +413,7 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   def("B_WILD", faults.wild);
   def("B_RRESTART", faults.receiver_restart);
   def("B_DROP", faults.drop);
+  def("B_SETTLE", faults.settle);
   if (!mutant.empty()) h << "#define " << mutant << "\n";
   return h.str() + kBusModel;
 }

@@ -465,7 +465,7 @@ struct SupervisorLog {
       const auto b = line.find('\'', a + 1);
       return a == std::string::npos || b == std::string::npos ? std::string() : line.substr(a + 1, b - a - 1);
     };
-    for (const std::string& line : lines_of(path)) {
+    for (std::string line : lines_of(path)) {  // a copy: a note may be cut off
       if (line.rfind("supervisor: connected to IceStorm", 0) == 0) {
         connected = true;
       } else if (line.rfind("supervisor: coordinator '", 0) == 0) {
@@ -492,6 +492,8 @@ struct SupervisorLog {
         std::string address, first, arrow, to;
         words >> address >> first >> arrow >> to;
         if (address == "reset") continue;  // a reset record: not a transition
+        // Taken while its coordinator was lost (shown lost meanwhile): the same record.
+        if (const auto at = line.find(" (while '"); at != std::string::npos) line.erase(at);
         if (const auto at = line.find(" (late: seq "); at != std::string::npos) {
           late[who].push_back(line.substr(0, at));
           continue;

@@ -156,6 +156,7 @@ struct Bus {
   std::optional<Signer> provider, other, supervisor, attacker;
   // The provider's heartbeat, sent by a thread while `beating`: the last seq of each stream.
   std::map<std::string, std::int64_t> last_sent;
+  std::vector<std::string> settling;        ///< what wire-p's heartbeats list as losses of its own it clears
   std::optional<std::int64_t> events_sent;  ///< the last event record listed, when the heartbeat lists one
   std::atomic<bool> beating{true};
   std::atomic<bool> running{true};
@@ -286,6 +287,7 @@ struct Bus {
     h.control = alive_proxy;
     for (const auto& [iface, last] : last_sent) h.lastSeq["state:" + iface] = last;
     if (events_sent) h.lastSeq["events"] = *events_sent;
+    h.settling = settling;
     return h;
   }
   /// A heartbeat of `name` signed by `key`, listing the streams' last numbers. wire-p's genuine
@@ -306,6 +308,7 @@ struct Bus {
       if (name == "wire-p") {
         for (const auto& [iface, seq] : last_sent) h.lastSeq["state:" + iface] = seq;
         if (events_sent) h.lastSeq["events"] = *events_sent;
+        h.settling = settling;
       }
     }
     heartbeat_pub(name)->beat(key.sign(middleware::kKindHeartbeat, encode(ice.communicator(), h)));
@@ -513,6 +516,44 @@ TEST(Wire, HeartbeatsAMemberKeptAndRelaysAfterTheProviderDiedEndNoLoss) {
     ASSERT_EQ(bus.state("C.s_R.D1"), State::Error) << "a relayed heartbeat ended the loss\n" << bus.all_log();
   }
   EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+// verify --bus, mutant no-settle-hold (P5), at wire level: wire-p comes back from a partition still
+// clearing a loss of its own (it lists the supervisor in Heartbeat::settling), its state about to
+// change. Proven, caught up and fresh, it would end the client's loss; the client keeps the loss
+// until wire-p has settled, and then clears it in one step to the state wire-p settled in.
+TEST(Wire, AClientKeepsALossUntilItsProviderHasSettledItsOwnSoItsViewChangesOnce) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  bus.beating.store(false);  // cut off
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; })) << bus.all_log();
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.settling = {"supervisor"};  // it lost the supervisor too, and has not heard it again yet
+  }
+  bus.beating.store(true);  // the network heals
+  // Proven again, and caught up with its Warning (republished each period, as a resync would):
+  // the loss would end within a few periods, and shows D0 at Warning; it is kept while wire-p
+  // settles, and D0 stays at Error.
+  std::int64_t seq = 0;
+  const auto until = std::chrono::steady_clock::now() + 1500ms;
+  while (std::chrono::steady_clock::now() < until) {
+    bus.send(*bus.provider, {update("P.D0", ++seq, "EVT_SUPERVISOR_LOST", wire::Level::Warning)});
+    std::this_thread::sleep_for(100ms);
+    ASSERT_EQ(bus.state("C.s_R.D0"), State::Error) << "a loss ended while wire-p settles\n" << bus.all_log();
+  }
+  EXPECT_TRUE(bus.explains("C.s_R.D0", "EVT_COORDINATOR_LOST"));
+  // wire-p hears the supervisor again: its Warning clears, and its heartbeats list nothing.
+  bus.send(*bus.provider, {update("P.D0", ++seq, "", wire::Level::Normal)});
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.settling.clear();
+  }
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Normal; })) << bus.all_log();
+  EXPECT_FALSE(bus.explains("C.s_R.D0", "EVT_COORDINATOR_LOST"));
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Normal);
 }
 
 // verify --bus, mutant arrival-time (P1), at wire level: wire-p is cut off from the client, and a

@@ -67,11 +67,11 @@ public:
     } else if (k == "rstart") {
       restart_receiver();
     } else if (k == "hb") {
-      on_heartbeat(std::stoi(w[1]), std::stoi(w[2]), {std::stoi(w[3]), std::stoi(w[4])});
+      on_heartbeat(std::stoi(w[1]), std::stoi(w[2]), {std::stoi(w[3]), std::stoi(w[4])}, w[5] == "1");
     } else if (k == "st") {
       on_update(std::stoi(w[1]), std::stoi(w[2]), std::stoul(w[3]), std::stoi(w[4]), std::stoi(w[5]));
     } else if (k == "proof") {
-      on_proof(std::stoi(w[1]), std::stoi(w[3]));
+      on_proof(std::stoi(w[1]), std::stoi(w[3]), w[4] == "1");
     } else if (k == "v" || k == "lost" || k == "recovered") {
       model_.push_back(k == "v" ? w[1] : k);
     }
@@ -138,14 +138,16 @@ private:
 
   void restart_receiver() {
     fresh_ = PeerFreshness{};
-    live_ = Liveness{};
+    // The model's wait for a settling provider: it holds while fewer than SL ticks have passed.
+    live_ = Liveness{std::chrono::milliseconds((verify::kBusSettleLimitTicks - 1) * kTick / 1'000'000)};
     held_[0] = held_[1] = Held{};
     behind_ = 0;
     watched_since_ = now();
     if (pattern_.watch_start) live_.start_lost();
   }
 
-  void believe(std::int64_t incarnation, std::int64_t sent, const std::array<std::int64_t, 2>& listed) {
+  /// `settling`: the heartbeat lists losses of the provider's own (Heartbeat::settling).
+  void believe(std::int64_t incarnation, std::int64_t sent, const std::array<std::int64_t, 2>& listed, bool settling) {
     std::string behind;
     for (std::size_t s = 0; s < streams(); ++s) {
       Held& h = held_[s];
@@ -155,11 +157,11 @@ private:
       h.behind = is_behind;
       if (is_behind && behind.empty()) behind = stream(s);
     }
-    if (live_.believed(now(), sent, behind, bound_)) ours_.push_back("recovered");
+    if (live_.believed(now(), sent, behind, bound_, settling)) ours_.push_back("recovered");
   }
   std::size_t streams() const { return simulated_streams_; }
 
-  void on_heartbeat(int k, int age, std::array<int, 2> relative) {
+  void on_heartbeat(int k, int age, std::array<int, 2> relative, bool settling) {
     const std::int64_t real = incarnation(k);
     if (!incarnation_out_of_bounds("a heartbeat", "robot", real).empty()) {
       ours_.push_back("refuse");
@@ -174,7 +176,7 @@ private:
       case PeerFreshness::Verdict::Accept: ours_.push_back("accept"); break;
     }
     believe(real, fresh_.sent_at(kRemote + sent_tick * kTick, now()),
-            {number(k, 0, relative[0]), number(k, 1, relative[1])});
+            {number(k, 0, relative[0]), number(k, 1, relative[1])}, settling);
   }
 
   void on_update(int who, int k, std::size_t s, int relative, int) {
@@ -201,7 +203,7 @@ private:
     }
   }
 
-  void on_proof(int k, int asked_ago) {
+  void on_proof(int k, int asked_ago, bool settling) {
     const std::int64_t asked = now() - asked_ago * kTick;
     if (asked_ago > kTicksPerPeriod) {  // Prover: an answer later than a period is refused
       ours_.push_back("late");
@@ -224,7 +226,7 @@ private:
       return;
     }
     ours_.push_back("accept");
-    believe(real, asked, {latest_[k][0], latest_[k][1]});
+    believe(real, asked, {latest_[k][0], latest_[k][1]}, settling);
   }
 
   void watch() {
@@ -286,7 +288,7 @@ TEST(BusConformance, TheReceiverClassesDecideEveryMessageProofAndLossAsTheModelD
   verify::BusFaultClass all;
   all.name = "conformance";
   all.crash = all.cut = all.unsubscribe = all.broker = all.flip = all.replay = all.forge = all.wild =
-      all.receiver_restart = all.drop = 3;
+      all.receiver_restart = all.drop = all.settle = 3;
   constexpr unsigned kRuns = 200;  // per pattern: a thousand runs over robodoc's five
   std::size_t decisions = 0, runs = 0;
   std::map<std::string, std::size_t> kinds;

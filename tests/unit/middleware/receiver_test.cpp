@@ -202,6 +202,45 @@ TEST(Liveness, AStreamFirstShownAheadIsBehindSinceTheHeartbeatBelievedBeforeIt) 
       << "heartbeats lost on the way do not restart the stream's clock";
 }
 
+TEST(Liveness, ALossIsKeptWhileThePeerSettlesItsOwnLossesSoTheViewChangesOnceAfterAHeal) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_FALSE(live.check(401 * kMs, 1, kBound, "start").empty());
+  // Back, caught up and fresh, but clearing losses of its own: its state is about to change.
+  EXPECT_FALSE(live.believed(1000 * kMs, 1000 * kMs, "", kBound, true)) << "settling: still lost";
+  EXPECT_FALSE(live.believed(1100 * kMs, 1100 * kMs, "", kBound, true));
+  EXPECT_TRUE(live.lost());
+  EXPECT_TRUE(live.believed(1200 * kMs, 1200 * kMs, "", kBound, false)) << "settled: back, in one step";
+  EXPECT_FALSE(live.lost());
+  EXPECT_FALSE(live.believed(1300 * kMs, 1300 * kMs, "", kBound, true)) << "not lost: settling changes nothing";
+  EXPECT_FALSE(live.lost());
+}
+
+TEST(Liveness, APeerThatNeverSettlesIsBackAfterTheSettleLimitSoAMutualWaitEnds) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_FALSE(live.check(401 * kMs, 1, kBound, "start").empty());
+  const std::int64_t first = 1000 * kMs;
+  const std::int64_t limit = std::chrono::nanoseconds(Liveness::kSettleLimit).count();
+  EXPECT_EQ(limit, 5000 * kMs);
+  EXPECT_FALSE(live.believed(first, first, "", kBound, true)) << "the wait starts here";
+  EXPECT_FALSE(live.believed(first + limit, first + limit, "", kBound, true)) << "at the limit, not yet";
+  EXPECT_TRUE(live.believed(first + limit + 1, first + limit + 1, "", kBound, true)) << "past it: back";
+  // A later loss waits afresh.
+  EXPECT_FALSE(live.check(first + limit + 1 + 301 * kMs, 1, kBound, "start").empty());
+  const std::int64_t again = first + limit + 1000 * kMs;
+  EXPECT_FALSE(live.believed(again, again, "", kBound, true)) << "a new loss's wait starts at its own heal";
+}
+
+TEST(Liveness, SettlingNeverEndsALossThatTheOtherRulesKeep) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_FALSE(live.check(401 * kMs, 1, kBound, "start").empty());
+  EXPECT_FALSE(live.believed(1000 * kMs, 1000 * kMs, "state:P.a", kBound, false)) << "behind: lost";
+  EXPECT_FALSE(live.believed(5000 * kMs, 4000 * kMs, "", kBound, false)) << "a heartbeat sent 1 s ago: lost";
+  EXPECT_TRUE(live.lost());
+}
+
 TEST(Liveness, CaughtUpClearsTheStreamsBehindUntilTheNextHeartbeatSaysOtherwise) {
   Liveness live;
   EXPECT_FALSE(beat(live, 100 * kMs, "state:P.a"));

@@ -38,6 +38,13 @@ struct BusOptions {
   std::string work_dir;  ///< where SPIN's files go (default: a fresh temporary directory, removed)
 };
 
+/// The model's scale for a provider settling its own losses (docs/verify.md "The bus"), in ticks of
+/// half a period: the provider hears its own peers again within kBusSettleTicks of the heal, and
+/// the receiver keeps a loss for it at most kBusSettleLimitTicks (Liveness::kSettleLimit, scaled
+/// down: longer than any wait of a provider that settles in time, which is what is checked).
+inline constexpr int kBusSettleTicks = 4;
+inline constexpr int kBusSettleLimitTicks = kBusSettleTicks + 6;
+
 /// One kind of pair: everything the protocol reads of a provider and its receiver.
 struct BusPattern {
   std::size_t streams = 0;  ///< state streams the receiver holds of the provider (at most 2 modelled)
@@ -56,6 +63,7 @@ struct BusFaultClass {
   std::string text;  ///< for people
   int crash = 0, cut = 0, unsubscribe = 0, broker = 0, flip = 0, replay = 0, forge = 0, wild = 0, receiver_restart = 0,
       drop = 0;
+  int settle = 0;            ///< the provider, cut off, loses its own peers and settles after the heal
   bool two_streams = false;  ///< only for patterns of two or more streams, and checked with two
 };
 
