@@ -1005,7 +1005,8 @@ struct CoordinatorNode::Impl {
 
   /// Clears the loss of a peer that is back and whose state we hold again (under peer_mutex).
   void recover(const std::string& who, Peer& peer) {
-    cleared_since_heartbeat.push_back(who);
+    if (std::find(cleared_since_heartbeat.begin(), cleared_since_heartbeat.end(), who) == cleared_since_heartbeat.end())
+      cleared_since_heartbeat.push_back(who);  // at most one entry per peer
     if (who == kSupervisorSigner) {
       log("middleware: " + name + ": the supervisor is back");
       const Structure& shape = co.structure();

@@ -187,7 +187,8 @@ private:
 /// lost when no heartbeat of it was believed for longer than the loss bound, or when a stream its
 /// heartbeats show ahead of what the receiver holds has not caught up within the bound (a lost
 /// subscription, updates dropped on the way). It is back once a heartbeat is believed with every
-/// stream caught up. Not thread-safe: the owner holds its own lock.
+/// stream caught up, and the peer has settled losses of its own (at most kSettleLimit is waited
+/// for that). Not thread-safe: the owner holds its own lock.
 class Liveness {
 public:
   Liveness() = default;

@@ -525,12 +525,12 @@ struct Supervisor::Impl {
     // Back only over a link that is up: what comes while it reconnects comes through a subscription
     // about to be replaced (as for a coordinator, node.cpp).
     const bool hold = peer.live.lost() && !link->connected();
-    // Its state is about to change while it clears losses of its own (the supervisor, a provider),
-    // or its records of what it did are still on their way (each topic's link between brokers comes
-    // back on its own after a partition): its loss clears once that is done, so each row changes
-    // once (Liveness::believed).
-    // (Records listed by the heartbeat before this one, believed since the loss: those sent since
-    // may be on their way. The first one believed after a loss is its proof: one more is waited for.)
+    // Settling (Liveness::believed): its state is about to change while it clears losses of its own
+    // (the supervisor, a provider), or the records that the heartbeat before this one listed have
+    // not all come (each topic's link between brokers comes back on its own after a partition;
+    // records sent since may still be on their way). After a loss nothing is listed yet: the first
+    // heartbeat believed is its proof, and one more is waited for. Its loss clears once that is
+    // done, so each row changes once.
     const std::int64_t records_sent = records == h.lastSeq.end() ? 0 : records->second;
     const bool settling = !h.settling.empty() || !peer.records_listed || *peer.records_listed > peer.records.last();
     peer.records_listed = records_sent;
