@@ -9,7 +9,8 @@
 // visibility. Without it, the faulting thread publishes itself.
 //
 // --tls DIR: over mutual TLS with the certificates of a key directory (`safecass keys`), as a
-// SAFECASS process runs the bus by default; the reader certificate is presented.
+// SAFECASS process runs the bus by default; the member certificate robot.pem is presented (the
+// members' broker refuses the tools' reader certificate, docs/security.md).
 //
 // Same as bench_middleware's latency phase, on the same IceStorm: the same Ice properties as
 // every SAFECASS process (middleware/src/ice_util.cpp), a oneway publisher and a oneway
@@ -53,8 +54,8 @@ std::int64_t now_ns() {
       .count();
 }
 
-/// With --tls DIR: mutual TLS as a SAFECASS process runs it, presenting DIR's reader certificate
-/// (raw IceStorm over the same TLS as the system); else plain TCP.
+/// With --tls DIR: mutual TLS as a SAFECASS process runs it, presenting DIR's member certificate
+/// robot.pem (raw IceStorm over the same TLS as the system); else plain TCP.
 std::string g_tls_dir;
 std::string protocol() { return g_tls_dir.empty() ? "tcp" : "ssl"; }
 
@@ -67,8 +68,8 @@ std::shared_ptr<Ice::Communicator> communicator() {
     init.properties->setProperty("Ice.Plugin.IceSSL", "IceSSL:createIceSSL");
     init.properties->setProperty("IceSSL.DefaultDir", g_tls_dir);
     init.properties->setProperty("IceSSL.CAs", "ca.pem");
-    init.properties->setProperty("IceSSL.CertFile", "reader.pem");
-    init.properties->setProperty("IceSSL.KeyFile", "reader.key");
+    init.properties->setProperty("IceSSL.CertFile", "robot.pem");
+    init.properties->setProperty("IceSSL.KeyFile", "robot.key");
     init.properties->setProperty("IceSSL.VerifyPeer", "2");
     init.properties->setProperty("IceSSL.Protocols", "tls1_2, tls1_3");
   }

@@ -35,6 +35,28 @@ void BusLink::renew(const std::vector<std::string>& topics) {
   }
 }
 
+void SentHeartbeats::sent(const wire::Signed& m) {
+  std::lock_guard lock(mutex_);
+  kept_[next_] = m;
+  next_ = (next_ + 1) % kept_.size();
+  filled_ = std::min(filled_ + 1, kept_.size());
+}
+
+bool SentHeartbeats::holds(const wire::Signed& m) const {
+  std::lock_guard lock(mutex_);
+  // Only slots filled: an empty message must not match one never sent.
+  return std::any_of(kept_.begin(), kept_.begin() + static_cast<std::ptrdiff_t>(filled_), [&](const wire::Signed& k) {
+    return k.signature == m.signature && k.body == m.body && k.signer == m.signer && k.kind == m.kind &&
+           k.tags == m.tags;
+  });
+}
+
+bool BusLink::heard_own(const wire::Signed& m) {
+  if (!sent_.holds(m)) return false;
+  last_own_heartbeat_.store(steady_ns());
+  return true;
+}
+
 void BusLink::sleep_for(std::chrono::milliseconds d) {
   (void)sleeper_.sleep_until(steady_ns() + std::chrono::nanoseconds(d).count());
 }
@@ -95,7 +117,9 @@ void BusLink::loop() {
         resubscriptions_.fetch_add(made.size());
         options_.rejoined();
       }
-      Ice::uncheckedCast<wire::HeartbeatTopicPrx>(publisher(options_.heartbeat_topic))->beat(options_.heartbeat());
+      const wire::Signed beat = options_.heartbeat();
+      sent_.sent(beat);  // before it is sent: it can come back before beat() returns
+      Ice::uncheckedCast<wire::HeartbeatTopicPrx>(publisher(options_.heartbeat_topic))->beat(beat);
       if (options_.every_period) options_.every_period();
       const std::int64_t now = steady_ns();
       if (now - connected_at_ > echo_bound && now - last_own_heartbeat_.load() > echo_bound) {

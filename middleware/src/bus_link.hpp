@@ -9,6 +9,7 @@
 
 #include <Ice/Ice.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -41,6 +42,23 @@ struct BusLinkOptions {
   std::function<void(const std::string&)> log;
 };
 
+/// The heartbeats a process sent last, so that it knows its own when they come back without
+/// checking their signatures (BusLink::heard_own). Thread-safe.
+class SentHeartbeats {
+public:
+  static constexpr std::size_t kKept = 8;  ///< 0.8 s of heartbeats at the default period
+  /// `m` is about to be sent; the oldest of those kept goes.
+  void sent(const wire::Signed& m);
+  /// Whether `m` equals one of those kept in every field.
+  [[nodiscard]] bool holds(const wire::Signed& m) const;
+
+private:
+  mutable std::mutex mutex_;
+  std::array<wire::Signed, kKept> kept_;
+  std::size_t next_ = 0;    ///< the slot the next one takes
+  std::size_t filled_ = 0;  ///< slots holding a heartbeat sent
+};
+
 class BusLink {
 public:
   BusLink(std::shared_ptr<Ice::Communicator> ic, const IceEndpoint& ice, const TlsOptions& tls, BusLinkOptions options);
@@ -64,8 +82,11 @@ public:
   void renew(const std::vector<std::string>& topics);
   /// Sending on the link failed (another thread): the link thread reconnects and resynchronises.
   void reconnect() noexcept { connected_.store(false); }
-  /// The process's own heartbeat of this run came back (its dispatch thread): its subscriptions work.
-  void own_heartbeat_heard() noexcept { last_own_heartbeat_.store(steady_ns()); }
+  /// Whether `m` is, byte for byte, one of the last heartbeats this link sent (SentHeartbeats; its
+  /// dispatch thread). If so its subscriptions work, and there is nothing else to read in it: its
+  /// signature is not checked again. Anything else is checked as any heartbeat is; an own
+  /// heartbeat of this run older than those (late, or replayed) tells nothing and is ignored.
+  [[nodiscard]] bool heard_own(const wire::Signed& m);
 
   [[nodiscard]] bool connected() const noexcept { return connected_.load(); }
   [[nodiscard]] std::uint64_t connects() const noexcept { return connects_.load(); }
@@ -89,7 +110,8 @@ private:
   std::atomic<bool> running_{false};
   Sleeper sleeper_;  ///< the link thread's waits, ended by stop()
   std::atomic<bool> connected_{false};
-  std::atomic<std::int64_t> last_own_heartbeat_{0};
+  std::atomic<std::int64_t> last_own_heartbeat_{0};  ///< when one of sent_ last came back
+  SentHeartbeats sent_;
   std::atomic<std::uint64_t> connects_{0};
   std::atomic<std::uint64_t> resubscriptions_{0};
   // Link thread only: how the failures to connect are said (once, then every 5 s with a count).

@@ -93,7 +93,8 @@ struct StreamHelper<std::vector<E>, StreamHelperCategorySequence> {
   template <class S>
   static void read(S* stream, std::vector<E>& v) {
     const Int size = safecass::bounded::read_count(stream, StreamableTraits<E>::minWireSize);
-    std::vector<E>(static_cast<std::size_t>(size)).swap(v);
+    v.resize(
+        static_cast<std::size_t>(size));  // a container read again keeps what it holds: reading overwrites every field
     for (E& e : v) stream->read(e);
   }
 };

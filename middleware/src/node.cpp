@@ -790,6 +790,7 @@ struct CoordinatorNode::Impl {
   }
 
   void on_beat(const wire::Signed& m) {
+    if (link->heard_own(m)) return;
     const OpenedHeartbeat opened = open_heartbeat(*keyring, ic, m);
     if (!opened.why.empty()) {
       refuse(opened.source, opened.why);
@@ -798,9 +799,8 @@ struct CoordinatorNode::Impl {
     const wire::Heartbeat& hb = opened.beat;
     const std::int64_t now = steady_ns();
     if (hb.coordinator == name) {
-      if (hb.incarnation == incarnation) {
-        link->own_heartbeat_heard();
-      } else {
+      // Of this run but not among the heartbeats sent last (heard_own): late or replayed, no news.
+      if (hb.incarnation != incarnation) {
         drops->drop(name + "/duplicate", "middleware: " + name + ": another process runs coordinator '" + name +
                                              "' (incarnation " + std::to_string(hb.incarnation) + ", ours " +
                                              std::to_string(incarnation) + "): two processes with one name; " +

@@ -44,9 +44,16 @@ struct Supervisor::Impl {
   /// heartbeat periods by default: 300 ms).
   static constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
 
+  /// A provided interface of one of a coordinator's components: the names its updates are filed
+  /// under, made once.
+  struct Service {
+    std::string address;  ///< "C.s_S.p", its row in the view
+    std::string stream;   ///< "state:C.p", its stream (state_stream)
+  };
   struct Peer {
     std::vector<std::string> components;
-    PeerFreshness fresh;  ///< its proven process, heartbeats and state streams
+    TextMap<Service> services;  ///< by interface "C.p": those its state updates may name
+    PeerFreshness fresh;        ///< its proven process, heartbeats and state streams
     /// The newest incarnation heard from but not proven yet, and the lowest number of its records
     /// it was heard to have sent (its first heartbeat's list, or its first record's number - 1):
     /// what it sent above that before its proof was not taken, and is reported missed.
@@ -91,10 +98,10 @@ struct Supervisor::Impl {
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
   introspect::HistoryEntry record_scratch;
+  wire::StateUpdateSeq updates_scratch;
+  wire::EventMessageSeq events_scratch;
   std::string record_note;  ///< dispatch thread: the note printed with a record (late, taken while lost)
-  std::string address_scratch;
   std::string note_scratch;
-  std::string stream_scratch;
 
   Impl(const spec::SystemSpec& s, SupervisorOptions o) : system(s), options(std::move(o)) {}
 
@@ -237,7 +244,7 @@ struct Supervisor::Impl {
   }
 
   void on_events(const wire::Signed& signed_batch) {
-    wire::EventMessageSeq batch;
+    wire::EventMessageSeq& batch = events_scratch;
     if (!open(signed_batch, kKindEvents, batch)) return;
     for (const wire::EventMessage& m : batch) on_event(signed_batch.signer, m);
   }
@@ -349,7 +356,7 @@ struct Supervisor::Impl {
   }
 
   void on_updates(const wire::Signed& signed_batch) {
-    wire::StateUpdateSeq batch;
+    wire::StateUpdateSeq& batch = updates_scratch;
     if (!open(signed_batch, kKindState, batch)) return;
     for (const wire::StateUpdate& u : batch) on_update(signed_batch.signer, u);
   }
@@ -364,15 +371,6 @@ struct Supervisor::Impl {
       refuse(from, "a state update of '" + printable(u.coordinator) + "' with an invalid level");
       return;
     }
-    const auto dot = u.iface.find('.');
-    if (dot == std::string::npos) {
-      refuse(from,
-             "a state update of '" + printable(u.coordinator) + "': malformed interface '" + printable(u.iface) + "'");
-      return;
-    }
-    std::string& address = address_scratch;
-    address::assign_service(address, std::string_view(u.iface).substr(0, dot),
-                            std::string_view(u.iface).substr(dot + 1));
     // The note printed with the state: "roots a:b, c:d"; the view keeps the causes after "roots ".
     constexpr std::string_view kRoots = "roots ";
     std::string& note = note_scratch;
@@ -382,6 +380,7 @@ struct Supervisor::Impl {
       note.append(r.origin).append(":").append(r.event);
     }
     const std::string_view causes = std::string_view(note).substr(kRoots.size());
+    std::string_view address;  // its row: Service::address (peers never change after create())
     {
       std::lock_guard lock(mutex);
       const auto p = peers.find(u.coordinator);
@@ -389,16 +388,19 @@ struct Supervisor::Impl {
         refuse(from, "a state update of '" + printable(u.coordinator) + "', which is not a coordinator of the system");
         return;
       }
-      if (!members->runs(u.coordinator, Members::component_of(u.iface))) {
+      const auto service = p->second.services.find(u.iface);
+      if (service == p->second.services.end()) {
         refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) +
-                         ", a component it does not run");
+                         (members->runs(u.coordinator, Members::component_of(u.iface))
+                              ? ", not a provided interface of its component"
+                              : ", a component it does not run"));
         return;
       }
+      address = service->second.address;
       // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
       // applied is a replay (or a duplicate) and must not bring back an older state; a gap needs
       // nothing more: this full state supersedes what was missed.
-      std::string& stream = stream_scratch;
-      state_stream(stream, u.iface);
+      const std::string& stream = service->second.stream;
       std::int64_t missed = 0;
       std::string why;
       switch (p->second.fresh.stream(stream, u.incarnation, u.seq, missed, why)) {
@@ -426,6 +428,7 @@ struct Supervisor::Impl {
   }
 
   void on_beat(const wire::Signed& m) {
+    if (link->heard_own(m)) return;
     const OpenedHeartbeat opened = open_heartbeat(*keyring, ic, m);
     if (!opened.why.empty()) {
       refuse(opened.source, opened.why);
@@ -433,9 +436,8 @@ struct Supervisor::Impl {
     }
     const wire::Heartbeat& h = opened.beat;
     if (h.coordinator == kSupervisorSigner) {
-      if (h.incarnation == incarnation) {
-        link->own_heartbeat_heard();
-      } else {
+      // Of this run but not among the heartbeats sent last (heard_own): late or replayed, no news.
+      if (h.incarnation != incarnation) {
         drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
                                                 std::to_string(h.incarnation) + ", ours " +
                                                 std::to_string(incarnation) + ")");
@@ -760,6 +762,15 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   impl->instance = std::move(*built);
   for (const auto& [name, components] : system.coordinators) impl->peers[name].components = components;
   impl->members = std::make_unique<Members>(system);
+  for (const spec::ComponentSpec& c : system.components) {
+    const auto peer = impl->peers.find(impl->members->coordinator_of(c.name));
+    if (peer == impl->peers.end()) continue;
+    for (const std::string& p : c.provided) {
+      std::string iface = c.name + "." + p;
+      std::string stream = state_stream(iface);
+      peer->second.services.emplace(std::move(iface), Impl::Service{address::service(c.name, p), std::move(stream)});
+    }
+  }
   Impl* d = impl.get();
   impl->model().subscribe([d](const Record& r) {
     if (r.kind != RecordKind::Transition) return;

@@ -1485,8 +1485,9 @@ TEST(Wire, UndecodableMessagesDropNoSubscriptionAndAreLoggedAtMostOnceASecond) {
 
 // Attack: members that sign as themselves but speak for others, or push a stream far ahead.
 // wire-c (a member, its own key) reports wire-p's component P Normal; wire-p's own update jumps
-// 2^21 ahead; a heartbeat carries an incarnation near 2^63. None changes the supervisor's view,
-// and none freezes a stream: wire-p's next genuine update applies.
+// 2^21 ahead; a heartbeat carries an incarnation near 2^63; wire-p reports an interface P does
+// not provide. None changes the supervisor's view, and none freezes a stream: wire-p's next
+// genuine update applies.
 TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJumpAndClockBounds) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
@@ -1523,6 +1524,15 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
     return bus.all_log().find("more than 60 s ahead of this host's clock") != std::string::npos;
   })) << bus.all_log();
   EXPECT_EQ(view_state(sup, "P.s_S.D0"), State::Error) << out.all();
+  // wire-p itself, about an interface its component does not provide: refused, no row is made
+  // for it. Sent until the refusal is logged (a source's refusals are logged at most once a second).
+  std::int64_t d9 = 0;
+  EXPECT_TRUE(eventually([&] {
+    bus.state_pub->updates(bus.provider->seal(
+        middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D9", ++d9, "EVT_E", wire::Level::Error)})));
+    return out.all().find("for P.D9, not a provided interface of its component") != std::string::npos;
+  })) << out.all();
+  EXPECT_EQ(view_state(sup, "P.s_S.D9"), std::nullopt) << out.all();
   // wire-p is not locked out: heard (a machine busy enough to starve its heartbeats past the loss
   // bound makes it lost for a while, and its proof of life ends that loss).
   EXPECT_TRUE(eventually([&] { return sup.lost().empty(); })) << out.all();

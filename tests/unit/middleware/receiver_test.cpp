@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "auth.hpp"
+#include "bus_link.hpp"
 #include "receiver.hpp"
 #include "safecass/middleware/keys.hpp"
 
@@ -542,6 +543,51 @@ TEST(Decode, AParameterWhoseNumbersOrTextsDeclareTooManyIsRefused) {
     EXPECT_FALSE(decode(ice, with_huge_size(numbers, size), v)) << size;
   }
   ice->destroy();
+}
+
+TEST(Decode, ABatchDecodedIntoAReusedOneHoldsOnlyTheNewBatch) {
+  const std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
+  wire::StateUpdate a{"robot", kRun, 1, "JR3.ForceData", wire::Level::Error, {}, 5};
+  a.roots.push_back(wire::Root{"EVT_FORCE", "JR3.s_A", 7, wire::Level::Error, "f", "force", 2.5, 6, false, {"JR3"}});
+  wire::StateUpdate b = a;
+  b.iface = "JR3.Other";
+  const wire::StateUpdate c{"robot", kRun, 2, "Arm.Joints", wire::Level::Normal, {}, 9};
+  wire::StateUpdateSeq batch;
+  ASSERT_TRUE(decode(ice, encode(ice, wire::StateUpdateSeq{a, b, a}), batch));
+  ASSERT_EQ(batch.size(), 3U);
+  ASSERT_TRUE(decode(ice, encode(ice, wire::StateUpdateSeq{c}), batch));
+  ASSERT_EQ(batch.size(), 1U);
+  EXPECT_EQ(batch[0], c);  // no root, no field of the earlier batch's first update is left
+  ice->destroy();
+}
+
+wire::Signed signed_heartbeat(std::int64_t seq) {
+  wire::Signed m;
+  m.signer = "robot";
+  m.kind = std::string(kKindHeartbeat);
+  m.body = {static_cast<Ice::Byte>(seq), 2, 3};
+  m.signature.assign(64, static_cast<Ice::Byte>(seq));
+  return m;
+}
+
+TEST(SentHeartbeats, AHeartbeatComingBackIsKnownOnlyAsOneOfTheLastSentByteForByte) {
+  SentHeartbeats sent;
+  EXPECT_FALSE(sent.holds(wire::Signed{}));  // nothing sent: an empty message is not one
+  for (std::int64_t k = 1; k <= 10; ++k) sent.sent(signed_heartbeat(k));
+  // The last kKept are known, the older ones are not (late or replayed: no news).
+  for (std::int64_t k = 1; k <= 10; ++k)
+    EXPECT_EQ(sent.holds(signed_heartbeat(k)), k > 10 - static_cast<std::int64_t>(SentHeartbeats::kKept)) << k;
+  EXPECT_FALSE(sent.holds(wire::Signed{}));
+  // A sent one with any field changed is not one of them: it is checked as any heartbeat.
+  wire::Signed other_body = signed_heartbeat(10);
+  other_body.body.back() = 4;
+  wire::Signed other_signer = signed_heartbeat(10);
+  other_signer.signer = "ui";
+  wire::Signed other_signature = signed_heartbeat(10);
+  other_signature.signature[63] ^= 1;
+  wire::Signed other_kind = signed_heartbeat(10);
+  other_kind.kind = "proof";
+  for (const wire::Signed& m : {other_body, other_signer, other_signature, other_kind}) EXPECT_FALSE(sent.holds(m));
 }
 
 }  // namespace
