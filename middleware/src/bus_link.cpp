@@ -53,7 +53,7 @@ bool SentHeartbeats::holds(const wire::Signed& m) const {
 
 bool BusLink::heard_own(const wire::Signed& m) {
   if (!sent_.holds(m)) return false;
-  last_own_heartbeat_.store(steady_ns());
+  own_heartbeat_heard();
   return true;
 }
 

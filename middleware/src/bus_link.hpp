@@ -83,10 +83,12 @@ public:
   /// Sending on the link failed (another thread): the link thread reconnects and resynchronises.
   void reconnect() noexcept { connected_.store(false); }
   /// Whether `m` is, byte for byte, one of the last heartbeats this link sent (SentHeartbeats; its
-  /// dispatch thread). If so its subscriptions work, and there is nothing else to read in it: its
-  /// signature is not checked again. Anything else is checked as any heartbeat is; an own
-  /// heartbeat of this run older than those (late, or replayed) tells nothing and is ignored.
+  /// dispatch thread). If so its subscriptions work (own_heartbeat_heard), and there is nothing
+  /// else to read in it: its signature is not checked again. Anything else is checked as any
+  /// heartbeat is; an older one of this run (late) is then heard as well.
   [[nodiscard]] bool heard_own(const wire::Signed& m);
+  /// The process's own heartbeat of this run came back (its dispatch thread): its subscriptions work.
+  void own_heartbeat_heard() noexcept { last_own_heartbeat_.store(steady_ns()); }
 
   [[nodiscard]] bool connected() const noexcept { return connected_.load(); }
   [[nodiscard]] std::uint64_t connects() const noexcept { return connects_.load(); }

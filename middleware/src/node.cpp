@@ -799,8 +799,9 @@ struct CoordinatorNode::Impl {
     const wire::Heartbeat& hb = opened.beat;
     const std::int64_t now = steady_ns();
     if (hb.coordinator == name) {
-      // Of this run but not among the heartbeats sent last (heard_own): late or replayed, no news.
-      if (hb.incarnation != incarnation) {
+      if (hb.incarnation == incarnation) {
+        link->own_heartbeat_heard();  // one of this run not among those sent last (heard_own): late
+      } else {
         drops->drop(name + "/duplicate", "middleware: " + name + ": another process runs coordinator '" + name +
                                              "' (incarnation " + std::to_string(hb.incarnation) + ", ours " +
                                              std::to_string(incarnation) + "): two processes with one name; " +

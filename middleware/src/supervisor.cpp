@@ -436,8 +436,9 @@ struct Supervisor::Impl {
     }
     const wire::Heartbeat& h = opened.beat;
     if (h.coordinator == kSupervisorSigner) {
-      // Of this run but not among the heartbeats sent last (heard_own): late or replayed, no news.
-      if (h.incarnation != incarnation) {
+      if (h.incarnation == incarnation) {
+        link->own_heartbeat_heard();  // one of this run not among those sent last (heard_own): late
+      } else {
         drops->drop("supervisor/duplicate", "supervisor: another supervisor runs on this bus (incarnation " +
                                                 std::to_string(h.incarnation) + ", ours " +
                                                 std::to_string(incarnation) + ")");
