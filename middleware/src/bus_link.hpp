@@ -112,7 +112,7 @@ private:
   std::atomic<bool> running_{false};
   Sleeper sleeper_;  ///< the link thread's waits, ended by stop()
   std::atomic<bool> connected_{false};
-  std::atomic<std::int64_t> last_own_heartbeat_{0};  ///< when one of sent_ last came back
+  std::atomic<std::int64_t> last_own_heartbeat_{0};  ///< when an own heartbeat of this run last came back
   SentHeartbeats sent_;
   std::atomic<std::uint64_t> connects_{0};
   std::atomic<std::uint64_t> resubscriptions_{0};
