@@ -252,7 +252,7 @@ struct CoordinatorNode::Impl {
   std::shared_ptr<Ice::Communicator> ic;
   std::shared_ptr<Ice::ObjectAdapter> adapter;
   /// The topics this process publishes on, in BusLink's order.
-  enum Topic : std::size_t { kPublishState, kPublishEvents, kPublishHeartbeat, kPublishResync };
+  enum Topic : std::size_t { PublishState, PublishEvents, PublishHeartbeat, PublishResync };
   std::unique_ptr<BusLink> link;
   std::string control;
 
@@ -575,8 +575,8 @@ struct CoordinatorNode::Impl {
     std::vector<std::pair<std::size_t, bool>> todo;
     wire::StateUpdateSeq updates;
     std::vector<Stream*> updated;
-    TypedPublisher<wire::StateTopicPrx> state_publisher(*link, kPublishState);
-    TypedPublisher<wire::EventTopicPrx> event_publisher(*link, kPublishEvents);
+    TypedPublisher<wire::StateTopicPrx> state_publisher(*link, PublishState);
+    TypedPublisher<wire::EventTopicPrx> event_publisher(*link, PublishEvents);
     const std::int64_t delay = std::chrono::nanoseconds(kEventDelay).count();
     while (running.load()) {
       todo.clear();
@@ -657,7 +657,7 @@ struct CoordinatorNode::Impl {
   /// Connected, or subscriptions made again: everything is republished, and every provider asked to.
   void rejoined() {
     mark_all(true);
-    Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync))->resync(resync_request(""));
+    Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(PublishResync))->resync(resync_request(""));
     resyncs_requested.fetch_add(1);
   }
 
@@ -875,7 +875,7 @@ struct CoordinatorNode::Impl {
     if (!peer.provider) return;
     if (!need || now - peer.last_resync < 3 * std::chrono::nanoseconds(options.heartbeat).count()) return;
     peer.last_resync = now;
-    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync));
+    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(PublishResync));
     if (pub == nullptr) return;
     try {
       pub->resync(resync_request(hb.coordinator));
@@ -1160,7 +1160,7 @@ Expected<void> CoordinatorNode::start() {
     BusLinkOptions bus;
     bus.who = who;
     bus.publish_on = {state_topic(d.name), kEventTopic, heartbeat_topic(d.name), kResyncTopic};
-    bus.heartbeat_topic = Impl::kPublishHeartbeat;
+    bus.heartbeat_topic = Impl::PublishHeartbeat;
     bus.period = d.options.heartbeat;
     bus.while_down = "running locally";
     bus.heartbeat = [&d] { return d.signer->sign(kKindHeartbeat, encode(d.ic, d.heartbeat())); };

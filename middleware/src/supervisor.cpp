@@ -80,7 +80,7 @@ struct Supervisor::Impl {
 
   std::shared_ptr<Ice::Communicator> ic;
   /// The topics the supervisor publishes on, in BusLink's order.
-  enum Topic : std::size_t { kPublishResync, kPublishHeartbeat };
+  enum Topic : std::size_t { PublishResync, PublishHeartbeat };
   std::unique_ptr<BusLink> link;
   std::optional<Signer> signer;
   std::optional<Keyring> keyring;
@@ -216,7 +216,7 @@ struct Supervisor::Impl {
   }
 
   void request_resync(const std::string& who) {
-    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(kPublishResync));
+    const auto pub = Ice::uncheckedCast<wire::ResyncTopicPrx>(link->publisher(PublishResync));
     if (pub == nullptr) return;
     try {
       pub->resync(signer->seal(kKindResync, encode(ic, wire::ResyncRequest{std::string(kSupervisorSigner), incarnation,
@@ -837,7 +837,7 @@ Expected<void> Supervisor::start() {
     BusLinkOptions bus;
     bus.who = "supervisor";
     bus.publish_on = {kResyncTopic, heartbeat_topic(kSupervisorSigner)};
-    bus.heartbeat_topic = Impl::kPublishHeartbeat;
+    bus.heartbeat_topic = Impl::PublishHeartbeat;
     // The monitor is itself monitored (DESIGN §4): coordinators watch this heartbeat.
     bus.period = Impl::kHeartbeatPeriod;
     bus.heartbeat = [&d] { return d.signer->sign(kKindHeartbeat, encode(d.ic, d.heartbeat(true))); };

@@ -73,7 +73,7 @@ struct IceEndpoint {
 /// Parses "HOST:PORT", "PORT", "locator:HOST:PORT", "NAME=HOST:PORT" or
 /// "NAME=HOST:PORT,PEER=HOST:PORT,..." (with peers every broker is named, each name and address
 /// once; a name is letters, digits, '-' and '_'). Errors: Parse (with what was wrong).
-[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view text);
+[[nodiscard]] Expected<IceEndpoint> parse_ice_endpoint(std::string_view whole);
 /// The text parse_ice_endpoint reads: "HOST:PORT", "locator:HOST:PORT" or "NAME=HOST:PORT,...".
 std::string to_string(const IceEndpoint& ice);
 
