@@ -390,10 +390,11 @@ struct Supervisor::Impl {
       }
       const auto service = p->second.services.find(u.iface);
       if (service == p->second.services.end()) {
-        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) +
-                         (members->runs(u.coordinator, Members::component_of(u.iface))
+        const char* why = u.iface.find('.') == std::string::npos ? ", a malformed interface (not Component.Interface)"
+                          : members->runs(u.coordinator, Members::component_of(u.iface))
                               ? ", not a provided interface of its component"
-                              : ", a component it does not run"));
+                              : ", a component it does not run";
+        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + why);
         return;
       }
       address = service->second.address;
