@@ -246,9 +246,30 @@ PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64
   missed = 0;
   if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
   if (doubt_) return Verdict::Unproven;
-  auto it = streams_.find(stream);
-  if (it == streams_.end()) it = streams_.emplace(std::string(stream), Stream{}).first;
-  Stream& s = it->second;
+  return take(entry(stream), seq, missed, why);
+}
+
+PeerFreshness::Slot PeerFreshness::track(std::string_view stream) {
+  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return Slot{it->second};
+  Stream s;
+  if (const auto it = untracked_.find(stream); it != untracked_.end()) {
+    s = it->second;
+    untracked_.erase(it);
+  }
+  tracked_.push_back(s);
+  tracked_index_.emplace(std::string(stream), tracked_.size() - 1);
+  return Slot{tracked_.size() - 1};
+}
+
+PeerFreshness::Verdict PeerFreshness::stream(Slot slot, std::int64_t incarnation, std::int64_t seq,
+                                             std::int64_t& missed, std::string& why) {
+  missed = 0;
+  if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
+  if (doubt_) return Verdict::Unproven;
+  return take(tracked_.at(slot.index), seq, missed, why);
+}
+
+PeerFreshness::Verdict PeerFreshness::take(Stream& s, std::int64_t seq, std::int64_t& missed, std::string& why) {
   if (seq <= s.last) {
     // At or below what the proof listed: sent before the process proved itself alive (still on
     // its way) or a replay; either way not taken, and what it held comes again in the republish
@@ -269,6 +290,19 @@ PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64
   return Verdict::Accept;
 }
 
+const PeerFreshness::Stream* PeerFreshness::find(std::string_view stream) const {
+  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return &tracked_[it->second];
+  const auto it = untracked_.find(stream);
+  return it == untracked_.end() ? nullptr : &it->second;
+}
+
+PeerFreshness::Stream& PeerFreshness::entry(std::string_view stream) {
+  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return tracked_[it->second];
+  auto it = untracked_.find(stream);
+  if (it == untracked_.end()) it = untracked_.emplace(std::string(stream), Stream{}).first;
+  return it->second;
+}
+
 bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::int64_t asked) {
   if (beat.incarnation < incarnation_) {
     why = "a proof of incarnation " + std::to_string(beat.incarnation) + ", older than " + std::to_string(incarnation_);
@@ -283,12 +317,13 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::i
     incarnation_ = beat.incarnation;
     heartbeat_seq_ = beat.seq;
     heartbeat_from_proof_ = true;
-    streams_.clear();
+    std::fill(tracked_.begin(), tracked_.end(), Stream{});
+    untracked_.clear();
   }
   // What the process had sent when it answered: anything at or below it that arrives later is
   // old; what it sends next is above it.
   for (const auto& [stream, last] : beat.lastSeq) {
-    Stream& have = streams_[stream];
+    Stream& have = entry(stream);
     if (last > have.last) {
       have.last = last;
       have.from_proof = true;
@@ -301,13 +336,13 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::i
 }
 
 std::int64_t PeerFreshness::taken(std::string_view stream) const {
-  const auto it = streams_.find(stream);
-  return it == streams_.end() ? 0 : it->second.taken;
+  const Stream* s = find(stream);
+  return s == nullptr ? 0 : s->taken;
 }
 
 std::int64_t PeerFreshness::last(std::string_view stream) const {
-  const auto it = streams_.find(stream);
-  return it == streams_.end() ? 0 : it->second.last;
+  const Stream* s = find(stream);
+  return s == nullptr ? 0 : s->last;
 }
 
 // ---- Prover -------------------------------------------------------------------------------------

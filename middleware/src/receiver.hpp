@@ -132,6 +132,16 @@ public:
   /// proof listed.
   Verdict stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed,
                  std::string& why);
+  /// A stream followed from the start (one of the state streams the system file gives the peer),
+  /// reached by its slot rather than by its name: a receiver of many updates looks each up once.
+  struct Slot {
+    std::size_t index = 0;
+  };
+  /// Follows `stream` from now on; its numbers start at 0, as an untracked stream's, and are reset
+  /// with them when another process is proven. Tracking a stream twice gives its slot again.
+  Slot track(std::string_view stream);
+  /// stream() for a tracked stream.
+  Verdict stream(Slot slot, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed, std::string& why);
   /// A proof of `beat` (checked by the Prover): its incarnation becomes the believed one, and its
   /// heartbeat and stream numbers the floor below which everything is a replay. `asked` is when
   /// the nonce it answers was sent (steady ns; 0: not known): the process's heartbeats are dated
@@ -173,13 +183,19 @@ private:
     bool from_proof = false;  ///< `last` is the proof's: nothing accepted since
     std::int64_t taken = 0;   ///< the last number accepted from a message
   };
+  Verdict take(Stream& s, std::int64_t seq, std::int64_t& missed, std::string& why);
+  const Stream* find(std::string_view stream) const;
+  /// Its entry, made (untracked) when it has none.
+  Stream& entry(std::string_view stream);
   std::int64_t incarnation_ = 0;
   bool doubt_ = false;              ///< lost since proven: a new proof is needed
   std::int64_t anchor_local_ = 0;   ///< when the last proof's question was sent (steady ns here)
   std::int64_t anchor_remote_ = 0;  ///< the time its heartbeat carried (the sender's steady ns)
   std::int64_t heartbeat_seq_ = 0;
-  bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
-  TextMap<Stream> streams_;
+  bool heartbeat_from_proof_ = false;   ///< heartbeat_seq_ is a proof's, no heartbeat taken since
+  std::vector<Stream> tracked_;         ///< by Slot::index
+  TextMap<std::size_t> tracked_index_;  ///< by name: the slot
+  TextMap<Stream> untracked_;           ///< the others a message or a proof named (this process's only)
 };
 
 /// Whether one peer a receiver follows is lost: the loss rule of DESIGN §4 and §7, the same for

@@ -44,11 +44,13 @@ struct Supervisor::Impl {
   /// heartbeat periods by default: 300 ms).
   static constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
 
-  /// A provided interface of one of a coordinator's components: the names its updates are filed
-  /// under, made once.
+  /// A provided interface of one of a coordinator's components: what an update of it reaches,
+  /// found once, so that an update costs one lookup (by its interface).
   struct Service {
-    std::string address;  ///< "C.s_S.p", its row in the view
-    std::string stream;   ///< "state:C.p", its stream (state_stream)
+    std::string address;       ///< "C.s_S.p", its row in the view
+    std::string stream;        ///< "state:C.p", its stream (state_stream)
+    PeerFreshness::Slot slot;  ///< its stream in the peer's PeerFreshness
+    ViewRow* row = nullptr;    ///< its row once it has one (view's nodes stay put until erased)
   };
   struct Peer {
     std::vector<std::string> components;
@@ -191,6 +193,7 @@ struct Supervisor::Impl {
           for (auto it = view.begin(); it != view.end();) {
             it = it->second.coordinator == who ? view.erase(it) : std::next(it);
           }
+          for (auto& [_, service] : peer.services) service.row = nullptr;
           print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
         }
         const auto sent = beat.lastSeq.find(std::string(kEventsStream));
@@ -388,8 +391,8 @@ struct Supervisor::Impl {
         refuse(from, "a state update of '" + printable(u.coordinator) + "', which is not a coordinator of the system");
         return;
       }
-      const auto service = p->second.services.find(u.iface);
-      if (service == p->second.services.end()) {
+      const auto found = p->second.services.find(u.iface);
+      if (found == p->second.services.end()) {
         const char* why = u.iface.find('.') == std::string::npos ? ", a malformed interface (not Component.Interface)"
                           : members->runs(u.coordinator, Members::component_of(u.iface))
                               ? ", not a provided interface of its component"
@@ -397,14 +400,14 @@ struct Supervisor::Impl {
         refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + why);
         return;
       }
-      address = service->second.address;
+      Service& service = found->second;
+      address = service.address;
       // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
       // applied is a replay (or a duplicate) and must not bring back an older state; a gap needs
       // nothing more: this full state supersedes what was missed.
-      const std::string& stream = service->second.stream;
       std::int64_t missed = 0;
       std::string why;
-      switch (p->second.fresh.stream(stream, u.incarnation, u.seq, missed, why)) {
+      switch (p->second.fresh.stream(service.slot, u.incarnation, u.seq, missed, why)) {
         case PeerFreshness::Verdict::Accept: break;
         case PeerFreshness::Verdict::Covered:           // (heartbeats only)
         case PeerFreshness::Verdict::Unproven: return;  // taken from its republish once proven
@@ -413,12 +416,11 @@ struct Supervisor::Impl {
           return;
       }
       if (auto& behind = p->second.behind; !behind.empty()) {
-        std::erase_if(behind, [&](const auto& b) { return b.first == stream && u.seq >= b.second; });
+        std::erase_if(behind, [&](const auto& b) { return b.first == service.stream && u.seq >= b.second; });
         if (behind.empty()) p->second.live.caught_up();  // every stream listed ahead has come
       }
-      auto row = view.find(address);
-      if (row == view.end()) row = view.emplace(address, ViewRow{}).first;
-      ViewRow& r = row->second;
+      if (service.row == nullptr) service.row = &view.try_emplace(service.address).first->second;
+      ViewRow& r = *service.row;
       if (r.address == address && r.coordinator == u.coordinator && r.state == s && r.cause == causes) return;
       r.coordinator = u.coordinator;
       r.address = address;
@@ -770,7 +772,9 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
     for (const std::string& p : c.provided) {
       std::string iface = c.name + "." + p;
       std::string stream = state_stream(iface);
-      peer->second.services.emplace(std::move(iface), Impl::Service{address::service(c.name, p), std::move(stream)});
+      const PeerFreshness::Slot slot = peer->second.fresh.track(stream);
+      peer->second.services.emplace(std::move(iface),
+                                    Impl::Service{address::service(c.name, p), std::move(stream), slot, nullptr});
     }
   }
   Impl* d = impl.get();

@@ -134,6 +134,35 @@ TEST(PeerFreshness, TakenIsWhatCameFromTheProcessNotWhatItsProofListed) {
   EXPECT_EQ(peer.taken(state_stream("JR3.ForceData")), 6);
 }
 
+// One lookup per update (the supervisor reaches each state stream by a slot made at start): a
+// tracked stream keeps every rule of a stream reached by name, shares its numbers with the name,
+// and starts again from 0 when another process is proven, as the others do.
+TEST(PeerFreshness, ATrackedStreamFollowsTheSameRulesAsByNameAndStartsAgainWithANewProcess) {
+  PeerFreshness peer;
+  std::string why;
+  std::int64_t missed = 0;
+  const std::string stream = state_stream("JR3.ForceData");
+  const PeerFreshness::Slot slot = peer.track(stream);
+  EXPECT_EQ(peer.track(stream).index, slot.index) << "tracked twice: the same slot";
+  EXPECT_EQ(peer.stream(slot, kRun, 1, missed, why), Verdict::Unproven) << "nothing before a proof";
+  ASSERT_TRUE(peer.proven(proof(kRun, 1, 5), why)) << why;
+  EXPECT_EQ(peer.last(stream), 5) << "the proof's count reaches the tracked stream by its name";
+  EXPECT_EQ(peer.stream(slot, kRun, 5, missed, why), Verdict::Unproven) << "sent before the proof";
+  EXPECT_EQ(peer.stream(slot, kRun, 8, missed, why), Verdict::Accept);
+  EXPECT_EQ(missed, 2) << "6 and 7 skipped";
+  EXPECT_EQ(peer.stream(stream, kRun, 8, missed, why), Verdict::Refuse) << "by name: the same stream, a replay";
+  EXPECT_EQ(peer.stream(slot, kRun, 8 + kMaxSeqJump + 1, missed, why), Verdict::Refuse);
+  EXPECT_NE(why.find("jumps more than"), std::string::npos) << why;
+  EXPECT_EQ(peer.taken(stream), 8);
+  peer.doubt();
+  EXPECT_EQ(peer.stream(slot, kRun, 9, missed, why), Verdict::Unproven) << "lost: believed again only on a proof";
+  ASSERT_TRUE(peer.proven(proof(kRun + 1, 1, 2), why)) << why;
+  EXPECT_EQ(peer.taken(stream), 0) << "a new process: nothing of it taken yet";
+  EXPECT_EQ(peer.stream(slot, kRun + 1, 2, missed, why), Verdict::Unproven) << "at the new proof's count";
+  EXPECT_EQ(peer.stream(slot, kRun + 1, 3, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.stream(slot, kRun, 9, missed, why), Verdict::Refuse) << "the older process";
+}
+
 constexpr std::int64_t kMs = 1'000'000;  // steady ns
 constexpr std::chrono::milliseconds kBound{300};
 
