@@ -24,6 +24,12 @@ finish() {
   echo "   hosts removed in $((SECONDS - down)) s (at ${SECONDS} s)"
   if [ $failures -ne 0 ]; then
     for f in "$HOSTS_DIR"/*.log; do echo "---- $f"; tail -15 "$f"; done
+    # A retry starts the case again in the same directory: the failed run's logs (the processes'
+    # and the brokers') are kept beside it, for the cause.
+    local kept="$HOSTS_DIR.failed-$(date +%Y%m%dT%H%M%S)"
+    mkdir -p "$kept" && cp "$HOSTS_DIR"/*.log "$kept"/ 2>/dev/null
+    for d in "$HOSTS_DIR"/ice*; do [ -f "$d/icebox.log" ] && cp "$d/icebox.log" "$kept/$(basename "$d")-icebox.log"; done
+    echo "   this run's logs are kept in $kept"
     exit 1
   fi
   echo "PASS $case_name"
@@ -65,7 +71,7 @@ ice_for() { echo "$ice"; }
 if [ $deployment = per_host ]; then
   for h in a b c; do
     on "$h" "$src/scripts/start-icestorm" --name "$h" --host "$(hosts_ip "$h")" --port 4061 --publish-port 4064 --dir "$HOSTS_DIR/ice-$h" \
-      --env "$HOSTS_DIR/ice-$h.env" >/dev/null 2>>"$HOSTS_DIR/icestorm-start.log" ||
+      --trace --env "$HOSTS_DIR/ice-$h.env" >/dev/null 2>>"$HOSTS_DIR/icestorm-start.log" ||
       { echo "start-icestorm on $h failed: $(cat icestorm-start.log)"; exit 1; }
     hosts_pids+=("$(sed -n 's/^ICESTORM_PID=//p' "ice-$h.env")")
   done
