@@ -190,10 +190,16 @@ struct Supervisor::Impl {
         // A new process: what the view held of an earlier one goes; its records join at what the
         // proof lists as sent, and those it sent before (dropped, unproven) are reported missed.
         if (known != 0) {
+          // A Service that points at one of the rows erased points at none (its next update makes
+          // the row again); checked by the row's coordinator, so before the rows go.
+          for (auto& [_, other] : peers) {
+            for (auto& [iface, service] : other.services) {
+              if (service.row != nullptr && service.row->coordinator == who) service.row = nullptr;
+            }
+          }
           for (auto it = view.begin(); it != view.end();) {
             it = it->second.coordinator == who ? view.erase(it) : std::next(it);
           }
-          for (auto& [_, service] : peer.services) service.row = nullptr;
           print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
         }
         const auto sent = beat.lastSeq.find(std::string(kEventsStream));
