@@ -262,7 +262,7 @@ across_hosts_with_a_broker_on_each_host_cutting_any_host_loses_only_that_hosts_p
   settled() {  # the supervisor holds both coordinators recovered and the ui's view of the robot is Normal
     local who
     for who in robot ui; do
-      grep -E "coordinator '$who' (is up|lost|recovered)" supervisor.log | tail -1 | grep -q "recovered$" || return 1
+      grep -E "coordinator '$who' (lost|recovered)" supervisor.log | tail -1 | grep -q "recovered$" || return 1
     done
     ui_shows Normal
   }
