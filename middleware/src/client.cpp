@@ -258,6 +258,7 @@ public:
       : client_(client), sink_(std::move(sink)), control_(client.control), last_(last) {
     std::string why;
     (void)fresh_.proven(client.proven, why);  // the process proven at connect(): a first proof is never refused
+    take_components(client.proven);
   }
 
   void on_records(const wire::Signed& batch);
@@ -333,9 +334,14 @@ private:
   std::size_t held_bytes_ = 0;           ///< of unvouched_
   std::vector<Waiting> unreceived_;      ///< digests listed, batches not received yet
   std::vector<Ice::ByteSeq> delivered_;  ///< digests of the batches delivered lately (listed twice)
-  /// The coordinator's own components, as its heartbeats list them: a read of its history shows
-  /// what its stream carries, not the records of its stand-ins for other processes' components.
+  /// The coordinator's own components, as the proof of its process lists them: a read of its
+  /// history shows what its stream carries, not the records of its stand-ins for other
+  /// processes' components.
   Ice::StringSeq components_;
+  void take_components(const wire::Heartbeat& proof) {
+    components_ = proof.components;
+    std::sort(components_.begin(), components_.end());
+  }
 };
 
 class RemoteSubscription final : public introspect::Subscription {
@@ -426,7 +432,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   }
   const wire::Heartbeat& h = opened.beat;
   std::string why;
-  PeerFreshness::Verdict v = fresh_.heartbeat(h.incarnation, h.seq, why);
+  PeerFreshness::Verdict v = fresh_.heartbeat(h, why);
   bool restarted = false;
   if (v == PeerFreshness::Verdict::Unproven) {
     // A process not proven alive: a restart of the coordinator (followed once the endpoint proves
@@ -436,6 +442,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
       ++client_.refused;
       return;
     }
+    take_components(*beat);
     last_ = 0;  // a restarted coordinator numbers its records from 1 again
     joined_ = false;
     stream_ = EventStream{};
@@ -443,7 +450,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
     delivered_.clear();
     restarted = true;
     // Sent with or before the proof (Covered): of the process just proven all the same.
-    v = fresh_.heartbeat(h.incarnation, h.seq, why);
+    v = fresh_.heartbeat(h, why);
   }
   if (v == PeerFreshness::Verdict::Refuse) {
     ++client_.refused;  // a replay: of an earlier process, or a heartbeat taken already
@@ -455,10 +462,7 @@ void Follower::on_heartbeat(const wire::Signed& m) {
   const auto now = std::chrono::steady_clock::now();
   if (!first) beat_interval_ = now - last_beat_;
   last_beat_ = now;
-  components_ = h.components;
-  std::sort(components_.begin(), components_.end());
-  const auto sent = h.lastSeq.find(std::string(kEventsStream));
-  const std::int64_t sent_now = sent == h.lastSeq.end() ? 0 : sent->second;
+  const std::int64_t sent_now = h.events;
   // The first heartbeat of the process followed: what it sent before this follower listened is
   // read once from its history, and the stream is followed from there (a read that fails leaves
   // the stream behind: a gap, read again at the next heartbeat).

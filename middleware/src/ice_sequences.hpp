@@ -38,6 +38,7 @@ struct List : std::vector<E> {
 };
 using Bytes = List<Ice::Byte>;
 using Ints = List<Ice::Int>;
+using Longs = List<Ice::Long>;
 using Doubles = List<Ice::Double>;
 using Strings = List<std::string>;
 

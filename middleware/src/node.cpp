@@ -11,6 +11,7 @@
 #include <deque>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <thread>
 
@@ -208,11 +209,15 @@ struct CoordinatorNode::Impl {
   };
   std::vector<std::unique_ptr<Stream>> streams;
   IdVector<std::vector<std::size_t>, ComponentId> streams_of;
+  /// The streams in the order its heartbeats list their numbers (StateStreams), and that list's id.
+  std::vector<std::size_t> heartbeat_order;
+  std::int64_t states_id = 0;
 
   /// A remote provided interface held here (under peer_mutex).
   struct Held {
     MachineId proxy;
     std::string provider;          ///< the coordinator that runs the provider
+    PeerFreshness::Slot slot;      ///< its stream in the provider's PeerFreshness
     std::int64_t incarnation = 0;  ///< of the provider process whose update the held state is
     std::int64_t last_seq = 0;     ///< the last update applied, of that incarnation
     bool behind = false;           ///< a heartbeat said we missed its last update
@@ -234,8 +239,7 @@ struct CoordinatorNode::Impl {
   };
   std::map<std::string, Peer, std::less<>> peers;
   std::vector<std::string> cleared_since_heartbeat;  ///< under peer_mutex: losses cleared since (Heartbeat::settling)
-  std::mutex peer_mutex;       ///< held, peers; taken before a coordinator write, never inside an observer
-  std::string stream_scratch;  ///< under peer_mutex: a stream's name, its storage reused per update
+  std::mutex peer_mutex;  ///< held, peers; taken before a coordinator write, never inside an observer
   std::int64_t started = 0;
 
   std::mutex queue_mutex;
@@ -675,15 +679,18 @@ struct CoordinatorNode::Impl {
     h.incarnation = incarnation;
     h.time = steady_ns();
     h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
-    for (const auto& s : streams) h.lastSeq[state_stream(s->iface)] = s->seq.load();
-    h.lastSeq[std::string(kEventsStream)] = event_seq.load();
-    const Structure& shape = co.structure();
-    for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
-      if (!shape.is_remote(c)) h.components.emplace_back(shape.component_name(c));
+    h.states.reserve(heartbeat_order.size());
+    for (const std::size_t i : heartbeat_order) h.states.push_back(streams[i]->seq.load());
+    h.statesId = states_id;
+    h.events = event_seq.load();
+    if (!next) {  // a proof: its components, which never change within a process
+      const Structure& shape = co.structure();
+      for (ComponentId c : id_range<ComponentId>(shape.component_count())) {
+        if (!shape.is_remote(c)) h.components.emplace_back(shape.component_name(c));
+      }
     }
     {
       std::lock_guard lock(peer_mutex);
-      for (const auto& [iface, _] : held) h.clients.push_back(iface);
       // Its receivers keep its loss until it has cleared its own (Liveness::believed): those it
       // holds now, and those cleared since the last heartbeat, whose state may not be sent yet. A
       // peer never heard (a supervisor not started) is not coming back after a partition: not
@@ -742,8 +749,7 @@ struct CoordinatorNode::Impl {
     Peer& peer = peers[u.coordinator];
     std::int64_t missed = 0;
     std::string why;
-    state_stream(stream_scratch, u.iface);
-    switch (peer.fresh.stream(stream_scratch, u.incarnation, u.seq, missed, why)) {
+    switch (peer.fresh.stream(h.slot, u.incarnation, u.seq, missed, why)) {
       case PeerFreshness::Verdict::Accept: break;
       case PeerFreshness::Verdict::Covered:  // (heartbeats only)
       case PeerFreshness::Verdict::Unproven:
@@ -813,7 +819,7 @@ struct CoordinatorNode::Impl {
     std::lock_guard lock(peer_mutex);
     Peer& peer = peers[hb.coordinator];  // a keyring name: bounded
     std::string why;
-    switch (peer.fresh.heartbeat(hb.incarnation, hb.seq, why)) {
+    switch (peer.fresh.heartbeat(hb, why)) {
       case PeerFreshness::Verdict::Accept: break;
       case PeerFreshness::Verdict::Unproven:
         // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
@@ -851,18 +857,17 @@ struct CoordinatorNode::Impl {
     std::string behind_stream;  // the first stream it lists ahead of what is held here
     for (auto& [iface, h] : held) {
       if (h.provider != hb.coordinator) continue;
-      state_stream(stream_scratch, iface);
-      const auto s = hb.lastSeq.find(stream_scratch);
       const std::int64_t have = h.incarnation == hb.incarnation ? h.last_seq : 0;
       // A provider is back only once what it lists as sent is received (a stream it has sent
-      // nothing on yet holds every machine's initial Normal, as this stand-in does).
-      const bool behind = s == hb.lastSeq.end() || s->second > have;
+      // nothing on yet holds every machine's initial Normal, as this stand-in does). The list is
+      // the one the system file gives the provider (PeerFreshness::heartbeat checked it).
+      const bool behind = hb.states.at(h.slot.index) > have;
       // Two heartbeats in a row: the update may simply be on its way on the other topic. A lost
       // provider is asked at once: its clients stay in Error until they have its state.
       if (behind && (h.behind || peer.live.lost())) need = true;
       if (behind != h.behind) behind ? ++peer.behind : --peer.behind;
       h.behind = behind;
-      if (behind && behind_stream.empty()) behind_stream = stream_scratch;
+      if (behind && behind_stream.empty()) behind_stream = state_stream(iface);
     }
     // Lost if not caught up within the loss bound (watch_loop); back once caught up, and only over a
     // link that is up: what comes while it reconnects comes through a subscription about to be
@@ -1086,7 +1091,7 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
       for (MachineId m : shape.provided_machines(c)) {
         const std::string iface = std::string(shape.component_name(c)) + "." + std::string(shape.interface_name(m));
         const std::string provider(impl->members.coordinator_of(shape.component_name(c)));
-        impl->held.emplace(iface, Impl::Held{m, provider});
+        impl->held.emplace(iface, Impl::Held{m, provider, {}});
         if (!provider.empty()) impl->peers[provider].provider = true;
       }
       continue;
@@ -1100,6 +1105,28 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
       impl->streams_of[c].push_back(impl->streams.size());
       impl->streams.push_back(std::move(s));
     }
+  }
+  // Its heartbeats list its streams' numbers in the order of their names (StateStreams); each
+  // provider's, as the system file gives them, are followed in that order.
+  impl->heartbeat_order.resize(impl->streams.size());
+  std::iota(impl->heartbeat_order.begin(), impl->heartbeat_order.end(), std::size_t{0});
+  std::sort(impl->heartbeat_order.begin(), impl->heartbeat_order.end(),
+            [&](std::size_t a, std::size_t b) { return impl->streams[a]->iface < impl->streams[b]->iface; });
+  std::vector<std::string> ifaces;
+  for (const std::size_t i : impl->heartbeat_order) ifaces.push_back(impl->streams[i]->iface);
+  impl->states_id = StateStreams::of(std::move(ifaces)).id;
+  for (auto& [provider, peer] : impl->peers) {
+    if (peer.provider) peer.fresh.follow(impl->members.state_streams(provider));
+  }
+  for (auto& [iface, held] : impl->held) {
+    const auto peer = impl->peers.find(held.provider);
+    if (peer == impl->peers.end()) continue;
+    const auto slot = peer->second.fresh.slot(iface);
+    if (!slot) {
+      return fail(ErrorCode::InvalidArgument, "coordinator '" + impl->name + "' holds " + iface + " of coordinator '" +
+                                                  held.provider + "', which the system file does not give it");
+    }
+    held.slot = *slot;
   }
   // The required interfaces each provider coordinator feeds: where its loss is raised.
   for (const Connection& k : shape.connections()) {

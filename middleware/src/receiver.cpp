@@ -48,6 +48,32 @@ Members::Members(const spec::SystemSpec& system) {
   for (const auto& [coordinator, components] : system.coordinators) {
     for (const std::string& c : components) owner_.emplace(c, coordinator);
   }
+  for (const spec::ComponentSpec& c : system.components) {
+    const auto owner = owner_.find(c.name);
+    if (owner == owner_.end()) continue;
+    auto& ifaces = provided_[owner->second];
+    for (const std::string& p : c.provided) ifaces.push_back(c.name + "." + p);
+  }
+}
+
+StateStreams Members::state_streams(std::string_view coordinator) const {
+  const auto it = provided_.find(coordinator);
+  return StateStreams::of(it == provided_.end() ? std::vector<std::string>{} : it->second);
+}
+
+StateStreams StateStreams::of(std::vector<std::string> ifaces) {
+  std::sort(ifaces.begin(), ifaces.end());
+  crypto_generichash_state state;
+  ::crypto_generichash_init(&state, nullptr, 0, crypto_generichash_BYTES);
+  for (const std::string& iface : ifaces) {
+    ::crypto_generichash_update(&state, reinterpret_cast<const unsigned char*>(iface.data()), iface.size());
+    ::crypto_generichash_update(&state, reinterpret_cast<const unsigned char*>("\n"), 1);
+  }
+  unsigned char digest[crypto_generichash_BYTES];
+  ::crypto_generichash_final(&state, digest, sizeof digest);
+  std::uint64_t id = 0;
+  for (int k = 0; k < 8; ++k) id = (id << 8) | digest[k];
+  return StateStreams{std::move(ifaces), static_cast<std::int64_t>(id)};
 }
 
 std::string_view Members::coordinator_of(std::string_view component) const {
@@ -226,8 +252,10 @@ PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::str
   return incarnation == incarnation_ ? Verdict::Accept : Verdict::Unproven;
 }
 
-PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why) {
-  if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
+PeerFreshness::Verdict PeerFreshness::heartbeat(const wire::Heartbeat& beat, std::string& why) {
+  if (why = other_streams(beat); !why.empty()) return Verdict::Refuse;
+  if (const Verdict v = process(beat.incarnation, why); v != Verdict::Accept) return v;
+  const std::int64_t seq = beat.seq;
   if (doubt_) return Verdict::Unproven;
   if (seq <= heartbeat_seq_) {
     // The proof carried the heartbeat it was sent with: that one (and older ones still on their
@@ -241,24 +269,25 @@ PeerFreshness::Verdict PeerFreshness::heartbeat(std::int64_t incarnation, std::i
   return Verdict::Accept;
 }
 
-PeerFreshness::Verdict PeerFreshness::stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq,
-                                             std::int64_t& missed, std::string& why) {
-  missed = 0;
-  if (const Verdict v = process(incarnation, why); v != Verdict::Accept) return v;
-  if (doubt_) return Verdict::Unproven;
-  return take(entry(stream), seq, missed, why);
+void PeerFreshness::follow(StateStreams streams) {
+  streams_ = std::move(streams);
+  tracked_.assign(streams_.ifaces.size(), Stream{});
+  index_.clear();
+  for (std::size_t i = 0; i < streams_.ifaces.size(); ++i) index_.emplace(streams_.ifaces[i], i);
 }
 
-PeerFreshness::Slot PeerFreshness::track(std::string_view stream) {
-  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return Slot{it->second};
-  Stream s;
-  if (const auto it = untracked_.find(stream); it != untracked_.end()) {
-    s = it->second;
-    untracked_.erase(it);
-  }
-  tracked_.push_back(s);
-  tracked_index_.emplace(std::string(stream), tracked_.size() - 1);
-  return Slot{tracked_.size() - 1};
+std::optional<PeerFreshness::Slot> PeerFreshness::slot(std::string_view iface) const {
+  const auto it = index_.find(iface);
+  if (it == index_.end()) return std::nullopt;
+  return Slot{it->second};
+}
+
+std::string PeerFreshness::other_streams(const wire::Heartbeat& beat) const {
+  if (streams_.ifaces.empty() && streams_.id == 0) return {};  // follows none (a tool)
+  if (beat.statesId == streams_.id && beat.states.size() == tracked_.size()) return {};
+  return "it lists " + std::to_string(beat.states.size()) + " state stream(s) of id " + std::to_string(beat.statesId) +
+         ", where the system file gives its coordinator " + std::to_string(tracked_.size()) + " of id " +
+         std::to_string(streams_.id) + " (its components' provided interfaces differ: another system file?)";
 }
 
 PeerFreshness::Verdict PeerFreshness::stream(Slot slot, std::int64_t incarnation, std::int64_t seq,
@@ -290,24 +319,12 @@ PeerFreshness::Verdict PeerFreshness::take(Stream& s, std::int64_t seq, std::int
   return Verdict::Accept;
 }
 
-const PeerFreshness::Stream* PeerFreshness::find(std::string_view stream) const {
-  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return &tracked_[it->second];
-  const auto it = untracked_.find(stream);
-  return it == untracked_.end() ? nullptr : &it->second;
-}
-
-PeerFreshness::Stream& PeerFreshness::entry(std::string_view stream) {
-  if (const auto it = tracked_index_.find(stream); it != tracked_index_.end()) return tracked_[it->second];
-  auto it = untracked_.find(stream);
-  if (it == untracked_.end()) it = untracked_.emplace(std::string(stream), Stream{}).first;
-  return it->second;
-}
-
 bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::int64_t asked) {
   if (beat.incarnation < incarnation_) {
     why = "a proof of incarnation " + std::to_string(beat.incarnation) + ", older than " + std::to_string(incarnation_);
     return false;
   }
+  if (why = other_streams(beat); !why.empty()) return false;
   if (beat.incarnation == incarnation_) {
     if (beat.seq >= heartbeat_seq_) {
       heartbeat_seq_ = beat.seq;
@@ -318,14 +335,13 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::i
     heartbeat_seq_ = beat.seq;
     heartbeat_from_proof_ = true;
     std::fill(tracked_.begin(), tracked_.end(), Stream{});
-    untracked_.clear();
   }
   // What the process had sent when it answered: anything at or below it that arrives later is
   // old; what it sends next is above it.
-  for (const auto& [stream, last] : beat.lastSeq) {
-    Stream& have = entry(stream);
-    if (last > have.last) {
-      have.last = last;
+  for (std::size_t i = 0; i < tracked_.size(); ++i) {
+    Stream& have = tracked_[i];
+    if (beat.states[i] > have.last) {
+      have.last = beat.states[i];
       have.from_proof = true;
     }
   }
@@ -333,16 +349,6 @@ bool PeerFreshness::proven(const wire::Heartbeat& beat, std::string& why, std::i
   anchor_local_ = asked;
   anchor_remote_ = beat.time;
   return true;
-}
-
-std::int64_t PeerFreshness::taken(std::string_view stream) const {
-  const Stream* s = find(stream);
-  return s == nullptr ? 0 : s->taken;
-}
-
-std::int64_t PeerFreshness::last(std::string_view stream) const {
-  const Stream* s = find(stream);
-  return s == nullptr ? 0 : s->last;
 }
 
 // ---- Prover -------------------------------------------------------------------------------------

@@ -82,17 +82,21 @@ private:
   wire::DigestSeq before_, now_;
 };
 
-/// The names of a peer's streams in its heartbeat's list (wire::Heartbeat::lastSeq): its event
-/// records, and the state of each provided interface "C.p".
-inline constexpr std::string_view kEventsStream = "events";
+/// A coordinator's state streams as its heartbeats list their numbers (wire::Heartbeat::states):
+/// one per interface "C.p" its components provide, sorted bytewise, and the id of that list
+/// (wire::Heartbeat::statesId: the first 8 bytes of the BLAKE2b digest of the names, each ended by
+/// a newline). The publisher and every receiver derive the list from the system file, so a
+/// heartbeat carries numbers alone; a receiver with another list refuses the heartbeat.
+struct StateStreams {
+  std::vector<std::string> ifaces;
+  std::int64_t id = 0;
+  /// The list of `ifaces`, sorted, and its id.
+  static StateStreams of(std::vector<std::string> ifaces);
+};
+
+/// The name of the state stream of interface `iface`, as a receiver says which stream it misses.
 inline constexpr std::string_view kStateStreamPrefix = "state:";
-/// Writes the name of the state stream of interface `iface` into `out` (its storage is reused).
-inline void state_stream(std::string& out, std::string_view iface) { out.assign(kStateStreamPrefix).append(iface); }
-inline std::string state_stream(std::string_view iface) {
-  std::string out;
-  state_stream(out, iface);
-  return out;
-}
+inline std::string state_stream(std::string_view iface) { return std::string(kStateStreamPrefix).append(iface); }
 
 /// The coordinator each component runs in, as the system file assigns them.
 class Members {
@@ -104,9 +108,13 @@ public:
   std::string_view coordinator_of(std::string_view component) const;
   /// The component of an interface or address "Component.rest".
   static std::string_view component_of(std::string_view address);
+  /// The state streams of `coordinator`'s heartbeats: the interfaces its components provide
+  /// (none for a name the system file does not give a component).
+  StateStreams state_streams(std::string_view coordinator) const;
 
 private:
-  TextMap<std::string> owner_;  // component -> coordinator
+  TextMap<std::string> owner_;                  // component -> coordinator
+  TextMap<std::vector<std::string>> provided_;  // coordinator -> "C.p" of its components
 };
 
 /// What one receiver believes of one peer's process: the proven incarnation, its heartbeats' and
@@ -125,28 +133,38 @@ public:
   /// The incarnation rule alone, for a message of `incarnation`: older than the believed one
   /// refused, another one not proven, the believed one accepted.
   Verdict process(std::int64_t incarnation, std::string& why) const;
-  /// A heartbeat of incarnation `incarnation`, number `seq`.
-  Verdict heartbeat(std::int64_t incarnation, std::int64_t seq, std::string& why);
-  /// A message of stream `stream` (state_stream(), kEventsStream): on Accept `missed` is the
-  /// number of messages of the stream skipped since the last one accepted, or since the count the
-  /// proof listed.
-  Verdict stream(std::string_view stream, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed,
-                 std::string& why);
-  /// A stream followed from the start (one of the state streams the system file gives the peer),
-  /// reached by its slot rather than by its name: a receiver of many updates looks each up once.
+  /// A heartbeat: its incarnation, its number `beat.seq`, and its list of state streams, which
+  /// must be the one follow() was given (a heartbeat of another list is refused).
+  Verdict heartbeat(const wire::Heartbeat& beat, std::string& why);
+  /// A peer's state stream, by its position in the peer's StateStreams.
   struct Slot {
     std::size_t index = 0;
   };
-  /// Follows `stream` from now on; its numbers start at 0, as an untracked stream's, and are reset
-  /// with them when another process is proven. Tracking a stream twice gives its slot again.
-  Slot track(std::string_view stream);
-  /// stream() for a tracked stream.
+  /// Follows the peer's state streams from now on (the receiver's system file's list): their
+  /// numbers start at 0 and are reset when another process is proven. A receiver that follows
+  /// none (a tool) checks no heartbeat's list.
+  void follow(StateStreams streams);
+  /// The slot of interface `iface`'s stream; none when the peer has no such stream.
+  std::optional<Slot> slot(std::string_view iface) const;
+  /// The interface of a slot.
+  const std::string& iface(Slot slot) const { return streams_.ifaces.at(slot.index); }
+  /// An update numbered `seq` of the stream in `slot`: on Accept `missed` is the number of updates
+  /// of the stream skipped since the last one accepted, or since the number the proof listed.
   Verdict stream(Slot slot, std::int64_t incarnation, std::int64_t seq, std::int64_t& missed, std::string& why);
+  /// Calls `behind(slot, listed)` for each stream that `beat` (a heartbeat of the process
+  /// believed, of the list followed) lists ahead of what was taken from the stream's messages.
+  template <class F>
+  void ahead(const wire::Heartbeat& beat, F&& behind) const {
+    const std::size_t n = std::min(beat.states.size(), tracked_.size());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (beat.states[i] > tracked_[i].taken) behind(Slot{i}, beat.states[i]);
+    }
+  }
   /// A proof of `beat` (checked by the Prover): its incarnation becomes the believed one, and its
   /// heartbeat and stream numbers the floor below which everything is a replay. `asked` is when
   /// the nonce it answers was sent (steady ns; 0: not known): the process's heartbeats are dated
   /// against it from now on (sent_at). Returns false, with `why`, when it is older than the
-  /// believed one.
+  /// believed one or lists other state streams than those followed.
   bool proven(const wire::Heartbeat& beat, std::string& why, std::int64_t asked = 0);
   /// The process believed is gone (its peer was declared lost): the next one proven is believed,
   /// whatever its incarnation. Only a proof of a fresh nonce is: a replay of any process stays
@@ -171,11 +189,11 @@ public:
   }
   /// The believed incarnation (0: none proven yet).
   std::int64_t incarnation() const noexcept { return incarnation_; }
-  /// The last number accepted on `stream`, or listed by the proof (0: none).
-  std::int64_t last(std::string_view stream) const;
-  /// The last number of `stream` taken from a message of the process believed (0: none): what
-  /// the receiver holds of it, whatever a proof listed.
-  std::int64_t taken(std::string_view stream) const;
+  /// The last number accepted on the stream in `slot`, or listed by the proof (0: none).
+  std::int64_t last(Slot slot) const { return tracked_.at(slot.index).last; }
+  /// The last number of the stream in `slot` taken from a message of the process believed (0:
+  /// none): what the receiver holds of it, whatever a proof listed.
+  std::int64_t taken(Slot slot) const { return tracked_.at(slot.index).taken; }
 
 private:
   struct Stream {
@@ -184,18 +202,17 @@ private:
     std::int64_t taken = 0;   ///< the last number accepted from a message
   };
   Verdict take(Stream& s, std::int64_t seq, std::int64_t& missed, std::string& why);
-  const Stream* find(std::string_view stream) const;
-  /// Its entry, made (untracked) when it has none.
-  Stream& entry(std::string_view stream);
+  /// Why `beat` lists other state streams than those followed (empty: the same, or none followed).
+  std::string other_streams(const wire::Heartbeat& beat) const;
   std::int64_t incarnation_ = 0;
   bool doubt_ = false;              ///< lost since proven: a new proof is needed
   std::int64_t anchor_local_ = 0;   ///< when the last proof's question was sent (steady ns here)
   std::int64_t anchor_remote_ = 0;  ///< the time its heartbeat carried (the sender's steady ns)
   std::int64_t heartbeat_seq_ = 0;
-  bool heartbeat_from_proof_ = false;   ///< heartbeat_seq_ is a proof's, no heartbeat taken since
-  std::vector<Stream> tracked_;         ///< by Slot::index
-  TextMap<std::size_t> tracked_index_;  ///< by name: the slot
-  TextMap<Stream> untracked_;           ///< the others a message or a proof named (this process's only)
+  bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
+  StateStreams streams_;               ///< followed (follow()); empty: none
+  std::vector<Stream> tracked_;        ///< by Slot::index, one per streams_.ifaces
+  TextMap<std::size_t> index_;         ///< by interface: the slot
 };
 
 /// Whether one peer a receiver follows is lost: the loss rule of DESIGN §4 and §7, the same for

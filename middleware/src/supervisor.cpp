@@ -48,7 +48,6 @@ struct Supervisor::Impl {
   /// found once, so that an update costs one lookup (by its interface).
   struct Service {
     std::string address;       ///< "C.s_S.p", its row in the view
-    std::string stream;        ///< "state:C.p", its stream (state_stream)
     PeerFreshness::Slot slot;  ///< its stream in the peer's PeerFreshness
     ViewRow* row = nullptr;    ///< its row once it has one (view's nodes stay put until erased)
   };
@@ -71,9 +70,9 @@ struct Supervisor::Impl {
     bool states_behind = false;  ///< the last heartbeat listed state updates not received
     /// The records the last heartbeat believed listed sent (0 when not followed); none since a loss.
     std::optional<std::int64_t> records_listed;
-    /// The state streams the last heartbeat listed ahead of what the view holds, with the
-    /// numbers it listed: caught up once every one of them has come.
-    std::vector<std::pair<std::string, std::int64_t>> behind;
+    /// The state streams (PeerFreshness::Slot::index) the last heartbeat listed ahead of what
+    /// the view holds, with the numbers it listed: caught up once every one of them has come.
+    std::vector<std::pair<std::size_t, std::int64_t>> behind;
     Liveness live;  ///< lost or not, and since when it was heard
   };
   mutable std::mutex mutex;
@@ -202,8 +201,7 @@ struct Supervisor::Impl {
           }
           print("supervisor: coordinator '" + printable(who) + "' restarted; its view is refreshed");
         }
-        const auto sent = beat.lastSeq.find(std::string(kEventsStream));
-        const std::int64_t joined = sent == beat.lastSeq.end() ? 0 : sent->second;
+        const std::int64_t joined = beat.events;
         peer.records.join(joined);
         peer.records_listed = joined;
         peer.states_behind = false;
@@ -422,7 +420,7 @@ struct Supervisor::Impl {
           return;
       }
       if (auto& behind = p->second.behind; !behind.empty()) {
-        std::erase_if(behind, [&](const auto& b) { return b.first == service.stream && u.seq >= b.second; });
+        std::erase_if(behind, [&](const auto& b) { return b.first == service.slot.index && u.seq >= b.second; });
         if (behind.empty()) p->second.live.caught_up();  // every stream listed ahead has come
       }
       if (service.row == nullptr) service.row = &view.try_emplace(service.address).first->second;
@@ -466,12 +464,11 @@ struct Supervisor::Impl {
       Peer& peer = p->second;
       const std::int64_t known = peer.fresh.incarnation();
       std::string why;
-      switch (peer.fresh.heartbeat(h.incarnation, h.seq, why)) {
+      switch (peer.fresh.heartbeat(h, why)) {
         case PeerFreshness::Verdict::Accept: break;
         case PeerFreshness::Verdict::Unproven: {
           // Believed only on a signed answer to a nonce of ours: a recorded heartbeat has none.
-          const auto sent = h.lastSeq.find(std::string(kEventsStream));
-          if (sent != h.lastSeq.end()) heard_unproven(peer, h.incarnation, sent->second);
+          heard_unproven(peer, h.incarnation, h.events);
           prover->ask(h.coordinator, h.control);
           return;
         }
@@ -502,8 +499,8 @@ struct Supervisor::Impl {
     // here: the heartbeat lists the last record sent. What the heartbeat two before this one
     // listed and has not come (the records may be on their way on the other topic until then):
     // reported as missed (EventStream::heard).
-    const auto records = options.records ? h.lastSeq.find(std::string(kEventsStream)) : h.lastSeq.end();
-    if (const auto missed = peer.records.heard(records == h.lastSeq.end() ? 0 : records->second)) {
+    const std::int64_t records_sent = options.records ? h.events : 0;
+    if (const auto missed = peer.records.heard(records_sent)) {
       report_missed(peer, h.coordinator, *missed);
       link->renew({kEventTopic});  // the records may no longer reach us at all
     }
@@ -513,16 +510,14 @@ struct Supervisor::Impl {
     // longer than the loss bound: lost (watch_loop), as a receiver whose subscription was taken
     // from it hears the heartbeats and not the stream.
     std::int64_t states_missed = 0;
-    std::string_view behind;  // the first state stream it lists ahead of what the view holds
+    std::string behind;  // the first state stream it lists ahead of what the view holds
     peer.behind.clear();
-    for (const auto& [stream, last] : h.lastSeq) {
-      if (!std::string_view(stream).starts_with(kStateStreamPrefix)) continue;
-      const std::int64_t have = peer.fresh.taken(stream);  // what the view holds, not what a proof listed
-      if (last <= have) continue;
-      states_missed += last - have;
-      if (behind.empty()) behind = stream;
-      peer.behind.emplace_back(stream, last);
-    }
+    // Ahead of what the view holds (taken), not of what a proof listed.
+    peer.fresh.ahead(h, [&](PeerFreshness::Slot slot, std::int64_t listed) {
+      states_missed += listed - peer.fresh.taken(slot);
+      if (behind.empty()) behind = state_stream(peer.fresh.iface(slot));
+      peer.behind.emplace_back(slot.index, listed);
+    });
     if (states_missed > 0 && peer.states_behind) {
       drops->note(h.coordinator + "/states-missed", "supervisor: " + std::to_string(states_missed) +
                                                         " state update(s) of '" + printable(h.coordinator) +
@@ -543,7 +538,6 @@ struct Supervisor::Impl {
     // records sent since may still be on their way). After a loss nothing is listed yet: the first
     // heartbeat believed is its proof, and one more is waited for. Its loss clears once that is
     // done, so each row changes once.
-    const std::int64_t records_sent = records == h.lastSeq.end() ? 0 : records->second;
     const bool settling = !h.settling.empty() || !peer.records_listed || *peer.records_listed > peer.records.last();
     peer.records_listed = records_sent;
     if (!hold && peer.live.believed(steady_ns(), sent, behind, options.lost_after, settling))
@@ -713,6 +707,8 @@ struct Supervisor::Impl {
     h.time = steady_ns();
     h.seq = next ? ++heartbeat_seq : heartbeat_seq.load();
     h.control = alive;
+    static const std::int64_t no_streams = StateStreams::of({}).id;  // it provides no interface
+    h.statesId = no_streams;
     return h;
   }
 
@@ -772,15 +768,14 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   impl->instance = std::move(*built);
   for (const auto& [name, components] : system.coordinators) impl->peers[name].components = components;
   impl->members = std::make_unique<Members>(system);
+  for (auto& [name, peer] : impl->peers) peer.fresh.follow(impl->members->state_streams(name));
   for (const spec::ComponentSpec& c : system.components) {
     const auto peer = impl->peers.find(impl->members->coordinator_of(c.name));
     if (peer == impl->peers.end()) continue;
     for (const std::string& p : c.provided) {
       std::string iface = c.name + "." + p;
-      std::string stream = state_stream(iface);
-      const PeerFreshness::Slot slot = peer->second.fresh.track(stream);
-      peer->second.services.emplace(std::move(iface),
-                                    Impl::Service{address::service(c.name, p), std::move(stream), slot, nullptr});
+      const PeerFreshness::Slot slot = *peer->second.fresh.slot(iface);
+      peer->second.services.emplace(std::move(iface), Impl::Service{address::service(c.name, p), slot, nullptr});
     }
   }
   Impl* d = impl.get();

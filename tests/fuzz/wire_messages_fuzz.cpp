@@ -140,7 +140,9 @@ void write_seeds(const std::string& dir) {
   h.coordinator = "robot";
   h.incarnation = 7;
   h.seq = 3;
-  h.lastSeq["events"] = 2;
+  h.states = {4, 1};
+  h.statesId = 12345;
+  h.events = 2;
   h.components = {"JR3", "CONTROL"};
   h.control = "ssl -h 127.0.0.1 -p 4100";
   write(dir, kHeartbeat, middleware::encode(ic, h));

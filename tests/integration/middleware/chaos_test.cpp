@@ -1227,7 +1227,7 @@ TEST(Chaos, WithAReplicatedBrokerEveryProcessConvergesAfterItsMasterOrAnotherRep
 
 // Nothing lost silently (DESIGN §7, STYLE "say what was lost"): the supervisor detects a gap in a
 // coordinator's event records only when a later record arrives, although every heartbeat lists
-// the last number of the coordinator's event stream (lastSeq["events"]). When nothing follows
+// the last number of the coordinator's event stream (Heartbeat::events). When nothing follows
 // the lost records — here the robot runs with --lost-after 5000, so it raises no
 // EVT_SUPERVISOR_LOST during the outage, as after any outage shorter than the bound — they are
 // never reported: the robot printed six transitions that the supervisor neither received nor

@@ -156,7 +156,10 @@ struct Bus {
   std::optional<Signer> provider, other, supervisor, attacker;
   // The provider's heartbeat, sent by a thread while `beating`: the last seq of each stream.
   std::map<std::string, std::int64_t> last_sent;
-  std::vector<std::string> settling;        ///< what wire-p's heartbeats list as losses of its own it clears
+  std::vector<std::string> settling;  ///< what wire-p's heartbeats list as losses of its own it clears
+  /// The state streams wire-p's heartbeats and proofs list when not the system file's (another
+  /// system file at wire-p).
+  std::optional<middleware::StateStreams> provider_streams;
   std::optional<std::int64_t> events_sent;  ///< the last event record listed, when the heartbeat lists one
   std::atomic<bool> beating{true};
   std::atomic<bool> running{true};
@@ -276,6 +279,19 @@ struct Bus {
     return all;
   }
 
+  /// Lists in `h` the state streams the system file gives `h.coordinator` (under mutex): wire-p's
+  /// at the numbers last sent, any other's at 0.
+  void list_states(wire::Heartbeat& h) const {
+    const middleware::StateStreams streams = h.coordinator == "wire-p" && provider_streams
+                                                 ? *provider_streams
+                                                 : middleware::Members(*load.system).state_streams(h.coordinator);
+    h.statesId = streams.id;
+    h.states.clear();
+    for (const std::string& iface : streams.ifaces) {
+      const auto it = h.coordinator == "wire-p" ? last_sent.find(iface) : last_sent.end();
+      h.states.push_back(it == last_sent.end() ? 0 : it->second);
+    }
+  }
   /// wire-p's heartbeat as it stands (under mutex): the streams' last numbers.
   wire::Heartbeat provider_heartbeat(std::int64_t incarnation, std::int64_t seq) {
     wire::Heartbeat h;
@@ -285,8 +301,8 @@ struct Bus {
     h.time = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
                  .count();
     h.control = alive_proxy;
-    for (const auto& [iface, last] : last_sent) h.lastSeq["state:" + iface] = last;
-    if (events_sent) h.lastSeq["events"] = *events_sent;
+    list_states(h);
+    if (events_sent) h.events = *events_sent;
     h.settling = settling;
     return h;
   }
@@ -305,9 +321,9 @@ struct Bus {
       std::lock_guard lock(mutex);
       h.seq = ++beat_seq;
       if (&key == &*provider) newest = std::max(newest, incarnation);
+      list_states(h);
       if (name == "wire-p") {
-        for (const auto& [iface, seq] : last_sent) h.lastSeq["state:" + iface] = seq;
-        if (events_sent) h.lastSeq["events"] = *events_sent;
+        if (events_sent) h.events = *events_sent;
         h.settling = settling;
       }
     }
@@ -349,6 +365,7 @@ wire::Signed FakeAlive::prove(wire::Bytes nonce, const Ice::Current&) {
   h.incarnation = kIncarnation;
   h.seq = bus_.beat_seq;
   h.control = bus_.supervisor_alive_proxy;
+  bus_.list_states(h);
   return middleware::make_proof(*bus_.supervisor, bus_.ice.communicator(), nonce, h);
 }
 
@@ -516,6 +533,34 @@ TEST(Wire, HeartbeatsAMemberKeptAndRelaysAfterTheProviderDiedEndNoLoss) {
     ASSERT_EQ(bus.state("C.s_R.D1"), State::Error) << "a relayed heartbeat ended the loss\n" << bus.all_log();
   }
   EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+}
+
+// A heartbeat lists numbers in the order both sides derive from the system file
+// (Heartbeat::states). A provider run with another system file (here one that gives P a fifth
+// interface) would have its numbers read as other interfaces' numbers: the client believes none
+// of its heartbeats nor proofs instead, says why, and holds it lost until the lists agree again.
+TEST(Wire, AProviderWhoseHeartbeatsListOtherStateStreamsThanTheSystemFileGivesItIsLostAndSaysWhy) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << bus.all_log();
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.provider_streams = middleware::StateStreams::of({"P.D0", "P.D1", "P.D2", "P.D3", "P.D4"});
+  }
+  ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; })) << bus.all_log();
+  EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
+  const std::string log = bus.all_log();
+  EXPECT_NE(log.find("it lists 5 state stream(s)"), std::string::npos) << log;
+  EXPECT_NE(log.find("another system file?"), std::string::npos) << log;
+  std::this_thread::sleep_for(500ms);  // proofs asked meanwhile carry the same list
+  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
+  {
+    std::lock_guard lock(bus.mutex);
+    bus.provider_streams.reset();
+  }
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Normal; })) << "the lists agree again\n"
+                                                                                  << bus.all_log();
 }
 
 // verify --bus, mutant no-settle-hold (P5), at wire level: wire-p comes back from a partition still
@@ -1968,7 +2013,8 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
     h.incarnation = incarnation;
     h.seq = seq.load();
     h.control = endpoint;
-    h.lastSeq["events"] = 1000 + seq.load();  // always ahead of what the supervisor holds
+    bus.list_states(h);
+    h.events = 1000 + seq.load();  // always ahead of what the supervisor holds
     return h;
   };
   ImpostorProcess fake(bus.keys, "wire-c",

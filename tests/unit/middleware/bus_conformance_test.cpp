@@ -112,6 +112,23 @@ private:
 
   std::int64_t now() const { return kBase + tick_ * kTick; }
   static std::string stream(std::size_t s) { return state_stream(s == 0 ? "P.s0" : "P.s1"); }
+  /// The provider's state streams, both followed whatever the run simulates (a stream never sent
+  /// on stays at 0); slot s is stream s.
+  static const StateStreams& provider_streams() {
+    static const StateStreams streams = StateStreams::of({"P.s0", "P.s1"});
+    return streams;
+  }
+  /// A heartbeat of the provider (or the one a proof carries) listing `listed`.
+  static wire::Heartbeat provider_beat(std::int64_t incarnation, std::int64_t seq,
+                                       const std::array<std::int64_t, 2>& listed) {
+    wire::Heartbeat beat;
+    beat.coordinator = "robot";
+    beat.incarnation = incarnation;
+    beat.seq = seq;
+    beat.states = {listed[0], listed[1]};
+    beat.statesId = provider_streams().id;
+    return beat;
+  }
   /// The model's incarnation k as a start time: sane ones in the past, in order; WILDINC beyond
   /// the margin.
   std::int64_t incarnation(int k) const {
@@ -138,6 +155,7 @@ private:
 
   void restart_receiver() {
     fresh_ = PeerFreshness{};
+    fresh_.follow(provider_streams());
     // The model's wait for a settling provider: it holds while fewer than SL ticks have passed.
     live_ = Liveness{std::chrono::milliseconds((verify::kBusSettleLimitTicks - 1) * kTick / 1'000'000)};
     held_[0] = held_[1] = Held{};
@@ -169,14 +187,14 @@ private:
     }
     const int sent_tick = tick_ - age;
     std::string why;
-    switch (fresh_.heartbeat(real, beat_number(k, sent_tick), why)) {
+    const std::array<std::int64_t, 2> listed{number(k, 0, relative[0]), number(k, 1, relative[1])};
+    switch (fresh_.heartbeat(provider_beat(real, beat_number(k, sent_tick), listed), why)) {
       case PeerFreshness::Verdict::Refuse: ours_.push_back("refuse"); return;
       case PeerFreshness::Verdict::Unproven: ours_.push_back("unproven"); return;
       case PeerFreshness::Verdict::Covered: ours_.push_back("covered"); return;
       case PeerFreshness::Verdict::Accept: ours_.push_back("accept"); break;
     }
-    believe(real, fresh_.sent_at(kRemote + sent_tick * kTick, now()),
-            {number(k, 0, relative[0]), number(k, 1, relative[1])}, settling);
+    believe(real, fresh_.sent_at(kRemote + sent_tick * kTick, now()), listed, settling);
   }
 
   void on_update(int who, int k, std::size_t s, int relative, int) {
@@ -188,7 +206,7 @@ private:
     const std::int64_t seq = number(k, s, relative);
     std::int64_t missed = 0;
     std::string why;
-    switch (fresh_.stream(stream(s), real, seq, missed, why)) {
+    switch (fresh_.stream(PeerFreshness::Slot{s}, real, seq, missed, why)) {
       case PeerFreshness::Verdict::Refuse: ours_.push_back("refuse"); return;
       case PeerFreshness::Verdict::Covered:
       case PeerFreshness::Verdict::Unproven: ours_.push_back("unproven"); return;
@@ -214,12 +232,9 @@ private:
       ours_.push_back("refuse");
       return;
     }
-    wire::Heartbeat beat;
-    beat.coordinator = "robot";
-    beat.incarnation = real;
+    wire::Heartbeat beat = provider_beat(real, static_cast<std::int64_t>(beats_[k].size()),
+                                         {streams() > 0 ? latest_[k][0] : 0, streams() > 1 ? latest_[k][1] : 0});
     beat.time = kRemote + tick_ * kTick;
-    beat.seq = static_cast<std::int64_t>(beats_[k].size());
-    for (std::size_t s = 0; s < streams(); ++s) beat.lastSeq[stream(s)] = latest_[k][s];
     std::string why;
     if (!fresh_.proven(beat, why, asked)) {
       ours_.push_back("refuse");

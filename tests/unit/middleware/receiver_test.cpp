@@ -23,35 +23,52 @@ using Verdict = PeerFreshness::Verdict;
 
 constexpr std::int64_t kRun = 1'000'000;  // a proven process's incarnation
 
+/// The robot's state streams, as every receiver's system file gives them.
+const StateStreams& robot_streams() {
+  static const StateStreams streams = StateStreams::of({"JR3.ForceData"});
+  return streams;
+}
+
+/// A receiver that follows the robot's state streams.
+PeerFreshness following() {
+  PeerFreshness peer;
+  peer.follow(robot_streams());
+  return peer;
+}
+
+/// A heartbeat of the robot (or the one a proof carries): number `seq`, its stream at `state_sent`.
 wire::Heartbeat proof(std::int64_t incarnation, std::int64_t seq, std::int64_t state_sent) {
   wire::Heartbeat beat;
   beat.coordinator = "robot";
   beat.incarnation = incarnation;
   beat.seq = seq;
-  beat.lastSeq[state_stream("JR3.ForceData")] = state_sent;
+  beat.states = {state_sent};
+  beat.statesId = robot_streams().id;
   return beat;
 }
+wire::Heartbeat beat(std::int64_t incarnation, std::int64_t seq) { return proof(incarnation, seq, 0); }
+
+constexpr PeerFreshness::Slot kForceData{0};
 
 TEST(PeerFreshness, NothingOfAPeerIsTakenBeforeItsProcessIsProvenNotEvenOfIncarnationZero) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
   for (std::int64_t incarnation : {std::int64_t{0}, std::int64_t{-1}, kRun}) {
-    EXPECT_EQ(peer.heartbeat(incarnation, 1, why), Verdict::Unproven) << incarnation;
-    EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), incarnation, 1, missed, why), Verdict::Unproven)
-        << incarnation;
+    EXPECT_EQ(peer.heartbeat(beat(incarnation, 1), why), Verdict::Unproven) << incarnation;
+    EXPECT_EQ(peer.stream(kForceData, incarnation, 1, missed, why), Verdict::Unproven) << incarnation;
     EXPECT_EQ(peer.process(incarnation, why), Verdict::Unproven) << incarnation;
   }
 }
 
 TEST(PeerFreshness, AfterAProofOnlyThatProcessIsTakenAnOlderOneIsRefusedANewerOneIsUnproven) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   ASSERT_TRUE(peer.proven(proof(kRun, 7, 0), why)) << why;
   EXPECT_EQ(peer.process(kRun, why), Verdict::Accept);
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse) << "a repeated heartbeat is a replay";
-  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Refuse) << "at or below the proof's number";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Refuse) << "a repeated heartbeat is a replay";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 7), why), Verdict::Refuse) << "at or below the proof's number";
   EXPECT_EQ(peer.process(kRun - 1, why), Verdict::Refuse);
   EXPECT_NE(why.find("is older than"), std::string::npos) << why;
   EXPECT_EQ(peer.process(kRun + 1, why), Verdict::Unproven) << "a restart is believed once it is proven";
@@ -60,107 +77,172 @@ TEST(PeerFreshness, AfterAProofOnlyThatProcessIsTakenAnOlderOneIsRefusedANewerOn
 }
 
 TEST(PeerFreshness, AHeartbeatNumberedAsTheProofSaysArrivingAfterItIsDroppedWithoutBlameUntilANewerIsTaken) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   ASSERT_TRUE(peer.proven(proof(kRun, 7, 0), why)) << why;
-  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Covered) << "the heartbeat sent with the proof, arriving after it";
-  EXPECT_EQ(peer.heartbeat(kRun, 6, why), Verdict::Covered) << "an older one still on its way";
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
-  EXPECT_EQ(peer.heartbeat(kRun, 7, why), Verdict::Refuse) << "once a newer one is taken, an older one is a replay";
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse);
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 7), why), Verdict::Covered)
+      << "the heartbeat sent with the proof, arriving after it";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 6), why), Verdict::Covered) << "an older one still on its way";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 7), why), Verdict::Refuse)
+      << "once a newer one is taken, an older one is a replay";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Refuse);
   ASSERT_TRUE(peer.proven(proof(kRun, 5, 0), why)) << "a slower proof of the same process";
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Refuse) << "a proof older than what was taken covers nothing";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Refuse) << "a proof older than what was taken covers nothing";
 }
 
 TEST(PeerFreshness, AStreamMessageAtOrBelowTheProofsCountIsDroppedWithoutBlameAndTheNextIsTaken) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
-  const std::string stream = state_stream("JR3.ForceData");
   ASSERT_TRUE(peer.proven(proof(kRun, 1, 5), why)) << why;
-  EXPECT_EQ(peer.stream(stream, kRun, 5, missed, why), Verdict::Unproven) << "sent before the proof";
-  EXPECT_EQ(peer.stream(stream, kRun, 6, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.stream(kForceData, kRun, 5, missed, why), Verdict::Unproven) << "sent before the proof";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 6, missed, why), Verdict::Accept);
   EXPECT_EQ(missed, 0);
-  EXPECT_EQ(peer.stream(stream, kRun, 6, missed, why), Verdict::Refuse) << "taken once: a repeat is a replay";
-  EXPECT_EQ(peer.stream(stream, kRun, 9, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.stream(kForceData, kRun, 6, missed, why), Verdict::Refuse) << "taken once: a repeat is a replay";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 9, missed, why), Verdict::Accept);
   EXPECT_EQ(missed, 2) << "7 and 8 skipped";
-  EXPECT_EQ(peer.last(stream), 9);
+  EXPECT_EQ(peer.last(kForceData), 9);
 }
 
 TEST(PeerFreshness, AStreamCannotJumpMoreThanTwoToTheTwentyAheadEvenFromItsOwnProcess) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
-  const std::string stream = state_stream("JR3.ForceData");
   ASSERT_TRUE(peer.proven(proof(kRun, 1, 0), why)) << why;
-  EXPECT_EQ(peer.stream(stream, kRun, kMaxSeqJump + 1, missed, why), Verdict::Refuse);
+  EXPECT_EQ(peer.stream(kForceData, kRun, kMaxSeqJump + 1, missed, why), Verdict::Refuse);
   EXPECT_NE(why.find("jumps more than"), std::string::npos) << why;
-  EXPECT_EQ(peer.stream(stream, kRun, 1, missed, why), Verdict::Accept) << "the stream is not frozen";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 1, missed, why), Verdict::Accept) << "the stream is not frozen";
 }
 
 TEST(PeerFreshness, AProcessDeclaredLostIsBelievedAgainOnlyOnANewProofOfIt) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
   ASSERT_TRUE(peer.proven(proof(kRun, 7, 3), why)) << why;
-  EXPECT_EQ(peer.heartbeat(kRun, 8, why), Verdict::Accept);
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 8), why), Verdict::Accept);
   peer.doubt();
-  EXPECT_EQ(peer.heartbeat(kRun, 9, why), Verdict::Unproven) << "a heartbeat it never sent us may be a recording";
-  EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), kRun, 4, missed, why), Verdict::Unproven);
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 9), why), Verdict::Unproven) << "a heartbeat it never sent us may be a recording";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 4, missed, why), Verdict::Unproven);
   EXPECT_EQ(peer.process(kRun - 1, why), Verdict::Refuse) << "an older process stays refused";
   ASSERT_TRUE(peer.proven(proof(kRun, 10, 4), why)) << why;
-  EXPECT_EQ(peer.heartbeat(kRun, 11, why), Verdict::Accept) << "proven again";
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 11), why), Verdict::Accept) << "proven again";
 }
 
 TEST(PeerFreshness, HeartbeatsAreDatedAgainstTheQuestionOfTheLastProofNeverLaterThanNow) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   EXPECT_EQ(peer.sent_at(123, 5000), 5000) << "no proof dated yet: now";
-  wire::Heartbeat beat = proof(kRun, 7, 0);
-  beat.time = 90'000;  // the sender's clock when it answered
-  ASSERT_TRUE(peer.proven(beat, why, 1000)) << why;
+  wire::Heartbeat answer = proof(kRun, 7, 0);
+  answer.time = 90'000;  // the sender's clock when it answered
+  ASSERT_TRUE(peer.proven(answer, why, 1000)) << why;
   EXPECT_EQ(peer.sent_at(90'500, 9000), 1500) << "500 after the answer, dated 500 after the question";
   EXPECT_EQ(peer.sent_at(99'000, 2000), 2000) << "never later than now";
 }
 
 TEST(PeerFreshness, TakenIsWhatCameFromTheProcessNotWhatItsProofListed) {
-  PeerFreshness peer;
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
   ASSERT_TRUE(peer.proven(proof(kRun, 7, 5), why)) << why;
-  EXPECT_EQ(peer.last(state_stream("JR3.ForceData")), 5);
-  EXPECT_EQ(peer.taken(state_stream("JR3.ForceData")), 0) << "listed, not received";
-  EXPECT_EQ(peer.stream(state_stream("JR3.ForceData"), kRun, 6, missed, why), Verdict::Accept);
-  EXPECT_EQ(peer.taken(state_stream("JR3.ForceData")), 6);
+  EXPECT_EQ(peer.last(kForceData), 5);
+  EXPECT_EQ(peer.taken(kForceData), 0) << "listed, not received";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 6, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.taken(kForceData), 6);
 }
 
-// One lookup per update (the supervisor reaches each state stream by a slot made at start): a
-// tracked stream keeps every rule of a stream reached by name, shares its numbers with the name,
-// and starts again from 0 when another process is proven, as the others do.
-TEST(PeerFreshness, ATrackedStreamFollowsTheSameRulesAsByNameAndStartsAgainWithANewProcess) {
-  PeerFreshness peer;
+TEST(PeerFreshness, ANewProcessStartsEveryStreamAgainAndTheOlderOneIsRefused) {
+  PeerFreshness peer = following();
   std::string why;
   std::int64_t missed = 0;
-  const std::string stream = state_stream("JR3.ForceData");
-  const PeerFreshness::Slot slot = peer.track(stream);
-  EXPECT_EQ(peer.track(stream).index, slot.index) << "tracked twice: the same slot";
-  EXPECT_EQ(peer.stream(slot, kRun, 1, missed, why), Verdict::Unproven) << "nothing before a proof";
   ASSERT_TRUE(peer.proven(proof(kRun, 1, 5), why)) << why;
-  EXPECT_EQ(peer.last(stream), 5) << "the proof's count reaches the tracked stream by its name";
-  EXPECT_EQ(peer.stream(slot, kRun, 5, missed, why), Verdict::Unproven) << "sent before the proof";
-  EXPECT_EQ(peer.stream(slot, kRun, 8, missed, why), Verdict::Accept);
-  EXPECT_EQ(missed, 2) << "6 and 7 skipped";
-  EXPECT_EQ(peer.stream(stream, kRun, 8, missed, why), Verdict::Refuse) << "by name: the same stream, a replay";
-  EXPECT_EQ(peer.stream(slot, kRun, 8 + kMaxSeqJump + 1, missed, why), Verdict::Refuse);
-  EXPECT_NE(why.find("jumps more than"), std::string::npos) << why;
-  EXPECT_EQ(peer.taken(stream), 8);
+  EXPECT_EQ(peer.stream(kForceData, kRun, 8, missed, why), Verdict::Accept);
   peer.doubt();
-  EXPECT_EQ(peer.stream(slot, kRun, 9, missed, why), Verdict::Unproven) << "lost: believed again only on a proof";
+  EXPECT_EQ(peer.stream(kForceData, kRun, 9, missed, why), Verdict::Unproven) << "lost: believed again only on a proof";
   ASSERT_TRUE(peer.proven(proof(kRun + 1, 1, 2), why)) << why;
-  EXPECT_EQ(peer.taken(stream), 0) << "a new process: nothing of it taken yet";
-  EXPECT_EQ(peer.stream(slot, kRun + 1, 2, missed, why), Verdict::Unproven) << "at the new proof's count";
-  EXPECT_EQ(peer.stream(slot, kRun + 1, 3, missed, why), Verdict::Accept);
-  EXPECT_EQ(peer.stream(slot, kRun, 9, missed, why), Verdict::Refuse) << "the older process";
+  EXPECT_EQ(peer.taken(kForceData), 0) << "a new process: nothing of it taken yet";
+  EXPECT_EQ(peer.stream(kForceData, kRun + 1, 2, missed, why), Verdict::Unproven) << "at the new proof's count";
+  EXPECT_EQ(peer.stream(kForceData, kRun + 1, 3, missed, why), Verdict::Accept);
+  EXPECT_EQ(peer.stream(kForceData, kRun, 9, missed, why), Verdict::Refuse) << "the older process";
+}
+
+// A heartbeat lists numbers, not names (wire::Heartbeat::states): their order is the one both
+// sides derive from the system file, sorted by interface, and the list's id travels with them.
+TEST(StateStreams, AreTheInterfacesSortedWithAnIdThatChangesWithTheListAndNotWithItsOrder) {
+  const StateStreams a = StateStreams::of({"JR3.Status", "JR3.ForceData", "ARM.Pose"});
+  EXPECT_EQ(a.ifaces, (std::vector<std::string>{"ARM.Pose", "JR3.ForceData", "JR3.Status"}));
+  EXPECT_EQ(StateStreams::of({"ARM.Pose", "JR3.Status", "JR3.ForceData"}).id, a.id)
+      << "the order given does not matter";
+  EXPECT_NE(StateStreams::of({"ARM.Pose", "JR3.ForceData"}).id, a.id) << "one interface fewer";
+  EXPECT_NE(StateStreams::of({"ARM.Pose", "JR3.ForceData", "JR3.Status2"}).id, a.id) << "one renamed";
+  EXPECT_NE(StateStreams::of({"ARM.PoseJR3.ForceData", "JR3.Status"}).id,
+            StateStreams::of({"ARM.Pose", "JR3.ForceDataJR3.Status"}).id)
+      << "names are delimited";
+  EXPECT_NE(StateStreams::of({}).id, 0) << "an empty list has an id too (the supervisor's heartbeats)";
+}
+
+TEST(StateStreams, OfACoordinatorAreTheInterfacesItsComponentsProvideAsTheSystemFileGivesThem) {
+  spec::SystemSpec system;
+  spec::ComponentSpec jr3;
+  jr3.name = "JR3";
+  jr3.provided = {"Status", "ForceData"};
+  spec::ComponentSpec control;
+  control.name = "CONTROL";
+  control.provided = {"Command"};
+  spec::ComponentSpec ui;
+  ui.name = "UI";
+  system.components = {jr3, control, ui};
+  system.coordinators = {{"robot", {"JR3", "CONTROL"}}, {"ui", {"UI"}}};
+  const Members members(system);
+  EXPECT_EQ(members.state_streams("robot").ifaces,
+            (std::vector<std::string>{"CONTROL.Command", "JR3.ForceData", "JR3.Status"}));
+  EXPECT_EQ(members.state_streams("robot").id, StateStreams::of({"JR3.Status", "JR3.ForceData", "CONTROL.Command"}).id);
+  EXPECT_TRUE(members.state_streams("ui").ifaces.empty());
+  EXPECT_EQ(members.state_streams("ui").id, StateStreams::of({}).id);
+}
+
+// A receiver whose system file gives the coordinator other interfaces than the coordinator's own
+// would read one interface's number as another's: it believes nothing of that process instead
+// (lost, toward safe), and says why.
+TEST(PeerFreshness, AHeartbeatOrProofOfAnotherListOfStateStreamsIsRefusedSoNoNumberIsReadAsAnotherInterfaces) {
+  PeerFreshness peer = following();
+  std::string why;
+  wire::Heartbeat other = proof(kRun, 7, 3);
+  other.statesId = StateStreams::of({"JR3.ForceData", "JR3.Status"}).id;
+  other.states = {3, 4};
+  EXPECT_FALSE(peer.proven(other, why));
+  EXPECT_NE(why.find("another system file?"), std::string::npos) << why;
+  EXPECT_EQ(peer.incarnation(), 0) << "nothing believed";
+  ASSERT_TRUE(peer.proven(proof(kRun, 7, 3), why)) << why;
+  other.seq = 8;
+  EXPECT_EQ(peer.heartbeat(other, why), Verdict::Refuse);
+  EXPECT_NE(why.find("lists 2 state stream(s)"), std::string::npos) << why;
+  wire::Heartbeat short_list = beat(kRun, 9);
+  short_list.states.clear();  // the right id, too few numbers
+  EXPECT_EQ(peer.heartbeat(short_list, why), Verdict::Refuse) << why;
+  EXPECT_EQ(peer.heartbeat(beat(kRun, 10), why), Verdict::Accept) << "its own list still is";
+  PeerFreshness tool;  // follows no state stream: checks no list
+  EXPECT_TRUE(tool.proven(other, why)) << why;
+}
+
+TEST(PeerFreshness, AheadNamesEachStreamAHeartbeatListsAboveWhatCameFromTheProcess) {
+  PeerFreshness peer;
+  peer.follow(StateStreams::of({"A.p", "B.p", "C.p"}));
+  std::string why;
+  std::int64_t missed = 0;
+  wire::Heartbeat answer = beat(kRun, 1);
+  answer.statesId = StateStreams::of({"A.p", "B.p", "C.p"}).id;
+  answer.states = {2, 0, 4};
+  ASSERT_TRUE(peer.proven(answer, why)) << why;
+  ASSERT_EQ(peer.stream(*peer.slot("C.p"), kRun, 5, missed, why), Verdict::Accept) << why;
+  wire::Heartbeat later = answer;
+  later.seq = 2;
+  later.states = {2, 1, 5};
+  std::vector<std::pair<std::string, std::int64_t>> behind;
+  peer.ahead(later, [&](PeerFreshness::Slot s, std::int64_t listed) { behind.emplace_back(peer.iface(s), listed); });
+  EXPECT_EQ(behind, (std::vector<std::pair<std::string, std::int64_t>>{{"A.p", 2}, {"B.p", 1}}))
+      << "A.p listed by the proof but never received; B.p sent since; C.p received";
+  EXPECT_FALSE(peer.slot("D.p").has_value());
 }
 
 constexpr std::int64_t kMs = 1'000'000;  // steady ns
