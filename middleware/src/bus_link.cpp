@@ -71,6 +71,7 @@ bool BusLink::connect() {
     }
     connected_at_ = steady_ns();
     last_own_heartbeat_.store(connected_at_);
+    last_beat_sent_ = 0;
     connected_.store(true);
     connects_.fetch_add(1);
     options_.log(options_.who + ": connected to IceStorm at " + where_ + "; resynchronising");
@@ -96,6 +97,9 @@ bool BusLink::connect() {
 void BusLink::loop() {
   const std::chrono::milliseconds period = options_.period;
   const std::int64_t echo_bound = 5 * std::chrono::nanoseconds(period).count();
+  // Typed once per connection: a proxy cast anew each period finds its connection anew (Ice shuffles
+  // the endpoints for it, a random_device made each time).
+  TypedPublisher<wire::HeartbeatTopicPrx> heartbeat_publisher(*this, options_.heartbeat_topic);
   while (running_.load()) {
     if (!connected_.load() && !connect()) {
       sleep_for(std::min(period, std::chrono::milliseconds(200)));
@@ -104,7 +108,10 @@ void BusLink::loop() {
     try {
       // IceStorm is asked whether it is there only when this process's last heartbeat did not
       // come back round within a period: one that did proves the whole way works.
-      const bool echo_late = steady_ns() - last_own_heartbeat_.load() > std::chrono::nanoseconds(period).count();
+      // Late: the heartbeat sent a period ago has not come back (a period counted from its
+      // sending: this loop's own work makes its cycle a little longer than the period).
+      const bool echo_late = last_beat_sent_ != 0 && last_own_heartbeat_.load() < last_beat_sent_;
+      if (echo_late) pings_.fetch_add(1);
       std::vector<std::string> renew;
       {
         std::lock_guard lock(renew_mutex_);
@@ -119,7 +126,8 @@ void BusLink::loop() {
       }
       const wire::Signed beat = options_.heartbeat();
       sent_.sent(beat);  // before it is sent: it can come back before beat() returns
-      Ice::uncheckedCast<wire::HeartbeatTopicPrx>(publisher(options_.heartbeat_topic))->beat(beat);
+      last_beat_sent_ = steady_ns();
+      heartbeat_publisher.get()->beat(beat);
       if (options_.every_period) options_.every_period();
       const std::int64_t now = steady_ns();
       if (now - connected_at_ > echo_bound && now - last_own_heartbeat_.load() > echo_bound) {

@@ -94,6 +94,8 @@ public:
   [[nodiscard]] std::uint64_t connects() const noexcept { return connects_.load(); }
   /// Subscriptions made again after IceStorm had lost them.
   [[nodiscard]] std::uint64_t resubscriptions() const noexcept { return resubscriptions_.load(); }
+  /// Times IceStorm was pinged because the heartbeat sent a period before had not come back.
+  [[nodiscard]] std::uint64_t pings() const noexcept { return pings_.load(); }
 
 private:
   void loop();
@@ -116,6 +118,8 @@ private:
   SentHeartbeats sent_;
   std::atomic<std::uint64_t> connects_{0};
   std::atomic<std::uint64_t> resubscriptions_{0};
+  std::atomic<std::uint64_t> pings_{0};
+  std::int64_t last_beat_sent_ = 0;  ///< link thread: when its last heartbeat was sent (0: none since connected)
   // Link thread only: how the failures to connect are said (once, then every 5 s with a count).
   std::uint64_t failed_connects_ = 0;
   std::int64_t last_down_report_ = 0;

@@ -1255,6 +1255,7 @@ NodeStats CoordinatorNode::stats() const {
   s.resyncs_requested = d.resyncs_requested.load();
   s.connects = d.link ? d.link->connects() : 0;
   s.resubscriptions = d.link ? d.link->resubscriptions() : 0;
+  s.broker_pings = d.link ? d.link->pings() : 0;
   s.state_messages_published = d.state_messages_published.load();
   s.event_messages_published = d.event_messages_published.load();
   s.connected = d.link && d.link->connected();

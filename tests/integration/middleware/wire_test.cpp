@@ -843,6 +843,21 @@ TEST(Wire, ACoordinatorHearsTheHeartbeatsOfItselfItsProvidersAndTheSupervisorAnd
   }
 }
 
+// A process knows its link to IceStorm works when its own heartbeat comes back round: only a
+// heartbeat not back a period after it was sent costs a ping. Counted from the arrival instead,
+// the period plus the link thread's own work made nearly every heartbeat late: a round trip to
+// IceStorm each period, from every process.
+TEST(Wire, AHealthyLinkCostsNoPingOfIceStormPerPeriod) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  const std::uint64_t before = bus.node->stats().broker_pings;
+  std::this_thread::sleep_for(2000ms);  // 20 heartbeat periods of a healthy link
+  const std::uint64_t pings = bus.node->stats().broker_pings - before;
+  EXPECT_LE(pings, 2u) << "pinged in " << pings << " of 20 periods\n" << bus.all_log();
+  EXPECT_EQ(bus.node->stats().connects, 1u) << bus.all_log();
+}
+
 // IceStorm drops a twoway subscriber whose delivery fails or times out (a process starved, or a
 // message it cannot decode), and anyone who reaches IceStorm can unsubscribe anybody: a process
 // that did not notice would go on with nothing reaching it. Here every subscription of the

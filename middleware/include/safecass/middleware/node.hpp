@@ -179,6 +179,9 @@ struct NodeStats {
   /// Subscriptions IceStorm no longer held (dropped as undeliverable, or removed from outside),
   /// noticed within kResubscribeCheckEvery heartbeat periods and made again, with a resync.
   std::uint64_t resubscriptions = 0;
+  /// Times IceStorm was pinged because this process's heartbeat had not come back round within a
+  /// period (a healthy link costs none: the echo proves the whole way works).
+  std::uint64_t broker_pings = 0;
   std::uint64_t messages_refused = 0;  ///< unauthenticated, forged, replayed or malformed bus messages
   std::uint64_t providers_lost = 0;    ///< times a provider coordinator was declared lost
   std::uint64_t duplicates_seen = 0;   ///< heartbeats of another process using this node's name
