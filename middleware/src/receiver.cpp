@@ -271,6 +271,7 @@ PeerFreshness::Verdict PeerFreshness::heartbeat(const wire::Heartbeat& beat, std
 
 void PeerFreshness::follow(StateStreams streams) {
   streams_ = std::move(streams);
+  following_ = true;
   tracked_.assign(streams_.ifaces.size(), Stream{});
   index_.clear();
   for (std::size_t i = 0; i < streams_.ifaces.size(); ++i) index_.emplace(streams_.ifaces[i], i);
@@ -283,7 +284,7 @@ std::optional<PeerFreshness::Slot> PeerFreshness::slot(std::string_view iface) c
 }
 
 std::string PeerFreshness::other_streams(const wire::Heartbeat& beat) const {
-  if (streams_.ifaces.empty() && streams_.id == 0) return {};  // follows none (a tool)
+  if (!following_) return {};  // follows none (a tool)
   if (beat.statesId == streams_.id && beat.states.size() == tracked_.size()) return {};
   return "it lists " + std::to_string(beat.states.size()) + " state stream(s) of id " + std::to_string(beat.statesId) +
          ", where the system file gives its coordinator " + std::to_string(tracked_.size()) + " of id " +

@@ -210,7 +210,8 @@ private:
   std::int64_t anchor_remote_ = 0;  ///< the time its heartbeat carried (the sender's steady ns)
   std::int64_t heartbeat_seq_ = 0;
   bool heartbeat_from_proof_ = false;  ///< heartbeat_seq_ is a proof's, no heartbeat taken since
-  StateStreams streams_;               ///< followed (follow()); empty: none
+  bool following_ = false;             ///< follow() was called: heartbeats' lists are checked
+  StateStreams streams_;               ///< followed (follow())
   std::vector<Stream> tracked_;        ///< by Slot::index, one per streams_.ifaces
   TextMap<std::size_t> index_;         ///< by interface: the slot
 };
