@@ -16,7 +16,7 @@
 // every SAFECASS process (middleware/src/ice_util.cpp), a oneway publisher and a oneway
 // subscriber without QoS (SAFECASS's Delivery::Stream), one onset every 2 ms followed 1 ms later
 // by its completion. The struct is padded to the size of the signed message SAFECASS sends for
-// that onset (a StateUpdateSeq of one update with one root, in its Signed envelope), computed
+// that onset (a StateBatch of one update with one root, in its Signed envelope), computed
 // here by encoding the same content. Latency = onset time stamped just before sending → the
 // subscriber's servant receiving it (the host's monotonic clock, the same in both processes).
 // Writes {"p50_us", "p99_us", "max_us", "samples", "message_bytes", ...} to FILE.
@@ -118,15 +118,13 @@ std::size_t payload_bytes(const std::shared_ptr<Ice::Communicator>& ic) {
   root.level = safecass::wire::Level::Error;
   root.path = {"JR3.s_A", "JR3.s_S.ForceData"};
   safecass::wire::StateUpdate update;
-  update.coordinator = "sensor";
-  update.incarnation = now_ns();
+  update.stream = 0;
   update.seq = 1;
-  update.iface = "JR3.ForceData";
   update.state = safecass::wire::Level::Error;
   update.roots = {root};
   update.sent = now_ns();
   Ice::OutputStream body(ic);
-  body.write(safecass::wire::StateUpdateSeq{update});
+  body.write(safecass::wire::StateBatch{"sensor", now_ns(), 0x5afeca55, {update}});
   safecass::wire::Signed envelope;
   envelope.signer = "sensor";
   envelope.kind = "state";

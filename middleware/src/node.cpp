@@ -200,7 +200,8 @@ struct CoordinatorNode::Impl {
   struct Stream {
     ComponentId component;
     std::uint32_t provided;
-    std::string iface;  ///< "C.p"
+    std::string iface;          ///< "C.p"
+    std::int32_t position = 0;  ///< among the process's streams in StateStreams order (wire::StateUpdate::stream)
     std::atomic<std::int64_t> seq{0};
     wire::RootSeq last;  ///< publisher thread only: the full state last sent (all its roots)
     bool dirty = true;   ///< under queue_mutex
@@ -212,6 +213,9 @@ struct CoordinatorNode::Impl {
   /// The streams in the order its heartbeats list their numbers (StateStreams), and that list's id.
   std::vector<std::size_t> heartbeat_order;
   std::int64_t states_id = 0;
+  /// The encoding of this process's wire::StateBatch without its updates, up to their sequence
+  /// (its last member): what every state message's body starts with (encode_states).
+  Ice::ByteSeq state_head;
 
   /// A remote provided interface held here (under peer_mutex).
   struct Held {
@@ -236,6 +240,9 @@ struct CoordinatorNode::Impl {
     bool provider = false;                ///< it runs a provider of an interface held here
     std::vector<MachineId> feeds;         ///< required interfaces here that it feeds
     std::size_t behind = 0;               ///< interfaces held of it that a heartbeat showed ahead
+    /// What its updates reach here, by their stream's position (PeerFreshness::Slot::index):
+    /// the interface held of it, or null for one no component here requires (a provider only).
+    std::vector<Held*> held;
   };
   std::map<std::string, Peer, std::less<>> peers;
   std::vector<std::string> cleared_since_heartbeat;  ///< under peer_mutex: losses cleared since (Heartbeat::settling)
@@ -353,11 +360,9 @@ struct CoordinatorNode::Impl {
       roots.push_back(root_to_wire(r.root, to_wire(r.level), std::move(r.path)));
     }
     if (!force && same_roots(roots, s.last)) return;
-    wire::StateUpdate u;
-    u.coordinator = name;
-    u.incarnation = incarnation;
+    wire::StateUpdate u{};  // sent: stamped when its message goes (send_states)
+    u.stream = s.position;
     u.seq = s.seq.load() + 1;
-    u.iface = s.iface;
     u.state = to_wire(co.service_state(s.component, s.provided));
     u.roots = std::move(roots);
     out.push_back(std::move(u));
@@ -369,11 +374,12 @@ struct CoordinatorNode::Impl {
   /// Bytes of the size prefix of a sequence (or string) of `n` elements in the Ice encoding.
   static std::size_t size_prefix(std::size_t n) noexcept { return n < 255 ? 1 : 5; }
 
-  /// The Ice encoding of items [first, first + n) as one sequence: the bytes encode() gives for a
-  /// sequence holding only them, without copying them into one.
-  template <class T>
-  Ice::ByteSeq encode_range(const std::vector<T>& items, std::size_t first, std::size_t n) const {
+  /// The body of a state message of the updates [first, first + n): the bytes encode() gives for
+  /// a wire::StateBatch of this process holding only them, without copying them into one. The
+  /// batch's other members come first in its encoding (state_head, made once).
+  Ice::ByteSeq encode_states(const wire::StateUpdateSeq& items, std::size_t first, std::size_t n) const {
     Ice::OutputStream out(ic);
+    out.writeBlob(state_head);
     out.writeSize(static_cast<Ice::Int>(n));
     for (std::size_t i = first; i < first + n; ++i) out.write(items[i]);
     Ice::ByteSeq bytes;
@@ -381,12 +387,12 @@ struct CoordinatorNode::Impl {
     return bytes;
   }
 
-  /// How many of the `n` items from `first` fit in one message (at least one: an item too large
-  /// on its own is cut down by the caller). Measured item by item, only for a batch that does
-  /// not fit as a whole.
+  /// How many of the `n` items from `first` fit in one message whose body holds `head` bytes
+  /// before the sequence (at least one: an item too large on its own is cut down by the caller).
+  /// Measured item by item, only for a batch that does not fit as a whole.
   template <class T>
-  std::size_t fitting(const std::vector<T>& items, std::size_t first, std::size_t n) const {
-    std::size_t total = 0;
+  std::size_t fitting(const std::vector<T>& items, std::size_t first, std::size_t n, std::size_t head) const {
+    std::size_t total = head;
     std::size_t k = 0;
     for (; k < n; ++k) {
       const std::size_t size = encode(ic, items[first + k]).size();
@@ -420,8 +426,8 @@ struct CoordinatorNode::Impl {
     const std::size_t limit = options.max_message_bytes;
     full = std::move(u.roots);
     u.roots.clear();
-    // One update in a sequence, with an empty root sequence (whose size is one byte).
-    const std::size_t base = size_prefix(1) + encode(ic, u).size() - size_prefix(0);
+    // One update in a batch, with an empty root sequence (whose size is one byte).
+    const std::size_t base = state_head.size() + size_prefix(1) + encode(ic, u).size() - size_prefix(0);
     std::vector<std::size_t> order(full.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(),
@@ -498,19 +504,19 @@ struct CoordinatorNode::Impl {
       std::size_t n = std::min(updates.size() - first, kMaxBatch);
       const std::int64_t sent = steady_ns();
       for (std::size_t i = first; i < first + n; ++i) updates[i].sent = sent;
-      Ice::ByteSeq body = encode_range(updates, first, n);
+      Ice::ByteSeq body = encode_states(updates, first, n);
       wire::RootSeq full;  // the whole state of an update sent cut down
       bool cut = false;
       if (body.size() > options.max_message_bytes) {
-        n = fitting(updates, first, n);
-        body = encode_range(updates, first, n);
+        n = fitting(updates, first, n, state_head.size());
+        body = encode_states(updates, first, n);
         if (body.size() > options.max_message_bytes) {  // n == 1: one update too large on its own
           if (!cut_roots(*of[first], updates[first], body.size(), full)) {
             ++first;  // not sent: its stream stays where it was
             continue;
           }
           cut = true;
-          body = encode_range(updates, first, 1);
+          body = encode_states(updates, first, 1);
         }
       }
       pub->updates(signer->seal(kKindState, std::move(body)));
@@ -540,7 +546,7 @@ struct CoordinatorNode::Impl {
         for (std::size_t i = 0; i < n; ++i) part.push_back(to_message(pending[sent + i]));
         Ice::ByteSeq body = encode(ic, part);
         if (body.size() > options.max_message_bytes) {
-          n = fitting(part, 0, n);
+          n = fitting(part, 0, n, 0);
           part.resize(n);
           event_seq.store(seq_before + static_cast<std::int64_t>(n));  // the others go next, with these numbers
           body = encode(ic, part);
@@ -716,40 +722,54 @@ struct CoordinatorNode::Impl {
   }
 
   void on_updates(const wire::Signed& m) {
-    wire::StateUpdateSeq batch;
+    wire::StateBatch batch;
     if (const std::string why = open_sealed(*signer, ic, m, kKindState, batch); !why.empty()) {
       updates_rejected.fetch_add(1);
       refuse(m.signer, "a state message signed '" + printable(m.signer) + "': " + why);
       return;
     }
+    if (batch.coordinator != m.signer) {
+      updates_rejected.fetch_add(1);
+      refuse(m.signer, "state updates from coordinator '" + printable(batch.coordinator) + "': signed by '" +
+                           printable(m.signer) + "', not by the coordinator it names");
+      return;
+    }
+    if (batch.coordinator == name) return;
     std::lock_guard lock(peer_mutex);
-    for (const wire::StateUpdate& u : batch) on_update(m.signer, u);
+    const auto peer = peers.find(batch.coordinator);
+    if (peer == peers.end() || !peer->second.provider) {
+      updates_rejected.fetch_add(1);
+      refuse(m.signer, "state updates from coordinator '" + printable(batch.coordinator) +
+                           "', which provides no interface held here");
+      return;
+    }
+    if (const std::string why = peer->second.fresh.other_streams(batch.statesId); !why.empty()) {
+      updates_rejected.fetch_add(1);
+      refuse(m.signer, "state updates from coordinator '" + printable(batch.coordinator) + "': " + why);
+      return;
+    }
+    for (const wire::StateUpdate& u : batch.updates) on_update(peer->second, batch, u);
   }
 
-  void on_update(const std::string& from, const wire::StateUpdate& u) {
+  /// An update of `batch`, a batch of `peer`'s list of state streams (under peer_mutex).
+  void on_update(Peer& peer, const wire::StateBatch& batch, const wire::StateUpdate& u) {
+    const std::string& from = batch.coordinator;
+    const std::optional<PeerFreshness::Slot> slot = peer.fresh.slot(u.stream);
     const auto what = [&] {
-      return "state update " + printable(u.iface) + " seq " + std::to_string(u.seq) + " from coordinator '" +
-             printable(u.coordinator) + "'";
+      return "state update " + (slot ? peer.fresh.iface(*slot) : "#" + std::to_string(u.stream)) + " seq " +
+             std::to_string(u.seq) + " from coordinator '" + printable(from) + "'";
     };
-    if (u.coordinator != from) {
+    if (!slot) {
       updates_rejected.fetch_add(1);
-      refuse(from, what() + ": signed by '" + printable(from) + "', not by the coordinator it names");
+      refuse(from, what() + ": not one of its " + std::to_string(peer.fresh.size()) + " state streams");
       return;
     }
-    if (u.coordinator == name) return;
-    const auto it = held.find(u.iface);
-    if (it == held.end()) return;  // every process sees every update; this one is not for us
-    Held& h = it->second;
-    if (u.coordinator != h.provider) {
-      updates_rejected.fetch_add(1);
-      refuse(from,
-             what() + ": " + std::string(Members::component_of(u.iface)) + " runs in coordinator '" + h.provider + "'");
-      return;
-    }
-    Peer& peer = peers[u.coordinator];
+    Held* const held_here = peer.held[slot->index];
+    if (held_here == nullptr) return;  // every client of the provider sees every update; this one is not for us
+    Held& h = *held_here;
     std::int64_t missed = 0;
     std::string why;
-    switch (peer.fresh.stream(h.slot, u.incarnation, u.seq, missed, why)) {
+    switch (peer.fresh.stream(*slot, batch.incarnation, u.seq, missed, why)) {
       case PeerFreshness::Verdict::Accept: break;
       case PeerFreshness::Verdict::Covered:  // (heartbeats only)
       case PeerFreshness::Verdict::Unproven:
@@ -762,7 +782,7 @@ struct CoordinatorNode::Impl {
         refuse(from, what() + ": " + why);
         return;
     }
-    if (missed > 0 && h.incarnation == u.incarnation) {
+    if (missed > 0 && h.incarnation == batch.incarnation) {
       updates_missed.fetch_add(static_cast<std::uint64_t>(missed));
       drops->note(from + "/missed", "middleware: " + name + ": " + what() + ": " + std::to_string(missed) +
                                         " update(s) missed; this full state supersedes them");
@@ -786,7 +806,7 @@ struct CoordinatorNode::Impl {
       refuse(from, what() + ": nothing changed: " + applied.error().message);
       return;
     }
-    h.incarnation = u.incarnation;
+    h.incarnation = batch.incarnation;
     h.last_seq = u.seq;
     if (h.behind) {
       h.behind = false;
@@ -1115,6 +1135,8 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   std::vector<std::string> ifaces;
   for (const std::size_t i : impl->heartbeat_order) ifaces.push_back(impl->streams[i]->iface);
   impl->states_id = StateStreams::of(std::move(ifaces)).id;
+  for (std::size_t k = 0; k < impl->heartbeat_order.size(); ++k)
+    impl->streams[impl->heartbeat_order[k]]->position = static_cast<std::int32_t>(k);
   for (auto& [provider, peer] : impl->peers) {
     if (peer.provider) peer.fresh.follow(impl->members.state_streams(provider));
   }
@@ -1127,6 +1149,8 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                                                   held.provider + "', which the system file does not give it");
     }
     held.slot = *slot;
+    peer->second.held.resize(peer->second.fresh.size(), nullptr);
+    peer->second.held[slot->index] = &held;
   }
   // The required interfaces each provider coordinator feeds: where its loss is raised.
   for (const Connection& k : shape.connections()) {
@@ -1147,6 +1171,8 @@ Expected<void> CoordinatorNode::start() {
   if (d.running.load()) return {};
   try {
     d.ic = make_communicator(d.options.tls, d.options.ice);
+    d.state_head = encode(d.ic, wire::StateBatch{d.name, d.incarnation, d.states_id, {}});
+    d.state_head.pop_back();  // the empty sequence of updates: its size, 0, in one byte
     const std::string endpoint = protocol(d.options.tls) + " -h " + d.options.listen_host +
                                  (d.options.control_port > 0 ? " -p " + std::to_string(d.options.control_port) : "");
     d.adapter = d.ic->createObjectAdapterWithEndpoints("SafecassNode", endpoint);

@@ -283,6 +283,13 @@ std::optional<PeerFreshness::Slot> PeerFreshness::slot(std::string_view iface) c
   return Slot{it->second};
 }
 
+std::string PeerFreshness::other_streams(std::int64_t states_id) const {
+  if (following_ && states_id == streams_.id) return {};
+  return "its updates number the state streams of a list of id " + std::to_string(states_id) +
+         ", where the system file gives its coordinator " + std::to_string(tracked_.size()) + " of id " +
+         std::to_string(streams_.id) + " (its components' provided interfaces differ: another system file?)";
+}
+
 std::string PeerFreshness::other_streams(const wire::Heartbeat& beat) const {
   if (!following_) return {};  // follows none (a tool)
   if (beat.statesId == streams_.id && beat.states.size() == tracked_.size()) return {};

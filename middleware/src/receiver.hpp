@@ -146,6 +146,18 @@ public:
   void follow(StateStreams streams);
   /// The slot of interface `iface`'s stream; none when the peer has no such stream.
   std::optional<Slot> slot(std::string_view iface) const;
+  /// Why a state batch that numbers the streams of the list of id `states_id`
+  /// (wire::StateBatch::statesId) is refused: another list than the one followed. Empty: its
+  /// updates' positions are slots of the followed list (slot(std::int64_t)).
+  std::string other_streams(std::int64_t states_id) const;
+  /// The slot an update of a batch of the followed list names by its position `stream`
+  /// (wire::StateUpdate::stream); none when the list has no such position.
+  std::optional<Slot> slot(std::int64_t stream) const noexcept {
+    if (stream < 0 || static_cast<std::uint64_t>(stream) >= tracked_.size()) return std::nullopt;
+    return Slot{static_cast<std::size_t>(stream)};
+  }
+  /// The number of state streams followed (slots 0 to size() - 1).
+  std::size_t size() const noexcept { return tracked_.size(); }
   /// The interface of a slot.
   const std::string& iface(Slot slot) const { return streams_.ifaces.at(slot.index); }
   /// An update numbered `seq` of the stream in `slot`: on Accept `missed` is the number of updates

@@ -45,16 +45,15 @@ struct Supervisor::Impl {
   static constexpr std::chrono::milliseconds kHeartbeatPeriod{100};
 
   /// A provided interface of one of a coordinator's components: what an update of it reaches,
-  /// found once, so that an update costs one lookup (by its interface).
+  /// found once, so that an update costs no lookup (its stream's position indexes Peer::services).
   struct Service {
-    std::string address;       ///< "C.s_S.p", its row in the view
-    PeerFreshness::Slot slot;  ///< its stream in the peer's PeerFreshness
-    ViewRow* row = nullptr;    ///< its row once it has one (view's nodes stay put until erased)
+    std::string address;     ///< "C.s_S.p", its row in the view
+    ViewRow* row = nullptr;  ///< its row once it has one (view's nodes stay put until erased)
   };
   struct Peer {
     std::vector<std::string> components;
-    TextMap<Service> services;  ///< by interface "C.p": those its state updates may name
-    PeerFreshness fresh;        ///< its proven process, heartbeats and state streams
+    std::vector<Service> services;  ///< by PeerFreshness::Slot::index: one per state stream
+    PeerFreshness fresh;            ///< its proven process, heartbeats and state streams
     /// The newest incarnation heard from but not proven yet, and the lowest number of its records
     /// it was heard to have sent (its first heartbeat's list, or its first record's number - 1):
     /// what it sent above that before its proof was not taken, and is reported missed.
@@ -99,7 +98,7 @@ struct Supervisor::Impl {
   // Scratch storage of the dispatch thread (Ice's one server thread): reused for every message,
   // so that a steady stream of records and updates does not allocate per record.
   introspect::HistoryEntry record_scratch;
-  wire::StateUpdateSeq updates_scratch;
+  wire::StateBatch updates_scratch;
   wire::EventMessageSeq events_scratch;
   std::string record_note;  ///< dispatch thread: the note printed with a record (late, taken while lost)
   std::string note_scratch;
@@ -192,7 +191,7 @@ struct Supervisor::Impl {
           // A Service that points at one of the rows erased points at none (its next update makes
           // the row again); checked by the row's coordinator, so before the rows go.
           for (auto& [_, other] : peers) {
-            for (auto& [iface, service] : other.services) {
+            for (Service& service : other.services) {
               if (service.row != nullptr && service.row->coordinator == who) service.row = nullptr;
             }
           }
@@ -363,19 +362,34 @@ struct Supervisor::Impl {
   }
 
   void on_updates(const wire::Signed& signed_batch) {
-    wire::StateUpdateSeq& batch = updates_scratch;
+    wire::StateBatch& batch = updates_scratch;
     if (!open(signed_batch, kKindState, batch)) return;
-    for (const wire::StateUpdate& u : batch) on_update(signed_batch.signer, u);
-  }
-
-  void on_update(const std::string& from, const wire::StateUpdate& u) {
-    if (u.coordinator != from) {
-      refuse(from, "a state update naming '" + printable(u.coordinator) + "' signed by '" + printable(from) + "'");
+    const std::string& from = signed_batch.signer;
+    if (batch.coordinator != from) {
+      refuse(from, "state updates naming '" + printable(batch.coordinator) + "' signed by '" + printable(from) + "'");
       return;
     }
+    const auto p = peers.find(from);  // (peers never change after create())
+    if (p == peers.end()) {
+      refuse(from, "state updates of '" + printable(from) + "', which is not a coordinator of the system");
+      return;
+    }
+    {
+      std::lock_guard lock(mutex);
+      if (const std::string why = p->second.fresh.other_streams(batch.statesId); !why.empty()) {
+        refuse(from, "state updates of '" + printable(from) + "': " + why);
+        return;
+      }
+    }
+    for (const wire::StateUpdate& u : batch.updates) on_update(p->second, batch, u);
+  }
+
+  /// An update of `batch`, a batch of `peer`'s list of state streams.
+  void on_update(Peer& peer, const wire::StateBatch& batch, const wire::StateUpdate& u) {
+    const std::string& from = batch.coordinator;
     State s = State::Normal;
     if (!from_wire(u.state, s)) {
-      refuse(from, "a state update of '" + printable(u.coordinator) + "' with an invalid level");
+      refuse(from, "a state update of '" + printable(from) + "' with an invalid level");
       return;
     }
     // The note printed with the state: "roots a:b, c:d"; the view keeps the causes after "roots ".
@@ -390,48 +404,40 @@ struct Supervisor::Impl {
     std::string_view address;  // its row: Service::address (peers never change after create())
     {
       std::lock_guard lock(mutex);
-      const auto p = peers.find(u.coordinator);
-      if (p == peers.end()) {
-        refuse(from, "a state update of '" + printable(u.coordinator) + "', which is not a coordinator of the system");
+      const std::optional<PeerFreshness::Slot> slot = peer.fresh.slot(u.stream);
+      if (!slot) {
+        refuse(from, "a state update of '" + printable(from) + "' for stream " + std::to_string(u.stream) +
+                         ", not one of its " + std::to_string(peer.fresh.size()) + " state streams");
         return;
       }
-      const auto found = p->second.services.find(u.iface);
-      if (found == p->second.services.end()) {
-        const char* why = u.iface.find('.') == std::string::npos ? ", a malformed interface (not Component.Interface)"
-                          : members->runs(u.coordinator, Members::component_of(u.iface))
-                              ? ", not a provided interface of its component"
-                              : ", a component it does not run";
-        refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + why);
-        return;
-      }
-      Service& service = found->second;
+      Service& service = peer.services[slot->index];
       address = service.address;
       // Each interface's stream numbers its updates 1, 2, 3...: an update not above the last one
       // applied is a replay (or a duplicate) and must not bring back an older state; a gap needs
       // nothing more: this full state supersedes what was missed.
       std::int64_t missed = 0;
       std::string why;
-      switch (p->second.fresh.stream(service.slot, u.incarnation, u.seq, missed, why)) {
+      switch (peer.fresh.stream(*slot, batch.incarnation, u.seq, missed, why)) {
         case PeerFreshness::Verdict::Accept: break;
         case PeerFreshness::Verdict::Covered:           // (heartbeats only)
         case PeerFreshness::Verdict::Unproven: return;  // taken from its republish once proven
         case PeerFreshness::Verdict::Refuse:
-          refuse(from, "a state update of '" + printable(u.coordinator) + "' for " + printable(u.iface) + ": " + why);
+          refuse(from, "a state update of '" + printable(from) + "' for " + peer.fresh.iface(*slot) + ": " + why);
           return;
       }
-      if (auto& behind = p->second.behind; !behind.empty()) {
-        std::erase_if(behind, [&](const auto& b) { return b.first == service.slot.index && u.seq >= b.second; });
-        if (behind.empty()) p->second.live.caught_up();  // every stream listed ahead has come
+      if (auto& behind = peer.behind; !behind.empty()) {
+        std::erase_if(behind, [&](const auto& b) { return b.first == slot->index && u.seq >= b.second; });
+        if (behind.empty()) peer.live.caught_up();  // every stream listed ahead has come
       }
       if (service.row == nullptr) service.row = &view.try_emplace(service.address).first->second;
       ViewRow& r = *service.row;
-      if (r.address == address && r.coordinator == u.coordinator && r.state == s && r.cause == causes) return;
-      r.coordinator = u.coordinator;
+      if (r.address == address && r.coordinator == from && r.state == s && r.cause == causes) return;
+      r.coordinator = from;
       r.address = address;
       r.state = s;
       r.cause.assign(causes);
     }
-    emit(SupervisorLine::of_state(u.coordinator, address, s, causes.empty() ? std::string_view() : note));
+    emit(SupervisorLine::of_state(from, address, s, causes.empty() ? std::string_view() : note));
   }
 
   void on_beat(const wire::Signed& m) {
@@ -611,7 +617,10 @@ struct Supervisor::Impl {
           // its remote providers too: what it believes of them is not theirs to say).
           if (!members->runs(name, Members::component_of(r.address))) continue;
           if (r.state != State::Normal) {
+            // Read after the list: the state it gives is the newer one, and its causes are those
+            // of that state (the machine may have changed between the two requests).
             const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
+            r.state = why.state;
             for (const Explanation& e : why.conditions) {
               if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root.name();
             }
@@ -772,10 +781,11 @@ Expected<std::unique_ptr<Supervisor>> Supervisor::create(const spec::SystemSpec&
   for (const spec::ComponentSpec& c : system.components) {
     const auto peer = impl->peers.find(impl->members->coordinator_of(c.name));
     if (peer == impl->peers.end()) continue;
+    Impl::Peer& to = peer->second;
+    to.services.resize(to.fresh.size());
     for (const std::string& p : c.provided) {
-      std::string iface = c.name + "." + p;
-      const PeerFreshness::Slot slot = *peer->second.fresh.slot(iface);
-      peer->second.services.emplace(std::move(iface), Impl::Service{address::service(c.name, p), slot, nullptr});
+      const PeerFreshness::Slot slot = *to.fresh.slot(c.name + "." + p);
+      to.services[slot.index].address = address::service(c.name, p);
     }
   }
   Impl* d = impl.get();

@@ -78,9 +78,9 @@ void answer(const Ice::ByteSeq& body, Read read) {
 }
 
 void state_batch(const Ice::ByteSeq& body) {
-  wire::StateUpdateSeq batch;
+  wire::StateBatch batch;
   if (!open_sealed_body(middleware::kKindState, body, batch)) return;
-  for (const wire::StateUpdate& u : batch) {
+  for (const wire::StateUpdate& u : batch.updates) {
     for (const wire::Root& root : u.roots) {
       ResolvedRoot r;
       middleware::root_from_wire(root, r);
@@ -119,11 +119,9 @@ void write(const std::string& dir, Kind kind, const Ice::ByteSeq& body) {
 
 void write_seeds(const std::string& dir) {
   const auto& ic = fuzz::bus_members().ice;
-  wire::StateUpdate u;
-  u.coordinator = "robot";
-  u.incarnation = 7;
+  wire::StateUpdate u{};
+  u.stream = 1;
   u.seq = 1;
-  u.iface = "JR3.s_A";
   u.state = wire::Level::Error;
   u.roots.push_back(wire::Root{"EVT_FORCE_ERROR",
                                "JR3.s_A",
@@ -135,7 +133,7 @@ void write_seeds(const std::string& dir) {
                                0,
                                false,
                                {"JR3.s_A", "CONTROL.s_R.ForceData"}});
-  write(dir, kState, middleware::encode(ic, wire::StateUpdateSeq{u}));
+  write(dir, kState, middleware::encode(ic, wire::StateBatch{"robot", 7, 0x5afeca55, {u}}));
   wire::Heartbeat h;
   h.coordinator = "robot";
   h.incarnation = 7;

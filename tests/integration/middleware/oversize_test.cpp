@@ -29,6 +29,7 @@
 
 #include "auth.hpp"
 #include "fixture.hpp"
+#include "receiver.hpp"
 #include "safecass.h"
 #include "safecass/core/named.hpp"
 #include "safecass/filters/monitor.hpp"
@@ -148,7 +149,7 @@ private:
   std::vector<Batch> batches_;
 };
 
-class StateTap final : public Tap<wire::StateTopic, wire::StateUpdateSeq> {
+class StateTap final : public Tap<wire::StateTopic, wire::StateBatch> {
 public:
   using Tap::Tap;
   void updates(wire::Signed m, const Ice::Current&) override { take(m); }
@@ -270,12 +271,16 @@ struct Bus {
   std::vector<Condition> held(const std::string& iface) {
     return client.co->conditions(*client.co->structure().find_machine("P.s_P." + iface));
   }
+  /// The interface "P.x" of an update of P's coordinator.
+  std::string iface_of(const wire::StateUpdate& u) const {
+    return middleware::Members(*load.system).state_streams("over-p").ifaces.at(static_cast<std::size_t>(u.stream));
+  }
   /// The last update of P.`iface` the tap saw.
   std::optional<wire::StateUpdate> last_update(const std::string& iface) {
     std::optional<wire::StateUpdate> last;
-    for (const wire::StateUpdateSeq& batch : states->batches()) {
-      for (const wire::StateUpdate& u : batch) {
-        if (u.iface == "P." + iface) last = u;
+    for (const wire::StateBatch& batch : states->batches()) {
+      for (const wire::StateUpdate& u : batch.updates) {
+        if (iface_of(u) == "P." + iface) last = u;
       }
     }
     return last;
@@ -366,8 +371,8 @@ TEST(Oversize, ABatchTooLargeForOneMessageIsSplitAndEveryUpdateArrivesWhole) {
   std::size_t most = 0;
   std::size_t after = 0;
   for (std::size_t i = before; i < batches.size(); ++i) {
-    most = std::max(most, batches[i].size());
-    for (const wire::StateUpdate& u : batches[i]) after += u.iface[2] == 'E' ? 1 : 0;
+    most = std::max(most, batches[i].updates.size());
+    for (const wire::StateUpdate& u : batches[i].updates) after += bus.iface_of(u)[2] == 'E' ? 1 : 0;
   }
   EXPECT_GE(after, 8u);
   EXPECT_GE(most, 2u) << "updates still share messages";

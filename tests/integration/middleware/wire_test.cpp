@@ -91,16 +91,21 @@ using middleware::Signer;
 
 constexpr std::int64_t kIncarnation = 42;
 
-wire::StateUpdate update(const std::string& iface, std::int64_t seq, const std::string& event, wire::Level level,
-                         std::int64_t incarnation = kIncarnation) {
-  wire::StateUpdate u;
-  u.coordinator = "wire-p";
-  u.incarnation = incarnation;
-  u.seq = seq;
-  u.iface = iface;
-  u.state = level;
+/// One state update as a test writes it: of wire-p's interface `iface`, by a process of
+/// `incarnation`. Bus::batch() turns a list of them into the wire's StateBatch.
+struct Update {
+  std::string iface;
+  wire::StateUpdate wire;
+  std::int64_t incarnation = kIncarnation;
+};
+
+Update update(const std::string& iface, std::int64_t seq, const std::string& event, wire::Level level,
+              std::int64_t incarnation = kIncarnation) {
+  Update u{iface, {}, incarnation};
+  u.wire.seq = seq;
+  u.wire.state = level;
   if (!event.empty()) {
-    u.roots.push_back(
+    u.wire.roots.push_back(
         wire::Root{event, "P.s_A", 1000, level, "", "", 0.0, 0, false, {"P.s_A", "P.s_S." + iface.substr(2)}});
   }
   return u;
@@ -141,7 +146,7 @@ struct Bus {
   Coordinator co{"wire-c", &clock};
   std::unique_ptr<Monitor> monitor;
   std::unique_ptr<middleware::CoordinatorNode> node;
-  std::mutex mutex;
+  mutable std::mutex mutex;
   std::vector<std::string> log;
   Ice::CommunicatorHolder ice;  ///< presents wire-p's certificate (made with the keys, below)
   /// Presents the supervisor's certificate: the supervisor's Alive object, which a receiver
@@ -329,12 +334,37 @@ struct Bus {
     }
     heartbeat_pub(name)->beat(key.sign(middleware::kKindHeartbeat, encode(ice.communicator(), h)));
   }
-  /// Publishes `batch` signed by `key`; a genuine batch also advances what the heartbeat lists.
-  void send(const Signer& key, const wire::StateUpdateSeq& batch) {
-    state_pub->updates(key.seal(middleware::kKindState, encode(ice.communicator(), batch)));
+  /// The state message body of `updates` (of one incarnation) as coordinator `coordinator` sends
+  /// it: each interface by its position among wire-p's streams (one past them when wire-p has no
+  /// such interface), the list's id the one `coordinator`'s heartbeats list.
+  wire::StateBatch batch(const std::vector<Update>& updates, const std::string& coordinator = "wire-p") const {
+    wire::Heartbeat listed;
+    listed.coordinator = coordinator;
+    std::lock_guard lock(mutex);
+    list_states(listed);
+    const middleware::StateStreams streams =
+        provider_streams ? *provider_streams : middleware::Members(*load.system).state_streams("wire-p");
+    wire::StateBatch b{coordinator, updates.empty() ? kIncarnation : updates.front().incarnation, listed.statesId, {}};
+    for (const Update& u : updates) {
+      EXPECT_EQ(u.incarnation, b.incarnation) << "a batch is of one process";
+      wire::StateUpdate w = u.wire;
+      w.stream = static_cast<std::int32_t>(std::find(streams.ifaces.begin(), streams.ifaces.end(), u.iface) -
+                                           streams.ifaces.begin());
+      b.updates.push_back(std::move(w));
+    }
+    return b;
+  }
+  /// `updates` sealed by `key` as a state message of `coordinator`.
+  wire::Signed sealed(const Signer& key, const std::vector<Update>& updates,
+                      const std::string& coordinator = "wire-p") const {
+    return key.seal(middleware::kKindState, encode(ice.communicator(), batch(updates, coordinator)));
+  }
+  /// Publishes `updates` sealed by `key`; a genuine batch also advances what the heartbeat lists.
+  void send(const Signer& key, const std::vector<Update>& updates) {
+    state_pub->updates(sealed(key, updates));
     if (&key != &*provider) return;
     std::lock_guard lock(mutex);
-    for (const wire::StateUpdate& u : batch) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.seq);
+    for (const Update& u : updates) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.wire.seq);
   }
   State state(const std::string& machine) { return co.state(*co.structure().find_machine(machine)); }
   std::string all_log() {
@@ -401,7 +431,7 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
-  const wire::StateUpdateSeq raise{update("P.D0", 1, "EVT_E", wire::Level::Error)};
+  const std::vector<Update> raise{update("P.D0", 1, "EVT_E", wire::Level::Error)};
   bus.send(*bus.provider, raise);
   ASSERT_TRUE(eventually([&] { return bus.state("C.s_R.D0") == State::Error; }));
   bus.send(*bus.provider, {update("P.D0", 2, "", wire::Level::Normal)});
@@ -418,8 +448,7 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   // 3. Signed by another coordinator of the system (a real key) but naming wire-p.
   bus.send(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
   // 4. Claiming wire-p as signer with another key's signature, and with no signature at all.
-  wire::Signed relabelled = bus.other->seal(
-      middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 3, "EVT_E", wire::Level::Error)}));
+  wire::Signed relabelled = bus.sealed(*bus.other, {update("P.D0", 3, "EVT_E", wire::Level::Error)});
   relabelled.signer = "wire-p";
   bus.state_pub->updates(relabelled);
   wire::Signed unsigned_message = relabelled;
@@ -539,7 +568,7 @@ TEST(Wire, HeartbeatsAMemberKeptAndRelaysAfterTheProviderDiedEndNoLoss) {
 // (Heartbeat::states). A provider run with another system file (here one that gives P a fifth
 // interface) would have its numbers read as other interfaces' numbers: the client believes none
 // of its heartbeats nor proofs instead, says why, and holds it lost until the lists agree again.
-TEST(Wire, AProviderWhoseHeartbeatsListOtherStateStreamsThanTheSystemFileGivesItIsLostAndSaysWhy) {
+TEST(Wire, AProviderWhoseHeartbeatsAndUpdatesNumberOtherStateStreamsThanTheSystemFileGivesItIsLostAndSaysWhy) {
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
@@ -553,6 +582,17 @@ TEST(Wire, AProviderWhoseHeartbeatsListOtherStateStreamsThanTheSystemFileGivesIt
   const std::string log = bus.all_log();
   EXPECT_NE(log.find("it lists 5 state stream(s)"), std::string::npos) << log;
   EXPECT_NE(log.find("another system file?"), std::string::npos) << log;
+  // Its state updates number the streams of its list too: refused whole, never read by position.
+  // Sent until the refusal is logged (its heartbeats' refusals share the source's one line a second).
+  const std::uint64_t rejected = bus.node->stats().updates_rejected;
+  EXPECT_TRUE(eventually(
+      [&] {
+        bus.state_pub->updates(bus.sealed(*bus.provider, {update("P.D1", 1, "", wire::Level::Normal)}));
+        return bus.all_log().find("its updates number the state streams of a list of id") != std::string::npos;
+      },
+      10000ms))
+      << bus.all_log();
+  EXPECT_GT(bus.node->stats().updates_rejected, rejected);
   std::this_thread::sleep_for(500ms);  // proofs asked meanwhile carry the same list
   EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
   {
@@ -1610,13 +1650,10 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
   auto ic = bus.ice.communicator();
   // wire-c, on its own topic and signing as itself, about wire-p's component.
   auto own = Ice::uncheckedCast<wire::StateTopicPrx>(bus.topic("safecass.state.wire-c")->getPublisher()->ice_oneway());
-  wire::StateUpdate lie = update("P.D0", 2, "", wire::Level::Normal);
-  lie.coordinator = "wire-c";
-  own->updates(bus.other->seal(middleware::kKindState, encode(ic, wire::StateUpdateSeq{lie})));
+  own->updates(bus.sealed(*bus.other, {update("P.D0", 2, "", wire::Level::Normal)}, "wire-c"));
   // wire-p itself, 2^21 ahead (sent raw: its heartbeats do not list it).
-  bus.state_pub->updates(bus.provider->seal(
-      middleware::kKindState,
-      encode(ic, wire::StateUpdateSeq{update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)})));
+  bus.state_pub->updates(
+      bus.sealed(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)}));
   // wire-p's key, an incarnation near 2^63: refused, it does not lock wire-p out.
   bus.beat(*bus.provider, "wire-p", std::numeric_limits<std::int64_t>::max() - 1);
   {
@@ -1624,7 +1661,8 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
     bus.newest = kIncarnation;  // that beat was a key holder's, not a restart: wire-p still proves its own
   }
   ASSERT_TRUE(eventually([&] { return sup.messages_refused() >= refused + 3; })) << out.all();
-  EXPECT_NE(out.all().find("for P.D0, a component it does not run"), std::string::npos) << out.all();
+  // wire-c provides no interface: an update of its own can name none of P's.
+  EXPECT_NE(out.all().find("of 'wire-c' for stream 0, not one of its 0 state streams"), std::string::npos) << out.all();
   EXPECT_NE(out.all().find("jumps more than 1048576 ahead"), std::string::npos) << out.all();
   EXPECT_NE(out.all().find("more than 60 s ahead of this host's clock"), std::string::npos) << out.all();
   EXPECT_TRUE(eventually([&] {
@@ -1635,9 +1673,8 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
   // for it. Sent until the refusal is logged (a source's refusals are logged at most once a second).
   std::int64_t d9 = 0;
   EXPECT_TRUE(eventually([&] {
-    bus.state_pub->updates(bus.provider->seal(
-        middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D9", ++d9, "EVT_E", wire::Level::Error)})));
-    return out.all().find("for P.D9, not a provided interface of its component") != std::string::npos;
+    bus.state_pub->updates(bus.sealed(*bus.provider, {update("P.D9", ++d9, "EVT_E", wire::Level::Error)}));
+    return out.all().find("for stream 4, not one of its 4 state streams") != std::string::npos;
   })) << out.all();
   EXPECT_EQ(view_state(sup, "P.s_S.D9"), std::nullopt) << out.all();
   // wire-p is not locked out: heard (a machine busy enough to starve its heartbeats past the loss
@@ -1708,8 +1745,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
     std::vector<std::shared_ptr<Ice::ObjectPrx>> pubs;
     for (const Topic& t : topics) pubs.push_back(bus.topic(t.name)->getPublisher()->ice_batchOneway());
     // Forged: an attacker's seal and signature under a hostile signer name.
-    wire::Signed forged = bus.attacker->seal(
-        middleware::kKindState, encode(ic, wire::StateUpdateSeq{update("P.D0", 99, "", wire::Level::Normal)}));
+    wire::Signed forged = bus.sealed(*bus.attacker, {update("P.D0", 99, "", wire::Level::Normal)});
     forged.signer = evil_name;
     Ice::ByteSeq forged_bytes;
     {
@@ -1772,7 +1808,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
 
   // Then 300 forged messages with 128 KiB signer names (64 MB of log before names were capped).
   {
-    wire::Signed huge = bus.attacker->seal(middleware::kKindState, encode(ic, wire::StateUpdateSeq{}));
+    wire::Signed huge = bus.sealed(*bus.attacker, {});
     huge.signer = std::string(std::size_t{128} * 1024, 'n');
     for (int i = 0; i < 300; ++i) bus.state_pub->updates(huge);
   }

@@ -225,6 +225,24 @@ TEST(PeerFreshness, AHeartbeatOrProofOfAnotherListOfStateStreamsIsRefusedSoNoNum
   EXPECT_TRUE(tool.proven(other, why)) << why;
 }
 
+TEST(PeerFreshness, AStateBatchOfAnotherListOfStreamsIsRefusedAndAnUpdateNamesOnlyAPositionInItsSignersList) {
+  PeerFreshness peer;
+  const StateStreams robot = StateStreams::of({"A.p", "B.p", "C.p"});
+  EXPECT_NE(peer.other_streams(robot.id), "") << "a receiver that follows no list reads no batch by position";
+  peer.follow(robot);
+  EXPECT_EQ(peer.other_streams(robot.id), "");
+  const std::string why = peer.other_streams(StateStreams::of({"A.p", "C.p"}).id);
+  EXPECT_NE(why.find("number the state streams of a list of id"), std::string::npos) << why;
+  EXPECT_NE(why.find("another system file?"), std::string::npos) << why;
+  ASSERT_TRUE(peer.slot(std::int64_t{2}));
+  EXPECT_EQ(peer.iface(*peer.slot(std::int64_t{2})), "C.p");
+  EXPECT_EQ(peer.slot(std::int64_t{0})->index, peer.slot("A.p")->index) << "the same slot by name and by position";
+  EXPECT_FALSE(peer.slot(std::int64_t{3})) << "one past the list";
+  EXPECT_FALSE(peer.slot(std::int64_t{-1}));
+  EXPECT_FALSE(peer.slot(std::int64_t{1} << 40));
+  EXPECT_EQ(peer.size(), 3U);
+}
+
 TEST(PeerFreshness, AheadNamesEachStreamAHeartbeatListsAboveWhatCameFromTheProcess) {
   PeerFreshness peer;
   peer.follow(StateStreams::of({"A.p", "B.p", "C.p"}));
@@ -658,17 +676,17 @@ TEST(Decode, AParameterWhoseNumbersOrTextsDeclareTooManyIsRefused) {
 
 TEST(Decode, ABatchDecodedIntoAReusedOneHoldsOnlyTheNewBatch) {
   const std::shared_ptr<Ice::Communicator> ice = Ice::initialize();
-  wire::StateUpdate a{"robot", kRun, 1, "JR3.ForceData", wire::Level::Error, {}, 5};
+  wire::StateUpdate a{1, 1, wire::Level::Error, {}, 5};
   a.roots.push_back(wire::Root{"EVT_FORCE", "JR3.s_A", 7, wire::Level::Error, "f", "force", 2.5, 6, false, {"JR3"}});
   wire::StateUpdate b = a;
-  b.iface = "JR3.Other";
-  const wire::StateUpdate c{"robot", kRun, 2, "Arm.Joints", wire::Level::Normal, {}, 9};
-  wire::StateUpdateSeq batch;
-  ASSERT_TRUE(decode(ice, encode(ice, wire::StateUpdateSeq{a, b, a}), batch));
-  ASSERT_EQ(batch.size(), 3U);
-  ASSERT_TRUE(decode(ice, encode(ice, wire::StateUpdateSeq{c}), batch));
-  ASSERT_EQ(batch.size(), 1U);
-  EXPECT_EQ(batch[0], c);  // no root, no field of the earlier batch's first update is left
+  b.stream = 2;
+  const wire::StateUpdate c{0, 2, wire::Level::Normal, {}, 9};
+  wire::StateBatch batch;
+  ASSERT_TRUE(decode(ice, encode(ice, wire::StateBatch{"robot", kRun, 11, {a, b, a}}), batch));
+  ASSERT_EQ(batch.updates.size(), 3U);
+  ASSERT_TRUE(decode(ice, encode(ice, wire::StateBatch{"robot", kRun, 11, {c}}), batch));
+  ASSERT_EQ(batch.updates.size(), 1U);
+  EXPECT_EQ(batch.updates[0], c);  // no root, no field of the earlier batch's first update is left
   ice->destroy();
 }
 
