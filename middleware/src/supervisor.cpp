@@ -617,12 +617,14 @@ struct Supervisor::Impl {
           // its remote providers too: what it believes of them is not theirs to say).
           if (!members->runs(name, Members::component_of(r.address))) continue;
           if (r.state != State::Normal) {
-            // Read after the list: the state it gives is the newer one, and its causes are those
-            // of that state (the machine may have changed between the two requests).
+            // Read after the list, an answer about the row gives the newer state and that
+            // state's causes (the machine may have changed between the two requests).
             const introspect::ExplainAnswer why = from_wire(prx->explain(r.address));
-            r.state = why.state;
-            for (const Explanation& e : why.conditions) {
-              if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root.name();
+            if (why.address == r.address) {
+              r.state = why.state;
+              for (const Explanation& e : why.conditions) {
+                if (e.outstanding || causes[r.address].empty()) causes[r.address] = e.root.name();
+              }
             }
           }
           rows.push_back(std::move(r));

@@ -1971,6 +1971,52 @@ struct ImpostorProcess {
   ~ImpostorProcess() { adapter->destroy(); }
 };
 
+/// wire-c restarted: a new incarnation that proves itself with wire-c's key and serves its own
+/// Control, answering `answer` for every operation but the proof. Its heartbeats list records
+/// always ahead of what the supervisor holds, so the supervisor reads its view again (its state
+/// list, then an explanation of each row not Normal).
+struct RestartedMember {
+  RestartedMember(Bus& bus_of, Relay::Answer answer)
+      : bus(bus_of),
+        process(bus.keys, "wire-c",
+                [this, answer = std::move(answer)](const std::string& operation,
+                                                   std::pair<const Ice::Byte*, const Ice::Byte*> in) {
+                  auto ic = bus.ice.communicator();
+                  if (operation == "prove") {
+                    return std::optional<std::vector<Ice::Byte>>(out_params(
+                        ic, middleware::make_proof(*bus.other, ic, in_param<Ice::ByteSeq>(ic, in), heartbeat())));
+                  }
+                  if (operation == "stateList") ++lists;
+                  return answer(operation, in);
+                }) {}
+  wire::Heartbeat heartbeat() {
+    wire::Heartbeat h;
+    h.coordinator = "wire-c";
+    h.incarnation = incarnation;
+    h.seq = seq.load();
+    h.control = process.proxy;
+    bus.list_states(h);
+    h.events = 1000 + seq.load();
+    return h;
+  }
+  /// Beats every 50 ms until the supervisor has read its state list twice, 3 s at most.
+  void beat_until_read() {
+    auto ic = bus.ice.communicator();
+    auto pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(bus.topic("safecass.heartbeat.wire-c")->getPublisher());
+    const auto until = std::chrono::steady_clock::now() + 3000ms;
+    while (std::chrono::steady_clock::now() < until && lists.load() < 2) {
+      ++seq;
+      pub->beat(bus.other->sign(middleware::kKindHeartbeat, encode(ic, heartbeat())));
+      std::this_thread::sleep_for(50ms);
+    }
+  }
+  Bus& bus;
+  const std::int64_t incarnation = middleware::new_incarnation();
+  std::atomic<std::int64_t> seq{0};
+  std::atomic<int> lists{0};  ///< state lists read
+  ImpostorProcess process;
+};
+
 // Attack 1 of the review: a fake Control on a dead robot's old port, announced by the robot's
 // replayed heartbeats, forwards the console's nonce to the live robot and returns its genuine
 // signed answer. Whatever certificate of the system's CA the impostor holds (the tools' reader,
@@ -2054,51 +2100,78 @@ TEST(Wire, AMemberCannotSpeakForAnotherMembersComponentsThroughTheSupervisorsRef
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << out.all();
 
   // wire-c restarted (a new incarnation it proves with its own key), serving its own Control.
-  const std::int64_t incarnation = middleware::new_incarnation();
-  std::atomic<std::int64_t> seq{0};
-  std::atomic<int> lists{0};
-  std::string endpoint;
-  auto heartbeat = [&] {
-    wire::Heartbeat h;
-    h.coordinator = "wire-c";
-    h.incarnation = incarnation;
-    h.seq = seq.load();
-    h.control = endpoint;
-    bus.list_states(h);
-    h.events = 1000 + seq.load();  // always ahead of what the supervisor holds
-    return h;
-  };
-  ImpostorProcess fake(bus.keys, "wire-c",
-                       [&](const std::string& operation,
-                           std::pair<const Ice::Byte*, const Ice::Byte*> in) -> std::optional<std::vector<Ice::Byte>> {
-                         if (operation == "prove") {
-                           return out_params(
-                               ic, middleware::make_proof(*bus.other, ic, in_param<Ice::ByteSeq>(ic, in), heartbeat()));
-                         }
-                         if (operation == "stateList") {
-                           ++lists;
-                           wire::StateEntrySeq rows{{"P", "component", wire::Level::Normal, ""},
-                                                    {"P.s_A", "application", wire::Level::Normal, ""},
-                                                    {"C.s_A", "application", wire::Level::Warning, "EVT_W"}};
-                           return out_params(ic, rows);
-                         }
-                         if (operation == "explain") return out_params(ic, wire::ExplainReply{});
-                         return std::nullopt;
-                       });
-  endpoint = fake.proxy;
-  const auto until = std::chrono::steady_clock::now() + 3000ms;
-  while (std::chrono::steady_clock::now() < until && lists.load() < 2) {
-    ++seq;
-    auto pub = Ice::uncheckedCast<wire::HeartbeatTopicPrx>(bus.topic("safecass.heartbeat.wire-c")->getPublisher());
-    pub->beat(bus.other->sign(middleware::kKindHeartbeat, encode(ic, heartbeat())));
-    std::this_thread::sleep_for(50ms);
-  }
-  ASSERT_GE(lists.load(), 1) << "the supervisor read the member's list\n" << out.all();
+  RestartedMember member(bus,
+                         [&](const std::string& operation,
+                             std::pair<const Ice::Byte*, const Ice::Byte*>) -> std::optional<std::vector<Ice::Byte>> {
+                           if (operation == "stateList") {
+                             return out_params(
+                                 ic, wire::StateEntrySeq{{"P", "component", wire::Level::Normal, ""},
+                                                         {"P.s_A", "application", wire::Level::Normal, ""},
+                                                         {"C.s_A", "application", wire::Level::Warning, "EVT_W"}});
+                           }
+                           if (operation == "explain") return out_params(ic, wire::ExplainReply{});
+                           return std::nullopt;
+                         });
+  member.beat_until_read();
+  ASSERT_GE(member.lists.load(), 1) << "the supervisor read the member's list\n" << out.all();
   // What wire-c says of its own component is taken; of wire-p's, nothing.
   EXPECT_TRUE(eventually([&] { return view_state(sup, "C.s_A") == State::Warning; })) << out.all();
   EXPECT_EQ(view_state(sup, "P.s_A"), State::Error) << out.all();
   EXPECT_EQ(out.all().find("[wire-c] P.s_A"), std::string::npos) << out.all();
   EXPECT_EQ(out.all().find("[wire-c] P Normal"), std::string::npos) << out.all();
+  supervisor->stop();
+}
+
+// The supervisor reads a member's view again after missed records: its state list, then an
+// explanation of each row not Normal. A row can change between the two requests (the member's
+// losses clear as it proves its peers alive): the row takes the state the explanation gives with
+// the causes it gives, never a state from one answer with the causes of another (an Error with no
+// cause). An explanation of another address changes nothing.
+TEST(Wire, TheSupervisorsRefreshTakesEachRowsStateFromTheExplanationItTakesTheCausesFrom) {
+  ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
+  Bus bus;
+  ASSERT_TRUE(bus.node);
+  SupervisorOutput out;
+  auto supervisor = start_supervisor(bus, out);
+  ASSERT_TRUE(supervisor);
+  const middleware::Supervisor& sup = *supervisor;
+  auto ic = bus.ice.communicator();
+  wire::ExplainEntry warning{};
+  warning.machine = "C.s_F";
+  warning.event = "EVT_W";
+  warning.outstanding = true;
+  warning.root.event = "EVT_W";
+  warning.root.origin = "C.s_F";
+  warning.root.level = wire::Level::Warning;
+  RestartedMember member(
+      bus,
+      [&](const std::string& operation,
+          std::pair<const Ice::Byte*, const Ice::Byte*> in) -> std::optional<std::vector<Ice::Byte>> {
+        if (operation == "stateList") {
+          return out_params(ic, wire::StateEntrySeq{{"C.s_A", "application", wire::Level::Error, ""},
+                                                    {"C.s_F", "framework", wire::Level::Error, ""},
+                                                    {"C.s_R.D0", "required", wire::Level::Error, ""}});
+        }
+        if (operation == "explain") {
+          const auto address = in_param<std::string>(ic, in);
+          if (address == "C.s_A") return out_params(ic, wire::ExplainReply{address, wire::Level::Normal, {}});
+          if (address == "C.s_F") return out_params(ic, wire::ExplainReply{address, wire::Level::Warning, {warning}});
+          return out_params(ic, wire::ExplainReply{"C.s_A", wire::Level::Normal, {}});  // not about the row asked
+        }
+        return std::nullopt;
+      });
+  member.beat_until_read();
+  ASSERT_GE(member.lists.load(), 1) << "the supervisor read the member's list\n" << out.all();
+  // Cleared between the reads: not shown in Error.
+  EXPECT_TRUE(eventually([&] { return view_state(sup, "C.s_F") == State::Warning; })) << out.all();
+  EXPECT_NE(view_state(sup, "C.s_A"), State::Error) << out.all();
+  EXPECT_EQ(out.all().find("[wire-c] C.s_A Error"), std::string::npos) << out.all();
+  // Eased between the reads: the explanation's state, with its cause.
+  EXPECT_NE(out.all().find("[wire-c] C.s_F Warning (refreshed after missed records; root C.s_F:EVT_W)"),
+            std::string::npos)
+      << out.all();
+  // An answer about another address: the list's state stands.
+  EXPECT_EQ(view_state(sup, "C.s_R.D0"), State::Error) << out.all();
   supervisor->stop();
 }
 
