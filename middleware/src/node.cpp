@@ -1138,7 +1138,9 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
   for (std::size_t k = 0; k < impl->heartbeat_order.size(); ++k)
     impl->streams[impl->heartbeat_order[k]]->position = static_cast<std::int32_t>(k);
   for (auto& [provider, peer] : impl->peers) {
-    if (peer.provider) peer.fresh.follow(impl->members.state_streams(provider));
+    if (!peer.provider) continue;
+    peer.fresh.follow(impl->members.state_streams(provider));
+    peer.held.assign(peer.fresh.size(), nullptr);
   }
   for (auto& [iface, held] : impl->held) {
     const auto peer = impl->peers.find(held.provider);
@@ -1149,7 +1151,6 @@ Expected<std::unique_ptr<CoordinatorNode>> CoordinatorNode::create(Coordinator& 
                                                   held.provider + "', which the system file does not give it");
     }
     held.slot = *slot;
-    peer->second.held.resize(peer->second.fresh.size(), nullptr);
     peer->second.held[slot->index] = &held;
   }
   // The required interfaces each provider coordinator feeds: where its loss is raised.
