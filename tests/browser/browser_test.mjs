@@ -1,7 +1,7 @@
 // Browser test of the web pages, in headless Chromium (Debian's /usr/bin/chromium) driven by
 // playwright-core (web/package.json):
 //   1. `safecass viewer` on robodoc with tests/browser/force_spike.json: CONTROL turns Error when
-//      the force crosses 30 N, pushed within 100 ms; clicking it shows the cause (JR3.s_A
+//      the force crosses 30 N, pushed by the first update after it; clicking it shows the cause (JR3.s_A
 //      EVT_FORCE_ERROR, filter force_limit); bad messages and writes without (or with a wrong)
 //      token are refused and change nothing; a write with the token is applied.
 //   2. `safecass timeline` of the robodoc story: the page draws Normal/Warning/Error bars.
@@ -106,13 +106,20 @@ async function testViewer() {
   check(await page.getAttribute('[data-address="JR3.s_A"]', 'data-state') === 'Error', 'JR3.s_A is Error');
   check(await page.getAttribute('[data-address="SYSTEM"]', 'data-state') === 'Error', 'SYSTEM is Error');
 
-  // How late was the transition pushed? The update's clock minus the transition's time.
-  let lag = null;
-  for (const u of updates) {
-    const r = u.records.find((x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error');
-    if (r !== undefined) { lag = u.t - r.t; break; }
-  }
-  check(lag !== null && lag >= 0 && lag < 0.1, `CONTROL's transition to Error pushed within 100 ms (lag ${lag === null ? '?' : (lag * 1000).toFixed(1)} ms of simulated time at speed 1)`);
+  // The transition is pushed by the first poll that runs the system past it: the update that
+  // carries it is the first whose clock is at or after the transition's time. How late that is
+  // (the update's clock minus the transition's time) is the poll period plus how late the machine
+  // ran the poll: printed, not bounded (a latency is a benchmark's figure, not a test's).
+  const carrying = updates.findIndex((u) => u.records.some(
+    (x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error'));
+  const r = carrying < 0 ? null : updates[carrying].records.find(
+    (x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error');
+  const earlier = carrying < 0 ? -1 : updates.slice(0, carrying).findIndex((u) => u.t >= r.t);
+  const lag = r === null ? null : updates[carrying].t - r.t;
+  check(r !== null && lag >= 0 && earlier < 0,
+    `CONTROL's transition to Error pushed by the first update after it (${r === null ? 'not pushed'
+      : earlier >= 0 ? `update ${earlier} at t = ${updates[earlier].t} s left it out`
+      : `lag ${(lag * 1000).toFixed(1)} ms of simulated time at speed 1`})`);
   const listed = await page.textContent('#transitions');
   check(/CONTROL/.test(listed) && /Normal → Error/.test(listed), 'the side list shows the transitions');
 

@@ -22,9 +22,10 @@
 //  3. no record is lost without being reported: every transition that the robot and the ui
 //     print (their own observer stream, before the node queues the record) since the current
 //     supervisor subscribed (or since the process started, when later) was printed by the
-//     supervisor, in order, as it received it — or the supervisor printed "N event record(s) of
-//     'X' missed" for at least as many records. Conversely the supervisor printed no transition
-//     the process did not make.
+//     supervisor, in order as it received it or marked late (out of order: a replicated IceStorm
+//     reorders a publisher's messages when it moves to another replica) — or the supervisor
+//     printed "N event record(s) of 'X' missed" for at least as many records. Conversely the supervisor printed no
+//     transition the process did not make.
 // During the disruptions it also checks fail-toward-safe: while the robot is killed or
 // unreachable (IceStorm down) the ui shows EVT_COORDINATOR_LOST, and it declares a stopped robot
 // lost; while the supervisor is gone both coordinators show EVT_SUPERVISOR_LOST. At the end every
@@ -451,9 +452,10 @@ struct SupervisorLog {
   std::map<std::string, std::pair<std::string, std::string>> view;  ///< address -> (coordinator, state)
   std::map<std::string, bool> lost;
   std::map<std::string, std::vector<std::string>> received;
-  /// Records printed late (" (late: seq N arrived after newer records)"): reported missed first,
-  /// then received out of order, which a replicated IceStorm can do when a publisher moves from
-  /// one replica to another. Not in `received` (which is in order), and they take no row back.
+  /// Records printed late (" (late: seq N arrived after newer records)"): received out of order,
+  /// which a replicated IceStorm does when a publisher moves from one replica to another. Either
+  /// within the reorder grace (they fill a gap, never reported missed) or after it (reported
+  /// missed first). Not in `received` (which is in order), and they take no row back.
   std::map<std::string, std::vector<std::string>> late;
   std::map<std::string, std::uint64_t> missed;
   std::uint64_t missed_total = 0;  ///< over every incarnation
@@ -473,6 +475,7 @@ struct SupervisorLog {
         if (line.find("' restarted; its view is refreshed") != std::string::npos) {
           std::erase_if(view, [&](const auto& row) { return row.second.first == who; });
           received[who].clear();
+          late[who].clear();
           missed[who] = 0;
         } else if (line.find("' lost: ") != std::string::npos) {
           lost[who] = true;
@@ -528,14 +531,25 @@ struct Delivery {
   }
 };
 
+/// `received`: what the supervisor printed in order; `late`: what it printed out of order. A
+/// printed transition is received when the in-order lines match it (walking back from the newest)
+/// or, failing that, a late line equal to it is left to match.
 Delivery delivered(const std::vector<std::string>& printed, std::size_t anchor,
-                   const std::vector<std::string>& received, std::uint64_t missed) {
+                   const std::vector<std::string>& received, const std::vector<std::string>& late,
+                   std::uint64_t missed) {
   Delivery d;
   d.printed = printed.size();
-  d.received = received.size();
+  d.received = received.size() + late.size();
   d.reported_missed = missed;
   anchor = std::min(anchor, printed.size());
   d.expected = printed.size() - anchor;
+  std::multiset<std::string> late_left(late.begin(), late.end());
+  auto late_match = [&](std::size_t i) {
+    const auto it = late_left.find(printed[i]);
+    if (i < anchor || it == late_left.end()) return false;
+    late_left.erase(it);
+    return true;
+  };
   std::size_t i = printed.size(), j = received.size(), matched = 0;
   while (j > 0) {
     if (i == 0) {
@@ -546,9 +560,12 @@ Delivery delivered(const std::vector<std::string>& printed, std::size_t anchor,
     if (printed[i - 1] == received[j - 1]) {
       if (i - 1 >= anchor) ++matched;
       --j;
+    } else if (late_match(i - 1)) {
+      ++matched;
     }
     --i;
   }
+  while (i > 0) matched += late_match(--i) ? 1 : 0;
   d.unmatched = d.expected - matched;
   return d;
 }
@@ -797,9 +814,9 @@ public:
     for (const auto* p : {&robot_, &ui_}) {
       const std::string who = p == &robot_ ? "robot" : "ui";
       const auto printed = transitions_printed((*p)->log(), who, components_[who]);
-      const Delivery d =
-          delivered(printed, anchor_[who], s.received.count(who) ? s.received.at(who) : std::vector<std::string>{},
-                    s.missed.count(who) ? s.missed.at(who) : 0);
+      const Delivery d = delivered(
+          printed, anchor_[who], s.received.count(who) ? s.received.at(who) : std::vector<std::string>{},
+          s.late.count(who) ? s.late.at(who) : std::vector<std::string>{}, s.missed.count(who) ? s.missed.at(who) : 0);
       if (!d.ok()) out += "records: " + d.text(who) + "\n";
       for (const std::string& line : s.late.count(who) ? s.late.at(who) : std::vector<std::string>{}) {
         if (std::find(printed.begin(), printed.end(), line) == printed.end())
