@@ -140,6 +140,18 @@ struct TwoProcesses {
       : ice(std::move(ice_endpoint)), tag(std::move(test_tag)) {}
 
   std::string token_file() const { return p.scratch + "/" + tag + "-robot.token"; }
+  /// The robot's write token, once it has started and written its token file: up to 15 s (a
+  /// process starting beside a loaded machine took over 5); none when it did not.
+  std::optional<std::string> await_token() const {
+    std::optional<std::string> token;
+    const bool written = eventually(
+        [&] {
+          if (auto t = middleware::read_token_file(token_file())) token = std::move(*t);
+          return token.has_value();
+        },
+        15000ms);
+    return written ? token : std::nullopt;
+  }
   void start_robot() {
     // A token file left by an earlier run (a process killed before it could remove it) must not be
     // read as this robot's.
@@ -221,9 +233,8 @@ TEST(MultiProcess, RobodocSplitInTwoProcessesHasTheSameStatesAndRootCausesAsInPr
   TwoProcesses sys(ice_of_fixture(), "propagation");
   sys.start_robot();
   sys.start_ui();
-  auto token = middleware::read_token_file(sys.token_file());
-  ASSERT_TRUE(eventually([&] { return (token = middleware::read_token_file(sys.token_file())).has_value(); }))
-      << sys.logs();
+  const auto token = sys.await_token();
+  ASSERT_TRUE(token.has_value()) << sys.logs();
   auto robot = sys.client("robot", *token);
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
@@ -271,9 +282,8 @@ TEST(MultiProcess, TheClientsAndTheSupervisorsHistoriesNameTheSameRootCausesAsAn
   Process supervisor(
       {sys.p.bin, "supervisor", sys.p.system, "--ice", sys.ice, "--lost-after", "3000", "--duration", "40"},
       sys.p.scratch + "/audit-supervisor.log");
-  auto token = middleware::read_token_file(sys.token_file());
-  ASSERT_TRUE(eventually([&] { return (token = middleware::read_token_file(sys.token_file())).has_value(); }))
-      << sys.logs();
+  const auto token = sys.await_token();
+  ASSERT_TRUE(token.has_value()) << sys.logs();
   auto robot = sys.client("robot", *token);
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
@@ -435,12 +445,8 @@ TEST(MultiProcess, AWriteIsRefusedWithoutTheTokenAndAcceptedWithIt) {
   TwoProcesses sys(ice_of_fixture(), "token");
   sys.start_robot();
   sys.start_ui();
-  std::optional<std::string> token;
-  ASSERT_TRUE(eventually([&] {
-    auto t = middleware::read_token_file(sys.token_file());
-    if (t) token = *t;
-    return token.has_value();
-  })) << sys.logs();
+  const auto token = sys.await_token();
+  ASSERT_TRUE(token.has_value()) << sys.logs();
   struct stat st {};
   ASSERT_EQ(::stat(sys.token_file().c_str(), &st), 0);
   EXPECT_EQ(st.st_mode & 0777, 0600u) << "the token file is readable by its owner only";
@@ -561,12 +567,8 @@ TEST(MultiProcess, NothingIsLostWhenIceStormIsKilledAndRestartedMidRun) {
   TwoProcesses sys("127.0.0.1:" + port, "restart");
   sys.start_robot();
   sys.start_ui();
-  std::optional<std::string> token;
-  ASSERT_TRUE(eventually([&] {
-    auto t = middleware::read_token_file(sys.token_file());
-    if (t) token = *t;
-    return token.has_value();
-  }));
+  const auto token = sys.await_token();
+  ASSERT_TRUE(token.has_value());
   auto robot = sys.client("robot", *token);
   auto ui = sys.client("ui");
   ASSERT_TRUE(robot && ui) << sys.logs();
