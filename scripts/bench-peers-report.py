@@ -29,15 +29,40 @@ def load(work, name):
         return None
 
 
-def median_round(work, name):
-    """The round of part `name` (NAME_r1.json, NAME_r2.json, ...) with the median CPU per update,
-    with every round's figure in "rounds"; the part's single run (NAME.json) when it has no rounds."""
+def rounds_of(work, name):
+    """The rounds of part `name` (NAME_r1.json, NAME_r2.json, ...), in order."""
     rounds = []
     for n in range(1, 100):
         part = load(work, f"{name}_r{n}")
         if part is None:
             break
         rounds.append(part)
+    return rounds
+
+
+def median(values):
+    values = sorted(v for v in values if v is not None)
+    return None if not values else values[(len(values) - 1) // 2]
+
+
+def median_latency(work, name):
+    """A latency part measured in rounds: its p50 and p99 each the median of the rounds' (every
+    round's pair in "rounds"), its max the largest; the part's single run when it has no rounds."""
+    rounds = rounds_of(work, name)
+    if not rounds:
+        return load(work, name)
+    out = dict(rounds[0])
+    out["p50_us"] = median(r.get("p50_us") for r in rounds)
+    out["p99_us"] = median(r.get("p99_us") for r in rounds)
+    out["max_us"] = max((r["max_us"] for r in rounds if r.get("max_us") is not None), default=None)
+    out["rounds"] = [[r.get("p50_us"), r.get("p99_us")] for r in rounds]
+    return out
+
+
+def median_round(work, name):
+    """The round of part `name` (NAME_r1.json, NAME_r2.json, ...) with the median CPU per update,
+    with every round's figure in "rounds"; the part's single run (NAME.json) when it has no rounds."""
+    rounds = rounds_of(work, name)
     usable = sorted((r for r in rounds if r.get("cpu_s_per_10k_updates") is not None),
                     key=lambda r: r["cpu_s_per_10k_updates"])
     if not usable:
@@ -96,10 +121,10 @@ def main():
     failed = os.environ.get("FAILED", "").split()
 
     vis = {
-        "safecass_over_icestorm": load(work, "safecass_visibility"),
+        "safecass_over_icestorm": median_latency(work, "safecass_visibility"),
         "icestorm_raw": load(work, "icestorm_visibility"),
         "icestorm_raw_tls": load(work, "icestorm_tls_visibility"),
-        "icestorm_raw_tls_sender_thread": load(work, "icestorm_tls_sender_visibility"),
+        "icestorm_raw_tls_sender_thread": median_latency(work, "icestorm_tls_sender_visibility"),
         "roscpp_raw": load(work, "ros_visibility"),
         "ros_diagnostics_default": load(work, "diag_default_visibility"),
         "ros_diagnostics_fastest": load(work, "diag_fastest_visibility"),
@@ -208,7 +233,14 @@ def main():
         return f"{v:.{digits}f}{unit}"
 
     def lat(p):
-        return "—" if p is None else f"{fmt(p.get('p50_us'))} / {fmt(p.get('p99_us'))} / {fmt(p.get('max_us'))} µs (n={p.get('samples')})"
+        if p is None:
+            return "—"
+        text = f"{fmt(p.get('p50_us'))} / {fmt(p.get('p99_us'))} / {fmt(p.get('max_us'))} µs (n={p.get('samples')}"
+        rounds = p.get("rounds") or []
+        if len(rounds) < 2:
+            return text + ")"
+        return (text + f" per round, the medians of each round's p50 / p99: "
+                + ", ".join(f"{fmt(a, '', 0)} / {fmt(b, '', 0)}" for a, b in rounds) + ")")
 
     rows = [
         ("visibility SAFECASS over IceStorm, TLS (p50/p99/max)", lat(sc)),
