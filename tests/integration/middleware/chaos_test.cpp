@@ -24,8 +24,8 @@
 //     supervisor subscribed (or since the process started, when later) was printed by the
 //     supervisor, in order as it received it or marked late (out of order: a replicated IceStorm
 //     reorders a publisher's messages when it moves to another replica) — or the supervisor
-//     printed "N event record(s) of 'X' missed" for at least as many records. Conversely the supervisor printed no
-//     transition the process did not make.
+//     printed "N event record(s) of 'X' missed" for at least as many records. Conversely the
+//     supervisor printed no transition the process did not make.
 // During the disruptions it also checks fail-toward-safe: while the robot is killed or
 // unreachable (IceStorm down) the ui shows EVT_COORDINATOR_LOST, and it declares a stopped robot
 // lost; while the supervisor is gone both coordinators show EVT_SUPERVISOR_LOST. At the end every
