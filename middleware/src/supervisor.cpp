@@ -256,13 +256,16 @@ struct Supervisor::Impl {
   }
 
   void on_event(const std::string& sender, const wire::EventMessage& m) {
+    // Its refusals are rate-limited apart from the sender's other messages: a failover's flood of
+    // repeated state updates must not hide what became of a record.
+    const auto refuse_record = [&](const std::string& what) { refuse(sender + "/records", what); };
     if (m.coordinator != sender) {
-      refuse(sender, "an event record naming '" + printable(m.coordinator) + "' signed by '" + printable(sender) + "'");
+      refuse_record("an event record naming '" + printable(m.coordinator) + "' signed by '" + printable(sender) + "'");
       return;
     }
     State from = State::Normal, to = State::Normal, level = State::Normal;
     if (!from_wire(m.record.from, from) || !from_wire(m.record.to, to) || !from_wire(m.record.level, level)) {
-      refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an invalid level");
+      refuse_record("an event record of '" + printable(m.coordinator) + "' with an invalid level");
       return;
     }
     const bool transition =
@@ -271,21 +274,21 @@ struct Supervisor::Impl {
     introspect::HistoryEntry& entry = record_scratch;
     if (shown) {
       if (!from_wire(m.record, entry)) {
-        refuse(sender, "an event record of '" + printable(m.coordinator) + "' with an unknown kind or outcome");
+        refuse_record("an event record of '" + printable(m.coordinator) + "' with an unknown kind or outcome");
         return;
       }
       // The address a transition's row is kept under: its machine, or its component.
       if (m.record.kind == wire::RecordKind::Transition ? m.record.machine.empty() : m.record.component.empty()) {
-        refuse(sender, "an event record of '" + printable(m.coordinator) + "' that names no " +
-                           (m.record.kind == wire::RecordKind::Transition ? "machine" : "component"));
+        refuse_record("an event record of '" + printable(m.coordinator) + "' that names no " +
+                      (m.record.kind == wire::RecordKind::Transition ? "machine" : "component"));
         return;
       }
     }
     // A member speaks only for the components the system file assigns to it.
     for (const std::string* named : {&m.record.component, &m.record.machine}) {
       if (named->empty() || members->runs(m.coordinator, Members::component_of(*named))) continue;
-      refuse(sender, "an event record of '" + printable(m.coordinator) + "' about '" + printable(*named) +
-                         "', a component it does not run");
+      refuse_record("an event record of '" + printable(m.coordinator) + "' about '" + printable(*named) +
+                    "', a component it does not run");
       return;
     }
     bool late = false;    // below a record received before it: printed as late
@@ -294,8 +297,8 @@ struct Supervisor::Impl {
       std::lock_guard lock(mutex);
       const auto p = peers.find(m.coordinator);
       if (p == peers.end()) {
-        refuse(sender,
-               "an event record of '" + printable(m.coordinator) + "', which is not a coordinator of the system");
+        refuse_record("an event record of '" + printable(m.coordinator) +
+                      "', which is not a coordinator of the system");
         return;
       }
       Peer& peer = p->second;
@@ -322,12 +325,12 @@ struct Supervisor::Impl {
           // proof when sent since the supervisor first heard of the process).
           return;
         case EventStream::Took::Again:
-          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                             " not above " + std::to_string(peer.records.last()) + " and received already (replayed)");
+          refuse_record("an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                        " not above " + std::to_string(peer.records.last()) + " and received already (replayed)");
           return;
         case EventStream::Took::TooFar:
-          refuse(sender, "an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
-                             " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
+          refuse_record("an event record of '" + printable(m.coordinator) + "': seq " + std::to_string(m.seq) +
+                        " jumps more than " + std::to_string(kMaxSeqJump) + " ahead");
           return;
       }
       if (!shown) return;
