@@ -1,9 +1,9 @@
 // Browser test of the web pages, in headless Chromium (Debian's /usr/bin/chromium) driven by
 // playwright-core (web/package.json):
 //   1. `safecass viewer` on robodoc with tests/browser/force_spike.json: CONTROL turns Error when
-//      the force crosses 30 N, pushed by the first update after it; clicking it shows the cause (JR3.s_A
-//      EVT_FORCE_ERROR, filter force_limit); bad messages and writes without (or with a wrong)
-//      token are refused and change nothing; a write with the token is applied.
+//      the force crosses 30 N, pushed by the first update after it; clicking it shows the cause
+//      (JR3.s_A EVT_FORCE_ERROR, filter force_limit); bad messages and writes without (or with a
+//      wrong) token are refused and change nothing; a write with the token is applied.
 //   2. `safecass timeline` of the robodoc story: the page draws Normal/Warning/Error bars.
 // Screenshots: OUT/viewer.png and OUT/timeline.png.
 //
@@ -110,10 +110,9 @@ async function testViewer() {
   // carries it is the first whose clock is at or after the transition's time. How late that is
   // (the update's clock minus the transition's time) is the poll period plus how late the machine
   // ran the poll: printed, not bounded (a latency is a benchmark's figure, not a test's).
-  const carrying = updates.findIndex((u) => u.records.some(
-    (x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error'));
-  const r = carrying < 0 ? null : updates[carrying].records.find(
-    (x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error');
+  const controlToError = (x) => x.kind === 'component-transition' && x.component === 'CONTROL' && x.to === 'Error';
+  const carrying = updates.findIndex((u) => u.records.some(controlToError));
+  const r = carrying < 0 ? null : updates[carrying].records.find(controlToError);
   const earlier = carrying < 0 ? -1 : updates.slice(0, carrying).findIndex((u) => u.t >= r.t);
   const lag = r === null ? null : updates[carrying].t - r.t;
   check(r !== null && lag >= 0 && earlier < 0,

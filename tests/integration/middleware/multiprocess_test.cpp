@@ -144,13 +144,13 @@ struct TwoProcesses {
   /// process starting beside a loaded machine took over 5); none when it did not.
   std::optional<std::string> await_token() const {
     std::optional<std::string> token;
-    const bool written = eventually(
+    (void)eventually(
         [&] {
           if (auto t = middleware::read_token_file(token_file())) token = std::move(*t);
           return token.has_value();
         },
         15000ms);
-    return written ? token : std::nullopt;
+    return token;
   }
   void start_robot() {
     // A token file left by an earlier run (a process killed before it could remove it) must not be
