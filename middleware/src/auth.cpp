@@ -466,7 +466,6 @@ wire::Signed Signer::sign(std::string_view kind, Ice::ByteSeq body) const {
 
 void DropLog::line(const std::string& raw_source, const std::string& what, bool refused) {
   constexpr std::size_t kMaxSource = 64;
-  constexpr std::size_t kMaxLine = 1024;
   const std::string source = raw_source.size() <= kMaxSource ? raw_source : printable(raw_source, kMaxSource);
   const std::int64_t now =
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -500,6 +499,27 @@ void DropLog::line(const std::string& raw_source, const std::string& what, bool 
     s.suppressed = 0;
   }
   if (log_) log_(line);
+}
+
+void DropLog::flush(std::string_view who, std::int64_t now) {
+  constexpr std::int64_t kSecond = 1'000'000'000;
+  std::string held;
+  {
+    std::lock_guard lock(mutex_);
+    for (auto& [source, s] : sources_) {
+      if (s.suppressed == 0 || now - s.last_logged < kSecond) continue;
+      held += (held.empty() ? "" : ", ") + std::to_string(s.suppressed) + " from '" + source + "'";
+      s.suppressed = 0;
+    }
+    if (over_budget_ > 0 && now - second_start_ >= kSecond) {
+      held += (held.empty() ? "" : ", ") + std::to_string(over_budget_) + " over the budget of " +
+              std::to_string(kLinesPerSecond) + " a second";
+      over_budget_ = 0;
+    }
+  }
+  if (held.empty() || !log_) return;
+  if (held.size() > kMaxLine) held = held.substr(0, kMaxLine) + "...(cut)";
+  log_(std::string(who) + ": lines held back by the rate limit and not said since: " + held);
 }
 
 std::uint64_t DropLog::count() const {

@@ -144,16 +144,22 @@ std::string open_sealed(const Signer& me, const std::shared_ptr<Ice::Communicato
 /// the number of sources (the next line says how many were suppressed meanwhile). Sources are
 /// kept capped (printable(source, 64)) and at most 256 of them, lines at most 1,024 bytes: memory
 /// stays bounded, and the log grows by at most kLinesPerSecond lines of 1,024 bytes (and their
-/// counts) a second, whatever arrives.
+/// counts) a second, whatever arrives. What the limit held back and no later line of its source
+/// said is said by flush(), once its second is over: no count is lost when a source falls silent.
 class DropLog {
 public:
   static constexpr std::uint64_t kLinesPerSecond = 8;
+  static constexpr std::size_t kMaxLine = 1024;  ///< bytes of a line's text, cut beyond
   explicit DropLog(std::function<void(const std::string&)> log) : log_(std::move(log)) {}
   /// A refused message: counted (count()) and logged, rate-limited.
   void drop(const std::string& source, const std::string& what) { line(source, what, true); }
   /// A line something from outside can make repeat (not a refusal): logged, rate-limited.
   void note(const std::string& source, const std::string& what) { line(source, what, false); }
   std::uint64_t count() const;
+  /// At `now` (steady ns), one line from `who` with the lines held back more than a second ago
+  /// and not said since (each source's count, and those over the total budget); none if none.
+  /// Called by a receiver's watch loop.
+  void flush(std::string_view who, std::int64_t now);
 
 private:
   void line(const std::string& source, const std::string& what, bool refused);

@@ -1054,6 +1054,7 @@ struct CoordinatorNode::Impl {
     for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
       next = now + std::chrono::nanoseconds(bound).count();
+      drops->flush("middleware: " + name, now);
       std::lock_guard lock(peer_mutex);
       for (auto& [who, peer] : peers) {
         // A provider is watched from the node's start (never heard of is as bad as gone); the

@@ -239,6 +239,37 @@ std::string EventStream::text(const Range& r) {
   return std::to_string(r.first) + (r.first == r.last ? std::string() : ".." + std::to_string(r.last));
 }
 
+// ---- MissedRecords ------------------------------------------------------------------------------
+
+void MissedRecords::add(const EventStream::Range& r) {
+  count_ += r.last - r.first + 1;
+  if (!shown_.empty() && more_ == 0 && shown_.back().last + 1 == r.first) {
+    shown_.back().last = r.last;  // adjoins the range before it (a heartbeat's, then a gap's)
+  } else if (shown_.size() < kShown) {
+    shown_.push_back(r);
+  } else {
+    ++more_;
+  }
+}
+
+std::int64_t MissedRecords::due_at() const noexcept {
+  if (count_ == 0) return std::numeric_limits<std::int64_t>::max();
+  return said_at_ ? *said_at_ + kInterval : std::numeric_limits<std::int64_t>::min();
+}
+
+std::optional<std::string> MissedRecords::take(std::int64_t now, std::string_view who, bool now_anyway) {
+  if (count_ == 0 || (!now_anyway && now < due_at())) return std::nullopt;
+  std::string line = std::to_string(count_) + " event record(s) of '" + printable(who) + "' missed (seq ";
+  for (std::size_t i = 0; i < shown_.size(); ++i) line += (i == 0 ? "" : ", ") + EventStream::text(shown_[i]);
+  if (more_ > 0) line += " and " + std::to_string(more_) + " more range(s)";
+  line += ")";
+  count_ = 0;
+  shown_.clear();
+  more_ = 0;
+  said_at_ = now;
+  return line;
+}
+
 // ---- PeerFreshness ------------------------------------------------------------------------------
 
 PeerFreshness::Verdict PeerFreshness::process(std::int64_t incarnation, std::string& why) const {

@@ -358,6 +358,29 @@ private:
   std::vector<Gap> missed_;         ///< missed, oldest first: a record of one that still comes is late
 };
 
+/// What a receiver says of the records it missed (EventStream's ranges): all of them, in at most
+/// one line a second per sender. The first range is said at once; ranges found within a second of
+/// the last line wait for the next one, which sums them exactly and lists them (the first kShown,
+/// then how many more). A rate limit that dropped lines would leave records lost unreported.
+class MissedRecords {
+public:
+  static constexpr std::size_t kShown = 8;
+  static constexpr std::int64_t kInterval = 1'000'000'000;  ///< steady ns between two lines
+
+  void add(const EventStream::Range& r);
+  /// The line due at `now` ("N event record(s) of 'who' missed (seq a..b, c)"), if one is: records
+  /// wait and a second has passed since the last line, or `now_anyway` (the receiver stops).
+  std::optional<std::string> take(std::int64_t now, std::string_view who, bool now_anyway = false);
+  /// When take() has a line (steady ns); INT64_MAX when no record waits.
+  std::int64_t due_at() const noexcept;
+
+private:
+  std::int64_t count_ = 0;                 ///< records waiting to be said
+  std::vector<EventStream::Range> shown_;  ///< their first kShown ranges
+  std::int64_t more_ = 0;                  ///< ranges beyond those
+  std::optional<std::int64_t> said_at_;    ///< the last line's time
+};
+
 /// Asks a peer's Alive endpoint (named in its heartbeat) to sign a fresh nonce, and checks the
 /// answer: asked over a connection to the peer's own process (not_served_by), kind "proof", signed
 /// by the peer's key, the nonce ours, the endpoint the one asked. At most one question per peer

@@ -64,6 +64,7 @@ struct Supervisor::Impl {
     /// sent before: any still on their way are not taken (they cannot be told from replays);
     /// those sent since the supervisor first heard of the process were reported missed at the proof.
     EventStream records;
+    MissedRecords missed;        ///< its records missed and not said yet (said by the watch loop)
     std::string control;         ///< its Control proxy, from its last authenticated heartbeat
     bool refresh = false;        ///< records were missed: fetch its state list again
     bool states_behind = false;  ///< the last heartbeat listed state updates not received
@@ -232,21 +233,27 @@ struct Supervisor::Impl {
     }
   }
 
-  void report_missed(Peer& peer, const std::string& who, const EventStream::Range& gap) {
-    drops->note(who + "/records-missed", "supervisor: " + std::to_string(gap.last - gap.first + 1) +
-                                             " event record(s) of '" + printable(who) + "' missed (seq " +
-                                             EventStream::text(gap) + ")");
+  /// `gap` of `peer`'s records is missed (under `mutex`): the watch loop says so (say_missed).
+  void report_missed(Peer& peer, const EventStream::Range& gap) {
+    peer.missed.add(gap);
     peer.refresh = true;  // the missed records may have changed rows: read them again
     watch_sleeper.wake();
   }
 
-  /// Reports the gaps still open kReorderGrace after they opened (watch loop).
-  void report_gaps(std::int64_t now) {
+  /// Reports the gaps still open kReorderGrace after they opened, and says the records missed
+  /// (at most a line a second per coordinator, none left out; every one at once when `stopping`)
+  /// (watch loop).
+  void report_gaps(std::int64_t now, bool stopping = false) {
     const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
-    std::lock_guard lock(mutex);
-    for (auto& [name, peer] : peers) {
-      while (const auto gap = peer.records.overdue(now, grace)) report_missed(peer, name, *gap);
+    std::vector<std::string> lines;
+    {
+      std::lock_guard lock(mutex);
+      for (auto& [name, peer] : peers) {
+        while (const auto gap = peer.records.overdue(now, grace)) report_missed(peer, *gap);
+        if (auto line = peer.missed.take(now, name, stopping)) lines.push_back("supervisor: " + *line);
+      }
     }
+    for (const std::string& line : lines) print(line);
   }
 
   void on_events(const wire::Signed& signed_batch) {
@@ -309,7 +316,7 @@ struct Supervisor::Impl {
       std::optional<EventStream::Range> range;
       switch (peer.records.take(m.seq, steady_ns(), range)) {
         case EventStream::Took::Next:
-          if (range) report_missed(peer, m.coordinator, *range);  // pushed out by more open gaps
+          if (range) report_missed(peer, *range);  // pushed out by more open gaps
           break;
         case EventStream::Took::Filled: late = true; break;  // it fills a gap below a record received before it
         case EventStream::Took::Late:
@@ -510,7 +517,7 @@ struct Supervisor::Impl {
     // reported as missed (EventStream::heard).
     const std::int64_t records_sent = options.records ? h.events : 0;
     if (const auto missed = peer.records.heard(records_sent)) {
-      report_missed(peer, h.coordinator, *missed);
+      report_missed(peer, *missed);
       link->renew({kEventTopic});  // the records may no longer reach us at all
     }
     // The state streams too, whether records are followed or not: an update lost with
@@ -667,9 +674,10 @@ struct Supervisor::Impl {
     }
   }
 
-  /// Reports the gaps past their grace, reads again the views of coordinators whose records were
-  /// missed, and declares lost the coordinators past their bound. It sleeps until the next of
-  /// these is due (a loss: Liveness::due; a gap: its grace), at most the shorter of the two
+  /// Reports the gaps past their grace and says the records missed, reads again the views of
+  /// coordinators whose records were missed, and declares lost the coordinators past their bound.
+  /// It sleeps until the next of these is due (a loss: Liveness::due; a gap: its grace; a line of
+  /// missed records: MissedRecords::due_at), at most the shorter of the two
   /// bounds, since a new duty is due no sooner than that after it starts; a view to read again
   /// wakes it.
   void watch_loop() {
@@ -680,6 +688,7 @@ struct Supervisor::Impl {
       const std::int64_t now = steady_ns();
       next = now + cap;
       report_gaps(now);
+      drops->flush("supervisor", now);
       refresh_missed();
       // A coordinator of the system file that was never heard from is lost too, once the bound
       // has passed since the supervisor connected: silence is never taken for health.
@@ -701,6 +710,7 @@ struct Supervisor::Impl {
           }
           next = std::min(next, peer.live.due(since, options.lost_after));
           next = std::min(next, peer.records.overdue_at(grace));
+          next = std::min(next, peer.missed.due_at());
         }
       }
       for (const auto& [name, components, why] : lost_now) {
@@ -711,6 +721,7 @@ struct Supervisor::Impl {
         for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
       }
     }
+    report_gaps(steady_ns(), true);  // stopping: the records missed that wait for their line are said now
   }
 
   /// The next heartbeat (`next`), or the last one sent (a proof of life).

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdint>
 #include <limits>
 #include <optional>
@@ -572,6 +573,36 @@ TEST(OpenHeartbeat, AHeartbeatIsOpenedOnlySignedAsAHeartbeatNamingItsSignerAndOf
 }
 
 }  // namespace
+// Missed records are said, all of them (a rate limit that dropped a line would lose records
+// unreported after a broker failover, when gaps come in bursts), in at most one line a second.
+TEST(MissedRecords, EveryMissedRecordIsSaidTheFirstRangeAtOnceAndThoseOfTheSameSecondSummedInTheNextLine) {
+  constexpr std::int64_t kSecond = MissedRecords::kInterval;
+  MissedRecords m;
+  EXPECT_EQ(m.due_at(), std::numeric_limits<std::int64_t>::max()) << "nothing waits";
+  EXPECT_FALSE(m.take(0, "robot"));
+  m.add(Range{5, 10});
+  EXPECT_EQ(m.take(100, "robot"), "6 event record(s) of 'robot' missed (seq 5..10)") << "the first: at once";
+  m.add(Range{20, 22});
+  m.add(Range{23, 23});  // adjoins the range before it
+  m.add(Range{30, 30});
+  EXPECT_EQ(m.due_at(), 100 + kSecond);
+  EXPECT_FALSE(m.take(100 + kSecond - 1, "robot")) << "within the second of the last line: waits";
+  EXPECT_EQ(m.take(100 + kSecond, "robot"), "5 event record(s) of 'robot' missed (seq 20..23, 30)")
+      << "none left unsaid";
+  EXPECT_FALSE(m.take(100 + 5 * kSecond, "robot")) << "said once";
+}
+
+TEST(MissedRecords, ManyRangesAreCountedExactlyAndListedUpToALimitAndWhatWaitsIsSaidWhenTheReceiverStops) {
+  MissedRecords m;
+  m.add(Range{1, 1});
+  ASSERT_TRUE(m.take(0, "robot"));  // the first line: the next waits a second
+  for (std::int64_t i = 0; i < 20; ++i) m.add(Range{10 + 2 * i, 10 + 2 * i});
+  EXPECT_FALSE(m.take(1, "robot"));
+  const auto line = m.take(1, "robot", true);
+  ASSERT_TRUE(line) << "the receiver stops: what waits is said now";
+  EXPECT_EQ(*line, "20 event record(s) of 'robot' missed (seq 10, 12, 14, 16, 18, 20, 22, 24 and 12 more range(s))");
+}
+
 }  // namespace safecass::middleware
 
 namespace safecass::middleware {
@@ -602,6 +633,24 @@ TEST(DropLogTest, TheFirstLineAfterTheBudgetSaysHowManyLinesWereSuppressed) {
   ASSERT_EQ(lines.size(), DropLog::kLinesPerSecond + 1);
   EXPECT_NE(lines.back().find("(5 more line(s) of every source suppressed: at most 8 a second)"), std::string::npos)
       << lines.back();
+}
+
+TEST(DropLogTest, WhatTheLimitHeldBackIsSaidOnceItsSecondIsOverWhenNoLaterLineOfItsSourceSaidIt) {
+  std::vector<std::string> lines;
+  DropLog log([&](const std::string& line) { lines.push_back(line); });
+  const std::int64_t start =
+      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  constexpr std::int64_t kSecond = 1'000'000'000;
+  for (int i = 0; i < 4; ++i) log.drop("robot/records", "refused a record");
+  log.note("robot", "a note");
+  log.flush("supervisor", start);
+  ASSERT_EQ(lines.size(), 2u) << "within the second: held back still";
+  log.flush("supervisor", start + 2 * kSecond);
+  ASSERT_EQ(lines.size(), 3u);
+  EXPECT_EQ(lines.back(), "supervisor: lines held back by the rate limit and not said since: 3 from 'robot/records'");
+  log.flush("supervisor", start + 4 * kSecond);
+  EXPECT_EQ(lines.size(), 3u) << "said once";
+  EXPECT_EQ(log.count(), 4u);
 }
 
 }  // namespace
