@@ -569,9 +569,9 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   return report;
 }
 
-[[nodiscard]] Expected<std::vector<std::string>> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults,
-                                                              unsigned seed, std::size_t steps,
-                                                              const BusOptions& options) {
+[[nodiscard]] Expected<void> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults, unsigned runs,
+                                          std::size_t steps, const BusOptions& options,
+                                          const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each) {
   if (auto v = spin_version(options.spin); !v) return tl::unexpected(v.error());
   auto dir = WorkDir::create(options.work_dir);
   if (!dir) return tl::unexpected(dir.error());
@@ -580,7 +580,7 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   std::string model = bus_promela(pattern, faults, options);
   const std::string caps = "#define CAPS " + std::to_string(kStreamCap) + "\n";
   model.replace(model.find(caps), caps.size(), "#define CAPS 250\n#define CAPH 250\n");
-  return simulate_model(dir->path(), model, seed, steps, options.spin);
+  return simulate_model(dir->path(), model, 1, runs, steps, options.spin, options.cc, each);
 }
 
 }  // namespace safecass::verify

@@ -186,18 +186,26 @@ bool write_file(const std::string& path, const std::string& text) {
   return r;
 }
 
-[[nodiscard]] Expected<std::vector<std::string>> simulate_model(const std::string& dir, const std::string& model,
-                                                                unsigned seed, std::size_t steps,
-                                                                const std::string& spin) {
+[[nodiscard]] Expected<void> simulate_model(const std::string& dir, const std::string& model, unsigned first_seed,
+                                            unsigned runs, std::size_t steps, const std::string& spin,
+                                            const std::string& cc, const SimulationRun& each) {
   const std::string pml = "simulation.pml";
+  const std::string pre = "simulation.pre";
   if (!write_file(dir + "/" + pml, model)) return fail(ErrorCode::Io, "cannot write '" + dir + "/" + pml + "'");
-  auto r = run_command(
-      dir, shell_quote(spin) + " -n" + std::to_string(seed) + " -u" + std::to_string(steps) + " " + shell_quote(pml));
-  if (!r) return tl::unexpected(r.error());
-  if (r->output.find("error") != std::string::npos && r->output.find("@ ") == std::string::npos) {
-    return fail(ErrorCode::Io, "SPIN's simulation failed:\n" + r->output);
+  auto cpp = run_command(dir, shell_quote(cc) + " -std=gnu99 -E -x c " + shell_quote(pml) + " > " + shell_quote(pre));
+  if (!cpp) return tl::unexpected(cpp.error());
+  if (cpp->status != 0) return fail(ErrorCode::Io, "the C preprocessor failed on " + pml + ":\n" + cpp->output);
+  for (unsigned seed = first_seed; seed - first_seed < runs; ++seed) {
+    auto r = run_command(dir, shell_quote(spin) + " -Pcat -n" + std::to_string(seed) + " -u" + std::to_string(steps) +
+                                  " " + shell_quote(pre));
+    if (!r) return tl::unexpected(r.error());
+    if (r->output.find("error") != std::string::npos && r->output.find("@ ") == std::string::npos) {
+      return fail(ErrorCode::Io, "SPIN's simulation failed:\n" + r->output);
+    }
+    std::vector<std::string> lines = marked_lines(r->output, nullptr, nullptr);
+    if (!each(seed, lines)) break;
   }
-  return marked_lines(r->output, nullptr, nullptr);
+  return {};
 }
 
 }  // namespace safecass::verify

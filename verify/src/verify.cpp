@@ -695,13 +695,18 @@ void structural_properties(const spec::SystemSpec& system, const Model& model, R
   if (!dir) return tl::unexpected(dir.error());
   // SPIN counts statements, not model steps; it stops where it stops, and the last step may be
   // cut short: ask for more and keep the whole steps.
-  auto lines = simulate_model(dir->path(), write_promela(model, spec), seed,
-                              steps * (spec.addresses.size() + 3 * spec.classes.size() + 16), options.spin);
-  if (!lines) return tl::unexpected(lines.error());
+  std::vector<std::string> printed;
+  auto ran = simulate_model(dir->path(), write_promela(model, spec), seed, 1,
+                            steps * (spec.addresses.size() + 3 * spec.classes.size() + 16), options.spin, options.cc,
+                            [&](unsigned, std::vector<std::string>& lines) {
+                              printed = std::move(lines);
+                              return true;
+                            });
+  if (!ran) return tl::unexpected(ran.error());
   Simulation sim;
   for (const AddressInfo& a : model.addresses()) sim.addresses.push_back(a.address);
   const Coordinator& co = model.coordinator();
-  for (const std::string& line : *lines) {
+  for (const std::string& line : printed) {
     std::istringstream in(line);
     std::string kind;
     in >> kind;

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -123,11 +124,13 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
 /// cannot be run), NotFound (an unknown mutant or fault class), InvalidArgument (bus_patterns).
 [[nodiscard]] Expected<BusReport> verify_bus(const spec::SystemSpec& system, const BusOptions& options);
 
-/// SPIN's random simulation of `pattern` under `faults` for `steps` steps: the model's "@ ..."
-/// lines (inputs, decisions, ticks) with the absolute numbers of the messages (SIM). Errors: Io.
-[[nodiscard]] Expected<std::vector<std::string>> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults,
-                                                              unsigned seed, std::size_t steps,
-                                                              const BusOptions& options);
+/// SPIN's random simulations of `pattern` under `faults`, with seeds 1 to `runs`, each for
+/// `steps` steps: each run's "@ ..." lines (inputs, decisions, ticks) with the absolute numbers of
+/// the messages (SIM), given to `each` with its seed; `each` returns false to stop. The model is
+/// made and preprocessed once for all the runs. Errors: Io.
+[[nodiscard]] Expected<void> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults, unsigned runs,
+                                          std::size_t steps, const BusOptions& options,
+                                          const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each);
 
 std::string_view to_string(BusVerdict verdict) noexcept;
 
