@@ -233,7 +233,7 @@ struct Supervisor::Impl {
     }
   }
 
-  /// `gap` of `peer`'s records is missed (under `mutex`): the watch loop says so (say_missed).
+  /// `gap` of `peer`'s records is missed (under `mutex`): the watch loop says so (report_gaps).
   void report_missed(Peer& peer, const EventStream::Range& gap) {
     peer.missed.add(gap);
     peer.refresh = true;  // the missed records may have changed rows: read them again

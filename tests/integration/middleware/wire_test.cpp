@@ -1318,11 +1318,13 @@ TEST(Wire, ASupervisorSaysEveryRecordMissedEvenWhenGapsComeFasterThanItsLinesMay
   // Said in one line when both gaps fall within the second after the first line (the usual case),
   // in two otherwise; either way with their numbers.
   const std::string out = r.out.all();
-  EXPECT_TRUE(out.find("missed (seq 5..6, 8..9)") != std::string::npos ||
-              (out.find("missed (seq 5..6)") != std::string::npos && out.find("missed (seq 8..9)") != std::string::npos))
+  EXPECT_TRUE(
+      out.find("missed (seq 5..6, 8..9)") != std::string::npos ||
+      (out.find("missed (seq 5..6)") != std::string::npos && out.find("missed (seq 8..9)") != std::string::npos))
       << out;
   std::size_t shown = 0;  // wire-p's records printed: 1, 4, 7 and 10
-  for (auto at = out.find("[wire-p] P.s_A "); at != std::string::npos; at = out.find("[wire-p] P.s_A ", at + 1)) ++shown;
+  for (auto at = out.find("[wire-p] P.s_A "); at != std::string::npos; at = out.find("[wire-p] P.s_A ", at + 1))
+    ++shown;
   EXPECT_EQ(shown, 4u) << out;
 }
 

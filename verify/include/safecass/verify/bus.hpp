@@ -128,9 +128,9 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
 /// `steps` steps: each run's "@ ..." lines (inputs, decisions, ticks) with the absolute numbers of
 /// the messages (SIM), given to `each` with its seed; `each` returns false to stop. The model is
 /// made and preprocessed once for all the runs. Errors: Io.
-[[nodiscard]] Expected<void> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults, unsigned runs,
-                                          std::size_t steps, const BusOptions& options,
-                                          const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each);
+[[nodiscard]] Expected<void> simulate_bus(
+    const BusPattern& pattern, const BusFaultClass& faults, unsigned runs, std::size_t steps, const BusOptions& options,
+    const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each);
 
 std::string_view to_string(BusVerdict verdict) noexcept;
 
