@@ -569,9 +569,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   return report;
 }
 
-[[nodiscard]] Expected<void> simulate_bus(
-    const BusPattern& pattern, const BusFaultClass& faults, unsigned runs, std::size_t steps, const BusOptions& options,
-    const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each) {
+[[nodiscard]] Expected<void> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults, unsigned runs,
+                                          std::size_t steps, const BusOptions& options, const SimulationRun& each) {
   if (auto v = spin_version(options.spin); !v) return tl::unexpected(v.error());
   auto dir = WorkDir::create(options.work_dir);
   if (!dir) return tl::unexpected(dir.error());

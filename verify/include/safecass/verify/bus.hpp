@@ -15,13 +15,13 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <string>
 #include <vector>
 
 #include "safecass/core/expected.hpp"
 #include "safecass/core/state.hpp"
 #include "safecass/spec/system.hpp"
+#include "safecass/verify/command.hpp"
 
 namespace safecass::verify {
 
@@ -128,9 +128,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
 /// `steps` steps: each run's "@ ..." lines (inputs, decisions, ticks) with the absolute numbers of
 /// the messages (SIM), given to `each` with its seed; `each` returns false to stop. The model is
 /// made and preprocessed once for all the runs. Errors: Io.
-[[nodiscard]] Expected<void> simulate_bus(
-    const BusPattern& pattern, const BusFaultClass& faults, unsigned runs, std::size_t steps, const BusOptions& options,
-    const std::function<bool(unsigned seed, std::vector<std::string>& lines)>& each);
+[[nodiscard]] Expected<void> simulate_bus(const BusPattern& pattern, const BusFaultClass& faults, unsigned runs,
+                                          std::size_t steps, const BusOptions& options, const SimulationRun& each);
 
 std::string_view to_string(BusVerdict verdict) noexcept;
 

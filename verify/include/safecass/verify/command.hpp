@@ -3,8 +3,10 @@
 /// Running the external tools the analyses call (SPIN and the C compiler for `verify`, SCRAM for
 /// `analyze`): a shell command's output and status, and a working directory for their files.
 
+#include <functional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "safecass/core/expected.hpp"
 
@@ -18,6 +20,10 @@ struct CommandResult {
 
 /// Runs `command` with /bin/sh in `dir`. Errors: Io (cannot start it).
 [[nodiscard]] Expected<CommandResult> run_command(const std::string& dir, const std::string& command);
+
+/// What one of SPIN's random simulations printed, given with its seed: its "@ ..." lines (the
+/// callee may take them); returning false stops the runs (verify's and the bus model's simulations).
+using SimulationRun = std::function<bool(unsigned seed, std::vector<std::string>& lines)>;
 
 /// Single-quotes a word for /bin/sh.
 std::string shell_quote(const std::string& word);
