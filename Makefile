@@ -184,7 +184,9 @@ TSAN_CI_DIRS := tests/unit/core
 # invalid (the check probes memory through a pipe), so the descriptor-exhaustion test is not run there.
 # The random model's seeds 6-20 are left to `make test`: under ASan each seed takes about 2.7 s of
 # one core (54 s for the twenty), and seeds 1-5 run its paths under ASan.
-ASAN_CI_ARGS := -LE known-defect -E '^ViewerBacksOffWhenOutOfFileDescriptors$$'
+# The Ids tests compile a file and read the compiler's verdict: nothing of theirs runs under a
+# sanitizer, and `make test` runs them.
+ASAN_CI_ARGS := -LE known-defect -E '^(ViewerBacksOffWhenOutOfFileDescriptors|Ids\..*)$$'
 space := $(subst ,, )
 ASAN_CI_SEEDS := $(foreach n,6 7 8 9 1? 20,Seeds/RandomModelTest.*/Seed$(n))
 # The filter bank's differential test runs 400 random systems under ASan (2,000 in `make test`):
@@ -192,7 +194,7 @@ ASAN_CI_SEEDS := $(foreach n,6 7 8 9 1? 20,Seeds/RandomModelTest.*/Seed$(n))
 ASAN_CI_ENV := SAFECASS_BANK_SEEDS=400 GTEST_FILTER='-$(subst $(space),:,$(ASAN_CI_SEEDS))'
 # The random model runs one thread, where ThreadSanitizer has nothing to find (it reports races
 # between threads); it is most of the TSan subset's time, and runs in `make test` and under ASan.
-TSAN_CI_ARGS := -LE known-defect -E '^(middleware\.tls\..*|test_core_random)$$'
+TSAN_CI_ARGS := -LE known-defect -E '^(middleware\.tls\..*|test_core_random|Ids\..*)$$'
 TSAN_ENV = TSAN_OPTIONS="suppressions=$(CURDIR)/tests/tsan.supp $${TSAN_OPTIONS:-}"
 # $(call sanitize,PRESET,CI_DIRS,CI_ARGS,ENV): with SANITIZER_SUBSET=ci the CI_DIRS' targets are
 # built and their tests run by one ctest (a test file of the folders, ci-subset/, so that the

@@ -826,7 +826,9 @@ TEST(Wire, TheSupervisorBelievesOnlyAuthenticatedFreshMessagesAndPrintsEachOnOne
 struct SupervisorOutput {
   std::mutex mutex;
   std::string text;
-  std::size_t records = 0;  ///< Record lines of a coordinator (not of the supervisor's own model)
+  /// Record lines of a coordinator (not of the supervisor's own model). Read by the test's thread
+  /// while the supervisor's adds: atomic.
+  std::atomic<std::size_t> records = 0;
   void operator()(const middleware::SupervisorLine& line) {
     std::lock_guard lock(mutex);
     if (line.kind() == middleware::SupervisorLine::Kind::Record && !line.coordinator().empty()) ++records;
@@ -1340,8 +1342,11 @@ TEST(Wire, ASupervisorReportsTheFirstRecordsOfACoordinatorMissedWhenItsHeartbeat
 
   r.records.send({3});
   // Waits for wire-p's report: wire-c's own records may be reported missed first (sent before it
-  // proved itself alive to the supervisor).
-  ASSERT_TRUE(eventually([&] { return r.out.all().find("of 'wire-p' missed") != std::string::npos; })) << r.out.all();
+  // proved itself alive to the supervisor). The record is printed as it is taken, the gap by the
+  // supervisor's watch loop: in either order.
+  ASSERT_TRUE(eventually([&] {
+    return r.out.all().find("of 'wire-p' missed") != std::string::npos && r.out.records >= 1;
+  })) << r.out.all();
   EXPECT_NE(r.out.all().find("supervisor: 2 event record(s) of 'wire-p' missed (seq 1..2)"), std::string::npos)
       << r.out.all();
   EXPECT_EQ(r.out.records, 1u) << r.out.all();
@@ -1370,7 +1375,9 @@ TEST(Wire, ASupervisorRefusesATransitionRecordThatNamesNoMachineAndItChangesNoth
   EXPECT_FALSE(view_state(sup, "").has_value()) << r.out.all();
 
   r.records.send({1});
-  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error; })) << r.out.all();
+  // The supervisor shows a record in its view, then prints it: wait for both.
+  ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_A") == State::Error && r.out.records >= 1; }))
+      << r.out.all();
   EXPECT_EQ(r.out.records, 1u) << r.out.all();
   EXPECT_EQ(sup.messages_refused(), 2u) << r.out.all();
   // Nothing of wire-p's is missed (wire-c's start-up records may be, under load: not this test's).
