@@ -171,8 +171,8 @@ bench-verify: build
 
 # The sanitizer runs. Without SANITIZER_SUBSET: the whole tree is built and every test runs
 # (CTEST_ARGS). With SANITIZER_SUBSET=ci (what .ci/run uses): only the test folders named below
-# are built (their `<folder>/all` targets: the test programs and the libraries they link) and run,
-# folder by folder; docs/contributing.md, "Continuous integration", says which and why. No test of
+# are built (their `<folder>/all` targets: the test programs and the libraries they link) and run
+# by one ctest; docs/contributing.md, "Continuous integration", says which and why. No test of
 # these folders starts the `safecass` command; a folder whose tests do adds it to the targets.
 ASAN_CI_DIRS := tests/unit/core tests/unit/filters tests/unit/json tests/unit/spec tests/unit/record tests/unit/replay \
   tests/unit/dds
