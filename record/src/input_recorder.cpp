@@ -109,13 +109,19 @@ InputRecorder::~InputRecorder() { close(); }
 
 void InputRecorder::open_chunk_locked() {
   if (!chunk_.bytes.empty()) return;
-  // Every chunk can be read after any other: it restates the time, and marks what was dropped.
+  // A chunk restates the time only where a reader would miss it, so that the same run records the
+  // same bytes however its chunks fall: after dropped chunks (with their loss mark), and at the
+  // start of a new segment (its `resume`, written by the file when this chunk rotates it).
+  if (have_time_) {
+    chunk_.resume.clear();
+    input_log::put_time(chunk_.resume, last_time_);
+  }
   if (pending_dropped_ != 0) {
     input_log::put_loss(chunk_.bytes, last_time_, input_log::kAnySignal, pending_dropped_);
     chunk_.carried = pending_dropped_;
     pending_dropped_ = 0;
+    chunk_.bytes += chunk_.resume;
   }
-  if (have_time_) input_log::put_time(chunk_.bytes, last_time_);
 }
 
 void InputRecorder::seal_locked(bool last) {
@@ -214,7 +220,7 @@ void InputRecorder::writer() {
     std::uint64_t written = 0;
     std::uint64_t failed = 0;
     for (const Chunk& c : batch) {
-      if (file_->write(c.bytes)) {
+      if (file_->write(c.bytes, c.resume)) {
         written += c.samples;
       } else {
         failed += c.samples;

@@ -61,7 +61,7 @@ bool SegmentedFile::write_all(std::string_view data) {
   return true;
 }
 
-bool SegmentedFile::rotate() {
+bool SegmentedFile::rotate(std::string_view resume) {
   if (::close(fd_) != 0) {
     fd_ = -1;
     error_ = std::strerror(errno);
@@ -87,13 +87,13 @@ bool SegmentedFile::rotate() {
   }
   ++rotations_;
   segment_bytes_ = 0;
-  return preamble_.empty() || write_all(preamble_);
+  return write_all(preamble_) && write_all(resume);
 }
 
-bool SegmentedFile::write(std::string_view chunk) {
+bool SegmentedFile::write(std::string_view chunk, std::string_view resume) {
   if (fd_ < 0 || !error_.empty()) return false;
   if (options_.max_bytes != 0 && segment_bytes_ > preamble_.size() &&
-      segment_bytes_ + chunk.size() > options_.max_bytes && !rotate()) {
+      segment_bytes_ + chunk.size() > options_.max_bytes && !rotate(resume)) {
     return false;
   }
   return write_all(chunk);

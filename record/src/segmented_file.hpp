@@ -32,9 +32,10 @@ public:
 
   /// Bytes that start every segment after a rotation (the first one is written by the caller).
   void set_preamble(std::string preamble) { preamble_ = std::move(preamble); }
-  /// Writes `chunk` whole into one segment (rotating first when needed). False after an error;
-  /// error() says why.
-  bool write(std::string_view chunk);
+  /// Writes `chunk` whole into one segment (rotating first when needed; a new segment starts with
+  /// the preamble, then `resume`: the state a reader needs to read the chunk alone). False after an
+  /// error; error() says why.
+  bool write(std::string_view chunk, std::string_view resume = {});
   /// Closes the file; false if close() reported an error (kept in error()).
   bool close();
 
@@ -45,7 +46,7 @@ public:
   std::uint64_t discarded() const noexcept { return discarded_; }  ///< old segments deleted
 
 private:
-  bool rotate();
+  bool rotate(std::string_view resume);
   bool write_all(std::string_view data);
 
   int fd_ = -1;

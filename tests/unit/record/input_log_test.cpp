@@ -391,8 +391,10 @@ TEST_F(InputRecording, WithAByteLimitTheFileRotatesEachSegmentReadsAloneAndOldOn
   o.limits.keep = 2;
   auto rec = InputRecorder::open(monitor_, path, o);
   ASSERT_TRUE(rec);
+  // A hundred samples share each time, so that segments start between samples of one time: each
+  // restates it.
   for (int i = 0; i < 5000; ++i) {
-    x_->push(Time{i}, i);
+    x_->push(Time{i / 100}, i);
     if (i % 10 == 0) (*rec)->drain();
   }
   (*rec)->close(Time{5000});
@@ -416,6 +418,37 @@ TEST_F(InputRecording, WithAByteLimitTheFileRotatesEachSegmentReadsAloneAndOldOn
   struct stat st {};
   EXPECT_NE(::stat((path + ".3").c_str(), &st), 0) << "at most keep=2 old segments";
   EXPECT_THAT(read_all(path), HasSubstr("E 5e-06\n"));
+}
+
+/// One run of its own system (a recorder reads its signals' whole history): samples x and v at
+/// one time, recorded either drained together or with the writer writing between them.
+class OneRun final : public InputRecording {
+public:
+  void TestBody() override {}
+  std::string record(const std::string& path, bool write_between) {
+    auto rec = InputRecorder::open(monitor_, path);
+    EXPECT_TRUE(rec) << rec.error().message;
+    const double v[3] = {1, 2, 3};
+    x_->push(Time{7}, 1.0);
+    (*rec)->drain();
+    if (write_between) {
+      const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      while ((*rec)->status().samples == 0 && std::chrono::steady_clock::now() < deadline) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+      EXPECT_EQ((*rec)->status().samples, 1u) << "the writer wrote the first sample alone";
+    }
+    v_->push(Time{7}, v);
+    (*rec)->close(Time{8});
+    return slurp(path);
+  }
+};
+
+TEST_F(InputRecording, TheSameRunRecordsTheSameBytesWhereverTheWriterCutsItsChunks) {
+  // The writer writes on its own clock: where it cuts depends on the machine, not on the run.
+  const std::string together = OneRun().record(scratch("together.inputs"), false);
+  const std::string apart = OneRun().record(scratch("apart.inputs"), true);
+  EXPECT_EQ(apart, together) << "a chunk restates the time only where a reader needs it";
 }
 
 TEST_F(InputRecording, WhatWasDrainedIsOnTheDiskSoonWithoutClosing) {

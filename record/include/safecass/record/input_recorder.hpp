@@ -118,6 +118,7 @@ private:
     std::string bytes;
     std::uint64_t samples = 0;
     std::uint64_t carried = 0;  ///< the dropped samples its loss record marks
+    std::string resume;         ///< the time record a reader needs when the chunk starts a segment
   };
   InputRecorder(Monitor& monitor, std::unique_ptr<detail::SegmentedFile> file, InputRecorderOptions options);
   void drain_locked();
