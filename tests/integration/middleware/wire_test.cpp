@@ -369,6 +369,9 @@ struct Bus {
     std::lock_guard lock(mutex);
     for (const Update& u : updates) last_sent[u.iface] = std::max<std::int64_t>(last_sent[u.iface], u.wire.seq);
   }
+  /// Publishes `updates` sealed by `key` without advancing what wire-p's heartbeats list: what its
+  /// process never sent (its key misused, an older incarnation's), so its heartbeats never list it.
+  void send_unlisted(const Signer& key, const std::vector<Update>& updates) { state_pub->updates(sealed(key, updates)); }
   State state(const std::string& machine) { return co.state(*co.structure().find_machine(machine)); }
   std::string all_log() {
     std::lock_guard lock(mutex);
@@ -459,10 +462,11 @@ TEST(Wire, ForgedReplayedMisattributedAndFarFutureUpdatesAreRefusedAndChangeNoth
   bus.state_pub->updates(unsigned_message);
   // 5. A replay of wire-p's genuine first message.
   bus.send(*bus.provider, raise);
-  // 6. A genuine key, an older incarnation.
-  bus.send(*bus.provider, {update("P.D0", 100, "EVT_E", wire::Level::Error, kIncarnation - 1)});
+  // 6. A genuine key, an older incarnation. wire-p's heartbeats do not list 6 and 7: if they did,
+  // the node would rightly count the numbers they list as lost once the loss bound passed.
+  bus.send_unlisted(*bus.provider, {update("P.D0", 100, "EVT_E", wire::Level::Error, kIncarnation - 1)});
   // 7. A genuine key, a jump far into the future (a stream must not be frozen even by its owner).
-  bus.send(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "EVT_E", wire::Level::Error)});
+  bus.send_unlisted(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "EVT_E", wire::Level::Error)});
   // 8. A heartbeat kind sent on the state topic.
   wire::Heartbeat hb;
   hb.coordinator = "wire-p";
@@ -1707,24 +1711,33 @@ TEST(Wire, TheSupervisorBelievesAMemberOnlyAboutItsOwnComponentsAndWithinTheJump
   ASSERT_TRUE(eventually([&] { return view_state(sup, "P.s_S.D0") == State::Error; })) << out.all();
   const auto refused = sup.messages_refused();
 
-  auto ic = bus.ice.communicator();
-  // wire-c, on its own topic and signing as itself, about wire-p's component.
+  // Each attack is sent until the supervisor says it refused it: on a machine too busy to deliver
+  // heartbeats within the loss bound, the supervisor subscribes again, and a message published
+  // while it does is never delivered. (Its refusals of one source are said at most once a second.)
+  const auto refused_until_said = [&](const std::string& said, const std::function<void()>& send) {
+    return eventually([&] {
+      send();
+      return out.all().find(said) != std::string::npos;
+    });
+  };
+  // wire-c, on its own topic and signing as itself, about wire-p's component. wire-c provides no
+  // interface: an update of its own can name none of P's.
   auto own = Ice::uncheckedCast<wire::StateTopicPrx>(bus.topic("safecass.state.wire-c")->getPublisher()->ice_oneway());
-  own->updates(bus.sealed(*bus.other, {update("P.D0", 2, "", wire::Level::Normal)}, "wire-c"));
+  EXPECT_TRUE(refused_until_said("of 'wire-c' for stream 0, not one of its 0 state streams", [&] {
+    own->updates(bus.sealed(*bus.other, {update("P.D0", 2, "", wire::Level::Normal)}, "wire-c"));
+  })) << out.all();
   // wire-p itself, 2^21 ahead (sent raw: its heartbeats do not list it).
-  bus.state_pub->updates(
-      bus.sealed(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)}));
+  EXPECT_TRUE(refused_until_said("jumps more than 1048576 ahead", [&] {
+    bus.state_pub->updates(
+        bus.sealed(*bus.provider, {update("P.D0", 2 + (std::int64_t{1} << 21), "", wire::Level::Normal)}));
+  })) << out.all();
   // wire-p's key, an incarnation near 2^63: refused, it does not lock wire-p out.
-  bus.beat(*bus.provider, "wire-p", std::numeric_limits<std::int64_t>::max() - 1);
-  {
+  EXPECT_TRUE(refused_until_said("more than 60 s ahead of this host's clock", [&] {
+    bus.beat(*bus.provider, "wire-p", std::numeric_limits<std::int64_t>::max() - 1);
     std::lock_guard lock(bus.mutex);
     bus.newest = kIncarnation;  // that beat was a key holder's, not a restart: wire-p still proves its own
-  }
-  ASSERT_TRUE(eventually([&] { return sup.messages_refused() >= refused + 3; })) << out.all();
-  // wire-c provides no interface: an update of its own can name none of P's.
-  EXPECT_NE(out.all().find("of 'wire-c' for stream 0, not one of its 0 state streams"), std::string::npos) << out.all();
-  EXPECT_NE(out.all().find("jumps more than 1048576 ahead"), std::string::npos) << out.all();
-  EXPECT_NE(out.all().find("more than 60 s ahead of this host's clock"), std::string::npos) << out.all();
+  })) << out.all();
+  EXPECT_GE(sup.messages_refused(), refused + 3);
   EXPECT_TRUE(eventually([&] {
     return bus.all_log().find("more than 60 s ahead of this host's clock") != std::string::npos;
   })) << bus.all_log();
