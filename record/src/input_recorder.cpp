@@ -13,7 +13,7 @@ std::string plural(std::uint64_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
-constexpr std::size_t kMaxChunk = 256 * 1024;
+constexpr std::size_t kMaxChunk = std::size_t{256} * 1024;
 constexpr auto kFlushEvery = std::chrono::milliseconds(50);
 }  // namespace
 

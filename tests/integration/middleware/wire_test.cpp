@@ -371,7 +371,9 @@ struct Bus {
   }
   /// Publishes `updates` sealed by `key` without advancing what wire-p's heartbeats list: what its
   /// process never sent (its key misused, an older incarnation's), so its heartbeats never list it.
-  void send_unlisted(const Signer& key, const std::vector<Update>& updates) { state_pub->updates(sealed(key, updates)); }
+  void send_unlisted(const Signer& key, const std::vector<Update>& updates) {
+    state_pub->updates(sealed(key, updates));
+  }
   State state(const std::string& machine) { return co.state(*co.structure().find_machine(machine)); }
   std::string all_log() {
     std::lock_guard lock(mutex);
@@ -1816,6 +1818,7 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   std::atomic<bool> flooding{true};
   std::thread flood([&] {
     std::vector<std::shared_ptr<Ice::ObjectPrx>> pubs;
+    pubs.reserve(topics.size());
     for (const Topic& t : topics) pubs.push_back(bus.topic(t.name)->getPublisher()->ice_batchOneway());
     // Forged: an attacker's seal and signature under a hostile signer name.
     wire::Signed forged = bus.sealed(*bus.attacker, {update("P.D0", 99, "", wire::Level::Normal)});
@@ -2513,6 +2516,7 @@ TEST(Wire, AFollowerTakesEachRecordFromTheBatchAHeartbeatVouchesForAndReadsNoHis
         rounds.push_back(line.substr(at));
     }
     std::vector<std::string> want;
+    want.reserve(10);
     for (int k = 0; k < 10; ++k) want.push_back("round " + std::to_string(k));
     EXPECT_EQ(rounds, want) << "in order";
     EXPECT_TRUE(std::is_sorted(follower.seqs.begin(), follower.seqs.end()) &&
