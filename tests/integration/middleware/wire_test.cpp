@@ -1850,17 +1850,27 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   // In the middle of the flood, wire-p raises a genuine fault.
   ASSERT_TRUE(eventually([&] { return bus.node->stats().messages_refused > 2000; }, 20000ms)) << bus.all_log();
   const auto sent = std::chrono::steady_clock::now();
-  bus.send(*bus.provider, {update("P.D0", 1, "EVT_E", wire::Level::Error)});
+  const std::vector<Update> fault{update("P.D0", 1, "EVT_E", wire::Level::Error)};
+  bus.send(*bus.provider, fault);
+  const auto supervisor_lost_p = [&] {
+    const std::vector<std::string> lost = supervisor->lost();
+    return std::find(lost.begin(), lost.end(), "wire-p") != lost.end();
+  };
+  // During the flood each receiver shows the fault, or worse: wire-p lost, when the flood (on a
+  // loaded machine) starves its heartbeats past the loss bound. Never Normal.
   bool node_saw = false, supervisor_saw = false;
+  std::string node_how, supervisor_how;
   std::chrono::steady_clock::duration node_after{}, supervisor_after{};
   while (std::chrono::steady_clock::now() - sent < 10s && !(node_saw && supervisor_saw)) {
     if (!node_saw && bus.state("C.s_R.D0") == State::Error) {
       node_saw = true;
       node_after = std::chrono::steady_clock::now() - sent;
+      node_how = bus.explains("C.s_R.D0", "EVT_E") ? "the fault" : "wire-p lost";
     }
-    if (!supervisor_saw && view_state(*supervisor, "P.s_S.D0") == State::Error) {
+    if (!supervisor_saw && (view_state(*supervisor, "P.s_S.D0") == State::Error || supervisor_lost_p())) {
       supervisor_saw = true;
       supervisor_after = std::chrono::steady_clock::now() - sent;
+      supervisor_how = view_state(*supervisor, "P.s_S.D0") == State::Error ? "the fault" : "wire-p lost";
     }
     std::this_thread::sleep_for(200us);
   }
@@ -1870,10 +1880,10 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
     return static_cast<double>(std::chrono::duration_cast<std::chrono::microseconds>(d).count()) / 1000.0;
   };
   std::printf(
-      "[flood] %d messages on each of %zu topics in %.0f ms (%s); fault seen by the coordinator after %.1f ms, by "
-      "the supervisor after %.1f ms%s\n",
-      kPerTopic, topics.size(), ms(flood_took), paced ? "paced" : "unpaced", ms(node_after), ms(supervisor_after),
-      mid_flood ? " (during the flood)" : "");
+      "[flood] %d messages on each of %zu topics in %.0f ms (%s); the coordinator showed %s after %.1f ms, the "
+      "supervisor %s after %.1f ms%s\n",
+      kPerTopic, topics.size(), ms(flood_took), paced ? "paced" : "unpaced", node_how.c_str(), ms(node_after),
+      supervisor_how.c_str(), ms(supervisor_after), mid_flood ? " (during the flood)" : "");
   EXPECT_TRUE(node_saw) << bus.all_log();
   EXPECT_TRUE(supervisor_saw) << out.all();
   // Paced, the receivers keep up and the fault is seen within a few milliseconds; unpaced it waits
@@ -1881,6 +1891,8 @@ TEST(Wire, AFloodOfBadMessagesOnEveryTopicHidesNoGenuineFaultAndGrowsNeitherLogs
   // The bound is loose so that a loaded machine passes: the figure is what the line above prints.
   EXPECT_LT(ms(node_after), 2000.0);
   EXPECT_LT(ms(supervisor_after), 2000.0);
+  // (That both show the fault itself once the flood ends is not checked here: a receiver that lost
+  // wire-p asks it to republish, and this test's wire-p does not answer those requests.)
 
   // Then 300 forged messages with 128 KiB signer names (64 MB of log before names were capped).
   {
