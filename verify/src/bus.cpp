@@ -501,6 +501,10 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
       case PanResult::Outcome::Violated: {
         search.verdict = BusVerdict::Violated;
         search.property = violated_property(r->output);
+        if (!options.shortest_trail) {
+          search.trace = trace_text(r->trail, options);
+          break;
+        }
         PanOptions bfs = pan;
         bfs.shortest = true;
         auto shortest = compile(sub, "bus", model, bfs);

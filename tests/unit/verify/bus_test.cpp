@@ -81,11 +81,15 @@ TEST(BusVerify, ASecondDeploymentWithTwoStreamsBetweenCoordinatorsMeetsP1ToP5) {
 }
 
 /// The mutation table of docs/verify.md: each mutant, the fault class that exposes it and the
-/// property that catches it.
+/// property that catches it. The searches stop at the depth-first search's violation, in about a
+/// fifth of the time: the breadth-first search again for a shortest trail (`--mutants`) is
+/// checked by one row, whose shortest trail breaks another property first (P5) than its
+/// depth-first one (P3), as the table says.
 struct MutantCase {
   const char* mutant;
   const char* fault_class;
   const char* property;
+  bool shortest = false;
 };
 
 class BusMutants : public ::testing::TestWithParam<MutantCase> {};
@@ -96,6 +100,7 @@ TEST_P(BusMutants, EachWeakenedRuleIsCaughtByAPropertyWithATraceOfBusMessages) {
   options.supervisor = false;
   options.mutant = c.mutant;
   options.fault_class = c.fault_class;
+  options.shortest_trail = c.shortest;
   auto r = verify_bus(load_bus("examples/robodoc/robodoc.json"), options);
   ASSERT_TRUE(r) << r.error().message;
   EXPECT_EQ(r->exit_code(), 1);
@@ -112,8 +117,9 @@ TEST_P(BusMutants, EachWeakenedRuleIsCaughtByAPropertyWithATraceOfBusMessages) {
 
 INSTANTIATE_TEST_SUITE_P(
     Table, BusMutants,
-    ::testing::Values(MutantCase{"unproven-heartbeat", "restarts", "P2"}, MutantCase{"no-catch-up", "restarts", "P5"},
-                      MutantCase{"no-jump-limit", "members", "P3"}, MutantCase{"no-incarnation-bound", "members", "P5"},
+    ::testing::Values(MutantCase{"unproven-heartbeat", "restarts", "P2"},
+                      MutantCase{"no-catch-up", "restarts", "P5", true}, MutantCase{"no-jump-limit", "members", "P3"},
+                      MutantCase{"no-incarnation-bound", "members", "P5"},
                       MutantCase{"no-resubscribe", "unsubscribed", "P5"}, MutantCase{"no-ownership", "members", "P4"},
                       MutantCase{"no-reproof", "restarts", "P2"}, MutantCase{"arrival-time", "cut", "P1"},
                       MutantCase{"no-settle-hold", "settle", "P5"}),

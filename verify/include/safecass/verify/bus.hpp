@@ -37,6 +37,9 @@ struct BusOptions {
   std::string spin = "spin";
   std::string cc = "cc";
   std::string work_dir;  ///< where SPIN's files go (default: a fresh temporary directory, removed)
+  /// A violation is searched again breadth-first, for a shortest trail and the property it breaks
+  /// first; false keeps the depth-first search's trail, found in a fraction of the time.
+  bool shortest_trail = true;
 };
 
 /// The model's scale for a provider settling its own losses (docs/verify.md "The bus"), in ticks of
