@@ -230,6 +230,28 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
   return out;
 }
 
+/// A violation the depth-first search found: its property and trace, taken from the breadth-first
+/// search of the same model (a shortest trail, and the property it breaks first) unless the
+/// options keep the first search's.
+[[nodiscard]] Expected<void> tell_violation(BusSearch& search, const PanResult& found, const std::string& dir,
+                                            const std::string& model, const PanOptions& pan,
+                                            const BusOptions& options) {
+  const PanResult* use = &found;
+  std::optional<PanResult> again;
+  if (options.shortest_trail) {
+    PanOptions bfs = pan;
+    bfs.shortest = true;
+    auto shortest = compile(dir, "bus", model, bfs);
+    if (!shortest) return tl::unexpected(shortest.error());
+    auto r = check_claim(dir, "bus", *shortest, {}, bfs);
+    if (!r) return tl::unexpected(r.error());
+    if (r->outcome == PanResult::Outcome::Violated) use = &again.emplace(std::move(*r));
+  }
+  search.property = violated_property(use->output);
+  search.trace = trace_text(use->trail, options);
+  return {};
+}
+
 }  // namespace
 
 std::string BusPattern::name() const {
@@ -393,8 +415,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   def("HB", kTicksPerPeriod);
   def("B", pattern.bound_ticks);
   def("D", 1);
-  def("RS", kResyncPeriods * kTicksPerPeriod);
-  def("RESUB", kResubscribePeriods * kTicksPerPeriod);
+  def("RS", long{kResyncPeriods} * kTicksPerPeriod);
+  def("RESUB", long{kResubscribePeriods} * kTicksPerPeriod);
   def("QT", proof_ticks(options.period));
   def("CAPS", kStreamCap);
   def("K", calm_periods(pattern));
@@ -500,20 +522,8 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
       case PanResult::Outcome::Holds: search.verdict = BusVerdict::Holds; break;
       case PanResult::Outcome::Violated: {
         search.verdict = BusVerdict::Violated;
-        search.property = violated_property(r->output);
-        if (!options.shortest_trail) {
-          search.trace = trace_text(r->trail, options);
-          break;
-        }
-        PanOptions bfs = pan;
-        bfs.shortest = true;
-        auto shortest = compile(sub, "bus", model, bfs);
-        if (!shortest) return tl::unexpected(shortest.error());
-        auto again = check_claim(sub, "bus", *shortest, {}, bfs);
-        if (!again) return tl::unexpected(again.error());
-        const PanResult& use = again->outcome == PanResult::Outcome::Violated ? *again : *r;
-        search.property = violated_property(use.output);
-        search.trace = trace_text(use.trail, options);
+        if (auto told = tell_violation(search, *r, sub, model, pan, options); !told)
+          return tl::unexpected(told.error());
         break;
       }
       case PanResult::Outcome::MemoryLimit:
