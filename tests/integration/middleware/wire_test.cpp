@@ -1628,7 +1628,8 @@ TEST(Wire, AStateStreamItsHeartbeatsShowAheadAndNotCaughtUpWithinTheBoundCountsA
       },
       3000ms))
       << bus.all_log();
-  EXPECT_EQ(bus.state("C.s_R.D1"), State::Error) << bus.all_log();
+  // The loss is said under the node's peer lock and written to the coordinator just after it.
+  EXPECT_TRUE(eventually([&] { return bus.state("C.s_R.D1") == State::Error; }, 1000ms)) << bus.all_log();
   EXPECT_TRUE(bus.explains("C.s_R.D1", "EVT_COORDINATOR_LOST"));
   // Back on a new proof of life (verify --bus, P2), which lists seq 1 as sent: the client asks for
   // a republish, and wire-p republishes (seq 2, 3, ... once a period, as a coordinator answers the
