@@ -236,19 +236,21 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
 [[nodiscard]] Expected<void> tell_violation(BusSearch& search, const PanResult& found, const std::string& dir,
                                             const std::string& model, const PanOptions& pan,
                                             const BusOptions& options) {
-  const PanResult* use = &found;
-  std::optional<PanResult> again;
-  if (options.shortest_trail) {
-    PanOptions bfs = pan;
-    bfs.shortest = true;
-    auto shortest = compile(dir, "bus", model, bfs);
-    if (!shortest) return tl::unexpected(shortest.error());
-    auto r = check_claim(dir, "bus", *shortest, {}, bfs);
-    if (!r) return tl::unexpected(r.error());
-    if (r->outcome == PanResult::Outcome::Violated) use = &again.emplace(std::move(*r));
+  const auto tell = [&](const PanResult& r) {
+    search.property = violated_property(r.output);
+    search.trace = trace_text(r.trail, options);
+  };
+  if (!options.shortest_trail) {
+    tell(found);
+    return {};
   }
-  search.property = violated_property(use->output);
-  search.trace = trace_text(use->trail, options);
+  PanOptions bfs = pan;
+  bfs.shortest = true;
+  auto shortest = compile(dir, "bus", model, bfs);
+  if (!shortest) return tl::unexpected(shortest.error());
+  auto again = check_claim(dir, "bus", *shortest, {}, bfs);
+  if (!again) return tl::unexpected(again.error());
+  tell(again->outcome == PanResult::Outcome::Violated ? *again : found);
   return {};
 }
 

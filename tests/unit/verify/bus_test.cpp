@@ -82,9 +82,9 @@ TEST(BusVerify, ASecondDeploymentWithTwoStreamsBetweenCoordinatorsMeetsP1ToP5) {
 
 /// The mutation table of docs/verify.md: each mutant, the fault class that exposes it and the
 /// property that catches it. The searches stop at the depth-first search's violation, in about a
-/// fifth of the time: the breadth-first search again for a shortest trail (`--mutants`) is
-/// checked by one row, whose shortest trail breaks another property first (P5) than its
-/// depth-first one (P3), as the table says.
+/// fifth of the time. One row also takes the breadth-first search for a shortest trail, as
+/// `--mutants` does: its shortest trail breaks P5, where its depth-first one breaks P3, as the
+/// table says.
 struct MutantCase {
   const char* mutant;
   const char* fault_class;
