@@ -28,10 +28,13 @@ std::shared_ptr<Ice::ObjectPrx> BusLink::publisher(std::size_t topic) const {
   return topic < publishers_.size() ? publishers_[topic] : nullptr;
 }
 
-void BusLink::renew(const std::vector<std::string>& topics) {
+void BusLink::renew(const std::vector<std::string>& topics, bool quiet) {
   std::lock_guard lock(renew_mutex_);
   for (const std::string& t : topics) {
     if (std::find(renew_.begin(), renew_.end(), t) == renew_.end()) renew_.push_back(t);
+    const auto q = std::find(quiet_.begin(), quiet_.end(), t);
+    if (quiet && q == quiet_.end()) quiet_.push_back(t);
+    if (!quiet && q != quiet_.end()) quiet_.erase(q);  // said after all
   }
 }
 
@@ -51,6 +54,17 @@ bool SentHeartbeats::holds(const wire::Signed& m) const {
   });
 }
 
+std::vector<std::string> BusLink::loud(std::vector<std::string> made) {
+  std::lock_guard lock(renew_mutex_);
+  std::erase_if(made, [&](const std::string& t) {
+    const auto q = std::find(quiet_.begin(), quiet_.end(), t);
+    if (q == quiet_.end()) return false;
+    quiet_.erase(q);
+    return true;
+  });
+  return made;
+}
+
 bool BusLink::heard_own(const wire::Signed& m) {
   if (!sent_.holds(m)) return false;
   own_heartbeat_heard();
@@ -64,6 +78,11 @@ void BusLink::sleep_for(std::chrono::milliseconds d) {
 bool BusLink::connect() {
   try {
     link_.connect(options_.publish_on);
+    {
+      std::lock_guard lock(renew_mutex_);  // every subscription is under a new identity now
+      renew_.clear();
+      quiet_.clear();
+    }
     {
       std::lock_guard lock(publishers_mutex_);
       publishers_.clear();
@@ -118,7 +137,7 @@ void BusLink::loop() {
         renew.swap(renew_);
       }
       for (const std::string& t : renew) link_.renew(t);
-      if (const std::vector<std::string> made = link_.check(echo_late); !made.empty()) {
+      if (const std::vector<std::string> made = loud(link_.check(echo_late)); !made.empty()) {
         // What arrived on those topics meanwhile is lost: every provider republishes its state.
         options_.log(options_.who + ": " + resubscribed_line(made));
         resubscriptions_.fetch_add(made.size());

@@ -78,8 +78,12 @@ public:
   /// The oneway publisher on `publish_on[topic]`; nullptr until connected. Any thread.
   [[nodiscard]] std::shared_ptr<Ice::ObjectPrx> publisher(std::size_t topic) const;
   /// A stream of `topics` was lost while its heartbeats came (any thread): the link thread
-  /// subscribes to them again under new identities (Link::renew) at its next period.
-  void renew(const std::vector<std::string>& topics);
+  /// subscribes to them again under new identities (Link::renew) at its next period. Said in the
+  /// log once made, and every provider is asked to republish (BusLinkOptions::rejoined). `quiet`:
+  /// a renewal repeated while a peer stays lost (Liveness::renew_due), which its owner says once
+  /// per loss: neither said nor followed by a republish of every provider (the owner asks the
+  /// lost peer once its heartbeats are believed again, as after any loss).
+  void renew(const std::vector<std::string>& topics, bool quiet = false);
   /// Sending on the link failed (another thread): the link thread reconnects and resynchronises.
   void reconnect() noexcept { connected_.store(false); }
   /// Whether `m` is, byte for byte, one of the last heartbeats this link sent (SentHeartbeats; its
@@ -103,12 +107,15 @@ private:
   bool connect();
   /// Until `d` has passed or stop().
   void sleep_for(std::chrono::milliseconds d);
+  /// Of the subscriptions Link::check() made again, those that are not quiet renewals (renew()).
+  std::vector<std::string> loud(std::vector<std::string> made);
 
   std::string where_;  ///< IceStorm's endpoint, as said in the log
   BusLinkOptions options_;
   Link link_;  ///< link thread only
   std::mutex renew_mutex_;
   std::vector<std::string> renew_;  ///< topics to subscribe to again (renew())
+  std::vector<std::string> quiet_;  ///< of those, the ones renewed quietly and not yet made (renew_mutex_)
   mutable std::mutex publishers_mutex_;
   std::vector<std::shared_ptr<Ice::ObjectPrx>> publishers_;
   std::atomic<bool> running_{false};

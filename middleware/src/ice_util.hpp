@@ -54,6 +54,11 @@ inline bool tools_hear(std::string_view topic) {
 /// fails toward safe without it (a silent heartbeat or a stream behind counts as lost within the
 /// loss bound); the check only bounds how long until the view recovers.
 inline constexpr std::uint64_t kResubscribeCheckEvery = 10;
+/// How long a subscription round takes with heartbeats every `period`: also how often a receiver
+/// subscribes again, under new identities, to a peer it still holds lost (Liveness::renew_due).
+constexpr std::chrono::nanoseconds subscription_round(std::chrono::milliseconds period) noexcept {
+  return period * static_cast<std::int64_t>(kResubscribeCheckEvery);
+}
 /// The log line (without the process's prefix) for subscriptions Link::check made again.
 std::string resubscribed_line(const std::vector<std::string>& topics);
 

@@ -1001,7 +1001,7 @@ struct CoordinatorNode::Impl {
         if (!shape.is_remote(c)) co.generate(framework_event::kSupervisorLost, shape.framework_machine(c));
       }
       // As for a provider: its heartbeats may only have stopped reaching us (an identity taken).
-      link->renew({heartbeat_topic(kSupervisorSigner)});
+      link->renew(topics_of(who));
       return;
     }
     providers_lost.fetch_add(1);
@@ -1010,8 +1010,26 @@ struct CoordinatorNode::Impl {
         std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
     // Its heartbeats or its state may have stopped reaching us only: subscriptions taken by
     // another endpoint under our identities. New identities bring them back if it is alive.
-    link->renew({state_topic(who), heartbeat_topic(who)});
+    link->renew(topics_of(who));
     for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
+  }
+
+  /// The topics on which a peer's messages reach us: what a loss subscribes to again.
+  static std::vector<std::string> topics_of(const std::string& who) {
+    if (who == kSupervisorSigner) return {heartbeat_topic(kSupervisorSigner)};
+    return {state_topic(who), heartbeat_topic(who)};
+  }
+
+  /// A peer still lost a subscription round after its loss began (or this node started) or after
+  /// the last renewal: its subscriptions may be held by a member under our identities since before
+  /// (a newcomer's loss begins with no renewal), so they are made again under new ones, each round
+  /// while it lasts (Liveness::renew_due; said once per loss). Under peer_mutex.
+  void renew_lost(const std::string& who, std::uint32_t renewal) {
+    if (renewal == 1)
+      log("middleware: " + name + ": " + (who == kSupervisorSigner ? "the supervisor" : "coordinator '" + who + "'") +
+          " still lost a subscription round on; subscribing to its topics again under new identities, each round "
+          "until it is back");
+    link->renew(topics_of(who), true);
   }
 
   /// A newcomer starts toward safe (DESIGN §7): until a provider is proven alive and its state is
@@ -1021,7 +1039,7 @@ struct CoordinatorNode::Impl {
     std::lock_guard lock(peer_mutex);
     for (auto& [who, peer] : peers) {
       if (!peer.provider || peer.live.lost()) continue;
-      peer.live.start_lost();
+      peer.live.start_lost(steady_ns());
       log("middleware: " + name + ": coordinator '" + who + "' not proven alive yet (this node just started); " +
           "EVT_COORDINATOR_LOST on the " + std::to_string(peer.feeds.size()) +
           " required interface(s) it feeds until it is and its state is received");
@@ -1051,6 +1069,7 @@ struct CoordinatorNode::Impl {
   /// (Liveness::due), one loss bound at most, so a loss is said as soon as it is one.
   void watch_loop() {
     const std::chrono::milliseconds bound = lost_after();
+    const std::chrono::nanoseconds round = subscription_round(options.heartbeat);
     for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
       next = now + std::chrono::nanoseconds(bound).count();
@@ -1063,8 +1082,10 @@ struct CoordinatorNode::Impl {
         if (!watched) continue;
         if (const std::string why = peer.live.check(now, started, bound, "this node started"); !why.empty()) {
           declare_lost(who, peer, why);
+        } else if (const std::uint32_t renewal = peer.live.renew_due(now, round); renewal != 0) {
+          renew_lost(who, renewal);
         }
-        next = std::min(next, peer.live.due(started, bound));
+        next = std::min(next, peer.live.due(started, bound, round));
       }
     }
   }

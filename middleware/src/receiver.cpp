@@ -118,11 +118,15 @@ std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::c
   const std::int64_t last = last_beat_ != 0 ? last_beat_ : watched_since;
   if (last != 0 && now - last > bound_ns) {
     lost_ = true;
+    renewed_at_ = now;
+    renewals_ = 0;
     return "no heartbeat for " + bound_text() +
            (last_beat_ != 0 ? std::string() : " (never proven alive since " + std::string(since) + ")");
   }
   if (behind_since_ != 0 && now - behind_since_ > bound_ns) {
     lost_ = true;
+    renewed_at_ = now;
+    renewals_ = 0;
     const std::string_view stream = behind_;
     const std::string what = stream.starts_with(kStateStreamPrefix)
                                  ? "state of " + printable(stream.substr(kStateStreamPrefix.size()))
@@ -132,9 +136,16 @@ std::string Liveness::check(std::int64_t now, std::int64_t watched_since, std::c
   return {};
 }
 
-std::int64_t Liveness::due(std::int64_t watched_since, std::chrono::milliseconds bound) const noexcept {
+std::uint32_t Liveness::renew_due(std::int64_t now, std::chrono::nanoseconds round) noexcept {
+  if (!lost_ || now - renewed_at_ < round.count()) return 0;
+  renewed_at_ = now;
+  return ++renewals_;
+}
+
+std::int64_t Liveness::due(std::int64_t watched_since, std::chrono::milliseconds bound,
+                           std::chrono::nanoseconds round) const noexcept {
   constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
-  if (lost_) return kNever;
+  if (lost_) return renewed_at_ + round.count();
   // check() finds a loss once more than the bound has passed: one nanosecond after it.
   const std::int64_t after = std::chrono::nanoseconds(bound).count() + 1;
   const std::int64_t last = last_beat_ != 0 ? last_beat_ : watched_since;

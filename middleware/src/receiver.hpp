@@ -270,16 +270,30 @@ public:
   /// `bound` the loss bound; `since` says what started the watch ("the supervisor connected").
   std::string check(std::int64_t now, std::int64_t watched_since, std::chrono::milliseconds bound,
                     std::string_view since);
-  /// The earliest time (steady ns) at which check() can find the peer lost if nothing comes
-  /// meanwhile; INT64_MAX when it cannot (lost already, or not watched yet). What comes only moves
-  /// it later, and what starts a new duty (a first heartbeat, a stream behind, the watch's start)
-  /// makes one at least `bound` after it: the owner's watch sleeps until the earliest due of its
-  /// peers, `bound` at most, instead of polling.
-  std::int64_t due(std::int64_t watched_since, std::chrono::milliseconds bound) const noexcept;
+  /// Called by the owner's watch at `now` after check(): nonzero when the peer has been lost for a
+  /// subscription round (`round`) since its loss began, or since this last said so (which renewal
+  /// of this loss it is: 1 for the first, which the owner says in its log); the owner
+  /// then subscribes to the peer's topics again under new identities (Link::renew). A loss renews
+  /// them as it begins; a peer still lost a round later may be one whose subscriptions a member
+  /// took before the loss began (a newcomer has no loss to begin: start_lost()) or after, and
+  /// IceStorm's subscription round cannot tell: it holds them, for the member (verify --bus,
+  /// class `unsubscribed`).
+  std::uint32_t renew_due(std::int64_t now, std::chrono::nanoseconds round) noexcept;
+  /// The earliest time (steady ns) at which check() can find the peer lost, or, while it is lost,
+  /// renew_due() says so, if nothing comes meanwhile; INT64_MAX when neither can (not watched
+  /// yet). What comes only moves it later, and what starts a new duty (a first heartbeat, a stream
+  /// behind, the watch's start) makes one at least `bound` after it: the owner's watch sleeps until
+  /// the earliest due of its peers, `bound` at most, instead of polling.
+  std::int64_t due(std::int64_t watched_since, std::chrono::milliseconds bound,
+                   std::chrono::nanoseconds round) const noexcept;
   bool lost() const noexcept { return lost_; }
-  /// Starts the peer lost (a newcomer starts toward safe): back once a heartbeat is believed
-  /// with every stream caught up, as after a loss.
-  void start_lost() noexcept { lost_ = true; }
+  /// Starts the peer lost at `now` (a newcomer starts toward safe): back once a heartbeat is
+  /// believed with every stream caught up, as after a loss.
+  void start_lost(std::int64_t now) noexcept {
+    lost_ = true;
+    renewed_at_ = now;
+    renewals_ = 0;
+  }
   /// When the newest heartbeat believed was sent (0: never).
   std::int64_t last_beat() const noexcept { return last_beat_; }
 
@@ -287,6 +301,8 @@ private:
   std::int64_t last_beat_ = 0;
   std::int64_t behind_since_ = 0;    ///< since when its heartbeats show `behind_` ahead (0: caught up)
   std::int64_t settling_since_ = 0;  ///< lost, and kept lost since then because it was settling (0: not)
+  std::int64_t renewed_at_ = 0;      ///< lost: when the loss began, or renew_due() last said so
+  std::uint32_t renewals_ = 0;       ///< lost: how often renew_due() said so since the loss began
   std::chrono::milliseconds settle_limit_ = kSettleLimit;
   std::string behind_;
   bool lost_ = false;

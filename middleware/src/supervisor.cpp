@@ -568,7 +568,7 @@ struct Supervisor::Impl {
       std::lock_guard lock(mutex);
       for (auto& [name, peer] : peers) {
         if (peer.live.lost() || peer.live.last_beat() != 0) continue;
-        peer.live.start_lost();
+        peer.live.start_lost(steady_ns());
         unproven.emplace_back(name, peer.components);
       }
     }
@@ -684,6 +684,7 @@ struct Supervisor::Impl {
     const std::int64_t cap =
         std::chrono::nanoseconds(std::min<std::chrono::milliseconds>(options.lost_after, kReorderGrace)).count();
     const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
+    const std::chrono::nanoseconds round = subscription_round(kHeartbeatPeriod);
     for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
       next = now + cap;
@@ -699,6 +700,7 @@ struct Supervisor::Impl {
         std::string why;
       };
       std::vector<Lost> lost_now;
+      std::vector<std::pair<std::string, std::uint32_t>> renew_now;
       {
         std::lock_guard lock(mutex);
         for (auto& [name, peer] : peers) {
@@ -707,8 +709,10 @@ struct Supervisor::Impl {
             peer.fresh.doubt();           // back only on a new proof of life, never on a recording of it
             peer.records_listed.reset();  // what it sent while out of reach is not known yet
             lost_now.push_back(Lost{name, peer.components, std::move(why)});
+          } else if (const std::uint32_t renewal = peer.live.renew_due(now, round); renewal != 0) {
+            renew_now.emplace_back(name, renewal);
           }
-          next = std::min(next, peer.live.due(since, options.lost_after));
+          next = std::min(next, peer.live.due(since, options.lost_after, round));
           next = std::min(next, peer.records.overdue_at(grace));
           next = std::min(next, peer.missed.due_at());
         }
@@ -719,6 +723,15 @@ struct Supervisor::Impl {
         // another endpoint under its identities): new identities bring them back if it is alive.
         link->renew({state_topic(name), heartbeat_topic(name)});
         for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
+      }
+      // Still lost a round on: its subscriptions may have been taken before the loss began (the
+      // supervisor's start begins none) or since; new identities again, each round while it lasts.
+      for (const auto& [name, renewal] : renew_now) {
+        if (renewal == 1)
+          print("supervisor: coordinator '" + name +
+                "' still lost a subscription round on; subscribing to its topics again under new identities, each "
+                "round until it is back");
+        link->renew({state_topic(name), heartbeat_topic(name)}, true);
       }
     }
     report_gaps(steady_ns(), true);  // stopping: the records missed that wait for their line are said now

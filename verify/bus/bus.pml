@@ -53,6 +53,8 @@ byte p_hon = NONE;     /* age of its last republish for a request */
 bool cut = false;      /* P cut off: what it sends, and questions to it, are lost */
 bool sub_hb = true;    /* R's subscription to P's heartbeat topic */
 bool sub_st = true;    /* R's subscription to P's state topic */
+bool taken = false;    /* the subscription gone is held by a member under R's identity: IceStorm still
+                          holds it, so R's subscription round does not make it again */
 byte down = 0;         /* ghost, P1: ticks since P last reached R: alive, not cut off, R subscribed to its
                           heartbeats; or answering R's question; or a member relayed one of its live
                           process's heartbeats to R (sent `age` ago) */
@@ -74,7 +76,9 @@ byte b_rrestart = B_RRESTART; byte b_drop = B_DROP; byte b_settle = B_SETTLE;
 
 /* ---- the receiver R ---- */
 byte r_age = 0;        /* ticks since it started */
-byte sub_gone = NONE;  /* ticks since IceStorm stopped holding a subscription of R (NONE: holds both) */
+byte sub_gone = NONE;  /* ticks since a subscription of R is gone and R's repair of it is due: IceStorm's
+                          round for one it no longer holds; for one a member took, the renewal while
+                          R holds P lost (NONE: holds both, or a taken one while P is not lost) */
 /* PeerFreshness */
 byte r_inc = 0;        /* the proven incarnation (0: none) */
 bool r_doubt = false;  /* lost since it was proven: believed again only on a new proof */
@@ -264,7 +268,7 @@ inline watch() {
      ((l_beat == NONE && r_age > B) || (l_beat != NONE && l_beat > B) || (l_behind != NONE && l_behind > B)) ->
      lost = true; l_hold = NONE; g_proof = false; g_seen = 0; flips_any++; printf("@ lost\n");
 #ifndef M_NORESUB
-     sub_hb = true; sub_st = true; sub_gone = NONE;  /* subscribed again under new identities */
+     sub_hb = true; sub_st = true; taken = false; sub_gone = NONE;  /* subscribed again under new identities */
 #endif
      if
      :: FORGET -> r_inc = 0
@@ -334,7 +338,8 @@ inline r_restart() {  /* a newcomer: knows nothing, starts toward safe */
   r_age = 0; sub_gone = NONE; r_inc = 0; r_doubt = false; r_hb = NONE; r_hbp = false; r_rtt = 0;
   l_beat = NONE; l_behind = NONE; lost = WATCH_START; l_hold = NONE; g_proof = false;
   for (s : 0 .. 1) { r_last[s] = NONE; r_lastp[s] = false; h_inc[s] = 0; h_seq[s] = NONE; h_behind[s] = false; view[s] = NORMAL }
-  r_resync = NONE; q_open = false; q_age = NONE; sub_hb = true; sub_st = true; sub_gone = NONE; flush();
+  r_resync = NONE; q_open = false; q_age = NONE; sub_hb = true; sub_st = true; taken = false; sub_gone = NONE;
+  flush();
   printf("@ rstart\n")
 }
 
@@ -388,7 +393,9 @@ active proctype bus() {
      :: cut -> disturbed = true; cut = false; printf("@ heal\n")
      :: b_unsub > 0 && sub_hb -> disturbed = true; b_unsub--; sub_hb = false; printf("@ unsub hb\n")
      :: b_unsub > 0 && sub_st && S > 0 -> disturbed = true; b_unsub--; sub_st = false; printf("@ unsub st\n")
-     :: b_broker > 0 -> disturbed = true; b_broker--; d_step { flush(); sub_hb = false; sub_st = false; rs_due = NONE; printf("@ broker\n") }
+     :: b_unsub > 0 && sub_hb -> disturbed = true; b_unsub--; sub_hb = false; taken = true; printf("@ take hb\n")
+     :: b_unsub > 0 && sub_st && S > 0 -> disturbed = true; b_unsub--; sub_st = false; taken = true; printf("@ take st\n")
+     :: b_broker > 0 -> disturbed = true; b_broker--; d_step { flush(); sub_hb = false; sub_st = false; taken = false; rs_due = NONE; printf("@ broker\n") }
      :: b_replay > 0 && rh -> disturbed = true; b_replay--; d_step { printf("@ replay hb\n"); hpush(rh_inc, rh_age, rh_l0, rh_l1, rh_set, 0); if :: p_alive && rh_inc == p_inc && rh_age < down -> down = rh_age :: else -> skip fi }
      :: b_replay > 0 && rst && sub_st -> disturbed = true; b_replay--; d_step { printf("@ replay st\n"); spush(0, rst_inc, 0, rst_seq, rst_lvl, 0) }
      :: b_forge > 0 && S > 0 && sub_st -> disturbed = true; b_forge--; d_step { printf("@ forge\n"); spush(1, p_inc, 0, 1, WARNING, 0) }
@@ -473,12 +480,24 @@ active proctype bus() {
           holds is made again, with a resync */
 #ifndef M_NORESUB
        if
-       :: resub || sub_gone == RESUB -> sub_hb = true; sub_st = true; rs_due = D; sub_gone = NONE; printf("@ resubscribed\n")
+       :: (resub || sub_gone == RESUB) && !taken ->
+          sub_hb = true; sub_st = true; rs_due = D; sub_gone = NONE; printf("@ resubscribed\n")
+       /* Liveness::renew_due: R holds P lost a round after the loss began (at its start, for a
+          newcomer: no loss begins) or after its last renewal, and subscribes again under new
+          identities. What a member took before the loss began was renewed as it began; what it
+          takes while R holds P lost is renewed within a round, at a tick the model leaves open */
+#ifndef M_NORENEW
+       :: (resub || sub_gone == RESUB) && taken -> sub_hb = true; sub_st = true; taken = false; sub_gone = NONE; printf("@ renew\n")
+#endif
        :: else -> skip
        fi;
 #endif
        resub = false;
-       if :: (!sub_hb || !sub_st) && sub_gone == NONE -> sub_gone = 0 :: else -> skip fi;
+       if
+       :: (!sub_hb || !sub_st) && (!taken || lost) && sub_gone == NONE -> sub_gone = 0
+       :: taken && !lost -> sub_gone = NONE   /* renewed only while P is lost: a loss renews it as it begins */
+       :: else -> skip
+       fi;
        /* 8. the loss rule */
        watch();
        /* the ghosts: since when P is out of reach; calm; what R shows, and how often it changed */

@@ -29,9 +29,10 @@ double since(Clock::time_point start) { return std::chrono::duration<double>(Clo
 /// middleware/src/node.cpp (resync spacing 3 periods), ice_util.hpp (kResubscribeCheckEvery),
 /// receiver.cpp (the Prover's 1 s question timeout).
 constexpr int kResyncPeriods = 3;
-constexpr int kResubscribePeriods = 10;
 constexpr std::chrono::milliseconds kProofTimeout{1000};
 constexpr int kTicksPerPeriod = 2;
+constexpr int kResubscribePeriods = kBusResubscribeTicks / kTicksPerPeriod;
+static_assert(kBusResubscribeTicks % kTicksPerPeriod == 0, "a subscription round is whole periods");
 /// Stream numbers this far behind P's latest compare equal (docs/verify.md "The bus").
 constexpr int kStreamCap = 4;
 // The receiver's wait at the model's scale outlasts any wait for a provider that settles in time.
@@ -70,8 +71,7 @@ int proof_ticks(std::chrono::milliseconds period) {
 /// Periods of calm after which every view must equal the truth (P5): a subscription round, a
 /// loss bound, the provider's settling and three periods (a proof, a resync, a heartbeat).
 int calm_periods(const BusPattern& p) {
-  return (kResubscribePeriods * kTicksPerPeriod + p.bound_ticks + kBusSettleTicks + 3 * kTicksPerPeriod +
-          kTicksPerPeriod - 1) /
+  return (kBusResubscribeTicks + p.bound_ticks + kBusSettleTicks + 3 * kTicksPerPeriod + kTicksPerPeriod - 1) /
          kTicksPerPeriod;
 }
 
@@ -205,6 +205,9 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
       say("P hears its own peers again: settled, its streams back to Normal");
     } else if (k == "unsub" && w.size() >= 2) {
       say(std::string("a member unsubscribes R from P's ") + (w[1] == "hb" ? "heartbeats" : "state"));
+    } else if (k == "take" && w.size() >= 2) {
+      say(std::string("a member takes R's subscription to P's ") + (w[1] == "hb" ? "heartbeats" : "state") +
+          " (IceStorm still holds it, delivering to the member)");
     } else if (k == "broker") {
       say("the broker restarts: messages in flight and subscriptions are gone");
     } else if (k == "replay" && w.size() >= 2) {
@@ -225,6 +228,8 @@ std::vector<std::string> trace_text(const std::vector<std::string>& lines, const
       say("R clears P's loss");
     } else if (k == "resubscribed") {
       say("R's subscription round subscribes it again");
+    } else if (k == "renew") {
+      say("R, still holding P lost a round on, subscribes again under new identities");
     }
   }
   return out;
@@ -329,6 +334,9 @@ const std::vector<BusMutant>& bus_mutants() {
       {"no-jump-limit", "drop the jump limit on stream numbers", "M_NOJUMP"},
       {"no-incarnation-bound", "forget the incarnation bound (an incarnation far ahead is believed)", "M_NOINCBOUND"},
       {"no-resubscribe", "never make a lost subscription again (no round, no renewal on a loss)", "M_NORESUB"},
+      {"no-renewal-while-lost",
+       "renew the subscriptions to a lost provider only as the loss begins, never while it lasts (a newcomer: never)",
+       "M_NORENEW"},
       {"no-ownership", "take a state update from any member", "M_NOOWNER"},
       {"no-reproof", "clear a loss on heartbeats of the process believed, without a new proof", "M_NOREPROOF"},
       {"arrival-time", "count a heartbeat as fresh when it arrives, not when it was sent", "M_ARRIVAL"},
@@ -418,7 +426,7 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
   def("B", pattern.bound_ticks);
   def("D", 1);
   def("RS", long{kResyncPeriods} * kTicksPerPeriod);
-  def("RESUB", long{kResubscribePeriods} * kTicksPerPeriod);
+  def("RESUB", kBusResubscribeTicks);
   def("QT", proof_ticks(options.period));
   def("CAPS", kStreamCap);
   def("K", calm_periods(pattern));

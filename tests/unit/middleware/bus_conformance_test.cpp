@@ -161,7 +161,7 @@ private:
     held_[0] = held_[1] = Held{};
     behind_ = 0;
     watched_since_ = now();
-    if (pattern_.watch_start) live_.start_lost();
+    if (pattern_.watch_start) live_.start_lost(now());
   }
 
   /// `settling`: the heartbeat lists losses of the provider's own (Heartbeat::settling).

@@ -266,6 +266,7 @@ TEST(PeerFreshness, AheadNamesEachStreamAHeartbeatListsAboveWhatCameFromTheProce
 
 constexpr std::int64_t kMs = 1'000'000;  // steady ns
 constexpr std::chrono::milliseconds kBound{300};
+constexpr std::chrono::nanoseconds kRound{1000 * kMs};  // a subscription round
 
 TEST(Liveness, APeerNeverHeardFromIsLostOnceTheBoundHasPassedSinceTheWatchBegan) {
   Liveness live;
@@ -384,30 +385,59 @@ TEST(Liveness, CaughtUpClearsTheStreamsBehindUntilTheNextHeartbeatSaysOtherwise)
 TEST(Liveness, TheWatchIsDueOneNanosecondPastTheBoundAfterTheLastHeartbeatAndCheckFindsTheLossExactlyThen) {
   Liveness live;
   constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::max();
-  EXPECT_EQ(live.due(0, kBound), kNever) << "not watched yet: nothing is due";
-  EXPECT_EQ(live.due(1000 * kMs, kBound), 1300 * kMs + 1) << "never heard from: the bound after the watch began";
+  EXPECT_EQ(live.due(0, kBound, kRound), kNever) << "not watched yet: nothing is due";
+  EXPECT_EQ(live.due(1000 * kMs, kBound, kRound), 1300 * kMs + 1)
+      << "never heard from: the bound after the watch began";
   EXPECT_FALSE(beat(live, 1100 * kMs));
-  const std::int64_t due = live.due(1000 * kMs, kBound);
+  const std::int64_t due = live.due(1000 * kMs, kBound, kRound);
   EXPECT_EQ(due, 1400 * kMs + 1);
   EXPECT_EQ(live.check(due - 1, 1000 * kMs, kBound, "start"), "") << "not a nanosecond before it is due";
   EXPECT_EQ(live.check(due, 1000 * kMs, kBound, "start"), "no heartbeat for 300 ms");
-  EXPECT_EQ(live.due(1000 * kMs, kBound), kNever) << "lost: nothing more is due until it is back";
+  EXPECT_EQ(live.due(1000 * kMs, kBound, kRound), due + kRound.count()) << "lost: only its renewal, a round on";
   EXPECT_TRUE(beat(live, 1500 * kMs));
-  EXPECT_EQ(live.due(1000 * kMs, kBound), 1800 * kMs + 1);
+  EXPECT_EQ(live.due(1000 * kMs, kBound, kRound), 1800 * kMs + 1);
+}
+
+TEST(Liveness, APeerStillLostASubscriptionRoundAfterItsLossBeganIsRenewedEachRoundUntilItIsBack) {
+  Liveness live;
+  EXPECT_FALSE(beat(live, 100 * kMs));
+  EXPECT_EQ(live.renew_due(5000 * kMs, kRound), 0u) << "not lost: nothing to renew";
+  ASSERT_NE(live.check(401 * kMs, 1, kBound, "start"), "") << "lost at 401 ms: the owner renews as the loss begins";
+  EXPECT_EQ(live.due(1, kBound, kRound), 1401 * kMs) << "lost: the next renewal is due a round after the loss";
+  EXPECT_EQ(live.renew_due(1400 * kMs, kRound), 0u) << "not a nanosecond before the round";
+  EXPECT_EQ(live.renew_due(1401 * kMs, kRound), 1u) << "the first renewal of this loss: the owner says it";
+  EXPECT_EQ(live.renew_due(1401 * kMs, kRound), 0u) << "said once a round";
+  EXPECT_EQ(live.due(1, kBound, kRound), 2401 * kMs);
+  EXPECT_EQ(live.renew_due(2500 * kMs, kRound), 2u) << "still lost: again, quietly";
+  EXPECT_TRUE(beat(live, 2600 * kMs)) << "back";
+  EXPECT_EQ(live.renew_due(9000 * kMs, kRound), 0u) << "back: nothing to renew";
+  ASSERT_NE(live.check(2901 * kMs, 1, kBound, "start"), "");
+  EXPECT_EQ(live.renew_due(3901 * kMs, kRound), 1u) << "a new loss counts its renewals afresh";
+}
+
+TEST(Liveness, ANewcomerHoldingAPeerLostFromItsStartRenewsItsSubscriptionsARoundLater) {
+  // No loss begins for a peer held lost from the start: a member that took the newcomer's
+  // subscriptions before the peer was proven would otherwise keep it lost for as long as it holds them.
+  Liveness live;
+  live.start_lost(1000 * kMs);
+  EXPECT_EQ(live.check(5000 * kMs, 1000 * kMs, kBound, "start"), "") << "already lost: no loss begins";
+  EXPECT_EQ(live.due(1000 * kMs, kBound, kRound), 2000 * kMs);
+  EXPECT_EQ(live.renew_due(1999 * kMs, kRound), 0u);
+  EXPECT_EQ(live.renew_due(2000 * kMs, kRound), 1u);
 }
 
 TEST(Liveness, AStreamBehindIsDueTheBoundAfterItFellBehindAndWhatComesOnlyMovesTheDueTimeLater) {
   Liveness live;
   EXPECT_FALSE(beat(live, 100 * kMs));
-  const std::int64_t first = live.due(1, kBound);
+  const std::int64_t first = live.due(1, kBound, kRound);
   EXPECT_FALSE(beat(live, 200 * kMs, "state:P.a"));
-  const std::int64_t behind = live.due(1, kBound);
+  const std::int64_t behind = live.due(1, kBound, kRound);
   EXPECT_EQ(behind, 400 * kMs + 1) << "behind since the heartbeat before, at 100 ms";
   EXPECT_GE(behind, first) << "a new duty starts no earlier than the one before it";
   EXPECT_FALSE(beat(live, 400 * kMs, "state:P.a"));
-  EXPECT_EQ(live.due(1, kBound), behind) << "still behind since 100 ms: due then, although beats keep coming";
+  EXPECT_EQ(live.due(1, kBound, kRound), behind) << "still behind since 100 ms: due then, although beats keep coming";
   live.caught_up();
-  EXPECT_EQ(live.due(1, kBound), 700 * kMs + 1) << "caught up: due a bound after the last heartbeat";
+  EXPECT_EQ(live.due(1, kBound, kRound), 700 * kMs + 1) << "caught up: due a bound after the last heartbeat";
   EXPECT_EQ(live.check(700 * kMs, 1, kBound, "start"), "");
   EXPECT_EQ(live.check(700 * kMs + 1, 1, kBound, "start"), "no heartbeat for 300 ms");
 }

@@ -48,6 +48,11 @@ struct BusOptions {
 /// down: longer than any wait of a provider that settles in time, which is what is checked).
 inline constexpr int kBusSettleTicks = 4;
 inline constexpr int kBusSettleLimitTicks = kBusSettleTicks + 6;
+/// The subscription round in ticks (middleware/src/ice_util.hpp: kResubscribeCheckEvery periods):
+/// what IceStorm no longer holds is made again, and a provider still held lost a round after its
+/// loss began, or after the last renewal, is subscribed to again under new identities
+/// (Liveness::renew_due).
+inline constexpr int kBusResubscribeTicks = 20;
 
 /// One kind of pair: everything the protocol reads of a provider and its receiver.
 struct BusPattern {
