@@ -2421,7 +2421,7 @@ TEST(Wire, ANewcomerHoldsTheInterfacesOfAProviderNotYetProvenAliveAtError) {
 
 // A newcomer holds its providers lost from its start, so no loss begins for them and no loss
 // renews their subscriptions. A member that takes the newcomer's subscriptions in that window
-// (here before wire-p can prove itself) would keep wire-p at Error there for as long as it holds
+// (here while wire-p is still silent) would keep wire-p at Error there for as long as it holds
 // them: fail-safe, but never live again. A round on, each receiver still holding wire-p lost
 // subscribes again under new identities, hears wire-p and believes it once it proves itself
 // (verify --bus, class unsubscribed: the member takes a subscription of a receiver that has just
