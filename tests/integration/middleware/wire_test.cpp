@@ -168,6 +168,7 @@ struct Bus {
   std::optional<middleware::StateStreams> provider_streams;
   std::optional<std::int64_t> events_sent;  ///< the last event record listed, when the heartbeat lists one
   std::atomic<bool> beating{true};
+  std::atomic<std::uint64_t> beat_rounds{0};  ///< rounds of the beat thread, each a heartbeat when `beating`
   std::atomic<bool> running{true};
   std::int64_t beat_seq = 0;
   std::int64_t newest = kIncarnation;  ///< the newest incarnation wire-p's key beat with: the one it proves
@@ -213,6 +214,7 @@ struct Bus {
           std::lock_guard lock(mutex);
           log.push_back(std::string("test: wire-p's heartbeat not sent (") + e.ice_id() + ")");
         }
+        beat_rounds.fetch_add(1);
         std::this_thread::sleep_for(100ms);
       }
     });
@@ -233,6 +235,13 @@ struct Bus {
     EXPECT_TRUE(
         eventually([&] { return all_log().find("coordinator 'wire-p' proved alive") != std::string::npos; }, 10000ms))
         << all_log();
+  }
+  /// wire-p falls silent: once this returns no heartbeat of it is on its way (one the beat thread
+  /// was sending when told may otherwise reach a receiver that subscribes after).
+  void silence() {
+    beating.store(false);
+    const std::uint64_t round = beat_rounds.load();
+    EXPECT_TRUE(eventually([&] { return beat_rounds.load() >= round + 2; }));
   }
   /// wire-c's node on this bus, its lines in `log`; started (null, said, when it cannot be).
   std::unique_ptr<middleware::CoordinatorNode> start_node(std::chrono::milliseconds lost_after = 0ms) {
@@ -2430,9 +2439,21 @@ TEST(Wire, ANewcomerWhoseSubscriptionsAreTakenBeforeItsProviderIsProvenRenewsThe
   ASSERT_FALSE(fixture_port().empty()) << "no IceStorm fixture";
   Bus bus;
   ASSERT_TRUE(bus.node);
+  bus.silence();  // wire-p is silent yet: both receivers stay newcomers, and ask for no proof
   bus.node->stop();
   bus.node.reset();
-  bus.beating.store(false);  // wire-p is silent yet: both receivers stay newcomers, and ask for no proof
+  // The stopped node's subscriptions stay at IceStorm until it drops them as undeliverable: the
+  // newcomers' are those made from now on.
+  std::vector<Ice::Identity> before;
+  for (const char* topic : {"safecass.heartbeat.wire-p", "safecass.state.wire-p"}) {
+    const std::vector<Ice::Identity> ids = bus.subscribers(topic);
+    before.insert(before.end(), ids.begin(), ids.end());
+  }
+  const auto newcomer = [&](const char* victim) {
+    return [&before, victim](const Ice::Identity& id) {
+      return of(victim)(id) && std::find(before.begin(), before.end(), id) == before.end();
+    };
+  };
   const auto node = bus.start_node();
   ASSERT_TRUE(node);
   SupervisorOutput out;
@@ -2444,7 +2465,7 @@ TEST(Wire, ANewcomerWhoseSubscriptionsAreTakenBeforeItsProviderIsProvenRenewsThe
     for (const char* topic : {"safecass.heartbeat.wire-p", "safecass.state.wire-p"}) {
       // Once the victim's subscription is there: it subscribes as it connects.
       std::vector<Ice::Identity> got;
-      ASSERT_TRUE(eventually([&] { return !(got = take_subscriptions(bus, thief, topic, of(victim))).empty(); }))
+      ASSERT_TRUE(eventually([&] { return !(got = take_subscriptions(bus, thief, topic, newcomer(victim))).empty(); }))
           << victim << " on " << topic;
       taken.insert(taken.end(), got.begin(), got.end());
     }
