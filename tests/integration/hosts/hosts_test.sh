@@ -40,7 +40,10 @@ check() {  # check DESCRIPTION COMMAND...
   local what="$1"; shift
   # Each line says when it was reached (seconds since the script started), so that a slow run
   # shows where its time went.
-  if "$@"; then echo "ok: $what [${SECONDS} s]"; else echo "FAILED: $what [${SECONDS} s]"; failures=$((failures + 1)); fi
+  # Each verdict also goes to checks.log, which a failed run keeps beside the processes' logs.
+  local verdict="ok"
+  "$@" || { verdict="FAILED"; failures=$((failures + 1)); }
+  echo "$verdict: $what [${SECONDS} s]" | tee -a "$HOSTS_DIR/checks.log"
 }
 # retry SECONDS COMMAND...: until COMMAND succeeds, for at most SECONDS.
 retry() {
