@@ -90,7 +90,8 @@ FUZZ_TARGETS := spec_loader ros_input read_answer scenario history input_log csv
 FUZZ_SECONDS ?= 60
 fuzz-tree: deps
 	@test -f $(FUZZ)/build.ninja || cmake -S . -B $(FUZZ) -G Ninja -DCMAKE_CXX_COMPILER=clang++ \
-	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_UNITY_BUILD=ON -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
+	  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
+	  -DCMAKE_UNITY_BUILD=ON -DSAFECASS_BUILD_FUZZ=ON -DSAFECASS_BUILD_TESTS=OFF \
 	  -DSAFECASS_BUILD_TOOLS=ON -DSAFECASS_BUILD_EXAMPLES=OFF -DSAFECASS_BUILD_BENCHMARKS=OFF >/dev/null
 
 # Every target for FUZZ_SECONDS (default 60) each: executions, edges and findings per target.

@@ -15,6 +15,7 @@
 #include "ice_sequences.hpp"  // before the generated header: its sequences' reader
 #include "safecass.h"
 #include "safecass/core/coordinator.hpp"
+#include "safecass/middleware/keys.hpp"
 #include "safecass/middleware/node.hpp"
 
 namespace safecass::middleware {
@@ -34,6 +35,12 @@ inline constexpr const char* kEventTopic = "safecass.events";
 inline constexpr const char* kHeartbeatTopic = "safecass.heartbeat";
 inline std::string heartbeat_topic(std::string_view signer) {
   return std::string(kHeartbeatTopic) + "." + std::string(signer);
+}
+/// The topics on which a peer's messages reach a receiver: the supervisor's heartbeats, or a
+/// coordinator's state and heartbeats. What a receiver subscribes to again when it holds the peer lost.
+inline std::vector<std::string> peer_topics(std::string_view signer) {
+  if (signer == kSupervisorSigner) return {heartbeat_topic(signer)};
+  return {state_topic(signer), heartbeat_topic(signer)};
 }
 inline constexpr const char* kResyncTopic = "safecass.resync";
 /// The subscriber categories of a tool's follower start with this (RemoteClient::follow).

@@ -1001,7 +1001,7 @@ struct CoordinatorNode::Impl {
         if (!shape.is_remote(c)) co.generate(framework_event::kSupervisorLost, shape.framework_machine(c));
       }
       // As for a provider: its heartbeats may only have stopped reaching us (an identity taken).
-      link->renew(topics_of(who));
+      link->renew(peer_topics(who));
       return;
     }
     providers_lost.fetch_add(1);
@@ -1010,14 +1010,8 @@ struct CoordinatorNode::Impl {
         std::to_string(peer.feeds.size()) + " required interface(s) it feeds");
     // Its heartbeats or its state may have stopped reaching us only: subscriptions taken by
     // another endpoint under our identities. New identities bring them back if it is alive.
-    link->renew(topics_of(who));
+    link->renew(peer_topics(who));
     for (MachineId m : peer.feeds) co.generate(framework_event::kCoordinatorLost, m);
-  }
-
-  /// The topics on which a peer's messages reach us: what a loss subscribes to again.
-  static std::vector<std::string> topics_of(const std::string& who) {
-    if (who == kSupervisorSigner) return {heartbeat_topic(kSupervisorSigner)};
-    return {state_topic(who), heartbeat_topic(who)};
   }
 
   /// A peer still lost a subscription round after its loss began (or this node started) or after
@@ -1029,7 +1023,7 @@ struct CoordinatorNode::Impl {
       log("middleware: " + name + ": " + (who == kSupervisorSigner ? "the supervisor" : "coordinator '" + who + "'") +
           " still lost a subscription round on; subscribing to its topics again under new identities, each round "
           "until it is back");
-    link->renew(topics_of(who), true);
+    link->renew(peer_topics(who), true);
   }
 
   /// A newcomer starts toward safe (DESIGN §7): until a provider is proven alive and its state is

@@ -685,10 +685,6 @@ struct Supervisor::Impl {
         std::chrono::nanoseconds(std::min<std::chrono::milliseconds>(options.lost_after, kReorderGrace)).count();
     const std::int64_t grace = std::chrono::nanoseconds(kReorderGrace).count();
     const std::chrono::nanoseconds round = subscription_round(kHeartbeatPeriod);
-    // The topics on which a coordinator's messages reach the supervisor: what a loss subscribes to again.
-    const auto topics_of = [](const std::string& name) {
-      return std::vector<std::string>{state_topic(name), heartbeat_topic(name)};
-    };
     for (std::int64_t next = steady_ns(); watch_sleeper.sleep_until(next);) {
       const std::int64_t now = steady_ns();
       next = now + cap;
@@ -725,7 +721,7 @@ struct Supervisor::Impl {
         print("supervisor: coordinator '" + name + "' lost: " + why + "; EVT_COORDINATOR_LOST on its components");
         // Its messages may have stopped reaching the supervisor only (subscriptions taken by
         // another endpoint under its identities): new identities bring them back if it is alive.
-        link->renew(topics_of(name));
+        link->renew(peer_topics(name));
         for (const std::string& c : components) (void)generate(model(), "EVT_COORDINATOR_LOST", address::framework(c));
       }
       // Still lost a round on: its subscriptions may have been taken before the loss began (the
@@ -735,7 +731,7 @@ struct Supervisor::Impl {
           print("supervisor: coordinator '" + name +
                 "' still lost a subscription round on; subscribing to its topics again under new identities, each "
                 "round until it is back");
-        link->renew(topics_of(name), true);
+        link->renew(peer_topics(name), true);
       }
     }
     report_gaps(steady_ns(), true);  // stopping: the records missed that wait for their line are said now
