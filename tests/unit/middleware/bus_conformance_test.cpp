@@ -299,12 +299,16 @@ TEST(BusConformance, TheReceiverClassesDecideEveryMessageProofAndLossAsTheModelD
   ASSERT_TRUE(robodoc.ok());
   auto patterns = verify::bus_patterns(*robodoc.system, verify::BusOptions{});
   ASSERT_TRUE(patterns) << patterns.error().message;
-  // Every fault and attack, several times a run: a simulation has no state space to outgrow.
+  // Every fault and attack, a dozen times a run: a simulation has no state space to outgrow. Few
+  // long runs rather than many short ones: starting SPIN (reading and building the model) takes
+  // about 45 ms, 8,000 steps 1 ms more. A run of 32,000 steps passes about 150 ticks (75 periods),
+  // so a dozen of each fault keeps their density of three in 8,000 steps.
   verify::BusFaultClass all;
   all.name = "conformance";
   all.crash = all.cut = all.unsubscribe = all.broker = all.flip = all.replay = all.forge = all.wild =
-      all.receiver_restart = all.drop = all.settle = 3;
-  constexpr unsigned kRuns = 200;  // per pattern: a thousand runs over robodoc's five
+      all.receiver_restart = all.drop = all.settle = 12;
+  constexpr unsigned kRuns = 50;  // per pattern: 250 runs over robodoc's five, 8 million steps
+  constexpr std::size_t kSteps = 32'000;
   std::size_t decisions = 0, runs = 0;
   std::map<std::string, std::size_t> kinds;
   for (const verify::BusPattern& pattern : *patterns) {
@@ -313,7 +317,7 @@ TEST(BusConformance, TheReceiverClassesDecideEveryMessageProofAndLossAsTheModelD
       all.two_streams = two;
       std::string failed;  // the first run the receiver classes decided otherwise than the model
       auto simulated = verify::simulate_bus(
-          pattern, all, kRuns, 8000, verify::BusOptions{}, [&](unsigned seed, std::vector<std::string>& lines) {
+          pattern, all, kRuns, kSteps, verify::BusOptions{}, [&](unsigned seed, std::vector<std::string>& lines) {
             Replay replay(pattern, system);
             replay.simulated_streams_ = two ? 2 : std::min<std::size_t>(pattern.streams, 1);
             // The run stops after a number of steps, maybe between a message and its verdict: it
