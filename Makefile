@@ -79,8 +79,8 @@ known-defects: build
 	@ctest --test-dir $(BUILD) --output-on-failure -L known-defect
 
 # The libFuzzer targets of tests/fuzz (clang, ASan + UBSan, line tables only, their own tree,
-# unity sources as the presets' builds: docs/contributing.md, "Continuous integration"), one per input that
-# crosses a boundary: the spec loader, the ROS inputs, the named reads' answers, scenarios, history
+# unity sources as the presets' builds: docs/contributing.md, "Continuous integration"), one per
+# input that crosses a boundary: the spec loader, the ROS inputs, the named reads' answers, scenarios, history
 # lines, input recordings, CSV logs, ROS 1 and ROS 2 bags, the viewer's messages, the console's
 # command lines and the bus's authenticated messages (docs/contributing.md, "Fuzzing").
 # scripts/fuzz runs them with their seeds; `make test` runs a smoke of each.

@@ -486,7 +486,6 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
                   std::to_string(kResubscribePeriods) + " periods; at most 2 messages in flight per topic";
   PanOptions pan_base;
   pan_base.memory_mb = options.memory_mb;
-  pan_base.hash_bits = 24;
   // Depth-first finds the verdict fastest; a violation is searched again for its shortest trail.
   pan_base.shortest = false;
   pan_base.spin = options.spin;
@@ -519,13 +518,14 @@ std::string bus_promela(const BusPattern& pattern, const BusFaultClass& faults, 
     if (ec) return fail(ErrorCode::Io, "cannot create '" + sub + "': " + ec.message());
     const std::string model = bus_promela(report.patterns[job.pattern], job.faults, options, mutant);
     // A pattern that holds no stream is searched in about 0.3 s: its verifier is not worth
-    // optimising (1 s more of compilation). A pattern with streams runs seconds: -O1 repays it.
-    // Its states (at most a few hundred thousand) fit a table of 2^20 slots; clearing one of 2^24
-    // took longer than its search (0.63 s against 0.22 s for robodoc's ui -> supervisor). With
-    // streams, millions of states: 2^24 was the fastest of 2^22, 2^24 and 2^26.
+    // optimising (1 s more of compilation), and its states (at most a few hundred thousand) fit a
+    // table of 2^20 slots, where clearing one of 2^24 took longer than the search (0.63 s against
+    // 0.22 s for robodoc's ui -> supervisor). A pattern with streams runs seconds over millions of
+    // states: -O1 repays its compilation, and 2^24 slots searched fastest of 2^22, 2^24 and 2^26.
+    const bool streams = report.patterns[job.pattern].streams > 0;
     PanOptions pan = pan_base;
-    pan.optimise = report.patterns[job.pattern].streams > 0;
-    if (!pan.optimise) pan.hash_bits = 20;
+    pan.optimise = streams;
+    pan.hash_bits = streams ? 24 : 20;
     auto binary = compile(sub, "bus", model, pan);
     if (!binary) return tl::unexpected(binary.error());
     auto r = check_claim(sub, "bus", *binary, {}, pan);
